@@ -1,0 +1,69 @@
+#pragma once
+// The whole configuration: one params struct per stage, mapped one to one onto TOML sections.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "animat/body.hpp"
+#include "animat/development.hpp"
+#include "animat/evolution.hpp"
+#include "animat/genome.hpp"
+#include "animat/grn.hpp"
+#include "animat/physics.hpp"
+#include "animat/scene.hpp"
+
+namespace animat {
+
+struct Config {
+  GenomeParams genome;
+  MutationParams mutation;
+  GrnParams grn;
+  DevelopmentParams development;
+  BodyParams body;
+  SceneParams scene;
+  PhysicsParams physics;
+  EvaluationParams evaluation;
+  EvolutionParams evolution;
+};
+
+/// Calls v(section_name, params) for every section, in TOML order.
+template <class C, class V>
+void visit_sections(C& c, V&& v) {
+  v("genome", c.genome);
+  v("mutation", c.mutation);
+  v("grn", c.grn);
+  v("development", c.development);
+  v("body", c.body);
+  v("scene", c.scene);
+  v("physics", c.physics);
+  v("evaluation", c.evaluation);
+  v("evolution", c.evolution);
+}
+
+/// A config value, as seen by --set and the Python dict view.
+using ConfigValue = std::variant<bool, std::int64_t, double, std::string, std::vector<std::string>, std::vector<double>>;
+
+/// Parses TOML text. Unknown keys, wrong types, out-of-range values and malformed TOML throw
+/// ConfigError naming `source`, the line, the key and what was expected. Missing keys keep defaults.
+[[nodiscard]] Config config_from_toml(std::string_view text, std::string_view source = "<string>");
+[[nodiscard]] Config load_config(const std::filesystem::path& path);
+/// The complete config as commented TOML; config_from_toml(to_toml(c)) == c.
+[[nodiscard]] std::string to_toml(const Config& config);
+/// Applies "section.key=value"; the value is parsed by the field's type.
+void apply_override(Config& config, std::string_view assignment);
+void set_value(Config& config, std::string_view dotted_key, const ConfigValue& value);
+[[nodiscard]] ConfigValue get_value(const Config& config, std::string_view dotted_key);
+/// Every "section.key", in order.
+[[nodiscard]] std::vector<std::string> config_keys();
+[[nodiscard]] std::string config_doc(std::string_view dotted_key);
+/// Checks every field's range and the cross-field rules; throws ConfigError naming the key.
+void validate(const Config& config, std::string_view source = "config");
+/// Stable 64-bit hash of the resolved config (FNV-1a of to_toml), for checkpoints.
+[[nodiscard]] std::uint64_t config_hash(const Config& config);
+
+bool operator==(const Config& a, const Config& b);
+
+}  // namespace animat

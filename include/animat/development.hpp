@@ -1,0 +1,204 @@
+#pragma once
+// Development (paper §2.2, Fig. 2): one cell grows into an embryo of up to `max_cells` cells in a
+// 2-D fluid-like Box2D world, driven by the GRN that every cell runs.
+//
+// One development step (DevelopmentWorld::step), for every cell in index order:
+//   1. sense: maternal morphogens (three fixed sources) and the diffusible products of all cells,
+//      through the grid-less, history-based model (level = Σ_j L_j(t − d/v)·e^(−d/λ), capped at 1);
+//   2. one GRN step (eq. 1, Δt = GrnParams::dt) with what was sensed;
+//   3. record the new morphogen-product levels in each cell's history ring buffer;
+//   4. divisions: a cell whose divide output is ≥ divide_threshold and that has not divided in the
+//      last `refractory_steps` steps divides (cell index order, never beyond max_cells);
+//   5. physics: pairwise soft repulsion + adhesion forces, then one Box2D step (linear damping).
+#include <array>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "animat/genome.hpp"
+#include "animat/grn.hpp"
+#include "animat/params.hpp"
+#include "animat/types.hpp"
+
+namespace animat {
+
+inline constexpr std::string_view kDevelopmentEffectNames[] = {"repulsion", "adhesion", "morphogens"};
+
+struct DevelopmentParams {
+  int steps = 400;                ///< development steps [paper: 400]
+  int max_cells = 32;             ///< hard cap on cells [paper: 32, one series 64]
+  double divide_threshold = 0.9;  ///< divide output level that triggers division [paper: 0.9]
+  int refractory_steps = 20;      ///< a cell (mother and daughter) cannot divide again for this many steps [choose]
+  int min_cells = 3;              ///< viability: at least this many cells [paper: 3]
+  int quiet_steps = 100;          ///< viability: last division at least this many steps before the end [paper: 100]
+  double cell_radius = 0.5;       ///< radius r0 of the first cell [choose]
+  double max_growth = 0.5;        ///< a daughter's radius is r0·(1 + max_growth·grow) [paper: up to +50%]
+  double division_offset = 0.2;   ///< daughter centre = mother centre + division_offset·r_mother·orientation [choose]
+  double frequency_min = 0.5;     ///< oscillator frequency at output 0, rad per unit time [choose]
+  double frequency_max = 12.0;    ///< oscillator frequency at output 1 [choose]
+  double amplitude_max = 0.2;     ///< amplitude scale [paper: 0.2]
+  // Physics of the development world [choose].
+  double time_step = 0.1;             ///< Box2D time step of one development step
+  double cell_mass = 1.0;             ///< mass of every cell body (equal masses)
+  double damping = 10.0;              ///< Box2D linear damping (fluid-like, overdamped)
+  double repulsion_stiffness = 5.0;   ///< force per unit overlap of two cells
+  double adhesion_stiffness = 2.0;    ///< force per unit gap between two close-by cells
+  double adhesion_range = 0.25;       ///< gap beyond which adhesion vanishes (force peaks at half of it)
+  // Morphogens [choose].
+  std::vector<double> maternal_sources = {0.0, 5.0, -4.330127018922193, -2.5, 4.330127018922193, -2.5};  ///< x0,y0,x1,y1,x2,y2
+  double maternal_decay_length = 5.0;   ///< maternal level at distance d is e^(−d/λm)
+  double morphogen_speed = 0.25;        ///< v: length units per development step
+  double morphogen_decay_length = 2.0;  ///< λ of e^(−d/λ) for cell-made morphogens
+  int morphogen_max_delay = 64;         ///< longest delay d/v kept in the history (steps); longer delays read the oldest sample
+  std::vector<std::string> effects = {"repulsion", "adhesion", "morphogens"};
+  int trace_every = 0;            ///< record a trace snapshot every k steps; 0 = off
+};
+
+template <class V>
+void visit_fields(DevelopmentParams& p, V&& v) {
+  v(FieldInfo{"steps", "development steps [paper: 400]", Bounds::closed(1, 100000)}, p.steps);
+  v(FieldInfo{"max_cells", "hard cap on the number of cells [paper: 32; 64 in one series]", Bounds::closed(1, 4096)}, p.max_cells);
+  v(FieldInfo{"divide_threshold", "divide output level that triggers division [paper: 0.9]", Bounds::closed(0, 1)}, p.divide_threshold);
+  v(FieldInfo{"refractory_steps", "steps after a division before the mother or daughter may divide again [choose]", Bounds::closed(0, 100000)}, p.refractory_steps);
+  v(FieldInfo{"min_cells", "viability: at least this many cells [paper: 3]", Bounds::closed(0, 4096)}, p.min_cells);
+  v(FieldInfo{"quiet_steps", "viability: last division at least this many steps before the end [paper: 100]", Bounds::closed(0, 100000)}, p.quiet_steps);
+  v(FieldInfo{"cell_radius", "radius r0 of a cell that does not grow [choose]", Bounds::positive()}, p.cell_radius);
+  v(FieldInfo{"max_growth", "daughter radius is r0*(1 + max_growth*grow) [paper: 0.5]", Bounds::closed(0, 10)}, p.max_growth);
+  v(FieldInfo{"division_offset", "daughter placed at division_offset*r_mother from the mother along its orientation [choose]", Bounds::closed(0, 10)}, p.division_offset);
+  v(FieldInfo{"frequency_min", "oscillator frequency (rad per time unit) at frequency output 0 [choose]", Bounds::non_negative()}, p.frequency_min);
+  v(FieldInfo{"frequency_max", "oscillator frequency (rad per time unit) at frequency output 1 [choose]", Bounds::non_negative()}, p.frequency_max);
+  v(FieldInfo{"amplitude_max", "oscillator amplitude at amplitude output 1 [paper: 0.2]", Bounds::closed(0, 0.45)}, p.amplitude_max);
+  v(FieldInfo{"time_step", "Box2D time step of one development step [choose]", Bounds{0.0, 1.0, true, false}}, p.time_step);
+  v(FieldInfo{"cell_mass", "mass of every cell body during development [choose]", Bounds::positive()}, p.cell_mass);
+  v(FieldInfo{"damping", "Box2D linear damping of cells, fluid-like [choose]", Bounds::non_negative()}, p.damping);
+  v(FieldInfo{"repulsion_stiffness", "repulsive force per unit overlap of two cells [choose]", Bounds::non_negative()}, p.repulsion_stiffness);
+  v(FieldInfo{"adhesion_stiffness", "adhesive force per unit gap between two close-by cells [choose]", Bounds::non_negative()}, p.adhesion_stiffness);
+  v(FieldInfo{"adhesion_range", "gap between cell surfaces beyond which adhesion vanishes [choose]", Bounds::non_negative()}, p.adhesion_range);
+  v(FieldInfo{"maternal_sources", "positions x0,y0,x1,y1,x2,y2 of the three maternal morphogen sources [choose]", Bounds::closed(-1e6, 1e6)}, p.maternal_sources);
+  v(FieldInfo{"maternal_decay_length", "maternal level at distance d from its source is exp(-d/length) [choose]", Bounds::positive()}, p.maternal_decay_length);
+  v(FieldInfo{"morphogen_speed", "speed v of cell-made morphogens, length units per step: delay = d/v [choose]", Bounds::positive()}, p.morphogen_speed);
+  v(FieldInfo{"morphogen_decay_length", "cell-made morphogen level falls as exp(-d/length) [choose]", Bounds::positive()}, p.morphogen_decay_length);
+  v(FieldInfo{"morphogen_max_delay", "longest morphogen delay kept in the per-cell history, in steps [choose]", Bounds::closed(0, 100000)}, p.morphogen_max_delay);
+  v(FieldInfo{"effects", "effects of the development world", Bounds::any(), kDevelopmentEffectNames}, p.effects);
+  v(FieldInfo{"trace_every", "record positions every k steps for plotting; 0 = off", Bounds::closed(0, 100000)}, p.trace_every);
+}
+
+/// Checks what visit_fields bounds cannot say (maternal_sources has 6 finite numbers, known effect
+/// names); throws ConfigError naming the key.
+void validate(const DevelopmentParams& params);
+
+/// Snapshots of a development, for paper Fig. 2.
+struct DevelopmentTrace {
+  std::vector<int> steps;
+  std::vector<Points> positions;
+  std::vector<Vector> radii;
+  std::vector<Points> orientations;  ///< unit vectors
+
+  [[nodiscard]] bool empty() const { return steps.empty(); }
+};
+
+using OutputLevels = Eigen::Matrix<double, Eigen::Dynamic, kOutputCount, Eigen::RowMajor>;
+
+/// The grown embryo.
+struct Embryo {
+  Points positions;                     ///< cell centres, n × 2
+  Vector radii;                         ///< n
+  Points orientations;                  ///< unit orientation vectors, n × 2
+  OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase)
+  Vector amplitude, frequency, phase;   ///< oscillator parameters derived from the outputs
+  std::vector<int> division_steps;      ///< step (1-based) of every division, in order
+  int steps_run = 0;                    ///< < params.steps when stopped early (verdict certain)
+  bool viable = false;
+  std::vector<std::string> reasons;     ///< why not viable; empty when viable
+  DevelopmentTrace trace;               ///< filled when params.trace_every > 0
+
+  [[nodiscard]] int cell_count() const { return static_cast<int>(positions.rows()); }
+};
+
+/// Grows an embryo from one cell. Deterministic: depends only on the genome and the params.
+/// A genome without the GRN paths of viability criterion 1 is not simulated at all (steps_run = 0);
+/// any other genome stops as soon as its non-viability is certain (a division within the last
+/// quiet_steps steps, or fewer than min_cells cells when no more division may happen in time).
+/// Throws SimulationError if a cell would move at a speed near Box2D's translation cap.
+[[nodiscard]] Embryo develop(const Genome& genome, const GenomeParams& genome_params, const GrnParams& grn_params,
+                             const DevelopmentParams& params);
+
+/// The lower-level development world: cells as fixture-less Box2D bodies plus their GRN states and
+/// morphogen histories. develop() drives one; tests use it to check the pieces of a step.
+class DevelopmentWorld {
+ public:
+  using Vec2 = Eigen::Vector2d;
+
+  /// An empty world (no cells). Throws ConfigError for invalid params.
+  DevelopmentWorld(Grn grn, const GrnParams& grn_params, const DevelopmentParams& params);
+  ~DevelopmentWorld();
+  DevelopmentWorld(DevelopmentWorld&&) noexcept;
+  DevelopmentWorld& operator=(DevelopmentWorld&&) noexcept;
+  DevelopmentWorld(const DevelopmentWorld&) = delete;
+  DevelopmentWorld& operator=(const DevelopmentWorld&) = delete;
+
+  /// Adds a cell at rest. Its state defaults to grn.initial_state(); its morphogen history is
+  /// filled with its current levels (as if they had always been so). Ignores max_cells. Returns its index.
+  int add_cell(const Vec2& position, double radius, const Vec2& orientation, const GrnState* state = nullptr);
+
+  /// One full development step (see the file comment). Returns the number of divisions in it.
+  int step();
+
+  // --- The pieces of a step, in order -------------------------------------------------------
+  /// Computes what every cell senses (maternal levels and cell-made morphogens) now.
+  void sense();
+  /// Advances every cell's GRN by one step with what sense() computed.
+  void step_grn();
+  /// Appends every cell's current morphogen-product levels to its history and advances the
+  /// history clock by one step.
+  void record_history();
+  /// Divides every eligible cell (divide output ≥ threshold, refractory period over), in index
+  /// order, while below max_cells; records the current step. Returns the number of divisions.
+  int divide_ready();
+  /// Divides `cell` now, whatever its outputs (daughter placement, inheritance, rotation and size
+  /// as in a normal division); ignores max_cells and the refractory period. Returns the daughter.
+  int divide(int cell);
+  /// Applies repulsion/adhesion (those enabled) plus optional external forces (one per cell, or
+  /// empty), then advances Box2D by time_step. Throws SimulationError on non-finite positions or a
+  /// displacement of more than half of Box2D's translation cap in one step.
+  void step_physics(std::span<const Vec2> external_forces = {});
+  /// Increments the step counter (step() does it first; division steps are recorded with it).
+  void advance_clock() { ++step_; }
+
+  // --- Observation -------------------------------------------------------------------------
+  [[nodiscard]] int cell_count() const;
+  [[nodiscard]] int current_step() const { return step_; }
+  [[nodiscard]] const Grn& grn() const;
+  [[nodiscard]] const DevelopmentParams& params() const;
+  [[nodiscard]] Vec2 position(int cell) const;
+  [[nodiscard]] Vec2 velocity(int cell) const;
+  [[nodiscard]] double radius(int cell) const;
+  [[nodiscard]] Vec2 orientation(int cell) const;
+  [[nodiscard]] GrnState& state(int cell);
+  [[nodiscard]] const GrnState& state(int cell) const;
+  [[nodiscard]] double output(int cell, OutputChannel c) const;
+  /// Maternal morphogen levels at a point: e^(−|p − source_k| / maternal_decay_length).
+  [[nodiscard]] std::array<double, 3> maternal_at(const Vec2& p) const;
+  /// Level of the k-th morphogen product (grn.morphogen_units()[k]) sensed by `cell` right now,
+  /// computed from the histories (includes the cell's own current level at distance 0).
+  [[nodiscard]] double sensed_morphogen(int cell, int k) const;
+  /// What sense() last computed for `cell` (empty if the morphogens effect is off).
+  [[nodiscard]] std::span<const double> sensed_morphogens(int cell) const;
+  [[nodiscard]] const std::array<double, 3>& sensed_maternal(int cell) const;
+  [[nodiscard]] const std::vector<int>& division_steps() const;
+  [[nodiscard]] bool has(std::string_view effect) const;
+
+  [[nodiscard]] Points positions() const;
+  [[nodiscard]] Vector radii() const;
+  [[nodiscard]] Points orientations() const;
+  [[nodiscard]] OutputLevels outputs() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int step_ = 0;
+};
+
+}  // namespace animat

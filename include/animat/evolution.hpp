@@ -1,0 +1,52 @@
+#pragma once
+// The genetic algorithm of paper §5 and its parameters.
+#include <cstdint>
+
+#include "animat/params.hpp"
+
+namespace animat {
+
+/// How an evaluation is run: the swim horizon.
+struct EvaluationParams {
+  int steps = 4000;  ///< swim steps at physics.dt [paper: 4000 or 8000]
+};
+
+template <class V>
+void visit_fields(EvaluationParams& p, V&& v) {
+  v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
+}
+
+struct EvolutionParams {
+  std::int64_t seed = 1;                  ///< run seed; every random number derives from it
+  int population = 100;                   ///< [paper: 100]
+  int elites = 2;                         ///< best individuals copied unchanged [choose]
+  double crossover_fraction = 0.2;        ///< share of offspring made by crossover [paper: 0.2]
+  double tournament_p_start = 0.8;        ///< p(fitter wins) at generation 0 [paper: 0.8]
+  double tournament_p_end = 1.0;          ///< p(fitter wins) after the ramp [paper: 1]
+  int tournament_ramp_generations = 1000; ///< [paper: 1000]
+  int generations = 0;                    ///< generation cap; 0 = none
+  int stall_generations = 500;            ///< stop after this many generations without improvement [paper: 500]
+  double wall_seconds = 0.0;              ///< wall-clock budget; 0 = none
+  int threads = 0;                        ///< OpenMP threads; 0 = all cores
+  int checkpoint_every = 1;               ///< write a checkpoint every k generations
+  int max_init_tries = 1000000;           ///< give up seeding one viable individual after this many tries
+};
+
+template <class V>
+void visit_fields(EvolutionParams& p, V&& v) {
+  v(FieldInfo{"seed", "run seed", Bounds::non_negative()}, p.seed);
+  v(FieldInfo{"population", "population size [paper: 100]", Bounds::closed(2, 100000)}, p.population);
+  v(FieldInfo{"elites", "best individuals copied unchanged into the next generation [choose]", Bounds::closed(0, 100000)}, p.elites);
+  v(FieldInfo{"crossover_fraction", "share of each generation made by crossover [paper: 0.2]", Bounds::unit()}, p.crossover_fraction);
+  v(FieldInfo{"tournament_p_start", "probability that the fitter of 2 wins, at generation 0 [paper: 0.8]", Bounds::unit()}, p.tournament_p_start);
+  v(FieldInfo{"tournament_p_end", "probability that the fitter wins after the ramp [paper: 1.0]", Bounds::unit()}, p.tournament_p_end);
+  v(FieldInfo{"tournament_ramp_generations", "generations of the linear ramp [paper: 1000]", Bounds::closed(0, 100000000)}, p.tournament_ramp_generations);
+  v(FieldInfo{"generations", "generation cap; 0 = no cap", Bounds::closed(0, 100000000)}, p.generations);
+  v(FieldInfo{"stall_generations", "stop after this many generations without improvement [paper: 500]; 0 = never", Bounds::closed(0, 100000000)}, p.stall_generations);
+  v(FieldInfo{"wall_seconds", "wall-clock budget in seconds; 0 = none", Bounds::non_negative()}, p.wall_seconds);
+  v(FieldInfo{"threads", "OpenMP threads; 0 = all cores", Bounds::closed(0, 1024)}, p.threads);
+  v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000)}, p.checkpoint_every);
+  v(FieldInfo{"max_init_tries", "tries to find one viable random individual before giving up", Bounds::closed(1, 1000000000)}, p.max_init_tries);
+}
+
+}  // namespace animat

@@ -1,0 +1,56 @@
+#pragma once
+// Field descriptors for the per-stage parameter structs.
+//
+// Every params struct (GrnParams, SceneParams, ...) lists its fields once, in a visit_fields()
+// overload. TOML loading, printing, --set overrides, validation and the Python dict view are all
+// written once against that list, so a new parameter is one line in one place.
+#include <cmath>
+#include <concepts>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace animat {
+
+/// Closed or open numeric interval a field must lie in.
+struct Bounds {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;
+  bool hi_open = false;
+
+  static constexpr Bounds any() { return {}; }
+  static constexpr Bounds positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
+  static constexpr Bounds non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static constexpr Bounds closed(double a, double b) { return {a, b, false, false}; }
+  static constexpr Bounds at_least(double a) { return {a, std::numeric_limits<double>::infinity(), false, false}; }
+  static constexpr Bounds unit() { return closed(0.0, 1.0); }
+
+  [[nodiscard]] bool contains(double x) const {
+    if (std::isnan(x)) return false;
+    if (lo_open ? !(x > lo) : !(x >= lo)) return false;
+    if (hi_open ? !(x < hi) : !(x <= hi)) return false;
+    return true;
+  }
+  [[nodiscard]] std::string describe() const;
+};
+
+/// Static description of one field: name, meaning, allowed values.
+struct FieldInfo {
+  std::string_view name;
+  std::string_view doc;
+  Bounds bounds = Bounds::any();
+  /// Allowed words for string and string-list fields; empty means any.
+  std::span<const std::string_view> choices = {};
+};
+
+/// Field value types a params struct may use.
+template <class T>
+concept ParamValue = std::same_as<T, bool> || std::same_as<T, int> || std::same_as<T, std::int64_t> ||
+                     std::same_as<T, double> || std::same_as<T, std::string> ||
+                     std::same_as<T, std::vector<std::string>> || std::same_as<T, std::vector<double>>;
+
+}  // namespace animat

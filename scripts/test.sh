@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# README command 2: set up, build, and run every test (C++ then Python).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+scripts/build.sh
+BUILD_DIR=${ANIMAT_BUILD_DIR:-build}
+echo "== C++ tests (ctest) =="
+ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$(nproc)"
+echo "== Python tests (pytest) =="
+ANIMAT_EVOLVE_EXE="$PWD/$BUILD_DIR/animat_evolve" PYTHONPATH="$PWD/$BUILD_DIR/python" \
+  .venv/bin/python -m pytest -q tests/python

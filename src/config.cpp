@@ -1,0 +1,411 @@
+#include "animat/config.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <toml++/toml.h>
+#include <type_traits>
+
+#include "animat/errors.hpp"
+
+namespace animat {
+
+std::string Bounds::describe() const {
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (!has_lo && !has_hi) return "any finite value";
+  if (has_lo && !has_hi) return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
+  if (!has_lo && has_hi) return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
+  return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+}
+
+namespace {
+
+// Calls f(section, info, value) for every field of the config.
+template <class C, class F>
+void for_each_field(C& config, F&& f) {
+  visit_sections(config, [&](std::string_view section, auto& params) {
+    visit_fields(params, [&](const FieldInfo& info, auto& value) { f(section, info, value); });
+  });
+}
+
+// Calls f(info, value) for the field "section.key"; returns false if there is none.
+template <class F>
+bool with_field(Config& config, std::string_view section, std::string_view key, F&& f) {
+  bool found = false;
+  for_each_field(config, [&](std::string_view s, const FieldInfo& info, auto& value) {
+    if (!found && s == section && info.name == key) {
+      found = true;
+      f(info, value);
+    }
+  });
+  return found;
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string suggestion(std::string_view word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_d = 4;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_d) { best_d = d; best = c; }
+  }
+  return best.empty() ? std::string{} : fmt::format(" (did you mean '{}'?)", best);
+}
+
+std::vector<std::string> section_names() {
+  std::vector<std::string> out;
+  Config c;
+  visit_sections(c, [&](std::string_view s, auto&) { out.emplace_back(s); });
+  return out;
+}
+
+std::vector<std::string> field_names(std::string_view section) {
+  std::vector<std::string> out;
+  Config c;
+  for_each_field(c, [&](std::string_view s, const FieldInfo& info, auto&) {
+    if (s == section) out.emplace_back(info.name);
+  });
+  return out;
+}
+
+template <class T>
+constexpr std::string_view type_name() {
+  if constexpr (std::is_same_v<T, bool>) return "a boolean (true or false)";
+  else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) return "an integer";
+  else if constexpr (std::is_same_v<T, double>) return "a number";
+  else if constexpr (std::is_same_v<T, std::string>) return "a string";
+  else if constexpr (std::is_same_v<T, std::vector<std::string>>) return "an array of strings";
+  else return "an array of numbers";
+}
+
+std::string format_double(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);  // shortest round-trip form
+  std::string s(buf, end);
+  if (s.find_first_of(".eE") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string quote(std::string_view s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+std::string format_value(const auto& value) {
+  using T = std::decay_t<decltype(value)>;
+  if constexpr (std::is_same_v<T, bool>) return value ? "true" : "false";
+  else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) return std::to_string(value);
+  else if constexpr (std::is_same_v<T, double>) return format_double(value);
+  else if constexpr (std::is_same_v<T, std::string>) return quote(value);
+  else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    std::vector<std::string> q;
+    for (const auto& s : value) q.push_back(quote(s));
+    return fmt::format("[{}]", fmt::join(q, ", "));
+  } else {
+    std::vector<std::string> q;
+    for (double d : value) q.push_back(format_double(d));
+    return fmt::format("[{}]", fmt::join(q, ", "));
+  }
+}
+
+// Checks a value against the field's bounds/choices; returns an empty string if fine.
+template <class T>
+std::string check(const FieldInfo& info, const T& value) {
+  auto check_number = [&](double x) -> std::string {
+    if (!std::isfinite(x)) return fmt::format("must be finite, {}", info.bounds.describe());
+    if (!info.bounds.contains(x)) return fmt::format("out of range: expected {}", info.bounds.describe());
+    return {};
+  };
+  auto allowed = [&](const std::string& s) {
+    return info.choices.empty() || std::find(info.choices.begin(), info.choices.end(), s) != info.choices.end();
+  };
+  if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t> || std::is_same_v<T, double>) {
+    return check_number(static_cast<double>(value));
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    if (!allowed(value)) return fmt::format("expected one of {}", fmt::join(info.choices, ", "));
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      if (!allowed(value[i]))
+        return fmt::format("unknown entry {} (expected any of {})", quote(value[i]), fmt::join(info.choices, ", "));
+      for (std::size_t j = 0; j < i; ++j)
+        if (value[j] == value[i]) return fmt::format("entry {} is listed twice", quote(value[i]));
+    }
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    for (double d : value)
+      if (auto e = check_number(d); !e.empty()) return "an entry is " + e;
+  }
+  return {};
+}
+
+// Reads a TOML node into a field of type T; returns an error text or empty.
+template <class T>
+std::string read_node(const toml::node& node, T& out) {
+  if constexpr (std::is_same_v<T, bool>) {
+    if (!node.is_boolean()) return "wrong type";
+    out = node.as_boolean()->get();
+  } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) {
+    if (!node.is_integer()) return "wrong type";
+    const std::int64_t v = node.as_integer()->get();
+    if constexpr (std::is_same_v<T, int>)
+      if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) return "out of the integer range";
+    out = static_cast<T>(v);
+  } else if constexpr (std::is_same_v<T, double>) {
+    if (node.is_integer()) out = static_cast<double>(node.as_integer()->get());
+    else if (node.is_floating_point()) out = node.as_floating_point()->get();
+    else return "wrong type";
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    if (!node.is_string()) return "wrong type";
+    out = node.as_string()->get();
+  } else {
+    const toml::array* arr = node.as_array();
+    if (!arr) return "wrong type";
+    T result;
+    for (const toml::node& el : *arr) {
+      typename T::value_type v{};
+      if (auto e = read_node(el, v); !e.empty()) return "wrong type";
+      result.push_back(std::move(v));
+    }
+    out = std::move(result);
+  }
+  return {};
+}
+
+std::string node_text(const toml::node& node) {
+  std::ostringstream ss;
+  if (node.is_string()) ss << quote(node.as_string()->get());
+  else node.visit([&](auto&& n) { ss << n; });
+  std::string s = ss.str();
+  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+std::string location(std::string_view source, const toml::source_region& r) {
+  return r.begin.line ? fmt::format("{}:{}", source, r.begin.line) : std::string(source);
+}
+
+void apply_table(Config& config, const toml::table& root, std::string_view source) {
+  const auto sections = section_names();
+  for (auto&& [skey, snode] : root) {
+    const std::string section(skey.str());
+    if (std::find(sections.begin(), sections.end(), section) == sections.end())
+      throw ConfigError(fmt::format("{}: unknown section [{}]{}; sections are: {}", location(source, skey.source()),
+                                    section, suggestion(section, sections), fmt::join(sections, ", ")));
+    const toml::table* table = snode.as_table();
+    if (!table)
+      throw ConfigError(fmt::format("{}: '{}' must be a table ([{}])", location(source, snode.source()), section, section));
+    for (auto&& [kkey, knode] : *table) {
+      const std::string key(kkey.str());
+      const bool found = with_field(config, section, key, [&](const FieldInfo& info, auto& value) {
+        using T = std::decay_t<decltype(value)>;
+        T parsed = value;
+        const std::string where = fmt::format("{}: {}.{} = {}", location(source, knode.source()), section, key, node_text(knode));
+        if (auto e = read_node(knode, parsed); !e.empty())
+          throw ConfigError(fmt::format("{}: {}, expected {}", where, e, type_name<T>()));
+        if (auto e = check(info, parsed); !e.empty()) throw ConfigError(fmt::format("{}: {}", where, e));
+        value = std::move(parsed);
+      });
+      if (!found) {
+        const auto names = field_names(section);
+        throw ConfigError(fmt::format("{}: unknown key '{}.{}'{}", location(source, kkey.source()), section, key,
+                                      suggestion(key, names)));
+      }
+    }
+  }
+}
+
+toml::table parse_toml(std::string_view text, std::string_view source) {
+  try {
+    return toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(fmt::format("{}:{}:{}: malformed TOML: {}", source, e.source().begin.line,
+                                  e.source().begin.column, e.description()));
+  }
+}
+
+}  // namespace
+
+Config config_from_toml(std::string_view text, std::string_view source) {
+  Config config;
+  apply_table(config, parse_toml(text, source), source);
+  validate(config, source);
+  return config;
+}
+
+Config load_config(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(fmt::format("{}: cannot open config file", path.string()));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return config_from_toml(ss.str(), path.string());
+}
+
+std::string to_toml(const Config& config) {
+  Config copy = config;
+  std::string out = fmt::format(
+      "# animat {} configuration. Every key is listed with its default or resolved value.\n"
+      "# [paper] marks values fixed by Joachimczak & Wrobel (GECCO 2012); [choose] marks project choices\n"
+      "# documented in docs/model.md.\n",
+      ANIMAT_VERSION);
+  std::string_view current;
+  for_each_field(copy, [&](std::string_view section, const FieldInfo& info, auto& value) {
+    if (section != current) {
+      out += fmt::format("\n[{}]\n", section);
+      current = section;
+    }
+    out += fmt::format("# {}\n{} = {}\n", info.doc, info.name, format_value(value));
+  });
+  return out;
+}
+
+void apply_override(Config& config, std::string_view assignment) {
+  const auto eq = assignment.find('=');
+  const auto dot = assignment.find('.');
+  if (eq == std::string_view::npos || dot == std::string_view::npos || dot > eq)
+    throw ConfigError(fmt::format("--set {}: expected section.key=value", assignment));
+  auto trim = [](std::string_view s) {
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+    return s;
+  };
+  const std::string section(trim(assignment.substr(0, dot)));
+  const std::string key(trim(assignment.substr(dot + 1, eq - dot - 1)));
+  std::string value(trim(assignment.substr(eq + 1)));
+  // Bare words are accepted for string fields: --set physics.drag_scheme=explicit.
+  with_field(config, section, key, [&](const FieldInfo&, auto& v) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>)
+      if (value.empty() || value.front() != '"') value = quote(value);
+  });
+  const std::string doc = fmt::format("[{}]\n{} = {}\n", section, key, value);
+  try {
+    apply_table(config, parse_toml(doc, "--set"), "--set");
+  } catch (const ConfigError& e) {
+    std::string msg = e.what();
+    if (msg.rfind("--set:", 0) == 0) msg = msg.substr(msg.find(' ') + 1);
+    if (msg.rfind("--set", 0) == 0) msg = msg.substr(msg.find(' ') + 1);
+    throw ConfigError(fmt::format("--set {}: {}", assignment, msg));
+  }
+  validate(config, "--set");
+}
+
+namespace {
+std::pair<std::string, std::string> split_key(std::string_view dotted) {
+  const auto dot = dotted.find('.');
+  if (dot == std::string_view::npos) throw ConfigError(fmt::format("config key '{}' must be 'section.key'", dotted));
+  return {std::string(dotted.substr(0, dot)), std::string(dotted.substr(dot + 1))};
+}
+}  // namespace
+
+void set_value(Config& config, std::string_view dotted, const ConfigValue& cv) {
+  const auto [section, key] = split_key(dotted);
+  const bool found = with_field(config, section, key, [&](const FieldInfo& info, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    T parsed{};
+    bool ok = true;
+    std::visit([&](const auto& x) {
+      using X = std::decay_t<decltype(x)>;
+      if constexpr (std::is_same_v<T, X>) parsed = x;
+      else if constexpr ((std::is_same_v<T, int>)&&std::is_same_v<X, std::int64_t>) {
+        if (x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max()) ok = false;
+        else parsed = static_cast<int>(x);
+      } else if constexpr (std::is_same_v<T, double> && std::is_same_v<X, std::int64_t>) parsed = static_cast<double>(x);
+      else if constexpr (std::is_same_v<T, std::vector<double>> && std::is_same_v<X, std::vector<std::string>>) ok = x.empty();
+      else if constexpr (std::is_same_v<T, std::vector<std::string>> && std::is_same_v<X, std::vector<double>>) ok = x.empty();
+      else ok = false;
+    }, cv);
+    if (!ok) throw ConfigError(fmt::format("{}: wrong type, expected {}", dotted, type_name<T>()));
+    if (auto e = check(info, parsed); !e.empty()) throw ConfigError(fmt::format("{} = {}: {}", dotted, format_value(parsed), e));
+    value = std::move(parsed);
+  });
+  if (!found) {
+    std::vector<std::string> keys = config_keys();
+    throw ConfigError(fmt::format("unknown config key '{}'{}", dotted, suggestion(dotted, keys)));
+  }
+}
+
+ConfigValue get_value(const Config& config, std::string_view dotted) {
+  const auto [section, key] = split_key(dotted);
+  Config copy = config;
+  ConfigValue out;
+  const bool found = with_field(copy, section, key, [&](const FieldInfo&, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if constexpr (std::is_same_v<T, int>) out = static_cast<std::int64_t>(value);
+    else out = value;
+  });
+  if (!found) {
+    std::vector<std::string> keys = config_keys();
+    throw ConfigError(fmt::format("unknown config key '{}'{}", dotted, suggestion(dotted, keys)));
+  }
+  return out;
+}
+
+std::vector<std::string> config_keys() {
+  std::vector<std::string> out;
+  Config c;
+  for_each_field(c, [&](std::string_view s, const FieldInfo& info, auto&) { out.push_back(fmt::format("{}.{}", s, info.name)); });
+  return out;
+}
+
+std::string config_doc(std::string_view dotted) {
+  const auto [section, key] = split_key(dotted);
+  Config c;
+  std::string doc;
+  if (!with_field(c, section, key, [&](const FieldInfo& info, auto&) {
+        doc = fmt::format("{} ({})", info.doc, info.bounds.describe());
+      }))
+    throw ConfigError(fmt::format("unknown config key '{}'", dotted));
+  return doc;
+}
+
+void validate(const Config& config, std::string_view source) {
+  Config copy = config;
+  for_each_field(copy, [&](std::string_view section, const FieldInfo& info, auto& value) {
+    if (auto e = check(info, value); !e.empty())
+      throw ConfigError(fmt::format("{}: {}.{} = {}: {}", source, section, info.name, format_value(value), e));
+  });
+  auto fail = [&](std::string_view msg) { throw ConfigError(fmt::format("{}: {}", source, msg)); };
+  if (config.evolution.elites >= config.evolution.population)
+    fail(fmt::format("evolution.elites = {} must be smaller than evolution.population = {}", config.evolution.elites,
+                     config.evolution.population));
+  if (config.development.frequency_min > config.development.frequency_max)
+    fail(fmt::format("development.frequency_min = {} exceeds development.frequency_max = {}",
+                     config.development.frequency_min, config.development.frequency_max));
+  if (config.development.min_cells > config.development.max_cells)
+    fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
+                     config.development.max_cells));
+}
+
+std::uint64_t config_hash(const Config& config) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char ch : to_toml(config)) {
+    h ^= ch;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+bool operator==(const Config& a, const Config& b) { return to_toml(a) == to_toml(b); }
+
+}  // namespace animat

@@ -1,0 +1,3 @@
+#include <gtest/gtest.h>
+#include "animat/config.hpp"
+TEST(Build, DefaultConfigValidates) { EXPECT_NO_THROW(animat::validate(animat::Config{})); }
