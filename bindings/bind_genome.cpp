@@ -27,10 +27,10 @@ using Array2 = nb::ndarray<nb::numpy, double, nb::ndim<2>>;
 
 // Copies a vector into a freshly owned numpy array.
 template <class T>
-nb::ndarray<nb::numpy, T> to_numpy(std::vector<T> v, std::initializer_list<std::size_t> shape) {
+nb::object to_numpy(std::vector<T> v, std::initializer_list<std::size_t> shape) {
   auto* heap = new std::vector<T>(std::move(v));
   nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
-  return nb::ndarray<nb::numpy, T>(heap->data(), shape.size(), shape.begin(), owner);
+  return nb::ndarray<nb::numpy, T>(heap->data(), shape.size(), shape.begin(), owner).cast();
 }
 
 using RngOrSeed = std::variant<Rng*, std::int64_t>;

@@ -1,9 +1,524 @@
+// Development (paper §2.2, Fig. 2): see include/animat/development.hpp for the step order and
+// docs/notes/development.md for every [choose].
+//
+// Cells are fixture-less dynamic Box2D bodies: Box2D integrates them (semi-implicit Euler with
+// linear damping) and never builds contacts, so the only cost of the physics is our own pairwise
+// force loop, which runs only when "repulsion" or "adhesion" is enabled. Pairs are enumerated
+// O(n²): at the paper's 32 (64) cells that is 496 (2016) distance checks per step, less than the
+// GRN steps themselves; the morphogen model needs every pair's distance anyway.
 #include "animat/development.hpp"
 
+#include <box2d/box2d.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
 #include "animat/errors.hpp"
+#include "animat/scene.hpp"  // has_effect
 
 namespace animat {
-Embryo develop(const Genome&, const GenomeParams&, const GrnParams&, const DevelopmentParams&) {
-  throw Error("develop: not implemented yet");
+
+namespace {
+constexpr long long kNever = std::numeric_limits<int>::min();  // last division of a cell that never divided
+}  // namespace
+
+void validate(const DevelopmentParams& p) {
+  auto fail = [](std::string_view key, const std::string& what) {
+    throw ConfigError(fmt::format("development.{}: {}", key, what));
+  };
+  if (p.maternal_sources.size() != 6)
+    fail("maternal_sources", fmt::format("expected 6 numbers x0,y0,x1,y1,x2,y2, got {}", p.maternal_sources.size()));
+  for (double x : p.maternal_sources)
+    if (!std::isfinite(x)) fail("maternal_sources", fmt::format("coordinates must be finite, got {}", x));
+  for (const auto& e : p.effects)
+    if (std::find(std::begin(kDevelopmentEffectNames), std::end(kDevelopmentEffectNames), e) == std::end(kDevelopmentEffectNames))
+      fail("effects", fmt::format("unknown effect '{}' (known: repulsion, adhesion, morphogens)", e));
+  if (p.steps < 1) fail("steps", fmt::format("must be >= 1, got {}", p.steps));
+  if (p.max_cells < 1) fail("max_cells", fmt::format("must be >= 1, got {}", p.max_cells));
+  if (!(p.time_step > 0.0 && p.time_step <= 1.0)) fail("time_step", fmt::format("must be in (0, 1], got {}", p.time_step));
+  if (!(p.cell_mass > 0.0)) fail("cell_mass", fmt::format("must be > 0, got {}", p.cell_mass));
+  if (!(p.cell_radius > 0.0)) fail("cell_radius", fmt::format("must be > 0, got {}", p.cell_radius));
+  if (!(p.damping >= 0.0)) fail("damping", fmt::format("must be >= 0, got {}", p.damping));
+  if (!(p.morphogen_speed > 0.0)) fail("morphogen_speed", fmt::format("must be > 0, got {}", p.morphogen_speed));
+  if (!(p.morphogen_decay_length > 0.0))
+    fail("morphogen_decay_length", fmt::format("must be > 0, got {}", p.morphogen_decay_length));
+  if (!(p.maternal_decay_length > 0.0))
+    fail("maternal_decay_length", fmt::format("must be > 0, got {}", p.maternal_decay_length));
+  if (p.morphogen_max_delay < 0) fail("morphogen_max_delay", fmt::format("must be >= 0, got {}", p.morphogen_max_delay));
+  if (!(p.max_force >= 0.0)) fail("max_force", fmt::format("must be >= 0, got {}", p.max_force));
+  if (!(p.repulsion_stiffness >= 0.0) || !(p.adhesion_stiffness >= 0.0) || !(p.adhesion_range >= 0.0))
+    fail("repulsion_stiffness", "stiffnesses and adhesion_range must be >= 0");
 }
+
+// ---------------------------------------------------------------------------------------------
+struct DevelopmentWorld::Impl {
+  struct Cell {
+    b2Body* body = nullptr;
+    double radius = 0.0;
+    Vec2 orientation{1.0, 0.0};
+    Vec2 position{0.0, 0.0};  ///< cached from Box2D after every physics step (float → double)
+    long long last_division = kNever;
+  };
+
+  Grn grn;
+  GrnParams grn_params;
+  DevelopmentParams params;
+  bool repulsion = false, adhesion = false, morphogens = false;
+  std::array<Vec2, 3> sources{};
+
+  std::unique_ptr<b2World> world;
+  std::vector<Cell> cells;
+  std::vector<GrnState> states;
+  std::vector<int> division_steps;
+
+  // Morphogen history: per cell, a ring of `hist_len` samples of its `morph_count` product levels.
+  int morph_count = 0;
+  int hist_len = 0;     ///< morphogen_max_delay + 1 when the morphogens effect is on and products exist; else 0
+  long long hist_time = 0;  ///< time of the newest sample
+  std::vector<double> history;  ///< [cell][slot][k]
+  std::vector<double> sensed;   ///< [cell][k], written by sense()
+  std::vector<std::array<double, 3>> maternal;  ///< per cell, written by sense()
+  std::vector<Vec2> forces;     ///< scratch of step_physics
+
+  Impl(Grn g, const GrnParams& gp, const DevelopmentParams& p) : grn(std::move(g)), grn_params(gp), params(p) {
+    validate(params);
+    repulsion = has_effect(params.effects, "repulsion");
+    adhesion = has_effect(params.effects, "adhesion");
+    morphogens = has_effect(params.effects, "morphogens");
+    for (std::size_t k = 0; k < 3; ++k) sources[k] = Vec2(params.maternal_sources[2 * k], params.maternal_sources[2 * k + 1]);
+    morph_count = static_cast<int>(grn.morphogen_units().size());
+    hist_len = (morphogens && morph_count > 0) ? params.morphogen_max_delay + 1 : 0;
+
+    world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
+    world->SetAllowSleeping(false);
+    world->SetContinuousPhysics(false);
+    const auto reserve = static_cast<std::size_t>(std::min(params.max_cells, 64));
+    cells.reserve(reserve);
+    states.reserve(reserve);
+    history.reserve(reserve * static_cast<std::size_t>(hist_len) * static_cast<std::size_t>(morph_count));
+  }
+
+  [[nodiscard]] std::size_t slot_of(long long time) const {
+    const long long h = hist_len;
+    return static_cast<std::size_t>(((time % h) + h) % h);
+  }
+  double* hist(std::size_t cell, std::size_t slot) {
+    return history.data() + (cell * static_cast<std::size_t>(hist_len) + slot) * static_cast<std::size_t>(morph_count);
+  }
+  [[nodiscard]] const double* hist(std::size_t cell, std::size_t slot) const {
+    return history.data() + (cell * static_cast<std::size_t>(hist_len) + slot) * static_cast<std::size_t>(morph_count);
+  }
+
+  /// Where to read a delay of `tau` steps: two slots and the weight of the older one.
+  struct Tap {
+    std::size_t newer, older;
+    double frac;
+  };
+  [[nodiscard]] Tap tap(double tau) const {
+    tau = std::min(tau, static_cast<double>(params.morphogen_max_delay));
+    const double whole = std::floor(tau);
+    const auto k = static_cast<long long>(whole);
+    const double frac = tau - whole;
+    return {slot_of(hist_time - k), frac > 0.0 ? slot_of(hist_time - k - 1) : slot_of(hist_time - k), frac};
+  }
+
+  b2Body* make_body(const Vec2& position, const Vec2& velocity) {
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(static_cast<float>(position.x()), static_cast<float>(position.y()));
+    def.linearVelocity.Set(static_cast<float>(velocity.x()), static_cast<float>(velocity.y()));
+    def.linearDamping = static_cast<float>(params.damping);
+    def.fixedRotation = true;
+    def.allowSleep = false;
+    b2Body* body = world->CreateBody(&def);
+    b2MassData md;
+    md.mass = static_cast<float>(params.cell_mass);
+    md.center.SetZero();
+    md.I = 0.0f;
+    body->SetMassData(&md);
+    return body;
+  }
+
+  int append_cell(const Vec2& position, const Vec2& velocity, double radius, const Vec2& orientation, GrnState state) {
+    Cell c;
+    c.body = make_body(position, velocity);
+    const b2Vec2 p = c.body->GetPosition();
+    c.position = Vec2(p.x, p.y);
+    c.radius = radius;
+    c.orientation = orientation;
+    cells.push_back(c);
+    states.push_back(std::move(state));
+    if (hist_len > 0) history.resize(cells.size() * static_cast<std::size_t>(hist_len) * static_cast<std::size_t>(morph_count));
+    return static_cast<int>(cells.size()) - 1;
+  }
+
+  double sample(std::size_t cell, std::size_t k, const Tap& t) const {
+    const double a = hist(cell, t.newer)[k];
+    if (t.frac == 0.0) return a;
+    return a + t.frac * (hist(cell, t.older)[k] - a);
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+DevelopmentWorld::DevelopmentWorld(Grn grn, const GrnParams& grn_params, const DevelopmentParams& params)
+    : impl_(std::make_unique<Impl>(std::move(grn), grn_params, params)) {}
+DevelopmentWorld::~DevelopmentWorld() = default;
+DevelopmentWorld::DevelopmentWorld(DevelopmentWorld&&) noexcept = default;
+DevelopmentWorld& DevelopmentWorld::operator=(DevelopmentWorld&&) noexcept = default;
+
+int DevelopmentWorld::add_cell(const Vec2& position, double radius, const Vec2& orientation, const GrnState* state) {
+  Impl& w = *impl_;
+  if (!position.allFinite() || !(radius > 0.0) || !orientation.allFinite() || orientation.norm() == 0.0)
+    throw Error(fmt::format("DevelopmentWorld::add_cell: invalid cell (position {},{}, radius {}, orientation {},{})",
+                            position.x(), position.y(), radius, orientation.x(), orientation.y()));
+  GrnState s = state ? *state : w.grn.initial_state();
+  if (s.levels.size() != static_cast<std::size_t>(w.grn.node_count()))
+    throw Error(fmt::format("DevelopmentWorld::add_cell: state has {} levels, the GRN has {} nodes", s.levels.size(),
+                            w.grn.node_count()));
+  s.activation.resize(s.levels.size());
+  const int i = w.append_cell(position, Vec2::Zero(), radius, orientation.normalized(), std::move(s));
+  if (w.hist_len > 0) {  // a new cell's past: its current levels
+    const auto& units = w.grn.morphogen_units();
+    for (int slot = 0; slot < w.hist_len; ++slot) {
+      double* h = w.hist(static_cast<std::size_t>(i), static_cast<std::size_t>(slot));
+      for (int k = 0; k < w.morph_count; ++k)
+        h[k] = w.states[static_cast<std::size_t>(i)].levels[static_cast<std::size_t>(units[static_cast<std::size_t>(k)])];
+    }
+  }
+  return i;
+}
+
+int DevelopmentWorld::step() {
+  advance_clock();
+  sense();
+  step_grn();
+  record_history();
+  const int divisions = divide_ready();
+  step_physics();
+  return divisions;
+}
+
+void DevelopmentWorld::sense() {
+  Impl& w = *impl_;
+  const std::size_t n = w.cells.size();
+  w.maternal.assign(n, {0.0, 0.0, 0.0});
+  if (!w.morphogens) return;  // the effect is off: maternal levels stay 0, products are sensed in-cell only
+  const double lm = w.params.maternal_decay_length;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < 3; ++k) w.maternal[i][k] = std::exp(-(w.cells[i].position - w.sources[k]).norm() / lm);
+
+  const auto m = static_cast<std::size_t>(w.morph_count);
+  if (m == 0) return;
+  w.sensed.assign(n * m, 0.0);
+  // Own level (distance 0, no delay), then every other emitter, pair by pair in index order.
+  const Impl::Tap now = w.tap(0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < m; ++k) w.sensed[i * m + k] = w.sample(i, k, now);
+  const double inv_lambda = 1.0 / w.params.morphogen_decay_length;
+  const double inv_speed = 1.0 / w.params.morphogen_speed;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const double d = (w.cells[j].position - w.cells[i].position).norm();
+      const double weight = std::exp(-d * inv_lambda);
+      const Impl::Tap t = w.tap(d * inv_speed);
+      for (std::size_t k = 0; k < m; ++k) {
+        w.sensed[i * m + k] += weight * w.sample(j, k, t);
+        w.sensed[j * m + k] += weight * w.sample(i, k, t);
+      }
+    }
+  }
+  for (double& s : w.sensed) s = std::min(s, 1.0);
+}
+
+void DevelopmentWorld::step_grn() {
+  Impl& w = *impl_;
+  const std::size_t n = w.cells.size();
+  if (w.maternal.size() != n) w.maternal.assign(n, {0.0, 0.0, 0.0});
+  const auto m = static_cast<std::size_t>(w.morph_count);
+  const bool use_sensed = w.morphogens && m > 0 && w.sensed.size() == n * m;
+  for (std::size_t i = 0; i < n; ++i) {
+    GrnInputs in;
+    in.maternal = w.maternal[i];
+    if (use_sensed) in.morphogens = std::span<const double>(w.sensed.data() + i * m, m);
+    w.grn.step(w.states[i], in, w.grn_params);
+  }
+}
+
+void DevelopmentWorld::record_history() {
+  Impl& w = *impl_;
+  if (w.hist_len == 0) return;
+  ++w.hist_time;
+  const std::size_t slot = w.slot_of(w.hist_time);
+  const auto& units = w.grn.morphogen_units();
+  for (std::size_t i = 0; i < w.cells.size(); ++i) {
+    double* h = w.hist(i, slot);
+    for (int k = 0; k < w.morph_count; ++k)
+      h[k] = w.states[i].levels[static_cast<std::size_t>(units[static_cast<std::size_t>(k)])];
+  }
+}
+
+int DevelopmentWorld::divide(int cell) {
+  Impl& w = *impl_;
+  const auto mi = static_cast<std::size_t>(cell);
+  const Impl::Cell mother = w.cells.at(mi);
+  const double angle = 2.0 * std::numbers::pi * output(cell, OutputChannel::rotate);
+  const double grow = output(cell, OutputChannel::grow);
+  const double c = std::cos(angle), s = std::sin(angle);
+  Vec2 orientation(c * mother.orientation.x() - s * mother.orientation.y(),
+                   s * mother.orientation.x() + c * mother.orientation.y());
+  orientation.normalize();
+  const Vec2 position = mother.position + w.params.division_offset * mother.radius * mother.orientation;
+  const double radius = w.params.cell_radius * (1.0 + w.params.max_growth * grow);
+  const b2Vec2 v = mother.body->GetLinearVelocity();
+  GrnState state = w.states[mi];  // inherits every level
+  const int d = w.append_cell(position, Vec2(v.x, v.y), radius, orientation, std::move(state));
+  if (w.hist_len > 0) {  // the daughter's past is its mother's
+    const std::size_t block = static_cast<std::size_t>(w.hist_len) * static_cast<std::size_t>(w.morph_count);
+    std::copy_n(w.history.begin() + static_cast<std::ptrdiff_t>(mi * block), block,
+                w.history.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(d) * block));
+  }
+  w.cells[mi].last_division = step_;
+  w.cells[static_cast<std::size_t>(d)].last_division = step_;
+  return d;
+}
+
+int DevelopmentWorld::divide_ready() {
+  Impl& w = *impl_;
+  const int n0 = cell_count();
+  int divisions = 0;
+  for (int i = 0; i < n0; ++i) {
+    if (cell_count() >= w.params.max_cells) break;
+    if (output(i, OutputChannel::divide) < w.params.divide_threshold) continue;
+    if (static_cast<long long>(step_) - w.cells[static_cast<std::size_t>(i)].last_division <= w.params.refractory_steps)
+      continue;
+    divide(i);
+    w.division_steps.push_back(step_);
+    ++divisions;
+  }
+  return divisions;
+}
+
+void DevelopmentWorld::step_physics(std::span<const Vec2> external_forces) {
+  Impl& w = *impl_;
+  const std::size_t n = w.cells.size();
+  if (!external_forces.empty() && external_forces.size() != n)
+    throw Error(fmt::format("DevelopmentWorld::step_physics: {} external forces for {} cells", external_forces.size(), n));
+  w.forces.assign(n, Vec2::Zero());
+  if (w.repulsion || w.adhesion) {
+    const double krep = w.params.repulsion_stiffness, kadh = w.params.adhesion_stiffness;
+    const double range = w.adhesion ? w.params.adhesion_range : 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = i + 1; j < n; ++j) {
+        const Vec2 dx = w.cells[j].position - w.cells[i].position;
+        const double contact = w.cells[i].radius + w.cells[j].radius;
+        const double reach = contact + range;
+        const double d2 = dx.squaredNorm();
+        if (d2 >= reach * reach) continue;
+        const double d = std::sqrt(d2);
+        // Unit vector i → j; coincident centres get a fixed direction (deterministic).
+        const Vec2 u = d > 1e-12 ? Vec2(dx / d) : Vec2(1.0, 0.0);
+        double f = 0.0;  // > 0 pushes apart
+        if (d < contact) {
+          if (w.repulsion) f = krep * (contact - d);
+        } else if (w.adhesion) {
+          const double gap = d - contact;
+          f = -kadh * std::min(gap, range - gap);  // rises to kadh·range/2 at half range, then fades to 0
+        }
+        w.forces[i] -= f * u;
+        w.forces[j] += f * u;
+      }
+    }
+  }
+  const double fmax = w.params.max_force;
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec2 f = w.forces[i];
+    if (fmax > 0.0) {
+      const double norm = f.norm();
+      if (norm > fmax) f *= fmax / norm;
+    }
+    if (!external_forces.empty()) f += external_forces[i];
+    if (f.x() != 0.0 || f.y() != 0.0)
+      w.cells[i].body->ApplyForceToCenter(b2Vec2(static_cast<float>(f.x()), static_cast<float>(f.y())), true);
+  }
+  w.world->Step(static_cast<float>(w.params.time_step), 1, 1);
+  constexpr double kMaxStep = 0.5 * static_cast<double>(b2_maxTranslation);
+  for (std::size_t i = 0; i < n; ++i) {
+    const b2Vec2 p = w.cells[i].body->GetPosition();
+    const Vec2 now(p.x, p.y);
+    if (!now.allFinite())
+      throw SimulationError(fmt::format("development step {}: cell {} has a non-finite position", step_, i));
+    const double moved = (now - w.cells[i].position).norm();
+    if (moved > kMaxStep)
+      throw SimulationError(fmt::format(
+          "development step {}: cell {} moved {:.3g} in one step, beyond half of Box2D's translation cap ({}); "
+          "lower development.time_step or the stiffnesses",
+          step_, i, moved, static_cast<double>(b2_maxTranslation)));
+    w.cells[i].position = now;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+int DevelopmentWorld::cell_count() const { return static_cast<int>(impl_->cells.size()); }
+const Grn& DevelopmentWorld::grn() const { return impl_->grn; }
+const DevelopmentParams& DevelopmentWorld::params() const { return impl_->params; }
+DevelopmentWorld::Vec2 DevelopmentWorld::position(int cell) const { return impl_->cells.at(static_cast<std::size_t>(cell)).position; }
+DevelopmentWorld::Vec2 DevelopmentWorld::velocity(int cell) const {
+  const b2Vec2 v = impl_->cells.at(static_cast<std::size_t>(cell)).body->GetLinearVelocity();
+  return {v.x, v.y};
+}
+double DevelopmentWorld::radius(int cell) const { return impl_->cells.at(static_cast<std::size_t>(cell)).radius; }
+DevelopmentWorld::Vec2 DevelopmentWorld::orientation(int cell) const {
+  return impl_->cells.at(static_cast<std::size_t>(cell)).orientation;
+}
+GrnState& DevelopmentWorld::state(int cell) { return impl_->states.at(static_cast<std::size_t>(cell)); }
+const GrnState& DevelopmentWorld::state(int cell) const { return impl_->states.at(static_cast<std::size_t>(cell)); }
+double DevelopmentWorld::output(int cell, OutputChannel c) const { return impl_->grn.output(state(cell), c); }
+const std::vector<int>& DevelopmentWorld::division_steps() const { return impl_->division_steps; }
+bool DevelopmentWorld::has(std::string_view effect) const { return has_effect(impl_->params.effects, effect); }
+
+std::array<double, 3> DevelopmentWorld::maternal_at(const Vec2& p) const {
+  std::array<double, 3> out{};
+  for (std::size_t k = 0; k < 3; ++k) out[k] = std::exp(-(p - impl_->sources[k]).norm() / impl_->params.maternal_decay_length);
+  return out;
+}
+
+double DevelopmentWorld::sensed_morphogen(int cell, int k) const {
+  const Impl& w = *impl_;
+  if (k < 0 || k >= w.morph_count) throw Error(fmt::format("sensed_morphogen: no morphogen product {}", k));
+  const auto i = static_cast<std::size_t>(cell);
+  const auto kk = static_cast<std::size_t>(k);
+  if (w.hist_len == 0)  // effect off: only the cell's own level
+    return w.states.at(i).levels[static_cast<std::size_t>(w.grn.morphogen_units()[kk])];
+  double sum = w.sample(i, kk, w.tap(0.0));
+  for (std::size_t j = 0; j < w.cells.size(); ++j) {
+    if (j == i) continue;
+    const double d = (w.cells[j].position - w.cells[i].position).norm();
+    sum += std::exp(-d / w.params.morphogen_decay_length) * w.sample(j, kk, w.tap(d / w.params.morphogen_speed));
+  }
+  return std::min(sum, 1.0);
+}
+
+std::span<const double> DevelopmentWorld::sensed_morphogens(int cell) const {
+  const Impl& w = *impl_;
+  const auto m = static_cast<std::size_t>(w.morph_count);
+  const auto i = static_cast<std::size_t>(cell);
+  if (!w.morphogens || m == 0 || w.sensed.size() < (i + 1) * m) return {};
+  return {w.sensed.data() + i * m, m};
+}
+
+const std::array<double, 3>& DevelopmentWorld::sensed_maternal(int cell) const {
+  return impl_->maternal.at(static_cast<std::size_t>(cell));
+}
+
+Points DevelopmentWorld::positions() const {
+  Points p(cell_count(), 2);
+  for (int i = 0; i < cell_count(); ++i) p.row(i) = impl_->cells[static_cast<std::size_t>(i)].position.transpose();
+  return p;
+}
+Vector DevelopmentWorld::radii() const {
+  Vector r(cell_count());
+  for (int i = 0; i < cell_count(); ++i) r[i] = impl_->cells[static_cast<std::size_t>(i)].radius;
+  return r;
+}
+Points DevelopmentWorld::orientations() const {
+  Points o(cell_count(), 2);
+  for (int i = 0; i < cell_count(); ++i) o.row(i) = impl_->cells[static_cast<std::size_t>(i)].orientation.transpose();
+  return o;
+}
+OutputLevels DevelopmentWorld::outputs() const {
+  OutputLevels out(cell_count(), kOutputCount);
+  for (int i = 0; i < cell_count(); ++i)
+    for (int c = 0; c < kOutputCount; ++c) out(i, c) = output(i, static_cast<OutputChannel>(c));
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+void snapshot(const DevelopmentWorld& w, DevelopmentTrace& t) {
+  t.steps.push_back(w.current_step());
+  t.positions.push_back(w.positions());
+  t.radii.push_back(w.radii());
+  t.orientations.push_back(w.orientations());
+}
+
+std::string missing_paths(const Grn& grn) {
+  std::string names;
+  for (OutputChannel c : {OutputChannel::divide, OutputChannel::amplitude, OutputChannel::frequency, OutputChannel::phase}) {
+    if (grn.reaches(c)) continue;
+    if (!names.empty()) names += ", ";
+    names += kOutputNames[static_cast<std::size_t>(c)];
+  }
+  return names;
+}
+
+}  // namespace
+
+Embryo develop(const Genome& genome, const GenomeParams& genome_params, const GrnParams& grn_params,
+               const DevelopmentParams& params) {
+  validate(params);
+  Grn grn(genome, genome_params);
+  const bool paths = grn.has_required_paths();
+  const bool divide_reachable = grn.reaches(OutputChannel::divide);
+  DevelopmentWorld world(std::move(grn), grn_params, params);
+  world.add_cell(DevelopmentWorld::Vec2::Zero(), params.cell_radius, DevelopmentWorld::Vec2(1.0, 0.0));
+
+  Embryo e;
+  const int steps = params.steps;
+  const int last_allowed = steps - params.quiet_steps;  // a division after this step is too late
+  const bool tracing = params.trace_every > 0;
+  if (tracing) snapshot(world, e.trace);
+
+  // Verdicts that are certain before any step.
+  if (!paths)
+    e.reasons.push_back(fmt::format("grn: no path from an input to the {} output(s)", missing_paths(world.grn())));
+  if (!divide_reachable && params.min_cells > 1)
+    e.reasons.push_back(fmt::format("cells: 1 cell, fewer than min_cells = {} (the divide output is unreachable)",
+                                    params.min_cells));
+  if (params.max_cells < params.min_cells)
+    e.reasons.push_back(fmt::format("cells: max_cells = {} is below min_cells = {}", params.max_cells, params.min_cells));
+  auto too_few_cells_for_good = [&] { return world.current_step() >= last_allowed && world.cell_count() < params.min_cells; };
+  if (e.reasons.empty() && too_few_cells_for_good())
+    e.reasons.push_back(fmt::format("cells: {} cell(s), fewer than min_cells = {}, and no division may come in time",
+                                    world.cell_count(), params.min_cells));
+
+  if (e.reasons.empty()) {
+    while (world.current_step() < steps) {
+      const int divisions = world.step();
+      const int s = world.current_step();
+      if (tracing && s % params.trace_every == 0) snapshot(world, e.trace);
+      if (divisions > 0 && s > last_allowed) {
+        e.reasons.push_back(fmt::format(
+            "late division: a division at step {} is fewer than quiet_steps = {} steps before the end (step {})", s,
+            params.quiet_steps, steps));
+        break;
+      }
+      if (too_few_cells_for_good()) {
+        e.reasons.push_back(fmt::format("cells: {} cell(s) at step {}, fewer than min_cells = {}{}", world.cell_count(), s,
+                                        params.min_cells, s < steps ? ", and no division may come in time" : ""));
+        break;
+      }
+    }
+  }
+  e.steps_run = world.current_step();
+  if (tracing && e.trace.steps.back() != e.steps_run) snapshot(world, e.trace);
+
+  e.positions = world.positions();
+  e.radii = world.radii();
+  e.orientations = world.orientations();
+  e.outputs = world.outputs();
+  const int n = world.cell_count();
+  e.amplitude = params.amplitude_max * e.outputs.col(static_cast<int>(OutputChannel::amplitude));
+  e.frequency = (Vector::Constant(n, params.frequency_min).array() +
+                 (params.frequency_max - params.frequency_min) * e.outputs.col(static_cast<int>(OutputChannel::frequency)).array())
+                    .matrix();
+  e.phase = 2.0 * std::numbers::pi * e.outputs.col(static_cast<int>(OutputChannel::phase));
+  e.division_steps = world.division_steps();
+  e.viable = e.reasons.empty();
+  return e;
+}
+
 }  // namespace animat

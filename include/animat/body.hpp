@@ -22,27 +22,46 @@ void visit_fields(BodyParams& p, V&& v) {
 }
 
 /// The spring-mass structure an embryo becomes.
+///
+/// Node i is cell i. Springs are the Gabriel edges; regions are the bounded faces of the planar
+/// Gabriel graph; the skin is the boundary of the unbounded face. Loops are vertex lists with an
+/// implicit closing edge (last -> first); each starts at its lexicographically smallest directed
+/// edge (loop[0], loop[1]). See docs/notes/body.md for every choice and degenerate case.
 struct Body {
   Points positions;                          ///< node (cell centre) positions at rest, n × 2
   IndexPairs springs;                        ///< Gabriel edges (i < j), sorted lexicographically
   Vector rest_lengths;                       ///< L0 per spring
-  std::vector<std::vector<int>> regions;     ///< bounded faces, vertex loops in CCW order
+  /// Bounded faces, vertex loops in CCW order (face on the left), sorted lexicographically. A loop is
+  /// the face's boundary walk: an edge that hangs into the face (a bridge) appears twice in it.
+  std::vector<std::vector<int>> regions;
   Vector rest_areas;                         ///< S0 per region (> 0 by CCW orientation)
   IndexPairs skin;                           ///< edges bordering the unbounded face, each once (i < j)
-  std::vector<std::vector<int>> skin_loops;  ///< closed walks around the outer boundary; dangling edges twice
+  /// Closed walks around the outer boundary, CCW around the body (body on the left); dangling
+  /// edges twice. One walk for n >= 2 (the Gabriel graph is connected), none for n <= 1.
+  std::vector<std::vector<int>> skin_loops;
   Vector amplitude, frequency, phase;        ///< per-node oscillator parameters (zeros if none given)
 
   [[nodiscard]] int node_count() const { return static_cast<int>(positions.rows()); }
   [[nodiscard]] int spring_count() const { return static_cast<int>(springs.rows()); }
+  [[nodiscard]] int region_count() const { return static_cast<int>(regions.size()); }
 };
 
-/// Delaunay edges (i < j, sorted) of the points; for Fig. 3(b).
+/// Delaunay edges (i < j, sorted) of the points; for Fig. 3(b). Same validation as gabriel_graph.
 [[nodiscard]] IndexPairs delaunay_edges(const Points& points, const BodyParams& params = {});
 /// Gabriel graph: Delaunay edges whose closed diametral disc holds no other point. O(n log n).
+/// Rows (i, j) with i < j, sorted. Collinear input gives the chain of consecutive points.
+/// Throws GeometryError for non-finite coordinates, |coordinate| > max_coordinate, and two points
+/// at distance 0 or closer than merge_distance (the message names the indices and the value).
 [[nodiscard]] IndexPairs gabriel_graph(const Points& points, const BodyParams& params = {});
-/// Builds the body from any point set; oscillator vectors may be empty (zeros).
+/// Builds the body from any point set; oscillator vectors may be empty (zeros), else length n and
+/// finite (GeometryError otherwise). Same point validation as gabriel_graph.
 [[nodiscard]] Body build_body(const Points& positions, const Vector& amplitude, const Vector& frequency,
                               const Vector& phase, const BodyParams& params = {});
+/// Builds the body from an embryo's cell centres and oscillator parameters (radii are ignored).
 [[nodiscard]] Body build_body(const Embryo& embryo, const BodyParams& params = {});
+
+/// Signed shoelace area of the closed vertex loop (positive when counter-clockwise); 0 for fewer
+/// than 3 vertices.
+[[nodiscard]] double polygon_area(const Points& positions, const std::vector<int>& loop);
 
 }  // namespace animat

@@ -46,6 +46,7 @@ struct DevelopmentParams {
   double repulsion_stiffness = 5.0;   ///< force per unit overlap of two cells
   double adhesion_stiffness = 2.0;    ///< force per unit gap between two close-by cells
   double adhesion_range = 0.25;       ///< gap beyond which adhesion vanishes (force peaks at half of it)
+  double max_force = 25.0;            ///< cap on the net contact force on one cell (crowded births); 0 = none
   // Morphogens [choose].
   std::vector<double> maternal_sources = {0.0, 5.0, -4.330127018922193, -2.5, 4.330127018922193, -2.5};  ///< x0,y0,x1,y1,x2,y2
   double maternal_decay_length = 5.0;   ///< maternal level at distance d is e^(−d/λm)
@@ -76,6 +77,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"repulsion_stiffness", "repulsive force per unit overlap of two cells [choose]", Bounds::non_negative()}, p.repulsion_stiffness);
   v(FieldInfo{"adhesion_stiffness", "adhesive force per unit gap between two close-by cells [choose]", Bounds::non_negative()}, p.adhesion_stiffness);
   v(FieldInfo{"adhesion_range", "gap between cell surfaces beyond which adhesion vanishes [choose]", Bounds::non_negative()}, p.adhesion_range);
+  v(FieldInfo{"max_force", "cap on the net repulsion+adhesion force on one cell, keeps crowded births far below Box2D's speed cap; 0 = no cap [choose]", Bounds::non_negative()}, p.max_force);
   v(FieldInfo{"maternal_sources", "positions x0,y0,x1,y1,x2,y2 of the three maternal morphogen sources [choose]", Bounds::closed(-1e6, 1e6)}, p.maternal_sources);
   v(FieldInfo{"maternal_decay_length", "maternal level at distance d from its source is exp(-d/length) [choose]", Bounds::positive()}, p.maternal_decay_length);
   v(FieldInfo{"morphogen_speed", "speed v of cell-made morphogens, length units per step: delay = d/v [choose]", Bounds::positive()}, p.morphogen_speed);

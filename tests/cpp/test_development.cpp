@@ -1,0 +1,501 @@
+// Development (issue 3, MODEL.md §3): division, physics while growing, morphogens, viability.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "animat/development.hpp"
+#include "animat/errors.hpp"
+#include "animat/genome.hpp"
+#include "animat/grn.hpp"
+#include "animat/random.hpp"
+
+using namespace animat;
+using Vec2 = DevelopmentWorld::Vec2;
+
+namespace {
+
+Element el(ElementType type, int channel, double x, double y, int sign = +1) {
+  return Element{type, sign, channel, {x, y}};
+}
+Element out(OutputChannel c, double x, double y) { return el(ElementType::output, static_cast<int>(c), x, y); }
+
+/// The bias input drives divide, amplitude, frequency and phase (affinity 10 at distance 0);
+/// rotate and grow sit far away and stay at 0.
+Genome bias_divide_genome() {
+  return Genome{2,
+                {el(ElementType::input, 0, 0, 0), out(OutputChannel::divide, 0, 0), out(OutputChannel::amplitude, 0, 0),
+                 out(OutputChannel::frequency, 0, 0), out(OutputChannel::phase, 0, 0), out(OutputChannel::rotate, 5, 5),
+                 out(OutputChannel::grow, 5, 5)}};
+}
+
+/// The same, but the bias also drives rotate, through a weaker affinity (distance 1): the
+/// daughters turn, so the embryo is a 2-D cluster, not a line.
+Genome bias_divide_rotate_genome() {
+  Genome g = bias_divide_genome();
+  g.elements[5] = out(OutputChannel::rotate, 1.0, 0.0);
+  return g;
+}
+
+/// One regulatory unit whose gene is a morphogen; nothing drives it, tests set its level by hand.
+Genome morphogen_genome() {
+  return Genome{2, {el(ElementType::promoter, 0, 8, 8), el(ElementType::morphogen_gene, 0, 9, 9)}};
+}
+
+/// Steps for a level starting at 0 to reach `threshold` under eq. 1 with a constant activation A.
+int steps_to_reach(double activation, double threshold, double dt = 0.05) {
+  double level = 0.0;
+  const double target = std::tanh(activation / 2.0);
+  for (int s = 1; s < 100000; ++s) {
+    level += (target - level) * dt;
+    if (level >= threshold) return s;
+  }
+  return -1;
+}
+
+DevelopmentParams with_effects(std::vector<std::string> effects) {
+  DevelopmentParams p;
+  p.effects = std::move(effects);
+  return p;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+TEST(Development, BiasDrivenDivisionGrowsToTheCapAndNeverBeyond) {
+  const Genome g = bias_divide_genome();
+  const DevelopmentParams p;  // max_cells 32, refractory 20
+  const Embryo e = develop(g, GenomeParams{}, GrnParams{}, p);
+  ASSERT_EQ(e.cell_count(), 32);
+  EXPECT_EQ(e.division_steps.size(), 31u);
+  EXPECT_TRUE(e.viable) << (e.reasons.empty() ? "" : e.reasons.front());
+  EXPECT_EQ(e.steps_run, 400);
+  // First division: the divide level (activation 10·1) first reaches 0.9; then every cell divides
+  // again right after its refractory period: 1 → 2 → 4 → 8 → 16 → 32.
+  const int first = steps_to_reach(10.0, 0.9);
+  EXPECT_EQ(first, 45);
+  EXPECT_EQ(e.division_steps.front(), first);
+  const int period = p.refractory_steps + 1;
+  std::vector<int> expected;
+  for (int round = 0, cells = 1; cells < 32; ++round, cells *= 2)
+    for (int k = 0; k < cells; ++k) expected.push_back(first + round * period);
+  EXPECT_EQ(e.division_steps, expected);
+
+  // A cap that is not a power of two is respected exactly, step by step.
+  DevelopmentParams p5;
+  p5.max_cells = 5;
+  DevelopmentWorld w(Grn(g, GenomeParams{}), GrnParams{}, p5);
+  w.add_cell(Vec2::Zero(), p5.cell_radius, Vec2(1, 0));
+  int max_seen = 0;
+  for (int s = 0; s < 400; ++s) {
+    w.step();
+    max_seen = std::max(max_seen, w.cell_count());
+    ASSERT_LE(w.cell_count(), 5) << "step " << s;
+  }
+  EXPECT_EQ(max_seen, 5);
+  EXPECT_EQ(w.division_steps().size(), 4u);
+  const Embryo e5 = develop(g, GenomeParams{}, GrnParams{}, p5);
+  EXPECT_EQ(e5.cell_count(), 5);
+  EXPECT_TRUE(e5.viable);
+}
+
+TEST(Development, NoPathToDivideStaysOneCellAndIsNotViable) {
+  Genome g = bias_divide_genome();
+  g.elements[1] = out(OutputChannel::divide, 7, 7);  // out of reach of every product
+  const Embryo e = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  EXPECT_EQ(e.cell_count(), 1);
+  EXPECT_FALSE(e.viable);
+  EXPECT_EQ(e.steps_run, 0);  // verdict certain before any step: nothing simulated
+  EXPECT_TRUE(e.division_steps.empty());
+  ASSERT_FALSE(e.reasons.empty());
+  EXPECT_NE(e.reasons[0].find("grn: no path"), std::string::npos) << e.reasons[0];
+  EXPECT_NE(e.reasons[0].find("divide"), std::string::npos) << e.reasons[0];
+  EXPECT_EQ(e.reasons[0].find("amplitude"), std::string::npos) << e.reasons[0];  // that path exists
+  ASSERT_EQ(e.reasons.size(), 2u);
+  EXPECT_NE(e.reasons[1].find("cells: 1 cell"), std::string::npos) << e.reasons[1];
+  // The single cell is still a well-formed embryo.
+  EXPECT_EQ(e.positions.rows(), 1);
+  EXPECT_DOUBLE_EQ(e.radii[0], DevelopmentParams{}.cell_radius);
+  EXPECT_EQ(e.outputs.rows(), 1);
+}
+
+TEST(Development, NoPathToAnOscillatorOutputIsNotViable) {
+  Genome g = bias_divide_genome();
+  g.elements[4] = out(OutputChannel::phase, 7, 7);
+  const Embryo e = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  EXPECT_FALSE(e.viable);
+  EXPECT_EQ(e.steps_run, 0);
+  ASSERT_EQ(e.reasons.size(), 1u);
+  EXPECT_NE(e.reasons[0].find("phase"), std::string::npos) << e.reasons[0];
+}
+
+TEST(Development, DaughterGeometry) {
+  const Genome g = bias_divide_genome();
+  const Grn grn(g, GenomeParams{});
+  DevelopmentParams p = with_effects({});
+  DevelopmentWorld w(grn, GrnParams{}, p);
+  const double a = 0.3;
+  const Vec2 o(std::cos(a), std::sin(a));
+  const int m = w.add_cell(Vec2(1.0, 2.0), 0.6, o);
+  GrnState& s = w.state(m);
+  s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::rotate))] = 0.25;  // quarter turn
+  s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::grow))] = 1.0;     // full growth
+  s.levels[0] = 0.123;  // any level, inherited as is
+  const GrnState mother_state = w.state(m);
+  const int d = w.divide(m);
+  ASSERT_EQ(d, 1);
+  // Placed along the mother's orientation, division_offset·r_mother away.
+  const Vec2 expected_pos = Vec2(1.0, 2.0) + p.division_offset * 0.6 * o;
+  EXPECT_NEAR(w.position(d).x(), expected_pos.x(), 1e-6);  // Box2D stores float positions
+  EXPECT_NEAR(w.position(d).y(), expected_pos.y(), 1e-6);
+  const Vec2 along = w.position(d) - w.position(m);
+  EXPECT_NEAR(along.normalized().dot(o), 1.0, 1e-6);
+  // Orientation rotated by 2π·0.25 (counter-clockwise); the mother keeps hers.
+  EXPECT_NEAR(w.orientation(d).x(), std::cos(a + std::numbers::pi / 2), 1e-12);
+  EXPECT_NEAR(w.orientation(d).y(), std::sin(a + std::numbers::pi / 2), 1e-12);
+  EXPECT_NEAR(w.orientation(m).x(), o.x(), 1e-15);
+  EXPECT_NEAR(w.orientation(m).y(), o.y(), 1e-15);
+  // Radius r0·(1 + 0.5·1) = 1.5·r0, whatever the mother's radius; the mother keeps hers.
+  EXPECT_DOUBLE_EQ(w.radius(d), 1.5 * p.cell_radius);
+  EXPECT_DOUBLE_EQ(w.radius(m), 0.6);
+  // All levels inherited.
+  EXPECT_EQ(w.state(d).levels, mother_state.levels);
+  // Rotation output 0 keeps the orientation; grow 0 gives r0.
+  DevelopmentWorld w2(grn, GrnParams{}, p);
+  w2.add_cell(Vec2::Zero(), 0.5, Vec2(0, 1));
+  const int d2 = w2.divide(0);
+  EXPECT_NEAR(w2.orientation(d2).x(), 0.0, 1e-15);
+  EXPECT_NEAR(w2.orientation(d2).y(), 1.0, 1e-15);
+  EXPECT_DOUBLE_EQ(w2.radius(d2), p.cell_radius);
+  EXPECT_GT(w2.position(d2).y(), 0.0);
+}
+
+TEST(Development, DivisionRespectsThresholdAndRefractoryPeriod) {
+  const Genome g = bias_divide_genome();
+  const Grn grn(g, GenomeParams{});
+  DevelopmentParams p = with_effects({});
+  p.refractory_steps = 5;
+  DevelopmentWorld w(grn, GrnParams{}, p);
+  w.add_cell(Vec2::Zero(), 0.5, Vec2(1, 0));
+  const auto divide_node = static_cast<std::size_t>(grn.output_node(OutputChannel::divide));
+  w.state(0).levels[divide_node] = 0.899;
+  w.advance_clock();
+  EXPECT_EQ(w.divide_ready(), 0);
+  w.state(0).levels[divide_node] = 0.9;
+  EXPECT_EQ(w.divide_ready(), 1);  // at step 1
+  // Both cells stay above threshold: blocked for 5 steps, then both divide at step 7.
+  for (int s = 2; s <= 6; ++s) {
+    w.advance_clock();
+    EXPECT_EQ(w.divide_ready(), 0) << "step " << s;
+  }
+  w.advance_clock();
+  EXPECT_EQ(w.divide_ready(), 2);
+  EXPECT_EQ(w.division_steps(), (std::vector<int>{1, 7, 7}));
+}
+
+TEST(Development, OverlappingPairSeparatesGraduallyAndMonotonically) {
+  DevelopmentParams p = with_effects({"repulsion", "adhesion"});
+  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, p);
+  w.add_cell(Vec2(0, 0), 0.5, Vec2(1, 0));
+  w.add_cell(Vec2(0.1, 0), 0.5, Vec2(1, 0));  // a fresh division: 90% overlap
+  std::vector<double> d{(w.position(1) - w.position(0)).norm()};
+  for (int s = 0; s < 80; ++s) {
+    w.step_physics();
+    d.push_back((w.position(1) - w.position(0)).norm());
+  }
+  double max_jump = 0.0;
+  for (std::size_t s = 1; s < d.size(); ++s) {
+    EXPECT_GE(d[s], d[s - 1]) << "step " << s;  // monotone
+    max_jump = std::max(max_jump, d[s] - d[s - 1]);
+  }
+  EXPECT_LT(max_jump, 0.1);       // no jump: at most a tenth of the contact distance per step
+  EXPECT_LT(d[10], 0.85);         // gradual: still clearly overlapping after 10 steps
+  EXPECT_GT(d[30], 0.95);         // about 30 steps to separate (paper Fig. 2)
+  EXPECT_LE(d.back(), 1.0 + 1e-5);  // overdamped: settles at contact, no overshoot
+  EXPECT_GT(d.back(), 1.0 - 1e-3);
+  // The centre of mass does not move (equal and opposite forces, equal masses).
+  EXPECT_NEAR((w.position(0) + w.position(1)).x() / 2, 0.05, 1e-5);
+  EXPECT_NEAR((w.position(0) + w.position(1)).y(), 0.0, 1e-7);
+}
+
+TEST(Development, DisabledRepulsionCostsNothingAndDoesNothing) {
+  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({}));
+  w.add_cell(Vec2(0, 0), 0.5, Vec2(1, 0));
+  w.add_cell(Vec2(0.1, 0), 0.5, Vec2(1, 0));
+  for (int s = 0; s < 20; ++s) w.step_physics();
+  EXPECT_NEAR(w.position(1).x() - w.position(0).x(), 0.1, 1e-7);
+}
+
+TEST(Development, AdhesionHoldsATouchingPairAgainstASmallPull) {
+  const DevelopmentParams p;
+  const double pull = 0.1;  // below the peak adhesion force adhesion_stiffness·adhesion_range/2 = 0.25
+  ASSERT_LT(pull, p.adhesion_stiffness * p.adhesion_range / 2);
+  auto run = [&](std::vector<std::string> effects) {
+    DevelopmentParams q = p;
+    q.effects = std::move(effects);
+    DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, q);
+    w.add_cell(Vec2(0, 0), 0.5, Vec2(1, 0));
+    w.add_cell(Vec2(1.0, 0), 0.5, Vec2(1, 0));  // touching
+    const std::vector<Vec2> forces{Vec2(-pull, 0), Vec2(pull, 0)};
+    double max_gap = 0.0;
+    for (int s = 0; s < 300; ++s) {
+      w.step_physics(forces);
+      max_gap = std::max(max_gap, (w.position(1) - w.position(0)).norm() - 1.0);
+    }
+    return std::pair{(w.position(1) - w.position(0)).norm() - 1.0, max_gap};
+  };
+  const auto [gap, max_gap] = run({"repulsion", "adhesion"});
+  EXPECT_NEAR(gap, pull / p.adhesion_stiffness, 1e-4);  // equilibrium of the adhesive spring: 0.05
+  EXPECT_LT(max_gap, p.adhesion_range / 2);
+  const auto [free_gap, unused] = run({"repulsion"});
+  (void)unused;
+  EXPECT_GT(free_gap, 2 * p.adhesion_range);  // without adhesion the same pull drags them apart (0.6 after 300 steps)
+}
+
+TEST(Development, MaternalMorphogensFallWithDistanceFromFixedSources) {
+  const DevelopmentParams p;
+  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, p);
+  const Vec2 s0(p.maternal_sources[0], p.maternal_sources[1]);
+  EXPECT_DOUBLE_EQ(w.maternal_at(s0)[0], 1.0);
+  double previous = 2.0;
+  for (double d : {0.0, 1.0, 2.0, 4.0, 8.0}) {
+    const double level = w.maternal_at(s0 + Vec2(0, d))[0];  // moving away from the origin side
+    EXPECT_NEAR(level, std::exp(-d / p.maternal_decay_length), 1e-12);
+    EXPECT_LT(level, previous);
+    previous = level;
+  }
+  // At the origin the three sources are equidistant (radius 5).
+  const auto at0 = w.maternal_at(Vec2::Zero());
+  for (double m : at0) EXPECT_NEAR(m, std::exp(-5.0 / p.maternal_decay_length), 1e-9);
+  // sense() fills them per cell; they are 0 when the morphogens effect is off.
+  w.add_cell(Vec2(1, 1), 0.5, Vec2(1, 0));
+  w.sense();
+  EXPECT_EQ(w.sensed_maternal(0), w.maternal_at(Vec2(1, 1)));
+  DevelopmentWorld off(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"repulsion"}));
+  off.add_cell(Vec2(1, 1), 0.5, Vec2(1, 0));
+  off.sense();
+  EXPECT_EQ(off.sensed_maternal(0), (std::array<double, 3>{0, 0, 0}));
+}
+
+TEST(Development, CellMorphogenFallsWithDistanceAndLagsByDistanceOverSpeed) {
+  const DevelopmentParams p = with_effects({"morphogens"});  // no forces: cells stay put
+  ASSERT_DOUBLE_EQ(p.morphogen_speed, 0.25);
+  ASSERT_DOUBLE_EQ(p.morphogen_decay_length, 2.0);
+  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, p);
+  ASSERT_EQ(w.grn().morphogen_units().size(), 1u);
+  const int src = w.add_cell(Vec2(0, 0), 0.5, Vec2(1, 0));
+  const int near = w.add_cell(Vec2(2.0, 0), 0.5, Vec2(1, 0));   // delay 2/0.25 = 8 steps
+  const int far = w.add_cell(Vec2(0, -4.0), 0.5, Vec2(1, 0));   // delay 16 steps
+  const int mid = w.add_cell(Vec2(-2.1, 0), 0.5, Vec2(1, 0));   // delay 8.4 steps: interpolated
+  const double L = 0.8;
+  const int switch_on = 10;
+  for (int t = 1; t <= 40; ++t) {
+    if (t == switch_on) w.state(src).levels[0] = L;  // the source switches on at time 10
+    w.record_history();
+    const double dn = 2.0, df = 4.0, dm = 2.1;
+    // Distances between the receivers are > 4, and they emit 0: only the source contributes.
+    const double exp_near = t >= switch_on + 8 ? L * std::exp(-dn / 2.0) : 0.0;
+    const double exp_far = t >= switch_on + 16 ? L * std::exp(-df / 2.0) : 0.0;
+    // Delay 8.4: sample at t − 8.4, linear between t − 8 and t − 9.
+    const double on_newer = (t - 8 >= switch_on) ? L : 0.0, on_older = (t - 9 >= switch_on) ? L : 0.0;
+    const double exp_mid = std::exp(-dm / 2.0) * (0.6 * on_newer + 0.4 * on_older);
+    EXPECT_NEAR(w.sensed_morphogen(near, 0), exp_near, 1e-6) << "t=" << t;
+    EXPECT_NEAR(w.sensed_morphogen(far, 0), exp_far, 1e-6) << "t=" << t;
+    EXPECT_NEAR(w.sensed_morphogen(mid, 0), exp_mid, 1e-6) << "t=" << t;
+    EXPECT_DOUBLE_EQ(w.sensed_morphogen(src, 0), t >= switch_on ? L : 0.0);  // own level, no delay
+    // sense() computes the same numbers for all cells at once.
+    w.sense();
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(w.sensed_morphogens(c)[0], w.sensed_morphogen(c, 0), 1e-12);
+  }
+  // After the delay the level falls with distance.
+  EXPECT_GT(w.sensed_morphogen(near, 0), w.sensed_morphogen(mid, 0));
+  EXPECT_GT(w.sensed_morphogen(mid, 0), w.sensed_morphogen(far, 0));
+  EXPECT_GT(w.sensed_morphogen(far, 0), 0.0);
+}
+
+TEST(Development, SensedMorphogenIsCappedAtOne) {
+  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"morphogens"}));
+  GrnState s = w.grn().initial_state();
+  s.levels[0] = 0.9;
+  for (int i = 0; i < 6; ++i) w.add_cell(Vec2(0.01 * i, 0), 0.5, Vec2(1, 0), &s);
+  EXPECT_DOUBLE_EQ(w.sensed_morphogen(0, 0), 1.0);
+  // A lone cell senses exactly its own level.
+  DevelopmentWorld lone(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"morphogens"}));
+  lone.add_cell(Vec2::Zero(), 0.5, Vec2(1, 0), &s);
+  EXPECT_DOUBLE_EQ(lone.sensed_morphogen(0, 0), 0.9);
+}
+
+TEST(Development, LateDivisionMakesTheEmbryoNonViable) {
+  // With the bias genome the first division comes at step 45 and the next one, for both cells,
+  // refractory_steps + 1 later. Put that second division exactly on the boundary step 300
+  // (= 400 − quiet_steps, allowed) or one step after it (not allowed). min_cells = 2, so that the
+  // 2-cell embryo before that division already meets criterion 2 and only criterion 3 decides.
+  const Genome g = bias_divide_genome();
+  const int first = steps_to_reach(10.0, 0.9);
+  DevelopmentParams ok;
+  ok.min_cells = 2;
+  ok.refractory_steps = 300 - first - 1;
+  const Embryo good = develop(g, GenomeParams{}, GrnParams{}, ok);
+  EXPECT_EQ(good.division_steps, (std::vector<int>{first, 300, 300}));
+  EXPECT_TRUE(good.viable);
+  EXPECT_EQ(good.cell_count(), 4);
+  EXPECT_EQ(good.steps_run, 400);
+
+  DevelopmentParams late = ok;
+  late.refractory_steps = 300 - first;
+  const Embryo bad = develop(g, GenomeParams{}, GrnParams{}, late);
+  EXPECT_FALSE(bad.viable);
+  EXPECT_EQ(bad.division_steps, (std::vector<int>{first, 301, 301}));
+  EXPECT_EQ(bad.steps_run, 301);  // stopped as soon as the verdict was certain
+  ASSERT_EQ(bad.reasons.size(), 1u);
+  EXPECT_NE(bad.reasons[0].find("late division"), std::string::npos) << bad.reasons[0];
+  EXPECT_NE(bad.reasons[0].find("301"), std::string::npos) << bad.reasons[0];
+}
+
+TEST(Development, TooFewCellsStopsWhenNoDivisionCanComeInTime) {
+  const Genome g = bias_divide_genome();
+  DevelopmentParams p;
+  p.refractory_steps = 1000;  // one division only: 2 cells < 3
+  const Embryo e = develop(g, GenomeParams{}, GrnParams{}, p);
+  EXPECT_FALSE(e.viable);
+  EXPECT_EQ(e.cell_count(), 2);
+  EXPECT_EQ(e.steps_run, 300);
+  ASSERT_EQ(e.reasons.size(), 1u);
+  EXPECT_NE(e.reasons[0].find("cells: 2"), std::string::npos) << e.reasons[0];
+}
+
+TEST(Development, OscillatorParametersAndTrace) {
+  const Genome g = bias_divide_rotate_genome();
+  DevelopmentParams p;
+  p.trace_every = 50;
+  const Embryo e = develop(g, GenomeParams{}, GrnParams{}, p);
+  ASSERT_TRUE(e.viable);
+  const int n = e.cell_count();
+  ASSERT_EQ(n, 32);
+  ASSERT_EQ(e.outputs.rows(), n);
+  for (int i = 0; i < n; ++i) {
+    const double a = e.outputs(i, 3), f = e.outputs(i, 4), ph = e.outputs(i, 5);
+    EXPECT_DOUBLE_EQ(e.amplitude[i], p.amplitude_max * a);
+    EXPECT_DOUBLE_EQ(e.frequency[i], p.frequency_min + (p.frequency_max - p.frequency_min) * f);
+    EXPECT_DOUBLE_EQ(e.phase[i], 2 * std::numbers::pi * ph);
+    EXPECT_GT(a, 0.99);  // driven by the bias at affinity 10
+    EXPECT_NEAR(e.orientations.row(i).norm(), 1.0, 1e-12);
+  }
+  EXPECT_EQ(e.trace.steps, (std::vector<int>{0, 50, 100, 150, 200, 250, 300, 350, 400}));
+  ASSERT_EQ(e.trace.positions.size(), 9u);
+  EXPECT_EQ(e.trace.positions.front().rows(), 1);
+  EXPECT_EQ(e.trace.positions[1].rows(), 2);  // one division at step 45
+  EXPECT_EQ(e.trace.positions.back(), e.positions);
+  EXPECT_EQ(e.trace.radii.back(), e.radii);
+  EXPECT_EQ(e.trace.orientations.back(), e.orientations);
+  // Rotated daughters make a 2-D cluster: no overlap left at the end (repulsion), compact (adhesion).
+  double min_gap = 1e9, extent = 0.0;
+  for (int i = 0; i < n; ++i) {
+    extent = std::max(extent, e.positions.row(i).norm());
+    for (int j = i + 1; j < n; ++j)
+      min_gap = std::min(min_gap, (e.positions.row(i) - e.positions.row(j)).norm() - e.radii[i] - e.radii[j]);
+  }
+  EXPECT_GT(min_gap, -0.15);  // soft cells: adhesion compresses the cluster a little
+  EXPECT_LT(extent, 6.0);
+  // Tracing off records nothing.
+  EXPECT_TRUE(develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{}).trace.empty());
+}
+
+TEST(Development, DeterministicBitIdentical) {
+  // A grown random genome, developed twice with every effect on.
+  for (std::uint64_t seed : {3u, 11u, 42u}) {
+    Rng rng = Rng::derive(seed, 7);
+    const Genome g = random_genome(GenomeParams{}, rng);
+    const Embryo a = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+    const Embryo b = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+    ASSERT_EQ(a.cell_count(), b.cell_count());
+    EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), sizeof(double) * static_cast<std::size_t>(a.positions.size())));
+    EXPECT_EQ(0, std::memcmp(a.outputs.data(), b.outputs.data(), sizeof(double) * static_cast<std::size_t>(a.outputs.size())));
+    EXPECT_EQ(a.division_steps, b.division_steps);
+    EXPECT_EQ(a.reasons, b.reasons);
+  }
+  const Genome g = bias_divide_rotate_genome();
+  const Embryo a = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  const Embryo b = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  ASSERT_EQ(a.cell_count(), 32);
+  EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), sizeof(double) * static_cast<std::size_t>(a.positions.size())));
+}
+
+TEST(Development, InvalidParamsAreRejected) {
+  DevelopmentParams p;
+  p.maternal_sources = {0, 1, 2};
+  EXPECT_THROW(validate(p), ConfigError);
+  p = DevelopmentParams{};
+  p.effects = {"repulsion", "gravity"};
+  EXPECT_THROW(validate(p), ConfigError);
+  EXPECT_THROW((void)develop(bias_divide_genome(), GenomeParams{}, GrnParams{}, p), ConfigError);
+  EXPECT_NO_THROW(validate(DevelopmentParams{}));
+}
+
+TEST(Development, RandomGenomesDevelopFiniteAndBounded) {
+  const int count = 2000;
+  const DevelopmentParams p;
+  const double sane_radius = 2.0 * p.max_cells * p.cell_radius * (1.0 + p.max_growth);  // a straight chain: 48
+  int viable = 0, simulated = 0, grown = 0;
+  long long total_cells = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < count; ++i) {
+    Rng rng = Rng::derive(20120707, i);
+    const Genome g = random_genome(GenomeParams{}, rng);
+    Embryo e;
+    ASSERT_NO_THROW(e = develop(g, GenomeParams{}, GrnParams{}, p)) << "genome " << i;
+    ASSERT_GE(e.cell_count(), 1);
+    ASSERT_LE(e.cell_count(), p.max_cells);
+    ASSERT_EQ(static_cast<int>(e.division_steps.size()), e.cell_count() - 1);
+    for (int c = 0; c < e.cell_count(); ++c) {
+      ASSERT_TRUE(e.positions.row(c).allFinite()) << "genome " << i;
+      ASSERT_LT(e.positions.row(c).norm(), sane_radius) << "genome " << i;
+      ASSERT_TRUE(e.outputs.row(c).allFinite());
+      ASSERT_GE(e.amplitude[c], 0.0);
+      ASSERT_LE(e.amplitude[c], p.amplitude_max);
+      ASSERT_GE(e.phase[c], 0.0);
+      ASSERT_LE(e.phase[c], 2 * std::numbers::pi);
+    }
+    ASSERT_EQ(e.viable, e.reasons.empty());
+    viable += e.viable ? 1 : 0;
+    simulated += e.steps_run > 0 ? 1 : 0;
+    grown += e.cell_count() > 1 ? 1 : 0;
+    total_cells += e.cell_count();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("[ development ] %d random genomes in %.2f s: viable %d (%.2f%%), simulated %d, grew %d, mean cells %.2f\n",
+              count, seconds, viable, 100.0 * viable / count, simulated, grown, static_cast<double>(total_cells) / count);
+  EXPECT_GT(viable, 0);  // the paper needed "a few hundred tries" per viable random genome
+}
+
+TEST(Development, DenseDivisionStressStaysFarBelowTheSpeedCap) {
+  // Every cell divides every step (refractory 0) with turning daughters, up to 64 cells: daughters
+  // are born inside a crowded cluster. No SimulationError (speed cap), finite, compact.
+  const Genome g = bias_divide_rotate_genome();
+  for (int cap : {64, 256}) {  // 1,024 also passes (~1 s in Release), too slow under sanitizers
+    DevelopmentParams p;
+    p.max_cells = cap;
+    p.refractory_steps = 0;
+    DevelopmentWorld w(Grn(g, GenomeParams{}), GrnParams{}, p);
+    w.add_cell(Vec2::Zero(), p.cell_radius, Vec2(1, 0));
+    double max_step = 0.0;
+    for (int s = 0; s < p.steps; ++s) {
+      std::vector<Vec2> before;
+      for (int i = 0; i < w.cell_count(); ++i) before.push_back(w.position(i));
+      ASSERT_NO_THROW(w.step()) << "cap " << cap << " step " << s;
+      for (int i = 0; i < static_cast<int>(before.size()); ++i)
+        max_step = std::max(max_step, (w.position(i) - before[static_cast<std::size_t>(i)]).norm());
+    }
+    EXPECT_EQ(w.cell_count(), cap);
+    const Points pos = w.positions();
+    EXPECT_TRUE(pos.allFinite());
+    EXPECT_LT(pos.rowwise().norm().maxCoeff(), std::sqrt(cap) * 1.5);
+    std::printf("[ development ] %d cells, every cell dividing every step: largest displacement %.3f per step (Box2D cap 2)\n",
+                cap, max_step);
+    // Terminal displacement under the force cap: time_step·max_force/(cell_mass·damping) = 0.25.
+    EXPECT_LT(max_step, 0.26);
+  }
+}
