@@ -17,6 +17,7 @@
 #include <numbers>
 
 #include "animat/errors.hpp"
+#include "animat/random.hpp"
 #include "animat/scene.hpp"  // has_effect
 
 namespace animat {
@@ -62,6 +63,7 @@ struct DevelopmentWorld::Impl {
     Vec2 position{0.0, 0.0};  ///< cached from Box2D after every physics step (float → double)
     long long last_division = kNever;
   };
+  std::uint64_t symmetry_seed = 0;
 
   Grn grn;
   GrnParams grn_params;
@@ -169,6 +171,8 @@ DevelopmentWorld::~DevelopmentWorld() = default;
 DevelopmentWorld::DevelopmentWorld(DevelopmentWorld&&) noexcept = default;
 DevelopmentWorld& DevelopmentWorld::operator=(DevelopmentWorld&&) noexcept = default;
 
+void DevelopmentWorld::set_symmetry_seed(std::uint64_t seed) { impl_->symmetry_seed = seed; }
+
 int DevelopmentWorld::add_cell(const Vec2& position, double radius, const Vec2& orientation, const GrnState* state) {
   Impl& w = *impl_;
   if (!position.allFinite() || !(radius > 0.0) || !orientation.allFinite() || orientation.norm() == 0.0)
@@ -270,7 +274,16 @@ int DevelopmentWorld::divide(int cell) {
   Vec2 orientation(c * mother.orientation.x() - s * mother.orientation.y(),
                    s * mother.orientation.x() + c * mother.orientation.y());
   orientation.normalize();
-  const Vec2 position = mother.position + w.params.division_offset * mother.radius * mother.orientation;
+  // A tiny deterministic deviation of the placement direction: without it, a genome that never
+  // expresses `rotate` grows an exactly straight line that no force can ever bend.
+  Vec2 direction = mother.orientation;
+  if (w.params.placement_jitter > 0.0) {
+    Rng rng = Rng::derive(w.symmetry_seed, static_cast<std::uint64_t>(step_), static_cast<std::uint64_t>(cell));
+    const double delta = w.params.placement_jitter * rng.uniform(-1.0, 1.0);
+    const double cj = std::cos(delta), sj = std::sin(delta);
+    direction = Vec2(cj * direction.x() - sj * direction.y(), sj * direction.x() + cj * direction.y());
+  }
+  const Vec2 position = mother.position + w.params.division_offset * mother.radius * direction;
   const double radius = w.params.cell_radius * (1.0 + w.params.max_growth * grow);
   const b2Vec2 v = mother.body->GetLinearVelocity();
   GrnState state = w.states[mi];  // inherits every level
@@ -464,6 +477,7 @@ Embryo develop(const Genome& genome, const GenomeParams& genome_params, const Gr
   const bool paths = grn.has_required_paths();
   const bool divide_reachable = grn.reaches(OutputChannel::divide);
   DevelopmentWorld world(std::move(grn), grn_params, params);
+  world.set_symmetry_seed(genome_hash(genome));
   world.add_cell(DevelopmentWorld::Vec2::Zero(), params.cell_radius, DevelopmentWorld::Vec2(1.0, 0.0));
 
   Embryo e;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -43,6 +44,25 @@ GenomeLayout parse_units(const Genome& genome) {
     if (!unit.genes.empty()) layout.units.push_back(std::move(unit));  // else: stray promoters
   }
   return layout;
+}
+
+std::uint64_t genome_hash(const Genome& g) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto feed = [&h](std::uint64_t x) {
+    for (int b = 0; b < 8; ++b) {
+      h ^= (x >> (8 * b)) & 0xffU;
+      h *= 0x100000001b3ULL;
+    }
+  };
+  feed(static_cast<std::uint64_t>(g.dimensions));
+  feed(g.elements.size());
+  for (const Element& e : g.elements) {
+    feed(static_cast<std::uint64_t>(e.type));
+    feed(static_cast<std::uint64_t>(static_cast<std::int64_t>(e.sign)));
+    feed(static_cast<std::uint64_t>(e.channel));
+    for (double x : e.coords) feed(std::bit_cast<std::uint64_t>(x));
+  }
+  return h;
 }
 
 std::string_view element_type_name(ElementType t) { return kElementTypeNames.at(static_cast<std::size_t>(t)); }

@@ -35,6 +35,7 @@ struct DevelopmentParams {
   int quiet_steps = 100;          ///< viability: last division at least this many steps before the end [paper: 100]
   double cell_radius = 0.5;       ///< radius r0 of the first cell [choose]
   double max_growth = 0.5;        ///< a daughter's radius is r0·(1 + max_growth·grow) [paper: up to +50%]
+  double placement_jitter = 0.05; ///< daughter placement direction deviates by up to ± this angle (rad), seeded from the genome [choose]
   double division_offset = 0.2;   ///< daughter centre = mother centre + division_offset·r_mother·orientation [choose]
   double frequency_min = 0.5;     ///< oscillator frequency at output 0, rad per unit time [choose]
   double frequency_max = 12.0;    ///< oscillator frequency at output 1 [choose]
@@ -67,6 +68,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"quiet_steps", "viability: last division at least this many steps before the end [paper: 100]", Bounds::closed(0, 100000)}, p.quiet_steps);
   v(FieldInfo{"cell_radius", "radius r0 of a cell that does not grow [choose]", Bounds::positive()}, p.cell_radius);
   v(FieldInfo{"max_growth", "daughter radius is r0*(1 + max_growth*grow) [paper: 0.5]", Bounds::closed(0, 10)}, p.max_growth);
+  v(FieldInfo{"placement_jitter", "daughter placement direction deviates by up to +-this angle (rad), seeded from the genome hash; breaks exact symmetry [choose]", Bounds::closed(0, 3.2)}, p.placement_jitter);
   v(FieldInfo{"division_offset", "daughter placed at division_offset*r_mother from the mother along its orientation [choose]", Bounds::closed(0, 10)}, p.division_offset);
   v(FieldInfo{"frequency_min", "oscillator frequency (rad per time unit) at frequency output 0 [choose]", Bounds::non_negative()}, p.frequency_min);
   v(FieldInfo{"frequency_max", "oscillator frequency (rad per time unit) at frequency output 1 [choose]", Bounds::non_negative()}, p.frequency_max);
@@ -147,6 +149,8 @@ class DevelopmentWorld {
 
   /// One full development step (see the file comment). Returns the number of divisions in it.
   int step();
+  /// Seeds the placement jitter (develop() uses genome_hash), so results depend only on genome + params.
+  void set_symmetry_seed(std::uint64_t seed);
 
   // --- The pieces of a step, in order -------------------------------------------------------
   /// Computes what every cell senses (maternal levels and cell-made morphogens) now.

@@ -158,6 +158,9 @@ inline constexpr int kGenomeFormatVersion = 1;
 [[nodiscard]] Genome load_genome(const std::filesystem::path& path, const GenomeParams& params = {});
 void save_genome(const Genome& genome, const std::filesystem::path& path);
 
+/// Stable 64-bit content hash (FNV-1a over every field's bits): equal genomes, equal hashes.
+[[nodiscard]] std::uint64_t genome_hash(const Genome& genome);
+
 [[nodiscard]] std::string_view element_type_name(ElementType t);
 [[nodiscard]] std::string_view channel_name(const Element& e);
 

@@ -136,6 +136,7 @@ TEST(Development, DaughterGeometry) {
   const Genome g = bias_divide_genome();
   const Grn grn(g, GenomeParams{});
   DevelopmentParams p = with_effects({});
+  p.placement_jitter = 0.0;  // exact placement; the jitter has its own test below
   DevelopmentWorld w(grn, GrnParams{}, p);
   const double a = 0.3;
   const Vec2 o(std::cos(a), std::sin(a));
@@ -171,6 +172,39 @@ TEST(Development, DaughterGeometry) {
   EXPECT_NEAR(w2.orientation(d2).y(), 1.0, 1e-15);
   EXPECT_DOUBLE_EQ(w2.radius(d2), p.cell_radius);
   EXPECT_GT(w2.position(d2).y(), 0.0);
+}
+
+TEST(Development, PlacementJitterIsBoundedSeededAndBreaksStraightLines) {
+  const Genome g = bias_divide_genome();  // never expresses rotate: every daughter points along +x
+  const Grn grn(g, GenomeParams{});
+  DevelopmentParams p = with_effects({});
+  p.placement_jitter = 0.05;
+  std::vector<double> deviations;
+  for (std::uint64_t seed : {1ULL, 2ULL, 3ULL, 4ULL, 5ULL, 6ULL, 7ULL, 8ULL}) {
+    DevelopmentWorld w(grn, GrnParams{}, p);
+    w.set_symmetry_seed(seed);
+    const int m = w.add_cell(Vec2(0.0, 0.0), 0.5, Vec2(1.0, 0.0));
+    const int d = w.divide(m);
+    const Vec2 along = w.position(d) - w.position(m);
+    const double angle = std::atan2(along.y(), along.x());
+    EXPECT_LE(std::abs(angle), p.placement_jitter + 1e-6);
+    EXPECT_NEAR(w.orientation(d).x(), 1.0, 1e-12);  // the orientation itself is inherited exactly
+    deviations.push_back(angle);
+  }
+  std::sort(deviations.begin(), deviations.end());
+  EXPECT_GT(deviations.back() - deviations.front(), 0.01);  // different seeds, different placements
+
+  // Through develop(): the embryo of a rotate-less genome is no longer an exact straight line,
+  // and the jitter is a function of the genome only (same genome, same embryo).
+  const Embryo e1 = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  const Embryo e2 = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  ASSERT_EQ(e1.cell_count(), DevelopmentParams{}.max_cells);
+  EXPECT_GT(e1.positions.col(1).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_TRUE(e1.positions == e2.positions);
+  DevelopmentParams straight;
+  straight.placement_jitter = 0.0;
+  const Embryo line = develop(g, GenomeParams{}, GrnParams{}, straight);
+  EXPECT_EQ(line.positions.col(1).cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(Development, DivisionRespectsThresholdAndRefractoryPeriod) {
