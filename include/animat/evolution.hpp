@@ -1,7 +1,15 @@
 #pragma once
 // The genetic algorithm of paper §5 and its parameters.
+#include <atomic>
 #include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include "animat/genome.hpp"
 #include "animat/params.hpp"
 
 namespace animat {
@@ -48,5 +56,128 @@ void visit_fields(EvolutionParams& p, V&& v) {
   v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000)}, p.checkpoint_every);
   v(FieldInfo{"max_init_tries", "tries to find one viable random individual before giving up", Bounds::closed(1, 1000000000)}, p.max_init_tries);
 }
+
+struct Config;
+
+/// What the GA needs to know about one evaluated genome.
+struct Fitness {
+  double fitness = 0.0;
+  bool viable = false;  ///< non-viable individuals take no part in creating the next generation
+  bool stable = true;   ///< false if the swim was flagged unstable (its fitness is 0)
+  int cell_count = 0;
+  friend bool operator==(const Fitness&, const Fitness&) = default;
+};
+
+/// Deterministic, thread-safe fitness of a genome. The real one develops and swims (swim_fitness);
+/// tests plug in cheap stubs.
+using FitnessFunction = std::function<Fitness(const Genome&)>;
+
+/// genome → development → body → swim, per `config` (see evaluate.hpp).
+[[nodiscard]] FitnessFunction swim_fitness(const Config& config);
+
+struct Individual {
+  Genome genome;
+  Fitness result;
+  int tries = 0;  ///< random genomes drawn to find this one (initial population only)
+};
+
+/// One row of history.csv.
+struct GenerationStats {
+  int generation = 0;
+  double best = 0.0;     ///< best fitness in the population (all-time best, thanks to elitism)
+  double mean = 0.0;     ///< over viable individuals
+  double median = 0.0;   ///< over viable individuals
+  double viable_fraction = 0.0;
+  int best_cells = 0;
+  std::int64_t evaluations = 0;  ///< cumulative fitness evaluations (swims and non-viable developments)
+  double wall_seconds = 0.0;     ///< cumulative wall time of the run (the only machine-dependent column)
+  double evaluations_per_second = 0.0;
+  bool best_changed = false;     ///< the best genome differs from the previous generation's
+  int crossovers = 0;            ///< offspring made by crossover in this generation
+};
+
+/// Probability that the fitter of two wins a tournament at generation g (linear ramp, paper §5).
+[[nodiscard]] double tournament_probability(const EvolutionParams& p, int generation);
+
+/// Index of the tournament winner among two distinct random eligible individuals.
+[[nodiscard]] std::size_t tournament(const std::vector<Individual>& population, const std::vector<std::size_t>& eligible,
+                                     double p_fitter, Rng& rng);
+
+/// Calls once, before any parallel region: Box2D's lazily-initialised globals (MODEL.md Traps).
+void prepare_parallel_evaluation();
+
+/// Evaluates genomes in parallel (OpenMP, dynamic schedule); results in input order, independent of
+/// the thread count. threads = 0 means all cores.
+[[nodiscard]] std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness,
+                                               int threads);
+
+/// The genetic algorithm (paper §5). Every random number of generation g, offspring i derives from
+/// Rng::derive(seed, g, i), so a run is bit-identical for any thread count and across resumes.
+class Evolution {
+ public:
+  Evolution(const Config& config, FitnessFunction fitness);
+
+  /// Draws the initial population: random genomes regenerated until viable.
+  void initialize();
+  /// Makes and evaluates the next generation; returns its statistics.
+  GenerationStats step();
+  /// Why the run should stop now ("" = keep going): stall, generation cap or wall-clock budget.
+  [[nodiscard]] std::string stop_reason() const;
+
+  [[nodiscard]] int generation() const { return generation_; }
+  [[nodiscard]] const std::vector<Individual>& population() const { return population_; }
+  [[nodiscard]] const Individual& best() const;
+  [[nodiscard]] const std::vector<GenerationStats>& history() const { return history_; }
+  [[nodiscard]] int generations_without_improvement() const { return stall_; }
+  [[nodiscard]] std::int64_t evaluations() const { return evaluations_; }
+  /// Tries per initial individual (paper: "a few hundred").
+  [[nodiscard]] std::vector<int> initial_tries() const;
+
+  /// Whole state as JSON text with a checksum; restore() refuses a corrupt or mismatched one.
+  [[nodiscard]] std::string checkpoint() const;
+  void restore(std::string_view checkpoint_text, std::string_view source = "checkpoint");
+
+  /// Seconds of wall time consumed before this process (restored from a checkpoint).
+  void set_wall_offset(double seconds) { wall_offset_ = seconds; }
+
+ private:
+  GenerationStats statistics(bool best_changed, double wall_seconds) const;
+
+  std::shared_ptr<const Config> config_;  ///< own copy: the engine outlives no caller state
+  std::uint64_t identity_;
+  FitnessFunction fitness_;
+  std::vector<Individual> population_;
+  std::vector<GenerationStats> history_;
+  int generation_ = -1;  ///< -1 before initialize()
+  int stall_ = 0;
+  double best_ever_ = -1.0;
+  std::int64_t evaluations_ = 0;
+  double wall_offset_ = 0.0;
+  double started_ = 0.0;
+};
+
+/// Hash of what defines a run: the config minus its stopping and resource knobs (generations,
+/// stall_generations, wall_seconds, threads, checkpoint_every), so a resumed run may extend its cap.
+[[nodiscard]] std::uint64_t run_identity(const Config& config);
+
+/// Options of a run on disk (animat_evolve and animat.evolve).
+struct RunOptions {
+  std::filesystem::path out;           ///< run directory ("" = write nothing)
+  bool resume = false;                 ///< continue the run in `out`
+  bool quiet = false;
+  double progress_interval = 1.0;      ///< seconds between progress lines
+  const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
+  /// Called after every generation; return false to stop (checkpointed).
+  std::function<bool(const GenerationStats&, const Evolution&)> callback;
+};
+
+struct RunSummary {
+  std::vector<GenerationStats> history;
+  Individual best;
+  std::string stop_reason;
+};
+
+/// Runs (or resumes) an evolution, writing config.toml, history.csv, best/ lineage and checkpoints.
+RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {});
 
 }  // namespace animat

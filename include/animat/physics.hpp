@@ -1,31 +1,122 @@
 #pragma once
 // Swimming physics (paper §4): a Box2D world with one fixture-less body per cell, plus our own force
-// effects (springs, actuation, pressure, drag, skin collision) applied before every Step.
+// effects (springs, actuation, pressure, drag, skin collision; see scene.hpp) applied before every
+// Step. Units and every coefficient choice: docs/notes/physics.md.
+#include <Eigen/Core>
+#include <memory>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "animat/params.hpp"
+#include "animat/scene.hpp"
+#include "animat/types.hpp"
+
+class b2World;
+class b2Body;
 
 namespace animat {
 
+struct Body;
+
 inline constexpr std::string_view kDragSchemeNames[] = {"explicit", "stable"};
 
-/// The accuracy knobs: what trades accuracy for speed.
+/// The accuracy knobs: what trades accuracy for speed (docs/accuracy.md measures them).
 struct PhysicsParams {
   double dt = 1.0 / 60.0;          ///< control step, simulated time units [choose]
   int substeps = 1;                ///< Box2D steps per control step (forces recomputed each) [choose]
   int velocity_iterations = 1;     ///< Box2D solver iterations (no joints or contacts: 1 suffices)
   int position_iterations = 1;
   std::string drag_scheme = "stable";  ///< "explicit" or "stable" (never reverses a velocity in a step)
+  /// A Box2D step that would move a cell farther than this is reported as unstable (SimulationError)
+  /// before Box2D's own cap of b2_maxTranslation = 2 silently clamps it [choose].
+  double max_step_displacement = 1.0;
 };
 
 template <class V>
 void visit_fields(PhysicsParams& p, V&& v) {
   v(FieldInfo{"dt", "control time step in simulated time units [choose]", Bounds{0.0, 1.0, true, false}}, p.dt);
   v(FieldInfo{"substeps", "Box2D steps per control step, forces recomputed each [choose]", Bounds::closed(1, 1000)}, p.substeps);
-  v(FieldInfo{"velocity_iterations", "Box2D velocity iterations", Bounds::closed(1, 100)}, p.velocity_iterations);
-  v(FieldInfo{"position_iterations", "Box2D position iterations", Bounds::closed(1, 100)}, p.position_iterations);
-  v(FieldInfo{"drag_scheme", "drag integration: explicit, or stable (never reverses a velocity)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
+  v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.velocity_iterations);
+  v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.position_iterations);
+  v(FieldInfo{"drag_scheme", "drag integration: explicit, or stable (implicit; never reverses an edge velocity)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
+  v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
 }
+
+/// Checks what visit_fields bounds cannot say (finite dt, known drag scheme); throws ConfigError.
+void validate(const PhysicsParams& params);
+
+/// Fills Box2D 2.4's lazily initialised process-wide globals (the contact registry) by stepping a
+/// tiny world with two touching circles. Call once on the main thread before any parallel region
+/// that creates worlds; later calls do nothing. Thread-safe.
+void warm_up_box2d();
+
+/// The swim of one body: a heap-allocated b2World with one dynamic, fixture-less body per cell
+/// (equal masses set with SetMassData, fixed rotation, sleeping off, continuous physics off, zero
+/// gravity), driven by the scene's effects.
+///
+/// One control step = `substeps` Box2D steps of h = dt/substeps. Each Box2D step:
+///   1. reads positions and velocities into the SoA state and zeroes the force buffer;
+///   2. runs the enabled effects in stage order (modifiers, forces, implicit), which add forces;
+///   3. checks the predicted velocity v + h·F/m of every cell: a non-finite value, or a
+///      displacement |v|·h above max_step_displacement, throws SimulationError (the world is left
+///      as it was before the step; Box2D never clamps anything silently);
+///   4. applies the forces (ApplyForceToCenter(f, true)) and calls b2World::Step.
+/// Nothing is allocated in the loop. Not thread-safe itself; use one Simulation per thread.
+class Simulation {
+ public:
+  Simulation(const Body& body, const SceneParams& scene = {}, const PhysicsParams& physics = {});
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  /// Adds an effect (custom or future: gravity, ground...). It runs with the effects of its stage,
+  /// after those already there.
+  void add_effect(std::unique_ptr<Effect> effect);
+
+  /// Advances n control steps. Throws SimulationError when a step leaves the valid domain; after
+  /// that, every further step() throws the same error.
+  void step(long n = 1);
+  /// Computes the forces of the current state (effects run, nothing integrated) into forces().
+  /// Modifier effects advance as if a step had started; meant for tests and inspection.
+  void compute_forces();
+
+  [[nodiscard]] int node_count() const;
+  [[nodiscard]] long steps_done() const;     ///< control steps done
+  [[nodiscard]] long substeps_done() const;  ///< Box2D steps done
+  [[nodiscard]] double time() const;         ///< simulated time
+  [[nodiscard]] Points positions() const;
+  [[nodiscard]] Points velocities() const;
+  [[nodiscard]] Eigen::Vector2d center_of_mass() const;
+  [[nodiscard]] Eigen::Vector2d momentum() const;
+  [[nodiscard]] double kinetic_energy() const;
+  /// Current rest length of every spring (actuation's eq. 2 at the last step; L0 before any step).
+  [[nodiscard]] std::span<const double> rest_lengths_now() const;
+  /// Forces of the last step (or compute_forces()), n each.
+  [[nodiscard]] std::span<const double> forces_x() const;
+  [[nodiscard]] std::span<const double> forces_y() const;
+  /// Enabled effects, in the order they run.
+  [[nodiscard]] std::vector<const Effect*> effects() const;
+  [[nodiscard]] const Effect* effect(std::string_view name) const;
+  /// Largest |v|·h a cell was about to move in one Box2D step so far (the quantity checked against
+  /// max_step_displacement), and the largest cell speed.
+  [[nodiscard]] double max_step_displacement_seen() const;
+  [[nodiscard]] double max_speed_seen() const;
+  [[nodiscard]] bool failed() const;
+  [[nodiscard]] const std::string& failure() const;  ///< empty unless failed()
+
+  [[nodiscard]] const SceneParams& scene() const;
+  [[nodiscard]] const PhysicsParams& physics() const;
+  /// The Box2D world (tests inspect it: bodies, fixtures, contacts).
+  [[nodiscard]] b2World& world();
+  [[nodiscard]] const b2World& world() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace animat

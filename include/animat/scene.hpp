@@ -1,7 +1,20 @@
 #pragma once
 // A scene: the list of effects a swim simulation needs, with their coefficients (paper §4).
 // Effects that are not listed cost nothing: they are not in the step loop, and Box2D gets no
-// fixtures or contacts unless an effect needs collisions.
+// fixtures or contacts unless an effect needs collisions (none of the built-in ones does: skin
+// collision is our own penalty force).
+//
+// An effect is a small object with one job. Once per Box2D step the simulation fills a
+// structure-of-arrays SwimState (positions, velocities, zeroed forces) and calls every enabled
+// effect in stage order:
+//   1. modifier effects change per-step parameters (actuation writes the spring rest lengths);
+//   2. force effects add their forces (springs, pressure, skin collision; future: gravity, ground);
+//   3. implicit effects see every other force and add theirs last (drag, whose stable scheme
+//      integrates the drag implicitly with the other forces included).
+// Effects loop over their own elements inside apply(): one virtual call per effect per step,
+// never one per element. New effects (gravity, ground friction, active control) are new Effect
+// subclasses plus a name in make_effect(); the stepper does not change.
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,30 +23,38 @@
 
 namespace animat {
 
+struct Body;
+struct PhysicsParams;
+
 inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation", "pressure", "drag", "skin_collision"};
 
+/// Units (docs/notes/physics.md): length = the cell spacing at the end of development (cell
+/// radius 0.5, so neighbouring centres are about 1 apart); mass = one cell; time = the unit of the
+/// oscillator frequencies (rad per time unit). Forces are mass·length/time².
 struct SceneParams {
   std::vector<std::string> effects = {"springs", "actuation", "pressure", "drag", "skin_collision"};
-  double cell_mass = 1.0;             ///< equal mass of every cell [paper: equal; value: choose]
+  double cell_mass = 1.0;             ///< equal mass m of every cell [paper: equal; value: choose, the mass unit]
   double spring_stiffness = 30.0;     ///< Hooke constant k of every spring [choose]
-  double spring_damping = 1.0;        ///< damping coefficient c of every spring [choose]
-  double pressure = 20.0;             ///< c_p of eq. 3 [choose]
+  double spring_damping = 1.0;        ///< damping coefficient c of every spring (force per unit stretching speed) [choose]
+  double pressure = 20.0;             ///< c_p of eq. 3, force per unit edge length at S = 0 [choose]
+  double pressure_area_floor = 0.1;   ///< eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
   double drag_normal = 2.0;           ///< d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]
-  double drag_tangential = 0.01;      ///< d_T of eq. 4 [paper: d_N / 200]
-  double collision_stiffness = 200.0; ///< penalty stiffness of skin collisions [choose]
+  double drag_tangential = -1.0;      ///< d_T of eq. 4; negative means d_N/200 [paper §6: d_N/200]
+  double collision_stiffness = 500.0; ///< penalty stiffness of skin collisions [choose]
   double collision_radius = 0.1;      ///< distance from a skin edge at which the penalty starts [choose]
 };
 
 template <class V>
 void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"effects", "effects simulated while swimming", Bounds::any(), kSceneEffectNames}, p.effects);
-  v(FieldInfo{"cell_mass", "mass of every cell [paper: equal masses]", Bounds::positive()}, p.cell_mass);
-  v(FieldInfo{"spring_stiffness", "Hooke stiffness of every spring [choose]", Bounds::non_negative()}, p.spring_stiffness);
-  v(FieldInfo{"spring_damping", "damping coefficient of every spring [choose]", Bounds::non_negative()}, p.spring_damping);
+  v(FieldInfo{"cell_mass", "mass of every cell, the mass unit [paper: equal masses; value: choose]", Bounds::positive()}, p.cell_mass);
+  v(FieldInfo{"spring_stiffness", "Hooke stiffness k of every spring [choose]", Bounds::non_negative()}, p.spring_stiffness);
+  v(FieldInfo{"spring_damping", "damping coefficient of every spring, force per unit stretching speed [choose]", Bounds::non_negative()}, p.spring_damping);
   v(FieldInfo{"pressure", "region pressure coefficient c_p of eq. 3 [choose]", Bounds::non_negative()}, p.pressure);
-  v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2 to 10]", Bounds::non_negative()}, p.drag_normal);
-  v(FieldInfo{"drag_tangential", "tangential drag coefficient d_T of eq. 4 [paper: d_N/200]", Bounds::non_negative()}, p.drag_tangential);
-  v(FieldInfo{"collision_stiffness", "penalty stiffness keeping cells out of skin edges [choose]", Bounds::non_negative()}, p.collision_stiffness);
+  v(FieldInfo{"pressure_area_floor", "eq. 3 uses max(S0, floor*(longest rest edge)^2) as its denominator, so sliver regions stay stable [choose]", Bounds::non_negative()}, p.pressure_area_floor);
+  v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]", Bounds::non_negative()}, p.drag_normal);
+  v(FieldInfo{"drag_tangential", "tangential drag coefficient d_T of eq. 4; negative = drag_normal/200 [paper: d_N/200]", Bounds::at_least(-1.0)}, p.drag_tangential);
+  v(FieldInfo{"collision_stiffness", "penalty stiffness keeping cells out of skin edges not their own [choose]", Bounds::non_negative()}, p.collision_stiffness);
   v(FieldInfo{"collision_radius", "distance from a skin edge where the collision penalty starts [choose]", Bounds::non_negative()}, p.collision_radius);
 }
 
@@ -42,5 +63,71 @@ void visit_fields(SceneParams& p, V&& v) {
     if (e == name) return true;
   return false;
 }
+
+/// d_T actually used: drag_tangential, or drag_normal/200 when drag_tangential is negative.
+[[nodiscard]] inline double tangential_drag(const SceneParams& p) {
+  return p.drag_tangential < 0.0 ? p.drag_normal / 200.0 : p.drag_tangential;
+}
+
+/// Checks what visit_fields bounds cannot say: known, non-duplicated effect names and finite
+/// coefficients. Throws ConfigError naming the key.
+void validate(const SceneParams& params);
+
+/// The state every effect reads and writes during one Box2D step, structure-of-arrays, sized once
+/// by the simulation (never resized in the step loop). Positions and velocities are Box2D's (float)
+/// values widened to double; forces are zeroed before the first effect runs.
+struct SwimState {
+  int n = 0;              ///< cells
+  long step = 0;          ///< Box2D steps done before this one
+  double time = 0.0;      ///< simulated time at the start of this Box2D step
+  double h = 0.0;         ///< length of this Box2D step (dt / substeps)
+  double mass = 1.0;      ///< every cell's mass
+  double inv_mass = 1.0;
+  std::vector<double> x, y, vx, vy;  ///< n each
+  std::vector<double> fx, fy;        ///< n each: the force accumulator
+  std::vector<double> rest;          ///< current rest length of every spring (actuation writes it)
+};
+
+/// One physical effect of a scene. apply() loops over the effect's own elements (stored as
+/// structure-of-arrays at construction) and must not allocate.
+class Effect {
+ public:
+  enum class Stage : int { modifier = 0, force = 1, implicit = 2 };
+
+  virtual ~Effect() = default;
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  [[nodiscard]] virtual Stage stage() const { return Stage::force; }
+  /// Adds this effect's forces to s.fx, s.fy (or modifies per-step parameters, for modifiers).
+  virtual void apply(SwimState& s) = 0;
+  /// Whether Box2D needs circle fixtures (and contacts) for this effect. None of the built-in
+  /// effects does.
+  [[nodiscard]] virtual bool needs_box2d_collisions() const { return false; }
+  /// Number of apply() calls so far (lets tests prove that a disabled effect never runs).
+  [[nodiscard]] long calls() const { return calls_; }
+
+ protected:
+  long calls_ = 0;
+};
+
+/// The built-in effect `name` (one of kSceneEffectNames) for `body`; throws ConfigError for an
+/// unknown name.
+[[nodiscard]] std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body, const SceneParams& scene,
+                                                  const PhysicsParams& physics);
+
+// --- Pure pieces of the effects, exposed for analytic tests ------------------------------------
+
+/// Time at which a cell with frequency f and phase phi starts its oscillation (paper §3): the
+/// first t >= 0 at which sin(f·t + phi) passes through zero, i.e. 0 when phi is a multiple of π,
+/// otherwise (π − (phi mod π)) / f, which is less than half a period. A cell with f <= 0 and
+/// sin(phi) != 0 never starts (+infinity).
+[[nodiscard]] double actuation_start_time(double frequency, double phase);
+/// A cell's term of eq. 2 at time t: a·sin(f·t + phi) once t >= actuation_start_time(f, phi), else 0.
+/// It is 0 at the start time and continuous in t.
+[[nodiscard]] double actuation_term(double amplitude, double frequency, double phase, double t);
+
+/// The stable drag update of one velocity component: the backward-Euler solution u' of
+/// u' = w − dt·c·u'·|u'| (c = d·L/M), i.e. 2w / (1 + sqrt(1 + 4·c·dt·|w|)). Same sign as w and
+/// |u'| <= |w|: it never reverses the velocity, whatever c·dt·|w|.
+[[nodiscard]] double implicit_quadratic_drag(double w, double c_dt);
 
 }  // namespace animat

@@ -1,27 +1,48 @@
 // animat_evolve: run an evolution experiment (paper §5) from the embedded default or a TOML config.
 #include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <ctime>
+#include <filesystem>
 #include <iostream>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/evolution.hpp"
 #include "animat/log.hpp"
 
+namespace {
+
+// Set by SIGINT/SIGTERM; the run finishes its generation, writes a checkpoint and exits cleanly.
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop.store(true); }
+
+std::string default_run_dir(std::int64_t seed) {
+  const std::time_t t = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&t));
+  return "runs/" + std::string(stamp) + "-seed" + std::to_string(seed);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  CLI::App app{"animat_evolve: co-evolve the morphology and control of soft-bodied swimmers"};
+  CLI::App app{"animat_evolve: co-evolve the morphology and control of soft-bodied swimmers (Joachimczak & Wrobel 2012)"};
   std::string config_path, out_dir, resume_dir, log_level = "info";
   std::vector<std::string> overrides;
   std::int64_t seed = -1;
   int generations = -1, threads = -1;
   bool print_config = false, quiet = false;
-  app.add_option("--config", config_path, "TOML config file (default: the embedded paper d_N = 2 setting)")
+  app.add_option("--config", config_path, "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
       ->check(CLI::ExistingFile);
   app.add_option("--set", overrides, "override one value: section.key=value (repeatable)");
   app.add_option("--seed", seed, "run seed (evolution.seed)")->check(CLI::NonNegativeNumber);
-  app.add_option("--generations", generations, "generation cap (evolution.generations)")->check(CLI::NonNegativeNumber);
+  app.add_option("--generations", generations, "generation cap, 0 = none (evolution.generations)")->check(CLI::NonNegativeNumber);
   app.add_option("--threads", threads, "OpenMP threads, 0 = all cores (evolution.threads)")->check(CLI::NonNegativeNumber);
-  app.add_option("--out", out_dir, "run directory to write");
-  app.add_option("--resume", resume_dir, "run directory to resume");
+  app.add_option("--out", out_dir, "run directory to write (default: runs/<time>-seed<seed>)");
+  app.add_option("--resume", resume_dir, "run directory to resume; its config.toml is the base config");
   app.add_flag("--print-config", print_config, "print the resolved config as TOML and exit");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
   app.add_flag("--quiet", quiet, "only warnings and errors");
@@ -33,7 +54,19 @@ int main(int argc, char** argv) {
 
   try {
     animat::set_log_level(quiet ? "warn" : log_level);
-    animat::Config config = config_path.empty() ? animat::Config{} : animat::load_config(config_path);
+    if (!resume_dir.empty() && !out_dir.empty() && std::filesystem::path(resume_dir) != std::filesystem::path(out_dir))
+      throw animat::ConfigError("--resume and --out name different directories; --resume continues in place");
+    if (!resume_dir.empty() && !config_path.empty())
+      throw animat::ConfigError("--resume takes its config from the run directory; do not also pass --config");
+    animat::Config config;
+    if (!resume_dir.empty()) {
+      const auto base = std::filesystem::path(resume_dir) / "config.toml";
+      if (!std::filesystem::is_directory(resume_dir))
+        throw animat::IoError(resume_dir + ": resume directory does not exist");
+      config = animat::load_config(base);
+    } else if (!config_path.empty()) {
+      config = animat::load_config(config_path);
+    }
     for (const auto& o : overrides) animat::apply_override(config, o);
     if (seed >= 0) config.evolution.seed = seed;
     if (generations >= 0) config.evolution.generations = generations;
@@ -43,12 +76,33 @@ int main(int argc, char** argv) {
       std::cout << animat::to_toml(config);
       return 0;
     }
-    spdlog::info("animat {}: resolved configuration follows", ANIMAT_VERSION);
-    std::cout << animat::to_toml(config);
-    spdlog::warn("evolution is not implemented yet; printed the configuration that would run");
-    return 0;
+
+    animat::RunOptions options;
+    options.resume = !resume_dir.empty();
+    options.out = options.resume ? resume_dir : (out_dir.empty() ? default_run_dir(config.evolution.seed) : out_dir);
+    options.quiet = quiet;
+    options.stop_flag = &g_stop;
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    if (!quiet)
+      spdlog::info("animat {} | population {} | {} cells max | d_N = {} | {} swim steps | seed {} | run dir {}",
+                   ANIMAT_VERSION, config.evolution.population, config.development.max_cells, config.scene.drag_normal,
+                   config.evaluation.steps, config.evolution.seed, options.out.string());
+    const animat::RunSummary summary = animat::run_evolution(config, options);
+    const auto& best = summary.best;
+    std::printf("\nBest swimmer: fitness %.4f (distance travelled by the centre of mass), %d cells, generation %d\n",
+                best.result.fitness, best.result.cell_count, summary.history.back().generation);
+    std::printf("Stopped: %s\n", summary.stop_reason.c_str());
+    std::printf("Results in %s: config.toml, history.csv, best/ (lineage of best genomes), checkpoint.json\n",
+                options.out.c_str());
+    std::printf("View them:  PYTHONPATH=build/python .venv/bin/python -m animat show %s\n", options.out.c_str());
+    std::printf("Resume:     animat_evolve --resume %s --generations N\n", options.out.c_str());
+    return summary.stop_reason == "interrupted" ? 130 : 0;
   } catch (const animat::Error& e) {
     std::fprintf(stderr, "animat_evolve: error: %s\n", e.what());
     return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "animat_evolve: internal error: %s\n", e.what());
+    return 3;
   }
 }

@@ -1,0 +1,70 @@
+#pragma once
+// Fitness evaluation (paper §5): genome -> development -> body -> swim -> distance of the centre of
+// mass. Deterministic and thread-safe: each call owns its Box2D worlds; call warm_up_box2d() once
+// before the first parallel region.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "animat/config.hpp"
+#include "animat/genome.hpp"
+
+namespace animat {
+
+struct Body;
+
+/// What a swim did.
+struct SwimResult {
+  double distance = 0.0;                        ///< |COM(end) − COM(start)| (0 when unstable)
+  Eigen::Vector2d displacement{0.0, 0.0};       ///< COM(end) − COM(start), as simulated
+  bool stable = true;                           ///< false if a step left the valid domain
+  std::string failure;                          ///< the SimulationError message when !stable
+  long steps = 0;                               ///< control steps completed
+  double simulated_time = 0.0;
+  double max_speed = 0.0;                       ///< largest cell speed seen
+  double max_step_displacement = 0.0;           ///< largest |v|·h of one Box2D step seen
+  double max_stretch = 0.0;                     ///< largest spring length / L0 (sampled every 16 steps and at the end)
+  double min_stretch = 0.0;                     ///< smallest spring length / L0 (same samples); 0 with no springs
+  double final_kinetic_energy = 0.0;
+  double max_kinetic_energy = 0.0;              ///< largest kinetic energy (same samples)
+};
+
+/// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
+/// simulation failure: it returns stable = false, distance 0 and the message. Throws ConfigError
+/// for invalid params.
+[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps);
+
+struct EvaluationResult {
+  double fitness = 0.0;          ///< straight-line distance of the centre of mass, start -> end
+  bool viable = false;           ///< development verdict; non-viable genomes are never swum
+  bool stable = true;            ///< false if the swim (or development) left the valid domain
+  int cell_count = 0;
+  std::vector<std::string> reasons;  ///< non-viability reasons or the instability description
+  // Diagnostics.
+  Eigen::Vector2d displacement{0.0, 0.0};  ///< COM(end) − COM(start)
+  int spring_count = 0;
+  int region_count = 0;
+  int skin_edge_count = 0;
+  int development_steps = 0;     ///< development steps actually run (early exits are shorter)
+  long swim_steps = 0;           ///< control steps swum
+  double simulated_time = 0.0;   ///< simulated swim time
+  double max_speed = 0.0;
+  double max_step_displacement = 0.0;
+  double max_stretch = 0.0;
+  double min_stretch = 0.0;
+  double max_kinetic_energy = 0.0;
+  double final_kinetic_energy = 0.0;
+  double seconds_development = 0.0;  ///< wall time per stage (not deterministic; diagnostics only)
+  double seconds_body = 0.0;
+  double seconds_swim = 0.0;
+};
+
+/// genome -> develop -> build_body -> swim(config.evaluation.steps). Deterministic (same genome and
+/// config give a bit-identical fitness), thread-safe. A non-viable genome is never swum (fitness 0,
+/// viable = false, reasons from development). A development or swim that leaves the valid domain
+/// gives fitness 0, stable = false and the reason; nothing is clamped silently. A body the body
+/// stage rejects (e.g. duplicate centres) is non-viable with the reason. Throws ConfigError for an
+/// invalid config.
+[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config);
+
+}  // namespace animat

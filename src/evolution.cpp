@@ -1,0 +1,551 @@
+#include "animat/evolution.hpp"
+
+#include <box2d/box2d.h>
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <omp.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+
+namespace animat {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr std::uint64_t kInitialKey = 0xffffffffffffffffULL;  // stream key of the initial population
+constexpr int kCheckpointVersion = 1;
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::uint64_t fnv1a(std::string_view s) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+std::string hex(std::uint64_t x) { return fmt::format("{:016x}", x); }
+
+int thread_count(int requested) { return requested > 0 ? requested : omp_get_num_procs(); }
+
+// Runs body(i) for i in [0, n) in parallel; rethrows the first exception (by index) afterwards.
+template <class Body>
+void parallel_for(std::size_t n, int threads, Body&& body) {
+  std::vector<std::exception_ptr> errors(n);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(thread_count(threads))
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+    try {
+      body(static_cast<std::size_t>(i));
+    } catch (...) {
+      errors[static_cast<std::size_t>(i)] = std::current_exception();
+    }
+  }
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+bool fitter(const Individual& a, const Individual& b) {
+  if (a.result.viable != b.result.viable) return a.result.viable;
+  return a.result.fitness > b.result.fitness;
+}
+
+}  // namespace
+
+double tournament_probability(const EvolutionParams& p, int generation) {
+  if (p.tournament_ramp_generations <= 0) return p.tournament_p_end;
+  const double t = std::clamp(static_cast<double>(generation) / p.tournament_ramp_generations, 0.0, 1.0);
+  return p.tournament_p_start + (p.tournament_p_end - p.tournament_p_start) * t;
+}
+
+std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std::size_t>& eligible, double p_fitter,
+                       Rng& rng) {
+  if (eligible.empty()) throw Error("tournament: no eligible individual");
+  if (eligible.size() == 1) return eligible[0];
+  const std::size_t a = eligible[rng.below(eligible.size())];
+  std::size_t b = eligible[rng.below(eligible.size() - 1)];
+  if (b == a) b = eligible.back();  // two distinct individuals, uniformly
+  const bool a_fitter = fitter(pop[a], pop[b]) || (!fitter(pop[b], pop[a]) && a < b);
+  const std::size_t winner = a_fitter ? a : b, loser = a_fitter ? b : a;
+  return rng.bernoulli(p_fitter) ? winner : loser;
+}
+
+void prepare_parallel_evaluation() {
+  // Box2D 2.4 fills its contact registry lazily and keeps process-wide GJK/TOI counters: touch them
+  // once on this thread with two touching circles before any parallel region.
+  static std::once_flag once;
+  std::call_once(once, [] {
+    b2World world(b2Vec2(0.0f, 0.0f));
+    world.SetContinuousPhysics(false);
+    b2CircleShape circle;
+    circle.m_radius = 0.5f;
+    for (float x : {0.0f, 0.6f}) {
+      b2BodyDef def;
+      def.type = b2_dynamicBody;
+      def.position.Set(x, 0.0f);
+      world.CreateBody(&def)->CreateFixture(&circle, 1.0f);
+    }
+    world.Step(1.0f / 60.0f, 1, 1);
+  });
+}
+
+std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness, int threads) {
+  prepare_parallel_evaluation();
+  std::vector<Fitness> out(genomes.size());
+  parallel_for(genomes.size(), threads, [&](std::size_t i) { out[i] = fitness(genomes[i]); });
+  return out;
+}
+
+std::uint64_t run_identity(const Config& config) {
+  Config c = config;
+  const EvolutionParams defaults;
+  c.evolution.generations = defaults.generations;
+  c.evolution.stall_generations = defaults.stall_generations;
+  c.evolution.wall_seconds = defaults.wall_seconds;
+  c.evolution.threads = defaults.threads;
+  c.evolution.checkpoint_every = defaults.checkpoint_every;
+  return config_hash(c);
+}
+
+// ---------------------------------------------------------------------------------------------------
+Evolution::Evolution(const Config& config, FitnessFunction fitness)
+    : config_(std::make_shared<const Config>(config)), identity_(run_identity(config)), fitness_(std::move(fitness)), started_(now_seconds()) {
+  validate(*config_);
+  if (!fitness_) throw Error("Evolution: no fitness function");
+}
+
+void Evolution::initialize() {
+  prepare_parallel_evaluation();
+  const EvolutionParams& ep = config_->evolution;
+  population_.assign(static_cast<std::size_t>(ep.population), Individual{});
+  parallel_for(population_.size(), ep.threads, [&](std::size_t i) {
+    Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i);
+    Individual& ind = population_[i];
+    for (ind.tries = 1; ind.tries <= ep.max_init_tries; ++ind.tries) {
+      ind.genome = random_genome(config_->genome, rng);
+      ind.result = fitness_(ind.genome);
+      if (ind.result.viable) return;
+    }
+    throw Error(fmt::format("initial population: no viable random genome in evolution.max_init_tries = {} tries "
+                            "(individual {}); the development or genome settings make viability too rare",
+                            ep.max_init_tries, i));
+  });
+  for (const auto& ind : population_) evaluations_ += ind.tries;
+  generation_ = 0;
+  best_ever_ = best().result.fitness;
+  stall_ = 0;
+  history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_));
+}
+
+const Individual& Evolution::best() const {
+  if (population_.empty()) throw Error("Evolution::best: the population is empty (call initialize first)");
+  // The first of the fittest, by index: ties resolve the same way on every machine.
+  return *std::min_element(population_.begin(), population_.end(),
+                           [](const Individual& a, const Individual& b) { return fitter(a, b); });
+}
+
+std::vector<int> Evolution::initial_tries() const {
+  std::vector<int> out;
+  for (const auto& ind : population_) out.push_back(ind.tries);
+  return out;
+}
+
+GenerationStats Evolution::step() {
+  if (generation_ < 0) throw Error("Evolution::step: call initialize() first");
+  const EvolutionParams& ep = config_->evolution;
+  const int g = generation_ + 1;
+  const std::size_t n = population_.size();
+
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return fitter(population_[a], population_[b]); });
+  std::vector<std::size_t> eligible;
+  for (std::size_t i = 0; i < n; ++i)
+    if (population_[i].result.viable) eligible.push_back(i);
+  if (eligible.empty()) {  // nobody viable (possible only without elites): fall back to everyone
+    eligible.resize(n);
+    std::iota(eligible.begin(), eligible.end(), 0);
+  }
+
+  std::vector<Individual> next(n);
+  std::vector<bool> needs_eval(n, false);
+  const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), n);
+  std::size_t copied = 0;
+  for (std::size_t k = 0; k < n && copied < elites; ++k) {
+    if (!population_[order[k]].result.viable) break;
+    next[copied] = population_[order[k]];
+    next[copied].tries = 0;
+    ++copied;
+  }
+  const double p = tournament_probability(ep, g);
+  int crossovers = 0;
+  // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated twice).
+  std::unordered_multimap<std::uint64_t, std::size_t> known;
+  for (std::size_t i = 0; i < n; ++i) known.emplace(genome_hash(population_[i].genome), i);
+  for (std::size_t i = copied; i < n; ++i) {
+    Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), static_cast<std::uint64_t>(g), i);
+    Individual& child = next[i];
+    if (rng.bernoulli(ep.crossover_fraction)) {
+      const std::size_t a = tournament(population_, eligible, p, rng);
+      const std::size_t b = tournament(population_, eligible, p, rng);
+      ++crossovers;
+      child.genome = crossover(population_[a].genome, population_[b].genome, config_->mutation.crossover_points, rng);
+    } else {
+      child.genome = population_[tournament(population_, eligible, p, rng)].genome;
+    }
+    mutate(child.genome, config_->mutation, config_->genome, rng);
+    needs_eval[i] = true;
+    auto [lo, hi] = known.equal_range(genome_hash(child.genome));
+    for (auto it = lo; it != hi; ++it)
+      if (population_[it->second].genome == child.genome) {
+        child.result = population_[it->second].result;
+        needs_eval[i] = false;
+        break;
+      }
+  }
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < n; ++i)
+    if (needs_eval[i]) todo.push_back(i);
+  parallel_for(todo.size(), ep.threads, [&](std::size_t k) { next[todo[k]].result = fitness_(next[todo[k]].genome); });
+  evaluations_ += static_cast<std::int64_t>(todo.size());
+
+  const Genome previous_best = best().genome;
+  population_ = std::move(next);
+  generation_ = g;
+  const Individual& b = best();
+  if (b.result.fitness > best_ever_) {
+    best_ever_ = b.result.fitness;
+    stall_ = 0;
+  } else {
+    ++stall_;
+  }
+  history_.push_back(statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_));
+  history_.back().crossovers = crossovers;
+  return history_.back();
+}
+
+GenerationStats Evolution::statistics(bool best_changed, double wall) const {
+  GenerationStats s;
+  s.generation = generation_;
+  std::vector<double> viable;
+  for (const auto& ind : population_)
+    if (ind.result.viable) viable.push_back(ind.result.fitness);
+  const Individual& b = best();
+  s.best = b.result.fitness;
+  s.best_cells = b.result.cell_count;
+  s.viable_fraction = static_cast<double>(viable.size()) / static_cast<double>(population_.size());
+  if (!viable.empty()) {
+    s.mean = std::accumulate(viable.begin(), viable.end(), 0.0) / static_cast<double>(viable.size());
+    std::sort(viable.begin(), viable.end());
+    const std::size_t m = viable.size() / 2;
+    s.median = viable.size() % 2 ? viable[m] : 0.5 * (viable[m - 1] + viable[m]);
+  }
+  s.evaluations = evaluations_;
+  s.wall_seconds = wall;
+  s.evaluations_per_second = wall > 0 ? static_cast<double>(evaluations_) / wall : 0.0;
+  s.best_changed = best_changed;
+  return s;
+}
+
+std::string Evolution::stop_reason() const {
+  const EvolutionParams& ep = config_->evolution;
+  if (generation_ < 0) return {};
+  if (ep.generations > 0 && generation_ >= ep.generations)
+    return fmt::format("generation cap evolution.generations = {} reached", ep.generations);
+  if (ep.stall_generations > 0 && stall_ >= ep.stall_generations)
+    return fmt::format("no improvement for evolution.stall_generations = {} generations", ep.stall_generations);
+  if (ep.wall_seconds > 0 && wall_offset_ + now_seconds() - started_ >= ep.wall_seconds)
+    return fmt::format("wall-clock budget evolution.wall_seconds = {} s used", ep.wall_seconds);
+  return {};
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Checkpoints
+namespace {
+
+json stats_to_json(const GenerationStats& s) {
+  return json{{"generation", s.generation}, {"best", s.best}, {"mean", s.mean}, {"median", s.median},
+              {"viable_fraction", s.viable_fraction}, {"best_cells", s.best_cells}, {"evaluations", s.evaluations},
+              {"wall_seconds", s.wall_seconds}, {"best_changed", s.best_changed}};
+}
+
+GenerationStats stats_from_json(const json& j) {
+  GenerationStats s;
+  s.generation = j.at("generation").get<int>();
+  s.best = j.at("best").get<double>();
+  s.mean = j.at("mean").get<double>();
+  s.median = j.at("median").get<double>();
+  s.viable_fraction = j.at("viable_fraction").get<double>();
+  s.best_cells = j.at("best_cells").get<int>();
+  s.evaluations = j.at("evaluations").get<std::int64_t>();
+  s.wall_seconds = j.at("wall_seconds").get<double>();
+  s.best_changed = j.at("best_changed").get<bool>();
+  s.evaluations_per_second = s.wall_seconds > 0 ? static_cast<double>(s.evaluations) / s.wall_seconds : 0.0;
+  return s;
+}
+
+}  // namespace
+
+std::string Evolution::checkpoint() const {
+  json payload;
+  payload["format"] = "animat.checkpoint";
+  payload["version"] = kCheckpointVersion;
+  payload["identity"] = hex(identity_);
+  payload["generation"] = generation_;
+  payload["stall"] = stall_;
+  payload["best_ever"] = best_ever_;
+  payload["evaluations"] = evaluations_;
+  payload["wall_seconds"] = history_.empty() ? 0.0 : history_.back().wall_seconds;
+  json pop = json::array();
+  for (const auto& ind : population_)
+    pop.push_back(json{{"genome", json::parse(to_json(ind.genome))},
+                       {"fitness", ind.result.fitness},
+                       {"viable", ind.result.viable},
+                       {"stable", ind.result.stable},
+                       {"cell_count", ind.result.cell_count},
+                       {"tries", ind.tries}});
+  payload["population"] = std::move(pop);
+  json hist = json::array();
+  for (const auto& s : history_) hist.push_back(stats_to_json(s));
+  payload["history"] = std::move(hist);
+  const std::string body = payload.dump();
+  return json{{"checksum", hex(fnv1a(body))}, {"payload", body}}.dump();
+}
+
+void Evolution::restore(std::string_view text, std::string_view source) {
+  json outer;
+  try {
+    outer = json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    throw CheckpointError(fmt::format("{}: corrupt checkpoint (not valid JSON at byte {}; truncated?)", source, e.byte));
+  }
+  try {
+    if (!outer.is_object() || !outer.contains("checksum") || !outer.contains("payload") || !outer["payload"].is_string())
+      throw CheckpointError(fmt::format("{}: not an animat checkpoint (missing checksum/payload)", source));
+    const std::string body = outer["payload"].get<std::string>();
+    if (outer["checksum"] != hex(fnv1a(body)))
+      throw CheckpointError(fmt::format("{}: corrupt checkpoint: checksum {} does not match its content ({})", source,
+                                        outer["checksum"].dump(), hex(fnv1a(body))));
+    const json p = json::parse(body);
+    if (p.value("format", "") != "animat.checkpoint")
+      throw CheckpointError(fmt::format("{}: not an animat checkpoint (format {})", source, p.value("format", "?")));
+    if (p.at("version").get<int>() != kCheckpointVersion)
+      throw CheckpointError(fmt::format("{}: checkpoint version {} is not supported (this build reads version {})", source,
+                                        p.at("version").dump(), kCheckpointVersion));
+    if (p.at("identity").get<std::string>() != hex(identity_))
+      throw CheckpointError(fmt::format(
+          "{}: checkpoint belongs to a different run configuration (identity {} vs {} for the current config); "
+          "only evolution.generations, stall_generations, wall_seconds, threads and checkpoint_every may change on resume",
+          source, p.at("identity").get<std::string>(), hex(identity_)));
+    std::vector<Individual> pop;
+    for (const json& ji : p.at("population")) {
+      Individual ind;
+      ind.genome = genome_from_json(ji.at("genome").dump(), config_->genome, source);
+      ind.result.fitness = ji.at("fitness").get<double>();
+      ind.result.viable = ji.at("viable").get<bool>();
+      ind.result.stable = ji.at("stable").get<bool>();
+      ind.result.cell_count = ji.at("cell_count").get<int>();
+      ind.tries = ji.at("tries").get<int>();
+      pop.push_back(std::move(ind));
+    }
+    if (pop.size() != static_cast<std::size_t>(config_->evolution.population))
+      throw CheckpointError(fmt::format("{}: checkpoint holds {} individuals, evolution.population is {}", source, pop.size(),
+                                        config_->evolution.population));
+    std::vector<GenerationStats> hist;
+    for (const json& js : p.at("history")) hist.push_back(stats_from_json(js));
+    population_ = std::move(pop);
+    history_ = std::move(hist);
+    generation_ = p.at("generation").get<int>();
+    stall_ = p.at("stall").get<int>();
+    best_ever_ = p.at("best_ever").get<double>();
+    evaluations_ = p.at("evaluations").get<std::int64_t>();
+    wall_offset_ = p.at("wall_seconds").get<double>();
+    started_ = now_seconds();
+  } catch (const json::exception& e) {
+    throw CheckpointError(fmt::format("{}: malformed checkpoint: {}", source, e.what()));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Run directory
+namespace {
+
+// Writes via a temporary file, fsync and rename: the target is either the old or the new file.
+void write_atomically(const std::filesystem::path& path, std::string_view content) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw IoError(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
+  std::size_t done = 0;
+  while (done < content.size()) {
+    const ssize_t w = ::write(fd, content.data() + done, content.size() - done);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw IoError(fmt::format("{}: write failed: {}", tmp.string(), std::strerror(err)));
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw IoError(fmt::format("{}: flush failed: {}", tmp.string(), std::strerror(err)));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw IoError(fmt::format("{}: rename failed: {}", path.string(), std::strerror(err)));
+  }
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(fmt::format("{}: cannot open", path.string()));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+constexpr std::string_view kHistoryHeader =
+    "generation,best,mean,median,viable_fraction,best_cells,evaluations,wall_seconds\n";
+
+std::string history_row(const GenerationStats& s) {
+  return fmt::format("{},{},{},{},{},{},{},{:.3f}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
+                     s.best_cells, s.evaluations, s.wall_seconds);
+}
+
+void append(const std::filesystem::path& path, std::string_view text) {
+  std::ofstream out(path, std::ios::app | std::ios::binary);
+  if (!out || !(out << text) || !out.flush()) throw IoError(fmt::format("{}: cannot append", path.string()));
+}
+
+void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
+  const Individual& b = evo.best();
+  json j{{"generation", evo.generation()},
+         {"fitness", b.result.fitness},
+         {"cell_count", b.result.cell_count},
+         {"genome", json::parse(to_json(b.genome))}};
+  write_atomically(dir / "best" / fmt::format("gen_{:06d}.json", evo.generation()), j.dump(1) + "\n");
+}
+
+std::string duration(double s) {
+  const auto t = static_cast<long long>(std::max(0.0, s));
+  return fmt::format("{}:{:02d}:{:02d}", t / 3600, (t / 60) % 60, t % 60);
+}
+
+}  // namespace
+
+RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
+  validate(config);
+  if (!fitness) fitness = swim_fitness(config);
+  Evolution evo(config, std::move(fitness));
+  const bool writing = !opt.out.empty();
+  const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
+
+  if (writing) {
+    std::error_code ec;
+    if (opt.resume) {
+      if (!std::filesystem::is_directory(opt.out))
+        throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
+      if (!std::filesystem::exists(ckpt))
+        throw CheckpointError(fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
+    } else if (std::filesystem::exists(ckpt)) {
+      throw IoError(fmt::format("{}: already holds a run (checkpoint.json); use --resume {} or another --out",
+                                opt.out.string(), opt.out.string()));
+    }
+    std::filesystem::create_directories(opt.out / "best", ec);
+    if (ec) throw IoError(fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
+    write_atomically(opt.out / "config.toml", to_toml(config));
+  }
+
+  if (opt.resume) {
+    if (!writing) throw Error("run_evolution: resume needs a run directory");
+    evo.restore(read_file(ckpt), ckpt.string());
+    std::string rows(kHistoryHeader);
+    for (const auto& s : evo.history()) rows += history_row(s);
+    write_atomically(hist, rows);  // drops rows written after the checkpoint
+    if (!opt.quiet) spdlog::info("resumed {} at generation {}", opt.out.string(), evo.generation());
+  } else {
+    if (!opt.quiet) spdlog::info("drawing {} viable random individuals...", config.evolution.population);
+    evo.initialize();
+    const auto tries = evo.initial_tries();
+    const double mean_tries = std::accumulate(tries.begin(), tries.end(), 0.0) / static_cast<double>(tries.size());
+    if (!opt.quiet)
+      spdlog::info("initial population: {:.0f} random genomes per viable individual on average (paper: \"a few hundred\")",
+                   mean_tries);
+    if (writing) {
+      write_atomically(hist, std::string(kHistoryHeader) + history_row(evo.history().back()));
+      write_lineage(opt.out, evo);
+      write_atomically(ckpt, evo.checkpoint());
+    }
+  }
+
+  RunSummary summary;
+  double last_print = 0.0;
+  auto report = [&](const GenerationStats& s, bool force) {
+    if (opt.quiet) return;
+    const double t = now_seconds();
+    if (!force && t - last_print < opt.progress_interval) return;
+    last_print = t;
+    std::string left;
+    if (config.evolution.wall_seconds > 0) left = fmt::format(", {} left of budget", duration(config.evolution.wall_seconds - s.wall_seconds));
+    else if (config.evolution.generations > 0 && s.generation > 0)
+      left = fmt::format(", ~{} left", duration(s.wall_seconds / s.generation * (config.evolution.generations - s.generation)));
+    spdlog::info("gen {:5d} | best {:8.4f} mean {:8.4f} median {:8.4f} | viable {:5.1f}% | {:6.1f} eval/s | {} elapsed{}",
+                 s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.evaluations_per_second,
+                 duration(s.wall_seconds), left);
+  };
+  report(evo.history().back(), true);
+  int since_checkpoint = 0;
+  bool dirty = false;
+  while (true) {
+    summary.stop_reason = evo.stop_reason();
+    if (summary.stop_reason.empty() && opt.stop_flag && opt.stop_flag->load()) summary.stop_reason = "interrupted";
+    if (!summary.stop_reason.empty()) break;
+    const GenerationStats s = evo.step();
+    report(s, false);
+    if (writing) {
+      append(hist, history_row(s));
+      if (s.best_changed) write_lineage(opt.out, evo);
+      dirty = true;
+      if (++since_checkpoint >= config.evolution.checkpoint_every) {
+        write_atomically(ckpt, evo.checkpoint());
+        since_checkpoint = 0;
+        dirty = false;
+      }
+    }
+    if (opt.callback && !opt.callback(s, evo)) {
+      summary.stop_reason = "stopped by callback";
+      break;
+    }
+  }
+  if (writing && dirty) write_atomically(ckpt, evo.checkpoint());
+  report(evo.history().back(), true);
+  if (!opt.quiet) spdlog::info("stopped: {}", summary.stop_reason);
+  summary.history = evo.history();
+  summary.best = evo.best();
+  return summary;
+}
+
+}  // namespace animat

@@ -1,0 +1,367 @@
+// The swim simulation: a Box2D world of fixture-less cell bodies driven by the scene's effects.
+// See physics.hpp for the step, docs/notes/physics.md for units and choices.
+#include "animat/physics.hpp"
+
+#include <box2d/box2d.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <numeric>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "animat/body.hpp"
+#include "animat/errors.hpp"
+
+namespace animat {
+namespace {
+
+constexpr double kMaxTranslation = static_cast<double>(b2_maxTranslation);
+
+/// The body as the simulation sees it: positions rounded to Box2D's float, and rest lengths and
+/// areas that equal the distance (area) at construction re-measured from those float positions,
+/// so that a body at rest feels exactly zero force. Rest values that differ from the geometry by
+/// more than float rounding (a pre-stressed hand-made body) are kept as given.
+Body float_body(const Body& in) {
+  Body b = in;
+  const int n = b.node_count();
+  double scale = 1.0;
+  for (int i = 0; i < n; ++i) {
+    for (int c = 0; c < 2; ++c) {
+      b.positions(i, c) = static_cast<double>(static_cast<float>(in.positions(i, c)));
+      scale = std::max(scale, std::abs(in.positions(i, c)));
+    }
+  }
+  const double tol = 1e-6 * scale;
+  for (int s = 0; s < b.spring_count(); ++s) {
+    const int i = b.springs(s, 0), j = b.springs(s, 1);
+    const double dx = b.positions(j, 0) - b.positions(i, 0), dy = b.positions(j, 1) - b.positions(i, 1);
+    const double len = std::sqrt(dx * dx + dy * dy);
+    if (std::abs(len - b.rest_lengths(s)) <= tol) b.rest_lengths(s) = len;
+  }
+  for (int r = 0; r < b.region_count(); ++r) {
+    const auto& loop = b.regions[static_cast<std::size_t>(r)];
+    const std::size_t k = loop.size();
+    double twice = 0.0, perimeter = 0.0;
+    for (std::size_t q = 0; q < k; ++q) {
+      const int i = loop[q], nx = loop[(q + 1) % k], pv = loop[(q + k - 1) % k];
+      twice += b.positions(i, 0) * (b.positions(nx, 1) - b.positions(pv, 1));  // same formula as Pressure
+      perimeter += std::hypot(b.positions(nx, 0) - b.positions(i, 0), b.positions(nx, 1) - b.positions(i, 1));
+    }
+    if (std::abs(0.5 * twice - b.rest_areas(r)) <= tol * perimeter) b.rest_areas(r) = 0.5 * twice;
+  }
+  return b;
+}
+
+void check_body(const Body& b) {
+  const int n = b.node_count();
+  auto fail = [](const std::string& what) { throw GeometryError("Simulation: " + what); };
+  if (b.springs.rows() != b.rest_lengths.size())
+    fail(fmt::format("{} springs but {} rest lengths", b.springs.rows(), b.rest_lengths.size()));
+  if (static_cast<Eigen::Index>(b.regions.size()) != b.rest_areas.size())
+    fail(fmt::format("{} regions but {} rest areas", b.regions.size(), b.rest_areas.size()));
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(b.positions(i, 0)) || !std::isfinite(b.positions(i, 1)))
+      fail(fmt::format("node {} has a non-finite position", i));
+  auto check_index = [&](int v, const char* what) {
+    if (v < 0 || v >= n) fail(fmt::format("{} refers to node {}, but there are {} nodes", what, v, n));
+  };
+  for (int s = 0; s < b.spring_count(); ++s) {
+    check_index(b.springs(s, 0), "a spring");
+    check_index(b.springs(s, 1), "a spring");
+    if (!(b.rest_lengths(s) >= 0.0) || !std::isfinite(b.rest_lengths(s)))
+      fail(fmt::format("spring {} has rest length {}", s, b.rest_lengths(s)));
+  }
+  for (const auto& loop : b.regions)
+    for (int v : loop) check_index(v, "a region");
+  for (int r = 0; r < b.region_count(); ++r)
+    if (!std::isfinite(b.rest_areas(r))) fail(fmt::format("region {} has rest area {}", r, b.rest_areas(r)));
+  for (int e = 0; e < b.skin.rows(); ++e) {
+    check_index(b.skin(e, 0), "a skin edge");
+    check_index(b.skin(e, 1), "a skin edge");
+  }
+  for (const Vector* v : {&b.amplitude, &b.frequency, &b.phase}) {
+    if (v->size() != 0 && v->size() != n)
+      fail(fmt::format("oscillator vectors must have {} entries (or none), got {}", n, v->size()));
+    for (Eigen::Index i = 0; i < v->size(); ++i)
+      if (!std::isfinite((*v)(i))) fail(fmt::format("node {} has a non-finite oscillator parameter", i));
+  }
+}
+
+}  // namespace
+
+void warm_up_box2d() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    b2World world(b2Vec2(0.0f, 0.0f));
+    world.SetContinuousPhysics(false);
+    b2CircleShape circle;
+    circle.m_radius = 0.5f;
+    for (int k = 0; k < 2; ++k) {
+      b2BodyDef def;
+      def.type = b2_dynamicBody;
+      def.position.Set(0.6f * static_cast<float>(k), 0.0f);
+      b2Body* body = world.CreateBody(&def);
+      body->CreateFixture(&circle, 1.0f);
+    }
+    world.Step(1.0f / 60.0f, 1, 1);
+  });
+}
+
+struct Simulation::Impl {
+  SceneParams scene;
+  PhysicsParams physics;
+  std::unique_ptr<b2World> world;
+  std::vector<b2Body*> bodies;
+  std::vector<std::unique_ptr<Effect>> effects;  // in run order
+  SwimState state;
+  double h = 0.0;
+  float hf = 0.0f;
+  long box2d_steps = 0;
+  long control_steps = 0;
+  double max_disp = 0.0;
+  double max_speed = 0.0;
+  std::string failure;
+
+  void read_state() {
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const b2Vec2 p = bodies[i]->GetPosition();
+      const b2Vec2 v = bodies[i]->GetLinearVelocity();
+      state.x[i] = static_cast<double>(p.x);
+      state.y[i] = static_cast<double>(p.y);
+      state.vx[i] = static_cast<double>(v.x);
+      state.vy[i] = static_cast<double>(v.y);
+    }
+  }
+
+  void run_effects() {
+    state.step = box2d_steps;
+    state.time = static_cast<double>(box2d_steps) * h;
+    std::fill(state.fx.begin(), state.fx.end(), 0.0);
+    std::fill(state.fy.begin(), state.fy.end(), 0.0);
+    for (auto& e : effects) e->apply(state);
+  }
+
+  [[noreturn]] void fail(std::string message) {
+    failure = std::move(message);
+    throw SimulationError(failure);
+  }
+
+  void check_forces() {
+    // Predicted velocity after this step; Box2D moves a cell by |v|·h.
+    double worst = 0.0;
+    int worst_i = -1;
+    const double k = h * state.inv_mass;
+    for (int i = 0; i < state.n; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      const double wx = state.vx[u] + k * state.fx[u];
+      const double wy = state.vy[u] + k * state.fy[u];
+      const double w2 = wx * wx + wy * wy;
+      if (!(w2 <= worst)) {  // also catches NaN
+        worst = w2;
+        worst_i = i;
+        if (!std::isfinite(w2)) break;
+      }
+    }
+    const double speed = std::sqrt(worst);
+    if (!std::isfinite(speed)) {
+      const auto u = static_cast<std::size_t>(worst_i);
+      fail(fmt::format("unstable swim: step {} (t = {:.6g}): cell {} has a non-finite state (position ({}, {}), "
+                       "velocity ({}, {}), force ({}, {}))",
+                       control_steps, state.time, worst_i, state.x[u], state.y[u], state.vx[u], state.vy[u],
+                       state.fx[u], state.fy[u]));
+    }
+    const double disp = speed * h;
+    max_speed = std::max(max_speed, speed);
+    max_disp = std::max(max_disp, disp);
+    if (disp > physics.max_step_displacement) {
+      fail(fmt::format("unstable swim: step {} (t = {:.6g}): cell {} would move {:.6g} length units in one Box2D "
+                       "step (speed {:.6g}), beyond physics.max_step_displacement = {} (Box2D silently caps at {})",
+                       control_steps, state.time, worst_i, disp, speed, physics.max_step_displacement,
+                       kMaxTranslation));
+    }
+  }
+
+  void box2d_step() {
+    read_state();
+    run_effects();
+    check_forces();
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(state.fx[i]), static_cast<float>(state.fy[i])), true);
+    world->Step(hf, physics.velocity_iterations, physics.position_iterations);
+    ++box2d_steps;
+  }
+
+  void insert(std::unique_ptr<Effect> e) {
+    const auto stage = e->stage();
+    auto pos = std::find_if(effects.begin(), effects.end(), [&](const auto& x) { return x->stage() > stage; });
+    effects.insert(pos, std::move(e));
+  }
+};
+
+Simulation::Simulation(const Body& body_in, const SceneParams& scene, const PhysicsParams& physics)
+    : impl_(std::make_unique<Impl>()) {
+  validate(scene);
+  validate(physics);
+  check_body(body_in);
+  Impl& s = *impl_;
+  s.scene = scene;
+  s.physics = physics;
+  s.h = physics.dt / physics.substeps;
+  s.hf = static_cast<float>(s.h);
+  const Body body = float_body(body_in);
+  const int n = body.node_count();
+
+  s.world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
+  s.world->SetAllowSleeping(false);
+  s.world->SetContinuousPhysics(false);
+  s.world->SetWarmStarting(false);
+  s.bodies.reserve(static_cast<std::size_t>(n));
+  b2MassData mass;
+  mass.mass = static_cast<float>(scene.cell_mass);
+  mass.center.SetZero();
+  mass.I = 0.0f;
+  for (int i = 0; i < n; ++i) {
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(static_cast<float>(body.positions(i, 0)), static_cast<float>(body.positions(i, 1)));
+    def.allowSleep = false;
+    def.awake = true;
+    def.fixedRotation = true;
+    def.bullet = false;
+    def.linearDamping = 0.0f;
+    def.angularDamping = 0.0f;
+    b2Body* b = s.world->CreateBody(&def);
+    b->SetMassData(&mass);
+    s.bodies.push_back(b);
+  }
+
+  SwimState& st = s.state;
+  st.n = n;
+  st.h = s.h;
+  st.mass = static_cast<double>(static_cast<float>(scene.cell_mass));  // what Box2D integrates with
+  st.inv_mass = 1.0 / st.mass;
+  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.fx, &st.fy}) v->assign(static_cast<std::size_t>(n), 0.0);
+  st.rest.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
+
+  for (const auto& name : kSceneEffectNames) {  // canonical order within a stage
+    if (!has_effect(scene.effects, name)) continue;
+    s.insert(make_effect(name, body, scene, physics));
+  }
+  for (const auto& e : s.effects)
+    if (e->needs_box2d_collisions())
+      throw ConfigError(fmt::format("effect '{}' needs Box2D collisions, which the swim world does not provide",
+                                    e->name()));
+  s.read_state();
+}
+
+Simulation::~Simulation() = default;
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+
+void Simulation::add_effect(std::unique_ptr<Effect> effect) {
+  if (!effect) throw ConfigError("Simulation::add_effect: null effect");
+  if (effect->needs_box2d_collisions())
+    throw ConfigError(fmt::format("effect '{}' needs Box2D collisions, which the swim world does not provide",
+                                  effect->name()));
+  impl_->insert(std::move(effect));
+}
+
+void Simulation::step(long n) {
+  Impl& s = *impl_;
+  if (!s.failure.empty()) throw SimulationError(s.failure);
+  for (long k = 0; k < n; ++k) {
+    for (int j = 0; j < s.physics.substeps; ++j) s.box2d_step();
+    ++s.control_steps;
+  }
+  s.read_state();
+}
+
+void Simulation::compute_forces() {
+  impl_->read_state();
+  impl_->run_effects();
+}
+
+int Simulation::node_count() const { return impl_->state.n; }
+long Simulation::steps_done() const { return impl_->control_steps; }
+long Simulation::substeps_done() const { return impl_->box2d_steps; }
+double Simulation::time() const { return static_cast<double>(impl_->box2d_steps) * impl_->h; }
+
+Points Simulation::positions() const {
+  Points p(impl_->state.n, 2);
+  for (int i = 0; i < impl_->state.n; ++i) {
+    const b2Vec2 v = impl_->bodies[static_cast<std::size_t>(i)]->GetPosition();
+    p(i, 0) = static_cast<double>(v.x);
+    p(i, 1) = static_cast<double>(v.y);
+  }
+  return p;
+}
+
+Points Simulation::velocities() const {
+  Points p(impl_->state.n, 2);
+  for (int i = 0; i < impl_->state.n; ++i) {
+    const b2Vec2 v = impl_->bodies[static_cast<std::size_t>(i)]->GetLinearVelocity();
+    p(i, 0) = static_cast<double>(v.x);
+    p(i, 1) = static_cast<double>(v.y);
+  }
+  return p;
+}
+
+Eigen::Vector2d Simulation::center_of_mass() const {
+  Eigen::Vector2d c(0.0, 0.0);
+  const int n = impl_->state.n;
+  if (n == 0) return c;
+  for (const b2Body* b : impl_->bodies) {
+    const b2Vec2 v = b->GetPosition();
+    c += Eigen::Vector2d(static_cast<double>(v.x), static_cast<double>(v.y));
+  }
+  return c / n;
+}
+
+Eigen::Vector2d Simulation::momentum() const {
+  Eigen::Vector2d c(0.0, 0.0);
+  for (const b2Body* b : impl_->bodies) {
+    const b2Vec2 v = b->GetLinearVelocity();
+    c += Eigen::Vector2d(static_cast<double>(v.x), static_cast<double>(v.y));
+  }
+  return c * impl_->state.mass;
+}
+
+double Simulation::kinetic_energy() const {
+  double e = 0.0;
+  for (const b2Body* b : impl_->bodies) {
+    const b2Vec2 v = b->GetLinearVelocity();
+    e += static_cast<double>(v.x) * v.x + static_cast<double>(v.y) * v.y;
+  }
+  return 0.5 * impl_->state.mass * e;
+}
+
+std::span<const double> Simulation::rest_lengths_now() const { return impl_->state.rest; }
+std::span<const double> Simulation::forces_x() const { return impl_->state.fx; }
+std::span<const double> Simulation::forces_y() const { return impl_->state.fy; }
+
+std::vector<const Effect*> Simulation::effects() const {
+  std::vector<const Effect*> out;
+  for (const auto& e : impl_->effects) out.push_back(e.get());
+  return out;
+}
+
+const Effect* Simulation::effect(std::string_view name) const {
+  for (const auto& e : impl_->effects)
+    if (e->name() == name) return e.get();
+  return nullptr;
+}
+
+double Simulation::max_step_displacement_seen() const { return impl_->max_disp; }
+double Simulation::max_speed_seen() const { return impl_->max_speed; }
+bool Simulation::failed() const { return !impl_->failure.empty(); }
+const std::string& Simulation::failure() const { return impl_->failure; }
+const SceneParams& Simulation::scene() const { return impl_->scene; }
+const PhysicsParams& Simulation::physics() const { return impl_->physics; }
+b2World& Simulation::world() { return *impl_->world; }
+const b2World& Simulation::world() const { return *impl_->world; }
+
+}  // namespace animat

@@ -1,0 +1,309 @@
+// The GA engine, checked in milliseconds with a cheap deterministic stub fitness.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/evolution.hpp"
+
+using namespace animat;
+
+namespace {
+
+// Viable for 3 genomes in 4; fitness = mean first coordinate, which mutation can improve.
+Fitness stub_fitness(const Genome& g) {
+  Fitness f;
+  f.viable = genome_hash(g) % 4 != 0 && !g.elements.empty();
+  if (!f.viable) return f;
+  double s = 0.0;
+  for (const auto& e : g.elements) s += e.coords[0];
+  f.fitness = s / static_cast<double>(g.size());
+  f.cell_count = static_cast<int>(g.size());
+  return f;
+}
+
+Config small_config(int population = 20, std::int64_t seed = 7) {
+  Config c;
+  c.evolution.population = population;
+  c.evolution.elites = 2;
+  c.evolution.seed = seed;
+  c.evolution.threads = 1;
+  return c;
+}
+
+std::vector<GenerationStats> run(const Config& c, int generations) {
+  Evolution evo(c, stub_fitness);
+  evo.initialize();
+  for (int g = 0; g < generations; ++g) evo.step();
+  return evo.history();
+}
+
+void expect_same_history(const std::vector<GenerationStats>& a, const std::vector<GenerationStats>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].generation, b[i].generation);
+    EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
+    EXPECT_EQ(a[i].mean, b[i].mean) << "generation " << i;
+    EXPECT_EQ(a[i].median, b[i].median) << "generation " << i;
+    EXPECT_EQ(a[i].viable_fraction, b[i].viable_fraction);
+    EXPECT_EQ(a[i].best_cells, b[i].best_cells);
+    EXPECT_EQ(a[i].evaluations, b[i].evaluations);
+  }
+}
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  auto p = std::filesystem::temp_directory_path() / ("animat_test_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(p);
+  return p;
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST(Tournament, FitterWinsWithProbabilityP) {
+  std::vector<Individual> pop(2);
+  pop[0].result = {1.0, true, true, 3};
+  pop[1].result = {0.5, true, true, 3};
+  const std::vector<std::size_t> eligible = {0, 1};
+  for (double p : {0.8, 0.9}) {
+    Rng rng(11);
+    const int draws = 100000;
+    int fitter = 0;
+    for (int k = 0; k < draws; ++k) fitter += tournament(pop, eligible, p, rng) == 0;
+    const double sigma = std::sqrt(p * (1 - p) / draws);
+    EXPECT_NEAR(static_cast<double>(fitter) / draws, p, 5 * sigma) << "p = " << p;
+  }
+  Rng rng(12);
+  for (int k = 0; k < 10000; ++k) ASSERT_EQ(tournament(pop, eligible, 1.0, rng), 0u);
+}
+
+TEST(Tournament, DrawsTwoDistinctIndividualsUniformly) {
+  std::vector<Individual> pop(5);
+  for (int i = 0; i < 5; ++i) pop[static_cast<std::size_t>(i)].result = {static_cast<double>(i), true, true, 3};
+  const std::vector<std::size_t> eligible = {0, 1, 2, 3, 4};
+  // With p = 1 the winner is the fitter of the pair: P(winner = k) = (number of pairs where k is max)/C(5,2) = k/10.
+  Rng rng(3);
+  std::vector<int> wins(5, 0);
+  const int draws = 200000;
+  for (int k = 0; k < draws; ++k) ++wins[tournament(pop, eligible, 1.0, rng)];
+  for (int k = 0; k < 5; ++k) {
+    const double p = k / 10.0, sigma = std::sqrt(p * (1 - p) / draws) + 1e-12;
+    EXPECT_NEAR(static_cast<double>(wins[static_cast<std::size_t>(k)]) / draws, p, 5 * sigma) << "k = " << k;
+  }
+}
+
+TEST(Tournament, ProbabilityRampsLinearlyOverTheFirst1000Generations) {
+  const EvolutionParams p;
+  EXPECT_DOUBLE_EQ(tournament_probability(p, 0), 0.8);
+  EXPECT_DOUBLE_EQ(tournament_probability(p, 250), 0.85);
+  EXPECT_DOUBLE_EQ(tournament_probability(p, 500), 0.9);
+  EXPECT_DOUBLE_EQ(tournament_probability(p, 1000), 1.0);
+  EXPECT_DOUBLE_EQ(tournament_probability(p, 5000), 1.0);
+  for (int g = 1; g <= 1000; ++g) ASSERT_GT(tournament_probability(p, g), tournament_probability(p, g - 1));
+}
+
+TEST(Evolution, InitialPopulationIsViableAndCountsTries) {
+  Evolution evo(small_config(), stub_fitness);
+  evo.initialize();
+  ASSERT_EQ(evo.population().size(), 20u);
+  int total = 0;
+  for (const auto& ind : evo.population()) {
+    EXPECT_TRUE(ind.result.viable);
+    EXPECT_GE(ind.tries, 1);
+    total += ind.tries;
+  }
+  EXPECT_EQ(evo.evaluations(), total);
+  EXPECT_GT(total, 20);  // 1 genome in 4 is non-viable, so some individual needed a second try
+}
+
+TEST(Evolution, ElitismNeverLosesTheBest) {
+  Evolution evo(small_config(), stub_fitness);
+  evo.initialize();
+  double previous = evo.history().back().best;
+  for (int g = 0; g < 60; ++g) {
+    const GenerationStats s = evo.step();
+    ASSERT_GE(s.best, previous) << "generation " << s.generation;
+    previous = s.best;
+  }
+  EXPECT_GT(previous, evo.history().front().best);  // selection works on the stub
+}
+
+TEST(Evolution, CrossoverFractionIsTwentyPercentWithinBinomialBounds) {
+  Config c = small_config(100);
+  Evolution evo(c, stub_fitness);
+  evo.initialize();
+  long long crossovers = 0, offspring = 0;
+  for (int g = 0; g < 40; ++g) {
+    crossovers += evo.step().crossovers;
+    offspring += c.evolution.population - c.evolution.elites;
+  }
+  const double p = 0.2, sigma = std::sqrt(p * (1 - p) / static_cast<double>(offspring));
+  EXPECT_NEAR(static_cast<double>(crossovers) / static_cast<double>(offspring), p, 4 * sigma);
+}
+
+TEST(Evolution, StallStopTriggersAfterExactlyNGenerationsWithoutImprovement) {
+  Config c = small_config();
+  c.evolution.stall_generations = 7;
+  const FitnessFunction flat = [](const Genome&) { return Fitness{1.0, true, true, 3}; };
+  Evolution evo(c, flat);
+  evo.initialize();
+  for (int g = 1; g <= 7; ++g) {
+    EXPECT_TRUE(evo.stop_reason().empty()) << "generation " << evo.generation();
+    evo.step();
+    EXPECT_EQ(evo.generations_without_improvement(), g);
+  }
+  EXPECT_NE(evo.stop_reason().find("no improvement for evolution.stall_generations = 7"), std::string::npos)
+      << evo.stop_reason();
+  EXPECT_EQ(evo.generation(), 7);
+}
+
+TEST(Evolution, GenerationCapStops) {
+  Config c = small_config();
+  c.evolution.generations = 3;
+  Evolution evo(c, stub_fitness);
+  evo.initialize();
+  for (int g = 0; g < 3; ++g) {
+    EXPECT_TRUE(evo.stop_reason().empty());
+    evo.step();
+  }
+  EXPECT_NE(evo.stop_reason().find("generation cap"), std::string::npos);
+}
+
+TEST(Evolution, UnchangedOffspringAreNeverReEvaluated) {
+  Config c = small_config();
+  c.mutation = MutationParams{0, 0, 0, 0, 0, 0, 1, 1};  // no mutation at all
+  c.evolution.crossover_fraction = 0.0;
+  std::atomic<int> calls{0};
+  const FitnessFunction counting = [&](const Genome& g) { ++calls; return stub_fitness(g); };
+  Evolution evo(c, counting);
+  evo.initialize();
+  const int after_init = calls.load();
+  for (int g = 0; g < 5; ++g) evo.step();
+  EXPECT_EQ(calls.load(), after_init);  // every offspring is a copy of a parent: nothing to swim
+}
+
+TEST(Evolution, DeterministicForAnyThreadCountAndSeed) {
+  Config one = small_config(30);
+  Config two = one;
+  two.evolution.threads = 2;
+  const auto h1 = run(one, 25), h2 = run(two, 25), h1b = run(one, 25);
+  expect_same_history(h1, h2);
+  expect_same_history(h1, h1b);
+  Config other = one;
+  other.evolution.seed = 8;
+  const auto h3 = run(other, 25);
+  bool differs = false;
+  for (std::size_t i = 0; i < h1.size(); ++i) differs |= h1[i].mean != h3[i].mean;
+  EXPECT_TRUE(differs);
+}
+
+TEST(Evolution, CheckpointResumeReproducesTheUninterruptedRun) {
+  const Config c = small_config(24);
+  Evolution straight(c, stub_fitness);
+  straight.initialize();
+  for (int g = 0; g < 20; ++g) straight.step();
+
+  Evolution first(c, stub_fitness);
+  first.initialize();
+  for (int g = 0; g < 10; ++g) first.step();
+  const std::string ckpt = first.checkpoint();
+  Evolution resumed(c, stub_fitness);
+  resumed.restore(ckpt);
+  EXPECT_EQ(resumed.generation(), 10);
+  for (int g = 0; g < 10; ++g) resumed.step();
+
+  expect_same_history(straight.history(), resumed.history());
+  ASSERT_EQ(straight.population().size(), resumed.population().size());
+  for (std::size_t i = 0; i < straight.population().size(); ++i) {
+    EXPECT_TRUE(straight.population()[i].genome == resumed.population()[i].genome) << "individual " << i;
+    EXPECT_EQ(straight.population()[i].result, resumed.population()[i].result);
+  }
+}
+
+TEST(Evolution, CorruptOrMismatchedCheckpointIsRefused) {
+  const Config c = small_config();
+  Evolution evo(c, stub_fitness);
+  evo.initialize();
+  evo.step();
+  const std::string good = evo.checkpoint();
+  auto message = [&](const std::string& text, const Config& cfg) {
+    Evolution other(cfg, stub_fitness);
+    try {
+      other.restore(text, "run/checkpoint.json");
+    } catch (const CheckpointError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(good.substr(0, good.size() / 2), c).find("run/checkpoint.json: corrupt checkpoint"), std::string::npos);
+  std::string flipped = good;
+  const auto pos = flipped.find("fitness");
+  ASSERT_NE(pos, std::string::npos);
+  flipped[pos + 12] = flipped[pos + 12] == '1' ? '2' : '1';
+  EXPECT_NE(message(flipped, c).find("checksum"), std::string::npos) << message(flipped, c);
+  Config changed = c;
+  changed.scene.drag_normal = 10.0;
+  EXPECT_NE(message(good, changed).find("different run configuration"), std::string::npos);
+  Config longer = c;
+  longer.evolution.generations = 500;  // stopping knobs may change on resume
+  EXPECT_EQ(message(good, longer), "no error");
+  EXPECT_NE(message("{\"checksum\": \"0\", \"payload\": 3}", c).find("not an animat checkpoint"), std::string::npos);
+}
+
+TEST(RunDirectory, WritesConfigHistoryLineageAndCheckpointThenResumes) {
+  const auto dir = fresh_dir("rundir");
+  Config c = small_config();
+  c.evolution.generations = 6;
+  RunOptions opt;
+  opt.out = dir;
+  opt.quiet = true;
+  const RunSummary s = run_evolution(c, opt, stub_fitness);
+  EXPECT_NE(s.stop_reason.find("generation cap"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.json"));
+  EXPECT_EQ(load_config(dir / "config.toml"), c);
+  const std::string hist = slurp(dir / "history.csv");
+  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,wall_seconds\n", 0), 0u);
+  EXPECT_EQ(std::count(hist.begin(), hist.end(), '\n'), 1 + 7);  // header + generations 0..6
+  EXPECT_TRUE(std::filesystem::exists(dir / "best" / "gen_000000.json"));
+
+  // A second run into the same directory is refused; a resume with a higher cap continues it.
+  EXPECT_THROW(run_evolution(c, opt, stub_fitness), IoError);
+  c.evolution.generations = 10;
+  opt.resume = true;
+  const RunSummary r = run_evolution(c, opt, stub_fitness);
+  EXPECT_EQ(r.history.back().generation, 10);
+  const std::string hist2 = slurp(dir / "history.csv");
+  EXPECT_EQ(std::count(hist2.begin(), hist2.end(), '\n'), 1 + 11);
+
+  Config straight_cfg = c;
+  RunOptions straight_opt;
+  straight_opt.out = fresh_dir("straight");
+  straight_opt.quiet = true;
+  const RunSummary straight = run_evolution(straight_cfg, straight_opt, stub_fitness);
+  expect_same_history(straight.history, r.history);
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(straight_opt.out);
+}
+
+TEST(RunDirectory, MissingResumeDirectoryIsAClearError) {
+  RunOptions opt;
+  opt.out = fresh_dir("missing");
+  opt.resume = true;
+  opt.quiet = true;
+  try {
+    (void)run_evolution(small_config(), opt, stub_fitness);
+    FAIL() << "expected an error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("resume directory does not exist"), std::string::npos) << e.what();
+  }
+}
