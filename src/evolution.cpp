@@ -1,6 +1,5 @@
 #include "animat/evolution.hpp"
 
-#include <box2d/box2d.h>
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <omp.h>
@@ -22,6 +21,7 @@
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/physics.hpp"
 
 namespace animat {
 
@@ -90,24 +90,7 @@ std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std
   return rng.bernoulli(p_fitter) ? winner : loser;
 }
 
-void prepare_parallel_evaluation() {
-  // Box2D 2.4 fills its contact registry lazily and keeps process-wide GJK/TOI counters: touch them
-  // once on this thread with two touching circles before any parallel region.
-  static std::once_flag once;
-  std::call_once(once, [] {
-    b2World world(b2Vec2(0.0f, 0.0f));
-    world.SetContinuousPhysics(false);
-    b2CircleShape circle;
-    circle.m_radius = 0.5f;
-    for (float x : {0.0f, 0.6f}) {
-      b2BodyDef def;
-      def.type = b2_dynamicBody;
-      def.position.Set(x, 0.0f);
-      world.CreateBody(&def)->CreateFixture(&circle, 1.0f);
-    }
-    world.Step(1.0f / 60.0f, 1, 1);
-  });
-}
+void prepare_parallel_evaluation() { warm_up_box2d(); }
 
 std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness, int threads) {
   prepare_parallel_evaluation();
@@ -503,11 +486,13 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
 
   RunSummary summary;
   double last_print = 0.0;
+  int last_printed = -1;
   auto report = [&](const GenerationStats& s, bool force) {
-    if (opt.quiet) return;
+    if (opt.quiet || s.generation == last_printed) return;
     const double t = now_seconds();
     if (!force && t - last_print < opt.progress_interval) return;
     last_print = t;
+    last_printed = s.generation;
     std::string left;
     if (config.evolution.wall_seconds > 0) left = fmt::format(", {} left of budget", duration(config.evolution.wall_seconds - s.wall_seconds));
     else if (config.evolution.generations > 0 && s.generation > 0)

@@ -342,6 +342,7 @@ double Simulation::kinetic_energy() const {
 std::span<const double> Simulation::rest_lengths_now() const { return impl_->state.rest; }
 std::span<const double> Simulation::forces_x() const { return impl_->state.fx; }
 std::span<const double> Simulation::forces_y() const { return impl_->state.fy; }
+const SwimState& Simulation::state() const { return impl_->state; }
 
 std::vector<const Effect*> Simulation::effects() const {
   std::vector<const Effect*> out;

@@ -98,6 +98,8 @@ class Simulation {
   /// Forces of the last step (or compute_forces()), n each.
   [[nodiscard]] std::span<const double> forces_x() const;
   [[nodiscard]] std::span<const double> forces_y() const;
+  /// The SoA state: positions and velocities as of the end of the last step (no allocation).
+  [[nodiscard]] const SwimState& state() const;
   /// Enabled effects, in the order they run.
   [[nodiscard]] std::vector<const Effect*> effects() const;
   [[nodiscard]] const Effect* effect(std::string_view name) const;

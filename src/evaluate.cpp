@@ -1,0 +1,133 @@
+// Fitness evaluation: genome -> development -> body -> swim -> distance of the centre of mass.
+#include "animat/evaluate.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "animat/body.hpp"
+#include "animat/development.hpp"
+#include "animat/errors.hpp"
+#include "animat/physics.hpp"
+
+namespace animat {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Spring length / L0 extremes, kinetic energy: sampled diagnostics of a swim.
+void sample(const Simulation& sim, const Body& body, SwimResult& r) {
+  const SwimState& st = sim.state();
+  for (int s = 0; s < body.spring_count(); ++s) {
+    const double l0 = body.rest_lengths(s);
+    if (!(l0 > 0.0)) continue;
+    const auto i = static_cast<std::size_t>(body.springs(s, 0)), j = static_cast<std::size_t>(body.springs(s, 1));
+    const double len = std::hypot(st.x[j] - st.x[i], st.y[j] - st.y[i]);
+    r.max_stretch = std::max(r.max_stretch, len / l0);
+    r.min_stretch = std::min(r.min_stretch, len / l0);
+  }
+  r.max_kinetic_energy = std::max(r.max_kinetic_energy, sim.kinetic_energy());
+}
+
+}  // namespace
+
+SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps) {
+  constexpr long kSampleEvery = 16;
+  SwimResult r;
+  Simulation sim(body, scene, physics);
+  r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  const Eigen::Vector2d start = sim.center_of_mass();
+  sample(sim, body, r);
+  try {
+    for (long done = 0; done < steps;) {
+      const long chunk = std::min(kSampleEvery, steps - done);
+      sim.step(chunk);
+      done += chunk;
+      sample(sim, body, r);
+    }
+  } catch (const SimulationError& e) {
+    r.stable = false;
+    r.failure = e.what();
+  }
+  r.steps = sim.steps_done();
+  r.simulated_time = sim.time();
+  r.max_speed = sim.max_speed_seen();
+  r.max_step_displacement = sim.max_step_displacement_seen();
+  r.final_kinetic_energy = sim.kinetic_energy();
+  r.displacement = sim.center_of_mass() - start;
+  if (r.stable && !r.displacement.allFinite()) {
+    r.stable = false;
+    r.failure = "unstable swim: non-finite centre of mass";
+  }
+  r.distance = r.stable ? r.displacement.norm() : 0.0;
+  if (body.spring_count() > 0 && !std::isfinite(r.min_stretch)) r.min_stretch = 0.0;
+  return r;
+}
+
+EvaluationResult evaluate(const Genome& genome, const Config& config) {
+  EvaluationResult out;
+  validate(config.scene);
+  validate(config.physics);
+  auto t0 = Clock::now();
+  Embryo embryo;
+  try {
+    embryo = develop(genome, config.genome, config.grn, config.development);
+  } catch (const SimulationError& e) {
+    out.seconds_development = seconds_since(t0);
+    out.viable = false;
+    out.stable = false;
+    out.reasons.push_back(fmt::format("development: {}", e.what()));
+    return out;
+  }
+  out.seconds_development = seconds_since(t0);
+  out.cell_count = embryo.cell_count();
+  out.development_steps = embryo.steps_run;
+  out.viable = embryo.viable;
+  if (!embryo.viable) {
+    out.reasons = embryo.reasons;
+    return out;
+  }
+
+  t0 = Clock::now();
+  Body body;
+  try {
+    body = build_body(embryo, config.body);
+  } catch (const GeometryError& e) {
+    out.seconds_body = seconds_since(t0);
+    out.viable = false;
+    out.reasons.push_back(fmt::format("body: {}", e.what()));
+    return out;
+  }
+  out.seconds_body = seconds_since(t0);
+  out.spring_count = body.spring_count();
+  out.region_count = body.region_count();
+  out.skin_edge_count = static_cast<int>(body.skin.rows());
+
+  t0 = Clock::now();
+  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps);
+  out.seconds_swim = seconds_since(t0);
+  out.stable = s.stable;
+  if (!s.stable) out.reasons.push_back(s.failure);
+  out.fitness = s.distance;
+  out.displacement = s.displacement;
+  out.swim_steps = s.steps;
+  out.simulated_time = s.simulated_time;
+  out.max_speed = s.max_speed;
+  out.max_step_displacement = s.max_step_displacement;
+  out.max_stretch = s.max_stretch;
+  out.min_stretch = s.min_stretch;
+  out.max_kinetic_energy = s.max_kinetic_energy;
+  out.final_kinetic_energy = s.final_kinetic_energy;
+  return out;
+}
+
+}  // namespace animat
