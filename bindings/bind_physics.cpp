@@ -1,5 +1,313 @@
+// Python bindings of the swim stage: Scene (effects + coefficients), Simulation, swim() and evaluate().
+#include <nanobind/eigen/dense.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/string_view.h>
+#include <nanobind/stl/variant.h>
+#include <nanobind/stl/vector.h>
+
+#include <fmt/format.h>
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "animat/body.hpp"
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluate.hpp"
+#include "animat/physics.hpp"
+#include "animat/scene.hpp"
 #include "bindings.hpp"
 
+namespace nb = nanobind;
+using namespace nb::literals;
+
 namespace animat::py {
-void bind_physics(nanobind::module_&) {}  // filled in by the physics stage
+namespace {
+
+std::vector<std::string> scene_keys() {
+  SceneParams p;
+  std::vector<std::string> out;
+  visit_fields(p, [&](const FieldInfo& info, auto&) { out.emplace_back(info.name); });
+  return out;
+}
+
+/// Sets scene fields from a {name: value} mapping through the config machinery (types and ranges
+/// checked there); an unknown name is a ValueError naming it.
+SceneParams scene_with(SceneParams base, const nb::handle& mapping, const char* who) {
+  const auto keys = scene_keys();
+  Config c;
+  c.scene = std::move(base);
+  for (auto item : nb::cast<nb::dict>(mapping)) {
+    const std::string key = nb::cast<std::string>(item.first);
+    if (std::find(keys.begin(), keys.end(), key) == keys.end())
+      throw ConfigError(fmt::format("{}: unknown keyword '{}' (expected any of {})", who, key, fmt::join(keys, ", ")));
+    ConfigValue v;
+    if (nb::isinstance<nb::tuple>(item.second) || nb::isinstance<nb::list>(item.second)) {
+      std::vector<std::string> words;
+      for (auto w : item.second) words.push_back(nb::cast<std::string>(w));
+      v = std::move(words);
+    } else {
+      v = nb::cast<ConfigValue>(item.second);
+    }
+    set_value(c, "scene." + key, v);
+  }
+  validate(c.scene);
+  return c.scene;
+}
+
+nb::dict scene_to_dict(const SceneParams& p) {
+  Config c;
+  c.scene = p;
+  nb::dict d;
+  for (const auto& k : scene_keys()) d[k.c_str()] = nb::cast(get_value(c, "scene." + k));
+  return d;
+}
+
+std::string scene_repr(const SceneParams& p) {
+  std::string out = "animat.Scene(";
+  Config c;
+  c.scene = p;
+  bool first = true;
+  for (const auto& k : scene_keys()) {
+    const ConfigValue v = get_value(c, "scene." + k);
+    std::string s;
+    std::visit([&](const auto& x) {
+      using X = std::decay_t<decltype(x)>;
+      if constexpr (std::is_same_v<X, std::vector<std::string>>) {
+        s = "[";
+        for (std::size_t i = 0; i < x.size(); ++i) s += (i ? ", '" : "'") + x[i] + "'";
+        s += "]";
+      } else if constexpr (std::is_same_v<X, std::vector<double>>) {
+        s = fmt::format("{}", fmt::join(x, ", "));
+      } else if constexpr (std::is_same_v<X, std::string>) {
+        s = "'" + x + "'";
+      } else if constexpr (std::is_same_v<X, bool>) {
+        s = x ? "True" : "False";
+      } else {
+        s = fmt::format("{}", x);
+      }
+    }, v);
+    out += (first ? "" : ", ") + k + "=" + s;
+    first = false;
+  }
+  return out + ")";
+}
+
+nb::ndarray<nb::numpy, double> owned_array(std::vector<double> v, std::initializer_list<std::size_t> shape) {
+  auto* heap = new std::vector<double>(std::move(v));
+  nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<double>*>(p); });
+  return nb::ndarray<nb::numpy, double>(heap->data(), shape.size(), shape.begin(), owner);
+}
+
+const char* kSceneDoc =
+    "The effects a swim simulates, with their coefficients (paper §4; MODEL.md §5).\n\n"
+    "``Scene()`` is the default swim scene (all five effects, d_N = 2). Keywords set fields by their\n"
+    "config names, e.g. ``Scene(effects=['springs', 'actuation', 'pressure', 'drag'], drag_normal=10)``;\n"
+    "an unknown keyword or an out-of-range value raises ValueError naming it. Effect names (same in\n"
+    "TOML): springs, actuation, pressure, drag, skin_collision. Fields are readable and writable as\n"
+    "attributes; ``drag_tangential < 0`` means drag_normal/200 (paper §6).";
+
+const char* kSimulationDoc =
+    "A swim simulation of one Body: a Box2D world with one fixture-less body per cell, driven by the\n"
+    "scene's effects (see ``animat.Scene``).\n\n"
+    "``Simulation(body, scene=None, config=None)``: ``scene`` (an animat.Scene) defaults to\n"
+    "``config.scene``, or the default scene; the physics (dt, substeps, drag scheme) come from\n"
+    "``config.physics`` (default config if None). One ``step()`` is one control step of dt =\n"
+    "``config.physics.dt`` (``substeps`` Box2D steps). A step that would leave the valid domain\n"
+    "(non-finite state, or a displacement per Box2D step above physics.max_step_displacement)\n"
+    "raises RuntimeError and leaves the state as it was before that Box2D step.";
+
+}  // namespace
+
+void bind_physics(nb::module_& m) {
+  auto scene = nb::class_<SceneParams>(m, "Scene", kSceneDoc);
+  scene
+      .def("__init__", [](SceneParams* p, const nb::kwargs& kw) { new (p) SceneParams(scene_with(SceneParams{}, kw, "Scene")); },
+           "Build a scene from keywords (config names of the [scene] section); no keyword = default scene.")
+      .def_static("from_dict", [](const nb::dict& d) { return scene_with(SceneParams{}, d, "Scene.from_dict"); }, "values"_a,
+                  "Build a scene from a {field: value} dict (the [scene] section of a config).")
+      .def_static("from_config", [](const Config& c) { return SceneParams(c.scene); }, "config"_a,
+                  "The scene of an animat.Config (its [scene] section).")
+      .def("to_dict", &scene_to_dict, "The scene as a {field: value} dict.")
+      .def("replace", [](const SceneParams& p, const nb::kwargs& kw) { return scene_with(p, kw, "Scene.replace"); },
+           "A copy with some fields changed by keyword.")
+      .def_prop_ro("effect_names", [](const SceneParams&) {
+        std::vector<std::string> out;
+        for (auto n : kSceneEffectNames) out.emplace_back(n);
+        return out;
+      }, "Every effect name a scene may list.")
+      .def("__getattr__", [](const SceneParams& p, const std::string& k) -> ConfigValue {
+        const auto keys = scene_keys();
+        if (std::find(keys.begin(), keys.end(), k) == keys.end())
+          throw nb::attribute_error(("Scene has no field '" + k + "'").c_str());
+        Config c;
+        c.scene = p;
+        return get_value(c, "scene." + k);
+      }, "name"_a)
+      .def("__setattr__", [](SceneParams& p, const std::string& k, nb::object v) {
+        nb::dict d;
+        d[k.c_str()] = v;
+        p = scene_with(p, d, "Scene");
+      }, "name"_a, "value"_a)
+      .def("__dir__", [](const SceneParams&) { return scene_keys(); })
+      .def("__eq__", [](const SceneParams& a, const SceneParams& b) {
+        Config ca, cb;
+        ca.scene = a;
+        cb.scene = b;
+        return ca == cb;
+      })
+      .def("__copy__", [](const SceneParams& p) { return SceneParams(p); })
+      .def("__deepcopy__", [](const SceneParams& p, nb::handle) { return SceneParams(p); }, "memo"_a)
+      .def("__repr__", &scene_repr);
+
+  nb::class_<SwimResult>(m, "SwimResult", "What one swim did (see ``animat.swim``).")
+      .def_ro("distance", &SwimResult::distance, "|COM(end) - COM(start)|; 0 when unstable.")
+      .def_prop_ro("displacement", [](const SwimResult& r) -> Eigen::Vector2d { return r.displacement; },
+                   "COM(end) - COM(start) as a (2,) array.")
+      .def_ro("stable", &SwimResult::stable, "False if a step left the valid domain.")
+      .def_ro("failure", &SwimResult::failure, "The instability message ('' when stable).")
+      .def_ro("steps", &SwimResult::steps, "Control steps completed.")
+      .def_ro("simulated_time", &SwimResult::simulated_time, "Simulated time swum.")
+      .def_ro("max_speed", &SwimResult::max_speed, "Largest cell speed seen.")
+      .def_ro("max_step_displacement", &SwimResult::max_step_displacement, "Largest |v|*h of one Box2D step seen.")
+      .def_ro("max_stretch", &SwimResult::max_stretch, "Largest spring length / L0 (sampled every 16 steps).")
+      .def_ro("min_stretch", &SwimResult::min_stretch, "Smallest spring length / L0 (same samples).")
+      .def_ro("final_kinetic_energy", &SwimResult::final_kinetic_energy, "Kinetic energy at the end.")
+      .def_ro("max_kinetic_energy", &SwimResult::max_kinetic_energy, "Largest kinetic energy (same samples).")
+      .def("__repr__", [](const SwimResult& r) {
+        return fmt::format("<animat.SwimResult distance={:.6g} stable={} steps={}>", r.distance, r.stable ? "True" : "False", r.steps);
+      });
+
+  nb::class_<EvaluationResult>(m, "EvaluationResult", "Fitness and diagnostics of one genome (see ``animat.evaluate``).")
+      .def_ro("fitness", &EvaluationResult::fitness, "Straight-line distance of the centre of mass, start to end (0 if not viable or unstable).")
+      .def_ro("viable", &EvaluationResult::viable, "Development verdict; non-viable genomes are never swum.")
+      .def_ro("stable", &EvaluationResult::stable, "False if the development or the swim left the valid domain.")
+      .def_ro("cell_count", &EvaluationResult::cell_count, "Cells of the embryo.")
+      .def_ro("reasons", &EvaluationResult::reasons, "Non-viability reasons, or the instability description.")
+      .def_prop_ro("displacement", [](const EvaluationResult& r) -> Eigen::Vector2d { return r.displacement; },
+                   "COM(end) - COM(start) as a (2,) array.")
+      .def_ro("spring_count", &EvaluationResult::spring_count, "Springs of the body.")
+      .def_ro("region_count", &EvaluationResult::region_count, "Regions of the body.")
+      .def_ro("skin_edge_count", &EvaluationResult::skin_edge_count, "Skin edges of the body.")
+      .def_ro("development_steps", &EvaluationResult::development_steps, "Development steps actually run.")
+      .def_ro("swim_steps", &EvaluationResult::swim_steps, "Control steps swum.")
+      .def_ro("simulated_time", &EvaluationResult::simulated_time, "Simulated swim time.")
+      .def_ro("max_speed", &EvaluationResult::max_speed, "Largest cell speed seen.")
+      .def_ro("max_step_displacement", &EvaluationResult::max_step_displacement, "Largest |v|*h of one Box2D step seen.")
+      .def_ro("max_stretch", &EvaluationResult::max_stretch, "Largest spring length / L0 (sampled every 16 steps).")
+      .def_ro("min_stretch", &EvaluationResult::min_stretch, "Smallest spring length / L0 (same samples).")
+      .def_ro("max_kinetic_energy", &EvaluationResult::max_kinetic_energy, "Largest kinetic energy (same samples).")
+      .def_ro("final_kinetic_energy", &EvaluationResult::final_kinetic_energy, "Kinetic energy at the end.")
+      .def_ro("seconds_development", &EvaluationResult::seconds_development, "Wall time of development (diagnostic).")
+      .def_ro("seconds_body", &EvaluationResult::seconds_body, "Wall time of body construction (diagnostic).")
+      .def_ro("seconds_swim", &EvaluationResult::seconds_swim, "Wall time of the swim (diagnostic).")
+      .def("__repr__", [](const EvaluationResult& r) {
+        return fmt::format("<animat.EvaluationResult fitness={:.6g} viable={} stable={} cells={}>", r.fitness,
+                           r.viable ? "True" : "False", r.stable ? "True" : "False", r.cell_count);
+      });
+
+  nb::class_<Simulation>(m, "Simulation", kSimulationDoc)
+      .def("__init__", [](Simulation* s, const Body& body, std::optional<SceneParams> scene, std::optional<Config> config) {
+        const Config c = config ? *config : Config{};
+        new (s) Simulation(body, scene ? *scene : c.scene, c.physics);
+      }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none())
+      .def("step", [](Simulation& s, long n) {
+        if (n < 0) throw ConfigError(fmt::format("Simulation.step: n must be >= 0, got {}", n));
+        nb::gil_scoped_release release;
+        s.step(n);
+      }, "n"_a = 1, "Advance n control steps; raises RuntimeError if a step leaves the valid domain.")
+      .def("record", [](Simulation& s, long steps, long every) {
+        if (steps < 0) throw ConfigError(fmt::format("Simulation.record: steps must be >= 0, got {}", steps));
+        if (every < 1) throw ConfigError(fmt::format("Simulation.record: every must be >= 1, got {}", every));
+        const auto n = static_cast<std::size_t>(s.node_count());
+        const auto frames = static_cast<std::size_t>(steps / every + 1);
+        std::vector<double> out;
+        out.reserve(frames * n * 2);
+        auto grab = [&] {
+          const SwimState& st = s.state();
+          for (std::size_t i = 0; i < n; ++i) {
+            out.push_back(st.x[i]);
+            out.push_back(st.y[i]);
+          }
+        };
+        {
+          nb::gil_scoped_release release;
+          grab();
+          for (std::size_t f = 1; f < frames; ++f) {
+            s.step(every);
+            grab();
+          }
+        }
+        return owned_array(std::move(out), {frames, n, 2});
+      }, "steps"_a, "every"_a = 1,
+         "Advance `steps` control steps and return the positions as a (frames, n, 2) array: the current\n"
+         "state, then every `every` steps (frames = steps // every + 1; trailing steps that do not fill\n"
+         "a frame are not run).")
+      .def("compute_forces", [](Simulation& s) {
+        s.compute_forces();
+        const auto n = static_cast<std::size_t>(s.node_count());
+        std::vector<double> f(2 * n);
+        for (std::size_t i = 0; i < n; ++i) {
+          f[2 * i] = s.forces_x()[i];
+          f[2 * i + 1] = s.forces_y()[i];
+        }
+        return owned_array(std::move(f), {n, 2});
+      }, "The (n, 2) forces the enabled effects produce in the current state (nothing is integrated).")
+      .def_prop_ro("positions", [](const Simulation& s) -> Points { return s.positions(); }, "(n, 2) cell positions.")
+      .def_prop_ro("velocities", [](const Simulation& s) -> Points { return s.velocities(); }, "(n, 2) cell velocities.")
+      .def("center_of_mass", [](const Simulation& s) -> Eigen::Vector2d { return s.center_of_mass(); },
+           "The centre of mass (equal masses: the mean position) as a (2,) array.")
+      .def("momentum", [](const Simulation& s) -> Eigen::Vector2d { return s.momentum(); }, "Total momentum, (2,).")
+      .def("kinetic_energy", &Simulation::kinetic_energy, "Total kinetic energy.")
+      .def_prop_ro("time", &Simulation::time, "Simulated time.")
+      .def_prop_ro("steps_done", &Simulation::steps_done, "Control steps done.")
+      .def_prop_ro("node_count", &Simulation::node_count, "Cells.")
+      .def_prop_ro("rest_lengths_now", [](const Simulation& s) {
+        const auto r = s.rest_lengths_now();
+        return owned_array(std::vector<double>(r.begin(), r.end()), {r.size()});
+      }, "(m,) current rest length of every spring (eq. 2 at the last step).")
+      .def_prop_ro("effects", [](const Simulation& s) {
+        std::vector<std::string> out;
+        for (const Effect* e : s.effects()) out.emplace_back(e->name());
+        return out;
+      }, "Enabled effects, in the order they run each step.")
+      .def_prop_ro("scene", [](const Simulation& s) { return s.scene(); }, "The simulation's Scene (a copy).")
+      .def_prop_ro("failed", &Simulation::failed, "True after a step raised.")
+      .def_prop_ro("max_speed_seen", &Simulation::max_speed_seen, "Largest cell speed seen so far.")
+      .def_prop_ro("max_step_displacement_seen", &Simulation::max_step_displacement_seen,
+                   "Largest |v|*h a cell was about to move in one Box2D step so far.")
+      .def("__len__", &Simulation::node_count)
+      .def("__repr__", [](const Simulation& s) {
+        return fmt::format("<animat.Simulation cells={} t={:.6g} steps={}>", s.node_count(), s.time(), s.steps_done());
+      });
+
+  m.def("swim", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config, std::optional<long> steps) {
+        const Config c = config ? *config : Config{};
+        const long n = steps ? *steps : c.evaluation.steps;
+        if (n < 0) throw ConfigError(fmt::format("swim: steps must be >= 0, got {}", n));
+        nb::gil_scoped_release release;
+        return swim(body, scene ? *scene : c.scene, c.physics, n);
+      }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "steps"_a = nb::none(),
+      "Swim a body for `steps` control steps (default config.evaluation.steps) and return a SwimResult.\n"
+      "Never raises for an unstable swim: it returns stable=False and distance 0.");
+  m.def("evaluate", [](const Genome& genome, std::optional<Config> config) {
+        const Config c = config ? *config : Config{};
+        nb::gil_scoped_release release;
+        return evaluate(genome, c);
+      }, "genome"_a, "config"_a = nb::none(),
+      "genome -> development -> body -> swim; returns an EvaluationResult (fitness = distance of the\n"
+      "centre of mass). Deterministic. Non-viable genomes are not swum; unstable swims give fitness 0\n"
+      "and stable=False.");
+  m.def("warm_up_box2d", &warm_up_box2d,
+        "Initialise Box2D's lazily filled globals; call once before using worlds from several threads.");
+  m.def("actuation_start_time", &actuation_start_time, "frequency"_a, "phase"_a,
+        "When a cell's oscillation starts (paper §3): the first t >= 0 where sin(f*t + phase) crosses 0.");
+  m.def("actuation_term", &actuation_term, "amplitude"_a, "frequency"_a, "phase"_a, "t"_a,
+        "A cell's term of eq. 2 at time t: a*sin(f*t + phase) once started, else 0.");
+}
+
 }  // namespace animat::py

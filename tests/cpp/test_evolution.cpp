@@ -307,3 +307,39 @@ TEST(RunDirectory, MissingResumeDirectoryIsAClearError) {
     EXPECT_NE(std::string(e.what()).find("resume directory does not exist"), std::string::npos) << e.what();
   }
 }
+
+TEST(EndToEnd, SmallRealRunImprovesTheBestFitness) {
+  // Real chain (development, body, swim) at a small scale: 16 individuals, 10 generations, 1000 steps.
+  Config c;
+  c.evolution.population = 16;
+  c.evolution.generations = 10;
+  c.evolution.seed = 1;
+  c.evolution.threads = 2;
+  c.evaluation.steps = 1000;
+  RunOptions opt;
+  opt.quiet = true;
+  const RunSummary r = run_evolution(c, opt);
+  ASSERT_EQ(r.history.size(), 11u);
+  EXPECT_GT(r.history.front().best, 0.0);
+  EXPECT_GT(r.history.back().best, 1.5 * r.history.front().best)
+      << "initial " << r.history.front().best << ", final " << r.history.back().best;
+  EXPECT_TRUE(r.best.result.viable);
+  EXPECT_TRUE(r.best.result.stable);
+  EXPECT_GE(r.best.result.cell_count, 3);
+}
+
+TEST(EndToEnd, RealRunIsIdenticalOnOneAndTwoThreads) {
+  Config c;
+  c.evolution.population = 12;
+  c.evolution.generations = 4;
+  c.evolution.seed = 5;
+  c.evaluation.steps = 400;
+  RunOptions opt;
+  opt.quiet = true;
+  c.evolution.threads = 1;
+  const RunSummary one = run_evolution(c, opt);
+  c.evolution.threads = 2;
+  const RunSummary two = run_evolution(c, opt);
+  expect_same_history(one.history, two.history);
+  EXPECT_TRUE(one.best.genome == two.best.genome);
+}

@@ -1,0 +1,92 @@
+"""The GA through `import animat`: evolve, callbacks, run directories, parallel evaluation."""
+import csv
+import json
+
+import pytest
+
+import animat
+
+
+def small_config(population=12, generations=3, steps=300, seed=3):
+    c = animat.Config()
+    c["evolution.population"] = population
+    c["evolution.generations"] = generations
+    c["evaluation.steps"] = steps
+    c["evolution.seed"] = seed
+    return c
+
+
+def test_tournament_probability_ramps_from_0_8_to_1():
+    assert animat.tournament_probability(0) == pytest.approx(0.8)
+    assert animat.tournament_probability(500) == pytest.approx(0.9)
+    assert animat.tournament_probability(1000) == pytest.approx(1.0)
+    assert animat.tournament_probability(4000) == pytest.approx(1.0)
+
+
+def test_evolve_returns_history_and_best_and_elitism_holds():
+    r = animat.evolve(small_config(generations=4))
+    assert [h.generation for h in r.history] == [0, 1, 2, 3, 4]
+    bests = [h.best for h in r.history]
+    assert all(b2 >= b1 for b1, b2 in zip(bests, bests[1:]))
+    assert r.best_fitness.fitness == pytest.approx(bests[-1])
+    assert r.best_fitness.viable
+    assert isinstance(r.best_genome, animat.Genome)
+    assert "generation cap" in r.stop_reason
+
+
+def test_callback_sees_every_generation_and_can_stop_the_run():
+    seen = []
+
+    def cb(stats):
+        seen.append(stats.generation)
+        return stats.generation < 2
+
+    r = animat.evolve(small_config(generations=10), callback=cb)
+    assert seen == [1, 2]
+    assert r.stop_reason == "stopped by callback"
+
+
+def test_run_directory_layout_and_resume(tmp_path):
+    out = tmp_path / "run"
+    c = small_config(generations=2)
+    animat.evolve(c, out=str(out))
+    assert (out / "config.toml").exists() and (out / "checkpoint.json").exists()
+    rows = list(csv.reader(open(out / "history.csv")))
+    assert rows[0] == ["generation", "best", "mean", "median", "viable_fraction", "best_cells", "evaluations", "wall_seconds"]
+    assert [r[0] for r in rows[1:]] == ["0", "1", "2"]
+    lineage = sorted((out / "best").glob("gen_*.json"))
+    assert lineage and lineage[0].name == "gen_000000.json"
+    entry = json.loads(lineage[-1].read_text())
+    assert {"generation", "fitness", "cell_count", "genome"} <= set(entry)
+    assert animat.Genome.from_json(json.dumps(entry["genome"])).__len__() > 0
+
+    with pytest.raises(OSError, match="already holds a run"):
+        animat.evolve(c, out=str(out))
+    c["evolution.generations"] = 4
+    r = animat.evolve(c, out=str(out), resume=True)
+    assert r.history[-1].generation == 4
+    straight = animat.evolve(c)
+    assert [h.best for h in straight.history] == [h.best for h in r.history]
+    assert [h.mean for h in straight.history] == [h.mean for h in r.history]
+
+    other = small_config(generations=4)
+    other["scene.drag_normal"] = 10.0
+    with pytest.raises(ValueError, match="different run configuration"):
+        animat.evolve(other, out=str(out), resume=True)
+
+
+def test_resume_of_a_missing_directory_is_a_clear_error(tmp_path):
+    with pytest.raises(OSError, match="resume directory does not exist"):
+        animat.evolve(small_config(), out=str(tmp_path / "nope"), resume=True)
+
+
+def test_evaluate_population_is_thread_count_independent():
+    c = small_config(steps=300)
+    genomes = [animat.Genome.random(s) for s in range(1500)]
+    one = animat.evaluate_population(genomes, c, threads=1)
+    two = animat.evaluate_population(genomes, c, threads=2)
+    assert [(f.fitness, f.viable, f.cell_count) for f in one] == [(f.fitness, f.viable, f.cell_count) for f in two]
+    viable = [f for f in one if f.viable]
+    assert viable, "1500 random genomes should contain a viable one (about 0.7% are)"
+    assert all(f.fitness >= 0 and f.stable for f in one)
+    assert all(f.fitness == 0 for f in one if not f.viable)
