@@ -421,7 +421,9 @@ TEST(Operators, MutateTypesAtRateOneChangesEveryTypeAndStaysValid) {
       EXPECT_NE(g.elements[i].type, before.elements[i].type);
       EXPECT_EQ(g.elements[i].sign, before.elements[i].sign);
       EXPECT_EQ(g.elements[i].coords, before.elements[i].coords);
-      if (!g.elements[i].is_special()) EXPECT_EQ(g.elements[i].channel, 0);
+      if (!g.elements[i].is_special()) {
+        EXPECT_EQ(g.elements[i].channel, 0);
+      }
     }
   }
   Genome g = random_with(1);
@@ -668,7 +670,9 @@ TEST(Operators, CrossoverOfDifferentLengthsIsBuiltFromParentSegments) {
       const bool in_b = i < b.size() && child.elements[i] == b.elements[i];
       ASSERT_TRUE(in_a || in_b) << "seed " << seed << " index " << i;
       const int now = in_a ? 0 : 1;
-      if (i == 0) ASSERT_TRUE(in_a) << "crossover starts with parent a";
+      if (i == 0) {
+        ASSERT_TRUE(in_a) << "crossover starts with parent a";
+      }
       if (from >= 0 && now != from) ++switches;
       from = now;
     }
@@ -722,7 +726,9 @@ TEST(Operators, CrossoverOfDifferentDimensionsIsRejectedOrValid) {
   } catch (const Error&) {
     threw = true;
   }
-  if (!threw) EXPECT_NO_THROW(validate(child, GenomeParams{})) << "crossover silently mixed 2-D and 3-D elements";
+  if (!threw) {
+    EXPECT_NO_THROW(validate(child, GenomeParams{})) << "crossover silently mixed 2-D and 3-D elements";
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------
