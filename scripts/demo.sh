@@ -1,7 +1,17 @@
 #!/usr/bin/env bash
-# README command 1: set up, build, and run animat_evolve on its embedded default config (short demo).
+# README command 1: set up, build, and run animat_evolve on its embedded default config as a short
+# demo (the paper's d_N = 2, 32-cell setting, capped at a few generations), then draw the result.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build.sh
-./build/animat_evolve "$@"
+OUT=${ANIMAT_DEMO_OUT:-runs/demo}
+GENERATIONS=${ANIMAT_DEMO_GENERATIONS:-25}
+rm -rf "$OUT"
+./build/animat_evolve --generations "$GENERATIONS" --out "$OUT" "$@"
+if [[ -f python/animat/__main__.py ]]; then
+  echo
+  echo "== Drawing the best swimmer of $OUT =="
+  PYTHONPATH=build/python .venv/bin/python -m animat show "$OUT"
+  PYTHONPATH=build/python .venv/bin/python -m animat animate "$OUT"
+fi
