@@ -10,3 +10,10 @@ ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$(nproc)"
 echo "== Python tests (pytest) =="
 ANIMAT_EVOLVE_EXE="$PWD/$BUILD_DIR/animat_evolve" PYTHONPATH="$PWD/$BUILD_DIR/python" \
   .venv/bin/python -m pytest -q tests/python
+# Sanitizers, ThreadSanitizer and time-boxed fuzzers: always in CI, on request locally.
+if [[ "${CI:-}" == "true" || "${ANIMAT_RELIABILITY:-0}" == "1" ]]; then
+  if [[ -x scripts/reliability.sh ]]; then
+    echo "== Reliability: sanitizers and fuzzers =="
+    scripts/reliability.sh
+  fi
+fi
