@@ -185,7 +185,21 @@ class Actuation final : public Effect {
   std::vector<double> rest0_;
 };
 
-// --- pressure ----------------------------------------------------------------------------------
+// --- pressure ---
+
+/// Twice the signed area of a region, the same way Pressure computes it: triangles by the cross
+/// product of two edges, other loops by Σ x_i·(y_next − y_prev).
+template <class X, class Y>
+double twice_area(const X& x, const Y& y, const std::vector<int>& loop) {
+  const std::size_t k = loop.size();
+  if (k == 3) {
+    const int a = loop[0], b = loop[1], c = loop[2];
+    return (x(b) - x(a)) * (y(c) - y(a)) - (x(c) - x(a)) * (y(b) - y(a));
+  }
+  double twice = 0.0;
+  for (std::size_t q = 0; q < k; ++q) twice += x(loop[q]) * (y(loop[(q + 1) % k]) - y(loop[(q + k - 1) % k]));
+  return twice;
+}
 
 /// Eq. 3 with the signed area: on each edge of a region, F = c_p·L·(S0 − S)/A along the edge's
 /// outward normal (CCW loop), half to each end, with A = max(S0, floor·Lmax²) (A = S0 except for
@@ -206,15 +220,24 @@ class Pressure final : public Effect {
         const double dx = body.positions(j, 0) - body.positions(i, 0);
         const double dy = body.positions(j, 1) - body.positions(i, 1);
         lmax2 = std::max(lmax2, dx * dx + dy * dy);
+      }
+      const double s0 = body.rest_areas(k);
+      const double ref = std::max(s0, p.pressure_area_floor * lmax2);
+      const double coef = ref > 0.0 ? p.pressure / ref : 0.0;
+      if (len == 3) {  // most regions: a specialised loop
+        tri_.push_back({loop[0], loop[1], loop[2]});
+        tri_area_.push_back(2.0 * s0);
+        tri_coef_.push_back(0.5 * coef);
+        continue;
+      }
+      for (std::size_t q = 0; q < len; ++q) {
         node_.push_back(loop[q]);
         prev_.push_back(loop[(q + len - 1) % len]);
         next_.push_back(loop[(q + 1) % len]);
       }
       offset_.push_back(static_cast<int>(node_.size()));
-      const double s0 = body.rest_areas(k);
-      const double ref = std::max(s0, p.pressure_area_floor * lmax2);
       rest_area_.push_back(s0);
-      coef_.push_back(ref > 0.0 ? p.pressure / ref : 0.0);
+      coef_.push_back(coef);
     }
   }
   std::string_view name() const override { return "pressure"; }
@@ -224,15 +247,26 @@ class Pressure final : public Effect {
     const double* y = s.y.data();
     double* fx = s.fx.data();
     double* fy = s.fy.data();
+    // F_i = c_p (S0 − S)/A · ∂S/∂p_i, with ∂S/∂p_i = ½ (y_next − y_prev, x_prev − x_next).
+    for (std::size_t r = 0; r < tri_.size(); ++r) {
+      const auto [a, b, c] = tri_[r];
+      const double xa = x[a], ya = y[a], xb = x[b], yb = y[b], xc = x[c], yc = y[c];
+      const double twice = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya);
+      const double g = 0.5 * tri_coef_[r] * (tri_area_[r] - twice);  // = ½·c_p·(S0 − S)/A
+      fx[a] += g * (yb - yc);
+      fy[a] += g * (xc - xb);
+      fx[b] += g * (yc - ya);
+      fy[b] += g * (xa - xc);
+      fx[c] += g * (ya - yb);
+      fy[c] += g * (xb - xa);
+    }
     const int* node = node_.data();
     const int* prev = prev_.data();
     const int* next = next_.data();
-    const std::size_t regions = rest_area_.size();
-    for (std::size_t r = 0; r < regions; ++r) {
+    for (std::size_t r = 0; r < rest_area_.size(); ++r) {
       const int lo = offset_[r], hi = offset_[r + 1];
       double twice_area = 0.0;
       for (int q = lo; q < hi; ++q) twice_area += x[node[q]] * (y[next[q]] - y[prev[q]]);
-      // F_i = c_p (S0 − S)/A · ∂S/∂p_i, with ∂S/∂p_i = ½ (y_next − y_prev, x_prev − x_next).
       const double g = 0.5 * coef_[r] * (rest_area_[r] - 0.5 * twice_area);
       for (int q = lo; q < hi; ++q) {
         fx[node[q]] += g * (y[next[q]] - y[prev[q]]);
@@ -242,6 +276,11 @@ class Pressure final : public Effect {
   }
 
  private:
+  struct Triangle {
+    int a, b, c;
+  };
+  std::vector<Triangle> tri_;
+  std::vector<double> tri_area_, tri_coef_;  // 2·S0, ½·c_p/A
   std::vector<int> offset_, node_, prev_, next_;
   std::vector<double> rest_area_, coef_;
 };
@@ -249,18 +288,33 @@ class Pressure final : public Effect {
 // --- drag --------------------------------------------------------------------------------------
 
 /// Eqs. 4–5 on skin edges (each once): the edge midpoint's velocity split into normal and
-/// tangential parts, F = −d·L·u·|u| per part, half the force to each end.
-///  - explicit: u is the midpoint velocity at the start of the step;
-///  - stable: backward Euler with every other force included. Each edge takes the predicted
-///    midpoint velocity w (velocities plus h·F/m of the forces added so far) and solves
-///    M·(u' − w) = −h·d·L·u'·|u'| per component (implicit_quadratic_drag), with M its share of the
-///    end masses, 2m / max(skin degree of its ends); the impulse M·(u' − w) is applied as a force.
-///    |u'| <= |w| with the same sign: the drag never reverses an edge's normal or tangential
-///    velocity, however large d·L·|w|·h/M. At a steady state (u' = w) it is eq. 4–5 exactly.
+/// tangential parts, F = −d·L·u·|u| per part, half the force to each end. Three schemes, with
+/// x = h·d·L·|u| / M the fraction of the velocity one explicit step would remove, where M is the
+/// edge's conservative share of its end masses, 2m / max(skin degree of its ends) (so that even
+/// when all the skin edges at a node push the same way their fractions add up to at most x):
+///  - explicit: F as above with u the velocity at the start of the step. First order; it
+///    overshoots for x > 1 (reverses the velocity) and blows up for x > 2;
+///  - stable (default): the explicit force times g(x) = 1 for x <= 1/2 and 1/(x + 1/2) beyond, so
+///    one step removes at most the fraction x·g(x) < 1 of the velocity it acts on: the drag never
+///    reverses an edge's normal or tangential velocity, whatever h, d or u. Where x <= 1/2 (every
+///    paper environment at the default dt) it is exactly the explicit scheme, so terminal velocities
+///    are exact;
+///  - implicit: backward Euler per edge and per part, with every other force included: the
+///    predicted midpoint velocity w (velocities plus h·F/m of the forces added so far) becomes the
+///    u' of M·(u' − w) = −h·d·L·u'·|u'| (implicit_quadratic_drag), and M·(u' − w)/h is the force.
+///    Never reverses either, but it is more dissipative, and with the conservative M its terminal
+///    velocity is biased by O(x) where a node carries several skin edges (docs/accuracy.md).
+/// g(x) of the stable drag scheme: 1 for x <= 1/2, 1/(x + 1/2) beyond; x·g(x) < 1 for every x.
+inline double drag_limiter(double x) { return x <= 0.5 ? 1.0 : 1.0 / (x + 0.5); }
+
 class Drag final : public Effect {
  public:
   Drag(const Body& body, const SceneParams& p, const PhysicsParams& physics)
-      : dn_(p.drag_normal), dt_(tangential_drag(p)), stable_(physics.drag_scheme == "stable") {
+      : dn_(p.drag_normal),
+        dt_(tangential_drag(p)),
+        scheme_(physics.drag_scheme == "explicit"   ? Scheme::explicit_
+                : physics.drag_scheme == "implicit" ? Scheme::implicit
+                                                    : Scheme::stable) {
     const int n = body.node_count();
     const int e = as_int(body.skin.rows());
     std::vector<int> degree(static_cast<std::size_t>(n), 0);
@@ -288,7 +342,7 @@ class Drag final : public Effect {
     double* fy = s.fy.data();
     const double* ux;
     const double* uy;
-    if (stable_) {
+    if (scheme_ == Scheme::implicit) {
       const double k = s.h * s.inv_mass;
       for (int i = 0; i < s.n; ++i) {
         wx_[static_cast<std::size_t>(i)] = s.vx[static_cast<std::size_t>(i)] + k * fx[i];
@@ -308,17 +362,19 @@ class Drag final : public Effect {
       if (!(len > 0.0)) continue;
       const double tx = dx / len, ty = dy / len;  // tangent; normal = (−ty, tx)
       const double mx = 0.5 * (ux[i] + ux[j]), my = 0.5 * (uy[i] + uy[j]);
-      const double vn = -mx * ty + my * tx;
-      const double vt = mx * tx + my * ty;
-      double fn, ft;
-      if (stable_) {
+      const double wn = -mx * ty + my * tx;  // normal and tangential parts of the midpoint velocity
+      const double wt = mx * tx + my * ty;
+      double fn = -dn_ * len * wn * std::abs(wn);
+      double ft = -dt_ * len * wt * std::abs(wt);
+      if (scheme_ == Scheme::stable) {
+        const double k = s.h * len / edge_mass_[e];  // x = k·d·|u|
+        fn *= drag_limiter(k * dn_ * std::abs(wn));
+        ft *= drag_limiter(k * dt_ * std::abs(wt));
+      } else if (scheme_ == Scheme::implicit) {
         const double m = edge_mass_[e];
         const double k = s.h * len / m;
-        fn = m * (implicit_quadratic_drag(vn, dn_ * k) - vn) * inv_h;
-        ft = m * (implicit_quadratic_drag(vt, dt_ * k) - vt) * inv_h;
-      } else {
-        fn = -dn_ * len * vn * std::abs(vn);
-        ft = -dt_ * len * vt * std::abs(vt);
+        fn = m * (implicit_quadratic_drag(wn, dn_ * k) - wn) * inv_h;
+        ft = m * (implicit_quadratic_drag(wt, dt_ * k) - wt) * inv_h;
       }
       const double gx = 0.5 * (-fn * ty + ft * tx);
       const double gy = 0.5 * (fn * tx + ft * ty);
@@ -330,8 +386,9 @@ class Drag final : public Effect {
   }
 
  private:
+  enum class Scheme { explicit_, stable, implicit };
   double dn_, dt_;
-  bool stable_;
+  Scheme scheme_;
   std::vector<int> a_, b_;
   std::vector<double> edge_mass_;
   std::vector<double> wx_, wy_;
@@ -363,7 +420,7 @@ inline SegmentHit closest_on_segment(double px, double py, double ax, double ay,
 /// near pairs; it never misses a pair, so forces equal the all-pairs computation.
 class SkinCollision final : public Effect {
  public:
-  static constexpr double kMargin = 0.3;
+  static constexpr double kMargin = 0.6;
 
   SkinCollision(const Body& body, const SceneParams& p) : k_(p.collision_stiffness), r_(p.collision_radius) {
     n_ = body.node_count();
@@ -392,8 +449,13 @@ class SkinCollision final : public Effect {
     double* fy = s.fy.data();
     for (const Pair& p : pairs_) {
       const int i = p.cell, a = a_[static_cast<std::size_t>(p.edge)], b = b_[static_cast<std::size_t>(p.edge)];
+      // Cheap rejection: the cell is farther than the radius from the edge's bounding box.
+      const double r = p.radius;
+      if (x[i] + r < std::min(x[a], x[b]) || x[i] - r > std::max(x[a], x[b]) || y[i] + r < std::min(y[a], y[b]) ||
+          y[i] - r > std::max(y[a], y[b]))
+        continue;
       const SegmentHit hit = closest_on_segment(x[i], y[i], x[a], y[a], x[b], y[b]);
-      if (!(hit.d2 < p.radius * p.radius)) continue;
+      if (!(hit.d2 < r * r)) continue;
       const double d = std::sqrt(hit.d2);
       double nx, ny;
       if (d > 0.0) {
@@ -406,7 +468,7 @@ class SkinCollision final : public Effect {
         nx = -ey / l;
         ny = ex / l;
       }
-      const double f = k_ * (p.radius - d);
+      const double f = k_ * (r - d);
       const double gx = f * nx, gy = f * ny;
       fx[i] += gx;
       fy[i] += gy;
@@ -417,6 +479,7 @@ class SkinCollision final : public Effect {
     }
   }
   [[nodiscard]] long rebuilds() const { return rebuilds_; }
+
 
  private:
   struct Pair {
@@ -456,18 +519,20 @@ class SkinCollision final : public Effect {
       yr_[static_cast<std::size_t>(i)] = s.y[static_cast<std::size_t>(i)] - cy;
     }
     pairs_.clear();
-    for (int i = 0; i < n_; ++i) {
-      const auto iu = static_cast<std::size_t>(i);
-      for (std::size_t e = 0; e < a_.size(); ++e) {
-        const int a = a_[e], b = b_[e];
-        if (a == i || b == i) continue;
-        const auto au = static_cast<std::size_t>(a), bu = static_cast<std::size_t>(b);
+    const double reach = r_ + kMargin;
+    for (std::size_t e = 0; e < a_.size(); ++e) {  // pairs stay sorted by (edge, cell)
+      const int a = a_[e], b = b_[e];
+      const auto au = static_cast<std::size_t>(a), bu = static_cast<std::size_t>(b);
+      const double x0 = std::min(s.x[au], s.x[bu]) - reach, x1 = std::max(s.x[au], s.x[bu]) + reach;
+      const double y0 = std::min(s.y[au], s.y[bu]) - reach, y1 = std::max(s.y[au], s.y[bu]) + reach;
+      for (int i = 0; i < n_; ++i) {
+        const auto iu = static_cast<std::size_t>(i);
+        if (s.x[iu] < x0 || s.x[iu] > x1 || s.y[iu] < y0 || s.y[iu] > y1 || a == i || b == i) continue;
+        const SegmentHit now = closest_on_segment(s.x[iu], s.y[iu], s.x[au], s.y[au], s.x[bu], s.y[bu]);
+        if (!(now.d2 < reach * reach)) continue;
         const SegmentHit rest = closest_on_segment(x0_[iu], y0_[iu], x0_[au], y0_[au], x0_[bu], y0_[bu]);
         const double radius = std::min(r_, 0.5 * std::sqrt(rest.d2));
-        if (!(radius > 0.0)) continue;
-        const SegmentHit now = closest_on_segment(s.x[iu], s.y[iu], s.x[au], s.y[au], s.x[bu], s.y[bu]);
-        const double reach = radius + kMargin;
-        if (now.d2 < reach * reach) pairs_.push_back({i, static_cast<int>(e), radius});
+        if (radius > 0.0) pairs_.push_back({i, static_cast<int>(e), radius});
       }
     }
   }
@@ -484,6 +549,40 @@ class SkinCollision final : public Effect {
 }  // namespace
 
 // --- public pieces -------------------------------------------------------------------------------
+
+Body swim_body(const Body& in) {
+  Body b = in;
+  const int n = b.node_count();
+  double scale = 1.0;
+  for (int i = 0; i < n; ++i) {
+    for (int c = 0; c < 2; ++c) {
+      b.positions(i, c) = static_cast<double>(static_cast<float>(in.positions(i, c)));
+      scale = std::max(scale, std::abs(in.positions(i, c)));
+    }
+  }
+  const double tol = 1e-6 * scale;
+  for (int s = 0; s < b.spring_count() && s < b.rest_lengths.size(); ++s) {
+    const int i = b.springs(s, 0), j = b.springs(s, 1);
+    if (i < 0 || j < 0 || i >= n || j >= n) continue;
+    const double dx = b.positions(j, 0) - b.positions(i, 0), dy = b.positions(j, 1) - b.positions(i, 1);
+    const double len = std::sqrt(dx * dx + dy * dy);  // as Springs measures it
+    if (std::abs(len - b.rest_lengths(s)) <= tol) b.rest_lengths(s) = len;
+  }
+  const auto px = [&](int i) { return b.positions(i, 0); };
+  const auto py = [&](int i) { return b.positions(i, 1); };
+  for (int r = 0; r < b.region_count() && r < b.rest_areas.size(); ++r) {
+    const auto& loop = b.regions[static_cast<std::size_t>(r)];
+    if (std::any_of(loop.begin(), loop.end(), [&](int v) { return v < 0 || v >= n; })) continue;
+    double perimeter = 0.0;
+    for (std::size_t q = 0; q < loop.size(); ++q) {
+      const int i = loop[q], j = loop[(q + 1) % loop.size()];
+      perimeter += std::hypot(px(j) - px(i), py(j) - py(i));
+    }
+    const double area = 0.5 * twice_area(px, py, loop);
+    if (std::abs(area - b.rest_areas(r)) <= tol * perimeter) b.rest_areas(r) = area;
+  }
+  return b;
+}
 
 double actuation_start_time(double frequency, double phase) {
   double theta = std::fmod(phase, kPi);

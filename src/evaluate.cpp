@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <vector>
 #include <string>
 #include <utility>
 
@@ -24,16 +25,25 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// Spring length / L0 extremes, kinetic energy: sampled diagnostics of a swim.
-void sample(const Simulation& sim, const Body& body, SwimResult& r) {
+/// Half the median rest length: the floor of the stretch denominators.
+double stretch_floor(const Body& body) {
+  if (body.spring_count() == 0) return 0.0;
+  std::vector<double> l(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
+  std::nth_element(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(l.size() / 2), l.end());
+  return 0.5 * l[l.size() / 2];
+}
+
+/// Spring stretch extremes and kinetic energy: sampled diagnostics of a swim. Stretch is
+/// length / max(L0, floor), compression is length / L0 over springs with L0 >= floor, so that
+/// near-zero rest lengths (slivers, near-coincident cells) do not make the ratios meaningless.
+void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r) {
   const SwimState& st = sim.state();
   for (int s = 0; s < body.spring_count(); ++s) {
     const double l0 = body.rest_lengths(s);
-    if (!(l0 > 0.0)) continue;
     const auto i = static_cast<std::size_t>(body.springs(s, 0)), j = static_cast<std::size_t>(body.springs(s, 1));
     const double len = std::hypot(st.x[j] - st.x[i], st.y[j] - st.y[i]);
-    r.max_stretch = std::max(r.max_stretch, len / l0);
-    r.min_stretch = std::min(r.min_stretch, len / l0);
+    r.max_stretch = std::max(r.max_stretch, len / std::max(l0, floor));
+    if (l0 >= floor && l0 > 0.0) r.min_stretch = std::min(r.min_stretch, len / l0);
   }
   r.max_kinetic_energy = std::max(r.max_kinetic_energy, sim.kinetic_energy());
 }
@@ -46,13 +56,14 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   Simulation sim(body, scene, physics);
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   const Eigen::Vector2d start = sim.center_of_mass();
-  sample(sim, body, r);
+  const double floor = stretch_floor(body);
+  sample(sim, body, floor, r);
   try {
     for (long done = 0; done < steps;) {
       const long chunk = std::min(kSampleEvery, steps - done);
       sim.step(chunk);
       done += chunk;
-      sample(sim, body, r);
+      sample(sim, body, floor, r);
     }
   } catch (const SimulationError& e) {
     r.stable = false;

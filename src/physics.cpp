@@ -21,41 +21,6 @@ namespace {
 
 constexpr double kMaxTranslation = static_cast<double>(b2_maxTranslation);
 
-/// The body as the simulation sees it: positions rounded to Box2D's float, and rest lengths and
-/// areas that equal the distance (area) at construction re-measured from those float positions,
-/// so that a body at rest feels exactly zero force. Rest values that differ from the geometry by
-/// more than float rounding (a pre-stressed hand-made body) are kept as given.
-Body float_body(const Body& in) {
-  Body b = in;
-  const int n = b.node_count();
-  double scale = 1.0;
-  for (int i = 0; i < n; ++i) {
-    for (int c = 0; c < 2; ++c) {
-      b.positions(i, c) = static_cast<double>(static_cast<float>(in.positions(i, c)));
-      scale = std::max(scale, std::abs(in.positions(i, c)));
-    }
-  }
-  const double tol = 1e-6 * scale;
-  for (int s = 0; s < b.spring_count(); ++s) {
-    const int i = b.springs(s, 0), j = b.springs(s, 1);
-    const double dx = b.positions(j, 0) - b.positions(i, 0), dy = b.positions(j, 1) - b.positions(i, 1);
-    const double len = std::sqrt(dx * dx + dy * dy);
-    if (std::abs(len - b.rest_lengths(s)) <= tol) b.rest_lengths(s) = len;
-  }
-  for (int r = 0; r < b.region_count(); ++r) {
-    const auto& loop = b.regions[static_cast<std::size_t>(r)];
-    const std::size_t k = loop.size();
-    double twice = 0.0, perimeter = 0.0;
-    for (std::size_t q = 0; q < k; ++q) {
-      const int i = loop[q], nx = loop[(q + 1) % k], pv = loop[(q + k - 1) % k];
-      twice += b.positions(i, 0) * (b.positions(nx, 1) - b.positions(pv, 1));  // same formula as Pressure
-      perimeter += std::hypot(b.positions(nx, 0) - b.positions(i, 0), b.positions(nx, 1) - b.positions(i, 1));
-    }
-    if (std::abs(0.5 * twice - b.rest_areas(r)) <= tol * perimeter) b.rest_areas(r) = 0.5 * twice;
-  }
-  return b;
-}
-
 void check_body(const Body& b) {
   const int n = b.node_count();
   auto fail = [](const std::string& what) { throw GeometryError("Simulation: " + what); };
@@ -212,7 +177,7 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   s.physics = physics;
   s.h = physics.dt / physics.substeps;
   s.hf = static_cast<float>(s.h);
-  const Body body = float_body(body_in);
+  const Body body = swim_body(body_in);
   const int n = body.node_count();
 
   s.world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
@@ -283,6 +248,17 @@ void Simulation::step(long n) {
 void Simulation::compute_forces() {
   impl_->read_state();
   impl_->run_effects();
+}
+
+void Simulation::set_velocities(const Points& v) {
+  Impl& s = *impl_;
+  if (v.rows() != s.state.n)
+    throw GeometryError(fmt::format("Simulation::set_velocities: expected {} rows, got {}", s.state.n, v.rows()));
+  if (!v.allFinite()) throw GeometryError("Simulation::set_velocities: non-finite velocity");
+  for (int i = 0; i < s.state.n; ++i)
+    s.bodies[static_cast<std::size_t>(i)]->SetLinearVelocity(
+        b2Vec2(static_cast<float>(v(i, 0)), static_cast<float>(v(i, 1))));
+  s.read_state();
 }
 
 int Simulation::node_count() const { return impl_->state.n; }

@@ -23,8 +23,11 @@ struct SwimResult {
   double simulated_time = 0.0;
   double max_speed = 0.0;                       ///< largest cell speed seen
   double max_step_displacement = 0.0;           ///< largest |v|·h of one Box2D step seen
-  double max_stretch = 0.0;                     ///< largest spring length / L0 (sampled every 16 steps and at the end)
-  double min_stretch = 0.0;                     ///< smallest spring length / L0 (same samples); 0 with no springs
+  /// Largest spring length / max(L0, median L0 / 2), sampled every 16 steps and at the end (the
+  /// floor keeps near-zero rest lengths of slivers and near-coincident cells meaningful).
+  double max_stretch = 0.0;
+  /// Smallest spring length / L0 over springs with L0 >= median L0 / 2 (same samples); 0 with no springs.
+  double min_stretch = 0.0;
   double final_kinetic_energy = 0.0;
   double max_kinetic_energy = 0.0;              ///< largest kinetic energy (same samples)
 };

@@ -20,7 +20,7 @@ namespace animat {
 
 struct Body;
 
-inline constexpr std::string_view kDragSchemeNames[] = {"explicit", "stable"};
+inline constexpr std::string_view kDragSchemeNames[] = {"explicit", "stable", "implicit"};
 
 /// The accuracy knobs: what trades accuracy for speed (docs/accuracy.md measures them).
 struct PhysicsParams {
@@ -28,7 +28,9 @@ struct PhysicsParams {
   int substeps = 1;                ///< Box2D steps per control step (forces recomputed each) [choose]
   int velocity_iterations = 1;     ///< Box2D solver iterations (no joints or contacts: 1 suffices)
   int position_iterations = 1;
-  std::string drag_scheme = "stable";  ///< "explicit" or "stable" (never reverses a velocity in a step)
+  /// "explicit", "stable" (linearly implicit: never reverses a velocity in a step) or "implicit"
+  /// (fully implicit quadratic law); see the Drag effect in src/effects.cpp.
+  std::string drag_scheme = "stable";
   /// A Box2D step that would move a cell farther than this is reported as unstable (SimulationError)
   /// before Box2D's own cap of b2_maxTranslation = 2 silently clamps it [choose].
   double max_step_displacement = 1.0;
@@ -40,7 +42,7 @@ void visit_fields(PhysicsParams& p, V&& v) {
   v(FieldInfo{"substeps", "Box2D steps per control step, forces recomputed each [choose]", Bounds::closed(1, 1000)}, p.substeps);
   v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.velocity_iterations);
   v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.position_iterations);
-  v(FieldInfo{"drag_scheme", "drag integration: explicit, or stable (implicit; never reverses an edge velocity)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
+  v(FieldInfo{"drag_scheme", "drag integration: explicit; stable (linearly implicit, never reverses an edge velocity); implicit (fully implicit, never reverses)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
   v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
 }
 
@@ -83,6 +85,9 @@ class Simulation {
   /// Computes the forces of the current state (effects run, nothing integrated) into forces().
   /// Modifier effects advance as if a step had started; meant for tests and inspection.
   void compute_forces();
+  /// Sets every cell's velocity (n × 2), e.g. to launch a body; throws GeometryError for a wrong
+  /// shape or non-finite values.
+  void set_velocities(const Points& velocities);
 
   [[nodiscard]] int node_count() const;
   [[nodiscard]] long steps_done() const;     ///< control steps done

@@ -34,14 +34,14 @@ inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation",
 struct SceneParams {
   std::vector<std::string> effects = {"springs", "actuation", "pressure", "drag", "skin_collision"};
   double cell_mass = 1.0;             ///< equal mass m of every cell [paper: equal; value: choose, the mass unit]
-  double spring_stiffness = 30.0;     ///< Hooke constant k of every spring [choose]
-  double spring_damping = 1.0;        ///< damping coefficient c of every spring (force per unit stretching speed) [choose]
-  double pressure = 20.0;             ///< c_p of eq. 3, force per unit edge length at S = 0 [choose]
+  double spring_stiffness = 100.0;    ///< Hooke constant k of every spring [choose]
+  double spring_damping = 4.0;        ///< damping coefficient c of every spring (force per unit stretching speed) [choose]
+  double pressure = 100.0;            ///< c_p of eq. 3, force per unit edge length at S = 0 [choose]
   double pressure_area_floor = 0.1;   ///< eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
   double drag_normal = 2.0;           ///< d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]
   double drag_tangential = -1.0;      ///< d_T of eq. 4; negative means d_N/200 [paper §6: d_N/200]
   double collision_stiffness = 500.0; ///< penalty stiffness of skin collisions [choose]
-  double collision_radius = 0.1;      ///< distance from a skin edge at which the penalty starts [choose]
+  double collision_radius = 0.25;     ///< distance from a skin edge at which the penalty starts [choose]
 };
 
 template <class V>
@@ -113,6 +113,13 @@ class Effect {
 /// unknown name.
 [[nodiscard]] std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body, const SceneParams& scene,
                                                   const PhysicsParams& physics);
+
+/// The body as a swim simulation sees it: positions rounded to Box2D's float, and rest lengths and
+/// areas that equal the geometry at construction (within 1e-6 of the coordinate scale) re-measured
+/// from those float positions with the very formulas the effects use, so that a body at rest feels
+/// exactly zero force. Rest values that differ from the geometry by more (a pre-stressed hand-made
+/// body) are kept as given.
+[[nodiscard]] Body swim_body(const Body& body);
 
 // --- Pure pieces of the effects, exposed for analytic tests ------------------------------------
 

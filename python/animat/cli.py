@@ -1,0 +1,136 @@
+"""``python -m animat``: the paper's figures and an animation of a run's best swimmer.
+
+    python -m animat show RUN_DIR       # figures/ development, construction, motion_cycle, phase_map, fitness_history
+    python -m animat animate RUN_DIR    # figures/best.gif
+    python -m animat info RUN_DIR       # a short summary of the run
+
+Every command exits with status 1 and a one-line message for a missing or malformed run directory.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import List, Optional
+
+FIGURES = ("development", "construction", "motion_cycle", "phase_map", "fitness_history")
+
+
+def _size(text: str):
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, e.g. 560x360, got {text!r}") from None
+    return w, h
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m animat", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True, metavar="{show,animate,info}")
+
+    s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
+    s.add_argument("run", metavar="RUN_DIR")
+    s.add_argument("--out", type=Path, help="output directory (default RUN_DIR/figures)")
+    s.add_argument("--only", nargs="+", choices=FIGURES, help="draw only these figures")
+    s.add_argument("--frames", type=int, default=6, help="snapshots in the motion cycle (default 6)")
+    s.add_argument("--steps", type=int, help="swim steps to replay (default: the run's evaluation.steps)")
+    s.add_argument("--dpi", type=int, default=110, help="PNG resolution (default 110)")
+
+    a = sub.add_parser("animate", help="render the run's best swimmer to RUN_DIR/figures/best.gif")
+    a.add_argument("run", metavar="RUN_DIR")
+    a.add_argument("--out", type=Path, help="output file, .gif or .mp4 (default RUN_DIR/figures/best.gif)")
+    a.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
+    a.add_argument("--max-frames", type=int, default=240, help="at most this many frames (default 240)")
+    a.add_argument("--start", type=int, help="first control step to show (default: show the end of the swim)")
+    a.add_argument("--steps", type=int, help="swim steps to replay (default: the run's evaluation.steps)")
+    a.add_argument("--size", type=_size, default=(560, 360), help="WIDTHxHEIGHT pixels (default 560x360)")
+    a.add_argument("--colors", type=int, default=64, help="GIF palette size (default 64)")
+    a.add_argument("--follow", action="store_true", default=None, help="camera follows the body")
+    a.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+    i = sub.add_parser("info", help="print a summary of a run directory")
+    i.add_argument("run", metavar="RUN_DIR")
+    return p
+
+
+def cmd_show(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    import animat
+    from animat import plot
+
+    run = animat.Run(args.run)
+    entry = run.best()
+    config = run.config
+    out = args.out or run.path / "figures"
+    out.mkdir(parents=True, exist_ok=True)
+    wanted = args.only or FIGURES
+    t0 = time.perf_counter()
+    trajectory = None
+    if "motion_cycle" in wanted:
+        trajectory = animat.replay(entry, config, steps=args.steps)
+    label = f"best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}"
+    makers = {
+        "development": lambda: plot.development(entry, config=config,
+                                                title=f"Development (paper Fig. 2) of the {label}"),
+        "construction": lambda: plot.construction(entry, config=config,
+                                                  title=f"From embryo to body (paper Fig. 3): {label}"),
+        "motion_cycle": lambda: plot.motion_cycle(trajectory, count=args.frames),
+        "phase_map": lambda: plot.phase_map(entry, config=config),
+        "fitness_history": lambda: plot.fitness_history(run),
+    }
+    for name in FIGURES:
+        if name not in wanted:
+            continue
+        fig = makers[name]()
+        path = out / f"{name}.png"
+        fig.savefig(path, dpi=args.dpi)
+        plt.close(fig)
+        print(path)
+    print(f"({label}; {time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    return 0
+
+
+def cmd_animate(args) -> int:
+    import animat
+
+    run = animat.Run(args.run)
+    entry = run.best()
+    config = run.config
+    out = args.out or run.path / "figures" / "best.gif"
+    t0 = time.perf_counter()
+    trajectory = animat.replay(entry, config, steps=args.steps)
+    start = None if args.start is None else trajectory.frame_index(args.start)
+    path = animat.animate(trajectory, out, fps=args.fps, max_frames=args.max_frames, start=start, size=args.size,
+                          colors=args.colors, follow=args.follow, progress=False if args.no_progress else None)
+    print(path)
+    print(f"(best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}; "
+          f"{time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    return 0
+
+
+def cmd_info(args) -> int:
+    import animat
+
+    run = animat.Run(args.run)
+    print(run.summary())
+    changes = run.morphology_changes() if run.best_genomes else []
+    if changes:
+        print(f"  morphology changed at generation(s) {', '.join(str(e.generation) for e in changes)}")
+    return 0
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    """Entry point of ``python -m animat``; returns the exit status (0 ok, 1 error, 2 usage)."""
+    args = _parser().parse_args(argv)
+    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info}[args.command]
+    try:
+        return command(args)
+    except (FileNotFoundError, NotADirectoryError, ValueError, RuntimeError, OSError) as e:
+        print(f"animat {args.command}: error: {e}", file=sys.stderr)
+        return 1

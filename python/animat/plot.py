@@ -1,0 +1,529 @@
+"""The paper's figures (Joachimczak & Wróbel, GECCO 2012) with matplotlib.
+
+Every function returns a :class:`matplotlib.figure.Figure` (made with ``pyplot.figure``, so
+``plt.show()`` and notebooks display it) and never calls ``show``; all of them work with the
+headless Agg backend. Save with ``fig.savefig("x.png")`` and free with ``plt.close(fig)``.
+
+=====================  ===========  ==========================================================
+function               paper        shows
+=====================  ===========  ==========================================================
+:func:`development`    Fig. 2       cells (circles + orientation ticks) at chosen steps
+:func:`construction`   Fig. 3       centres → Delaunay → Gabriel graph (regions, skin)
+:func:`motion_cycle`   Figs. 4–6    snapshots of one motion cycle, nodes red / blue / green
+:func:`phase_map`      Fig. 7       nodes coloured by phase shift, maximum indicated
+:func:`fitness_history` Figs. 8–9   best fitness per generation, morphology changes marked
+=====================  ===========  ==========================================================
+
+:func:`draw_body` draws one body into an existing Axes (used by all of the above and by
+:func:`animat.animate`).
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, Optional, Sequence
+
+import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import EllipseCollection, LineCollection, PatchCollection, PolyCollection
+from matplotlib.colors import Normalize
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, ConnectionPatch, Polygon
+
+from . import _core
+from .run import MORPHOLOGY_TOLERANCE, Run
+from .trajectory import CONTRACTING, EXPANDING, NEUTRAL, STATE_NAMES, Trajectory, body_of
+
+__all__ = [
+    "development", "construction", "motion_cycle", "phase_map", "fitness_history", "draw_body",
+    "STATE_COLORS", "PHASE_CMAP", "rotation_to", "development_steps",
+]
+
+#: Node colours of the motion figures (paper Figs. 4–6): red expanding, blue contracting, green neutral.
+STATE_COLORS = {EXPANDING: "#d62728", CONTRACTING: "#1f77b4", NEUTRAL: "#2ca02c"}
+#: Colour map of :func:`phase_map` (low phase blue, maximum red, as in paper Fig. 7).
+PHASE_CMAP = "jet"
+
+SPRING_COLOR = "#8c8c8c"
+SKIN_COLOR = "#111111"
+FILL_COLOR = "#e9eef3"
+
+
+# --- helpers ------------------------------------------------------------------------------------------
+
+def rotation_to(direction: Sequence[float], target: Sequence[float] = (1.0, 0.0)) -> np.ndarray:
+    """The 2×2 rotation matrix R with ``R @ direction`` parallel to ``target`` (default +x).
+
+    Use it as ``positions @ R.T`` on (…, 2) arrays."""
+    d = np.asarray(direction, dtype=float)
+    t = np.asarray(target, dtype=float)
+    angle = math.atan2(t[1], t[0]) - math.atan2(d[1], d[0])
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def _node_radius(body) -> float:
+    L0 = np.asarray(body.rest_lengths)
+    return 0.22 * float(np.median(L0)) if len(L0) else 0.25
+
+
+def _loops_closed(positions, loops):
+    return [positions[np.append(loop, loop[0])] for loop in loops if len(loop)]
+
+
+def draw_body(ax, body, positions: Optional[np.ndarray] = None, node_colors: Any = "#444444", *,
+              node_radius: Optional[float] = None, fill: bool = True, springs: bool = True,
+              spring_colors: Any = SPRING_COLOR, skin_width: float = 2.2, spring_width: float = 0.8,
+              node_edge: str = "#222222", zorder: float = 2.0, label: str = "nodes") -> Dict[str, Any]:
+    """Draw one body into ``ax``: light region fill, springs (thin), skin (thick) and nodes.
+
+    Args:
+        ax: a matplotlib Axes (its aspect is not changed).
+        body: an :class:`animat.Body` (springs, skin loops, regions).
+        positions: (n, 2) node positions (default: ``body.positions``, the rest state).
+        node_colors: one colour or a sequence of n colours.
+        node_radius: node disc radius in data units (default 0.22 × median spring rest length).
+        fill, springs: draw the region fill / the springs.
+        spring_colors: one colour or m colours.
+
+    Returns:
+        dict of the artists: ``"fill"`` (PolyCollection or None), ``"springs"`` and ``"skin"``
+        (LineCollection), ``"nodes"`` (EllipseCollection with label ``label``, facecolors in node
+        order) — update them for animation.
+    """
+    pos = np.asarray(body.positions if positions is None else positions, dtype=float)
+    r = _node_radius(body) if node_radius is None else node_radius
+    out: Dict[str, Any] = {"fill": None}
+    if fill and len(body.regions):
+        out["fill"] = PolyCollection([pos[reg] for reg in body.regions], facecolors=FILL_COLOR, edgecolors="none",
+                                     zorder=zorder - 0.3)
+        ax.add_collection(out["fill"])
+    sp = np.asarray(body.springs)
+    out["springs"] = LineCollection(pos[sp] if springs and len(sp) else np.zeros((0, 2, 2)), colors=spring_colors,
+                                    linewidths=spring_width, zorder=zorder - 0.2)
+    ax.add_collection(out["springs"])
+    out["skin"] = LineCollection(_loops_closed(pos, body.skin_loops), colors=SKIN_COLOR, linewidths=skin_width,
+                                 capstyle="round", joinstyle="round", zorder=zorder - 0.1)
+    ax.add_collection(out["skin"])
+    n = len(pos)
+    out["nodes"] = EllipseCollection(np.full(n, 2 * r), np.full(n, 2 * r), np.zeros(n), units="xy", offsets=pos,
+                                     offset_transform=ax.transData, facecolors=node_colors, edgecolors=node_edge,
+                                     linewidths=0.5, zorder=zorder, label=label)
+    ax.add_collection(out["nodes"])
+    return out
+
+
+def _frame_axes(ax, lo, hi, pad):
+    ax.set_aspect("equal")
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    for s in ax.spines.values():
+        s.set_color("#bbbbbb")
+
+
+# --- Fig. 2: development --------------------------------------------------------------------------------
+
+def development_steps(embryo_or_trace) -> list:
+    """Default steps for :func:`development`: the first cell, every division round (daughters still
+    overlapping), 30 steps after the last division (pushed apart, paper Fig. 2e) and the end."""
+    trace = getattr(embryo_or_trace, "trace", None) or embryo_or_trace
+    steps = list(trace.steps)
+    if hasattr(embryo_or_trace, "division_steps"):
+        divisions = sorted(set(embryo_or_trace.division_steps))
+    else:
+        counts = [len(p) for p in trace.positions]
+        divisions = [steps[k] for k in range(1, len(steps)) if counts[k] != counts[k - 1]]
+    end = steps[-1]
+    picks = [steps[0]] + divisions + ([divisions[-1] + 30] if divisions else []) + [end]
+    available = set(steps)
+    chosen = []
+    for s in sorted(set(picks)):
+        if s not in available:  # trace recorded every k steps: nearest snapshot at or after s
+            later = [x for x in steps if x >= s]
+            s = later[0] if later else end
+        if s not in chosen:
+            chosen.append(s)
+    if len(chosen) > 12:  # many division rounds: keep the first, the last three and an even spread
+        keep = np.unique(np.linspace(0, len(chosen) - 4, 8).round().astype(int)).tolist() + list(
+            range(len(chosen) - 3, len(chosen)))
+        chosen = [chosen[k] for k in sorted(set(keep))]
+    return chosen
+
+
+def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, config: Optional[Any] = None,
+                cols: int = 4, title: Optional[str] = None) -> "matplotlib.figure.Figure":
+    """Paper Fig. 2: the embryo at chosen development steps, cells as circles with a short line
+    along each cell's orientation vector, all panels at the same scale.
+
+    Args:
+        embryo_or_trace: an :class:`animat.DevelopmentTrace`, an :class:`animat.Embryo` developed
+            with ``config.development.trace_every > 0``, or an :class:`animat.Genome` /
+            LineageEntry (developed here with ``config`` and ``trace_every = 1``).
+        steps: development steps to draw (must be recorded in the trace; default
+            :func:`development_steps`).
+        config: config for developing a genome (default: animat defaults).
+        cols: panels per row.
+    Returns:
+        The Figure, one Axes per step, titled "step s (k cells)".
+    Raises:
+        ValueError: an embryo without a trace, or a step that is not in the trace.
+    """
+    embryo = None
+    if hasattr(embryo_or_trace, "genome") and not isinstance(embryo_or_trace, _core.Genome):
+        embryo_or_trace = embryo_or_trace.genome
+    if isinstance(embryo_or_trace, _core.Genome):
+        cfg = (config if config is not None else _core.Config()).copy()
+        cfg["development.trace_every"] = 1
+        embryo_or_trace = _core.develop(embryo_or_trace, cfg)
+    if isinstance(embryo_or_trace, _core.Embryo):
+        embryo = embryo_or_trace
+        if embryo.trace is None:
+            raise ValueError("development: this Embryo has no trace; develop it with "
+                             "config['development.trace_every'] = 1 (or pass the genome)")
+        trace = embryo.trace
+    else:
+        trace = embryo_or_trace
+    steps = list(steps) if steps is not None else development_steps(embryo if embryo is not None else trace)
+    index = {s: k for k, s in enumerate(trace.steps)}
+    missing = [s for s in steps if s not in index]
+    if missing:
+        raise ValueError(f"development: steps {missing} are not in the trace (recorded: {trace.steps[0]}.."
+                         f"{trace.steps[-1]} every {trace.steps[1] - trace.steps[0] if len(trace.steps) > 1 else 1})")
+    if not steps:
+        raise ValueError("development: no steps to draw")
+    last = index[max(steps)]
+    centre = trace.positions[last].mean(axis=0)
+    half = np.max([np.abs(trace.positions[index[s]] - centre).max(axis=0) + np.max(trace.radii[index[s]])
+                   for s in steps], axis=0) * 1.08  # (2,) half-extent of the common frame
+    half = np.maximum(half, 0.35 * half.max())
+    cols = max(1, min(cols, len(steps)))
+    rows = (len(steps) + cols - 1) // cols
+    panel_w = 2.1
+    panel_h = float(np.clip(panel_w * half[1] / half[0], 0.9, 2.6))
+    fig = plt.figure(figsize=(panel_w * cols, (panel_h + 0.35) * rows + 0.45))
+    axes = fig.subplots(rows, cols, squeeze=False)
+    for ax in axes.flat[len(steps):]:
+        ax.set_visible(False)
+    for ax, s, letter in zip(axes.flat, steps, "abcdefghijklmnopqrstuvwxyz"):
+        k = index[s]
+        pos, radii, orient = trace.positions[k], trace.radii[k], trace.orientations[k]
+        ax.add_collection(PatchCollection([Circle(p, r) for p, r in zip(pos, radii)], facecolor="#cfe3f7",
+                                          edgecolor="#1f4e79", linewidth=0.8))
+        ax.add_collection(LineCollection([(p, p + r * o) for p, r, o in zip(pos, radii, orient)],
+                                         colors="#b22222", linewidths=1.2))
+        _frame_axes(ax, centre - half, centre + half, 0.0)
+        ax.set_title(f"step {s} ({len(radii)} cell{'s' if len(radii) != 1 else ''})", fontsize=9)
+        ax.text(0.03, 0.97, f"({letter})", transform=ax.transAxes, va="top", fontsize=8)
+    fig.suptitle(title or "Development (paper Fig. 2): cells and their orientation vectors", fontsize=10)
+    fig.tight_layout(h_pad=1.0)
+    return fig
+
+
+# --- Fig. 3: construction -------------------------------------------------------------------------------
+
+def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, config: Optional[Any] = None,
+                 title: Optional[str] = None) -> "matplotlib.figure.Figure":
+    """Paper Fig. 3: (a) cell centres at the end of development, (b) their Delaunay
+    triangulation, (c) the Gabriel graph, the final structure, with its regions shaded (one colour
+    each) and the skin (the only edges that feel drag) drawn thick.
+
+    Args:
+        embryo_or_points: an :class:`animat.Embryo`, a Genome / LineageEntry (developed with
+            ``config``), a :class:`animat.Body`, or an (n, 2) array of cell centres.
+        radii: (n,) cell radii for panel (a) (default: the embryo's, else 0.5).
+        config: config for developing / building (default: animat defaults).
+    Returns:
+        The Figure with three Axes.
+    """
+    thing = embryo_or_points
+    if hasattr(thing, "genome") and not isinstance(thing, _core.Genome):
+        thing = thing.genome
+    if isinstance(thing, _core.Genome):
+        thing = _core.develop(thing, config)
+    if isinstance(thing, _core.Embryo):
+        pos = np.asarray(thing.positions)
+        radii = np.asarray(thing.radii) if radii is None else np.asarray(radii)
+        body = _core.build_body(thing, config)
+    elif isinstance(thing, _core.Body):
+        pos = np.asarray(thing.positions)
+        body = thing
+    else:
+        pos = np.asarray(thing, dtype=float)
+        body = _core.build_body(pos, config=config)
+    if radii is None:
+        radii = np.full(len(pos), 0.5)
+    delaunay = np.asarray(_core.delaunay_edges(pos, config))
+
+    pad = float(np.max(radii)) + 0.3
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    ext = hi - lo + 2 * pad
+    panel_h = float(np.clip(3.8 * ext[1] / max(ext[0], 1e-9), 1.6, 5.0))
+    fig = plt.figure(figsize=(12, panel_h + 1.1))
+    axes = fig.subplots(1, 3)
+    for ax in axes:
+        _frame_axes(ax, lo, hi, pad)
+
+    ax = axes[0]
+    ax.add_collection(PatchCollection([Circle(p, r) for p, r in zip(pos, radii)], facecolor="#dde8f3",
+                                      edgecolor="#8aa6c1", linewidth=0.6))
+    ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5)
+    ax.set_title(f"(a) cell centres ({len(pos)} cells)", fontsize=10)
+
+    ax = axes[1]
+    ax.add_collection(LineCollection(pos[delaunay] if len(delaunay) else np.zeros((0, 2, 2)), colors="#555555",
+                                     linewidths=0.9))
+    ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5)
+    ax.set_title(f"(b) Delaunay triangulation ({len(delaunay)} edges)", fontsize=10)
+
+    ax = axes[2]
+    cmap = plt.get_cmap("Pastel1")
+    if body.region_count:
+        ax.add_collection(PatchCollection([Polygon(pos[r]) for r in body.regions],
+                                          facecolor=[cmap(k % 9) for k in range(body.region_count)], edgecolor="none"))
+    springs = np.asarray(body.springs)
+    ax.add_collection(LineCollection(pos[springs] if len(springs) else np.zeros((0, 2, 2)), colors="#555555",
+                                     linewidths=0.9))
+    skin = np.asarray(body.skin)
+    ax.add_collection(LineCollection(pos[skin] if len(skin) else np.zeros((0, 2, 2)), colors="#b2182b",
+                                     linewidths=2.8, capstyle="round"))
+    ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5, zorder=3)
+    ax.set_title(f"(c) Gabriel graph: {body.spring_count} springs,\n{body.region_count} regions (shaded), "
+                 f"{len(skin)} skin edges (thick)", fontsize=10)
+    fig.suptitle(title or "From embryo to body (paper Fig. 3)", fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+# --- Figs. 4-6: motion cycle ----------------------------------------------------------------------------
+
+def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None, *, count: int = 6,
+                 align: bool = True, cols: Optional[int] = None, color_springs: bool = False,
+                 title: Optional[str] = None) -> "matplotlib.figure.Figure":
+    """Paper Figs. 4–6: snapshots of one motion cycle. Node colour is the cell's actuation state
+    from eq. 2 (``trajectory.node_state``): red expanding, blue contracting, green neutral
+    (:data:`STATE_COLORS`). The skin is drawn thick, springs thin, and an arrow in each panel
+    marks the overall direction of motion.
+
+    Args:
+        trajectory: from :func:`animat.replay` (record with ``every`` small enough to resolve the
+            cycle; the default ``every=1`` does).
+        frames: frame indices (into the trajectory) to draw; default
+            ``trajectory.cycle_frames(count)``, ``count`` frames spread over the last dominant
+            oscillation period.
+        align: rotate every snapshot so that the overall direction of motion points right, as in
+            the paper (the same rotation for all panels).
+        cols: panels per row (default: all in one row up to 6).
+        color_springs: colour the springs by ``trajectory.spring_state`` instead of grey.
+    Returns:
+        The Figure; panel k shows ``frames[k]``, titled with its control step, and its node
+        collection (label ``"nodes"``) has node i's facecolour ``STATE_COLORS[node_state[frame, i]]``.
+    """
+    tr = trajectory
+    frames = list(tr.cycle_frames(count) if frames is None else frames)
+    if not frames:
+        raise ValueError("motion_cycle: no frames to draw")
+    for f in frames:
+        if not -tr.frame_count <= f < tr.frame_count:
+            raise ValueError(f"motion_cycle: frame {f} out of range (trajectory has {tr.frame_count} frames)")
+    rot = rotation_to(tr.direction) if align else np.eye(2)
+    direction = rot @ tr.direction
+    origin = tr.com[frames[0]]
+    snaps = [(tr.positions[f] - origin) @ rot.T for f in frames]
+    allpts = np.concatenate(snaps)
+    r = _node_radius(tr.body)
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    ext = hi - lo + 2 * (r + 0.4)
+    cols = cols or min(len(frames), 6)
+    rows = (len(frames) + cols - 1) // cols
+    panel_w = 2.2 if cols > 3 else 3.0
+    panel_h = float(np.clip(panel_w * ext[1] / ext[0], 1.2, 4.0))
+    fig = plt.figure(figsize=(panel_w * cols, panel_h * rows + 1.0))
+    axes = fig.subplots(rows, cols, squeeze=False)
+    for ax in axes.flat[len(frames):]:
+        ax.set_visible(False)
+    steps0 = int(tr.steps[frames[0]])
+    for ax, f, pos in zip(axes.flat, frames, snaps):
+        colors = [STATE_COLORS[int(s)] for s in tr.node_state[f]]
+        scol = [STATE_COLORS[int(s)] for s in tr.spring_state[f]] if color_springs else SPRING_COLOR
+        draw_body(ax, tr.body, pos, colors, node_radius=r, spring_colors=scol)
+        _frame_axes(ax, lo, hi, r + 0.4)
+        ax.set_title(f"step {int(tr.steps[f])}", fontsize=9)
+        ax.text(0.02, 0.03, f"+{int(tr.steps[f]) - steps0}", transform=ax.transAxes, fontsize=7, color="#666666")
+        ax.annotate("", xy=(0.93 + 0.05 * direction[0], 0.12 + 0.05 * direction[1] * panel_w / panel_h),
+                    xytext=(0.93 - 0.05 * direction[0], 0.12 - 0.05 * direction[1] * panel_w / panel_h),
+                    xycoords="axes fraction", arrowprops=dict(arrowstyle="-|>", color="#555555", lw=1.2))
+    handles = [Line2D([], [], marker="o", ls="", markerfacecolor=STATE_COLORS[s], markeredgecolor="#222222",
+                      markersize=8, label=STATE_NAMES[s]) for s in (EXPANDING, CONTRACTING, NEUTRAL)]
+    handles.append(Line2D([], [], color=SKIN_COLOR, lw=2.2, label="skin"))
+    handles.append(Line2D([], [], marker=r"$\rightarrow$", ls="", color="#555555", markersize=12,
+                          label="direction of motion" + (" (rotated to point right)" if align else "")))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+    period = tr.period()
+    cycle = (f"dominant period {period / tr.dt:.0f} steps" if math.isfinite(period) else "no oscillation")
+    fig.suptitle(title or f"Motion cycle (paper Figs. 4-6): steps {int(tr.steps[frames[0]])}-"
+                          f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g} in "
+                          f"{int(tr.steps[-1] - tr.steps[0])} steps", fontsize=9.5)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig
+
+
+# --- Fig. 7: phase map ----------------------------------------------------------------------------------
+
+def phase_map(body: Any, *, config: Optional[Any] = None, ax=None, cmap: str = PHASE_CMAP,
+              colorbar: bool = True, title: Optional[str] = None) -> "matplotlib.figure.Figure":
+    """Paper Fig. 7: the body at rest (its initial, equilibrium state) with every node coloured by
+    its oscillation phase shift. The colour range is normalised to the body's phases
+    (``vmin = phase.min()``, ``vmax = phase.max()``) and the maximum (the red node) is written
+    next to it and in the title. When all phases are equal every node is red and the range is
+    ``[max - 1, max]``; the title says "all equal".
+
+    Args:
+        body: an :class:`animat.Body`, Embryo, Genome / LineageEntry (developed with ``config``)
+            or a Trajectory.
+        ax: draw into this Axes (default: a new Figure).
+        cmap: matplotlib colour map name (default ``"jet"``: blue low, red maximum).
+        colorbar: add a colour bar (radians).
+    Returns:
+        The Figure. The node collection (label ``"nodes"``) carries the phases as its array and
+        the Normalize as its ``norm``.
+    """
+    body = body_of(body, config)
+    phase = np.asarray(body.phase, dtype=float)
+    pos = np.asarray(body.positions)
+    standalone = ax is None
+    r = _node_radius(body)
+    pad = r + 0.5
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    if ax is None:
+        ext = hi - lo + 2 * pad
+        h = 3.6
+        w = float(np.clip(h * ext[0] / max(ext[1], 1e-9), 2.5, 8.0)) + (1.1 if colorbar else 0.2)
+        fig = plt.figure(figsize=(w, h + 0.5))
+        ax = fig.add_subplot()
+    else:
+        fig = ax.figure
+    vmin, vmax = (float(phase.min()), float(phase.max())) if len(phase) else (0.0, 1.0)
+    # all phases equal: every node is the maximum (red); the colour range is then [max - 1, max]
+    norm = Normalize(vmin=vmin if vmax > vmin else vmax - 1.0, vmax=vmax)
+    artists = draw_body(ax, body, pos, "#ffffff")
+    nodes = artists["nodes"]
+    nodes.set_array(phase)
+    nodes.set_cmap(cmap)
+    nodes.set_norm(norm)
+    nodes.update_scalarmappable()  # facecolours now, not only at draw time
+    _frame_axes(ax, lo, hi, pad)
+    if len(phase):
+        k = int(np.argmax(phase))
+        toward = (lo + hi) / 2 - pos[k]
+        toward = toward / (np.linalg.norm(toward) or 1.0)
+        ax.annotate(f"max {vmax:.2f}", xy=pos[k], xytext=tuple(22 * toward), textcoords="offset points", fontsize=8,
+                    ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
+                    va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
+                    arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
+                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9), zorder=5)
+    if colorbar:
+        cb = fig.colorbar(nodes, ax=ax, fraction=0.045, pad=0.03)
+        cb.set_label("phase shift φ (rad)", fontsize=8)
+        cb.ax.tick_params(labelsize=7)
+    ax.set_title(title if title is not None else (f"Phase shifts (paper Fig. 7)\nmax φ = {vmax:.2f} rad" + (
+        " (all equal)" if vmax == vmin else f", min {vmin:.2f} rad")), fontsize=9)
+    if standalone:
+        fig.tight_layout()
+    return fig
+
+
+# --- Figs. 8-9: fitness history ------------------------------------------------------------------------
+
+def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MORPHOLOGY_TOLERANCE,
+                    show_mean: bool = True, title: Optional[str] = None) -> "matplotlib.figure.Figure":
+    """Paper Figs. 8–9: the best fitness over generations, with the generations at which the best
+    individual's morphology changed marked, and thumbnails of those bodies (at rest, nodes
+    coloured by phase shift, each thumbnail normalised like :func:`phase_map`; plain nodes when
+    all cells have the same phase) joined to their point on the curve.
+
+    Args:
+        run: an :class:`animat.Run` or a run directory path.
+        max_thumbnails: at most this many thumbnails (always the first and the last morphology;
+            the others evenly spread over the changes). Every change is still marked on the curve.
+        tolerance: morphology-change tolerance, see :meth:`animat.Run.morphology_changes`.
+        show_mean: also draw the population's mean fitness (thin grey).
+    Returns:
+        The Figure: the main Axes (label ``"fitness"``) and one small Axes per thumbnail.
+    """
+    run = run if isinstance(run, Run) else Run(run)
+    cfg = run.config
+    hist = run.history
+    lineage = run.best_genomes
+    changes = run.morphology_changes(tolerance, cfg) if lineage else []
+
+    k = min(len(changes), max(0, max_thumbnails))
+    if k and len(changes) > k:
+        idx = np.unique(np.linspace(0, len(changes) - 1, k).round().astype(int))
+        shown = [changes[i] for i in idx]
+    else:
+        shown = changes[:k]
+
+    fig = plt.figure(figsize=(10, 6.2 if shown else 4.2))
+    if shown:
+        gs = fig.add_gridspec(2, max(len(shown), 1), height_ratios=[1.0, 1.5], hspace=0.25, left=0.07, right=0.98,
+                              top=0.88, bottom=0.09, wspace=0.12)
+        main = fig.add_subplot(gs[1, :])
+    else:
+        main = fig.add_subplot()
+    main.set_label("fitness")
+    gens = hist["generation"] if len(hist) else np.array([e.generation for e in lineage])
+    best = hist["best"] if len(hist) else np.array([e.fitness for e in lineage])
+    if len(gens):
+        main.plot(gens, best, drawstyle="steps-post", color="#1f4e79", lw=1.6, label="best fitness")
+        if show_mean and len(hist):
+            main.plot(gens, hist["mean"], color="#999999", lw=0.9, label="mean fitness (viable)")
+    lg = [e.generation for e in lineage]
+    lf = [e.fitness for e in lineage]
+    if lineage:
+        main.plot(lg, lf, "o", ms=3.5, color="#1f4e79", label="new best individual")
+    cg = [e.generation for e in changes]
+    cf = [e.fitness for e in changes]
+    for g in cg:
+        main.axvline(g, color="#d62728", lw=0.6, ls=":", zorder=0)
+    if changes:
+        main.plot(cg, cf, "D", ms=6, mfc="#d62728", mec="k", mew=0.6, label="morphology changed", zorder=4)
+    main.set_xlabel("generation")
+    main.set_ylabel("best fitness (distance travelled)")
+    main.grid(alpha=0.25)
+    main.legend(fontsize=8, loc="lower right")
+    if len(gens):
+        span = max(float(gens[-1] - gens[0]), 1.0)
+        main.set_xlim(float(gens[0]) - 0.02 * span, float(gens[-1]) + 0.02 * span)
+    main.set_ylim(bottom=0)
+
+    for col, entry in enumerate(shown):
+        ax = fig.add_subplot(gs[0, col])
+        try:
+            body = body_of(entry, cfg)
+        except ValueError:
+            ax.set_axis_off()
+            continue
+        ph = np.asarray(body.phase)
+        if len(ph) and np.ptp(ph) > 0:
+            phase_map(body, ax=ax, colorbar=False, title="")
+            for t in list(ax.texts):
+                t.remove()
+            note = f"φ {ph.min():.2f}-{ph.max():.2f}"
+        else:  # no phase shift among the cells (paper Fig. 8: such bodies are not coloured)
+            pos = np.asarray(body.positions)
+            draw_body(ax, body, pos, "#f2f2f2")
+            _frame_axes(ax, pos.min(axis=0), pos.max(axis=0), _node_radius(body) + 0.5)
+            note = "no phase shift"
+        ax.set_title(f"gen {entry.generation}: {entry.fitness:.3g}\n{note}", fontsize=8)
+        con = ConnectionPatch(xyA=(0.5, 0.0), coordsA=ax.transAxes, xyB=(entry.generation, entry.fitness),
+                              coordsB=main.transData, color="#d62728", lw=0.7, alpha=0.7)
+        fig.add_artist(con)
+    n_changes = len(changes)
+    fig.suptitle(title or f"Fitness history (paper Figs. 8-9): {run.path.name}, {len(hist)} generations, "
+                          f"{len(lineage)} improvements, {n_changes} morpholog{'y' if n_changes == 1 else 'ies'}"
+                          f"{f' ({len(shown)} shown, nodes coloured by phase)' if shown else ''}", fontsize=10)
+    if not shown:
+        fig.tight_layout()
+    return fig

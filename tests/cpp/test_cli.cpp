@@ -1,0 +1,206 @@
+// animat_evolve command line: --print-config prints the resolved config as TOML that parses back to
+// the same config; --config/--set/--seed/--generations/--threads change it; every bad option exits
+// non-zero with a message on stderr naming the problem.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+
+using namespace animat;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path scratch_dir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("animat_test_cli_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+// Runs animat_evolve with `args` (already shell-quoted where needed), in a scratch directory so
+// that nothing it might write lands in the source tree.
+Result run(const std::string& args) {
+  const fs::path out = scratch_dir() / "stdout.txt", err = scratch_dir() / "stderr.txt";
+  const std::string cmd = "cd '" + scratch_dir().string() + "' && '" + ANIMAT_EVOLVE_EXE + "' " + args + " >'" +
+                          out.string() + "' 2>'" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+fs::path write_file(const std::string& name, const std::string& text) {
+  const fs::path p = scratch_dir() / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "expected '" << (needle) << "' in: " << (haystack)
+
+}  // namespace
+
+TEST(Cli, ExecutableExists) { ASSERT_TRUE(fs::exists(ANIMAT_EVOLVE_EXE)) << ANIMAT_EVOLVE_EXE; }
+
+TEST(Cli, PrintConfigParsesBackToTheDefault) {
+  const Result r = run("--print-config");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Config printed = config_from_toml(r.out, "--print-config output");
+  EXPECT_TRUE(printed == Config{});
+  EXPECT_EQ(r.out, to_toml(Config{}));
+  EXPECT_CONTAINS(r.out, "[grn]");
+  EXPECT_CONTAINS(r.out, "dt = 0.05");
+}
+
+TEST(Cli, SetOverridesAreReflected) {
+  const Result r = run("--print-config --set evolution.population=50 --set grn.dt=0.025 --set physics.drag_scheme=explicit");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Config c = config_from_toml(r.out, "stdout");
+  EXPECT_EQ(c.evolution.population, 50);
+  EXPECT_EQ(c.grn.dt, 0.025);
+  EXPECT_EQ(c.physics.drag_scheme, "explicit");
+  Config expected;
+  apply_override(expected, "evolution.population=50");
+  apply_override(expected, "grn.dt=0.025");
+  apply_override(expected, "physics.drag_scheme=explicit");
+  EXPECT_TRUE(c == expected);
+}
+
+TEST(Cli, SeedGenerationsThreadsOptions) {
+  const Result r = run("--print-config --seed 1234 --generations 7 --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Config c = config_from_toml(r.out, "stdout");
+  EXPECT_EQ(c.evolution.seed, 1234);
+  EXPECT_EQ(c.evolution.generations, 7);
+  EXPECT_EQ(c.evolution.threads, 1);
+}
+
+TEST(Cli, ConfigFileThenSetOverridesIt) {
+  Config file_cfg;
+  file_cfg.evolution.population = 60;
+  file_cfg.scene.drag_normal = 3.5;
+  const fs::path p = write_file("good.toml", to_toml(file_cfg));
+  Result r = run("--print-config --config '" + p.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(config_from_toml(r.out, "stdout") == file_cfg);
+  r = run("--print-config --config '" + p.string() + "' --set evolution.population=70");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Config c = config_from_toml(r.out, "stdout");
+  EXPECT_EQ(c.evolution.population, 70);
+  EXPECT_EQ(c.scene.drag_normal, 3.5);
+  // A partial file keeps the defaults for everything else.
+  const fs::path partial = write_file("partial.toml", "[grn]\ndt = 0.1\n");
+  r = run("--print-config --config '" + partial.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Config expected;
+  expected.grn.dt = 0.1;
+  EXPECT_TRUE(config_from_toml(r.out, "stdout") == expected);
+}
+
+TEST(CliErrors, UnknownOption) {
+  const Result r = run("--print-config --bogus-option");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "--bogus-option");
+  EXPECT_TRUE(r.out.find("[grn]") == std::string::npos) << "printed a config despite the error";
+}
+
+TEST(CliErrors, UnknownSetKeyWithSuggestion) {
+  const Result r = run("--print-config --set genome.dimensons=3");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "genome.dimensons");
+  EXPECT_CONTAINS(r.err, "did you mean 'dimensions'");
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(CliErrors, BadSetValues) {
+  Result r = run("--print-config --set evolution.population=0");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "evolution.population");
+  EXPECT_CONTAINS(r.err, "out of range");
+  EXPECT_CONTAINS(r.err, "[2, 100000]");
+  r = run("--print-config --set grn.dt=abc");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "grn.dt=abc");
+  r = run("--print-config --set grn.dt=-1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "grn.dt");
+  EXPECT_CONTAINS(r.err, "(0, 1]");
+  r = run("--print-config --set nodotatall");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "section.key=value");
+  r = run("--print-config --set grn.dt=nan");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "finite");
+}
+
+TEST(CliErrors, MissingConfigFile) {
+  const std::string missing = (scratch_dir() / "does_not_exist.toml").string();
+  const Result r = run("--print-config --config '" + missing + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, missing);
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(CliErrors, BadConfigFileNamesFileLineAndKey) {
+  const fs::path p = write_file("bad.toml", "# comment\n[evolution]\npopulaton = 50\n");
+  const Result r = run("--print-config --config '" + p.string() + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, p.string() + ":3");
+  EXPECT_CONTAINS(r.err, "evolution.populaton");
+  EXPECT_CONTAINS(r.err, "did you mean 'population'");
+  EXPECT_EQ(r.out, "");
+  const fs::path bad_file = fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / "config_dt_nan.toml";
+  const Result r2 = run("--print-config --config '" + bad_file.string() + "'");
+  EXPECT_NE(r2.exit_code, 0);
+  EXPECT_CONTAINS(r2.err, bad_file.string() + ":6");
+  EXPECT_CONTAINS(r2.err, "grn.dt = nan");
+}
+
+TEST(CliErrors, BadLogLevel) {
+  const Result r = run("--print-config --log-level loud");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "loud");
+  EXPECT_CONTAINS(r.err, "--log-level");
+  EXPECT_EQ(r.out, "");
+  for (const char* ok : {"trace", "debug", "info", "warn", "error", "critical", "off"}) {
+    const Result good = run(std::string("--print-config --log-level ") + ok);
+    EXPECT_EQ(good.exit_code, 0) << ok << ": " << good.err;
+  }
+}
+
+TEST(CliErrors, BadNumericOptions) {
+  Result r = run("--print-config --seed -1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "--seed");
+  r = run("--print-config --generations many");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "--generations");
+  r = run("--print-config --threads 5000");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "evolution.threads");
+  EXPECT_EQ(r.out, "");
+}

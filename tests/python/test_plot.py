@@ -1,0 +1,211 @@
+"""animat.plot on a small real run, headless (Agg): every function returns a Figure and draws what
+the paper's figure shows; motion_cycle colours follow eq. 2, phase_map's colour range the phases."""
+import math
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+import animat  # noqa: E402
+from animat import plot  # noqa: E402
+
+RED, BLUE, GREEN = (to_rgba(c) for c in ("#d62728", "#1f77b4", "#2ca02c"))
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    c = animat.Config()
+    c["evolution.population"] = 12
+    c["evolution.generations"] = 3
+    c["evaluation.steps"] = 300
+    c["evolution.seed"] = 5
+    out = tmp_path_factory.mktemp("plot") / "run"
+    animat.evolve(c, out=str(out))
+    return animat.Run(out)
+
+
+@pytest.fixture(scope="module")
+def trajectory(run):
+    return animat.replay(run.best(), run.config)
+
+
+@pytest.fixture(autouse=True)
+def no_show_and_close(monkeypatch):
+    def refuse(*args, **kwargs):
+        raise AssertionError("plot functions must never call show()")
+
+    monkeypatch.setattr(plt, "show", refuse)
+    monkeypatch.setattr(Figure, "show", refuse)
+    yield
+    plt.close("all")
+
+
+def nodes_of(ax):
+    found = [c for c in ax.collections if c.get_label() == "nodes"]
+    assert len(found) == 1
+    return found[0]
+
+
+def test_backend_is_headless():
+    assert matplotlib.get_backend().lower() == "agg"
+
+
+def test_every_plot_function_returns_a_figure(run, trajectory, tmp_path):
+    best = run.best()
+    figures = {
+        "development": plot.development(best, config=run.config),
+        "construction": plot.construction(best, config=run.config),
+        "motion_cycle": plot.motion_cycle(trajectory),
+        "phase_map": plot.phase_map(best, config=run.config),
+        "fitness_history": plot.fitness_history(run),
+    }
+    for name, fig in figures.items():
+        assert isinstance(fig, Figure), name
+        fig.savefig(tmp_path / f"{name}.png", dpi=50)
+        assert (tmp_path / f"{name}.png").stat().st_size > 1000
+
+
+def expected_state(body, t, neutral=animat.DEFAULT_NEUTRAL):
+    """Eq. 2 independently: a cell expands its springs when d/dt[a sin(f t + phi)] > 0 (after its
+    delayed start, the first zero crossing of the sine), contracts when < 0, with a neutral band."""
+    a, f, p = np.asarray(body.amplitude), np.asarray(body.frequency), np.asarray(body.phase)
+    theta = np.mod(p, math.pi)
+    start = np.where(theta == 0, 0.0, np.where(f > 0, (math.pi - theta) / np.where(f > 0, f, 1), np.inf))
+    rate = np.where(t >= start, a * f * np.cos(f * t + p), 0.0)
+    thr = neutral * np.max(a * f)
+    return np.where(rate > thr, 1, np.where(rate < -thr, -1, 0))
+
+
+def check_motion_cycle_colours(fig, tr):
+    dt = animat.Config()["physics.dt"]
+    seen = set()
+    panels = [ax for ax in fig.axes if ax.get_visible() and any(c.get_label() == "nodes" for c in ax.collections)]
+    assert panels
+    for ax in panels:
+        step = int(re.search(r"step (\d+)", ax.get_title()).group(1))
+        state = expected_state(tr.body, step * dt)
+        colours = nodes_of(ax).get_facecolor()
+        assert len(colours) == tr.body.node_count
+        for c, s in zip(colours, state):
+            assert tuple(c) == {1: RED, -1: BLUE, 0: GREEN}[int(s)]
+            seen.add(int(s))
+    return panels, seen
+
+
+def test_motion_cycle_node_colours_follow_eq2(trajectory):
+    fig = plot.motion_cycle(trajectory, count=5)
+    panels, _ = check_motion_cycle_colours(fig, trajectory)
+    assert len(panels) == 5
+    # the skin is drawn thick in every panel and the direction of motion is marked
+    for ax in panels:
+        widths = [lc.get_linewidth()[0] for lc in ax.collections if lc.get_label() != "nodes"
+                  and hasattr(lc, "get_segments") and len(lc.get_segments())]
+        assert max(widths) >= 2.0
+    assert any("direction of motion" in t.get_text() for t in fig.legends[0].get_texts())
+
+
+def test_motion_cycle_on_a_wave_shows_all_three_states():
+    xs, ys = np.meshgrid(np.arange(7.0), np.arange(3.0))
+    pos = np.column_stack([xs.ravel() + 0.5 * (ys.ravel() % 2), 0.87 * ys.ravel()])
+    n = len(pos)
+    body = animat.build_body(pos, np.full(n, 0.15), np.full(n, 2 * np.pi), 1.5 * pos[:, 0] % (2 * np.pi))
+    tr = animat.replay(body, steps=240)
+    fig = plot.motion_cycle(tr, frames=[180, 190, 200, 210, 220, 230], align=False, color_springs=True)
+    panels, seen = check_motion_cycle_colours(fig, tr)
+    assert seen == {-1, 0, 1}
+    assert [ax.get_title() for ax in panels] == [f"step {s}" for s in (180, 190, 200, 210, 220, 230)]
+    with pytest.raises(ValueError, match="out of range"):
+        plot.motion_cycle(tr, frames=[10_000])
+
+
+def test_phase_map_colour_range_matches_the_phases(run):
+    embryo = animat.develop(run.best().genome, run.config)
+    phase = np.random.default_rng(1).uniform(0.3, 2.9, embryo.cell_count)  # evolved phases may all be equal
+    body = animat.build_body(embryo.positions, embryo.amplitude, embryo.frequency, phase)
+    fig = plot.phase_map(body)
+    ax = fig.axes[0]
+    nodes = nodes_of(ax)
+    assert nodes.norm.vmin == pytest.approx(phase.min())
+    assert nodes.norm.vmax == pytest.approx(phase.max())
+    assert np.allclose(nodes.get_array(), phase)
+    # the red node is the maximum, and its value is written out
+    rgba = nodes.get_facecolor()
+    cmap = plt.get_cmap(plot.PHASE_CMAP)
+    assert np.allclose(rgba[int(np.argmax(phase))], cmap(1.0))
+    assert np.allclose(rgba[int(np.argmin(phase))], cmap(0.0))
+    label = f"{phase.max():.2f}"
+    texts = [t.get_text() for t in ax.texts] + [ax.get_title()]
+    assert any(label in t for t in texts)
+    # the colour bar spans the same range
+    cbar_ax = fig.axes[1]
+    assert cbar_ax.get_ylim() == pytest.approx((phase.min(), phase.max()))
+
+
+def test_phase_map_of_uniform_phases_and_into_given_axes(run):
+    pos = np.array([[0, 0], [1, 0], [0.5, 0.9], [1.5, 0.9]], dtype=float)
+    body = animat.build_body(pos, np.full(4, 0.1), np.full(4, 3.0), np.full(4, 1.25))
+    fig, ax = plt.subplots()
+    out = plot.phase_map(body, ax=ax, colorbar=False)
+    assert out is fig and "all equal" in ax.get_title() and "1.25" in ax.get_title()
+    nodes = nodes_of(ax)
+    assert nodes.norm.vmax == pytest.approx(1.25) and nodes.norm.vmin == pytest.approx(0.25)
+    assert np.allclose(nodes.get_facecolor(), plt.get_cmap(plot.PHASE_CMAP)(1.0))  # all red: all are the max
+    # the run's own best, whatever its phases, from a LineageEntry
+    phase = animat.develop(run.best().genome, run.config).phase
+    fig = plot.phase_map(run.best(), config=run.config)
+    assert nodes_of(fig.axes[0]).norm.vmax == pytest.approx(phase.max())
+
+
+def test_fitness_history_marks_morphology_changes(run):
+    fig = plot.fitness_history(run, max_thumbnails=2)
+    main = next(ax for ax in fig.axes if ax.get_label() == "fitness")
+    h = run.history
+    line = main.get_lines()[0]
+    assert np.array_equal(line.get_xdata(), h["generation"]) and np.allclose(line.get_ydata(), h["best"])
+    changes = run.morphology_changes()
+    diamonds = [ln for ln in main.get_lines() if ln.get_marker() == "D"]
+    assert len(diamonds) == 1 and list(diamonds[0].get_xdata()) == [e.generation for e in changes]
+    thumbs = [ax for ax in fig.axes if ax is not main]
+    assert len(thumbs) == min(2, len(changes))
+    for ax in thumbs:
+        assert nodes_of(ax) is not None and ax.get_title().startswith("gen ")
+    assert main.get_xlabel() == "generation" and "fitness" in main.get_ylabel()
+    # a run given by its path works too
+    assert isinstance(plot.fitness_history(run.path, max_thumbnails=0), Figure)
+
+
+def test_development_panels_and_errors(run):
+    cfg = run.config
+    cfg["development.trace_every"] = 1
+    embryo = animat.develop(run.best().genome, cfg)
+    steps = [0, embryo.division_steps[0], embryo.steps_run]
+    fig = plot.development(embryo, steps=steps)
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title().split(" (")[0] for ax in visible] == [f"step {s}" for s in steps]
+    assert visible[0].get_title() == "step 0 (1 cell)"
+    assert isinstance(plot.development(embryo.trace), Figure)  # a bare trace and default steps
+    with pytest.raises(ValueError, match="no trace"):
+        plot.development(animat.develop(run.best().genome, run.config))
+    with pytest.raises(ValueError, match="not in the trace"):
+        plot.development(embryo, steps=[100_000])
+
+
+def test_construction_shows_delaunay_then_gabriel(run):
+    embryo = animat.develop(run.best().genome, run.config)
+    body = animat.build_body(embryo)
+    fig = plot.construction(embryo)
+    a, b, c = fig.axes
+    delaunay = animat.delaunay_edges(embryo.positions)
+    segs_b = [len(lc.get_segments()) for lc in b.collections if hasattr(lc, "get_segments")]
+    assert segs_b == [len(delaunay)]
+    segs_c = sorted(len(lc.get_segments()) for lc in c.collections if hasattr(lc, "get_segments"))
+    assert segs_c == sorted([body.spring_count, len(body.skin)])
+    assert "Delaunay" in b.get_title() and "Gabriel" in c.get_title()
+    # points work too
+    assert isinstance(plot.construction(embryo.positions), Figure)
