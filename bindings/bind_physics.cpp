@@ -258,7 +258,9 @@ void bind_physics(nb::module_& m) {
         return owned_array(std::move(f), {n, 2});
       }, "The (n, 2) forces the enabled effects produce in the current state (nothing is integrated).")
       .def_prop_ro("positions", [](const Simulation& s) -> Points { return s.positions(); }, "(n, 2) cell positions.")
-      .def_prop_ro("velocities", [](const Simulation& s) -> Points { return s.velocities(); }, "(n, 2) cell velocities.")
+      .def_prop_rw("velocities", [](const Simulation& s) -> Points { return s.velocities(); },
+                   [](Simulation& s, const Points& v) { s.set_velocities(v); },
+                   "(n, 2) cell velocities; assign an (n, 2) array to set them (e.g. to launch a body).")
       .def("center_of_mass", [](const Simulation& s) -> Eigen::Vector2d { return s.center_of_mass(); },
            "The centre of mass (equal masses: the mean position) as a (2,) array.")
       .def("momentum", [](const Simulation& s) -> Eigen::Vector2d { return s.momentum(); }, "Total momentum, (2,).")
@@ -269,7 +271,7 @@ void bind_physics(nb::module_& m) {
       .def_prop_ro("rest_lengths_now", [](const Simulation& s) {
         const auto r = s.rest_lengths_now();
         return owned_array(std::vector<double>(r.begin(), r.end()), {r.size()});
-      }, "(m,) current rest length of every spring (eq. 2 at the last step).")
+      }, nb::rv_policy::move, "(m,) current rest length of every spring (eq. 2 at the last step).")
       .def_prop_ro("effects", [](const Simulation& s) {
         std::vector<std::string> out;
         for (const Effect* e : s.effects()) out.emplace_back(e->name());

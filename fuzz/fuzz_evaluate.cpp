@@ -2,7 +2,7 @@
 //
 // The first byte picks how the genome is made:
 //   '{'   the input is genome JSON (genome_from_json; rejected inputs end there);
-//   'R'   8 bytes seed a random genome (as the GA seeds its population), the rest drive up to 8
+//   'R'   the next 8 bytes (little-endian) seed a random genome (as the GA seeds its population), the rest drive up to 8
 //         rounds of the GA's mutation operators: the way to reach viable, swimming bodies;
 //   else  raw: each element takes its type, sign, channel and coordinates from the bytes.
 // The swim is shortened to evaluation.steps = 200 so each input takes milliseconds.
@@ -12,9 +12,11 @@
 #include <fmt/format.h>
 #include <fuzzer/FuzzedDataProvider.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string_view>
 
 #include "animat/config.hpp"
@@ -55,8 +57,8 @@ Genome raw_genome(FuzzedDataProvider& in, const Config& c) {
   return g;
 }
 
-Genome mutated_genome(FuzzedDataProvider& in, const Config& c) {
-  Rng rng(in.ConsumeIntegral<std::uint64_t>());
+Genome mutated_genome(std::uint64_t seed, FuzzedDataProvider& in, const Config& c) {
+  Rng rng(seed);
   Genome g = random_genome(c.genome, rng);
   const int rounds = in.ConsumeIntegralInRange<int>(0, 8);
   for (int r = 0; r < rounds; ++r) {
@@ -78,9 +80,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } catch (const Error&) {
       return 0;
     }
+  } else if (data[0] == 'R') {
+    // The seed is read from the front, so a corpus file is 'R' + the seed's 8 little-endian bytes.
+    std::uint64_t seed = 0;
+    std::memcpy(&seed, data + 1, std::min<std::size_t>(size - 1, 8));
+    FuzzedDataProvider in(data + std::min<std::size_t>(size, 9), size - std::min<std::size_t>(size, 9));
+    g = mutated_genome(seed, in, config);
   } else {
     FuzzedDataProvider in(data + 1, size - 1);
-    g = data[0] == 'R' ? mutated_genome(in, config) : raw_genome(in, config);
+    g = raw_genome(in, config);
   }
   validate(g, config.genome, "fuzz genome");  // the builders make valid genomes only
 

@@ -420,7 +420,7 @@ inline SegmentHit closest_on_segment(double px, double py, double ax, double ay,
 /// near pairs; it never misses a pair, so forces equal the all-pairs computation.
 class SkinCollision final : public Effect {
  public:
-  static constexpr double kMargin = 0.6;
+  static constexpr double kMargin = 0.4;
 
   SkinCollision(const Body& body, const SceneParams& p) : k_(p.collision_stiffness), r_(p.collision_radius) {
     n_ = body.node_count();

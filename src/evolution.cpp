@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -468,6 +469,12 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     std::string rows(kHistoryHeader);
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
+    // Lineage files of generations after the checkpoint belong to the lost future; they are rewritten.
+    for (const auto& entry : std::filesystem::directory_iterator(opt.out / "best")) {
+      const std::string name = entry.path().filename().string();
+      int g = -1;
+      if (std::sscanf(name.c_str(), "gen_%d.json", &g) == 1 && g > evo.generation()) std::filesystem::remove(entry.path());
+    }
     if (!opt.quiet) spdlog::info("resumed {} at generation {}", opt.out.string(), evo.generation());
   } else {
     if (!opt.quiet) spdlog::info("drawing {} viable random individuals...", config.evolution.population);

@@ -29,6 +29,7 @@ from matplotlib.collections import EllipseCollection, LineCollection, PatchColle
 from matplotlib.colors import Normalize
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, ConnectionPatch, Polygon
+from matplotlib.ticker import MaxNLocator
 
 from . import _core
 from .run import MORPHOLOGY_TOLERANCE, Run
@@ -492,7 +493,8 @@ def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MOR
     main.set_xlabel("generation")
     main.set_ylabel("best fitness (distance travelled)")
     main.grid(alpha=0.25)
-    main.legend(fontsize=8, loc="lower right")
+    main.legend(fontsize=8, loc="upper left")
+    main.xaxis.set_major_locator(MaxNLocator(integer=True))
     if len(gens):
         span = max(float(gens[-1] - gens[0]), 1.0)
         main.set_xlim(float(gens[0]) - 0.02 * span, float(gens[-1]) + 0.02 * span)

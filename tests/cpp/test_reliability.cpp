@@ -31,6 +31,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <typeinfo>
 #include <vector>
 
@@ -754,6 +755,72 @@ TEST(ExtremeConfigs, NeverANaNNeverACrash) {
       }
     }
   }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Parallel evaluation: scripts/reliability.sh runs these under ThreadSanitizer
+
+/// Random genomes plus mutants of the first viable ones found: development for all, swims for some.
+std::vector<Genome> parallel_workload(const Config& c, int random_count, int viable_wanted) {
+  std::vector<Genome> out, viable;
+  for (int i = 0; i < 3000 && static_cast<int>(viable.size()) < viable_wanted; ++i) {
+    Rng rng = Rng::derive(4242, i);
+    Genome g = random_genome(c.genome, rng);
+    if (evaluate(g, c).viable) viable.push_back(g);
+    if (i < random_count) out.push_back(std::move(g));
+  }
+  for (std::size_t k = 0; k < viable.size(); ++k) {
+    out.push_back(viable[k]);
+    for (int m = 0; m < 3; ++m) {
+      Rng rng = Rng::derive(4243, k, m);
+      Genome g = viable[k];
+      mutate(g, c.mutation, c.genome, rng);
+      out.push_back(std::move(g));
+    }
+  }
+  return out;
+}
+
+FitnessFunction evaluate_fitness(const Config& c) {
+  return [c](const Genome& g) {
+    const EvaluationResult r = evaluate(g, c);
+    return Fitness{r.fitness, r.viable, r.stable, r.cell_count};
+  };
+}
+
+TEST(ParallelEvaluation, EvaluateAllOnTwoOpenMPThreadsMatchesOneThread) {
+  Config c;
+  c.evaluation.steps = 300;
+  const auto genomes = parallel_workload(c, 24, 2);
+  const auto one = evaluate_all(genomes, evaluate_fitness(c), 1);
+  const auto two = evaluate_all(genomes, evaluate_fitness(c), 2);
+  ASSERT_EQ(one.size(), two.size());
+  int viable = 0;
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i], two[i]) << "genome " << i;
+    viable += one[i].viable;
+  }
+  EXPECT_GE(viable, 2) << "the workload should include swims";
+}
+
+TEST(ParallelEvaluation, StdThreadsWithTheirOwnWorldsMatchSerial) {
+  // The same per-thread worlds without OpenMP: what ThreadSanitizer checks here is our code (and
+  // Box2D's use of shared state) independently of the OpenMP runtime's own synchronisation.
+  Config c;
+  c.evaluation.steps = 300;
+  const auto genomes = parallel_workload(c, 24, 2);
+  const FitnessFunction f = evaluate_fitness(c);
+  std::vector<Fitness> serial;
+  for (const auto& g : genomes) serial.push_back(f(g));
+  prepare_parallel_evaluation();
+  std::vector<Fitness> threaded(genomes.size());
+  std::vector<std::thread> pool;
+  for (std::size_t t = 0; t < 2; ++t)
+    pool.emplace_back([&, t] {
+      for (std::size_t i = t; i < genomes.size(); i += 2) threaded[i] = f(genomes[i]);
+    });
+  for (auto& th : pool) th.join();
+  for (std::size_t i = 0; i < genomes.size(); ++i) EXPECT_EQ(serial[i], threaded[i]) << "genome " << i;
 }
 
 // ---------------------------------------------------------------------------------------------------

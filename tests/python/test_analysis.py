@@ -240,7 +240,7 @@ def test_rest_lengths_match_the_simulation():
     sim.step(50)
     try:
         now = np.asarray(sim.rest_lengths_now)
-    except RuntimeError as e:  # binding bug in some builds: see docs/python.md
+    except RuntimeError as e:  # nanobind rv_policy bug of the property in some builds
         pytest.skip(f"Simulation.rest_lengths_now unavailable: {e}")
     # the simulation's last actuation update ran at the start of the last Box2D step
     h = animat.Config()["physics.dt"] / animat.Config()["physics.substeps"]
