@@ -34,7 +34,8 @@ nb::dict to_dict(const Config& c) {
   return out;
 }
 
-void update(Config& c, const nb::dict& d) {
+void update(Config& target, const nb::dict& d) {
+  Config c = target;  // all or nothing: a rejected value leaves the config unchanged
   for (auto [k, v] : d) {
     const std::string key = nb::cast<std::string>(k);
     if (nb::isinstance<nb::dict>(v)) {
@@ -45,13 +46,20 @@ void update(Config& c, const nb::dict& d) {
     }
   }
   validate(c, "dict");
+  target = std::move(c);
 }
 
 }  // namespace
 
 void bind_config(nb::module_& m) {
   nb::class_<SectionView>(m, "ConfigSection", "Attribute view of one config section (e.g. ``config.scene``).")
-      .def("__getattr__", [](const SectionView& s, const std::string& k) { return get_value(*s.config, s.name + "." + k); })
+      .def("__getattr__", [](const SectionView& s, const std::string& k) {
+        try {
+          return get_value(*s.config, s.name + "." + k);
+        } catch (const ConfigError& e) {
+          throw nb::attribute_error(e.what());  // so hasattr/getattr(default) follow the protocol
+        }
+      })
       .def("__setattr__", [](SectionView& s, const std::string& k, const ConfigValue& v) { set_value(*s.config, s.name + "." + k, v); })
       .def("__dir__", [](const SectionView& s) {
         std::vector<std::string> out;

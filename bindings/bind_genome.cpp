@@ -63,18 +63,18 @@ void bind_genome(nb::module_& m) {
                    "The four 64-bit words of the generator state.")
       .def("__eq__", [](const Rng& a, const Rng& b) { return a == b; });
 
-  nb::enum_<ElementType>(m, "ElementType", "Type of a genetic element (paper Fig. 1).")
+  nb::enum_<ElementType>(m, "ElementType", nb::is_arithmetic(), "Type of a genetic element (paper Fig. 1).")
       .value("promoter", ElementType::promoter)
       .value("internal_gene", ElementType::internal_gene)
       .value("morphogen_gene", ElementType::morphogen_gene)
       .value("input", ElementType::input)
       .value("output", ElementType::output);
-  nb::enum_<InputChannel>(m, "InputChannel", "Special inputs: the constant 1 and three maternal morphogens.")
+  nb::enum_<InputChannel>(m, "InputChannel", nb::is_arithmetic(), "Special inputs: the constant 1 and three maternal morphogens.")
       .value("bias", InputChannel::bias)
       .value("maternal0", InputChannel::maternal0)
       .value("maternal1", InputChannel::maternal1)
       .value("maternal2", InputChannel::maternal2);
-  nb::enum_<OutputChannel>(m, "OutputChannel", "Special outputs: divide, rotate, grow and the oscillator's amplitude, frequency, phase.")
+  nb::enum_<OutputChannel>(m, "OutputChannel", nb::is_arithmetic(), "Special outputs: divide, rotate, grow and the oscillator's amplitude, frequency, phase.")
       .value("divide", OutputChannel::divide)
       .value("rotate", OutputChannel::rotate)
       .value("grow", OutputChannel::grow)

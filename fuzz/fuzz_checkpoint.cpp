@@ -58,7 +58,12 @@ std::string fnv_hex(std::string_view s) {
   return fmt::format("{:016x}", h);
 }
 
-std::string wrap(const std::string& body) { return json{{"checksum", fnv_hex(body)}, {"payload", body}}.dump(); }
+/// {"checksum": FNV-1a of body, "payload": body}. Invalid UTF-8 in body is replaced first (JSON
+/// strings hold UTF-8 only, and the checksum must be of what restore() will read back).
+std::string wrap(std::string body) {
+  body = json::parse(json(body).dump(-1, ' ', false, json::error_handler_t::replace)).get<std::string>();
+  return json{{"checksum", fnv_hex(body)}, {"payload", body}}.dump();
+}
 
 }  // namespace
 
@@ -76,7 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       p["identity"] = fmt::format("{:016x}", run_identity(config));
       p["format"] = "animat.checkpoint";
       p["version"] = 1;
-      text = wrap(p.dump());
+      text = wrap(p.dump(-1, ' ', false, json::error_handler_t::replace));
     }
   }
   Evolution evo(config, stub);

@@ -280,7 +280,10 @@ std::string to_toml(const Config& config) {
   return out;
 }
 
-void apply_override(Config& config, std::string_view assignment) {
+void apply_override(Config& target, std::string_view assignment) {
+  if (assignment.find_first_of("\r\n") != std::string_view::npos)
+    throw ConfigError(fmt::format("--set {}: one assignment per --set; newlines are not allowed", assignment));
+  Config config = target;  // applied to a copy: a rejected override leaves the config unchanged
   const auto eq = assignment.find('=');
   const auto dot = assignment.find('.');
   if (eq == std::string_view::npos || dot == std::string_view::npos || dot > eq)
@@ -294,13 +297,25 @@ void apply_override(Config& config, std::string_view assignment) {
   const std::string key(trim(assignment.substr(dot + 1, eq - dot - 1)));
   std::string value(trim(assignment.substr(eq + 1)));
   // Bare words are accepted for string fields: --set physics.drag_scheme=explicit.
+  std::string expected;
   with_field(config, section, key, [&](const FieldInfo&, auto& v) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>)
+    using T = std::decay_t<decltype(v)>;
+    expected = type_name<T>();
+    if constexpr (std::is_same_v<T, std::string>)
       if (value.empty() || value.front() != '"') value = quote(value);
   });
   const std::string doc = fmt::format("[{}]\n{} = {}\n", section, key, value);
+  toml::table table;
   try {
-    apply_table(config, parse_toml(doc, "--set"), "--set");
+    table = toml::parse(std::string_view(doc), std::string_view("--set"));
+  } catch (const toml::parse_error&) {
+    if (!expected.empty())
+      throw ConfigError(fmt::format("--set {}: '{}' is not a valid value for {}.{} (expected {})", assignment, value,
+                                    section, key, expected));
+    throw ConfigError(fmt::format("--set {}: malformed value", assignment));
+  }
+  try {
+    apply_table(config, table, "--set");
   } catch (const ConfigError& e) {
     std::string msg = e.what();
     if (msg.rfind("--set:", 0) == 0) msg = msg.substr(msg.find(' ') + 1);
@@ -308,6 +323,7 @@ void apply_override(Config& config, std::string_view assignment) {
     throw ConfigError(fmt::format("--set {}: {}", assignment, msg));
   }
   validate(config, "--set");
+  target = std::move(config);
 }
 
 namespace {
@@ -392,6 +408,10 @@ void validate(const Config& config, std::string_view source) {
   if (config.development.frequency_min > config.development.frequency_max)
     fail(fmt::format("development.frequency_min = {} exceeds development.frequency_max = {}",
                      config.development.frequency_min, config.development.frequency_max));
+  if (config.genome.max_elements < 2 * config.genome.initial_units + kInputCount + kOutputCount)
+    fail(fmt::format("genome.max_elements = {} cannot hold a random genome of genome.initial_units = {} units "
+                     "(needs at least {} elements)", config.genome.max_elements, config.genome.initial_units,
+                     2 * config.genome.initial_units + kInputCount + kOutputCount));
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
                      config.development.max_cells));

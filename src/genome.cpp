@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <optional>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -17,7 +18,7 @@ double affinity(double d, const GenomeParams& p) {
   if (!(d < p.affinity_cutoff)) return 0.0;
   // 10·(e^{-βd} − e^{-βc}) / (1 − e^{-βc}): 10 at d = 0, monotone, exactly 0 at the cut-off c.
   const double tail = std::exp(-p.affinity_decay * p.affinity_cutoff);
-  return 10.0 * (std::exp(-p.affinity_decay * d) - tail) / (1.0 - tail);
+  return 10.0 * ((std::exp(-p.affinity_decay * d) - tail) / (1.0 - tail));
 }
 
 double distance(const Element& a, const Element& b) {
@@ -60,7 +61,7 @@ std::uint64_t genome_hash(const Genome& g) {
     feed(static_cast<std::uint64_t>(e.type));
     feed(static_cast<std::uint64_t>(static_cast<std::int64_t>(e.sign)));
     feed(static_cast<std::uint64_t>(e.channel));
-    for (double x : e.coords) feed(std::bit_cast<std::uint64_t>(x));
+    for (double x : e.coords) feed(std::bit_cast<std::uint64_t>(x == 0.0 ? 0.0 : x));  // -0.0 == 0.0
   }
   return h;
 }
@@ -217,6 +218,9 @@ int mutate(Genome& g, const MutationParams& m, const GenomeParams& p, Rng& rng) 
 }
 
 Genome crossover(const Genome& a, const Genome& b, int points, Rng& rng) {
+  if (a.dimensions != b.dimensions)
+    throw GenomeError(fmt::format("crossover: parents have {} and {} dimensions; they must match", a.dimensions,
+                                  b.dimensions));
   const std::size_t shortest = std::min(a.size(), b.size());
   std::vector<std::size_t> cuts(static_cast<std::size_t>(std::max(points, 0)));
   for (auto& c : cuts) c = rng.below(shortest + 1);
@@ -269,6 +273,19 @@ int index_of(const Names& names, std::string_view s) {
   return -1;
 }
 
+// An integer value in [lo, hi], whatever JSON integer type holds it; nullopt otherwise.
+std::optional<long long> small_int(const json& v, long long lo, long long hi) {
+  if (v.is_number_unsigned()) {
+    const auto u = v.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(hi) || static_cast<long long>(u) < lo) return std::nullopt;
+    return static_cast<long long>(u);
+  }
+  if (!v.is_number_integer()) return std::nullopt;
+  const auto x = v.get<std::int64_t>();
+  if (x < lo || x > hi) return std::nullopt;
+  return x;
+}
+
 const json& require(const json& obj, const char* key, std::string_view where) {
   auto it = obj.find(key);
   if (it == obj.end()) throw GenomeError(fmt::format("{}: missing key \"{}\"", where, key));
@@ -283,6 +300,8 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
     j = json::parse(text.begin(), text.end());
   } catch (const json::parse_error& e) {
     throw GenomeError(fmt::format("{}: not valid JSON (at byte {}): {}", source, e.byte, e.what()));
+  } catch (const json::exception& e) {  // e.g. a number too large for a double (1e999)
+    throw GenomeError(fmt::format("{}: not valid genome JSON: {}", source, e.what()));
   }
   if (!j.is_object()) throw GenomeError(fmt::format("{}: expected a JSON object at the top level", source));
   try {
@@ -291,11 +310,11 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
     if (!format.is_string() || format.get<std::string>() != "animat.genome")
       throw GenomeError(fmt::format("{}: \"format\" is {}, expected \"animat.genome\"", source, format.dump()));
     const json& version = require(j, "version", where);
-    if (!version.is_number_integer() || version.get<int>() != kGenomeFormatVersion)
+    if (small_int(version, kGenomeFormatVersion, kGenomeFormatVersion) == std::nullopt)
       throw GenomeError(fmt::format("{}: unsupported \"version\" {} (this build reads version {})", source,
                                     version.dump(), kGenomeFormatVersion));
     const json& dims = require(j, "dimensions", where);
-    if (!dims.is_number_integer() || dims.get<long long>() < 1 || dims.get<long long>() > 16)
+    if (small_int(dims, 1, 16) == std::nullopt)
       throw GenomeError(fmt::format("{}: \"dimensions\" is {}, expected an integer in [1, 16]", source, dims.dump()));
     const json& els = require(j, "elements", where);
     if (!els.is_array()) throw GenomeError(fmt::format("{}: \"elements\" must be an array", source));
@@ -317,9 +336,10 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
                                       "morphogen_gene, input, output)", at, type.dump()));
       e.type = static_cast<ElementType>(t);
       const json& sign = require(je, "sign", at);
-      if (!sign.is_number_integer() || (sign.get<long long>() != 1 && sign.get<long long>() != -1))
+      const auto sign_value = small_int(sign, -1, 1);
+      if (sign_value == std::nullopt || *sign_value == 0)
         throw GenomeError(fmt::format("{}: sign is {}, expected 1 or -1", at, sign.dump()));
-      e.sign = sign.get<int>();
+      e.sign = static_cast<int>(*sign_value);
       if (e.is_special()) {
         const json& ch = require(je, "channel", at);
         const int c = !ch.is_string() ? -1

@@ -8,6 +8,10 @@
 
 namespace animat {
 
+namespace {
+constexpr double kBelowOne = 1.0 - 0x1.0p-53;  // the largest double below 1
+}  // namespace
+
 Grn::Grn(const Genome& genome, const GenomeParams& params) : layout_(parse_units(genome)) {
   units_ = static_cast<int>(layout_.units.size());
   morphogen_index_.assign(static_cast<std::size_t>(units_), -1);
@@ -108,7 +112,9 @@ void Grn::step(GrnState& state, const GrnInputs& in, const GrnParams& params) co
     act[t] = a;
   }
   for (int t = 0; t < nodes; ++t) {
-    const double target = std::tanh(std::max(act[t], 0.0) * 0.5);
+    // tanh rounds to exactly 1 for A > ~38; the paper's range is [0, 1), so the target stays below 1
+    // and the convex update keeps the level below it for every dt in (0, 1].
+    const double target = std::min(std::tanh(std::max(act[t], 0.0) * 0.5), kBelowOne);
     state.levels[static_cast<std::size_t>(t)] += (target - state.levels[static_cast<std::size_t>(t)]) * params.dt;
   }
 }

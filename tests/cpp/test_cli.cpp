@@ -3,6 +3,7 @@
 // non-zero with a message on stderr naming the problem.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>

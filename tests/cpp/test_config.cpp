@@ -2,6 +2,7 @@
 // after overrides), --set overrides, get/set by key, and every kind of bad TOML is a ConfigError
 // naming the file, the line, the key, the value and what was expected.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cmath>
@@ -230,7 +231,7 @@ TEST(ConfigRoundTrip, AfterOverrides) {
 }
 
 TEST(ConfigRoundTrip, LoadConfigFromFile) {
-  const fs::path path = fs::temp_directory_path() / "animat_test_config_roundtrip.toml";
+  const fs::path path = fs::temp_directory_path() / ("animat_test_config_" + std::to_string(::getpid()) + ".toml");
   Config c;
   c.evolution.population = 33;
   c.grn.dt = 0.07;

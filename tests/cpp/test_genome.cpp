@@ -1,6 +1,7 @@
 // Genome (include/animat/genome.hpp, MODEL.md §1): affinity, parsing into regulatory units,
 // validation, the random genome, genetic operators, JSON round trips and rejection of bad JSON.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cfloat>
@@ -62,8 +63,8 @@ std::string message_of(const auto& f) {
 fs::path bad_input(const std::string& name) { return fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / name; }
 
 fs::path temp_path(const std::string& name) {
-  return fs::temp_directory_path() / ("animat_test_genome_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                      "_" + name);
+  // Per process: ctest runs tests in parallel, and other build trees may run the same tests.
+  return fs::temp_directory_path() / ("animat_test_genome_" + std::to_string(::getpid()) + "_" + name);
 }
 
 bool bit_equal(const Genome& a, const Genome& b) {

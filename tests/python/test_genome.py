@@ -126,8 +126,8 @@ def test_random_genome_arrays_dtypes_and_layout():
     c = g.coords
     c[0, 0] = 123.0
     assert g.coords[0, 0] != 123.0
-    assert int(animat.ElementType.output) == O and int(animat.OutputChannel.phase) == 5
-    assert int(animat.InputChannel.maternal2) == 3
+    assert animat.ElementType.output.value == O and animat.OutputChannel.phase.value == 5
+    assert animat.InputChannel.maternal2.value == 3
 
 
 def test_random_genome_respects_config():
