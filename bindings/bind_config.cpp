@@ -90,6 +90,8 @@ void bind_config(nb::module_& m) {
       .def("to_toml", &to_toml, "The complete config as commented TOML (what ``animat_evolve --print-config`` prints).")
       .def("to_dict", &to_dict, "Nested dict {section: {key: value}}.")
       .def("update", &update, "values"_a, "Set several values from a nested or flat dict.")
+      .def("apply_override", [](Config& c, const std::string& a) { apply_override(c, a); }, "assignment"_a,
+           "Apply 'section.key=value' exactly as `animat_evolve --set` does (the value is parsed by the key's type).")
       .def("keys", [](const Config&) { return config_keys(); }, "Every 'section.key', in TOML order.")
       .def("__getitem__", &get_value, "key"_a)
       .def("__setitem__", &set_value, "key"_a, "value"_a)

@@ -41,3 +41,4 @@ def __getattr__(name):
 
 def __dir__():
     return sorted(set(globals()) | {"plot"})
+from .experiment import run_experiment  # noqa: E402,F401

@@ -3,6 +3,7 @@
     python -m animat show RUN_DIR       # figures/ development, construction, motion_cycle, phase_map, fitness_history
     python -m animat animate RUN_DIR    # figures/best.gif
     python -m animat info RUN_DIR       # a short summary of the run
+    python -m animat experiment CONFIG --runs N --out DIR   # N independent seeds, resumable, with a summary
 
 Every command exits with status 1 and a one-line message for a missing or malformed run directory.
 """
@@ -28,7 +29,7 @@ def _size(text: str):
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m animat", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", required=True, metavar="{show,animate,info}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="{show,animate,info,experiment}")
 
     s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
     s.add_argument("run", metavar="RUN_DIR")
@@ -52,6 +53,17 @@ def _parser() -> argparse.ArgumentParser:
 
     i = sub.add_parser("info", help="print a summary of a run directory")
     i.add_argument("run", metavar="RUN_DIR")
+
+    e = sub.add_parser("experiment", help="run (or resume) N independent seeds of a config and summarise them")
+    e.add_argument("config", metavar="CONFIG", help="TOML config file")
+    e.add_argument("--runs", type=int, default=3, help="independent runs, seeds evolution.seed + 0..N-1 (default 3)")
+    e.add_argument("--out", required=True, help="experiment directory (run_<i>/ per run, summary.json, summary.md)")
+    e.add_argument("--parallel", type=int, default=1, help="runs at once; the cores are split between them")
+    e.add_argument("--threads", type=int, default=0, help="cores in all (default: all)")
+    e.add_argument("--generations", type=int, help="per-run generation cap (overrides the config)")
+    e.add_argument("--wall-seconds", type=float, help="per-run wall-clock budget in seconds (overrides the config)")
+    e.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a config value")
+    e.add_argument("--quiet", action="store_true", help="no per-run lines")
     return p
 
 
@@ -125,10 +137,23 @@ def cmd_info(args) -> int:
     return 0
 
 
+def cmd_experiment(args) -> int:
+    from .experiment import run_experiment, summarize
+
+    records = run_experiment(args.config, args.runs, args.out, parallel=args.parallel, threads=args.threads,
+                             generations=args.generations, wall_seconds=args.wall_seconds, overrides=args.set,
+                             quiet=args.quiet)
+    stats = summarize(records)
+    print(f"{args.out}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
+          f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {args.out}/summary.md")
+    return 0
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Entry point of ``python -m animat``; returns the exit status (0 ok, 1 error, 2 usage)."""
     args = _parser().parse_args(argv)
-    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info}[args.command]
+    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info,
+               "experiment": cmd_experiment}[args.command]
     try:
         return command(args)
     except (FileNotFoundError, NotADirectoryError, ValueError, RuntimeError, OSError) as e:

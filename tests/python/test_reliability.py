@@ -181,8 +181,8 @@ def test_deeply_nested_genome_is_a_value_error_not_a_crash():
 # Kill-and-resume of the real binary
 
 RUN_ARGS = ["--quiet", "--threads", "2", "--seed", "5", "--set", "evolution.population=12",
-            "--set", "evaluation.steps=300", "--generations", "12"]
-FINAL_GENERATION = 12
+            "--set", "evaluation.steps=300", "--generations", "20"]
+FINAL_GENERATION = 20
 
 
 def fnv1a(data: bytes) -> str:
@@ -244,13 +244,14 @@ def reference(tmp_path_factory):
 def test_sigkill_at_random_moments_then_resume_equals_an_uninterrupted_run(reference, tmp_path):
     run = tmp_path / "run"
     rng = random.Random(20240901)
-    kills, checked = 0, 0
+    kills, checked, mid_run = 0, 0, []
     for attempt in range(40):
         resuming = (run / "checkpoint.json").exists()
         proc = start(["--resume", str(run), "--threads", "2", "--quiet"] if resuming else [*RUN_ARGS, "--out", str(run)])
-        if kills < 5:
-            # A random moment within the remaining run (the first kills often land in initialization).
-            delay = rng.uniform(0.05, 0.8) * reference["seconds"]
+        if kills < 6:
+            # A random moment within the next third of the run: initialization, an evaluation, a
+            # checkpoint write or a history append.
+            delay = rng.uniform(0.05, 0.33) * reference["seconds"]
             try:
                 proc.wait(timeout=delay)
             except subprocess.TimeoutExpired:
@@ -258,7 +259,7 @@ def test_sigkill_at_random_moments_then_resume_equals_an_uninterrupted_run(refer
                 proc.wait()
                 kills += 1
                 if (run / "checkpoint.json").exists():
-                    read_checkpoint(run)
+                    mid_run.append(read_checkpoint(run)["generation"])
                     if checked < 2:  # a full restore costs one generation: do it for the first two
                         assert_restores(run, tmp_path)
                         checked += 1
@@ -271,6 +272,8 @@ def test_sigkill_at_random_moments_then_resume_equals_an_uninterrupted_run(refer
     else:
         pytest.fail("the run never finished")
     assert kills >= 3, f"only {kills} kills landed"
+    assert len(mid_run) >= 2, f"kills after the first checkpoint: generations {mid_run}"
+    print(f"{kills} SIGKILLs; checkpoints found at generations {mid_run}")
     assert read_checkpoint(run)["generation"] == FINAL_GENERATION
     assert history(run) == reference["history"]
     assert lineage(run) == reference["lineage"]
