@@ -412,6 +412,11 @@ void validate(const Config& config, std::string_view source) {
     fail(fmt::format("genome.max_elements = {} cannot hold a random genome of genome.initial_units = {} units "
                      "(needs at least {} elements)", config.genome.max_elements, config.genome.initial_units,
                      2 * config.genome.initial_units + kInputCount + kOutputCount));
+  try {
+    validate(config.development);
+  } catch (const ConfigError& e) {
+    fail(e.what());
+  }
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
                      config.development.max_cells));
