@@ -39,6 +39,7 @@ REF_DIV = 16                         # reference step = DEFAULT_DT / 16
 SAMPLES = 40                         # COM samples along the horizon
 STEPS = [1 / 15, 1 / 30, 1 / 60, 1 / 120, 1 / 240]
 SCHEMES = ["explicit", "stable", "implicit"]
+VELOCITY_FORCES = ["midpoint", "start"]
 SUBSTEP_COMBOS = [(1 / 30, 2), (1 / 15, 4)]  # (dt, substeps) for the default scheme
 ENVIRONMENTS = [0.5, 2.0, 10.0]
 
@@ -81,7 +82,7 @@ def genome_bodies(count, seed):
     return out
 
 
-def run(body_spec, dn, h, scheme, substeps=1, perturb=0.0):
+def run(body_spec, dn, h, scheme, substeps=1, perturb=0.0, velocity_forces="midpoint"):
     """COM samples (SAMPLES + 1, 2) over the horizon, or None if the swim failed."""
     name, p, a, f, ph = body_spec
     if perturb:
@@ -91,6 +92,7 @@ def run(body_spec, dn, h, scheme, substeps=1, perturb=0.0):
     cfg.physics.dt = h * substeps
     cfg.physics.substeps = substeps
     cfg.physics.drag_scheme = scheme
+    cfg.physics.velocity_forces = velocity_forces
     sim = animat.Simulation(body, animat.Scene(drag_normal=dn), config=cfg)
     control = HORIZON / (h * substeps)
     every = int(round(control / SAMPLES))
@@ -119,25 +121,30 @@ def case(body_spec, dn):
     fit_ref = float(np.linalg.norm(ref[-1] - ref[0]))
     rows = []
     floor_err = errors(floor, ref)
-    for scheme in SCHEMES:
-        for h in STEPS:
-            rows.append(dict(body=body_spec[0], d_N=dn, h=h, dt=h, substeps=1, scheme=scheme, fitness_ref=fit_ref,
-                             chaos_floor=floor_err["fit_err"], **errors(run(body_spec, dn, h, scheme), ref)))
+    for vf in VELOCITY_FORCES:
+        for scheme in SCHEMES:
+            for h in STEPS:
+                rows.append(dict(body=body_spec[0], d_N=dn, h=h, dt=h, substeps=1, scheme=scheme, velocity_forces=vf,
+                                 fitness_ref=fit_ref, chaos_floor=floor_err["fit_err"],
+                                 **errors(run(body_spec, dn, h, scheme, velocity_forces=vf), ref)))
     for dt, s in SUBSTEP_COMBOS:
-        rows.append(dict(body=body_spec[0], d_N=dn, h=dt / s, dt=dt, substeps=s, scheme="stable", fitness_ref=fit_ref,
-                         chaos_floor=floor_err["fit_err"], **errors(run(body_spec, dn, dt / s, "stable", s), ref)))
+        rows.append(dict(body=body_spec[0], d_N=dn, h=dt / s, dt=dt, substeps=s, scheme="stable", velocity_forces="midpoint",
+                         fitness_ref=fit_ref, chaos_floor=floor_err["fit_err"],
+                         **errors(run(body_spec, dn, dt / s, "stable", s), ref)))
     return rows
 
 
 def cost_table(repeats=3):
-    """CPU seconds per simulated time unit for each (h, scheme), 32-cell lattice swimmer, d_N = 2."""
+    """CPU seconds per simulated time unit for each (h, scheme, velocity_forces), 32-cell lattice
+    swimmer, d_N = 2."""
     spec = hand_made()[1]
     out = {}
-    for scheme in SCHEMES:
+    for scheme, vf in [(s, v) for v in VELOCITY_FORCES for s in SCHEMES]:
         for h in STEPS:
             cfg = animat.Config()
             cfg.physics.dt = h
             cfg.physics.drag_scheme = scheme
+            cfg.physics.velocity_forces = vf
             body = animat.build_body(*spec[1:])
             steps = int(round(HORIZON / h))
             best = float("inf")
@@ -150,7 +157,7 @@ def cost_table(repeats=3):
                     best = float("nan")
                     break
                 best = min(best, time.process_time() - t0)
-            out[(h, scheme)] = best / HORIZON
+            out[(h, scheme, vf)] = best / HORIZON
     return out
 
 
@@ -169,20 +176,22 @@ def machine():
 def summarise(rows, costs, min_fitness):
     """Per (h, scheme, substeps): median/max fitness error over cases with reference fitness >=
     min_fitness, share within 1%, median trajectory error, failures, cost."""
-    keys = sorted({(r["dt"], r["substeps"], r["scheme"]) for r in rows}, key=lambda k: (SCHEMES.index(k[2]), -k[0] / k[1], k[1]))
+    keys = sorted({(r["dt"], r["substeps"], r["scheme"], r["velocity_forces"]) for r in rows},
+                  key=lambda k: (VELOCITY_FORCES.index(k[3]), SCHEMES.index(k[2]), -k[0] / k[1], k[1]))
     out = []
-    for dt, s, scheme in keys:
-        sel = [r for r in rows if r["dt"] == dt and r["substeps"] == s and r["scheme"] == scheme]
+    for dt, s, scheme, vf in keys:
+        sel = [r for r in rows if r["dt"] == dt and r["substeps"] == s and r["scheme"] == scheme and r["velocity_forces"] == vf]
         good = [r for r in sel if r["fitness_ref"] >= min_fitness]
         fe = np.array([r["fit_err"] for r in good], dtype=float)
         te = np.array([r["traj_err"] for r in good], dtype=float)
         ae = np.array([abs(r["fitness"] - r["fitness_ref"]) if not r["failed"] else float("inf") for r in sel])
         h = dt / s
-        out.append(dict(dt=dt, substeps=s, h=h, scheme=scheme, cases=len(good), failed=sum(r["failed"] for r in sel),
+        out.append(dict(dt=dt, substeps=s, h=h, scheme=scheme, velocity_forces=vf, cases=len(good),
+                        failed=sum(r["failed"] for r in sel),
                         abs_max=float(ae.max()),
                         fit_median=float(np.median(fe)), fit_p90=float(np.percentile(fe, 90)), fit_max=float(fe.max()),
                         within_1pct=float(np.mean(fe <= 0.01)), traj_median=float(np.median(te)),
-                        cost=costs.get((h, scheme), float("nan"))))
+                        cost=costs.get((h, scheme, vf), float("nan")) if s == 1 else float("nan")))
     return out
 
 
@@ -191,17 +200,17 @@ def frac(x):
 
 
 def markdown(summary, floors, default_cost):
-    lines = ["| h = dt/substeps | dt | substeps | drag scheme | failed | fitness error median | p90 | max | within 1% | "
+    lines = ["| h = dt/substeps | dt | substeps | velocity forces | drag scheme | failed | fitness error median | p90 | max | within 1% | "
              "trajectory error median | max abs. fitness error, all cases | CPU ms per time unit | cost vs default |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for s in summary:
         pct = lambda x: "∞" if not math.isfinite(x) else f"{100 * x:.2f}%"
         cost = s["cost"]
-        lines.append(f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['scheme']} | {s['failed']} | "
+        lines.append(f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['velocity_forces']} | {s['scheme']} | {s['failed']} | "
                      f"{pct(s['fit_median'])} | {pct(s['fit_p90'])} | {pct(s['fit_max'])} | {100 * s['within_1pct']:.0f}% | "
                      f"{pct(s['traj_median'])} | {s['abs_max']:.3g} | {1e3 * cost:.2f} | {cost / default_cost:.2f}× |"
                      if math.isfinite(cost) else
-                     f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['scheme']} | {s['failed']} | "
+                     f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['velocity_forces']} | {s['scheme']} | {s['failed']} | "
                      f"{pct(s['fit_median'])} | {pct(s['fit_p90'])} | {pct(s['fit_max'])} | {100 * s['within_1pct']:.0f}% | "
                      f"{pct(s['traj_median'])} | {s['abs_max']:.3g} | = h row | = h row |")
     lines.append("")
@@ -212,26 +221,30 @@ def markdown(summary, floors, default_cost):
 
 def plot(summary, path):
     import matplotlib
+    import matplotlib.ticker
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for scheme, marker in zip(SCHEMES, "osd"):
-        pts = [s for s in summary if s["scheme"] == scheme and s["substeps"] == 1 and math.isfinite(s["cost"])]
+    for (scheme, vf), marker, ls in zip([(s, v) for v in VELOCITY_FORCES for s in SCHEMES], "osdosd",
+                                        ["-", "-", "-", ":", ":", ":"]):
+        pts = [s for s in summary if s["scheme"] == scheme and s["velocity_forces"] == vf and s["substeps"] == 1
+               and math.isfinite(s["cost"]) and math.isfinite(s["fit_median"])]
         x = [1e3 * s["cost"] for s in pts]
         for ax, key, label in [(axes[0], "fit_median", "median fitness error"), (axes[1], "traj_median", "median trajectory error")]:
             y = [max(s[key], 1e-6) for s in pts]
-            ax.plot(x, y, marker=marker, label=scheme)
+            ax.plot(x, y, marker=marker, ls=ls, label=f"{scheme}, {vf}")
             for s, xi, yi in zip(pts, x, y):
-                if scheme == "stable":
+                if scheme == "stable" and vf == "midpoint":
                     ax.annotate(f"h={frac(s['h'])}", (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=7)
             ax.set_xscale("log")
             ax.set_yscale("log")
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
             ax.set_xlabel("CPU ms per simulated time unit (32 cells)")
             ax.set_ylabel(label + " vs dt/16")
             ax.axhline(0.01, color="grey", lw=0.8, ls="--")
             ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend()
-    fig.suptitle("Swim accuracy vs cost (d_N = 0.5, 2, 10; hand-made + random viable genomes)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Swim accuracy vs cost: median over cases with fitness >= 0.5 (explicit and stable coincide)")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
 
@@ -266,7 +279,7 @@ def main():
         w.writerows(rows)
     summary = summarise(rows, costs, args.min_fitness)
     floors = sorted({(r["body"], r["d_N"]): r["chaos_floor"] for r in rows if r["fitness_ref"] >= args.min_fitness}.values())
-    default_cost = costs[(DEFAULT_DT, "stable")]
+    default_cost = costs[(DEFAULT_DT, "stable", "midpoint")]
     plot(summary, args.plot)
     try:
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
@@ -275,18 +288,19 @@ def main():
     print(f"machine: {machine()}; commit {commit}; sweep {sweep_seconds:.0f} s wall on {args.threads} threads")
     print(f"bodies: {len(bodies)} x d_N {envs}; horizon {HORIZON:.2f} time units; reference h = 1/{round(REF_DIV / DEFAULT_DT)}")
     print(f"cases in summaries (reference fitness >= {args.min_fitness}): "
-          f"{sum(1 for r in rows if r['fitness_ref'] >= args.min_fitness) // (len(SCHEMES) * len(STEPS) + len(SUBSTEP_COMBOS))}"
+          f"{sum(1 for r in rows if r['fitness_ref'] >= args.min_fitness) // (len(VELOCITY_FORCES) * len(SCHEMES) * len(STEPS) + len(SUBSTEP_COMBOS))}"
           f" of {len(cases)}")
-    print(f"default (h = 1/60, stable): {1e3 * default_cost:.2f} CPU ms per time unit, "
+    print(f"default (h = 1/60, stable drag, midpoint velocity forces): {1e3 * default_cost:.2f} CPU ms per time unit, "
           f"{1e3 * default_cost * HORIZON:.0f} ms per evaluation horizon, "
           f"{1e6 * default_cost * DEFAULT_DT:.1f} us per step")
     print()
     print(markdown(summary, floors, default_cost))
     print()
-    print("per case (fitness error %, stable scheme):")
+    print("per case (fitness error %, default: stable drag, midpoint velocity forces):")
     for b in bodies:
         for dn in sorted({r["d_N"] for r in rows}):
-            sel = {r["h"]: r for r in rows if r["body"] == b[0] and r["d_N"] == dn and r["scheme"] == "stable" and r["substeps"] == 1}
+            sel = {r["h"]: r for r in rows if r["body"] == b[0] and r["d_N"] == dn and r["scheme"] == "stable"
+                   and r["substeps"] == 1 and r["velocity_forces"] == "midpoint"}
             if not sel:
                 continue
             any_row = next(iter(sel.values()))

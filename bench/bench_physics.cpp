@@ -4,7 +4,10 @@
 //   build-phys/bench_physics --benchmark_out=bench_physics.csv --benchmark_out_format=csv
 //
 // Bodies are triangular lattices (spacing 1, jitter 0.05) with a travelling-wave actuation at
-// f = 4 rad/time unit, amplitude 0.2: a typical evolved swimmer. Counters: us_per_step.
+// f = 4 rad/time unit, amplitude 0.2: a typical evolved swimmer. One iteration = one control step
+// (the "CPU" column is the cost per step). On a shared machine, prefer instruction counts:
+//   valgrind --tool=callgrind build-phys/bench_physics --benchmark_filter=BM_SwimStep/32
+// (docs/notes/physics.md quotes them per effect).
 #include <benchmark/benchmark.h>
 #include <box2d/box2d.h>
 
@@ -54,8 +57,7 @@ void run_swim(benchmark::State& state, const Body& body, const SceneParams& scen
       state.ResumeTiming();
     }
   }
-  state.counters["us_per_step"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = body.node_count();
 }
 
@@ -78,8 +80,7 @@ void BM_Box2DBareStep(benchmark::State& state) {
     world.CreateBody(&def)->SetMassData(&md);
   }
   for (auto _ : state) world.Step(1.0f / 60.0f, 1, 1);
-  state.counters["us_per_step"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = n;
 }
 BENCHMARK(BM_Box2DBareStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
@@ -109,6 +110,15 @@ void BM_DragScheme(benchmark::State& state) {
   run_swim(state, lattice_swimmer(32), SceneParams{}, physics);
 }
 BENCHMARK(BM_DragScheme)->DenseRange(0, 2);
+
+/// Velocity-dependent forces at the midpoint (default, two passes) or start velocity, 32 cells.
+void BM_VelocityForces(benchmark::State& state) {
+  PhysicsParams physics;
+  physics.velocity_forces = std::string(kVelocityForceNames[state.range(0)]);
+  state.SetLabel(physics.velocity_forces);
+  run_swim(state, lattice_swimmer(32), SceneParams{}, physics);
+}
+BENCHMARK(BM_VelocityForces)->DenseRange(0, 1);
 
 }  // namespace
 

@@ -56,6 +56,8 @@ int as_int(Eigen::Index i) { return static_cast<int>(i); }
 
 /// Damped Hooke springs: f = k·(len − rest) + c·(relative velocity along the spring), equal and
 /// opposite on the two ends. Reads the current rest lengths from the state (actuation writes them).
+/// apply() adds the elastic part and keeps the unit vectors; apply_velocity() adds the damping part
+/// at the evaluation velocity s.ux, s.uy.
 class Springs final : public Effect {
  public:
   Springs(const Body& body, const SceneParams& p) : k_(p.spring_stiffness), c_(p.spring_damping) {
@@ -66,6 +68,8 @@ class Springs final : public Effect {
       a_[static_cast<std::size_t>(s)] = body.springs(s, 0);
       b_[static_cast<std::size_t>(s)] = body.springs(s, 1);
     }
+    ex_.assign(static_cast<std::size_t>(m), 0.0);
+    ey_.assign(static_cast<std::size_t>(m), 0.0);
   }
   std::string_view name() const override { return "springs"; }
   void apply(SwimState& s) override {
@@ -74,22 +78,48 @@ class Springs final : public Effect {
     const int* b = b_.data();
     const double* x = s.x.data();
     const double* y = s.y.data();
-    const double* vx = s.vx.data();
-    const double* vy = s.vy.data();
     const double* rest = s.rest.data();
     double* fx = s.fx.data();
     double* fy = s.fy.data();
+    double* ex = ex_.data();
+    double* ey = ey_.data();
     const std::size_t m = a_.size();
     for (std::size_t e = 0; e < m; ++e) {
       const int i = a[e], j = b[e];
       const double dx = x[j] - x[i], dy = y[j] - y[i];
       const double len = std::sqrt(dx * dx + dy * dy);
-      if (!(len > 0.0)) continue;  // coincident ends: no direction, no force
+      if (!(len > 0.0)) {  // coincident ends: no direction, no force
+        ex[e] = 0.0;
+        ey[e] = 0.0;
+        continue;
+      }
       const double inv = 1.0 / len;
       const double ux = dx * inv, uy = dy * inv;
-      const double rate = (vx[j] - vx[i]) * ux + (vy[j] - vy[i]) * uy;
-      const double f = k_ * (len - rest[e]) + c_ * rate;
+      ex[e] = ux;
+      ey[e] = uy;
+      const double f = k_ * (len - rest[e]);
       const double gx = f * ux, gy = f * uy;
+      fx[i] += gx;
+      fy[i] += gy;
+      fx[j] -= gx;
+      fy[j] -= gy;
+    }
+  }
+  bool velocity_dependent() const override { return c_ != 0.0; }
+  void apply_velocity(SwimState& s) override {
+    const int* a = a_.data();
+    const int* b = b_.data();
+    const double* vx = s.ux.data();
+    const double* vy = s.uy.data();
+    const double* ex = ex_.data();
+    const double* ey = ey_.data();
+    double* fx = s.fx.data();
+    double* fy = s.fy.data();
+    const std::size_t m = a_.size();
+    for (std::size_t e = 0; e < m; ++e) {
+      const int i = a[e], j = b[e];
+      const double f = c_ * ((vx[j] - vx[i]) * ex[e] + (vy[j] - vy[i]) * ey[e]);
+      const double gx = f * ex[e], gy = f * ey[e];
       fx[i] += gx;
       fy[i] += gy;
       fx[j] -= gx;
@@ -100,6 +130,7 @@ class Springs final : public Effect {
  private:
   double k_, c_;
   std::vector<int> a_, b_;
+  std::vector<double> ex_, ey_;  // unit vectors of the current step
 };
 
 // --- actuation ---------------------------------------------------------------------------------
@@ -287,12 +318,16 @@ class Pressure final : public Effect {
 
 // --- drag --------------------------------------------------------------------------------------
 
-/// Eqs. 4–5 on skin edges (each once): the edge midpoint's velocity split into normal and
-/// tangential parts, F = −d·L·u·|u| per part, half the force to each end. Three schemes, with
+/// g(x) of the stable drag scheme: 1 for x <= 1/2, 1/(x + 1/2) beyond; x·g(x) < 1 for every x.
+inline double drag_limiter(double x) { return x <= 0.5 ? 1.0 : 1.0 / (x + 0.5); }
+
+/// Eqs. 4–5 on skin edges (each once): the edge midpoint's velocity u split into normal and
+/// tangential parts, F = −d·L·u·|u| per part, half the force to each end; u is the midpoint of the
+/// evaluation velocities s.ux, s.uy (physics.velocity_forces). Three schemes, with
 /// x = h·d·L·|u| / M the fraction of the velocity one explicit step would remove, where M is the
 /// edge's conservative share of its end masses, 2m / max(skin degree of its ends) (so that even
 /// when all the skin edges at a node push the same way their fractions add up to at most x):
-///  - explicit: F as above with u the velocity at the start of the step. First order; it
+///  - explicit: F as above. First order in time (second with the midpoint velocity); it
 ///    overshoots for x > 1 (reverses the velocity) and blows up for x > 2;
 ///  - stable (default): the explicit force times g(x) = 1 for x <= 1/2 and 1/(x + 1/2) beyond, so
 ///    one step removes at most the fraction x·g(x) < 1 of the velocity it acts on: the drag never
@@ -300,13 +335,11 @@ class Pressure final : public Effect {
 ///    paper environment at the default dt) it is exactly the explicit scheme, so terminal velocities
 ///    are exact;
 ///  - implicit: backward Euler per edge and per part, with every other force included: the
-///    predicted midpoint velocity w (velocities plus h·F/m of the forces added so far) becomes the
-///    u' of M·(u' − w) = −h·d·L·u'·|u'| (implicit_quadratic_drag), and M·(u' − w)/h is the force.
-///    Never reverses either, but it is more dissipative, and with the conservative M its terminal
-///    velocity is biased by O(x) where a node carries several skin edges (docs/accuracy.md).
-/// g(x) of the stable drag scheme: 1 for x <= 1/2, 1/(x + 1/2) beyond; x·g(x) < 1 for every x.
-inline double drag_limiter(double x) { return x <= 0.5 ? 1.0 : 1.0 / (x + 0.5); }
-
+///    predicted midpoint velocity w (velocities at the start of the step plus h·F/m of the forces
+///    added so far) becomes the u' of M·(u' − w) = −h·d·L·u'·|u'| (implicit_quadratic_drag), and
+///    M·(u' − w)/h is the force. Never reverses either, but it is more dissipative, and with the
+///    conservative M its terminal velocity is biased by O(x) where a node carries several skin edges.
+/// apply() caches the edge geometry; apply_velocity() adds the forces.
 class Drag final : public Effect {
  public:
   Drag(const Body& body, const SceneParams& p, const PhysicsParams& physics)
@@ -329,15 +362,29 @@ class Drag final : public Effect {
       const int dmax = std::max(degree[static_cast<std::size_t>(i)], degree[static_cast<std::size_t>(j)]);
       edge_mass_.push_back(2.0 * p.cell_mass / dmax);
     }
+    len_.assign(a_.size(), 0.0);
+    tx_.assign(a_.size(), 0.0);
+    ty_.assign(a_.size(), 0.0);
     wx_.assign(static_cast<std::size_t>(n), 0.0);
     wy_.assign(static_cast<std::size_t>(n), 0.0);
   }
   std::string_view name() const override { return "drag"; }
-  Stage stage() const override { return Stage::implicit; }
   void apply(SwimState& s) override {
     ++calls_;
     const double* x = s.x.data();
     const double* y = s.y.data();
+    for (std::size_t e = 0; e < a_.size(); ++e) {
+      const int i = a_[e], j = b_[e];
+      const double dx = x[j] - x[i], dy = y[j] - y[i];
+      const double len = std::sqrt(dx * dx + dy * dy);
+      len_[e] = len;
+      if (!(len > 0.0)) continue;
+      tx_[e] = dx / len;
+      ty_[e] = dy / len;
+    }
+  }
+  bool velocity_dependent() const override { return true; }
+  void apply_velocity(SwimState& s) override {
     double* fx = s.fx.data();
     double* fy = s.fy.data();
     const double* ux;
@@ -351,16 +398,15 @@ class Drag final : public Effect {
       ux = wx_.data();
       uy = wy_.data();
     } else {
-      ux = s.vx.data();
-      uy = s.vy.data();
+      ux = s.ux.data();
+      uy = s.uy.data();
     }
     const double inv_h = 1.0 / s.h;
     for (std::size_t e = 0; e < a_.size(); ++e) {
-      const int i = a_[e], j = b_[e];
-      const double dx = x[j] - x[i], dy = y[j] - y[i];
-      const double len = std::sqrt(dx * dx + dy * dy);
+      const double len = len_[e];
       if (!(len > 0.0)) continue;
-      const double tx = dx / len, ty = dy / len;  // tangent; normal = (−ty, tx)
+      const int i = a_[e], j = b_[e];
+      const double tx = tx_[e], ty = ty_[e];  // tangent; normal = (−ty, tx)
       const double mx = 0.5 * (ux[i] + ux[j]), my = 0.5 * (uy[i] + uy[j]);
       const double wn = -mx * ty + my * tx;  // normal and tangential parts of the midpoint velocity
       const double wt = mx * tx + my * ty;
@@ -391,6 +437,7 @@ class Drag final : public Effect {
   Scheme scheme_;
   std::vector<int> a_, b_;
   std::vector<double> edge_mass_;
+  std::vector<double> len_, tx_, ty_;  // edge geometry of the current step
   std::vector<double> wx_, wy_;
 };
 

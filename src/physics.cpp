@@ -82,6 +82,9 @@ struct Simulation::Impl {
   std::unique_ptr<b2World> world;
   std::vector<b2Body*> bodies;
   std::vector<std::unique_ptr<Effect>> effects;  // in run order
+  std::vector<Effect*> velocity_effects;          // those with velocity-dependent forces, in run order
+  bool midpoint = true;
+  std::vector<double> fx_pos, fy_pos;             // position-dependent forces (midpoint scheme)
   SwimState state;
   double h = 0.0;
   float hf = 0.0f;
@@ -108,6 +111,24 @@ struct Simulation::Impl {
     std::fill(state.fx.begin(), state.fx.end(), 0.0);
     std::fill(state.fy.begin(), state.fy.end(), 0.0);
     for (auto& e : effects) e->apply(state);
+    if (velocity_effects.empty()) return;
+    // Velocity-dependent forces at u = v (start) or u = v + (h/2)·F(v)/m (midpoint: predictor at v,
+    // then the forces are recomputed at u on top of the position-dependent ones).
+    std::copy(state.vx.begin(), state.vx.end(), state.ux.begin());
+    std::copy(state.vy.begin(), state.vy.end(), state.uy.begin());
+    if (midpoint) {
+      std::copy(state.fx.begin(), state.fx.end(), fx_pos.begin());
+      std::copy(state.fy.begin(), state.fy.end(), fy_pos.begin());
+      for (Effect* e : velocity_effects) e->apply_velocity(state);
+      const double k = 0.5 * h * state.inv_mass;
+      for (std::size_t i = 0; i < state.ux.size(); ++i) {
+        state.ux[i] = state.vx[i] + k * state.fx[i];
+        state.uy[i] = state.vy[i] + k * state.fy[i];
+      }
+      std::copy(fx_pos.begin(), fx_pos.end(), state.fx.begin());
+      std::copy(fy_pos.begin(), fy_pos.end(), state.fy.begin());
+    }
+    for (Effect* e : velocity_effects) e->apply_velocity(state);
   }
 
   [[noreturn]] void fail(std::string message) {
@@ -164,6 +185,9 @@ struct Simulation::Impl {
     const auto stage = e->stage();
     auto pos = std::find_if(effects.begin(), effects.end(), [&](const auto& x) { return x->stage() > stage; });
     effects.insert(pos, std::move(e));
+    velocity_effects.clear();
+    for (const auto& x : effects)
+      if (x->velocity_dependent()) velocity_effects.push_back(x.get());
   }
 };
 
@@ -209,7 +233,9 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   st.h = s.h;
   st.mass = static_cast<double>(static_cast<float>(scene.cell_mass));  // what Box2D integrates with
   st.inv_mass = 1.0 / st.mass;
-  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.fx, &st.fy}) v->assign(static_cast<std::size_t>(n), 0.0);
+  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &s.fx_pos, &s.fy_pos})
+    v->assign(static_cast<std::size_t>(n), 0.0);
+  s.midpoint = physics.velocity_forces == "midpoint";
   st.rest.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
 
   for (const auto& name : kSceneEffectNames) {  // canonical order within a stage

@@ -21,6 +21,7 @@ namespace animat {
 struct Body;
 
 inline constexpr std::string_view kDragSchemeNames[] = {"explicit", "stable", "implicit"};
+inline constexpr std::string_view kVelocityForceNames[] = {"midpoint", "start"};
 
 /// The accuracy knobs: what trades accuracy for speed (docs/accuracy.md measures them).
 struct PhysicsParams {
@@ -31,6 +32,10 @@ struct PhysicsParams {
   /// "explicit", "stable" (linearly implicit: never reverses a velocity in a step) or "implicit"
   /// (fully implicit quadratic law); see the Drag effect in src/effects.cpp.
   std::string drag_scheme = "stable";
+  /// The velocity that spring damping and drag are evaluated at: "midpoint" (a predictor step
+  /// estimates the velocity at the middle of the step; second order, two evaluations) or "start"
+  /// (the velocity at the start of the step; first order, one evaluation).
+  std::string velocity_forces = "midpoint";
   /// A Box2D step that would move a cell farther than this is reported as unstable (SimulationError)
   /// before Box2D's own cap of b2_maxTranslation = 2 silently clamps it [choose].
   double max_step_displacement = 1.0;
@@ -43,6 +48,7 @@ void visit_fields(PhysicsParams& p, V&& v) {
   v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.velocity_iterations);
   v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.position_iterations);
   v(FieldInfo{"drag_scheme", "drag integration: explicit; stable (linearly implicit, never reverses an edge velocity); implicit (fully implicit, never reverses)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
+  v(FieldInfo{"velocity_forces", "velocity that damping and drag use: midpoint (predicted, second order) or start (first order) [choose]", Bounds::any(), kVelocityForceNames}, p.velocity_forces);
   v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
 }
 
@@ -60,7 +66,10 @@ void warm_up_box2d();
 ///
 /// One control step = `substeps` Box2D steps of h = dt/substeps. Each Box2D step:
 ///   1. reads positions and velocities into the SoA state and zeroes the force buffer;
-///   2. runs the enabled effects in stage order (modifiers, forces, implicit), which add forces;
+///   2. runs apply() of the enabled effects in stage order (modifiers, then position-dependent
+///      forces), then the velocity-dependent forces (spring damping, drag) at the velocity chosen by
+///      physics.velocity_forces: "start" = v; "midpoint" = v + (h/2)·F(v)/m, which needs a
+///      predictor pass at v first (second order: v lives at half steps in symplectic Euler);
 ///   3. checks the predicted velocity v + h·F/m of every cell: a non-finite value, or a
 ///      displacement |v|·h above max_step_displacement, throws SimulationError (the world is left
 ///      as it was before the step; Box2D never clamps anything silently);

@@ -5,14 +5,16 @@
 // collision is our own penalty force).
 //
 // An effect is a small object with one job. Once per Box2D step the simulation fills a
-// structure-of-arrays SwimState (positions, velocities, zeroed forces) and calls every enabled
-// effect in stage order:
-//   1. modifier effects change per-step parameters (actuation writes the spring rest lengths);
-//   2. force effects add their forces (springs, pressure, skin collision; future: gravity, ground);
-//   3. implicit effects see every other force and add theirs last (drag, whose stable scheme
-//      integrates the drag implicitly with the other forces included).
-// Effects loop over their own elements inside apply(): one virtual call per effect per step,
-// never one per element. New effects (gravity, ground friction, active control) are new Effect
+// structure-of-arrays SwimState (positions, velocities, zeroed forces) and calls:
+//   1. apply() of every enabled effect in stage order: modifiers first (actuation writes the spring
+//      rest lengths), then force effects, which add their position-dependent forces (spring
+//      elasticity, pressure, skin collision; future: gravity, ground);
+//   2. apply_velocity() of the velocity-dependent effects (spring damping, drag), which add forces
+//      evaluated at the velocity s.ux, s.uy chosen by physics.velocity_forces: the velocity at the
+//      start of the step, or (default) a prediction of the velocity at the middle of the step, for
+//      which the stepper runs them twice (predictor, then corrector).
+// Effects loop over their own elements inside apply(): one virtual call per effect per pass, never
+// one per element. New effects (gravity, ground friction, active control) are new Effect
 // subclasses plus a name in make_effect(); the stepper does not change.
 #include <memory>
 #include <string>
@@ -83,22 +85,29 @@ struct SwimState {
   double h = 0.0;         ///< length of this Box2D step (dt / substeps)
   double mass = 1.0;      ///< every cell's mass
   double inv_mass = 1.0;
-  std::vector<double> x, y, vx, vy;  ///< n each
+  std::vector<double> x, y, vx, vy;  ///< n each: positions and velocities at the start of the step
+  std::vector<double> ux, uy;        ///< n each: the velocity apply_velocity() evaluates forces at
   std::vector<double> fx, fy;        ///< n each: the force accumulator
   std::vector<double> rest;          ///< current rest length of every spring (actuation writes it)
 };
 
-/// One physical effect of a scene. apply() loops over the effect's own elements (stored as
-/// structure-of-arrays at construction) and must not allocate.
+/// One physical effect of a scene. apply() and apply_velocity() loop over the effect's own elements
+/// (stored as structure-of-arrays at construction) and must not allocate.
 class Effect {
  public:
-  enum class Stage : int { modifier = 0, force = 1, implicit = 2 };
+  enum class Stage : int { modifier = 0, force = 1 };
 
   virtual ~Effect() = default;
   [[nodiscard]] virtual std::string_view name() const = 0;
   [[nodiscard]] virtual Stage stage() const { return Stage::force; }
-  /// Adds this effect's forces to s.fx, s.fy (or modifies per-step parameters, for modifiers).
+  /// Modifiers change per-step parameters; force effects add their position-dependent forces to
+  /// s.fx, s.fy (and may cache geometry for apply_velocity). Called once per Box2D step.
   virtual void apply(SwimState& s) = 0;
+  /// Whether apply_velocity() adds anything.
+  [[nodiscard]] virtual bool velocity_dependent() const { return false; }
+  /// Adds the forces that depend on velocity, evaluated at s.ux, s.uy (positions as in apply()).
+  /// Called after every effect's apply(), once or twice per step (physics.velocity_forces).
+  virtual void apply_velocity(SwimState& s) { (void)s; }
   /// Whether Box2D needs circle fixtures (and contacts) for this effect. None of the built-in
   /// effects does.
   [[nodiscard]] virtual bool needs_box2d_collisions() const { return false; }

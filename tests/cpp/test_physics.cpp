@@ -1,6 +1,7 @@
 // Swimming physics (issue 5, MODEL.md §5): analytic checks of every effect, conservation laws,
 // "off means off", the stable drag scheme, error detection, and the named stability cases.
 // No timing assertions anywhere.
+#include <Eigen/LU>
 #include <box2d/box2d.h>
 #include <gtest/gtest.h>
 
@@ -245,66 +246,106 @@ TEST(Springs, TwoNodePeriodMatchesAnalyticAtDefaultDt) {
   }
 }
 
-TEST(Springs, DampingMakesEnergyDecayMonotonically) {
-  // Box2D integrates with symplectic Euler (v += h·a; x += h·v). For the stretch x and stretching
-  // speed v of a damped two-node spring (ω² = k/μ, γ = c/μ) one step is the linear map
-  //   v' = (1 − hγ)·v − hω²·x,   x' = x + h·v'.
-  // Its discrete energy V = p·x² + 2q·x·v + v², with p, q solving A^T Q A − Q = diag(0, m11), falls
-  // by |m11|·v² at every step (for γ = 0: p = ω², q = −hω²/2, the conserved "shadow" energy; the
-  // textbook energy ½μv² + ½kx² wobbles by O(ωh) within a period). So V must fall at every single
-  // step, and the textbook energy from one period to the next.
-  SceneParams scene = scene_with({"springs"});
-  Simulation sim(two_nodes(1.3, 1.0), scene);
-  const double mu = 0.5, k = scene.spring_stiffness, h = sim.physics().dt;
-  const double w2 = k / mu, g = scene.spring_damping / mu;
-  const double d = 1.0 - h * g, a = 1.0 - h * h * w2, bb = h * d, c = -h * w2;
-  // p·(a² − 1) + q·2ac = −c²;  p·ab + q·(ad + bc − 1) = −cd
-  const double m00 = a * a - 1.0, m01 = 2.0 * a * c, m10 = a * bb, m11 = a * d + bb * c - 1.0;
-  const double det = m00 * m11 - m01 * m10;
-  const double p = (-c * c * m11 + c * d * m01) / det;
-  const double q = (-c * d * m00 + c * c * m10) / det;
-  ASSERT_LT(p * bb * bb + 2.0 * q * bb * d + d * d - 1.0, 0.0);
-  ASSERT_GT(p, q * q);  // positive definite
-  auto state = [&](double& x, double& v) {
-    const Points pos = sim.positions(), u = sim.velocities();
-    x = pos(1, 0) - pos(0, 0) - 1.0;
-    v = u(1, 0) - u(0, 0);
-  };
-  double x, v;
-  state(x, v);
-  double prev = p * x * x + 2.0 * q * x * v + v * v;
-  const double v0 = prev;
-  std::vector<double> per_period;
-  const int period_steps = static_cast<int>(std::round(2.0 * kPi / std::sqrt(w2) / h));
-  for (int s = 1; s <= 600; ++s) {
-    sim.step();
-    state(x, v);
-    const double now = p * x * x + 2.0 * q * x * v + v * v;
-    EXPECT_LE(now, prev + 1e-6 * v0) << "step " << s;  // float state: round-off allowance
-    prev = now;
-    if (s % period_steps == 0) per_period.push_back(0.5 * mu * v * v + 0.5 * k * x * x);
+/// The linear map (x, v) -> (x', v') of one Box2D step for a damped oscillator x'' = −ω²x − γv, with
+/// the damping evaluated at the start velocity or at the predicted midpoint velocity.
+Eigen::Matrix2d oscillator_step(double w2, double g, double h, bool midpoint) {
+  Eigen::Matrix2d a;
+  for (int c = 0; c < 2; ++c) {
+    double x = c == 0 ? 1.0 : 0.0, v = c == 1 ? 1.0 : 0.0;
+    double u = v;
+    if (midpoint) u = v + 0.5 * h * (-w2 * x - g * v);
+    v += h * (-w2 * x - g * u);
+    x += h * v;
+    a(0, c) = x;
+    a(1, c) = v;
   }
-  ASSERT_GE(per_period.size(), 5u);
-  for (std::size_t i = 1; i < per_period.size(); ++i) EXPECT_LT(per_period[i], per_period[i - 1]) << i;
-  EXPECT_LT(prev, 1e-4 * v0);
+  return a;
+}
+
+/// Solves AᵀQA − Q = −e₂e₂ᵀ (Q symmetric): then V(z) = zᵀQz falls by exactly v² at every step.
+Eigen::Matrix2d lyapunov(const Eigen::Matrix2d& a) {
+  Eigen::Matrix4d k;  // vec(AᵀQA) = (Aᵀ ⊗ Aᵀ) vec(Q), column-major vec
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int p = 0; p < 2; ++p)
+        for (int q = 0; q < 2; ++q) k(i + 2 * j, p + 2 * q) = a(p, i) * a(q, j);
+  const Eigen::Vector4d r(0.0, 0.0, 0.0, 1.0);
+  const Eigen::Vector4d q = (Eigen::Matrix4d::Identity() - k).inverse() * r;
+  Eigen::Matrix2d out;
+  out << q(0), q(2), q(1), q(3);
+  return 0.5 * (out + out.transpose());
+}
+
+TEST(Springs, DampingMakesEnergyDecayMonotonically) {
+  // Box2D integrates with symplectic Euler (v += h·a; x += h·v); spring damping is evaluated at the
+  // start velocity or at the predicted midpoint velocity (physics.velocity_forces). For the stretch x
+  // and stretching speed v of a damped two-node spring (ω² = k/μ, γ = c/μ) a step is a linear map A.
+  // Its discrete energy V = zᵀQz (AᵀQA − Q = −e₂e₂ᵀ, Q positive definite) falls by exactly v² per
+  // step: V must fall at every single step. (For γ = 0 it is the conserved "shadow" energy; the
+  // textbook energy ½μv² + ½kx² wobbles by O(ωh) within a period, so it must fall period by period.)
+  for (const std::string mode : {"midpoint", "start"}) {
+    SceneParams scene = scene_with({"springs"});
+    PhysicsParams physics;
+    physics.velocity_forces = mode;
+    Simulation sim(two_nodes(1.3, 1.0), scene, physics);
+    const double mu = 0.5, k = scene.spring_stiffness, h = sim.physics().dt;
+    const double w2 = k / mu, g = scene.spring_damping / mu;
+    const Eigen::Matrix2d q = lyapunov(oscillator_step(w2, g, h, mode == "midpoint"));
+    ASSERT_GT(q(0, 0), 0.0) << mode;
+    ASSERT_GT(q.determinant(), 0.0) << mode;
+    auto energy = [&](double& x, double& v) {
+      const Points pos = sim.positions(), u = sim.velocities();
+      x = pos(1, 0) - pos(0, 0) - 1.0;
+      v = u(1, 0) - u(0, 0);
+      return q(0, 0) * x * x + 2.0 * q(0, 1) * x * v + q(1, 1) * v * v;
+    };
+    double x, v;
+    double prev = energy(x, v);
+    const double v0 = prev, e0 = 0.5 * k * x * x;
+    std::vector<double> per_period;
+    const int period_steps = static_cast<int>(std::round(2.0 * kPi / std::sqrt(w2) / h));
+    for (int s = 1; s <= 600; ++s) {
+      sim.step();
+      const double now = energy(x, v);
+      EXPECT_LE(now, prev + 1e-6 * v0) << mode << " step " << s;  // float state: round-off allowance
+      prev = now;
+      if (s % period_steps == 0) per_period.push_back(0.5 * mu * v * v + 0.5 * k * x * x);
+    }
+    ASSERT_GE(per_period.size(), 5u);
+    for (std::size_t i = 1; i < per_period.size() && per_period[i - 1] > 1e-9 * e0; ++i)
+      EXPECT_LT(per_period[i], per_period[i - 1]) << mode << " period " << i;
+    EXPECT_LT(prev, 1e-4 * v0) << mode;
+  }
 }
 
 TEST(Springs, MatchTrajectoryOfIndependentIntegrator) {
   // A trajectory computed without any of the simulation's effect code: symplectic Euler in double
-  // for a damped two-node spring. Box2D stores float, so they agree to float round-off.
-  SceneParams scene = scene_with({"springs"});
-  Simulation sim(two_nodes(1.25, 1.0), scene);
-  const double k = scene.spring_stiffness, c = scene.spring_damping, h = sim.physics().dt;
-  double x0 = 0.0, x1 = 1.25, v0 = 0.0, v1 = 0.0;
-  for (int s = 0; s < 600; ++s) {
-    const double f = k * ((x1 - x0) - 1.0) + c * (v1 - v0);
-    v0 += h * f;
-    v1 -= h * f;
-    x0 += h * v0;
-    x1 += h * v1;
-    sim.step();
-    ASSERT_NEAR(sim.positions()(0, 0), x0, 2e-5) << s;
-    ASSERT_NEAR(sim.positions()(1, 0), x1, 2e-5) << s;
+  // for a damped two-node spring, damping at the start or the predicted midpoint velocity. Box2D
+  // stores float, so they agree to float round-off.
+  for (const std::string mode : {"midpoint", "start"}) {
+    SceneParams scene = scene_with({"springs"});
+    PhysicsParams physics;
+    physics.velocity_forces = mode;
+    Simulation sim(two_nodes(1.25, 1.0), scene, physics);
+    const double k = scene.spring_stiffness, c = scene.spring_damping, h = sim.physics().dt;
+    double x0 = 0.0, x1 = 1.25, v0 = 0.0, v1 = 0.0;
+    for (int s = 0; s < 600; ++s) {
+      const double elastic = k * ((x1 - x0) - 1.0);
+      double u0 = v0, u1 = v1;
+      if (mode == "midpoint") {
+        const double f = elastic + c * (v1 - v0);
+        u0 = v0 + 0.5 * h * f;
+        u1 = v1 - 0.5 * h * f;
+      }
+      const double f = elastic + c * (u1 - u0);
+      v0 += h * f;
+      v1 -= h * f;
+      x0 += h * v0;
+      x1 += h * v1;
+      sim.step();
+      ASSERT_NEAR(sim.positions()(0, 0), x0, 2e-5) << mode << " " << s;
+      ASSERT_NEAR(sim.positions()(1, 0), x1, 2e-5) << mode << " " << s;
+    }
   }
 }
 
@@ -574,6 +615,7 @@ TEST(Drag, OnlySkinEdgesFeelDrag) {
   for (const std::string scheme : {"stable", "explicit", "implicit"}) {
     PhysicsParams physics;
     physics.drag_scheme = scheme;
+    physics.velocity_forces = "start";  // forces at the given velocities
     Simulation sim(b, scene_with({"drag"}), physics);
     sim.set_velocities(Points::Constant(5, 2, 0.7));
     sim.compute_forces();
@@ -604,11 +646,13 @@ TEST(Drag, ImplicitQuadraticNeverReverses) {
 }
 
 /// A free dimer (two nodes, one skin edge, no spring) launched normal to itself at speed v0.
-std::vector<double> launched_dimer_speeds(const std::string& scheme, double dn, double v0, int steps) {
+std::vector<double> launched_dimer_speeds(const std::string& scheme, double dn, double v0, int steps,
+                                          const std::string& velocity_forces = "midpoint") {
   SceneParams scene = scene_with({"drag"});
   scene.drag_normal = dn;
   PhysicsParams physics;
   physics.drag_scheme = scheme;
+  physics.velocity_forces = velocity_forces;
   Simulation sim(two_nodes(1.0, 1.0), scene, physics);
   sim.set_velocities(Points::Constant(2, 2, 0.0).rowwise() + Eigen::RowVector2d(0.0, v0));
   std::vector<double> v = {v0};
@@ -622,26 +666,34 @@ std::vector<double> launched_dimer_speeds(const std::string& scheme, double dn, 
 TEST(Drag, StableSchemeNeverReversesWhereExplicitDoesAndBlowsUp) {
   // c·h·|v| = d·L·h·|v|/M with M = 2m for a free edge: d = 50, v0 = 10 gives 4.2, far beyond the
   // explicit scheme's limit of 1 (reversal) and 2 (growth).
-  const auto stable = launched_dimer_speeds("stable", 50.0, 10.0, 200);
-  const auto implicit = launched_dimer_speeds("implicit", 50.0, 10.0, 200);
-  for (std::size_t k = 1; k < stable.size(); ++k) {
-    EXPECT_GT(stable[k], 0.0) << k;
-    EXPECT_LE(stable[k], stable[k - 1]) << k;
-    EXPECT_GT(implicit[k], 0.0) << k;
-    EXPECT_LE(implicit[k], implicit[k - 1]) << k;
+  for (const std::string mode : {"midpoint", "start"}) {
+    const auto stable = launched_dimer_speeds("stable", 50.0, 10.0, 200, mode);
+    const auto implicit = launched_dimer_speeds("implicit", 50.0, 10.0, 200, mode);
+    for (std::size_t k = 1; k < stable.size(); ++k) {
+      EXPECT_GT(stable[k], 0.0) << mode << " " << k;
+      EXPECT_LE(stable[k], stable[k - 1]) << mode << " " << k;
+      EXPECT_GT(implicit[k], 0.0) << mode << " " << k;
+      EXPECT_LE(implicit[k], implicit[k - 1]) << mode << " " << k;
+    }
   }
-  // Explicit: the first step reverses the velocity; then it grows until the step is rejected.
-  SceneParams scene = scene_with({"drag"});
-  scene.drag_normal = 50.0;
-  PhysicsParams physics;
-  physics.drag_scheme = "explicit";
-  Simulation sim(two_nodes(1.0, 1.0), scene, physics);
-  sim.set_velocities(Points::Constant(2, 2, 0.0).rowwise() + Eigen::RowVector2d(0.0, 10.0));
-  sim.step();
-  EXPECT_LT(sim.velocities()(0, 1), 0.0) << "explicit drag reverses the velocity";
-  EXPECT_THROW(sim.step(10), SimulationError);
-  EXPECT_TRUE(sim.failed());
-  EXPECT_THROW(sim.step(), SimulationError) << "a failed simulation stays failed";
+  // Explicit: the first step reverses the velocity (drag at the start velocity) or makes it grow
+  // (at the predicted midpoint velocity, whose predictor has reversed); either way it then grows
+  // until the step is rejected.
+  for (const std::string mode : {"start", "midpoint"}) {
+    SceneParams scene = scene_with({"drag"});
+    scene.drag_normal = 50.0;
+    PhysicsParams physics;
+    physics.drag_scheme = "explicit";
+    physics.velocity_forces = mode;
+    Simulation sim(two_nodes(1.0, 1.0), scene, physics);
+    sim.set_velocities(Points::Constant(2, 2, 0.0).rowwise() + Eigen::RowVector2d(0.0, 10.0));
+    sim.step();
+    const double v1 = sim.velocities()(0, 1);
+    EXPECT_TRUE(v1 < 0.0 || v1 > 10.0) << mode << ": explicit drag reverses or amplifies, got " << v1;
+    EXPECT_THROW(sim.step(10), SimulationError) << mode;
+    EXPECT_TRUE(sim.failed());
+    EXPECT_THROW(sim.step(), SimulationError) << "a failed simulation stays failed";
+  }
 }
 
 TEST(Drag, StableSchemeFollowsTheExactDecayOfAFreeEdge) {
@@ -767,12 +819,12 @@ TEST(Effects, DisabledEffectIsNotInTheLoop) {
     for (const Effect* e : sim.effects()) EXPECT_EQ(e->calls(), 50) << e->name();
     EXPECT_EQ(sim.world().GetBodyList()->GetFixtureList(), nullptr);
   }
-  // Stage order: actuation (modifier) first, drag (implicit) last, custom force effects between.
+  // Stage order: actuation (modifier) first, then force effects in canonical order, custom ones last.
   Simulation sim(b, SceneParams{});
   sim.add_effect(std::make_unique<ConstantForce>(0.0, 0.0));
   std::vector<std::string> order;
   for (const Effect* e : sim.effects()) order.emplace_back(e->name());
-  EXPECT_EQ(order, (std::vector<std::string>{"actuation", "springs", "pressure", "skin_collision", "constant_force", "drag"}));
+  EXPECT_EQ(order, (std::vector<std::string>{"actuation", "springs", "pressure", "drag", "skin_collision", "constant_force"}));
 }
 
 TEST(Effects, ZeroCoefficientTrajectoryEqualsEffectAbsent) {

@@ -80,7 +80,7 @@ def test_config_scene_section_drives_the_simulation():
     assert sim.scene.drag_normal == 10.0
     # An explicit scene wins over the config's.
     sim = animat.Simulation(wave_body(), animat.Scene(), config=cfg)
-    assert sim.effects == ["actuation", "springs", "pressure", "skin_collision", "drag"]
+    assert sim.effects == ["actuation", "springs", "pressure", "drag", "skin_collision"]
 
 
 # --- Simulation ----------------------------------------------------------------------------------
@@ -156,7 +156,8 @@ def test_explicit_drag_blows_up_where_stable_does_not():
             assert np.all(v > 0) and np.all(v < 10.0)
         else:
             sim.step()
-            assert sim.velocities[0, 1] < 0  # reversed
+            v1 = sim.velocities[0, 1]
+            assert v1 < 0 or v1 > 10.0  # reversed or amplified: the explicit overshoot
             with pytest.raises(RuntimeError, match="max_step_displacement"):
                 sim.step(20)
             assert sim.failed
