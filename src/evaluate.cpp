@@ -86,6 +86,7 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
 
 EvaluationResult evaluate(const Genome& genome, const Config& config) {
   EvaluationResult out;
+  validate(genome, config.genome, "evaluate");  // a genome no loader would accept is an error, not UB
   validate(config.scene);
   validate(config.physics);
   auto t0 = Clock::now();

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -23,6 +24,7 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/physics.hpp"
+#include "json_util.hpp"
 
 namespace animat {
 
@@ -273,17 +275,38 @@ json stats_to_json(const GenerationStats& s) {
               {"wall_seconds", s.wall_seconds}, {"best_changed", s.best_changed}};
 }
 
+// Integer and number fields of a checkpoint: type- and range-checked, never converted out of range.
+long long int_field(const json& j, const char* key, long long lo, long long hi) {
+  const auto v = detail::int_in(j.at(key), lo, hi);
+  if (!v) throw CheckpointError(fmt::format("field \"{}\" is {}, expected an integer in [{}, {}]", key, detail::describe(j.at(key)), lo, hi));
+  return *v;
+}
+
+double number_field(const json& j, const char* key) {
+  const auto v = detail::finite_number(j.at(key));
+  if (!v) throw CheckpointError(fmt::format("field \"{}\" is {}, expected a finite number", key, detail::describe(j.at(key))));
+  return *v;
+}
+
+bool bool_field(const json& j, const char* key) {
+  if (!j.at(key).is_boolean()) throw CheckpointError(fmt::format("field \"{}\" is {}, expected true or false", key, detail::describe(j.at(key))));
+  return j.at(key).get<bool>();
+}
+
+constexpr long long kIntMax = std::numeric_limits<int>::max();
+constexpr long long kInt64Max = std::numeric_limits<std::int64_t>::max();
+
 GenerationStats stats_from_json(const json& j) {
   GenerationStats s;
-  s.generation = j.at("generation").get<int>();
-  s.best = j.at("best").get<double>();
-  s.mean = j.at("mean").get<double>();
-  s.median = j.at("median").get<double>();
-  s.viable_fraction = j.at("viable_fraction").get<double>();
-  s.best_cells = j.at("best_cells").get<int>();
-  s.evaluations = j.at("evaluations").get<std::int64_t>();
-  s.wall_seconds = j.at("wall_seconds").get<double>();
-  s.best_changed = j.at("best_changed").get<bool>();
+  s.generation = static_cast<int>(int_field(j, "generation", 0, kIntMax));
+  s.best = number_field(j, "best");
+  s.mean = number_field(j, "mean");
+  s.median = number_field(j, "median");
+  s.viable_fraction = number_field(j, "viable_fraction");
+  s.best_cells = static_cast<int>(int_field(j, "best_cells", 0, kIntMax));
+  s.evaluations = int_field(j, "evaluations", 0, kInt64Max);
+  s.wall_seconds = number_field(j, "wall_seconds");
+  s.best_changed = bool_field(j, "best_changed");
   s.evaluations_per_second = s.wall_seconds > 0 ? static_cast<double>(s.evaluations) / s.wall_seconds : 0.0;
   return s;
 }
@@ -319,9 +342,13 @@ std::string Evolution::checkpoint() const {
 void Evolution::restore(std::string_view text, std::string_view source) {
   json outer;
   try {
-    outer = json::parse(text.begin(), text.end());
+    outer = detail::parse_bounded(text, 64);
+  } catch (const detail::JsonLimit& e) {
+    throw CheckpointError(fmt::format("{}: not an animat checkpoint ({})", source, e.what()));
   } catch (const json::parse_error& e) {
     throw CheckpointError(fmt::format("{}: corrupt checkpoint (not valid JSON at byte {}; truncated?)", source, e.byte));
+  } catch (const json::exception& e) {
+    throw CheckpointError(fmt::format("{}: corrupt checkpoint ({})", source, e.what()));
   }
   try {
     if (!outer.is_object() || !outer.contains("checksum") || !outer.contains("payload") || !outer["payload"].is_string())
@@ -329,13 +356,14 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     const std::string body = outer["payload"].get<std::string>();
     if (outer["checksum"] != hex(fnv1a(body)))
       throw CheckpointError(fmt::format("{}: corrupt checkpoint: checksum {} does not match its content ({})", source,
-                                        outer["checksum"].dump(), hex(fnv1a(body))));
-    const json p = json::parse(body);
+                                        detail::describe(outer["checksum"]), hex(fnv1a(body))));
+    const json p = detail::parse_bounded(body, 64);
     if (p.value("format", "") != "animat.checkpoint")
       throw CheckpointError(fmt::format("{}: not an animat checkpoint (format {})", source, p.value("format", "?")));
-    if (p.at("version").get<int>() != kCheckpointVersion)
+    if (!detail::int_in(p.at("version"), kCheckpointVersion, kCheckpointVersion))
       throw CheckpointError(fmt::format("{}: checkpoint version {} is not supported (this build reads version {})", source,
-                                        p.at("version").dump(), kCheckpointVersion));
+                                        detail::describe(p.at("version")), kCheckpointVersion));
+    if (!p.at("identity").is_string()) throw CheckpointError(fmt::format("{}: field \"identity\" must be a string", source));
     if (p.at("identity").get<std::string>() != hex(identity_))
       throw CheckpointError(fmt::format(
           "{}: checkpoint belongs to a different run configuration (identity {} vs {} for the current config); "
@@ -345,11 +373,11 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     for (const json& ji : p.at("population")) {
       Individual ind;
       ind.genome = genome_from_json(ji.at("genome").dump(), config_->genome, source);
-      ind.result.fitness = ji.at("fitness").get<double>();
-      ind.result.viable = ji.at("viable").get<bool>();
-      ind.result.stable = ji.at("stable").get<bool>();
-      ind.result.cell_count = ji.at("cell_count").get<int>();
-      ind.tries = ji.at("tries").get<int>();
+      ind.result.fitness = number_field(ji, "fitness");
+      ind.result.viable = bool_field(ji, "viable");
+      ind.result.stable = bool_field(ji, "stable");
+      ind.result.cell_count = static_cast<int>(int_field(ji, "cell_count", 0, kIntMax));
+      ind.tries = static_cast<int>(int_field(ji, "tries", 0, kIntMax));
       pop.push_back(std::move(ind));
     }
     if (pop.size() != static_cast<std::size_t>(config_->evolution.population))
@@ -357,15 +385,25 @@ void Evolution::restore(std::string_view text, std::string_view source) {
                                         config_->evolution.population));
     std::vector<GenerationStats> hist;
     for (const json& js : p.at("history")) hist.push_back(stats_from_json(js));
+    const int generation = static_cast<int>(int_field(p, "generation", 0, kIntMax));
+    if (hist.empty()) throw CheckpointError(fmt::format("{}: checkpoint has an empty history", source));
+    if (hist.back().generation != generation)
+      throw CheckpointError(fmt::format("{}: checkpoint generation {} does not match its history, which ends at generation {}",
+                                        source, generation, hist.back().generation));
     population_ = std::move(pop);
     history_ = std::move(hist);
-    generation_ = p.at("generation").get<int>();
-    stall_ = p.at("stall").get<int>();
-    best_ever_ = p.at("best_ever").get<double>();
-    evaluations_ = p.at("evaluations").get<std::int64_t>();
-    wall_offset_ = p.at("wall_seconds").get<double>();
+    generation_ = generation;
+    stall_ = static_cast<int>(int_field(p, "stall", 0, kIntMax));
+    best_ever_ = number_field(p, "best_ever");
+    evaluations_ = int_field(p, "evaluations", 0, kInt64Max);
+    wall_offset_ = number_field(p, "wall_seconds");
     started_ = now_seconds();
+  } catch (const CheckpointError& e) {
+    if (std::string_view(e.what()).starts_with(source)) throw;
+    throw CheckpointError(fmt::format("{}: malformed checkpoint: {}", source, e.what()));
   } catch (const json::exception& e) {
+    throw CheckpointError(fmt::format("{}: malformed checkpoint: {}", source, e.what()));
+  } catch (const detail::JsonLimit& e) {
     throw CheckpointError(fmt::format("{}: malformed checkpoint: {}", source, e.what()));
   }
 }

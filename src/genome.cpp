@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "animat/errors.hpp"
+#include "json_util.hpp"
 
 namespace animat {
 
@@ -273,18 +274,8 @@ int index_of(const Names& names, std::string_view s) {
   return -1;
 }
 
-// An integer value in [lo, hi], whatever JSON integer type holds it; nullopt otherwise.
-std::optional<long long> small_int(const json& v, long long lo, long long hi) {
-  if (v.is_number_unsigned()) {
-    const auto u = v.get<std::uint64_t>();
-    if (u > static_cast<std::uint64_t>(hi) || static_cast<long long>(u) < lo) return std::nullopt;
-    return static_cast<long long>(u);
-  }
-  if (!v.is_number_integer()) return std::nullopt;
-  const auto x = v.get<std::int64_t>();
-  if (x < lo || x > hi) return std::nullopt;
-  return x;
-}
+using detail::int_in;
+using detail::describe;
 
 const json& require(const json& obj, const char* key, std::string_view where) {
   auto it = obj.find(key);
@@ -297,7 +288,15 @@ const json& require(const json& obj, const char* key, std::string_view where) {
 Genome genome_from_json(std::string_view text, const GenomeParams& params, std::string_view source) {
   json j;
   try {
-    j = json::parse(text.begin(), text.end());
+    // Elements are objects at depth 2; nothing beyond max_elements + 1 of them is ever built.
+    // Parsing stops once the element count is far past the cap (then the exact count is unknown);
+    // up to twice the cap, the count is exact.
+    j = detail::parse_bounded(text, 16, 2, 2LL * params.max_elements + 1000);
+  } catch (const detail::JsonLimit& e) {
+    if (std::string_view(e.what()).starts_with("more than"))
+      throw GenomeError(fmt::format("{}: more than {} elements exceed genome.max_elements = {} (parsing stopped there)",
+                                    source, 2LL * params.max_elements + 1000, params.max_elements));
+    throw GenomeError(fmt::format("{}: not a genome: {}", source, e.what()));
   } catch (const json::parse_error& e) {
     throw GenomeError(fmt::format("{}: not valid JSON (at byte {}): {}", source, e.byte, e.what()));
   } catch (const json::exception& e) {  // e.g. a number too large for a double (1e999)
@@ -308,14 +307,14 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
     const std::string where(source);
     const json& format = require(j, "format", where);
     if (!format.is_string() || format.get<std::string>() != "animat.genome")
-      throw GenomeError(fmt::format("{}: \"format\" is {}, expected \"animat.genome\"", source, format.dump()));
+      throw GenomeError(fmt::format("{}: \"format\" is {}, expected \"animat.genome\"", source, describe(format)));
     const json& version = require(j, "version", where);
-    if (small_int(version, kGenomeFormatVersion, kGenomeFormatVersion) == std::nullopt)
+    if (int_in(version, kGenomeFormatVersion, kGenomeFormatVersion) == std::nullopt)
       throw GenomeError(fmt::format("{}: unsupported \"version\" {} (this build reads version {})", source,
-                                    version.dump(), kGenomeFormatVersion));
+                                    describe(version), kGenomeFormatVersion));
     const json& dims = require(j, "dimensions", where);
-    if (small_int(dims, 1, 16) == std::nullopt)
-      throw GenomeError(fmt::format("{}: \"dimensions\" is {}, expected an integer in [1, 16]", source, dims.dump()));
+    if (int_in(dims, 1, 16) == std::nullopt)
+      throw GenomeError(fmt::format("{}: \"dimensions\" is {}, expected an integer in [1, 16]", source, describe(dims)));
     const json& els = require(j, "elements", where);
     if (!els.is_array()) throw GenomeError(fmt::format("{}: \"elements\" must be an array", source));
     if (els.size() > static_cast<std::size_t>(params.max_elements))
@@ -333,12 +332,12 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
       const int t = type.is_string() ? index_of(kElementTypeNames, type.get<std::string>()) : -1;
       if (t < 0)
         throw GenomeError(fmt::format("{}: unknown type {} (expected one of promoter, internal_gene, "
-                                      "morphogen_gene, input, output)", at, type.dump()));
+                                      "morphogen_gene, input, output)", at, describe(type)));
       e.type = static_cast<ElementType>(t);
       const json& sign = require(je, "sign", at);
-      const auto sign_value = small_int(sign, -1, 1);
+      const auto sign_value = int_in(sign, -1, 1);
       if (sign_value == std::nullopt || *sign_value == 0)
-        throw GenomeError(fmt::format("{}: sign is {}, expected 1 or -1", at, sign.dump()));
+        throw GenomeError(fmt::format("{}: sign is {}, expected 1 or -1", at, describe(sign)));
       e.sign = static_cast<int>(*sign_value);
       if (e.is_special()) {
         const json& ch = require(je, "channel", at);
@@ -346,7 +345,7 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
                       : e.type == ElementType::input ? index_of(kInputNames, ch.get<std::string>())
                                                      : index_of(kOutputNames, ch.get<std::string>());
         if (c < 0)
-          throw GenomeError(fmt::format("{}: channel {} is not a valid {} channel ({})", at, ch.dump(),
+          throw GenomeError(fmt::format("{}: channel {} is not a valid {} channel ({})", at, describe(ch),
                                         element_type_name(e.type),
                                         e.type == ElementType::input ? fmt::format("{}", fmt::join(kInputNames, ", "))
                                                                      : fmt::format("{}", fmt::join(kOutputNames, ", "))));
@@ -357,10 +356,10 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
       const json& coords = require(je, "coords", at);
       if (!coords.is_array() || coords.size() != static_cast<std::size_t>(g.dimensions))
         throw GenomeError(fmt::format("{}: coords must be an array of {} numbers, got {}", at, g.dimensions,
-                                      coords.dump().substr(0, 80)));
+                                      describe(coords)));
       for (std::size_t k = 0; k < coords.size(); ++k) {
         if (!coords[k].is_number())
-          throw GenomeError(fmt::format("{}: coordinate {} is {}, expected a number", at, k, coords[k].dump()));
+          throw GenomeError(fmt::format("{}: coordinate {} is {}, expected a number", at, k, describe(coords[k])));
         const double x = coords[k].get<double>();
         if (!std::isfinite(x)) throw GenomeError(fmt::format("{}: coordinate {} is {} (must be finite)", at, k, x));
         e.coords.push_back(x);

@@ -674,10 +674,23 @@ TEST(Soak, RandomAndMutatedGenomesNeverCrashNeverNaNNeverExceedTheSpeedBound) {
   std::vector<bool> viable;
   soak(random, c, random_stats, &viable);
   if (HasFatalFailure()) return;
+  // About 0.7% of random genomes are viable: small soaks (sanitizer builds) draw more until one is.
+  while (std::find(viable.begin(), viable.end(), true) == viable.end() && random.size() < 20'000) {
+    std::vector<Genome> more;
+    for (std::size_t i = random.size(); i < random.size() + 500; ++i) {
+      Rng rng = Rng::derive(20'240'901, 0, i);
+      more.push_back(random_genome(c.genome, rng));
+    }
+    std::vector<bool> more_viable;
+    soak(more, c, random_stats, &more_viable);
+    if (HasFatalFailure()) return;
+    random.insert(random.end(), more.begin(), more.end());
+    viable.insert(viable.end(), more_viable.begin(), more_viable.end());
+  }
   std::vector<const Genome*> parents;
   for (std::size_t i = 0; i < random.size(); ++i)
     if (viable[i]) parents.push_back(&random[i]);
-  ASSERT_FALSE(parents.empty()) << "no viable random genome among " << n_random;
+  ASSERT_FALSE(parents.empty()) << "no viable random genome among " << random.size();
 
   // Mutated genomes: 1-4 rounds of the GA's own operators on a viable parent, a fifth of them after a
   // crossover with a second viable parent, a quarter at 10x the default rates (farther from viability).
@@ -1042,6 +1055,47 @@ TEST(FuzzRegressions, GenomeJsonInputsRaiseOnlyAnimatErrors) {
     try {
       const Genome g = genome_from_json(slurp(f), params, "fuzz");
       EXPECT_TRUE(genome_from_json(to_json(g), params) == g);
+    } catch (const Error&) {
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << error_class(e) << ": " << e.what();
+    }
+  }
+}
+
+TEST(FuzzRegressions, CheckpointInputsRaiseOnlyAnimatErrors) {
+  // As fuzz/fuzz_checkpoint.cpp: the first byte mod 3 says how the rest reaches restore().
+  Config c;
+  c.evolution.population = 4;
+  c.evolution.elites = 1;
+  c.evolution.seed = 7;
+  c.evolution.threads = 1;
+  const auto files = regressions("checkpoint");
+  ASSERT_FALSE(files.empty());
+  for (const auto& f : files) {
+    SCOPED_TRACE(f.filename().string());
+    const std::string data = slurp(f);
+    ASSERT_FALSE(data.empty());
+    const std::string rest = data.substr(1);
+    std::string text;
+    switch (static_cast<unsigned char>(data[0]) % 3) {
+      case 0: text = rest; break;
+      case 1: {
+        const std::string body = json::parse(json(rest).dump(-1, ' ', false, json::error_handler_t::replace)).get<std::string>();
+        text = json{{"checksum", fnv_hex(body)}, {"payload", body}}.dump();
+        break;
+      }
+      default: {
+        json p = json::parse(rest, nullptr, false);
+        if (p.is_discarded() || !p.is_object()) continue;
+        p["identity"] = fmt::format("{:016x}", run_identity(c));
+        p["format"] = "animat.checkpoint";
+        p["version"] = 1;
+        text = rewrap(p);
+      }
+    }
+    Evolution evo(c, stub_fitness);
+    try {
+      evo.restore(text, "fuzz");
     } catch (const Error&) {
     } catch (const std::exception& e) {
       ADD_FAILURE() << error_class(e) << ": " << e.what();
