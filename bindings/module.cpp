@@ -1,9 +1,25 @@
 #include <nanobind/nanobind.h>
 
+#include <cstring>
+
 #include "animat/errors.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;
+
+namespace {
+// Messages can quote bytes of a bad input file; invalid UTF-8 is replaced, never a second exception.
+void set_error(PyObject* type, const char* message) {
+  PyObject* text = PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)), "replace");
+  if (!text) {
+    PyErr_Clear();
+    PyErr_SetString(type, "animat: error message could not be decoded");
+    return;
+  }
+  PyErr_SetObject(type, text);
+  Py_DECREF(text);
+}
+}  // namespace
 
 NB_MODULE(_core, m) {
   m.doc() = "animat: co-evolution of morphology and control of soft-bodied multicellular animats (compiled core)";
@@ -13,11 +29,11 @@ NB_MODULE(_core, m) {
     try {
       std::rethrow_exception(p);
     } catch (const animat::IoError& e) {
-      PyErr_SetString(PyExc_OSError, e.what());
+      set_error(PyExc_OSError, e.what());
     } catch (const animat::SimulationError& e) {
-      PyErr_SetString(PyExc_RuntimeError, e.what());
+      set_error(PyExc_RuntimeError, e.what());
     } catch (const animat::Error& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+      set_error(PyExc_ValueError, e.what());
     }
   });
   animat::py::bind_config(m);
