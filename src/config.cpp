@@ -216,7 +216,8 @@ void apply_table(Config& config, const toml::table& root, std::string_view sourc
     const toml::table* table = snode.as_table();
     if (!table)
       throw ConfigError(fmt::format("{}: '{}' must be a table ([{}])", location(source, snode.source()), section, section));
-    for (auto&& [kkey, knode] : *table) {
+    for (auto&& [kkey, kvalue] : *table) {
+      const toml::node& knode = kvalue;  // a named reference: lambdas may not capture structured bindings before C++20 in clang < 16
       const std::string key(kkey.str());
       const bool found = with_field(config, section, key, [&](const FieldInfo& info, auto& value) {
         using T = std::decay_t<decltype(value)>;
@@ -345,8 +346,8 @@ void set_value(Config& config, std::string_view dotted, const ConfigValue& cv) {
       if constexpr (std::is_same_v<T, X>) parsed = x;
       else if constexpr ((std::is_same_v<T, int>)&&std::is_same_v<X, std::int64_t>) {
         if (x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max()) ok = false;
-        else parsed = static_cast<int>(x);
-      } else if constexpr (std::is_same_v<T, double> && std::is_same_v<X, std::int64_t>) parsed = static_cast<double>(x);
+        else parsed = static_cast<T>(x);
+      } else if constexpr (std::is_same_v<T, double> && std::is_same_v<X, std::int64_t>) parsed = static_cast<T>(x);
       else if constexpr (std::is_same_v<T, std::vector<double>> && std::is_same_v<X, std::vector<std::string>>) ok = x.empty();
       else if constexpr (std::is_same_v<T, std::vector<std::string>> && std::is_same_v<X, std::vector<double>>) ok = x.empty();
       else ok = false;

@@ -1014,6 +1014,14 @@ TEST(DiskFaults, CliTinyAndReadOnlyTmpfs) {
     fs::remove_all(mnt);
     GTEST_SKIP() << "cannot mount a tmpfs here (" << std::strerror(errno) << "); the /dev/full and ulimit tests cover a full disk";
   }
+  struct Unmount {
+    fs::path dir;
+    ~Unmount() {
+      ::umount(dir.c_str());
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } unmount{mnt};
   std::string err;
   int rc = shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--set evolution.population=100 --generations 50 --out " +
                      (mnt / "run").string(), &err);
@@ -1027,8 +1035,6 @@ TEST(DiskFaults, CliTinyAndReadOnlyTmpfs) {
   rc = shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " + (mnt / "run2").string(), &err);
   EXPECT_EQ(rc, 2) << err;
   EXPECT_NE(err.find("Read-only file system"), std::string::npos) << err;
-  ::umount(mnt.c_str());
-  fs::remove_all(mnt);
 }
 
 // ---------------------------------------------------------------------------------------------------
