@@ -9,22 +9,14 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "test_support.hpp"
 
 using namespace animat;
 
 namespace {
 
-// Viable for 3 genomes in 4; fitness = mean first coordinate, which mutation can improve.
-Fitness stub_fitness(const Genome& g) {
-  Fitness f;
-  f.viable = genome_hash(g) % 4 != 0 && !g.elements.empty();
-  if (!f.viable) return f;
-  double s = 0.0;
-  for (const auto& e : g.elements) s += e.coords[0];
-  f.fitness = s / static_cast<double>(g.size());
-  f.cell_count = static_cast<int>(g.size());
-  return f;
-}
+using animat::test::slurp;
+using animat::test::stub_fitness;
 
 Config small_config(int population = 20, std::int64_t seed = 7) {
   Config c;
@@ -55,18 +47,7 @@ void expect_same_history(const std::vector<GenerationStats>& a, const std::vecto
   }
 }
 
-std::filesystem::path fresh_dir(const std::string& name) {
-  auto p = std::filesystem::temp_directory_path() / ("animat_test_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(p);
-  return p;
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::filesystem::path fresh_dir(const std::string& name) { return animat::test::fresh_dir("animat_test_", name); }
 
 }  // namespace
 

@@ -15,6 +15,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <sys/mount.h>
+
+#include "test_support.hpp"
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -60,28 +62,15 @@ namespace {
 
 const fs::path kCatalogue = fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / "catalogue";
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void spit(const fs::path& p, std::string_view text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-}
+using animat::test::slurp;
+using animat::test::spit;
 
 std::string replace_all(std::string s, std::string_view from, std::string_view to) {
   for (std::size_t pos = 0; (pos = s.find(from, pos)) != std::string::npos; pos += to.size()) s.replace(pos, from.size(), to);
   return s;
 }
 
-fs::path fresh_dir(const std::string& name) {
-  auto p = fs::temp_directory_path() / ("animat_rel_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  return p;
-}
+fs::path fresh_dir(const std::string& name) { return animat::test::fresh_dir("animat_rel_", name); }
 
 /// The most derived animat error class of `e`, or "foreign <type>" for anything else.
 std::string error_class(const std::exception& e) {
@@ -95,17 +84,7 @@ std::string error_class(const std::exception& e) {
   return std::string("foreign ") + typeid(e).name();
 }
 
-// Viable for 3 genomes in 4; fitness = mean first coordinate (cheap, deterministic; as test_evolution).
-Fitness stub_fitness(const Genome& g) {
-  Fitness f;
-  f.viable = genome_hash(g) % 4 != 0 && !g.elements.empty();
-  if (!f.viable) return f;
-  double s = 0.0;
-  for (const auto& e : g.elements) s += e.coords[0];
-  f.fitness = s / static_cast<double>(g.size());
-  f.cell_count = static_cast<int>(g.size());
-  return f;
-}
+using animat::test::stub_fitness;
 
 Config stub_config(int population = 16, std::int64_t seed = 11) {
   Config c;
