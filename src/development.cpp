@@ -17,6 +17,7 @@
 #include <numbers>
 
 #include "animat/errors.hpp"
+#include "box2d_island.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"  // has_effect
 
@@ -97,6 +98,7 @@ struct DevelopmentWorld::Impl {
     world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
     world->SetAllowSleeping(false);
     world->SetContinuousPhysics(false);
+    world->SetWarmStarting(false);  // no contacts; the island-linking joints carry no impulse to warm-start
     const auto reserve = static_cast<std::size_t>(std::min(params.max_cells, 64));
     cells.reserve(reserve);
     states.reserve(reserve);
@@ -147,6 +149,7 @@ struct DevelopmentWorld::Impl {
   int append_cell(const Vec2& position, const Vec2& velocity, double radius, const Vec2& orientation, GrnState state) {
     Cell c;
     c.body = make_body(position, velocity);
+    if (!cells.empty()) link_bodies(*world, cells.back().body, c.body);  // one island: see box2d_island.hpp
     const b2Vec2 p = c.body->GetPosition();
     c.position = Vec2(p.x, p.y);
     c.radius = radius;

@@ -15,6 +15,7 @@
 
 #include "animat/body.hpp"
 #include "animat/errors.hpp"
+#include "box2d_island.hpp"
 
 namespace animat {
 namespace {
@@ -57,6 +58,24 @@ void check_body(const Body& b) {
 }
 
 }  // namespace
+
+void link_bodies(b2World& world, b2Body* a, b2Body* b) {
+  // Box2D solves each island separately, at ~700 instructions of fixed cost per island and step
+  // (timers, solver setup, bookkeeping); unlinked cells are one island each. A friction joint with
+  // zero maximum force and torque applies no impulse (it is clamped to zero before it reaches the
+  // velocities) but puts both bodies in the same island.
+  b2FrictionJointDef def;
+  def.bodyA = a;
+  def.bodyB = b;
+  def.maxForce = 0.0f;
+  def.maxTorque = 0.0f;
+  def.collideConnected = true;  // no fixtures anyway: nothing to filter
+  world.CreateJoint(&def);
+}
+
+void link_into_one_island(b2World& world, const std::vector<b2Body*>& bodies) {
+  for (std::size_t i = 1; i < bodies.size(); ++i) link_bodies(world, bodies[i - 1], bodies[i]);
+}
 
 void warm_up_box2d() {
   static std::once_flag once;
@@ -227,6 +246,7 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
     b->SetMassData(&mass);
     s.bodies.push_back(b);
   }
+  link_into_one_island(*s.world, s.bodies);
 
   SwimState& st = s.state;
   st.n = n;

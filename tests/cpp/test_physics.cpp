@@ -26,6 +26,7 @@
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
+#include "../../src/box2d_island.hpp"
 
 // --- counting allocator: proves the swim loop allocates nothing ---------------------------------
 namespace {
@@ -999,6 +1000,67 @@ TEST(Performance, SwimLoopAllocatesNothing) {
     g_counting = false;
     EXPECT_EQ(g_allocations.load(), 0) << scheme;
   }
+}
+
+// --- one Box2D island --------------------------------------------------------------------------------
+
+/// The island-linking joints (src/box2d_island.hpp) must not change the motion: two worlds with the
+/// same cells and the same random forces, one linked and one not, stay bitwise equal.
+TEST(Performance, IslandLinkingJointsLeaveTheMotionBitwiseUnchanged) {
+  for (const bool warm_starting : {false, true}) {
+    std::vector<b2Body*> linked, free;
+    b2World w_linked(b2Vec2(0.0f, 0.0f)), w_free(b2Vec2(0.0f, 0.0f));
+    for (b2World* w : {&w_linked, &w_free}) {
+      w->SetAllowSleeping(false);
+      w->SetContinuousPhysics(false);
+      w->SetWarmStarting(warm_starting);
+    }
+    Rng rng(11);
+    b2MassData md;
+    md.mass = 1.0f;
+    md.center.SetZero();
+    md.I = 0.0f;
+    for (int i = 0; i < 24; ++i) {
+      b2BodyDef def;
+      def.type = b2_dynamicBody;
+      def.fixedRotation = true;
+      def.allowSleep = false;
+      def.linearDamping = warm_starting ? 10.0f : 0.0f;  // the development world damps, the swim world does not
+      def.position.Set(static_cast<float>(rng.uniform(-3.0, 3.0)), static_cast<float>(rng.uniform(-3.0, 3.0)));
+      def.linearVelocity.Set(static_cast<float>(rng.uniform(-1.0, 1.0)), static_cast<float>(rng.uniform(-1.0, 1.0)));
+      linked.push_back(w_linked.CreateBody(&def));
+      free.push_back(w_free.CreateBody(&def));
+      linked.back()->SetMassData(&md);
+      free.back()->SetMassData(&md);
+    }
+    link_into_one_island(w_linked, linked);
+    EXPECT_EQ(w_linked.GetJointCount(), 23);
+    for (int step = 0; step < 500; ++step) {
+      for (std::size_t i = 0; i < linked.size(); ++i) {
+        const b2Vec2 f(static_cast<float>(rng.uniform(-50.0, 50.0)), static_cast<float>(rng.uniform(-50.0, 50.0)));
+        linked[i]->ApplyForceToCenter(f, true);
+        free[i]->ApplyForceToCenter(f, true);
+      }
+      w_linked.Step(1.0f / 60.0f, 1, 1);
+      w_free.Step(1.0f / 60.0f, 1, 1);
+    }
+    for (std::size_t i = 0; i < linked.size(); ++i) {
+      EXPECT_EQ(linked[i]->GetPosition().x, free[i]->GetPosition().x) << i;
+      EXPECT_EQ(linked[i]->GetPosition().y, free[i]->GetPosition().y) << i;
+      EXPECT_EQ(linked[i]->GetLinearVelocity().x, free[i]->GetLinearVelocity().x) << i;
+      EXPECT_EQ(linked[i]->GetLinearVelocity().y, free[i]->GetLinearVelocity().y) << i;
+    }
+  }
+}
+
+TEST(Performance, SwimWorldIsOneIslandWithoutFixturesOrContacts) {
+  Simulation sim(swimmer(lattice_points(8, 4), Drive::wave), SceneParams{}, PhysicsParams{});
+  sim.step(10);
+  const b2World& w = sim.world();
+  EXPECT_EQ(w.GetBodyCount(), 32);
+  EXPECT_EQ(w.GetJointCount(), 31);
+  EXPECT_EQ(w.GetContactCount(), 0);
+  for (const b2Body* b = w.GetBodyList(); b; b = b->GetNext()) EXPECT_EQ(b->GetFixtureList(), nullptr);
 }
 
 // --- stability suite -----------------------------------------------------------------------------------
