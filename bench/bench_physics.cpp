@@ -22,6 +22,7 @@
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
+#include "../src/box2d_island.hpp"
 
 namespace {
 
@@ -84,6 +85,35 @@ void BM_Box2DBareStep(benchmark::State& state) {
   state.counters["cells"] = n;
 }
 BENCHMARK(BM_Box2DBareStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
+
+/// The same bodies linked into one island by zero-force friction joints, as the swim world does
+/// (src/box2d_island.hpp): Box2D's own cost inside a swim step.
+void BM_Box2DLinkedStep(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  b2World world(b2Vec2(0.0f, 0.0f));
+  world.SetAllowSleeping(false);
+  world.SetContinuousPhysics(false);
+  world.SetWarmStarting(false);
+  b2MassData md;
+  md.mass = 1.0f;
+  md.center.SetZero();
+  md.I = 0.0f;
+  std::vector<b2Body*> bodies;
+  for (int i = 0; i < n; ++i) {
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(static_cast<float>(i % 8), static_cast<float>(i / 8));
+    def.allowSleep = false;
+    def.fixedRotation = true;
+    bodies.push_back(world.CreateBody(&def));
+    bodies.back()->SetMassData(&md);
+  }
+  link_into_one_island(world, bodies);
+  for (auto _ : state) world.Step(1.0f / 60.0f, 1, 1);
+  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["cells"] = n;
+}
+BENCHMARK(BM_Box2DLinkedStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 
 /// The default scene (all five effects, stable drag, d_N = 2).
 void BM_SwimStep(benchmark::State& state) {
