@@ -226,14 +226,29 @@ void DevelopmentWorld::sense() {
     for (std::size_t k = 0; k < m; ++k) w.sensed[i * m + k] = w.sample(i, k, now);
   const double inv_lambda = 1.0 / w.params.morphogen_decay_length;
   const double inv_speed = 1.0 / w.params.morphogen_speed;
+  // Same arithmetic as w.sample(), with the four history rows of a pair located once.
+  double* sensed = w.sensed.data();
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 1; j < n; ++j) {
       const double d = (w.cells[j].position - w.cells[i].position).norm();
       const double weight = std::exp(-d * inv_lambda);
       const Impl::Tap t = w.tap(d * inv_speed);
-      for (std::size_t k = 0; k < m; ++k) {
-        w.sensed[i * m + k] += weight * w.sample(j, k, t);
-        w.sensed[j * m + k] += weight * w.sample(i, k, t);
+      const double* i_new = w.hist(i, t.newer);
+      const double* j_new = w.hist(j, t.newer);
+      double* si = sensed + i * m;
+      double* sj = sensed + j * m;
+      if (t.frac == 0.0) {
+        for (std::size_t k = 0; k < m; ++k) {
+          si[k] += weight * j_new[k];
+          sj[k] += weight * i_new[k];
+        }
+      } else {
+        const double* i_old = w.hist(i, t.older);
+        const double* j_old = w.hist(j, t.older);
+        for (std::size_t k = 0; k < m; ++k) {
+          si[k] += weight * (j_new[k] + t.frac * (j_old[k] - j_new[k]));
+          sj[k] += weight * (i_new[k] + t.frac * (i_old[k] - i_new[k]));
+        }
       }
     }
   }
