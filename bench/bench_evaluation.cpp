@@ -23,6 +23,7 @@
 #include "animat/genome.hpp"
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
+#include "bench_context.hpp"
 
 namespace {
 
@@ -142,6 +143,7 @@ BENCHMARK(BM_RandomTry)->Unit(benchmark::kMicrosecond);
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  animat::bench::add_context();
   sample();  // draw the genomes before any benchmark (and outside callgrind's --toggle-collect window)
   benchmark::AddCustomContext("genomes", std::to_string(kGenomes) + " viable random genomes, seeds from 0");
   benchmark::AddCustomContext("tries_per_viable", std::to_string(static_cast<double>(sample().tries) / kGenomes));

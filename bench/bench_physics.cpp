@@ -23,6 +23,7 @@
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
 #include "../src/box2d_island.hpp"
+#include "bench_context.hpp"
 
 namespace {
 
@@ -152,4 +153,12 @@ BENCHMARK(BM_VelocityForces)->DenseRange(0, 1);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  animat::bench::add_context();
+  benchmark::AddCustomContext("bodies", "triangular lattices, spacing 1, jitter 0.05, travelling wave a=0.2 f=4");
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -12,7 +12,8 @@ It builds the benchmarks (scripts/build.sh with ANIMAT_BUILD_BENCH=ON), then:
   4. animat_evolve with 1 and 2 threads: generations per second, speedup, peak memory
      (/usr/bin/time -v), and a check that both thread counts give the same run;
   5. the size exponent fit and the paper-scale projection.
-Every result goes to bench/results/*.csv, and the tables into docs/performance.md between the
+Every result goes to bench/results/*.csv (the console output with the machine and settings to
+bench/results/*.txt), and the tables into docs/performance.md between the
 "BEGIN MEASURED" and "END MEASURED" markers (the text around them is written by hand).
 Timings are medians of repetitions; ratios are taken within one benchmark process.
 """
@@ -82,7 +83,7 @@ def run_gbench(exe: Path, out_csv: Path, filt: str, reps: int, min_time: float) 
     subprocess.run([str(exe), f"--benchmark_filter={filt}", f"--benchmark_repetitions={reps}",
                     "--benchmark_report_aggregates_only=true", f"--benchmark_min_time={min_time}",
                     f"--benchmark_out={out_csv}", "--benchmark_out_format=csv"],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                   check=True, stdout=open(out_csv.with_suffix(".txt"), "w"), stderr=subprocess.STDOUT)
     text = out_csv.read_text()
     text = text[text.index("name,"):]  # skip the context lines
     rows = {}
