@@ -156,7 +156,7 @@ std::string check(const FieldInfo& info, const T& value) {
     }
   } else if constexpr (std::is_same_v<T, std::vector<double>>) {
     for (double d : value)
-      if (auto e = check_number(d); !e.empty()) return "an entry is " + e;
+      if (auto e = check_number(d); !e.empty()) return fmt::format("entry {}: {}", format_double(d), e);
   }
   return {};
 }

@@ -351,7 +351,8 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
                                                                      : fmt::format("{}", fmt::join(kOutputNames, ", "))));
         e.channel = c;
       } else if (je.contains("channel")) {
-        throw GenomeError(fmt::format("{}: a {} has no channel", at, element_type_name(e.type)));
+        throw GenomeError(fmt::format("{}: {} {} has no channel", at,
+                                      element_type_name(e.type).front() == 'i' ? "an" : "a", element_type_name(e.type)));
       }
       const json& coords = require(je, "coords", at);
       if (!coords.is_array() || coords.size() != static_cast<std::size_t>(g.dimensions))
