@@ -173,7 +173,7 @@ def main() -> int:
     ap.add_argument("--doc", default="docs/performance.md")
     ap.add_argument("--repetitions", type=int, default=5)
     ap.add_argument("--min-time", type=float, default=0.2)
-    ap.add_argument("--generations", type=int, default=5, help="animat_evolve generations per thread count")
+    ap.add_argument("--generations", type=int, default=20, help="animat_evolve generations per thread count")
     ap.add_argument("--no-build", action="store_true")
     ap.add_argument("--no-callgrind", action="store_true")
     ap.add_argument("--no-evolve", action="store_true")
@@ -181,8 +181,13 @@ def main() -> int:
     os.chdir(ROOT)
     build = Path(args.build)
     if not args.no_build:
+        # valgrind and GNU time are only needed here, so scripts/setup.sh installs them on request.
+        subprocess.run(["scripts/setup.sh"], check=True, env={**os.environ, "ANIMAT_EXTRA_APT": "valgrind time"})
         subprocess.run(["scripts/build.sh"], check=True, env={**os.environ, "ANIMAT_BUILD_BENCH": "ON",
                                                                "ANIMAT_BUILD_DIR": str(build)})
+    for tool, needed in (("valgrind", not args.no_callgrind), ("/usr/bin/time", not args.no_evolve)):
+        if needed and not shutil.which(tool):
+            sys.exit(f"run_benchmarks: {tool} is missing (apt install valgrind time, or run without --no-build)")
     results = Path(args.results)
     results.mkdir(parents=True, exist_ok=True)
     info = machine()
