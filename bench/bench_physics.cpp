@@ -63,38 +63,14 @@ void run_swim(benchmark::State& state, const Body& body, const SceneParams& scen
   state.counters["cells"] = body.node_count();
 }
 
-/// The floor: a bare Box2D Step over n fixture-less dynamic bodies with no forces.
-void BM_Box2DBareStep(benchmark::State& state) {
+/// Box2D alone: n fixture-less dynamic bodies, no forces, stepped at the default dt. Unlinked, each
+/// body is its own island; linked, they are one island as in the swim world (src/box2d_island.hpp).
+void run_box2d_only(benchmark::State& state, bool linked) {
   const int n = static_cast<int>(state.range(0));
   b2World world(b2Vec2(0.0f, 0.0f));
   world.SetAllowSleeping(false);
   world.SetContinuousPhysics(false);
-  b2MassData md;
-  md.mass = 1.0f;
-  md.center.SetZero();
-  md.I = 0.0f;
-  for (int i = 0; i < n; ++i) {
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    def.position.Set(static_cast<float>(i % 8), static_cast<float>(i / 8));
-    def.allowSleep = false;
-    def.fixedRotation = true;
-    world.CreateBody(&def)->SetMassData(&md);
-  }
-  for (auto _ : state) world.Step(1.0f / 60.0f, 1, 1);
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["cells"] = n;
-}
-BENCHMARK(BM_Box2DBareStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
-
-/// The same bodies linked into one island by zero-force friction joints, as the swim world does
-/// (src/box2d_island.hpp): Box2D's own cost inside a swim step.
-void BM_Box2DLinkedStep(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
-  b2World world(b2Vec2(0.0f, 0.0f));
-  world.SetAllowSleeping(false);
-  world.SetContinuousPhysics(false);
-  world.SetWarmStarting(false);
+  if (linked) world.SetWarmStarting(false);  // as the swim world
   b2MassData md;
   md.mass = 1.0f;
   md.center.SetZero();
@@ -109,11 +85,18 @@ void BM_Box2DLinkedStep(benchmark::State& state) {
     bodies.push_back(world.CreateBody(&def));
     bodies.back()->SetMassData(&md);
   }
-  link_into_one_island(world, bodies);
+  if (linked) link_into_one_island(world, bodies);
   for (auto _ : state) world.Step(1.0f / 60.0f, 1, 1);
   state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = n;
 }
+
+/// The floor: a bare Box2D Step over n unlinked fixture-less bodies with no forces.
+void BM_Box2DBareStep(benchmark::State& state) { run_box2d_only(state, false); }
+BENCHMARK(BM_Box2DBareStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
+
+/// The same bodies linked into one island: Box2D's own cost inside a swim step.
+void BM_Box2DLinkedStep(benchmark::State& state) { run_box2d_only(state, true); }
 BENCHMARK(BM_Box2DLinkedStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 
 /// The default scene (all five effects, stable drag, d_N = 2).
