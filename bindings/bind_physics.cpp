@@ -12,10 +12,12 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
+#include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/physics.hpp"
@@ -164,7 +166,28 @@ void bind_physics(nb::module_& m) {
       .def("__deepcopy__", [](const SceneParams& p, nb::handle) { return SceneParams(p); }, "memo"_a)
       .def("__repr__", &scene_repr);
 
-  nb::class_<SwimResult>(m, "SwimResult", "What one swim did (see ``animat.swim``).")
+  nb::class_<SwimResult> swim_result(m, "SwimResult", "What one swim did (see ``animat.swim``).");
+  nb::class_<EvaluationResult> evaluation_result(m, "EvaluationResult",
+                                                 "Fitness and diagnostics of one genome (see ``animat.evaluate``).");
+  // The invariants and counted deviations, the same fields in both results.
+  auto invariant_fields = [](auto& cls, auto tag) {
+    using R = typename decltype(tag)::type;
+    cls.def_ro("valid", &R::valid,
+               "False if the swim broke an invariant: unstable, a region inverted, the skin crossed itself, or a\n"
+               "collision could not be resolved. An invalid swim has fitness/distance 0.")
+        .def_ro("max_kinetic_energy_per_cell", &R::max_kinetic_energy_per_cell, "Largest kinetic energy / cells.")
+        .def_ro("min_area_ratio", &R::min_area_ratio, "Smallest S/S0 of any region over the swim (must stay > 0).")
+        .def_ro("inverted_region_steps", &R::inverted_region_steps, "(region, step) pairs with S/S0 <= 0 (must be 0).")
+        .def_ro("skin_crossing_steps", &R::skin_crossing_steps, "Steps in which two skin edges intersected (must be 0).")
+        .def_ro("first_invalid_step", &R::first_invalid_step, "Step at whose end an invariant first broke (-1: never).")
+        .def_ro("collisions", &R::collisions, "Cell-edge collisions resolved by an impulse.")
+        .def_ro("collisions_inelastic", &R::collisions_inelastic, "Collisions resolved by the inelastic fallback.")
+        .def_ro("collisions_unresolved", &R::collisions_unresolved, "Steps with a crossing no impulse prevented (must be 0).")
+        .def_ro("drag_limited", &R::drag_limited, "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.");
+  };
+  invariant_fields(swim_result, std::type_identity<SwimResult>{});
+  invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});
+  swim_result
       .def_ro("distance", &SwimResult::distance, "|COM(end) - COM(start)|; 0 when unstable.")
       .def_prop_ro("displacement", [](const SwimResult& r) -> Eigen::Vector2d { return r.displacement; },
                    "COM(end) - COM(start) as a (2,) array.")
@@ -179,10 +202,11 @@ void bind_physics(nb::module_& m) {
       .def_ro("final_kinetic_energy", &SwimResult::final_kinetic_energy, "Kinetic energy at the end.")
       .def_ro("max_kinetic_energy", &SwimResult::max_kinetic_energy, "Largest kinetic energy (same samples).")
       .def("__repr__", [](const SwimResult& r) {
-        return fmt::format("<animat.SwimResult distance={:.6g} stable={} steps={}>", r.distance, r.stable ? "True" : "False", r.steps);
+        return fmt::format("<animat.SwimResult distance={:.6g} stable={} valid={} steps={}>", r.distance,
+                           r.stable ? "True" : "False", r.valid ? "True" : "False", r.steps);
       });
 
-  nb::class_<EvaluationResult>(m, "EvaluationResult", "Fitness and diagnostics of one genome (see ``animat.evaluate``).")
+  evaluation_result
       .def_ro("fitness", &EvaluationResult::fitness, "Straight-line distance of the centre of mass, start to end (0 if not viable or unstable).")
       .def_ro("viable", &EvaluationResult::viable, "Development verdict; non-viable genomes are never swum.")
       .def_ro("stable", &EvaluationResult::stable, "False if the development or the swim left the valid domain.")
@@ -206,8 +230,9 @@ void bind_physics(nb::module_& m) {
       .def_ro("seconds_body", &EvaluationResult::seconds_body, "Wall time of body construction (diagnostic).")
       .def_ro("seconds_swim", &EvaluationResult::seconds_swim, "Wall time of the swim (diagnostic).")
       .def("__repr__", [](const EvaluationResult& r) {
-        return fmt::format("<animat.EvaluationResult fitness={:.6g} viable={} stable={} cells={}>", r.fitness,
-                           r.viable ? "True" : "False", r.stable ? "True" : "False", r.cell_count);
+        return fmt::format("<animat.EvaluationResult fitness={:.6g} viable={} stable={} valid={} cells={}>", r.fitness,
+                           r.viable ? "True" : "False", r.stable ? "True" : "False", r.valid ? "True" : "False",
+                           r.cell_count);
       });
 
   nb::class_<Simulation>(m, "Simulation", kSimulationDoc)
@@ -282,20 +307,54 @@ void bind_physics(nb::module_& m) {
       .def_prop_ro("max_speed_seen", &Simulation::max_speed_seen, "Largest cell speed seen so far.")
       .def_prop_ro("max_step_displacement_seen", &Simulation::max_step_displacement_seen,
                    "Largest |v|*h a cell was about to move in one Box2D step so far.")
+      .def_prop_ro("counters", [](const Simulation& s) {
+        const SwimCounters& c = s.counters();
+        nb::dict d;
+        d["collisions"] = c.collisions;
+        d["collisions_inelastic"] = c.collisions_inelastic;
+        d["collisions_unresolved"] = c.collisions_unresolved;
+        d["collision_max_passes"] = c.collision_max_passes;
+        d["drag_limited"] = c.drag_limited;
+        return d;
+      }, "What the effects counted so far: collisions (resolved, inelastic, unresolved, most passes in a\n"
+         "step) and drag limiter engagements, as a dict.")
+      .def("monitor_embedding", &Simulation::monitor_embedding, "body"_a,
+           "Check the planar embedding of `body` (the body this simulation swims) now and after every step:\n"
+           "region signs and skin simplicity; see `embedding`.")
+      .def_prop_ro("embedding", [](const Simulation& s) -> nb::object {
+        const EmbeddingMonitor* m = s.embedding_monitor();
+        if (!m) return nb::none();
+        nb::dict d;
+        d["steps_checked"] = m->frames();
+        d["min_area_ratio"] = m->min_area_ratio();
+        d["inverted_region_steps"] = m->inverted_region_frames();
+        d["skin_crossing_steps"] = m->skin_crossing_frames();
+        d["first_broken_step"] = s.first_broken_step();
+        d["intact"] = m->intact();
+        return d;
+      }, "The embedding checks so far (a dict), or None before monitor_embedding().")
       .def("__len__", &Simulation::node_count)
       .def("__repr__", [](const Simulation& s) {
         return fmt::format("<animat.Simulation cells={} t={:.6g} steps={}>", s.node_count(), s.time(), s.steps_done());
       });
 
-  m.def("swim", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config, std::optional<long> steps) {
+  m.def("swim", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config, std::optional<long> steps,
+                   std::optional<bool> check_embedding, bool stop_when_invalid) {
         const Config c = config ? *config : Config{};
         const long n = steps ? *steps : c.evaluation.steps;
         if (n < 0) throw ConfigError(fmt::format("swim: steps must be >= 0, got {}", n));
+        SwimOptions options;
+        options.check_embedding = check_embedding ? *check_embedding : c.evaluation.check_embedding;
+        options.stop_when_invalid = stop_when_invalid;
         nb::gil_scoped_release release;
-        return swim(body, scene ? *scene : c.scene, c.physics, n);
+        return swim(body, scene ? *scene : c.scene, c.physics, n, options);
       }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "steps"_a = nb::none(),
+      "check_embedding"_a = nb::none(), "stop_when_invalid"_a = true,
       "Swim a body for `steps` control steps (default config.evaluation.steps) and return a SwimResult.\n"
-      "Never raises for an unstable swim: it returns stable=False and distance 0.");
+      "Never raises for an unstable or invalid swim: it returns stable/valid=False and distance 0.\n"
+      "check_embedding (default config.evaluation.check_embedding) checks region signs and skin\n"
+      "simplicity after every step; stop_when_invalid=False swims on after a broken invariant so that\n"
+      "the counts cover the whole horizon.");
   m.def("evaluate", [](const Genome& genome, std::optional<Config> config) {
         const Config c = config ? *config : Config{};
         nb::gil_scoped_release release;

@@ -421,6 +421,12 @@ void validate(const Config& config, std::string_view source) {
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
                      config.development.max_cells));
+  if (config.evaluation.reference_check != "off" &&
+      static_cast<long long>(config.physics.substeps) * config.evaluation.reference_substeps > 1000)
+    fail(fmt::format("the exploit guard's reference step needs physics.substeps x evaluation.reference_substeps = {} x {} "
+                     "Box2D steps per control step, more than physics.substeps allows (1000); lower one of them or "
+                     "set evaluation.reference_check = \"off\"",
+                     config.physics.substeps, config.evaluation.reference_substeps));
 }
 
 std::uint64_t config_hash(const Config& config) {

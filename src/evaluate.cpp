@@ -13,6 +13,7 @@
 
 #include "animat/body.hpp"
 #include "animat/development.hpp"
+#include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/physics.hpp"
 
@@ -50,20 +51,32 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 
 }  // namespace
 
-SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps) {
+SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
+                const SwimOptions& options) {
   constexpr long kSampleEvery = 16;
   SwimResult r;
   Simulation sim(body, scene, physics);
+  if (options.check_embedding) sim.monitor_embedding(body);
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   const Eigen::Vector2d start = sim.center_of_mass();
   const double floor = stretch_floor(body);
   sample(sim, body, floor, r);
+  auto broken = [&] {
+    return sim.first_broken_step() >= 0 || sim.counters().collisions_unresolved > 0;
+  };
   try {
     for (long done = 0; done < steps;) {
       const long chunk = std::min(kSampleEvery, steps - done);
-      sim.step(chunk);
-      done += chunk;
-      sample(sim, body, floor, r);
+      if (options.stop_when_invalid && options.check_embedding) {
+        for (long k = 0; k < chunk && !broken(); ++k) sim.step(1);
+        done += chunk;
+        sample(sim, body, floor, r);
+        if (broken()) break;
+      } else {
+        sim.step(chunk);
+        done += chunk;
+        sample(sim, body, floor, r);
+      }
     }
   } catch (const SimulationError& e) {
     r.stable = false;
@@ -79,7 +92,31 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
     r.stable = false;
     r.failure = "unstable swim: non-finite centre of mass";
   }
-  r.distance = r.stable ? r.displacement.norm() : 0.0;
+  r.max_kinetic_energy_per_cell = body.node_count() > 0 ? r.max_kinetic_energy / body.node_count() : 0.0;
+  const SwimCounters& c = sim.counters();
+  r.collisions = c.collisions;
+  r.collisions_inelastic = c.collisions_inelastic;
+  r.collisions_unresolved = c.collisions_unresolved;
+  r.drag_limited = c.drag_limited;
+  if (const EmbeddingMonitor* m = sim.embedding_monitor()) {
+    r.embedding_checked = true;
+    r.min_area_ratio = m->min_area_ratio();
+    r.inverted_region_steps = m->inverted_region_frames();
+    r.skin_crossing_steps = m->skin_crossing_frames();
+    r.first_invalid_step = sim.first_broken_step();
+  }
+  r.valid = r.stable && r.inverted_region_steps == 0 && r.skin_crossing_steps == 0 && r.collisions_unresolved == 0;
+  if (r.stable && !r.valid) {
+    std::vector<std::string> what;
+    if (r.inverted_region_steps > 0)
+      what.push_back(fmt::format("a region turned inside out (smallest S/S0 {:.3g})", r.min_area_ratio));
+    if (r.skin_crossing_steps > 0) what.push_back("the skin crossed itself");
+    if (r.collisions_unresolved > 0)
+      what.push_back(fmt::format("{} steps with an unresolved cell-edge collision", r.collisions_unresolved));
+    r.failure = fmt::format("invalid swim: {} (first at step {})", fmt::join(what, "; "),
+                            r.first_invalid_step >= 0 ? r.first_invalid_step : r.steps);
+  }
+  r.distance = r.valid ? r.displacement.norm() : 0.0;
   if (body.spring_count() > 0 && !std::isfinite(r.min_stretch)) r.min_stretch = 0.0;
   return r;
 }
@@ -97,6 +134,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config) {
     out.seconds_development = seconds_since(t0);
     out.viable = false;
     out.stable = false;
+    out.valid = false;
     out.reasons.push_back(fmt::format("development: {}", e.what()));
     return out;
   }
@@ -125,10 +163,13 @@ EvaluationResult evaluate(const Genome& genome, const Config& config) {
   out.skin_edge_count = static_cast<int>(body.skin.rows());
 
   t0 = Clock::now();
-  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps);
+  SwimOptions options;
+  options.check_embedding = config.evaluation.check_embedding;
+  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, options);
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
-  if (!s.stable) out.reasons.push_back(s.failure);
+  out.valid = s.valid;
+  if (!s.valid) out.reasons.push_back(s.failure);
   out.fitness = s.distance;
   out.displacement = s.displacement;
   out.swim_steps = s.steps;
@@ -139,6 +180,15 @@ EvaluationResult evaluate(const Genome& genome, const Config& config) {
   out.min_stretch = s.min_stretch;
   out.max_kinetic_energy = s.max_kinetic_energy;
   out.final_kinetic_energy = s.final_kinetic_energy;
+  out.max_kinetic_energy_per_cell = s.max_kinetic_energy_per_cell;
+  out.min_area_ratio = s.min_area_ratio;
+  out.inverted_region_steps = s.inverted_region_steps;
+  out.skin_crossing_steps = s.skin_crossing_steps;
+  out.first_invalid_step = s.first_invalid_step;
+  out.collisions = s.collisions;
+  out.collisions_inelastic = s.collisions_inelastic;
+  out.collisions_unresolved = s.collisions_unresolved;
+  out.drag_limited = s.drag_limited;
   return out;
 }
 

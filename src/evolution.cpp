@@ -114,10 +114,39 @@ std::uint64_t run_identity(const Config& config) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-Evolution::Evolution(const Config& config, FitnessFunction fitness)
-    : config_(std::make_shared<const Config>(config)), identity_(run_identity(config)), fitness_(std::move(fitness)), started_(now_seconds()) {
+Evolution::Evolution(const Config& config, FitnessFunction fitness, FitnessFunction reference)
+    : config_(std::make_shared<const Config>(config)),
+      identity_(run_identity(config)),
+      fitness_(std::move(fitness)),
+      started_(now_seconds()) {
   validate(*config_);
   if (!fitness_) throw Error("Evolution: no fitness function");
+  if (config_->evaluation.reference_check != "off") reference_ = std::move(reference);
+}
+
+void Evolution::check_reference() {
+  if (!reference_ || population_.empty() || history_.empty()) return;
+  const Individual& b = best();
+  if (!b.result.viable) return;
+  Individual& mutable_best = population_[static_cast<std::size_t>(&b - population_.data())];
+  if (std::isnan(mutable_best.reference)) mutable_best.reference = reference_(mutable_best.genome).fitness;
+  history_.back().best_reference = mutable_best.reference;
+}
+
+std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size_t>& order, std::size_t elites) {
+  // Candidates: the 2·elites fittest viable individuals by their nominal fitness.
+  std::vector<std::size_t> cand;
+  for (std::size_t k = 0; k < order.size() && cand.size() < 2 * elites; ++k)
+    if (population_[order[k]].result.viable) cand.push_back(order[k]);
+  std::vector<std::size_t> todo;
+  for (std::size_t c : cand)
+    if (std::isnan(population_[c].reference)) todo.push_back(c);
+  parallel_for(todo.size(), config_->evolution.threads,
+               [&](std::size_t k) { population_[todo[k]].reference = reference_(population_[todo[k]].genome).fitness; });
+  std::stable_sort(cand.begin(), cand.end(),
+                   [&](std::size_t a, std::size_t b) { return population_[a].reference > population_[b].reference; });
+  if (cand.size() > elites) cand.resize(elites);
+  return cand;
 }
 
 void Evolution::initialize() {
@@ -141,6 +170,7 @@ void Evolution::initialize() {
   best_ever_ = best().result.fitness;
   stall_ = 0;
   history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_));
+  check_reference();
 }
 
 const Individual& Evolution::best() const {
@@ -177,11 +207,19 @@ GenerationStats Evolution::step() {
   std::vector<bool> needs_eval(n, false);
   const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), n);
   std::size_t copied = 0;
-  for (std::size_t k = 0; k < n && copied < elites; ++k) {
-    if (!population_[order[k]].result.viable) break;
-    next[copied] = population_[order[k]];
-    next[copied].tries = 0;
-    ++copied;
+  if (reference_ && config_->evaluation.reference_check == "select") {
+    for (std::size_t i : reference_ranked(order, elites)) {
+      next[copied] = population_[i];
+      next[copied].tries = 0;
+      ++copied;
+    }
+  } else {
+    for (std::size_t k = 0; k < n && copied < elites; ++k) {
+      if (!population_[order[k]].result.viable) break;
+      next[copied] = population_[order[k]];
+      next[copied].tries = 0;
+      ++copied;
+    }
   }
   const double p = tournament_probability(ep, g);
   int crossovers = 0;
@@ -227,6 +265,7 @@ GenerationStats Evolution::step() {
   }
   history_.push_back(statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_));
   history_.back().crossovers = crossovers;
+  check_reference();
   return history_.back();
 }
 
@@ -234,8 +273,10 @@ GenerationStats Evolution::statistics(bool best_changed, double wall) const {
   GenerationStats s;
   s.generation = generation_;
   std::vector<double> viable;
-  for (const auto& ind : population_)
+  for (const auto& ind : population_) {
     if (ind.result.viable) viable.push_back(ind.result.fitness);
+    if (ind.result.viable && (!ind.result.valid || !ind.result.stable)) ++s.invalid;
+  }
   const Individual& b = best();
   s.best = b.result.fitness;
   s.best_cells = b.result.cell_count;
@@ -270,9 +311,11 @@ std::string Evolution::stop_reason() const {
 namespace {
 
 json stats_to_json(const GenerationStats& s) {
-  return json{{"generation", s.generation}, {"best", s.best}, {"mean", s.mean}, {"median", s.median},
-              {"viable_fraction", s.viable_fraction}, {"best_cells", s.best_cells}, {"evaluations", s.evaluations},
-              {"wall_seconds", s.wall_seconds}, {"best_changed", s.best_changed}};
+  json j{{"generation", s.generation}, {"best", s.best}, {"mean", s.mean}, {"median", s.median},
+         {"viable_fraction", s.viable_fraction}, {"best_cells", s.best_cells}, {"evaluations", s.evaluations},
+         {"wall_seconds", s.wall_seconds}, {"best_changed", s.best_changed}, {"invalid", s.invalid}};
+  if (!std::isnan(s.best_reference)) j["best_reference"] = s.best_reference;
+  return j;
 }
 
 // Integer and number fields of a checkpoint: type- and range-checked, never converted out of range.
@@ -307,6 +350,9 @@ GenerationStats stats_from_json(const json& j) {
   s.evaluations = int_field(j, "evaluations", 0, kInt64Max);
   s.wall_seconds = number_field(j, "wall_seconds");
   s.best_changed = bool_field(j, "best_changed");
+  // Fields added with the exploit guard; absent in older checkpoints.
+  if (j.contains("invalid")) s.invalid = static_cast<int>(int_field(j, "invalid", 0, kIntMax));
+  if (j.contains("best_reference")) s.best_reference = number_field(j, "best_reference");
   s.evaluations_per_second = s.wall_seconds > 0 ? static_cast<double>(s.evaluations) / s.wall_seconds : 0.0;
   return s;
 }
@@ -324,13 +370,17 @@ std::string Evolution::checkpoint() const {
   payload["evaluations"] = evaluations_;
   payload["wall_seconds"] = history_.empty() ? 0.0 : history_.back().wall_seconds;
   json pop = json::array();
-  for (const auto& ind : population_)
-    pop.push_back(json{{"genome", json::parse(to_json(ind.genome))},
-                       {"fitness", ind.result.fitness},
-                       {"viable", ind.result.viable},
-                       {"stable", ind.result.stable},
-                       {"cell_count", ind.result.cell_count},
-                       {"tries", ind.tries}});
+  for (const auto& ind : population_) {
+    json ji{{"genome", json::parse(to_json(ind.genome))},
+            {"fitness", ind.result.fitness},
+            {"viable", ind.result.viable},
+            {"stable", ind.result.stable},
+            {"valid", ind.result.valid},
+            {"cell_count", ind.result.cell_count},
+            {"tries", ind.tries}};
+    if (!std::isnan(ind.reference)) ji["reference"] = ind.reference;
+    pop.push_back(std::move(ji));
+  }
   payload["population"] = std::move(pop);
   json hist = json::array();
   for (const auto& s : history_) hist.push_back(stats_to_json(s));
@@ -376,6 +426,8 @@ void Evolution::restore(std::string_view text, std::string_view source) {
       ind.result.fitness = number_field(ji, "fitness");
       ind.result.viable = bool_field(ji, "viable");
       ind.result.stable = bool_field(ji, "stable");
+      if (ji.contains("valid")) ind.result.valid = bool_field(ji, "valid");
+      if (ji.contains("reference")) ind.reference = number_field(ji, "reference");
       ind.result.cell_count = static_cast<int>(int_field(ji, "cell_count", 0, kIntMax));
       ind.tries = static_cast<int>(int_field(ji, "tries", 0, kIntMax));
       pop.push_back(std::move(ind));
@@ -450,11 +502,11 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 constexpr std::string_view kHistoryHeader =
-    "generation,best,mean,median,viable_fraction,best_cells,evaluations,wall_seconds\n";
+    "generation,best,mean,median,viable_fraction,best_cells,evaluations,wall_seconds,best_reference,invalid\n";
 
 std::string history_row(const GenerationStats& s) {
-  return fmt::format("{},{},{},{},{},{},{},{:.3f}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
-                     s.best_cells, s.evaluations, s.wall_seconds);
+  return fmt::format("{},{},{},{},{},{},{},{:.3f},{},{}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
+                     s.best_cells, s.evaluations, s.wall_seconds, s.best_reference, s.invalid);
 }
 
 void append(const std::filesystem::path& path, std::string_view text) {
@@ -466,6 +518,7 @@ void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
   const Individual& b = evo.best();
   json j{{"generation", evo.generation()},
          {"fitness", b.result.fitness},
+         {"reference_fitness", std::isnan(b.reference) ? json(nullptr) : json(b.reference)},
          {"cell_count", b.result.cell_count},
          {"genome", json::parse(to_json(b.genome))}};
   write_atomically(dir / "best" / fmt::format("gen_{:06d}.json", evo.generation()), j.dump(1) + "\n");
@@ -480,8 +533,12 @@ std::string duration(double s) {
 
 RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
   validate(config);
-  if (!fitness) fitness = swim_fitness(config);
-  Evolution evo(config, std::move(fitness));
+  FitnessFunction reference;
+  if (!fitness) {  // the real swim: its exploit guard re-evaluates each new best at the reference step
+    fitness = swim_fitness(config);
+    if (config.evaluation.reference_check != "off") reference = swim_fitness(reference_config(config));
+  }
+  Evolution evo(config, std::move(fitness), std::move(reference));
   const bool writing = !opt.out.empty();
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
@@ -546,7 +603,19 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
                  s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.evaluations_per_second,
                  duration(s.wall_seconds), left);
   };
+  // Exploit guard: a best whose fitness the reference step does not confirm is reported.
+  const EvaluationParams& ev = config.evaluation;
+  auto guard = [&](const GenerationStats& s) {
+    if (opt.quiet || !s.best_changed || std::isnan(s.best_reference)) return;
+    const double diff = std::abs(s.best - s.best_reference);
+    if (diff > ev.reference_abs_tolerance && diff > ev.reference_tolerance * std::abs(s.best_reference))
+      spdlog::warn("gen {}: the new best's fitness {:.4f} is not confirmed at the reference step "
+                   "(physics.substeps x {}: {:.4f}, {:+.1f}%): its swim depends on the step size",
+                   s.generation, s.best, ev.reference_substeps, s.best_reference,
+                   100.0 * (s.best - s.best_reference) / std::max(std::abs(s.best_reference), 1e-12));
+  };
   report(evo.history().back(), true);
+  guard(evo.history().back());
   int since_checkpoint = 0;
   bool dirty = false;
   while (true) {
@@ -555,6 +624,7 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     if (!summary.stop_reason.empty()) break;
     const GenerationStats s = evo.step();
     report(s, false);
+    guard(s);
     if (writing) {
       append(hist, history_row(s));
       if (s.best_changed) write_lineage(opt.out, evo);

@@ -12,8 +12,14 @@ FitnessFunction swim_fitness(const Config& config) {
   auto shared = std::make_shared<const Config>(config);
   return [shared](const Genome& genome) {
     const EvaluationResult r = evaluate(genome, *shared);
-    return Fitness{r.fitness, r.viable, r.stable, r.cell_count};
+    return Fitness{r.fitness, r.viable, r.stable, r.cell_count, r.valid};
   };
+}
+
+Config reference_config(const Config& config) {
+  Config c = config;
+  c.physics.substeps = config.physics.substeps * config.evaluation.reference_substeps;
+  return c;
 }
 
 }  // namespace animat

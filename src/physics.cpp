@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "animat/body.hpp"
+#include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "box2d_island.hpp"
 
@@ -101,7 +102,9 @@ struct Simulation::Impl {
   std::unique_ptr<b2World> world;
   std::vector<b2Body*> bodies;
   std::vector<std::unique_ptr<Effect>> effects;  // in run order
+  std::vector<Effect*> force_effects;             // modifier and force stages, in run order
   std::vector<Effect*> velocity_effects;          // those with velocity-dependent forces, in run order
+  std::vector<Effect*> constraint_effects;        // run after every force is known
   bool midpoint = true;
   std::vector<double> fx_pos, fy_pos;             // position-dependent forces (midpoint scheme)
   SwimState state;
@@ -112,6 +115,9 @@ struct Simulation::Impl {
   double max_disp = 0.0;
   double max_speed = 0.0;
   std::string failure;
+  bool monitoring = false;
+  EmbeddingMonitor monitor;
+  long first_broken_step = -1;  // control step at the end of which the embedding first broke
 
   void read_state() {
     for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -127,9 +133,15 @@ struct Simulation::Impl {
   void run_effects() {
     state.step = box2d_steps;
     state.time = static_cast<double>(box2d_steps) * h;
+    state.position_corrected = false;
     std::fill(state.fx.begin(), state.fx.end(), 0.0);
     std::fill(state.fy.begin(), state.fy.end(), 0.0);
-    for (auto& e : effects) e->apply(state);
+    for (Effect* e : force_effects) e->apply(state);
+    velocity_forces();
+    for (Effect* e : constraint_effects) e->apply(state);
+  }
+
+  void velocity_forces() {
     if (velocity_effects.empty()) return;
     // Velocity-dependent forces at u = v (start) or u = v + (h/2)·F(v)/m (midpoint: predictor at v,
     // then the forces are recomputed at u on top of the position-dependent ones).
@@ -138,7 +150,9 @@ struct Simulation::Impl {
     if (midpoint) {
       std::copy(state.fx.begin(), state.fx.end(), fx_pos.begin());
       std::copy(state.fy.begin(), state.fy.end(), fy_pos.begin());
+      state.predictor = true;
       for (Effect* e : velocity_effects) e->apply_velocity(state);
+      state.predictor = false;
       const double k = 0.5 * h * state.inv_mass;
       for (std::size_t i = 0; i < state.ux.size(); ++i) {
         state.ux[i] = state.vx[i] + k * state.fx[i];
@@ -190,23 +204,38 @@ struct Simulation::Impl {
     }
   }
 
+  /// One Box2D step from the current state (read after the previous step).
   void box2d_step() {
-    read_state();
     run_effects();
     check_forces();
     for (std::size_t i = 0; i < bodies.size(); ++i)
       bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(state.fx[i]), static_cast<float>(state.fy[i])), true);
     world->Step(hf, physics.velocity_iterations, physics.position_iterations);
     ++box2d_steps;
+    if (state.position_corrected) {
+      for (std::size_t i = 0; i < bodies.size(); ++i) {
+        if (state.cx[i] == 0.0 && state.cy[i] == 0.0) continue;
+        const b2Vec2 p = bodies[i]->GetPosition();
+        bodies[i]->SetTransform(b2Vec2(static_cast<float>(static_cast<double>(p.x) + state.cx[i]),
+                                       static_cast<float>(static_cast<double>(p.y) + state.cy[i])),
+                                0.0f);
+      }
+    }
+    read_state();
+    if (monitoring && !monitor.observe(state.x, state.y) && first_broken_step < 0) first_broken_step = control_steps;
   }
 
   void insert(std::unique_ptr<Effect> e) {
     const auto stage = e->stage();
     auto pos = std::find_if(effects.begin(), effects.end(), [&](const auto& x) { return x->stage() > stage; });
     effects.insert(pos, std::move(e));
+    force_effects.clear();
     velocity_effects.clear();
-    for (const auto& x : effects)
+    constraint_effects.clear();
+    for (const auto& x : effects) {
+      (x->stage() == Effect::Stage::constraint ? constraint_effects : force_effects).push_back(x.get());
       if (x->velocity_dependent()) velocity_effects.push_back(x.get());
+    }
   }
 };
 
@@ -253,7 +282,7 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   st.h = s.h;
   st.mass = static_cast<double>(static_cast<float>(scene.cell_mass));  // what Box2D integrates with
   st.inv_mass = 1.0 / st.mass;
-  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &s.fx_pos, &s.fy_pos})
+  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &st.cx, &st.cy, &s.fx_pos, &s.fy_pos})
     v->assign(static_cast<std::size_t>(n), 0.0);
   s.midpoint = physics.velocity_forces == "midpoint";
   st.rest.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
@@ -288,13 +317,27 @@ void Simulation::step(long n) {
     for (int j = 0; j < s.physics.substeps; ++j) s.box2d_step();
     ++s.control_steps;
   }
-  s.read_state();
 }
 
 void Simulation::compute_forces() {
-  impl_->read_state();
+  impl_->read_state();  // in case a caller moved bodies in world() directly
   impl_->run_effects();
 }
+
+void Simulation::monitor_embedding(const Body& body) {
+  Impl& s = *impl_;
+  if (body.node_count() != s.state.n)
+    throw GeometryError(fmt::format("Simulation::monitor_embedding: the body has {} nodes, the simulation {}",
+                                    body.node_count(), s.state.n));
+  s.monitor = EmbeddingMonitor(body);
+  s.monitoring = true;
+  s.first_broken_step = -1;
+  if (!s.monitor.observe(s.state.x, s.state.y)) s.first_broken_step = s.control_steps;
+}
+
+const EmbeddingMonitor* Simulation::embedding_monitor() const { return impl_->monitoring ? &impl_->monitor : nullptr; }
+long Simulation::first_broken_step() const { return impl_->first_broken_step; }
+const SwimCounters& Simulation::counters() const { return impl_->state.counters; }
 
 void Simulation::set_velocities(const Points& v) {
   Impl& s = *impl_;

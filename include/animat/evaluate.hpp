@@ -30,17 +30,41 @@ struct SwimResult {
   double min_stretch = 0.0;
   double final_kinetic_energy = 0.0;
   double max_kinetic_energy = 0.0;              ///< largest kinetic energy (same samples)
+  double max_kinetic_energy_per_cell = 0.0;     ///< max_kinetic_energy / cells
+  // Invariants and counted deviations (every one is reported, never silent).
+  bool valid = true;                  ///< stable, embedding intact, every collision resolved
+  bool embedding_checked = false;     ///< whether the embedding was checked after every step
+  double min_area_ratio = 1.0;        ///< smallest S/S0 of any region seen (checked steps)
+  long inverted_region_steps = 0;     ///< (region, step) pairs with S/S0 <= 0
+  long skin_crossing_steps = 0;       ///< steps in which two skin edges intersected
+  long first_invalid_step = -1;       ///< control step at whose end an invariant first broke (-1: never)
+  long collisions = 0;                ///< cell-edge collisions resolved (SwimCounters)
+  long collisions_inelastic = 0;
+  long collisions_unresolved = 0;
+  long drag_limited = 0;              ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
+};
+
+/// Options of swim() beyond the scene and physics.
+struct SwimOptions {
+  bool check_embedding = true;   ///< check the planar embedding after every Box2D step
+  bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
 };
 
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
-/// simulation failure: it returns stable = false, distance 0 and the message. Throws ConfigError
-/// for invalid params.
-[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps);
+/// simulation failure: it returns stable = false, distance 0 and the message. A swim that breaks
+/// the planar embedding (a region inverted, the skin not simple) or leaves a collision unresolved
+/// is invalid: valid = false, distance 0 and the reason in `failure`. Throws ConfigError for
+/// invalid params.
+[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
+                              const SwimOptions& options = {});
 
 struct EvaluationResult {
   double fitness = 0.0;          ///< straight-line distance of the centre of mass, start -> end
   bool viable = false;           ///< development verdict; non-viable genomes are never swum
   bool stable = true;            ///< false if the swim (or development) left the valid domain
+  /// False if the swim broke an invariant: unstable, a region inverted, the skin not simple, or a
+  /// collision left unresolved (fitness 0). True for non-viable genomes (never swum).
+  bool valid = true;
   int cell_count = 0;
   std::vector<std::string> reasons;  ///< non-viability reasons or the instability description
   // Diagnostics.
@@ -57,6 +81,15 @@ struct EvaluationResult {
   double min_stretch = 0.0;
   double max_kinetic_energy = 0.0;
   double final_kinetic_energy = 0.0;
+  double max_kinetic_energy_per_cell = 0.0;
+  double min_area_ratio = 1.0;      ///< smallest S/S0 of any region over the swim
+  long inverted_region_steps = 0;   ///< (region, step) pairs with S/S0 <= 0 (must be 0)
+  long skin_crossing_steps = 0;     ///< steps with intersecting skin edges (must be 0)
+  long first_invalid_step = -1;     ///< control step at whose end an invariant first broke (-1: never)
+  long collisions = 0;              ///< cell-edge collisions resolved
+  long collisions_inelastic = 0;    ///< of those, by the inelastic fallback
+  long collisions_unresolved = 0;   ///< steps with a crossing no impulse could prevent (must be 0)
+  long drag_limited = 0;            ///< drag limiter engagements (drag_scheme "stable" only)
   double seconds_development = 0.0;  ///< wall time per stage (not deterministic; diagnostics only)
   double seconds_body = 0.0;
   double seconds_swim = 0.0;

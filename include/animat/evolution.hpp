@@ -4,9 +4,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "animat/genome.hpp"
@@ -14,15 +16,37 @@
 
 namespace animat {
 
-/// How an evaluation is run: the swim horizon.
+inline constexpr std::string_view kReferenceCheckNames[] = {"record", "select", "off"};
+
+/// How an evaluation is run: the swim horizon, the invariants checked, and the exploit guard.
 struct EvaluationParams {
   int steps = 4000;  ///< swim steps at physics.dt [paper: 4000 or 8000]
+  /// Check the body's planar embedding after every step (no region inverted, the skin simple); a
+  /// swim that breaks it is invalid and gets fitness 0, like an unstable one.
+  bool check_embedding = true;
+  /// "record": each time the GA's best changes, re-evaluate it with physics.substeps multiplied by
+  /// reference_substeps (the same horizon at a finer step) and record both fitnesses; "select": the
+  /// same, and elites are ranked by the reference fitness; "off".
+  std::string reference_check = "record";
+  int reference_substeps = 16;             ///< refinement factor of the reference evaluation
+  double reference_tolerance = 0.01;       ///< relative fitness difference that is warned about...
+  double reference_abs_tolerance = 0.05;   ///< ...when it also exceeds this many length units
 };
 
 template <class V>
 void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
+  v(FieldInfo{"check_embedding", "check after every step that no region is inverted and the skin is a simple polygon; a swim that breaks it gets fitness 0", Bounds::any()}, p.check_embedding);
+  v(FieldInfo{"reference_check", "exploit guard: re-evaluate each new best at a finer step and record both fitnesses (record), also rank elites by it (select), or off", Bounds::any(), kReferenceCheckNames}, p.reference_check);
+  v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
+  v(FieldInfo{"reference_tolerance", "warn when the best's fitness and its reference differ by more than this fraction...", Bounds::non_negative()}, p.reference_tolerance);
+  v(FieldInfo{"reference_abs_tolerance", "...and by more than this many length units", Bounds::non_negative()}, p.reference_abs_tolerance);
 }
+
+struct Config;
+/// The config of the reference evaluation of the exploit guard: physics.substeps multiplied by
+/// evaluation.reference_substeps, everything else equal.
+[[nodiscard]] Config reference_config(const Config& config);
 
 struct EvolutionParams {
   std::int64_t seed = 1;                  ///< run seed; every random number derives from it
@@ -65,6 +89,7 @@ struct Fitness {
   bool viable = false;  ///< non-viable individuals take no part in creating the next generation
   bool stable = true;   ///< false if the swim was flagged unstable (its fitness is 0)
   int cell_count = 0;
+  bool valid = true;    ///< false if the swim broke an invariant (embedding, collisions); fitness 0
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
@@ -79,6 +104,9 @@ struct Individual {
   Genome genome;
   Fitness result;
   int tries = 0;  ///< random genomes drawn to find this one (initial population only)
+  /// Fitness at the reference step (the exploit guard, evaluation.reference_check); NaN = not
+  /// evaluated.
+  double reference = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One row of history.csv.
@@ -94,6 +122,9 @@ struct GenerationStats {
   double evaluations_per_second = 0.0;
   bool best_changed = false;     ///< the best genome differs from the previous generation's
   int crossovers = 0;            ///< offspring made by crossover in this generation
+  /// The best's fitness at the reference step (evaluation.reference_check); NaN when off.
+  double best_reference = std::numeric_limits<double>::quiet_NaN();
+  int invalid = 0;               ///< viable individuals whose swim was unstable or broke an invariant (fitness 0)
 };
 
 /// Probability that the fitter of two wins a tournament at generation g (linear ramp, paper §5).
@@ -115,7 +146,9 @@ void prepare_parallel_evaluation();
 /// Rng::derive(seed, g, i), so a run is bit-identical for any thread count and across resumes.
 class Evolution {
  public:
-  Evolution(const Config& config, FitnessFunction fitness);
+  /// `reference` is the exploit guard's fitness at the reference step (reference_config()); with
+  /// none, evaluation.reference_check has no effect.
+  Evolution(const Config& config, FitnessFunction fitness, FitnessFunction reference = {});
 
   /// Draws the initial population: random genomes regenerated until viable.
   void initialize();
@@ -142,10 +175,16 @@ class Evolution {
 
  private:
   GenerationStats statistics(bool best_changed, double wall_seconds) const;
+  /// Exploit guard, after a generation is complete: the best's reference fitness (evaluated once
+  /// per genome), recorded in the last history row.
+  void check_reference();
+  /// "select": reference fitness of the elite candidates, which are then ranked by it.
+  std::vector<std::size_t> reference_ranked(const std::vector<std::size_t>& order, std::size_t elites);
 
   std::shared_ptr<const Config> config_;  ///< own copy: the engine outlives no caller state
   std::uint64_t identity_;
   FitnessFunction fitness_;
+  FitnessFunction reference_;
   std::vector<Individual> population_;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()

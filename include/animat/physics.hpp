@@ -19,8 +19,9 @@ class b2Body;
 namespace animat {
 
 struct Body;
+class EmbeddingMonitor;
 
-inline constexpr std::string_view kDragSchemeNames[] = {"explicit", "stable", "implicit"};
+inline constexpr std::string_view kDragSchemeNames[] = {"semi_implicit", "explicit", "stable", "implicit"};
 inline constexpr std::string_view kVelocityForceNames[] = {"midpoint", "start"};
 
 /// The accuracy knobs: what trades accuracy for speed (docs/accuracy.md measures them).
@@ -29,9 +30,11 @@ struct PhysicsParams {
   int substeps = 1;                ///< Box2D steps per control step (forces recomputed each) [choose]
   int velocity_iterations = 1;     ///< Box2D solver iterations (no joints or contacts: 1 suffices)
   int position_iterations = 1;
-  /// "explicit", "stable" (linearly implicit: never reverses a velocity in a step) or "implicit"
-  /// (fully implicit quadratic law); see the Drag effect in src/effects.cpp.
-  std::string drag_scheme = "stable";
+  /// "semi_implicit" (eq. 5 as F = −d·L·|u_start|·u_end, solved for the end-of-step velocity:
+  /// second order, exact for a free edge and at terminal velocity, never reverses a velocity),
+  /// "explicit", "stable" (explicit scaled down where it would overshoot; every scaled step is
+  /// counted) or "implicit" (backward Euler of the quadratic law); see src/effects/drag.cpp.
+  std::string drag_scheme = "semi_implicit";
   /// The velocity that spring damping and drag are evaluated at: "midpoint" (a predictor step
   /// estimates the velocity at the middle of the step; second order, two evaluations) or "start"
   /// (the velocity at the start of the step; first order, one evaluation).
@@ -47,7 +50,7 @@ void visit_fields(PhysicsParams& p, V&& v) {
   v(FieldInfo{"substeps", "Box2D steps per control step, forces recomputed each [choose]", Bounds::closed(1, 1000)}, p.substeps);
   v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.velocity_iterations);
   v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.position_iterations);
-  v(FieldInfo{"drag_scheme", "drag integration: explicit; stable (linearly implicit, never reverses an edge velocity); implicit (fully implicit, never reverses)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
+  v(FieldInfo{"drag_scheme", "drag integration: semi_implicit (F = -d L |u_start| u_end, second order, never reverses an edge velocity); explicit; stable (explicit, scaled down where it would overshoot, counted); implicit (backward Euler)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
   v(FieldInfo{"velocity_forces", "velocity that damping and drag use: midpoint (predicted, second order) or start (first order) [choose]", Bounds::any(), kVelocityForceNames}, p.velocity_forces);
   v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
 }
@@ -69,11 +72,13 @@ void warm_up_box2d();
 ///   2. runs apply() of the enabled effects in stage order (modifiers, then position-dependent
 ///      forces), then the velocity-dependent forces (spring damping, drag) at the velocity chosen by
 ///      physics.velocity_forces: "start" = v; "midpoint" = v + (h/2)·F(v)/m, which needs a
-///      predictor pass at v first (second order: v lives at half steps in symplectic Euler);
+///      predictor pass at v first (second order: v lives at half steps in symplectic Euler), then
+///      the constraint effects (collisions), which change the end-of-step velocities by impulses;
 ///   3. checks the predicted velocity v + h·F/m of every cell: a non-finite value, or a
 ///      displacement |v|·h above max_step_displacement, throws SimulationError (the world is left
 ///      as it was before the step; Box2D never clamps anything silently);
-///   4. applies the forces (ApplyForceToCenter(f, true)) and calls b2World::Step.
+///   4. applies the forces (ApplyForceToCenter(f, true)), calls b2World::Step and reads the new
+///      state (and checks the planar embedding when monitor_embedding() was called).
 /// Nothing is allocated in the loop. Not thread-safe itself; use one Simulation per thread.
 class Simulation {
  public:
@@ -121,6 +126,15 @@ class Simulation {
   /// max_step_displacement), and the largest cell speed.
   [[nodiscard]] double max_step_displacement_seen() const;
   [[nodiscard]] double max_speed_seen() const;
+  /// What the effects counted so far (collisions, drag limiter engagements...).
+  [[nodiscard]] const SwimCounters& counters() const;
+  /// Checks the planar embedding of `body` (the body this simulation was built from) now and after
+  /// every Box2D step from now on: region signs and skin simplicity (EmbeddingMonitor).
+  void monitor_embedding(const Body& body);
+  /// The monitor, or nullptr if monitor_embedding() was not called.
+  [[nodiscard]] const EmbeddingMonitor* embedding_monitor() const;
+  /// Control step at the end of which the embedding was first seen broken (-1: never, or no monitor).
+  [[nodiscard]] long first_broken_step() const;
   [[nodiscard]] bool failed() const;
   [[nodiscard]] const std::string& failure() const;  ///< empty unless failed()
 

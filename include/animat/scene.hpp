@@ -1,8 +1,8 @@
 #pragma once
 // A scene: the list of effects a swim simulation needs, with their coefficients (paper §4).
 // Effects that are not listed cost nothing: they are not in the step loop, and Box2D gets no
-// fixtures or contacts unless an effect needs collisions (none of the built-in ones does: skin
-// collision is our own penalty force).
+// fixtures or contacts unless an effect needs collisions (none of the built-in ones does: cell-edge
+// collisions are resolved by our own swept test and impulses, src/effects/collisions.cpp).
 //
 // An effect is a small object with one job. Once per Box2D step the simulation fills a
 // structure-of-arrays SwimState (positions, velocities, zeroed forces) and calls:
@@ -12,10 +12,15 @@
 //   2. apply_velocity() of the velocity-dependent effects (spring damping, drag), which add forces
 //      evaluated at the velocity s.ux, s.uy chosen by physics.velocity_forces: the velocity at the
 //      start of the step, or (default) a prediction of the velocity at the middle of the step, for
-//      which the stepper runs them twice (predictor, then corrector).
+//      which the stepper runs them twice (predictor, then corrector). An effect sees the forces of
+//      the effects before it in s.fx, s.fy, so an implicit scheme (drag) can solve for the
+//      velocity at the end of the step, v + h·F/m;
+//   3. apply() of the constraint effects (collisions), which see every force and change the
+//      end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h).
 // Effects loop over their own elements inside apply(): one virtual call per effect per pass, never
 // one per element. New effects (gravity, ground friction, active control) are new Effect
-// subclasses plus a name in make_effect(); the stepper does not change.
+// subclasses (one file each in src/effects/) plus a name in make_effect(); the stepper does not
+// change.
 #include <memory>
 #include <string>
 #include <string_view>
@@ -28,13 +33,15 @@ namespace animat {
 struct Body;
 struct PhysicsParams;
 
-inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation", "pressure", "drag", "skin_collision"};
+inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation", "pressure", "drag", "collisions",
+                                                         "skin_collision"};
+inline constexpr std::string_view kCollisionEdgeNames[] = {"all", "skin"};
 
 /// Units (docs/notes/physics.md): length = the cell spacing at the end of development (cell
 /// radius 0.5, so neighbouring centres are about 1 apart); mass = one cell; time = the unit of the
 /// oscillator frequencies (rad per time unit). Forces are mass·length/time².
 struct SceneParams {
-  std::vector<std::string> effects = {"springs", "actuation", "pressure", "drag", "skin_collision"};
+  std::vector<std::string> effects = {"springs", "actuation", "pressure", "drag", "collisions"};
   double cell_mass = 1.0;             ///< equal mass m of every cell [paper: equal; value: choose, the mass unit]
   double spring_stiffness = 100.0;    ///< Hooke constant k of every spring [choose]
   double spring_damping = 4.0;        ///< damping coefficient c of every spring (force per unit stretching speed) [choose]
@@ -42,8 +49,15 @@ struct SceneParams {
   double pressure_area_floor = 0.1;   ///< eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
   double drag_normal = 2.0;           ///< d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]
   double drag_tangential = -1.0;      ///< d_T of eq. 4; negative means d_N/200 [paper §6: d_N/200]
-  double collision_stiffness = 500.0; ///< penalty stiffness of skin collisions [choose]
-  double collision_radius = 0.25;     ///< distance from a skin edge at which the penalty starts [choose]
+  /// Edges a cell may not cross (effect "collisions"): "all" springs (keeps the planar embedding:
+  /// no region inverts, the skin stays simple) or only "skin" edges [choose].
+  std::string collision_edges = "all";
+  double collision_restitution = 1.0; ///< normal restitution of cell-edge collisions [paper: elastic, 1]
+  /// A cell that would come closer than this to an edge it is not an end of collides (a band that
+  /// float rounding of Box2D's positions cannot jump) [choose]
+  double collision_tolerance = 1e-3;
+  double collision_stiffness = 500.0; ///< penalty stiffness of the optional "skin_collision" effect [choose]
+  double collision_radius = 0.25;     ///< distance from a skin edge at which that penalty starts [choose]
 };
 
 template <class V>
@@ -56,8 +70,11 @@ void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"pressure_area_floor", "eq. 3 uses max(S0, floor*(longest rest edge)^2) as its denominator, so sliver regions stay stable [choose]", Bounds::non_negative()}, p.pressure_area_floor);
   v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]", Bounds::non_negative()}, p.drag_normal);
   v(FieldInfo{"drag_tangential", "tangential drag coefficient d_T of eq. 4; negative = drag_normal/200 [paper: d_N/200]", Bounds::at_least(-1.0)}, p.drag_tangential);
-  v(FieldInfo{"collision_stiffness", "penalty stiffness keeping cells out of skin edges not their own [choose]", Bounds::non_negative()}, p.collision_stiffness);
-  v(FieldInfo{"collision_radius", "distance from a skin edge where the collision penalty starts [choose]", Bounds::non_negative()}, p.collision_radius);
+  v(FieldInfo{"collision_edges", "edges a cell may not cross (effect collisions): all springs, or skin edges only [choose]", Bounds::any(), kCollisionEdgeNames}, p.collision_edges);
+  v(FieldInfo{"collision_restitution", "normal restitution of cell-edge collisions: 1 = elastic [paper: elastic]", Bounds::unit()}, p.collision_restitution);
+  v(FieldInfo{"collision_tolerance", "a cell closer than this to an edge it is not an end of collides (length units) [choose]", Bounds{0.0, 0.1, true, false}}, p.collision_tolerance);
+  v(FieldInfo{"collision_stiffness", "penalty stiffness of the optional skin_collision effect (a soft force, lets cells through) [choose]", Bounds::non_negative()}, p.collision_stiffness);
+  v(FieldInfo{"collision_radius", "distance from a skin edge where the skin_collision penalty starts [choose]", Bounds::non_negative()}, p.collision_radius);
 }
 
 [[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {
@@ -75,6 +92,16 @@ void visit_fields(SceneParams& p, V&& v) {
 /// coefficients. Throws ConfigError naming the key.
 void validate(const SceneParams& params);
 
+/// What the effects count while a body swims (totals since the simulation started). Every deviation
+/// from the equations as written is counted here, never silent.
+struct SwimCounters {
+  long collisions = 0;             ///< cell-edge collisions resolved by an impulse (effect collisions)
+  long collisions_inelastic = 0;   ///< of those, resolved by the inelastic fallback (restitution 0)
+  long collisions_unresolved = 0;  ///< Box2D steps after which a crossing could not be prevented
+  long collision_max_passes = 0;   ///< most resolution passes one step needed
+  long drag_limited = 0;           ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
+};
+
 /// The state every effect reads and writes during one Box2D step, structure-of-arrays, sized once
 /// by the simulation (never resized in the step loop). Positions and velocities are Box2D's (float)
 /// values widened to double; forces are zeroed before the first effect runs.
@@ -89,19 +116,30 @@ struct SwimState {
   std::vector<double> ux, uy;        ///< n each: the velocity apply_velocity() evaluates forces at
   std::vector<double> fx, fy;        ///< n each: the force accumulator
   std::vector<double> rest;          ///< current rest length of every spring (actuation writes it)
+  /// True during the predictor pass of the midpoint scheme: velocity effects then only estimate
+  /// their forces (the stepper discards them after computing the midpoint velocity).
+  bool predictor = false;
+  /// Position corrections a constraint effect asks for, applied after Box2D's step (n each, read
+  /// only when position_corrected): a collision at a fraction τ of the step turns the cell back at
+  /// τ, not at the start of the step, so its end position differs from x + h·v by this much.
+  std::vector<double> cx, cy;
+  bool position_corrected = false;
+  SwimCounters counters;
 };
 
 /// One physical effect of a scene. apply() and apply_velocity() loop over the effect's own elements
 /// (stored as structure-of-arrays at construction) and must not allocate.
 class Effect {
  public:
-  enum class Stage : int { modifier = 0, force = 1 };
+  enum class Stage : int { modifier = 0, force = 1, constraint = 2 };
 
   virtual ~Effect() = default;
   [[nodiscard]] virtual std::string_view name() const = 0;
   [[nodiscard]] virtual Stage stage() const { return Stage::force; }
   /// Modifiers change per-step parameters; force effects add their position-dependent forces to
-  /// s.fx, s.fy (and may cache geometry for apply_velocity). Called once per Box2D step.
+  /// s.fx, s.fy (and may cache geometry for apply_velocity); constraint effects run after every
+  /// force is known and change the end-of-step velocities v + h·F/m by impulses. Called once per
+  /// Box2D step.
   virtual void apply(SwimState& s) = 0;
   /// Whether apply_velocity() adds anything.
   [[nodiscard]] virtual bool velocity_dependent() const { return false; }
@@ -141,7 +179,7 @@ class Effect {
 /// It is 0 at the start time and continuous in t.
 [[nodiscard]] double actuation_term(double amplitude, double frequency, double phase, double t);
 
-/// The stable drag update of one velocity component: the backward-Euler solution u' of
+/// The fully implicit drag update of one velocity component: the backward-Euler solution u' of
 /// u' = w − dt·c·u'·|u'| (c = d·L/M), i.e. 2w / (1 + sqrt(1 + 4·c·dt·|w|)). Same sign as w and
 /// |u'| <= |w|: it never reverses the velocity, whatever c·dt·|w|.
 [[nodiscard]] double implicit_quadratic_drag(double w, double c_dt);

@@ -1,0 +1,95 @@
+// EmbeddingMonitor: region signs and skin simplicity, frame by frame (see embedding.hpp).
+#include "animat/embedding.hpp"
+
+#include <algorithm>
+#include <cstddef>
+
+#include "animat/body.hpp"
+#include "effects/effect_support.hpp"
+
+namespace animat {
+namespace {
+
+inline double orient(double ax, double ay, double bx, double by, double cx, double cy) {
+  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+inline bool within(double a, double b, double c) { return std::min(a, b) <= c && c <= std::max(a, b); }
+
+}  // namespace
+
+bool segments_intersect(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy) {
+  const double o1 = orient(ax, ay, bx, by, cx, cy), o2 = orient(ax, ay, bx, by, dx, dy);
+  const double o3 = orient(cx, cy, dx, dy, ax, ay), o4 = orient(cx, cy, dx, dy, bx, by);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+  // Touching or collinear overlap: an end lies on the other segment.
+  if (o1 == 0 && within(ax, bx, cx) && within(ay, by, cy)) return true;
+  if (o2 == 0 && within(ax, bx, dx) && within(ay, by, dy)) return true;
+  if (o3 == 0 && within(cx, dx, ax) && within(cy, dy, ay)) return true;
+  if (o4 == 0 && within(cx, dx, bx) && within(cy, dy, by)) return true;
+  return false;
+}
+
+EmbeddingMonitor::EmbeddingMonitor(const Body& body) : regions_(body.regions) {
+  for (int r = 0; r < body.region_count(); ++r) rest_twice_.push_back(2.0 * body.rest_areas(r));
+  for (int e = 0; e < static_cast<int>(body.skin.rows()); ++e) {
+    sa_.push_back(body.skin(e, 0));
+    sb_.push_back(body.skin(e, 1));
+    order_.push_back(e);
+  }
+  lo_.assign(sa_.size(), 0.0);
+  hi_.assign(sa_.size(), 0.0);
+}
+
+int EmbeddingMonitor::count_skin_crossings(std::span<const double> x, std::span<const double> y) {
+  const std::size_t m = sa_.size();
+  for (std::size_t e = 0; e < m; ++e) {
+    lo_[e] = std::min(x[effects::at(sa_[e])], x[effects::at(sb_[e])]);
+    hi_[e] = std::max(x[effects::at(sa_[e])], x[effects::at(sb_[e])]);
+  }
+  // Insertion sort by the smallest x: the order barely changes between frames, so this is ~O(m).
+  for (std::size_t q = 1; q < m; ++q)
+    for (std::size_t r = q; r > 0 && lo_[effects::at(order_[r])] < lo_[effects::at(order_[r - 1])]; --r)
+      std::swap(order_[r], order_[r - 1]);
+  int count = 0;
+  for (std::size_t q = 0; q < m; ++q) {
+    const auto e = effects::at(order_[q]);
+    const int a = sa_[e], b = sb_[e];
+    const double ymin = std::min(y[effects::at(a)], y[effects::at(b)]), ymax = std::max(y[effects::at(a)], y[effects::at(b)]);
+    for (std::size_t r = q + 1; r < m && lo_[effects::at(order_[r])] <= hi_[e]; ++r) {
+      const auto f = effects::at(order_[r]);
+      const int c = sa_[f], d = sb_[f];
+      if (c == a || c == b || d == a || d == b) continue;
+      if (std::max(y[effects::at(c)], y[effects::at(d)]) < ymin || std::min(y[effects::at(c)], y[effects::at(d)]) > ymax) continue;
+      if (segments_intersect(x[effects::at(a)], y[effects::at(a)], x[effects::at(b)], y[effects::at(b)], x[effects::at(c)],
+                             y[effects::at(c)], x[effects::at(d)], y[effects::at(d)]))
+        ++count;
+    }
+  }
+  return count;
+}
+
+bool EmbeddingMonitor::observe(std::span<const double> x, std::span<const double> y) {
+  ++frames_;
+  bool ok = true;
+  const auto px = [&](int i) { return x[effects::at(i)]; };
+  const auto py = [&](int i) { return y[effects::at(i)]; };
+  for (std::size_t r = 0; r < regions_.size(); ++r) {
+    if (!(rest_twice_[r] != 0.0)) continue;
+    const double ratio = effects::twice_area(px, py, regions_[r]) / rest_twice_[r];
+    min_ratio_ = std::min(min_ratio_, ratio);
+    if (!(ratio > 0.0)) {
+      ++inverted_;
+      ok = false;
+    }
+  }
+  const int c = count_skin_crossings(x, y);
+  if (c > 0) {
+    ++crossing_frames_;
+    crossings_ += c;
+    ok = false;
+  }
+  return ok;
+}
+
+}  // namespace animat
