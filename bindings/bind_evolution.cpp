@@ -21,6 +21,7 @@ void bind_evolution(nb::module_& m) {
       .def_ro("viable", &Fitness::viable, "Development verdict; non-viable genomes are never swum.")
       .def_ro("stable", &Fitness::stable, "False if the swim was flagged unstable.")
       .def_ro("cell_count", &Fitness::cell_count)
+      .def_ro("valid", &Fitness::valid, "False if the swim broke an invariant (embedding, collisions); its fitness is 0.")
       .def("__repr__", [](const Fitness& f) {
         return "<animat.Fitness " + std::to_string(f.fitness) + (f.viable ? " viable" : " non-viable") +
                (f.stable ? "" : " UNSTABLE") + ", " + std::to_string(f.cell_count) + " cells>";
@@ -38,6 +39,10 @@ void bind_evolution(nb::module_& m) {
       .def_ro("evaluations_per_second", &GenerationStats::evaluations_per_second)
       .def_ro("best_changed", &GenerationStats::best_changed)
       .def_ro("crossovers", &GenerationStats::crossovers)
+      .def_ro("best_reference", &GenerationStats::best_reference,
+              "The best's fitness at the reference step (evaluation.reference_check); NaN when off.")
+      .def_ro("invalid", &GenerationStats::invalid,
+              "Viable individuals whose swim was unstable or broke an invariant (fitness 0).")
       .def("__repr__", [](const GenerationStats& s) {
         return "<animat.GenerationStats gen " + std::to_string(s.generation) + " best " + std::to_string(s.best) + ">";
       });

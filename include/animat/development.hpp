@@ -38,7 +38,7 @@ struct DevelopmentParams {
   double placement_jitter = 0.05; ///< daughter placement direction deviates by up to ± this angle (rad), seeded from the genome [choose]
   double division_offset = 0.2;   ///< daughter centre = mother centre + division_offset·r_mother·orientation [choose]
   double frequency_min = 0.5;     ///< oscillator frequency at output 0, rad per unit time [choose]
-  double frequency_max = 12.0;    ///< oscillator frequency at output 1 [choose]
+  double frequency_max = 6.0;     ///< oscillator frequency at output 1 [choose: docs/model.md]
   double amplitude_max = 0.2;     ///< amplitude scale [paper: 0.2]
   // Physics of the development world [choose].
   double time_step = 0.1;             ///< Box2D time step of one development step

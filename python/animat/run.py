@@ -35,7 +35,12 @@ HISTORY_DTYPE = np.dtype([
     ("best_cells", np.int64),
     ("evaluations", np.int64),
     ("wall_seconds", np.float64),
+    ("best_reference", np.float64),
+    ("invalid", np.int64),
 ])
+
+#: Columns that runs written before the exploit guard do not have, and the value they read as.
+_LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0}
 
 _LINEAGE_NAME = re.compile(r"^gen_(\d+)\.json$")
 
@@ -52,6 +57,8 @@ class LineageEntry:
         cell_count: cells of its embryo (int).
         genome: the :class:`animat.Genome`.
         path: the JSON file it was read from.
+        reference_fitness: its fitness at the exploit guard's reference step (float; NaN when the
+            run did not check it).
     """
 
     generation: int
@@ -59,6 +66,7 @@ class LineageEntry:
     cell_count: int
     genome: Any
     path: Path
+    reference_fitness: float = float("nan")
 
     def develop(self, config: Optional[Any] = None):
         """Develop the genome (``animat.develop``) with ``config`` (default: the animat defaults)."""
@@ -79,7 +87,10 @@ def read_history(path: PathLike) -> np.ndarray:
     Returns:
         numpy structured array, shape (rows,), one row per completed generation; fields
         ``generation`` (int64), ``best``, ``mean``, ``median``, ``viable_fraction`` (float64),
-        ``best_cells``, ``evaluations`` (int64), ``wall_seconds`` (float64).
+        ``best_cells``, ``evaluations`` (int64), ``wall_seconds``, ``best_reference`` (float64: the
+        best's fitness at the exploit guard's reference step, NaN when not evaluated),
+        ``invalid`` (int64: viable individuals whose swim broke an invariant). Runs written before
+        the last two columns existed read with NaN and 0 there.
     """
     path = Path(path)
     if not path.is_file():
@@ -94,17 +105,20 @@ def read_history(path: PathLike) -> np.ndarray:
             raise ValueError(f"{path}:1: not a history.csv header: {lines[0]!r}")
         return np.zeros(0, dtype=HISTORY_DTYPE)  # empty or header being written
     header = complete[0].strip().split(",")
-    if header != expected:
+    older = expected[:len(expected) - len(_LATER_COLUMNS)]
+    if header != expected and header != older:
         raise ValueError(f"{path}:1: unexpected header {complete[0].strip()!r}; expected {','.join(expected)!r}")
+    missing = tuple(_LATER_COLUMNS[name] for name in expected[len(header):])
     rows = []
     for number, line in enumerate(complete[1:], start=2):
         if not line.strip():
             continue
         fields = line.strip().split(",")
-        if len(fields) != len(expected):
-            raise ValueError(f"{path}:{number}: expected {len(expected)} comma-separated values, got {len(fields)}: {line!r}")
+        if len(fields) != len(header):
+            raise ValueError(f"{path}:{number}: expected {len(header)} comma-separated values, got {len(fields)}: {line!r}")
         try:
-            rows.append(tuple(int(v) if HISTORY_DTYPE[k].kind == "i" else float(v) for k, v in enumerate(fields)))
+            rows.append(tuple(int(v) if HISTORY_DTYPE[k].kind == "i" else float(v) for k, v in enumerate(fields))
+                        + missing)
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
     return np.array(rows, dtype=HISTORY_DTYPE)
@@ -124,7 +138,9 @@ def _read_lineage_file(path: Path) -> LineageEntry:
         genome = _core.Genome.from_json(json.dumps(data["genome"]))
     except ValueError as e:
         raise ValueError(f"{path}: invalid genome: {e}") from None
-    return LineageEntry(int(data["generation"]), float(data["fitness"]), int(data["cell_count"]), genome, path)
+    reference = data.get("reference_fitness")
+    return LineageEntry(int(data["generation"]), float(data["fitness"]), int(data["cell_count"]), genome, path,
+                        float("nan") if reference is None else float(reference))
 
 
 def morphology_distance(a, b) -> float:

@@ -1,14 +1,22 @@
 // Effect "collisions": "penetration of an edge by a cell is not allowed and results in an elastic
-// collision" [paper §4]. A cell never crosses an edge it is not an end of: every Box2D step, the
-// motion of each nearby (cell, edge) pair over the step is tested (a swept point-versus-moving-segment
-// test), and a crossing is resolved by an elastic impulse between the cell and the edge's two end
-// cells. With collision_edges = "all" this keeps the body's planar embedding: two edges can only
-// come to cross after an end of one has crossed the other, and a triangle only inverts when a vertex
-// crosses the opposite edge (docs/model.md, "Collisions").
+// collision" [paper §4]. A cell never crosses an edge it is not an end of: within every Box2D step,
+// the motion of each (cell, edge) pair that could meet is tested (a swept point-versus-moving-segment
+// test), and a crossing is resolved, at its time within the step, by an elastic impulse between the
+// cell and the edge's two end cells.
+//
+// Which pairs can meet follows from the planar embedding itself. Just before a cell first touches an
+// edge it is not an end of, the body is still planar, so the cell and the edge lie on a common face:
+// a region (then the edge is an edge of that region) or the outer face (then both are on the skin).
+// So with collision_edges = "all" it suffices to test, per region, its vertices against its edges,
+// and skin vertices against skin edges; preventing those crossings keeps the embedding: no region
+// turns inside out (a triangle inverts only when a vertex crosses the opposite edge) and the skin
+// stays simple (two edges can only come to cross after an end of one has touched the other).
+// collision_edges = "skin" tests only the skin pairs (measured: internal regions then invert).
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <map>
 #include <memory>
 #include <string_view>
 #include <utility>
@@ -19,11 +27,11 @@
 namespace animat::effects {
 namespace {
 
-/// Roots of A·τ² + B·τ + C = 0 in [0, 1], ascending; returns how many (0–2).
+/// Roots of A·u² + B·u + C = 0 in [0, 1], ascending; returns how many (0–2).
 int roots_in_unit_interval(double A, double B, double C, std::array<double, 2>& out) {
   int count = 0;
   auto keep = [&](double t) {
-    if (t >= 0.0 && t <= 1.0) out[static_cast<std::size_t>(count++)] = t;
+    if (t >= 0.0 && t <= 1.0) out[at(count++)] = t;
   };
   const double scale = std::abs(A) + std::abs(B) + std::abs(C);
   if (scale == 0.0) return 0;
@@ -47,48 +55,113 @@ int roots_in_unit_interval(double A, double B, double C, std::array<double, 2>& 
 /// s.fx, s.fy:
 ///  1. w = v + h·F/m is the velocity Box2D will give every cell; within the step the cells move in
 ///     straight lines at w (what symplectic Euler does);
-///  2. for each candidate pair (cell i, edge ab), the gap function cross(b − a, p − a) is
-///     quadratic in time under that motion; the pair's first event is the first time at which the
-///     cell comes within the tolerance band of the edge (on the side it is on) or reaches the
-///     segment (from either side) with its projection inside the segment, while approaching the
-///     edge point q = (1 − s)·a + s·b (relative normal velocity v_n < 0);
-///  3. the earliest event of all pairs is processed: every cell advances to that time, and the
-///     impulse J = −(1 + e)·v_n / (1/m_i + (1 − s)²/m_a + s²/m_b) along the normal changes w_i by
-///     +J/m_i and w_a, w_b by −(1 − s)·J/m_a and −s·J/m_b: momentum is conserved exactly and, for
-///     e = 1, kinetic energy too. Then the next earliest event from that time on, until none is
-///     left in the step. After kMaxEvents events in one step the rest are resolved with e = 0
-///     (counted as inelastic); a step that still has events after 2·kMaxEvents is counted as
-///     unresolved (the swim is then invalid);
-///  4. the velocity changes go to Box2D as forces m·Δw/h, and since a bounce happens at its event
+///  2. the candidate pairs are gathered: the three vertex-edge pairs of every triangular region
+///     whose signed area can come within the band in the rest of the step (one quadratic per
+///     triangle: the doubled area is the cross product of all three pairs), the vertex-edge pairs of
+///     larger regions whose swept boxes overlap, and the skin vertices against the skin edges whose
+///     swept boxes overlap (sort and sweep along x);
+///  3. for each candidate (cell i, edge ab) the gap function cross(b − a, p − a), quadratic in time
+///     under that motion, gives the pair's first event: the first time at which the cell comes
+///     within the tolerance band of the edge (on the side it is on) or reaches the segment (from
+///     either side), with its projection inside the segment, while approaching the edge point
+///     q = (1 − s)·a + s·b (relative normal velocity v_n < 0);
+///  4. the earliest event of all is processed: every cell advances to that time, and the impulse
+///     J = −(1 + e)·v_n / (1/m_i + (1 − s)²/m_a + s²/m_b) along the normal changes w_i by +J/m_i and
+///     w_a, w_b by −(1 − s)·J/m_a and −s·J/m_b: momentum is conserved exactly and, for e = 1,
+///     kinetic energy too. Then steps 2–4 again from that time on, until no event is left in the
+///     step. After kMaxEvents events in one step the rest are resolved with e = 0 (counted as
+///     inelastic); a step that still has events after 2·kMaxEvents is counted as unresolved (the
+///     swim is then invalid);
+///  5. the velocity changes go to Box2D as forces m·Δw/h, and since a bounce happens at its event
 ///     time and not at the start of the step, the end positions of the cells involved differ from
 ///     x + h·w; the stepper applies that difference after Box2D's step (SwimState::cx, cy). Events
 ///     are thus located to O(h²) on the actual piecewise-straight paths.
-/// Candidates come from a Verlet list: the pairs closer than tolerance + margin when it was built,
-/// valid while every cell stays within margin/2 of its position then (relative to the centre of
-/// mass), which bounds the change of any cell-edge distance by margin. It is checked at the start,
-/// at every event and at the end of the step; if a step leaves it, the list is rebuilt with a wider
-/// margin and the step resolved again from its start.
+/// Nothing is allocated per step: every list is sized at construction.
 class Collisions final : public Effect {
  public:
-  static constexpr double kMargin = 0.4;
   static constexpr int kMaxEvents = 64;
 
   Collisions(const Body& body, const SceneParams& p) : restitution_(p.collision_restitution), tol_(p.collision_tolerance) {
     n_ = body.node_count();
-    const IndexPairs& edges = p.collision_edges == "skin" ? body.skin : body.springs;
-    for (int e = 0; e < as_int(edges.rows()); ++e) {
-      a_.push_back(edges(e, 0));
-      b_.push_back(edges(e, 1));
-    }
-    x0_.resize(at(n_));
-    y0_.resize(at(n_));
+    rx_.resize(at(n_));
+    ry_.resize(at(n_));
     for (int i = 0; i < n_; ++i) {
-      x0_[at(i)] = body.positions(i, 0);
-      y0_[at(i)] = body.positions(i, 1);
+      rx_[at(i)] = body.positions(i, 0);
+      ry_[at(i)] = body.positions(i, 1);
     }
-    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &xr_, &yr_}) v->assign(at(n_), 0.0);
+    // Edges: every spring, or only the skin.
+    std::map<std::pair<int, int>, int> index;
+    auto edge_of = [&](int u, int v) {
+      const auto key = std::minmax(u, v);
+      auto it = index.find({key.first, key.second});
+      if (it != index.end()) return it->second;
+      const int e = static_cast<int>(a_.size());
+      a_.push_back(key.first);
+      b_.push_back(key.second);
+      index.emplace(std::make_pair(key.first, key.second), e);
+      return e;
+    };
+    const bool all = p.collision_edges != "skin";
+    if (all)
+      for (int s = 0; s < body.spring_count(); ++s) edge_of(body.springs(s, 0), body.springs(s, 1));
+    std::vector<int> skin_edges;
+    for (int s = 0; s < as_int(body.skin.rows()); ++s) skin_edges.push_back(edge_of(body.skin(s, 0), body.skin(s, 1)));
+    opposite_.assign(a_.size(), -1);
+    if (all) {
+      std::vector<std::pair<int, int>> region_pairs;
+      for (const auto& loop : body.regions) {
+        const std::size_t k = loop.size();
+        if (k == 3 && loop[0] != loop[1] && loop[1] != loop[2] && loop[0] != loop[2]) {
+          Triangle t{};
+          for (std::size_t c = 0; c < 3; ++c) {
+            t.v[c] = loop[c];
+            t.e[c] = edge_of(loop[(c + 1) % 3], loop[(c + 2) % 3]);  // the edge opposite vertex c
+            t.band[c] = band_of(t.v[c], t.e[c]);
+            opposite_[at(t.e[c])] = t.v[c];
+          }
+          t.band_max = std::max({t.band[0], t.band[1], t.band[2]});
+          tris_.push_back(t);
+          continue;
+        }
+        for (std::size_t q = 0; q < k; ++q) {
+          const int e = edge_of(loop[q], loop[(q + 1) % k]);
+          for (std::size_t r = 0; r < k; ++r) {
+            const int v = loop[r];
+            if (v != a_[at(e)] && v != b_[at(e)]) region_pairs.emplace_back(v, e);
+          }
+        }
+      }
+      std::sort(region_pairs.begin(), region_pairs.end());
+      region_pairs.erase(std::unique(region_pairs.begin(), region_pairs.end()), region_pairs.end());
+      for (const auto& [v, e] : region_pairs) fixed_.push_back({v, e, band_of(v, e)});
+    }
+    // Skin items for the sort and sweep: skin vertices and skin edges.
+    // Cells on the outer face: the ends of skin edges, and cells without any edge (a hand-made body).
+    std::vector<char> on_skin(at(n_), 1);
+    for (int s = 0; s < body.spring_count(); ++s) {
+      on_skin[at(body.springs(s, 0))] = 0;
+      on_skin[at(body.springs(s, 1))] = 0;
+    }
+    for (int e : skin_edges) {
+      on_skin[at(a_[at(e)])] = 1;
+      on_skin[at(b_[at(e)])] = 1;
+    }
+    // A skin vertex farther than 2·tolerance (at rest) from every skin edge not its own has the band
+    // `tolerance` with all of them; the others get theirs computed per candidate.
+    exact_band_.assign(at(n_), 0);
+    for (int i = 0; i < n_; ++i) {
+      if (!on_skin[at(i)]) continue;
+      items_.push_back({0, 0, 0, 0, i, -1});
+      for (int e : skin_edges)
+        if (i != a_[at(e)] && i != b_[at(e)] && band_of(i, e) < tol_) exact_band_[at(i)] = 1;
+    }
+    for (int e : skin_edges) items_.push_back({0, 0, 0, 0, -1, e});
+    for (std::size_t k = 0; k < items_.size(); ++k) order_.push_back(static_cast<int>(k));
+
+    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_}) v->assign(at(n_), 0.0);
     kicked_.assign(at(n_), 0);
-    pairs_.reserve(at(n_) * a_.size());
+    const std::size_t skin_vertices = items_.size() - skin_edges.size();
+    candidates_.reserve(3 * tris_.size() + fixed_.size() + skin_vertices * skin_edges.size());
   }
   std::string_view name() const override { return "collisions"; }
   Stage stage() const override { return Stage::constraint; }
@@ -98,20 +171,54 @@ class Collisions final : public Effect {
     if (a_.empty() || n_ < 3) return;
     const double kv = s.h * s.inv_mass;
     for (int i = 0; i < n_; ++i) {
-      w0x_[at(i)] = s.vx[at(i)] + kv * s.fx[at(i)];
-      w0y_[at(i)] = s.vy[at(i)] + kv * s.fy[at(i)];
+      const auto u = at(i);
+      w0x_[u] = s.vx[u] + kv * s.fx[u];
+      w0y_[u] = s.vy[u] + kv * s.fy[u];
+      wx_[u] = w0x_[u];
+      wy_[u] = w0y_[u];
+      qx_[u] = s.x[u];
+      qy_[u] = s.y[u];
     }
-    Outcome outcome = Outcome::left_list;
-    for (int round = 0; round < 4 && outcome == Outcome::left_list; ++round) {
-      if (round > 0) {
-        built_ = false;  // the resolved motion left the list: rebuild it wider
-        wide_ = 2.0 * margin_;
+    tau_ = 0.0;
+    int events = 0;
+    long collisions = 0, inelastic = 0;
+    bool resolved = true;
+    while (tau_ < 1.0) {
+      const double span = (1.0 - tau_) * s.h;  // time left in the step
+      gather(span);
+      double first_u = 2.0;
+      std::size_t first = 0;
+      for (std::size_t k = 0; k < candidates_.size(); ++k) {
+        const double u = event_time(candidates_[k], span);
+        if (u < first_u) {  // ties: the first candidate in order
+          first_u = u;
+          first = k;
+        }
       }
-      if (!covers_straight_step(s)) rebuild(s);
-      outcome = run_events(s);
+      if (first_u > 1.0) break;
+      if (events >= 2 * kMaxEvents) {
+        resolved = false;
+        break;
+      }
+      if (events == 0)
+        for (int i = 0; i < n_; ++i) kicked_[at(i)] = 0;
+      const bool fallback = events >= kMaxEvents;
+      ++events;
+      const double dt = first_u * span;
+      for (int i = 0; i < n_; ++i) {
+        qx_[at(i)] += dt * wx_[at(i)];
+        qy_[at(i)] += dt * wy_[at(i)];
+      }
+      tau_ += first_u * (1.0 - tau_);
+      bounce(candidates_[first], fallback ? 0.0 : restitution_);
+      ++collisions;
+      if (fallback && restitution_ > 0.0) ++inelastic;
     }
-    if (outcome != Outcome::resolved) ++s.counters.collisions_unresolved;
-    if (events_ == 0) return;
+    s.counters.collisions += collisions;
+    s.counters.collisions_inelastic += inelastic;
+    s.counters.collision_max_passes = std::max(s.counters.collision_max_passes, static_cast<long>(events));
+    if (!resolved) ++s.counters.collisions_unresolved;
+    if (events == 0) return;
     const double mh = s.mass / s.h;
     for (int i = 0; i < n_; ++i) {
       const auto u = at(i);
@@ -127,150 +234,188 @@ class Collisions final : public Effect {
     s.position_corrected = true;
   }
 
-  [[nodiscard]] long rebuilds() const { return rebuilds_; }
-
  private:
   struct Pair {
     int cell;
     int edge;
     double band;  // tolerance of this pair: min(tolerance, half the rest distance)
   };
-  enum class Outcome { resolved, unresolved, left_list };
-  struct Event {
-    double u = 2.0;  // fraction of the remaining step; > 1: none
-    std::size_t pair = 0;
+  struct Triangle {
+    std::array<int, 3> v;        // vertices (CCW at rest)
+    std::array<int, 3> e;        // e[c]: the edge opposite v[c]
+    std::array<double, 3> band;  // band of the pair (v[c], e[c])
+    double band_max;
+  };
+  struct Item {  // a skin vertex (vertex >= 0) or a skin edge (edge >= 0) in the sort and sweep
+    double lo, hi, ylo, yhi;
+    int vertex, edge;
   };
 
-  /// Processes the events of one step in time order (see the class comment).
-  Outcome run_events(SwimState& s) {
-    for (int i = 0; i < n_; ++i) {
-      const auto u = at(i);
-      wx_[u] = w0x_[u];
-      wy_[u] = w0y_[u];
-      qx_[u] = s.x[u];
-      qy_[u] = s.y[u];
-      kicked_[u] = 0;
-    }
-    tau_ = 0.0;
-    events_ = 0;
-    long collisions = 0, inelastic = 0;
-    Outcome outcome = Outcome::resolved;
-    while (tau_ < 1.0) {
-      const double span = (1.0 - tau_) * s.h;  // time left in the step
-      Event first;
-      for (std::size_t k = 0; k < pairs_.size(); ++k) {
-        const double u = event_time(pairs_[k], span);
-        if (u < first.u) first = {u, k};  // ties: the first pair in list order
-      }
-      if (first.u > 1.0) break;
-      if (events_ >= 2 * kMaxEvents) {
-        outcome = Outcome::unresolved;
-        break;
-      }
-      const bool fallback = events_ >= kMaxEvents;
-      ++events_;
-      const double dt = first.u * span;
-      for (int i = 0; i < n_; ++i) {
-        qx_[at(i)] += dt * wx_[at(i)];
-        qy_[at(i)] += dt * wy_[at(i)];
-      }
-      tau_ += first.u * (1.0 - tau_);
-      if (!within_list(s, 0.0)) return Outcome::left_list;
-      bounce(pairs_[first.pair], fallback ? 0.0 : restitution_);
-      ++collisions;
-      if (fallback && restitution_ > 0.0) ++inelastic;
-    }
-    if (!within_list(s, (1.0 - tau_) * s.h)) return Outcome::left_list;
-    s.counters.collisions += collisions;
-    s.counters.collisions_inelastic += inelastic;
-    s.counters.collision_max_passes = std::max(s.counters.collision_max_passes, static_cast<long>(events_));
-    return outcome;
+  double band_of(int v, int e) const {
+    const SegmentHit rest = closest_on_segment(rx_[at(v)], ry_[at(v)], rx_[at(a_[at(e)])], ry_[at(a_[at(e)])],
+                                               rx_[at(b_[at(e)])], ry_[at(b_[at(e)])]);
+    return std::min(tol_, 0.5 * std::sqrt(rest.d2));
   }
 
-  /// The pair's first approaching event within the next `span` of time, as a fraction u in [0, 1]
-  /// of it (> 1: none), with the cells at q moving at w.
-  double event_time(const Pair& pr, double span) const {
-    const int i = pr.cell, a = a_[at(pr.edge)], b = b_[at(pr.edge)];
-    const double px = qx_[at(i)], py = qy_[at(i)], ax = qx_[at(a)], ay = qy_[at(a)], bx = qx_[at(b)], by = qy_[at(b)];
-    const double dpx = span * wx_[at(i)], dpy = span * wy_[at(i)];
-    const double dax = span * wx_[at(a)], day = span * wy_[at(a)];
-    const double dbx = span * wx_[at(b)], dby = span * wy_[at(b)];
-    const double band = pr.band;
-    // Swept bounding boxes, widened by the band: no overlap, no event.
-    const double pminx = std::min(px, px + dpx), pmaxx = std::max(px, px + dpx);
-    const double pminy = std::min(py, py + dpy), pmaxy = std::max(py, py + dpy);
-    const double eminx = std::min({ax, ax + dax, bx, bx + dbx}) - band, emaxx = std::max({ax, ax + dax, bx, bx + dbx}) + band;
-    const double eminy = std::min({ay, ay + day, by, by + dby}) - band, emaxy = std::max({ay, ay + day, by, by + dby}) + band;
-    if (pmaxx < eminx || pminx > emaxx || pmaxy < eminy || pminy > emaxy) return 2.0;
+  /// The pairs that can have an event in the next `span` of time (step 2 of the class comment).
+  void gather(double span) {
+    candidates_.clear();
+    const double* qx = qx_.data();
+    const double* qy = qy_.data();
+    const double* wx = wx_.data();
+    const double* wy = wy_.data();
+    for (const Triangle& t : tris_) {
+      const int a = t.v[0], b = t.v[1], c = t.v[2];
+      const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
+      const double dbx = span * (wx[b] - wx[a]), dby = span * (wy[b] - wy[a]);
+      const double dcx = span * (wx[c] - wx[a]), dcy = span * (wy[c] - wy[a]);
+      // Doubled signed area over the step: c0 + c1·u + c2·u², and its minimum on [0, 1].
+      const double c0 = abx * acy - aby * acx;
+      const double c1 = abx * dcy - aby * dcx + dbx * acy - dby * acx;
+      const double c2 = dbx * dcy - dby * dcx;
+      double lowest = std::min(c0, c0 + c1 + c2);
+      if (c2 > 0.0 && c1 < 0.0 && -c1 < 2.0 * c2) lowest = std::min(lowest, c0 - c1 * c1 / (4.0 * c2));
+      // A vertex is within the band of its opposite edge only if 2·area <= band·|edge|; bound every
+      // edge length over the step by its L1 length now plus its L1 change.
+      const double bcx = acx - abx, bcy = acy - aby, dbcx = dcx - dbx, dbcy = dcy - dby;
+      const double lmax = std::max(std::abs(abx) + std::abs(aby) + std::abs(dbx) + std::abs(dby),
+                                   std::max(std::abs(acx) + std::abs(acy) + std::abs(dcx) + std::abs(dcy),
+                                            std::abs(bcx) + std::abs(bcy) + std::abs(dbcx) + std::abs(dbcy)));
+      if (lowest > t.band_max * lmax) continue;
+      for (std::size_t k = 0; k < 3; ++k) candidates_.push_back({t.v[k], t.e[k], t.band[k]});
+    }
+    for (const Pair& p : fixed_)
+      if (boxes_meet(p, span)) candidates_.push_back(p);
+    if (items_.empty()) return;
+    // Skin: sort and sweep the swept x-extents (insertion sort: the order barely changes).
+    for (Item& it : items_) {
+      if (it.vertex >= 0) {
+        const auto v = at(it.vertex);
+        const double x1 = qx[v] + span * wx[v], y1 = qy[v] + span * wy[v];
+        it.lo = std::min(qx[v], x1) - tol_;
+        it.hi = std::max(qx[v], x1) + tol_;
+        it.ylo = std::min(qy[v], y1) - tol_;
+        it.yhi = std::max(qy[v], y1) + tol_;
+      } else {
+        const auto a = at(a_[at(it.edge)]), b = at(b_[at(it.edge)]);
+        const double ax1 = qx[a] + span * wx[a], ay1 = qy[a] + span * wy[a];
+        const double bx1 = qx[b] + span * wx[b], by1 = qy[b] + span * wy[b];
+        it.lo = std::min(std::min(qx[a], ax1), std::min(qx[b], bx1));
+        it.hi = std::max(std::max(qx[a], ax1), std::max(qx[b], bx1));
+        it.ylo = std::min(std::min(qy[a], ay1), std::min(qy[b], by1));
+        it.yhi = std::max(std::max(qy[a], ay1), std::max(qy[b], by1));
+      }
+    }
+    for (std::size_t q = 1; q < order_.size(); ++q)
+      for (std::size_t r = q; r > 0 && items_[at(order_[r])].lo < items_[at(order_[r - 1])].lo; --r)
+        std::swap(order_[r], order_[r - 1]);
+    for (std::size_t q = 0; q < order_.size(); ++q) {
+      const Item& p = items_[at(order_[q])];
+      for (std::size_t r = q + 1; r < order_.size(); ++r) {
+        const Item& o = items_[at(order_[r])];
+        if (o.lo > p.hi) break;
+        if ((p.vertex >= 0) == (o.vertex >= 0)) continue;
+        if (o.ylo > p.yhi || o.yhi < p.ylo) continue;
+        const int v = p.vertex >= 0 ? p.vertex : o.vertex;
+        const int e = p.vertex >= 0 ? o.edge : p.edge;
+        if (v == a_[at(e)] || v == b_[at(e)] || v == opposite_[at(e)]) continue;  // own edge, or its triangle's
+        candidates_.push_back({v, e, exact_band_[at(v)] ? band_of(v, e) : tol_});
+      }
+    }
+  }
 
-    // e(u) = e0 + u·de (edge vector), r(u) = r0 + u·dr (cell relative to a); cross(e, r) = c0 + c1·u + c2·u².
-    const double ex0 = bx - ax, ey0 = by - ay, dex = dbx - dax, dey = dby - day;
-    const double rx0 = px - ax, ry0 = py - ay, drx = dpx - dax, dry = dpy - day;
+  /// Whether the swept boxes of a pair's cell and edge (widened by the band) overlap.
+  bool boxes_meet(const Pair& p, double span) const {
+    const auto i = at(p.cell), a = at(a_[at(p.edge)]), b = at(b_[at(p.edge)]);
+    const double px1 = qx_[i] + span * wx_[i], py1 = qy_[i] + span * wy_[i];
+    const double ax1 = qx_[a] + span * wx_[a], ay1 = qy_[a] + span * wy_[a];
+    const double bx1 = qx_[b] + span * wx_[b], by1 = qy_[b] + span * wy_[b];
+    const double band = p.band;
+    return !(std::max(qx_[i], px1) < std::min({qx_[a], ax1, qx_[b], bx1}) - band ||
+             std::min(qx_[i], px1) > std::max({qx_[a], ax1, qx_[b], bx1}) + band ||
+             std::max(qy_[i], py1) < std::min({qy_[a], ay1, qy_[b], by1}) - band ||
+             std::min(qy_[i], py1) > std::max({qy_[a], ay1, qy_[b], by1}) + band);
+  }
+
+  /// The pair's first event within the next `span` of time, as a fraction u in [0, 1] of it
+  /// (> 1: none), with the cells at q moving at w: the first time the cell enters the capsule of
+  /// radius `band` around the segment (through one of its two sides or one of its two end caps)
+  /// while approaching it, or u = 0 if it is inside and approaching. The capsule keeps the cell
+  /// `band` away from the edge itself, so float rounding can never put it on the wrong side.
+  double event_time(const Pair& pr, double span) const {
+    const auto i = at(pr.cell), a = at(a_[at(pr.edge)]), b = at(b_[at(pr.edge)]);
+    const double band = pr.band;
+    // e(u) = e0 + u·de (edge vector), r(u) = r0 + u·dr (cell relative to a).
+    const double ex0 = qx_[b] - qx_[a], ey0 = qy_[b] - qy_[a];
+    const double dex = span * (wx_[b] - wx_[a]), dey = span * (wy_[b] - wy_[a]);
+    const double rx0 = qx_[i] - qx_[a], ry0 = qy_[i] - qy_[a];
+    const double drx = span * (wx_[i] - wx_[a]), dry = span * (wy_[i] - wy_[a]);
     const double l2 = ex0 * ex0 + ey0 * ey0;
     if (!(l2 > 0.0)) return 2.0;
+    if (approaching_within(pr, 0.0, span, l2)) return 0.0;  // inside the capsule already, closing in
+    std::array<double, 8> times{};  // two roots per side and per cap
+    int count = 0;
+    std::array<double, 2> r{};
+    // Sides: the signed distance cross(e, r)/|e0| reaches ±band (|e| taken at the start: the band is
+    // a tolerance).
     const double len = std::sqrt(l2);
     const double c0 = ex0 * ry0 - ey0 * rx0;
     const double c1 = ex0 * dry - ey0 * drx + dex * ry0 - dey * rx0;
     const double c2 = dex * dry - dey * drx;
-    const double sigma = c0 > 0.0 ? 1.0 : c0 < 0.0 ? -1.0 : (c1 >= 0.0 ? 1.0 : -1.0);
-
-    // Candidates: entry into the band on the starting side (σ·cross = band·|e0|), and the cell
-    // reaching the edge's line (cross = 0) from either side.
-    // Each candidate carries the side the cell comes from: σ for the band, and for the line the
-    // side it leaves (the sign of cross just before the root).
-    std::array<std::pair<double, double>, 4> events{};
-    int count = 0;
-    const double g0 = sigma * c0 - band * len;
-    std::array<double, 2> r{};
-    if (g0 <= 0.0) {
-      events[at(count++)] = {0.0, sigma};
-    } else {
-      const int k = roots_in_unit_interval(sigma * c2, sigma * c1, g0, r);
-      for (int q = 0; q < k; ++q) events[at(count++)] = {r[at(q)], sigma};
+    for (double sign : {1.0, -1.0}) {
+      const int k = roots_in_unit_interval(sign * c2, sign * c1, sign * c0 - band * len, r);
+      for (int q = 0; q < k; ++q) times[at(count++)] = r[at(q)];
     }
-    const int k = roots_in_unit_interval(c2, c1, c0, r);
-    for (int q = 0; q < k; ++q) {
-      const double rate = c1 + 2.0 * c2 * r[at(q)];
-      events[at(count++)] = {r[at(q)], rate > 0.0 ? -1.0 : rate < 0.0 ? 1.0 : sigma};
-    }
-    std::sort(events.begin(), events.begin() + count);
-
-    const double slack = band / len;  // the band, as a fraction of the edge, beyond its ends
-    for (int q = 0; q < count; ++q) {
-      const auto [u, side] = events[at(q)];
-      const double ex = ex0 + u * dex, ey = ey0 + u * dey;
-      const double rx = rx0 + u * drx, ry = ry0 + u * dry;
-      const double el2 = ex * ex + ey * ey;
-      if (!(el2 > 0.0)) continue;
-      const double sp = (rx * ex + ry * ey) / el2;
-      if (sp < -slack || sp > 1.0 + slack) continue;
-      // Approaching the edge at the projection, from the side the cell is on just before u.
-      const double sc = std::clamp(sp, 0.0, 1.0);
-      const double vx = wx_[at(i)] - ((1.0 - sc) * wx_[at(a)] + sc * wx_[at(b)]);
-      const double vy = wy_[at(i)] - ((1.0 - sc) * wy_[at(a)] + sc * wy_[at(b)]);
-      if (side * (ex * vy - ey * vx) < 0.0) return u;  // the gap closes
-    }
+    // End caps: |cell − a| or |cell − b| reaches band.
+    const double sx0 = rx0 - ex0, sy0 = ry0 - ey0, dsx = drx - dex, dsy = dry - dey;  // cell relative to b
+    const int ka = roots_in_unit_interval(drx * drx + dry * dry, 2.0 * (rx0 * drx + ry0 * dry),
+                                          rx0 * rx0 + ry0 * ry0 - band * band, r);
+    for (int q = 0; q < ka; ++q) times[at(count++)] = r[at(q)];
+    const int kb = roots_in_unit_interval(dsx * dsx + dsy * dsy, 2.0 * (sx0 * dsx + sy0 * dsy),
+                                          sx0 * sx0 + sy0 * sy0 - band * band, r);
+    for (int q = 0; q < kb; ++q) times[at(count++)] = r[at(q)];
+    for (int q = 1; q < count; ++q)  // insertion sort: at most eight
+      for (int k = q; k > 0 && times[at(k)] < times[at(k - 1)]; --k) std::swap(times[at(k)], times[at(k - 1)]);
+    for (int q = 0; q < count; ++q)
+      if (approaching_within(pr, times[at(q)], span, l2)) return times[at(q)];
     return 2.0;
   }
 
-  /// The elastic (e = 1) or partly inelastic impulse of a pair whose cells are at their event.
+  /// Whether, at fraction u of the next `span`, the cell is within its band of the segment and
+  /// approaching it. The side roots measure the distance with the edge's length at the start of
+  /// the span (l2_start, squared), so the band is widened by that length over the current one; the
+  /// relative slack of 1e-9 covers the rounding of roots that put the cell exactly on the band.
+  bool approaching_within(const Pair& pr, double u, double span, double l2_start) const {
+    const auto i = at(pr.cell), a = at(a_[at(pr.edge)]), b = at(b_[at(pr.edge)]);
+    const double t = u * span;
+    const double ax = qx_[a] + t * wx_[a], ay = qy_[a] + t * wy_[a];
+    const double bx = qx_[b] + t * wx_[b], by = qy_[b] + t * wy_[b];
+    const double px = qx_[i] + t * wx_[i], py = qy_[i] + t * wy_[i];
+    const SegmentHit hit = closest_on_segment(px, py, ax, ay, bx, by);
+    const double l2_now = (bx - ax) * (bx - ax) + (by - ay) * (by - ay);
+    const double widen = l2_now < l2_start && l2_now > 0.0 ? std::sqrt(l2_start / l2_now) : 1.0;
+    const double reach = pr.band * widen * (1.0 + 1e-9);
+    if (!(hit.d2 <= reach * reach)) return false;
+    const double vx = wx_[i] - ((1.0 - hit.t) * wx_[a] + hit.t * wx_[b]);
+    const double vy = wy_[i] - ((1.0 - hit.t) * wy_[a] + hit.t * wy_[b]);
+    return (px - hit.qx) * vx + (py - hit.qy) * vy < 0.0;
+  }
+
+  /// The elastic (e = 1) or partly inelastic impulse of a pair whose cells are at their event: along
+  /// the direction from the closest point of the edge to the cell.
   void bounce(const Pair& pr, double e) {
-    const int i = pr.cell, a = a_[at(pr.edge)], b = b_[at(pr.edge)];
-    const double ex = qx_[at(b)] - qx_[at(a)], ey = qy_[at(b)] - qy_[at(a)];
-    const double rx = qx_[at(i)] - qx_[at(a)], ry = qy_[at(i)] - qy_[at(a)];
-    const double el2 = ex * ex + ey * ey;
-    const double el = std::sqrt(el2);
-    const double sc = std::clamp((rx * ex + ry * ey) / el2, 0.0, 1.0);
-    const double vx = wx_[at(i)] - ((1.0 - sc) * wx_[at(a)] + sc * wx_[at(b)]);
-    const double vy = wy_[at(i)] - ((1.0 - sc) * wy_[at(a)] + sc * wy_[at(b)]);
-    // Unit normal pointing to the side the cell approaches from.
-    double nx = -ey / el, ny = ex / el;
-    const double vn0 = nx * vx + ny * vy;
-    if (vn0 > 0.0) {
-      nx = -nx;
-      ny = -ny;
-    }
-    const double vn = -std::abs(vn0);
+    const auto i = at(pr.cell), a = at(a_[at(pr.edge)]), b = at(b_[at(pr.edge)]);
+    const SegmentHit hit = closest_on_segment(qx_[i], qy_[i], qx_[a], qy_[a], qx_[b], qy_[b]);
+    const double sc = hit.t;
+    double nx = qx_[i] - hit.qx, ny = qy_[i] - hit.qy;
+    const double d = std::sqrt(nx * nx + ny * ny);
+    if (!(d > 0.0)) return;  // cannot happen: events keep the band between them
+    nx /= d;
+    ny /= d;
+    const double vx = wx_[i] - ((1.0 - sc) * wx_[a] + sc * wx_[b]);
+    const double vy = wy_[i] - ((1.0 - sc) * wy_[a] + sc * wy_[b]);
+    const double vn = nx * vx + ny * vy;
+    if (!(vn < 0.0)) return;
     // Equal masses: 1/m_eff = (1 + (1 − s)² + s²)/m; the velocity changes are J/m per unit weight.
     const double dv = -(1.0 + e) * vn / (1.0 + (1.0 - sc) * (1.0 - sc) + sc * sc);
     kick(i, dv * nx, dv * ny);
@@ -278,107 +423,28 @@ class Collisions final : public Effect {
     kick(b, -sc * dv * nx, -sc * dv * ny);
   }
 
-  void kick(int i, double dvx, double dvy) {
-    wx_[at(i)] += dvx;
-    wy_[at(i)] += dvy;
-    kicked_[at(i)] = 1;
-  }
-
-  void centre(const std::vector<double>& x, const std::vector<double>& y, double& cx, double& cy) const {
-    cx = 0.0;
-    cy = 0.0;
-    for (int i = 0; i < n_; ++i) {
-      cx += x[at(i)];
-      cy += y[at(i)];
-    }
-    cx /= n_;
-    cy /= n_;
-  }
-
-  /// Whether every cell, at q advanced by `ahead`·w, is within margin/2 of where it was when the
-  /// list was built, relative to the centre of mass.
-  bool within_list(const SwimState& s, double ahead) const {
-    (void)s;
-    double cx = 0.0, cy = 0.0, vx = 0.0, vy = 0.0;
-    centre(qx_, qy_, cx, cy);
-    centre(wx_, wy_, vx, vy);
-    const double limit2 = 0.25 * margin_ * margin_;
-    for (int i = 0; i < n_; ++i) {
-      const auto u = at(i);
-      const double dx = qx_[u] - cx + ahead * (wx_[u] - vx) - xr_[u];
-      const double dy = qy_[u] - cy + ahead * (wy_[u] - vy) - yr_[u];
-      if (!(dx * dx + dy * dy <= limit2)) return false;
-    }
-    return true;
-  }
-
-  /// Whether the list covers the straight motion of the step at w0 (start and end; a straight
-  /// path's distance to a point is largest at an end).
-  bool covers_straight_step(const SwimState& s) const {
-    if (!built_) return false;
-    double cx = 0.0, cy = 0.0, vx = 0.0, vy = 0.0;
-    centre(s.x, s.y, cx, cy);
-    centre(w0x_, w0y_, vx, vy);
-    const double limit2 = 0.25 * margin_ * margin_;
-    for (int i = 0; i < n_; ++i) {
-      const auto u = at(i);
-      const double sx = s.x[u] - cx - xr_[u], sy = s.y[u] - cy - yr_[u];
-      const double ex = sx + s.h * (w0x_[u] - vx), ey = sy + s.h * (w0y_[u] - vy);
-      if (!(sx * sx + sy * sy <= limit2) || !(ex * ex + ey * ey <= limit2)) return false;
-    }
-    return true;
-  }
-
-  void rebuild(const SwimState& s) {
-    ++rebuilds_;
-    built_ = true;
-    double cx = 0.0, cy = 0.0, vx = 0.0, vy = 0.0;
-    centre(s.x, s.y, cx, cy);
-    centre(w0x_, w0y_, vx, vy);
-    double step2 = 0.0;  // largest displacement of the step relative to the centre of mass
-    for (int i = 0; i < n_; ++i) {
-      const auto u = at(i);
-      xr_[u] = s.x[u] - cx;
-      yr_[u] = s.y[u] - cy;
-      const double dx = w0x_[u] - vx, dy = w0y_[u] - vy;
-      step2 = std::max(step2, dx * dx + dy * dy);
-    }
-    margin_ = std::max({kMargin, wide_, 2.5 * s.h * std::sqrt(step2)});
-    wide_ = 0.0;
-    pairs_.clear();
-    const double reach = tol_ + margin_;
-    for (std::size_t e = 0; e < a_.size(); ++e) {  // pairs stay sorted by (edge, cell)
-      const int a = a_[e], b = b_[e];
-      const auto au = at(a), bu = at(b);
-      const double x0 = std::min(s.x[au], s.x[bu]) - reach, x1 = std::max(s.x[au], s.x[bu]) + reach;
-      const double y0 = std::min(s.y[au], s.y[bu]) - reach, y1 = std::max(s.y[au], s.y[bu]) + reach;
-      for (int i = 0; i < n_; ++i) {
-        const auto iu = at(i);
-        if (s.x[iu] < x0 || s.x[iu] > x1 || s.y[iu] < y0 || s.y[iu] > y1 || a == i || b == i) continue;
-        const SegmentHit now = closest_on_segment(s.x[iu], s.y[iu], s.x[au], s.y[au], s.x[bu], s.y[bu]);
-        if (!(now.d2 < reach * reach)) continue;
-        const SegmentHit rest = closest_on_segment(x0_[iu], y0_[iu], x0_[au], y0_[au], x0_[bu], y0_[bu]);
-        pairs_.push_back({i, static_cast<int>(e), std::min(tol_, 0.5 * std::sqrt(rest.d2))});
-      }
-    }
+  void kick(std::size_t i, double dvx, double dvy) {
+    wx_[i] += dvx;
+    wy_[i] += dvy;
+    kicked_[i] = 1;
   }
 
   double restitution_, tol_;
   int n_ = 0;
-  std::vector<int> a_, b_;              // edges a cell may not cross
-  std::vector<double> x0_, y0_;         // rest positions (per-pair tolerance)
-  std::vector<double> w0x_, w0y_;       // end-of-step velocities before any bounce
-  std::vector<double> wx_, wy_;         // current velocities while the events are processed
-  std::vector<double> qx_, qy_;         // positions at the current event time
-  std::vector<char> kicked_;            // cells whose velocity a bounce changed this step
-  std::vector<double> xr_, yr_;         // positions relative to the centre of mass at the last build
-  std::vector<Pair> pairs_;
-  double margin_ = kMargin;             // margin of the current list
-  double wide_ = 0.0;                   // a wider margin the next rebuild must use (a step left the list)
-  double tau_ = 0.0;                    // fraction of the step done
-  int events_ = 0;
-  bool built_ = false;
-  long rebuilds_ = 0;
+  std::vector<int> a_, b_;          // edges a cell may not cross
+  std::vector<int> opposite_;       // per edge: the opposite vertex of its triangular region (-1: none)
+  std::vector<double> rx_, ry_;     // rest positions (per-pair tolerance)
+  std::vector<Triangle> tris_;      // triangular regions
+  std::vector<Pair> fixed_;         // vertex-edge pairs of larger regions
+  std::vector<Item> items_;         // skin vertices and skin edges
+  std::vector<int> order_;          // items sorted by their swept x-extent (kept between steps)
+  std::vector<char> exact_band_;    // skin vertices whose band differs from the tolerance for some edge
+  std::vector<Pair> candidates_;
+  std::vector<double> w0x_, w0y_;   // end-of-step velocities before any bounce
+  std::vector<double> wx_, wy_;     // current velocities while the events are processed
+  std::vector<double> qx_, qy_;     // positions at the current event time
+  std::vector<char> kicked_;        // cells whose velocity a bounce changed this step
+  double tau_ = 0.0;                // fraction of the step done
 };
 
 }  // namespace

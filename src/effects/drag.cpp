@@ -29,8 +29,8 @@ inline double drag_limiter(double x) { return x <= 0.5 ? 1.0 : 1.0 / (x + 0.5); 
 ///    drag and step. The coupled linear system (neighbouring skin edges share nodes) is solved by
 ///    Gauss–Seidel sweeps over the edges, each edge solving its own relation exactly with its two
 ///    end masses: one sweep already leaves an error O(x²) in the force (x = h·d·L·|u|/m), so two
-///    sweeps keep the scheme second order; the predictor pass of the midpoint scheme uses one.
-///    Nothing is clipped.
+///    sweeps keep the scheme second order. The predictor pass of the midpoint scheme (which only
+///    needs the forces to O(h)) takes the edge forces of the previous step. Nothing is clipped.
 ///  - explicit: F at the evaluation velocity s.ux, s.uy. It overshoots for x > 1 and blows up for
 ///    x > 2;
 ///  - stable: explicit times g(x) = 1 for x <= 1/2 and 1/(x + 1/2) beyond (x with a conservative
@@ -76,7 +76,7 @@ class Drag final : public Effect {
       edge_mass_.push_back(2.0 * p.cell_mass / dmax);
     }
     const std::size_t m = a_.size();
-    for (auto* v : {&len_, &tx_, &ty_, &gn_, &gt_, &fn_, &ft_}) v->assign(m, 0.0);
+    for (auto* v : {&len_, &tx_, &ty_, &gn_, &gt_, &rn_, &rt_, &fn_, &ft_}) v->assign(m, 0.0);
     wx_.assign(nodes_.size(), 0.0);
     wy_.assign(nodes_.size(), 0.0);
     if (scheme_ == Scheme::implicit) {
@@ -169,12 +169,16 @@ class Drag final : public Effect {
     const double* vy = s.vy.data();
     double* fx = s.fx.data();
     double* fy = s.fy.data();
+    const std::size_t m = a_.size();
+    if (s.predictor) {  // the previous step's edge forces, in the current edge frames
+      add_edge_forces(s);
+      return;
+    }
     for (std::size_t q = 0; q < nodes_.size(); ++q) {
       const int i = nodes_[q];
       wx_[q] = vx[i] + kv * fx[i];
       wy_[q] = vy[i] + kv * fy[i];
     }
-    const std::size_t m = a_.size();
     for (std::size_t e = 0; e < m; ++e) {
       fn_[e] = 0.0;
       ft_[e] = 0.0;
@@ -188,9 +192,10 @@ class Drag final : public Effect {
       const double mx = 0.5 * (vx[i] + vx[j]), my = 0.5 * (vy[i] + vy[j]);
       gn_[e] = dn_ * len * std::abs(-mx * ty_[e] + my * tx_[e]);  // d·L·|u₀|, normal
       gt_[e] = dt_ * len * std::abs(mx * tx_[e] + my * ty_[e]);   // tangential
+      rn_[e] = 1.0 / (1.0 + gn_[e] * k_edge);
+      rt_[e] = 1.0 / (1.0 + gt_[e] * k_edge);
     }
-    const int sweeps = s.predictor ? 1 : 2;
-    for (int sweep = 0; sweep < sweeps; ++sweep) {
+    for (int sweep = 0; sweep < 2; ++sweep) {
       for (std::size_t e = 0; e < m; ++e) {
         const double gn = gn_[e], gt = gt_[e];
         if (gn == 0.0 && gt == 0.0) continue;
@@ -199,8 +204,8 @@ class Drag final : public Effect {
         const double cx = 0.5 * (wx_[at(p)] + wx_[at(q)]), cy = 0.5 * (wy_[at(p)] + wy_[at(q)]);
         const double cn = -cx * ty + cy * tx, ct = cx * tx + cy * ty;
         // This edge's relation F = −g·u₁ with u₁ = c + k_edge·ΔF (c already holds its current F):
-        const double dfn = -(gn * cn + fn_[e]) / (1.0 + gn * k_edge);
-        const double dft = -(gt * ct + ft_[e]) / (1.0 + gt * k_edge);
+        const double dfn = -(gn * cn + fn_[e]) * rn_[e];
+        const double dft = -(gt * ct + ft_[e]) * rt_[e];
         fn_[e] += dfn;
         ft_[e] += dft;
         const double dvx = 0.5 * kv * (-dfn * ty + dft * tx), dvy = 0.5 * kv * (dfn * tx + dft * ty);
@@ -210,7 +215,14 @@ class Drag final : public Effect {
         wy_[at(q)] += dvy;
       }
     }
-    for (std::size_t e = 0; e < m; ++e) {
+    add_edge_forces(s);
+  }
+
+  /// Adds the edge forces fn_, ft_ (normal, tangential), half to each end.
+  void add_edge_forces(SwimState& s) const {
+    double* fx = s.fx.data();
+    double* fy = s.fy.data();
+    for (std::size_t e = 0; e < a_.size(); ++e) {
       const double fn = fn_[e], ft = ft_[e];
       const double tx = tx_[e], ty = ty_[e];
       const double gx = 0.5 * (-fn * ty + ft * tx);
@@ -230,7 +242,8 @@ class Drag final : public Effect {
   std::vector<int> nodes_;      // skin nodes
   std::vector<double> edge_mass_;
   std::vector<double> len_, tx_, ty_;  // edge geometry of the current step
-  std::vector<double> gn_, gt_, fn_, ft_;
+  std::vector<double> gn_, gt_, rn_, rt_;  // d·L·|u₀| per part, and 1/(1 + g·h/(2m))
+  std::vector<double> fn_, ft_;            // edge forces (kept: the next predictor pass uses them)
   std::vector<double> wx_, wy_;        // end-of-step velocity estimate per skin node
   std::vector<double> wxn_, wyn_;      // implicit scheme: predicted velocity of every node
 };
