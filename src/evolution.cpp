@@ -502,11 +502,12 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 constexpr std::string_view kHistoryHeader =
-    "generation,best,mean,median,viable_fraction,best_cells,evaluations,wall_seconds,best_reference,invalid\n";
+    "generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,wall_seconds\n";
 
+// wall_seconds stays the last column: the only machine-dependent one.
 std::string history_row(const GenerationStats& s) {
-  return fmt::format("{},{},{},{},{},{},{},{:.3f},{},{}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
-                     s.best_cells, s.evaluations, s.wall_seconds, s.best_reference, s.invalid);
+  return fmt::format("{},{},{},{},{},{},{},{},{},{:.3f}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
+                     s.best_cells, s.evaluations, s.best_reference, s.invalid, s.wall_seconds);
 }
 
 void append(const std::filesystem::path& path, std::string_view text) {

@@ -34,9 +34,9 @@ HISTORY_DTYPE = np.dtype([
     ("viable_fraction", np.float64),
     ("best_cells", np.int64),
     ("evaluations", np.int64),
-    ("wall_seconds", np.float64),
     ("best_reference", np.float64),
     ("invalid", np.int64),
+    ("wall_seconds", np.float64),
 ])
 
 #: Columns that runs written before the exploit guard do not have, and the value they read as.
@@ -87,10 +87,11 @@ def read_history(path: PathLike) -> np.ndarray:
     Returns:
         numpy structured array, shape (rows,), one row per completed generation; fields
         ``generation`` (int64), ``best``, ``mean``, ``median``, ``viable_fraction`` (float64),
-        ``best_cells``, ``evaluations`` (int64), ``wall_seconds``, ``best_reference`` (float64: the
-        best's fitness at the exploit guard's reference step, NaN when not evaluated),
-        ``invalid`` (int64: viable individuals whose swim broke an invariant). Runs written before
-        the last two columns existed read with NaN and 0 there.
+        ``best_cells``, ``evaluations`` (int64), ``best_reference`` (float64: the best's fitness at
+        the exploit guard's reference step, NaN when not evaluated), ``invalid`` (int64: viable
+        individuals whose swim was unstable or broke an invariant), ``wall_seconds`` (float64, the
+        only machine-dependent column, always last). Runs written before ``best_reference`` and
+        ``invalid`` existed read with NaN and 0 there.
     """
     path = Path(path)
     if not path.is_file():
@@ -105,10 +106,10 @@ def read_history(path: PathLike) -> np.ndarray:
             raise ValueError(f"{path}:1: not a history.csv header: {lines[0]!r}")
         return np.zeros(0, dtype=HISTORY_DTYPE)  # empty or header being written
     header = complete[0].strip().split(",")
-    older = expected[:len(expected) - len(_LATER_COLUMNS)]
+    older = [name for name in expected if name not in _LATER_COLUMNS]
     if header != expected and header != older:
         raise ValueError(f"{path}:1: unexpected header {complete[0].strip()!r}; expected {','.join(expected)!r}")
-    missing = tuple(_LATER_COLUMNS[name] for name in expected[len(header):])
+    column = {name: k for k, name in enumerate(header)}
     rows = []
     for number, line in enumerate(complete[1:], start=2):
         if not line.strip():
@@ -117,8 +118,9 @@ def read_history(path: PathLike) -> np.ndarray:
         if len(fields) != len(header):
             raise ValueError(f"{path}:{number}: expected {len(header)} comma-separated values, got {len(fields)}: {line!r}")
         try:
-            rows.append(tuple(int(v) if HISTORY_DTYPE[k].kind == "i" else float(v) for k, v in enumerate(fields))
-                        + missing)
+            rows.append(tuple(_LATER_COLUMNS[name] if name not in column
+                              else int(fields[column[name]]) if HISTORY_DTYPE[name].kind == "i"
+                              else float(fields[column[name]]) for name in expected))
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
     return np.array(rows, dtype=HISTORY_DTYPE)

@@ -7,7 +7,7 @@ import pytest
 
 import animat
 
-EFFECTS = ["springs", "actuation", "pressure", "drag", "skin_collision"]
+EFFECTS = ["springs", "actuation", "pressure", "drag", "collisions"]  # the default scene
 
 
 def lattice(nx=8, ny=4, jitter=0.0, seed=0):
@@ -80,7 +80,7 @@ def test_config_scene_section_drives_the_simulation():
     assert sim.scene.drag_normal == 10.0
     # An explicit scene wins over the config's.
     sim = animat.Simulation(wave_body(), animat.Scene(), config=cfg)
-    assert sim.effects == ["actuation", "springs", "pressure", "drag", "skin_collision"]
+    assert sim.effects == ["actuation", "springs", "pressure", "drag", "collisions"]
 
 
 # --- Simulation ----------------------------------------------------------------------------------
@@ -126,7 +126,7 @@ def test_body_at_rest_stays_at_rest():
 
 def test_centre_of_mass_fixed_without_drag_and_moves_with_it():
     b = wave_body(f=4.0)
-    still = animat.Simulation(b, animat.Scene(effects=["springs", "actuation", "pressure", "skin_collision"]))
+    still = animat.Simulation(b, animat.Scene(effects=["springs", "actuation", "pressure", "collisions"]))
     c0 = still.center_of_mass()
     still.step(4000)
     assert np.linalg.norm(still.center_of_mass() - c0) < 1e-3  # float round-off, see test_physics.cpp
