@@ -102,6 +102,11 @@ std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const Fitn
   return out;
 }
 
+bool reference_disagrees(double fitness, double reference, const EvaluationParams& params) {
+  const double diff = std::abs(fitness - reference);
+  return diff > params.reference_abs_tolerance && diff > params.reference_tolerance * std::abs(reference);
+}
+
 std::uint64_t run_identity(const Config& config) {
   Config c = config;
   const EvolutionParams defaults;
@@ -608,8 +613,7 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
   const EvaluationParams& ev = config.evaluation;
   auto guard = [&](const GenerationStats& s) {
     if (opt.quiet || !s.best_changed || std::isnan(s.best_reference)) return;
-    const double diff = std::abs(s.best - s.best_reference);
-    if (diff > ev.reference_abs_tolerance && diff > ev.reference_tolerance * std::abs(s.best_reference))
+    if (reference_disagrees(s.best, s.best_reference, ev))
       spdlog::warn("gen {}: the new best's fitness {:.4f} is not confirmed at the reference step "
                    "(physics.substeps x {}: {:.4f}, {:+.1f}%): its swim depends on the step size",
                    s.generation, s.best, ev.reference_substeps, s.best_reference,

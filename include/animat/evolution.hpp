@@ -44,6 +44,9 @@ void visit_fields(EvaluationParams& p, V&& v) {
 }
 
 struct Config;
+/// Whether a fitness and its reference differ by more than both evaluation.reference_tolerance
+/// (relative to the reference) and evaluation.reference_abs_tolerance: the exploit guard warns.
+[[nodiscard]] bool reference_disagrees(double fitness, double reference, const EvaluationParams& params);
 /// The config of the reference evaluation of the exploit guard: physics.substeps multiplied by
 /// evaluation.reference_substeps, everything else equal.
 [[nodiscard]] Config reference_config(const Config& config);
