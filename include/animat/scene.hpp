@@ -45,8 +45,8 @@ struct SceneParams {
   double cell_mass = 1.0;             ///< equal mass m of every cell [paper: equal; value: choose, the mass unit]
   double spring_stiffness = 100.0;    ///< Hooke constant k of every spring [choose]
   double spring_damping = 4.0;        ///< damping coefficient c of every spring (force per unit stretching speed) [choose]
-  double pressure = 100.0;            ///< c_p of eq. 3, force per unit edge length at S = 0 [choose]
-  double pressure_area_floor = 0.1;   ///< eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
+  double pressure = 300.0;            ///< c_p of eq. 3, force per unit edge length at S = 0 [choose: docs/model.md]
+  double pressure_area_floor = 0.3;   ///< eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
   double drag_normal = 2.0;           ///< d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]
   double drag_tangential = -1.0;      ///< d_T of eq. 4; negative means d_N/200 [paper §6: d_N/200]
   /// Edges a cell may not cross (effect "collisions"): "all" springs (keeps the planar embedding:

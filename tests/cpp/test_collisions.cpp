@@ -271,20 +271,24 @@ TEST(Embedding, HoldsForHardHandMadeSwimmersAtEveryStep) {
 }
 
 TEST(Embedding, SkinEdgesAloneDoNotKeepRegionsFromInverting) {
-  // Why collision_edges = "all": with skin edges only, internal cells cross internal springs.
+  // Why collision_edges = "all": with skin edges only, internal cells cross internal springs. The
+  // whole body breathing at f = 12 under the pressure of the first release (c_p = 100, floor 0.1)
+  // squeezes regions flat.
   Body b = swimmer(lattice_points(8, 4, 0.05, 8), Drive::wave, 0.2, 12.0);
   b.phase.setZero();
   SceneParams skin_only;
   skin_only.collision_edges = "skin";
   skin_only.drag_normal = 0.2;
-  SceneParams all;
-  all.drag_normal = 0.2;
+  skin_only.pressure = 100.0;
+  skin_only.pressure_area_floor = 0.1;
+  SceneParams all = skin_only;
+  all.collision_edges = "all";
   EXPECT_GT(checked_swim(b, skin_only).inverted_region_steps, 0);
   EXPECT_EQ(checked_swim(b, all).inverted_region_steps, 0);
 }
 
-/// Evolved genomes shipped as test data (tests/data/evolved/*.json): {"drag_normal", "max_cells",
-/// "frequency_max", "genome"}.
+/// Evolved genomes shipped as test data (tests/data/evolved/*.json): the environment they evolved in
+/// ("drag_normal", "max_cells", "frequency_max", "pressure", "pressure_area_floor") and "genome".
 struct Evolved {
   std::string name;
   Config config;
@@ -307,6 +311,8 @@ std::vector<Evolved> evolved_genomes() {
     e.config.scene.drag_normal = j.at("drag_normal").get<double>();
     e.config.development.max_cells = j.at("max_cells").get<int>();
     e.config.development.frequency_max = j.at("frequency_max").get<double>();
+    e.config.scene.pressure = j.at("pressure").get<double>();
+    e.config.scene.pressure_area_floor = j.at("pressure_area_floor").get<double>();
     e.genome = genome_from_json(j.at("genome").dump(), e.config.genome, f.string());
     out.push_back(std::move(e));
   }
@@ -331,7 +337,9 @@ TEST(Collisions, MomentumIsConservedThroughCollisionsWithDragOff) {
   // impulse is internal.
   const auto genomes = evolved_genomes();
   const Evolved& e = named(genomes, "colliding_f12_dn0.5.json");
-  Simulation sim(body_of(e), scene_with({"springs", "actuation", "pressure", "collisions"}));
+  SceneParams scene = e.config.scene;  // the c_p it evolved with: regions collapse and cells collide
+  scene.effects = {"springs", "actuation", "pressure", "collisions"};
+  Simulation sim(body_of(e), scene);
   const Eigen::Vector2d c0 = sim.center_of_mass();
   double biggest = 0.0;
   for (int k = 0; k < 2000; ++k) {
@@ -347,7 +355,7 @@ TEST(Collisions, MomentumIsConservedThroughCollisionsWithDragOff) {
 
 TEST(Embedding, TheOldPenaltyLetsAnEvolvedExploitThroughWhereCollisionsDoNot) {
   const auto genomes = evolved_genomes();
-  const Evolved& e = named(genomes, "exploit_old_physics_dn0.5.json");
+  const Evolved& e = named(genomes, "exploit_old_physics_dn0.5.json");  // with the c_p it evolved under
   const Body b = body_of(e);
   SceneParams old_scene = e.config.scene;
   old_scene.effects = {"springs", "actuation", "pressure", "drag", "skin_collision"};
