@@ -76,7 +76,10 @@ void bind_evolution(nb::module_& m) {
                 nb::object r = cb(s);
                 if (r.is_none()) return true;
                 const std::string type = nb::type_name(r.type()).c_str();
-                if (PyBool_Check(r.ptr()) || type == "numpy.bool_" || type == "numpy.bool") return PyObject_IsTrue(r.ptr()) == 1;
+                const bool numpy_bool = nb::hasattr(r.type(), "__module__") &&
+                                        nb::str(r.type().attr("__module__")).equal(nb::str("numpy")) &&
+                                        (type == "bool" || type == "bool_" || type == "numpy.bool_" || type == "numpy.bool");
+                if (PyBool_Check(r.ptr()) || numpy_bool) return PyObject_IsTrue(r.ptr()) == 1;
                 const std::string shown = nb::repr(r).c_str();
                 PyErr_SetString(PyExc_TypeError,
                                 ("evolve: the callback must return True, False or None (None = go on), got " + type + " " +

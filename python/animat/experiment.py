@@ -90,7 +90,21 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
     # sets `stop`, which every running evolve polls between evaluations (each writes its checkpoint).
     stop = threading.Event()
 
+    # Thread.join() interrupted by Ctrl-C can mark a running thread as stopped (CPython issue 90882), so
+    # the main thread waits on this event instead, set by the last worker to finish.
+    active = [0]
+    all_done = threading.Event()
+
     def worker():
+        try:
+            work()
+        finally:
+            with lock:
+                active[0] -= 1
+                if active[0] == 0:
+                    all_done.set()
+
+    def work():
         while True:
             with lock:
                 if not pending or errors or stop.is_set():
@@ -109,18 +123,20 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
                 stop.set()  # one failed run stops the others cleanly too
 
     workers = [threading.Thread(target=worker, name=f"animat-experiment-{k}") for k in range(min(parallel, runs))]
+    active[0] = len(workers)
     for w in workers:
         w.start()
     interrupted = False
     try:
-        for w in workers:
-            while w.is_alive():
-                w.join(0.1)
+        while not all_done.wait(0.1):
+            pass
     except KeyboardInterrupt:
         interrupted = True
         stop.set()
-        for w in workers:
-            w.join()
+        while not all_done.wait(0.1):
+            pass
+    for w in workers:
+        w.join()
     done = [r for r in records if r is not None]
     if interrupted:
         if done:
