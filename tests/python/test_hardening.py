@@ -221,7 +221,10 @@ def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_ch
     time.sleep(1.0)  # inside generation 1's evaluations
     p.send_signal(signal.SIGINT)
     t0 = time.perf_counter()
-    stdout, stderr = p.communicate(timeout=30)
+    try:
+        stdout, stderr = p.communicate(timeout=30)
+    finally:
+        p.kill()  # never leave a run behind when the Ctrl-C is ignored
     took = time.perf_counter() - t0
     assert p.returncode == 0, stderr[-2000:]
     assert stdout.startswith("interrupted interrupted"), stdout
@@ -253,7 +256,10 @@ def test_experiment_stops_every_run_on_one_ctrl_c(tmp_path):
     time.sleep(0.5)
     p.send_signal(signal.SIGINT)  # one Ctrl-C
     t0 = time.perf_counter()
-    stdout, stderr = p.communicate(timeout=30)
+    try:
+        stdout, stderr = p.communicate(timeout=30)
+    finally:
+        p.kill()
     took = time.perf_counter() - t0
     assert p.returncode == 130, (p.returncode, stderr[-2000:])
     assert "interrupted" in stderr and "resume" in stderr, stderr
