@@ -659,6 +659,8 @@ TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNo
   EXPECT_THROW((void)evo.step(), Interrupted);
   const double took = seconds_since(t0);
   t.join();
+  std::printf("[ stop     ] in-process stop during a generation (50 ms evaluations): step() returned %.3f s after it "
+              "started, %.3f s after the stop\n", took, took - 0.12);
   EXPECT_LT(took, 0.3) << "the generation ran on after the stop";
   EXPECT_EQ(evo.generation(), 1) << "an interrupted generation must leave the state at the previous one";
   stop = false;
@@ -718,6 +720,7 @@ TEST(StopRequests, CliSignalWhileSeedingEndsWithinASecond) {
     const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--set", "development.quiet_steps=400",
                                            "--set", "evolution.population=100", "--out", out.string()},
                                           sig, 1.0);
+    std::printf("[ stop     ] %s while seeding: exit %d, %.3f s after the signal\n", strsignal(sig), rc, seconds);
     EXPECT_EQ(rc, 130) << strsignal(sig);
     EXPECT_LT(seconds, 1.0) << strsignal(sig);
     EXPECT_FALSE(fs::exists(out / "checkpoint.json"));
@@ -736,6 +739,8 @@ TEST(StopRequests, CliSignalDuringAGenerationEndsWithinASecondWithAResumableChec
                                          "evolution.population=60", "--set", "evolution.checkpoint_every=5", "--out",
                                          out.string()},
                                         SIGTERM, 0.5, [&] { return fs::exists(out / "checkpoint.json"); });
+  std::printf("[ stop     ] SIGTERM during a generation (population 60, 4000 swim steps): exit %d, %.3f s after the "
+              "signal\n", rc, seconds);
   EXPECT_EQ(rc, 130);
   EXPECT_LT(seconds, 1.0);
   ASSERT_TRUE(fs::exists(out / "checkpoint.json"));

@@ -226,6 +226,7 @@ def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_ch
     finally:
         p.kill()  # never leave a run behind when the Ctrl-C is ignored
     took = time.perf_counter() - t0
+    print(f"Ctrl-C during animat.evolve: the interpreter exited {took:.3f} s after the signal")
     assert p.returncode == 0, stderr[-2000:]
     assert stdout.startswith("interrupted interrupted"), stdout
     assert took < 1.5, f"Ctrl-C took {took:.2f} s"  # within a second of the signal, plus the interpreter's exit
@@ -261,6 +262,7 @@ def test_experiment_stops_every_run_on_one_ctrl_c(tmp_path):
     finally:
         p.kill()
     took = time.perf_counter() - t0
+    print(f"one Ctrl-C during python -m animat experiment: exit {p.returncode}, {took:.3f} s after the signal")
     assert p.returncode == 130, (p.returncode, stderr[-2000:])
     assert "interrupted" in stderr and "resume" in stderr, stderr
     assert took < 2.0, f"one Ctrl-C took {took:.2f} s"
