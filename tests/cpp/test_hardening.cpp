@@ -72,6 +72,7 @@ struct Shell {
 Shell run_exe(const std::vector<std::string>& args) {
   const fs::path errfile = fresh_dir("stderr.txt");
   const auto t0 = Clock::now();
+  std::fflush(nullptr);  // the child must not write the parent's buffered output again
   const pid_t pid = fork();
   if (pid == 0) {
     std::vector<char*> argv;
@@ -119,6 +120,7 @@ template <class F>
 ChildResult in_child(F&& f, double limit_seconds) {
   int fds[2];
   if (pipe(fds) != 0) return {ChildResult::foreign, "pipe failed"};
+  std::fflush(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
     close(fds[0]);
@@ -628,7 +630,7 @@ TEST(ResumeSettings, InProcessResumeWithAnotherConfigWritesNothing) {
 // Stop requests
 
 namespace {
-// A fitness that takes a while: a generation of 8 takes 0.4 s on one thread.
+// A fitness that takes a while (sleeping, so the machine's load hardly matters).
 Fitness slow_fitness(const Genome& g) {
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
   return stub_fitness(g);
@@ -637,7 +639,7 @@ Fitness slow_fitness(const Genome& g) {
 
 TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNothing) {
   Config c;
-  c.evolution.population = 8;
+  c.evolution.population = 16;  // 15 evaluations of 50 ms: 0.75 s for the whole generation
   c.evolution.elites = 1;
   c.evolution.threads = 1;
   c.genome.initial_units = 30;  // no duplicates among offspring: every child is evaluated
@@ -693,6 +695,7 @@ namespace {
 // status and the seconds from the signal to the exit.
 std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig, double after,
                                   const std::function<bool()>& ready = [] { return true; }) {
+  std::fflush(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
     std::vector<char*> argv;
@@ -722,7 +725,9 @@ TEST(StopRequests, CliSignalWhileSeedingEndsWithinASecond) {
                                           sig, 1.0);
     std::printf("[ stop     ] %s while seeding: exit %d, %.3f s after the signal\n", strsignal(sig), rc, seconds);
     EXPECT_EQ(rc, 130) << strsignal(sig);
-    EXPECT_LT(seconds, 1.0) << strsignal(sig);
+    // Measured 0.001 to 0.03 s (docs/reliability.md); the machine is shared, so the test allows 3 s.
+    // Before, the signal was ignored until the population was complete: here, never.
+    EXPECT_LT(seconds, 3.0) << strsignal(sig);
     EXPECT_FALSE(fs::exists(out / "checkpoint.json"));
     // Nothing to resume, so the same command may start over in the same directory.
     const Shell again = run_exe({kExe, "--quiet", "--threads", "1", "--set", "evolution.population=4", "--set",
@@ -733,16 +738,17 @@ TEST(StopRequests, CliSignalWhileSeedingEndsWithinASecond) {
 }
 
 TEST(StopRequests, CliSignalDuringAGenerationEndsWithinASecondWithAResumableCheckpoint) {
-  // Population 60 at the paper's 4000 swim steps: a generation takes seconds on 2 threads.
+  // 30 individuals swimming 40,000 steps: about 0.3 s per evaluation, 4 s per generation on 2 idle cores.
+  // Before, the generation was finished first (4 s or more); now one evaluation per thread at most.
   const fs::path out = fresh_dir("gen_signal");
   const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--seed", "4", "--set",
-                                         "evolution.population=60", "--set", "evolution.checkpoint_every=5", "--out",
-                                         out.string()},
+                                         "evolution.population=30", "--set", "evaluation.steps=40000", "--set",
+                                         "evolution.checkpoint_every=5", "--out", out.string()},
                                         SIGTERM, 0.5, [&] { return fs::exists(out / "checkpoint.json"); });
-  std::printf("[ stop     ] SIGTERM during a generation (population 60, 4000 swim steps): exit %d, %.3f s after the "
+  std::printf("[ stop     ] SIGTERM during a generation (population 30, 40000 swim steps): exit %d, %.3f s after the "
               "signal\n", rc, seconds);
   EXPECT_EQ(rc, 130);
-  EXPECT_LT(seconds, 1.0);
+  EXPECT_LT(seconds, 2.0) << "the generation ran on after the signal (the test allows 2 s on a shared machine)";
   ASSERT_TRUE(fs::exists(out / "checkpoint.json"));
   Config c = load_config(out / "config.toml");
   Evolution evo(c, stub_fitness);

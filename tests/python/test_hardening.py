@@ -229,7 +229,8 @@ def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_ch
     print(f"Ctrl-C during animat.evolve: the interpreter exited {took:.3f} s after the signal")
     assert p.returncode == 0, stderr[-2000:]
     assert stdout.startswith("interrupted interrupted"), stdout
-    assert took < 1.5, f"Ctrl-C took {took:.2f} s"  # within a second of the signal, plus the interpreter's exit
+    # Measured 0.2 to 0.6 s (docs/reliability.md); 3 s allowed on a shared machine. Before: never.
+    assert took < 3.0, f"Ctrl-C took {took:.2f} s"
     generations = int(stdout.split()[2])
     assert generations >= 1
     # The checkpoint is the last complete generation, and it resumes.
@@ -265,7 +266,7 @@ def test_experiment_stops_every_run_on_one_ctrl_c(tmp_path):
     print(f"one Ctrl-C during python -m animat experiment: exit {p.returncode}, {took:.3f} s after the signal")
     assert p.returncode == 130, (p.returncode, stderr[-2000:])
     assert "interrupted" in stderr and "resume" in stderr, stderr
-    assert took < 2.0, f"one Ctrl-C took {took:.2f} s"
+    assert took < 3.0, f"one Ctrl-C took {took:.2f} s"  # measured 0.13 to 0.19 s; before: never
     for i in (0, 1):  # both running runs stopped with a checkpoint that restores
         run = animat.Run(out / f"run_{i}")
         assert len(run.history["generation"]) >= 1
