@@ -40,6 +40,17 @@
 #include "animat/random.hpp"
 #include "test_support.hpp"
 
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define ANIMAT_TEST_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define ANIMAT_TEST_SANITIZED 1
+#endif
+#endif
+#ifndef ANIMAT_TEST_SANITIZED
+#define ANIMAT_TEST_SANITIZED 0
+#endif
+
 namespace fs = std::filesystem;
 using namespace animat;
 using nlohmann::json;
@@ -738,6 +749,7 @@ TEST(StopRequests, CliSignalWhileSeedingEndsWithinASecond) {
 }
 
 TEST(StopRequests, CliSignalDuringAGenerationEndsWithinASecondWithAResumableCheckpoint) {
+  if (ANIMAT_TEST_SANITIZED) GTEST_SKIP() << "a latency test: one sanitized evaluation of 40,000 steps takes seconds";
   // 30 individuals swimming 40,000 steps: about 0.3 s per evaluation, 4 s per generation on 2 idle cores.
   // Before, the generation was finished first (4 s or more); now one evaluation per thread at most.
   const fs::path out = fresh_dir("gen_signal");
