@@ -58,29 +58,84 @@ void bind_evolution(nb::module_& m) {
       });
 
   m.def("evolve", [](std::optional<Config> config, std::optional<std::filesystem::path> out, bool resume,
-                     std::optional<nb::callable> callback, bool quiet) {
+                     std::optional<nb::callable> callback, bool quiet, nb::object stop) {
           const Config c = config.value_or(Config{});
           RunOptions opt;
           if (out) opt.out = *out;
           opt.resume = resume;
           opt.quiet = quiet;
+          // A Python exception raised while the run is in progress (Ctrl-C's KeyboardInterrupt, an error
+          // in or about the callback) stops the run like a signal does: the last complete generation is
+          // checkpointed, and the exception is raised afterwards with the partial result as `.result`.
+          // Touched with the GIL held only.
+          std::optional<nb::python_error> pending;
+          auto keep = [&pending] {
+            if (!pending) pending.emplace();  // fetches the error indicator
+            else PyErr_Clear();
+          };
           if (callback) {
             nb::callable cb = *callback;
-            opt.callback = [cb](const GenerationStats& s, const Evolution&) {
+            opt.callback = [cb, &keep](const GenerationStats& s, const Evolution&) {
               nb::gil_scoped_acquire gil;
-              nb::object r = cb(s);
-              return r.is_none() || nb::cast<bool>(r);
+              try {
+                nb::object r = cb(s);
+                if (r.is_none()) return true;
+                const std::string type = nb::type_name(r.type()).c_str();
+                const bool numpy_bool = nb::hasattr(r.type(), "__module__") &&
+                                        nb::str(r.type().attr("__module__")).equal(nb::str("numpy")) &&
+                                        (type == "bool" || type == "bool_" || type == "numpy.bool_" || type == "numpy.bool");
+                if (PyBool_Check(r.ptr()) || numpy_bool) return PyObject_IsTrue(r.ptr()) == 1;
+                const std::string shown = nb::repr(r).c_str();
+                PyErr_SetString(PyExc_TypeError,
+                                ("evolve: the callback must return True, False or None (None = go on), got " + type + " " +
+                                 (shown.size() > 60 ? shown.substr(0, 57) + "..." : shown)).c_str());
+              } catch (nb::python_error& e) {
+                e.restore();
+              }
+              keep();
+              return false;
             };
           }
-          nb::gil_scoped_release release;
-          return run_evolution(c, opt);
+          // Polled between evaluations (about every 20 ms) on this thread: Ctrl-C, and the `stop` event.
+          opt.stop_poll = [&stop, &keep]() -> bool {
+            nb::gil_scoped_acquire gil;
+            if (PyErr_CheckSignals() != 0) {
+              keep();
+              return true;
+            }
+            if (stop.is_none()) return false;
+            nb::object set = nb::steal(PyObject_CallMethod(stop.ptr(), "is_set", nullptr));
+            if (!set.is_valid()) {
+              keep();
+              return true;
+            }
+            return PyObject_IsTrue(set.ptr()) == 1;
+          };
+          RunSummary summary;
+          {
+            nb::gil_scoped_release release;
+            summary = run_evolution(c, opt);
+          }
+          if (pending) {
+            nb::object result = nb::cast(std::move(summary));
+            PyObject_SetAttrString(pending->value().ptr(), "result", result.ptr());
+            pending->restore();
+            throw nb::python_error();
+          }
+          return summary;
         }, "config"_a = nb::none(), "out"_a = nb::none(), "resume"_a = false, "callback"_a = nb::none(), "quiet"_a = true,
+        "stop"_a = nb::none(),
         "Run the paper's genetic algorithm (the engine behind animat_evolve).\n\n"
         "config: animat.Config (default: the embedded paper setting; set evolution.generations!).\n"
         "out: run directory for config.toml, history.csv, best/ and checkpoint.json (None = write nothing).\n"
-        "resume: continue the run in `out`.\n"
-        "callback: called with each generation's GenerationStats; return False to stop.\n"
-        "The GIL is released while it runs. Returns an EvolutionResult (history, best_genome, best_fitness).");
+        "resume: continue the run in `out` (settings other than the caps, threads and checkpoint interval\n"
+        "must equal the run's; a difference is a ValueError naming the keys, and nothing is written).\n"
+        "callback: called with each generation's GenerationStats; return False to stop (True or None: go on).\n"
+        "stop: an object with is_set() (e.g. threading.Event), polled between evaluations; set = stop.\n"
+        "The GIL is released while it runs. Returns an EvolutionResult (history, best_genome, best_fitness);\n"
+        "stop_reason is 'interrupted' when `stop` ended it. Ctrl-C (or an exception from the callback)\n"
+        "stops it within one evaluation, leaves a checkpoint of the last complete generation in `out`\n"
+        "(resume=True continues), and is raised with the partial EvolutionResult as its `.result`.");
 
   m.def("evaluate_population", [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads) {
           const Config c = config.value_or(Config{});

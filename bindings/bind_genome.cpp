@@ -7,6 +7,9 @@
 #include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
+#include <fmt/format.h>
+
+#include <stdexcept>
 #include <variant>
 
 #include "animat/config.hpp"
@@ -40,6 +43,21 @@ Rng resolve(RngOrSeed r) {
   if (seed < 0) throw Error("seed must be a non-negative integer, got " + std::to_string(seed));
   return Rng(static_cast<std::uint64_t>(seed));
 }
+// A Python int argument that must fit int64: a clear TypeError / OverflowError naming it, never a wrap.
+std::int64_t int64_argument(const char* name, nb::handle h) {
+  if (!PyIndex_Check(h.ptr()))
+    throw nb::type_error(fmt::format("Rng.integer: {} must be an integer, got {}", name,
+                                     nb::type_name(h.type()).c_str()).c_str());
+  nb::object index = nb::steal(PyNumber_Index(h.ptr()));
+  if (!index.is_valid()) throw nb::python_error();
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0)
+    throw std::overflow_error(fmt::format("Rng.integer: {} = {} is outside the 64-bit signed range [-2**63, 2**63-1]",
+                                          name, nb::str(index).c_str()));
+  if (v == -1 && PyErr_Occurred()) throw nb::python_error();
+  return static_cast<std::int64_t>(v);
+}
 // Advances a caller-supplied Rng so that repeated calls draw fresh numbers.
 void write_back(RngOrSeed r, const Rng& used) {
   if (auto* p = std::get_if<Rng*>(&r)) **p = used;
@@ -57,7 +75,13 @@ void bind_genome(nb::module_& m) {
                   "The stream of individual `index` in `generation` of the run with `seed`.")
       .def("uniform", [](Rng& r) { return r.uniform(); }, "Uniform double in [0, 1).")
       .def("normal", [](Rng& r) { return r.normal(); }, "Standard normal deviate.")
-      .def("integer", &Rng::integer, "low"_a, "high"_a, "Uniform integer in [low, high].")
+      .def("integer", [](Rng& r, nb::handle low, nb::handle high) {
+            const std::int64_t a = int64_argument("low", low), b = int64_argument("high", high);
+            if (a > b) throw nb::value_error(fmt::format("Rng.integer: low = {} exceeds high = {}", a, b).c_str());
+            return r.integer(a, b);
+          }, "low"_a, "high"_a,
+          "Uniform integer in [low, high] (inclusive), both 64-bit signed; the whole int64 range is allowed.\n"
+          "Raises TypeError for a non-integer, OverflowError beyond int64, ValueError if low > high.")
       .def("next", [](Rng& r) { return r(); }, "Next raw 64-bit value.")
       .def_prop_rw("state", [](const Rng& r) { return r.state(); }, [](Rng& r, const Rng::State& s) { r.set_state(s); },
                    "The four 64-bit words of the generator state.")

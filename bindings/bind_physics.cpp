@@ -10,7 +10,10 @@
 #include <fmt/format.h>
 
 #include <cstddef>
+#include <mutex>
 #include <optional>
+#include <stdexcept>
+#include <unordered_set>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -29,6 +32,38 @@ using namespace nb::literals;
 
 namespace animat::py {
 namespace {
+
+// A Simulation owns one Box2D world and is not thread-safe. step() and record() run without the GIL,
+// so two Python threads could drive one world at once (Box2D aborts on its stack allocator). Every
+// method holds a lease on its Simulation; a second thread gets a RuntimeError instead.
+class Lease {
+ public:
+  Lease(const Simulation& s, const char* method) : sim_(&s) {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (!busy().insert(sim_).second)
+      throw std::runtime_error(fmt::format(
+          "animat.Simulation.{}: this Simulation is in use by another thread; a Simulation (one Box2D world) is not "
+          "thread-safe: give each thread its own Simulation",
+          method));
+  }
+  ~Lease() {
+    std::lock_guard<std::mutex> lock(mutex());
+    busy().erase(sim_);
+  }
+  Lease(const Lease&) = delete;
+  Lease& operator=(const Lease&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static std::unordered_set<const Simulation*>& busy() {
+    static std::unordered_set<const Simulation*> set;
+    return set;
+  }
+  const Simulation* sim_;
+};
 
 std::vector<std::string> scene_keys() {
   SceneParams p;
@@ -242,12 +277,14 @@ void bind_physics(nb::module_& m) {
       }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none())
       .def("step", [](Simulation& s, long n) {
         if (n < 0) throw ConfigError(fmt::format("Simulation.step: n must be >= 0, got {}", n));
+        Lease lease(s, "step");
         nb::gil_scoped_release release;
         s.step(n);
       }, "n"_a = 1, "Advance n control steps; raises RuntimeError if a step leaves the valid domain.")
       .def("record", [](Simulation& s, long steps, long every) {
         if (steps < 0) throw ConfigError(fmt::format("Simulation.record: steps must be >= 0, got {}", steps));
         if (every < 1) throw ConfigError(fmt::format("Simulation.record: every must be >= 1, got {}", every));
+        Lease lease(s, "record");
         const auto n = static_cast<std::size_t>(s.node_count());
         const auto frames = static_cast<std::size_t>(steps / every + 1);
         std::vector<double> out;
@@ -273,6 +310,7 @@ void bind_physics(nb::module_& m) {
          "state, then every `every` steps (frames = steps // every + 1; trailing steps that do not fill\n"
          "a frame are not run).")
       .def("compute_forces", [](Simulation& s) {
+        Lease lease(s, "compute_forces");
         s.compute_forces();
         const auto n = static_cast<std::size_t>(s.node_count());
         std::vector<double> f(2 * n);
@@ -282,18 +320,23 @@ void bind_physics(nb::module_& m) {
         }
         return owned_array(std::move(f), {n, 2});
       }, "The (n, 2) forces the enabled effects produce in the current state (nothing is integrated).")
-      .def_prop_ro("positions", [](const Simulation& s) -> Points { return s.positions(); }, "(n, 2) cell positions.")
-      .def_prop_rw("velocities", [](const Simulation& s) -> Points { return s.velocities(); },
-                   [](Simulation& s, const Points& v) { s.set_velocities(v); },
+      .def_prop_ro("positions", [](const Simulation& s) -> Points { Lease l(s, "positions"); return s.positions(); },
+                   "(n, 2) cell positions.")
+      .def_prop_rw("velocities", [](const Simulation& s) -> Points { Lease l(s, "velocities"); return s.velocities(); },
+                   [](Simulation& s, const Points& v) { Lease l(s, "velocities"); s.set_velocities(v); },
                    "(n, 2) cell velocities; assign an (n, 2) array to set them (e.g. to launch a body).")
-      .def("center_of_mass", [](const Simulation& s) -> Eigen::Vector2d { return s.center_of_mass(); },
+      .def("center_of_mass", [](const Simulation& s) -> Eigen::Vector2d { Lease l(s, "center_of_mass"); return s.center_of_mass(); },
            "The centre of mass (equal masses: the mean position) as a (2,) array.")
-      .def("momentum", [](const Simulation& s) -> Eigen::Vector2d { return s.momentum(); }, "Total momentum, (2,).")
-      .def("kinetic_energy", &Simulation::kinetic_energy, "Total kinetic energy.")
-      .def_prop_ro("time", &Simulation::time, "Simulated time.")
-      .def_prop_ro("steps_done", &Simulation::steps_done, "Control steps done.")
+      .def("momentum", [](const Simulation& s) -> Eigen::Vector2d { Lease l(s, "momentum"); return s.momentum(); },
+           "Total momentum, (2,).")
+      .def("kinetic_energy", [](const Simulation& s) { Lease l(s, "kinetic_energy"); return s.kinetic_energy(); },
+           "Total kinetic energy.")
+      .def_prop_ro("time", [](const Simulation& s) { Lease l(s, "time"); return s.time(); }, "Simulated time.")
+      .def_prop_ro("steps_done", [](const Simulation& s) { Lease l(s, "steps_done"); return s.steps_done(); },
+                   "Control steps done.")
       .def_prop_ro("node_count", &Simulation::node_count, "Cells.")
       .def_prop_ro("rest_lengths_now", [](const Simulation& s) {
+        Lease l(s, "rest_lengths_now");
         const auto r = s.rest_lengths_now();
         return owned_array(std::vector<double>(r.begin(), r.end()), {r.size()});
       }, nb::rv_policy::move, "(m,) current rest length of every spring (eq. 2 at the last step).")
@@ -303,9 +346,12 @@ void bind_physics(nb::module_& m) {
         return out;
       }, "Enabled effects, in the order they run each step.")
       .def_prop_ro("scene", [](const Simulation& s) { return s.scene(); }, "The simulation's Scene (a copy).")
-      .def_prop_ro("failed", &Simulation::failed, "True after a step raised.")
-      .def_prop_ro("max_speed_seen", &Simulation::max_speed_seen, "Largest cell speed seen so far.")
-      .def_prop_ro("max_step_displacement_seen", &Simulation::max_step_displacement_seen,
+      .def_prop_ro("failed", [](const Simulation& s) { Lease l(s, "failed"); return s.failed(); },
+                   "True after a step raised.")
+      .def_prop_ro("max_speed_seen", [](const Simulation& s) { Lease l(s, "max_speed_seen"); return s.max_speed_seen(); },
+                   "Largest cell speed seen so far.")
+      .def_prop_ro("max_step_displacement_seen",
+                   [](const Simulation& s) { Lease l(s, "max_step_displacement_seen"); return s.max_step_displacement_seen(); },
                    "Largest |v|*h a cell was about to move in one Box2D step so far.")
       .def_prop_ro("counters", [](const Simulation& s) {
         const SwimCounters& c = s.counters();
@@ -335,6 +381,7 @@ void bind_physics(nb::module_& m) {
       }, "The embedding checks so far (a dict), or None before monitor_embedding().")
       .def("__len__", &Simulation::node_count)
       .def("__repr__", [](const Simulation& s) {
+        Lease l(s, "__repr__");
         return fmt::format("<animat.Simulation cells={} t={:.6g} steps={}>", s.node_count(), s.time(), s.steps_done());
       });
 
@@ -346,6 +393,7 @@ void bind_physics(nb::module_& m) {
         SwimOptions options;
         options.check_embedding = check_embedding ? *check_embedding : c.evaluation.check_embedding;
         options.stop_when_invalid = stop_when_invalid;
+        warm_up_box2d();  // Box2D's lazily filled globals, before other threads may run worlds too
         nb::gil_scoped_release release;
         return swim(body, scene ? *scene : c.scene, c.physics, n, options);
       }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "steps"_a = nb::none(),
@@ -357,6 +405,7 @@ void bind_physics(nb::module_& m) {
       "the counts cover the whole horizon.");
   m.def("evaluate", [](const Genome& genome, std::optional<Config> config) {
         const Config c = config ? *config : Config{};
+        warm_up_box2d();
         nb::gil_scoped_release release;
         return evaluate(genome, c);
       }, "genome"_a, "config"_a = nb::none(),

@@ -42,9 +42,9 @@ Fitness stub(const Genome& g) {
   Fitness f;
   f.viable = genome_hash(g) % 4 != 0 && !g.elements.empty();
   if (!f.viable) return f;
-  double s = 0.0;
-  for (const auto& e : g.elements) s += e.coords[0];
-  f.fitness = std::abs(s) / static_cast<double>(g.size());
+  double s = 0.0;  // a mean that cannot overflow: a fitness must be finite and >= 0 (the engine checks)
+  for (const auto& e : g.elements) s += e.coords[0] / static_cast<double>(g.size());
+  f.fitness = std::abs(s);
   f.cell_count = static_cast<int>(g.size());
   return f;
 }
@@ -97,6 +97,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                            evo.history().back().generation));
   if (evo.population().size() != static_cast<std::size_t>(config.evolution.population))
     fuzz::fail("accepted a population of the wrong size");
+  for (const auto& ind : evo.population())
+    if (!std::isfinite(ind.result.fitness) || ind.result.fitness < 0.0)
+      fuzz::fail(fmt::format("accepted a fitness of {}", ind.result.fitness));
+  for (std::size_t k = 0; k < evo.history().size(); ++k)
+    if (evo.history()[k].generation != static_cast<int>(k)) fuzz::fail("accepted a history that does not count 0, 1, 2, ...");
   const std::string again = evo.checkpoint();
   Evolution copy(config, stub);
   try {

@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
+#include <cstring>
+#include <iterator>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -256,11 +259,18 @@ Config config_from_toml(std::string_view text, std::string_view source) {
 }
 
 Config load_config(const std::filesystem::path& path) {
+  // A directory opens as a stream on Linux and reads as nothing: it would be the default config.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw IoError(fmt::format("{}: cannot read config file: Is a directory", path.string()));
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(fmt::format("{}: cannot open config file", path.string()));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return config_from_toml(ss.str(), path.string());
+  if (!in)
+    throw IoError(fmt::format("{}: cannot open config file: {}", path.string(),
+                              errno ? std::strerror(errno) : "unknown error"));
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw IoError(fmt::format("{}: cannot read config file: {}", path.string(), std::strerror(errno)));
+  return config_from_toml(text, path.string());
 }
 
 std::string to_toml(const Config& config) {
@@ -352,6 +362,9 @@ void set_value(Config& config, std::string_view dotted, const ConfigValue& cv) {
       else if constexpr (std::is_same_v<T, std::vector<std::string>> && std::is_same_v<X, std::vector<double>>) ok = x.empty();
       else ok = false;
     }, cv);
+    if (!ok && std::is_same_v<T, int> && std::holds_alternative<std::int64_t>(cv))
+      throw ConfigError(fmt::format("{} = {}: out of the integer range, expected {}", dotted, std::get<std::int64_t>(cv),
+                                    info.bounds.describe()));
     if (!ok) throw ConfigError(fmt::format("{}: wrong type, expected {}", dotted, type_name<T>()));
     if (auto e = check(info, parsed); !e.empty()) throw ConfigError(fmt::format("{} = {}: {}", dotted, format_value(parsed), e));
     value = std::move(parsed);
@@ -427,6 +440,17 @@ void validate(const Config& config, std::string_view source) {
                      "Box2D steps per control step, more than physics.substeps allows (1000); lower one of them or "
                      "set evaluation.reference_check = \"off\"",
                      config.physics.substeps, config.evaluation.reference_substeps));
+}
+
+std::vector<std::string> config_differences(const Config& a, const Config& b) {
+  std::vector<std::string> out;
+  for (const auto& key : config_keys())
+    if (get_value(a, key) != get_value(b, key)) out.push_back(key);
+  return out;
+}
+
+std::string format_config_value(const ConfigValue& value) {
+  return std::visit([](const auto& v) { return format_value(v); }, value);
 }
 
 std::uint64_t config_hash(const Config& config) {

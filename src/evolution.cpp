@@ -11,7 +11,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <climits>
 #include <cstring>
+#include <ctime>
 #include <exception>
 #include <limits>
 #include <fstream>
@@ -68,6 +70,44 @@ void parallel_for(std::size_t n, int threads, Body&& body) {
     if (e) std::rethrow_exception(e);
 }
 
+// Watches a StopRequest during one parallel piece of work. Any thread may ask stopped(); only the
+// thread that created it (OpenMP's thread 0 of the regions it runs) calls the poll, at most every 20 ms.
+class StopWatch {
+ public:
+  explicit StopWatch(const StopRequest& request) : request_(request) {}
+  bool stopped() {
+    if (request_.empty()) return false;
+    if (stopped_.load(std::memory_order_relaxed)) return true;
+    if (request_.flag && request_.flag->load()) return stop();
+    if (request_.poll && omp_get_thread_num() == 0) {
+      const double t = now_seconds();
+      if (t - last_poll_ >= 0.02) {
+        last_poll_ = t;
+        if (request_.poll()) return stop();
+      }
+    }
+    return false;
+  }
+  /// Whether a stop was seen (no new poll).
+  [[nodiscard]] bool fired() const { return stopped_.load(); }
+
+ private:
+  bool stop() {
+    stopped_.store(true);
+    return true;
+  }
+  const StopRequest& request_;
+  std::atomic<bool> stopped_{false};
+  double last_poll_ = 0.0;  // touched by thread 0 only
+};
+
+// A fitness the GA can rank and a checkpoint can hold: finite and >= 0 (a distance).
+void check_fitness(const Fitness& f, std::string_view where) {
+  if (!std::isfinite(f.fitness) || f.fitness < 0.0)
+    throw Error(fmt::format("{}: the fitness function returned {}; a fitness must be finite and >= 0", where, f.fitness));
+  if (f.cell_count < 0) throw Error(fmt::format("{}: the fitness function returned cell_count {} (must be >= 0)", where, f.cell_count));
+}
+
 bool fitter(const Individual& a, const Individual& b) {
   if (a.result.viable != b.result.viable) return a.result.viable;
   return a.result.fitness > b.result.fitness;
@@ -107,14 +147,17 @@ bool reference_disagrees(double fitness, double reference, const EvaluationParam
   return diff > params.reference_abs_tolerance && diff > params.reference_tolerance * std::abs(reference);
 }
 
+const std::vector<std::string>& resumable_keys() {
+  static const std::vector<std::string> keys = {"evolution.generations", "evolution.stall_generations",
+                                                "evolution.wall_seconds", "evolution.threads",
+                                                "evolution.checkpoint_every"};
+  return keys;
+}
+
 std::uint64_t run_identity(const Config& config) {
   Config c = config;
-  const EvolutionParams defaults;
-  c.evolution.generations = defaults.generations;
-  c.evolution.stall_generations = defaults.stall_generations;
-  c.evolution.wall_seconds = defaults.wall_seconds;
-  c.evolution.threads = defaults.threads;
-  c.evolution.checkpoint_every = defaults.checkpoint_every;
+  const Config defaults;
+  for (const auto& key : resumable_keys()) set_value(c, key, get_value(defaults, key));
   return config_hash(c);
 }
 
@@ -157,19 +200,24 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
 void Evolution::initialize() {
   prepare_parallel_evaluation();
   const EvolutionParams& ep = config_->evolution;
-  population_.assign(static_cast<std::size_t>(ep.population), Individual{});
-  parallel_for(population_.size(), ep.threads, [&](std::size_t i) {
+  std::vector<Individual> population(static_cast<std::size_t>(ep.population));
+  StopWatch watch(stop_);
+  parallel_for(population.size(), ep.threads, [&](std::size_t i) {
     Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i);
-    Individual& ind = population_[i];
+    Individual& ind = population[i];
     for (ind.tries = 1; ind.tries <= ep.max_init_tries; ++ind.tries) {
+      if (watch.stopped()) return;
       ind.genome = random_genome(config_->genome, rng);
       ind.result = fitness_(ind.genome);
+      check_fitness(ind.result, fmt::format("initial population, individual {}", i));
       if (ind.result.viable) return;
     }
     throw Error(fmt::format("initial population: no viable random genome in evolution.max_init_tries = {} tries "
                             "(individual {}); the development or genome settings make viability too rare",
                             ep.max_init_tries, i));
   });
+  if (watch.fired()) throw Interrupted("interrupted while drawing the initial population");
+  population_ = std::move(population);
   for (const auto& ind : population_) evaluations_ += ind.tries;
   generation_ = 0;
   best_ever_ = best().result.fitness;
@@ -255,7 +303,13 @@ GenerationStats Evolution::step() {
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < n; ++i)
     if (needs_eval[i]) todo.push_back(i);
-  parallel_for(todo.size(), ep.threads, [&](std::size_t k) { next[todo[k]].result = fitness_(next[todo[k]].genome); });
+  StopWatch watch(stop_);
+  parallel_for(todo.size(), ep.threads, [&](std::size_t k) {
+    if (watch.stopped()) return;
+    next[todo[k]].result = fitness_(next[todo[k]].genome);
+    check_fitness(next[todo[k]].result, fmt::format("generation {}, individual {}", g, todo[k]));
+  });
+  if (watch.fired()) throw Interrupted(fmt::format("interrupted during generation {}", g));
   evaluations_ += static_cast<std::int64_t>(todo.size());
 
   const Genome previous_best = best().genome;
@@ -274,24 +328,35 @@ GenerationStats Evolution::step() {
   return history_.back();
 }
 
-GenerationStats Evolution::statistics(bool best_changed, double wall) const {
+namespace {
+// The population columns of a history row: best, best_cells, viable_fraction, mean, median.
+GenerationStats population_statistics(const std::vector<Individual>& population) {
   GenerationStats s;
-  s.generation = generation_;
   std::vector<double> viable;
-  for (const auto& ind : population_) {
+  for (const auto& ind : population) {
     if (ind.result.viable) viable.push_back(ind.result.fitness);
     if (ind.result.viable && (!ind.result.valid || !ind.result.stable)) ++s.invalid;
   }
-  const Individual& b = best();
+  // The first of the fittest, by index (as Evolution::best()).
+  const Individual& b = *std::min_element(population.begin(), population.end(),
+                                          [](const Individual& x, const Individual& y) { return fitter(x, y); });
   s.best = b.result.fitness;
   s.best_cells = b.result.cell_count;
-  s.viable_fraction = static_cast<double>(viable.size()) / static_cast<double>(population_.size());
+  s.viable_fraction = static_cast<double>(viable.size()) / static_cast<double>(population.size());
   if (!viable.empty()) {
     s.mean = std::accumulate(viable.begin(), viable.end(), 0.0) / static_cast<double>(viable.size());
     std::sort(viable.begin(), viable.end());
     const std::size_t m = viable.size() / 2;
     s.median = viable.size() % 2 ? viable[m] : 0.5 * (viable[m - 1] + viable[m]);
   }
+  return s;
+}
+}  // namespace
+
+GenerationStats Evolution::statistics(bool best_changed, double wall) const {
+  if (population_.empty()) throw Error("Evolution::statistics: the population is empty");
+  GenerationStats s = population_statistics(population_);
+  s.generation = generation_;
   s.evaluations = evaluations_;
   s.wall_seconds = wall;
   s.evaluations_per_second = wall > 0 ? static_cast<double>(evaluations_) / wall : 0.0;
@@ -360,6 +425,56 @@ GenerationStats stats_from_json(const json& j) {
   if (j.contains("best_reference")) s.best_reference = number_field(j, "best_reference");
   s.evaluations_per_second = s.wall_seconds > 0 ? static_cast<double>(s.evaluations) / s.wall_seconds : 0.0;
   return s;
+}
+
+// What a checksum cannot catch: a hand-edited checkpoint whose content the engine could never have
+// written. Everything is compared with what the engine computes from the same population and history.
+void check_semantics(const std::vector<Individual>& pop, const std::vector<GenerationStats>& hist, int stall,
+                     double best_ever, std::int64_t evaluations, double wall, std::string_view source) {
+  auto fail = [&](const std::string& what) { throw CheckpointError(fmt::format("{}: inconsistent checkpoint: {}", source, what)); };
+  for (std::size_t i = 0; i < pop.size(); ++i) {
+    const Fitness& f = pop[i].result;
+    if (f.fitness < 0.0) fail(fmt::format("individual {} has fitness {} (a fitness is >= 0)", i, f.fitness));
+    if (f.viable && pop[i].genome.elements.empty()) fail(fmt::format("individual {} is viable with an empty genome", i));
+  }
+  double best_so_far = -1.0;
+  int expected_stall = 0;
+  for (std::size_t k = 0; k < hist.size(); ++k) {
+    const GenerationStats& s = hist[k];
+    if (s.generation != static_cast<int>(k))
+      fail(fmt::format("history row {} is generation {}; the history must count 0, 1, 2, ... without gaps", k, s.generation));
+    if (s.best < 0.0 || s.mean < 0.0 || s.median < 0.0)
+      fail(fmt::format("history row {} has a negative fitness statistic", k));
+    if (!(s.viable_fraction >= 0.0 && s.viable_fraction <= 1.0))
+      fail(fmt::format("history row {} has viable_fraction {} (expected in [0, 1])", k, s.viable_fraction));
+    if (s.wall_seconds < 0.0) fail(fmt::format("history row {} has wall_seconds {} (expected >= 0)", k, s.wall_seconds));
+    if (k > 0 && s.evaluations < hist[k - 1].evaluations)
+      fail(fmt::format("history row {}: evaluations decrease ({} after {})", k, s.evaluations, hist[k - 1].evaluations));
+    if (k > 0 && s.wall_seconds < hist[k - 1].wall_seconds)
+      fail(fmt::format("history row {}: wall_seconds decrease ({} after {})", k, s.wall_seconds, hist[k - 1].wall_seconds));
+    if (k == 0 || s.best > best_so_far) {
+      best_so_far = s.best;
+      expected_stall = 0;
+    } else {
+      ++expected_stall;
+    }
+  }
+  if (best_ever != best_so_far)
+    fail(fmt::format("best_ever is {}, but the best of the history is {}", best_ever, best_so_far));
+  if (stall != expected_stall)
+    fail(fmt::format("stall is {}, but the history has {} generations without improvement", stall, expected_stall));
+  const GenerationStats& last = hist.back();
+  if (evaluations != last.evaluations)
+    fail(fmt::format("evaluations is {}, but the last history row counts {}", evaluations, last.evaluations));
+  if (wall != last.wall_seconds)
+    fail(fmt::format("wall_seconds is {}, but the last history row has {}", wall, last.wall_seconds));
+  const GenerationStats now = population_statistics(pop);
+  if (now.best != last.best || now.best_cells != last.best_cells || now.viable_fraction != last.viable_fraction ||
+      now.mean != last.mean || now.median != last.median)
+    fail(fmt::format("the last history row (generation {}: best {}, mean {}, median {}, viable {}, {} cells) does not "
+                     "describe the population (best {}, mean {}, median {}, viable {}, {} cells)",
+                     last.generation, last.best, last.mean, last.median, last.viable_fraction, last.best_cells, now.best,
+                     now.mean, now.median, now.viable_fraction, now.best_cells));
 }
 
 }  // namespace
@@ -447,13 +562,18 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     if (hist.back().generation != generation)
       throw CheckpointError(fmt::format("{}: checkpoint generation {} does not match its history, which ends at generation {}",
                                         source, generation, hist.back().generation));
+    const int stall = static_cast<int>(int_field(p, "stall", 0, kIntMax));
+    const double best_ever = number_field(p, "best_ever");
+    const std::int64_t evaluations = int_field(p, "evaluations", 0, kInt64Max);
+    const double wall = number_field(p, "wall_seconds");
+    check_semantics(pop, hist, stall, best_ever, evaluations, wall, source);
     population_ = std::move(pop);
     history_ = std::move(hist);
     generation_ = generation;
-    stall_ = static_cast<int>(int_field(p, "stall", 0, kIntMax));
-    best_ever_ = number_field(p, "best_ever");
-    evaluations_ = int_field(p, "evaluations", 0, kInt64Max);
-    wall_offset_ = number_field(p, "wall_seconds");
+    stall_ = stall;
+    best_ever_ = best_ever;
+    evaluations_ = evaluations;
+    wall_offset_ = wall;
     started_ = now_seconds();
   } catch (const CheckpointError& e) {
     if (std::string_view(e.what()).starts_with(source)) throw;
@@ -537,7 +657,66 @@ std::string duration(double s) {
 
 }  // namespace
 
-RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
+namespace {
+
+// A run directory the file system can hold: every component within NAME_MAX, the whole within PATH_MAX
+// (with room for "/best/gen_000000.json.tmp"). Checked before anything is created.
+void check_run_path(const std::filesystem::path& dir) {
+  auto shown = [](const std::string& s) { return s.size() > 60 ? s.substr(0, 57) + "..." : s; };
+  for (const auto& part : dir) {
+    const std::string name = part.string();
+    if (name.size() > static_cast<std::size_t>(NAME_MAX))
+      throw IoError(fmt::format("{}: a component of the run directory's path has {} characters; the file system allows "
+                                "at most {} (NAME_MAX)", shown(dir.string()), name.size(), NAME_MAX));
+  }
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(dir, ec);
+  const std::size_t length = (ec ? dir : absolute).string().size() + 32;
+  if (length > static_cast<std::size_t>(PATH_MAX))
+    throw IoError(fmt::format("{}: the run directory's path has {} characters; with its file names it must stay within "
+                              "{} (PATH_MAX)", shown(dir.string()), length - 32, PATH_MAX));
+}
+
+// Refuses a resume whose settings differ from the run's own config.toml in a key that defines the run,
+// naming every such key; returns the resumable keys that changed (accepted).
+std::vector<std::string> check_resume_settings(const Config& config, const std::filesystem::path& dir) {
+  const std::filesystem::path stored_path = dir / "config.toml";
+  std::error_code ec;
+  if (!std::filesystem::exists(stored_path, ec)) return {};  // the checkpoint's identity still decides
+  const Config stored = load_config(stored_path);
+  const auto& resumable = resumable_keys();
+  std::vector<std::string> refused, accepted;
+  for (const auto& key : config_differences(stored, config)) {
+    const bool may_change = std::find(resumable.begin(), resumable.end(), key) != resumable.end();
+    (may_change ? accepted : refused).push_back(key);
+  }
+  if (!refused.empty()) {
+    std::vector<std::string> parts;
+    for (const auto& key : refused)
+      parts.push_back(fmt::format("{} (the run has {}, this command gives {})", key,
+                                  format_config_value(get_value(stored, key)), format_config_value(get_value(config, key))));
+    throw ConfigError(fmt::format(
+        "{}: cannot resume with changed settings: {}. Only {} may change on resume; start a new run (another --out) "
+        "to change the others. Nothing was written.",
+        dir.string(), fmt::join(parts, ", "), fmt::join(resumable, ", ")));
+  }
+  return accepted;
+}
+
+std::string local_time_stamp() {
+  const std::time_t t = std::time(nullptr);
+  char stamp[32];
+  std::tm tm{};
+  localtime_r(&t, &tm);
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M:%S", &tm);
+  return stamp;
+}
+
+}  // namespace
+
+namespace {
+
+RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
   validate(config);
   FitnessFunction reference;
   if (!fitness) {  // the real swim: its exploit guard re-evaluates each new best at the reference step
@@ -545,28 +724,51 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     if (config.evaluation.reference_check != "off") reference = swim_fitness(reference_config(config));
   }
   Evolution evo(config, std::move(fitness), std::move(reference));
+  evo.set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
   const bool writing = !opt.out.empty();
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
+  // 1. Everything that can refuse the command, before any file is written.
+  std::vector<std::string> changed_on_resume;
+  if (opt.resume && !writing) throw Error("run_evolution: resume needs a run directory");
   if (writing) {
+    check_run_path(opt.out);
     std::error_code ec;
     if (opt.resume) {
-      if (!std::filesystem::is_directory(opt.out))
+      if (!std::filesystem::is_directory(opt.out, ec))
         throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
-      if (!std::filesystem::exists(ckpt))
+      if (!std::filesystem::exists(ckpt, ec))
         throw CheckpointError(fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
-    } else if (std::filesystem::exists(ckpt)) {
+      changed_on_resume = check_resume_settings(config, opt.out);
+      evo.restore(read_file(ckpt), ckpt.string());
+    } else if (std::filesystem::exists(ckpt, ec)) {
       throw IoError(fmt::format("{}: already holds a run (checkpoint.json); use --resume {} or another --out",
                                 opt.out.string(), opt.out.string()));
     }
+  }
+
+  // 2. Write.
+  if (writing) {
+    std::error_code ec;
     std::filesystem::create_directories(opt.out / "best", ec);
     if (ec) throw IoError(fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
+    if (!changed_on_resume.empty()) {
+      const Config stored = load_config(opt.out / "config.toml");
+      std::string note = fmt::format("{} resumed at generation {}:", local_time_stamp(), evo.generation());
+      for (const auto& key : changed_on_resume) {
+        note += fmt::format(" {} {} -> {};", key, format_config_value(get_value(stored, key)),
+                            format_config_value(get_value(config, key)));
+        if (!opt.quiet)
+          spdlog::info("resume: {} changed from {} to {}", key, format_config_value(get_value(stored, key)),
+                       format_config_value(get_value(config, key)));
+      }
+      note.back() = '\n';
+      append(opt.out / "resume.log", note);
+    }
     write_atomically(opt.out / "config.toml", to_toml(config));
   }
 
   if (opt.resume) {
-    if (!writing) throw Error("run_evolution: resume needs a run directory");
-    evo.restore(read_file(ckpt), ckpt.string());
     std::string rows(kHistoryHeader);
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
@@ -579,7 +781,14 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     if (!opt.quiet) spdlog::info("resumed {} at generation {}", opt.out.string(), evo.generation());
   } else {
     if (!opt.quiet) spdlog::info("drawing {} viable random individuals...", config.evolution.population);
-    evo.initialize();
+    try {
+      evo.initialize();
+    } catch (const Interrupted&) {
+      if (!opt.quiet) spdlog::info("stopped: interrupted before the initial population was complete (nothing to resume)");
+      RunSummary summary;
+      summary.stop_reason = "interrupted";
+      return summary;
+    }
     const auto tries = evo.initial_tries();
     const double mean_tries = std::accumulate(tries.begin(), tries.end(), 0.0) / static_cast<double>(tries.size());
     if (!opt.quiet)
@@ -625,9 +834,16 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
   bool dirty = false;
   while (true) {
     summary.stop_reason = evo.stop_reason();
-    if (summary.stop_reason.empty() && opt.stop_flag && opt.stop_flag->load()) summary.stop_reason = "interrupted";
+    if (summary.stop_reason.empty() && ((opt.stop_flag && opt.stop_flag->load()) || (opt.stop_poll && opt.stop_poll())))
+      summary.stop_reason = "interrupted";
     if (!summary.stop_reason.empty()) break;
-    const GenerationStats s = evo.step();
+    GenerationStats s;
+    try {
+      s = evo.step();
+    } catch (const Interrupted&) {
+      summary.stop_reason = "interrupted";  // the generation in progress is dropped; resuming recomputes it
+      break;
+    }
     report(s, false);
     guard(s);
     if (writing) {
@@ -651,6 +867,16 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
   summary.history = evo.history();
   summary.best = evo.best();
   return summary;
+}
+
+}  // namespace
+
+RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
+  try {
+    return run_evolution_unchecked(config, opt, std::move(fitness));
+  } catch (const std::filesystem::filesystem_error& e) {  // never an "internal error": name the path and the reason
+    throw IoError(fmt::format("{}: {}", e.path1().string(), e.code().message()));
+  }
 }
 
 }  // namespace animat

@@ -375,6 +375,9 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
 }
 
 Genome load_genome(const std::filesystem::path& path, const GenomeParams& params) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw IoError(fmt::format("{}: cannot read genome file: Is a directory", path.string()));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(fmt::format("{}: cannot open genome file", path.string()));
   std::ostringstream ss;

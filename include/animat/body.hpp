@@ -17,8 +17,8 @@ struct BodyParams {
 
 template <class V>
 void visit_fields(BodyParams& p, V&& v) {
-  v(FieldInfo{"merge_distance", "centres closer than this are duplicates and are rejected [choose]", Bounds::non_negative()}, p.merge_distance);
-  v(FieldInfo{"max_coordinate", "coordinates beyond this magnitude are rejected [choose]", Bounds::positive()}, p.max_coordinate);
+  v(FieldInfo{"merge_distance", "centres closer than this are duplicates and are rejected [choose]", Bounds::upto(kMaxLength)}, p.merge_distance);
+  v(FieldInfo{"max_coordinate", "coordinates beyond this magnitude are rejected [choose]", Bounds::positive_upto(kMaxLength)}, p.max_coordinate);
 }
 
 /// The spring-mass structure an embryo becomes.

@@ -61,6 +61,10 @@ void set_value(Config& config, std::string_view dotted_key, const ConfigValue& v
 [[nodiscard]] std::string config_doc(std::string_view dotted_key);
 /// Checks every field's range and the cross-field rules; throws ConfigError naming the key.
 void validate(const Config& config, std::string_view source = "config");
+/// The keys whose values differ between a and b, in config order (as "section.key").
+[[nodiscard]] std::vector<std::string> config_differences(const Config& a, const Config& b);
+/// A value as the TOML form writes it (for messages).
+[[nodiscard]] std::string format_config_value(const ConfigValue& value);
 /// Stable 64-bit hash of the resolved config (FNV-1a of to_toml), for checkpoints.
 [[nodiscard]] std::uint64_t config_hash(const Config& config);
 

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "animat/errors.hpp"
 #include "animat/genome.hpp"
 #include "animat/params.hpp"
 
@@ -39,8 +40,8 @@ void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"check_embedding", "check after every step that no region is inverted and the skin is a simple polygon; a swim that breaks it gets fitness 0", Bounds::any()}, p.check_embedding);
   v(FieldInfo{"reference_check", "exploit guard: re-evaluate each new best at a finer step and record both fitnesses (record), also rank elites by it (select), or off", Bounds::any(), kReferenceCheckNames}, p.reference_check);
   v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
-  v(FieldInfo{"reference_tolerance", "warn when the best's fitness and its reference differ by more than this fraction...", Bounds::non_negative()}, p.reference_tolerance);
-  v(FieldInfo{"reference_abs_tolerance", "...and by more than this many length units", Bounds::non_negative()}, p.reference_abs_tolerance);
+  v(FieldInfo{"reference_tolerance", "warn when the best's fitness and its reference differ by more than this fraction...", Bounds::upto(1e6)}, p.reference_tolerance);
+  v(FieldInfo{"reference_abs_tolerance", "...and by more than this many length units", Bounds::upto(kMaxLength)}, p.reference_abs_tolerance);
 }
 
 struct Config;
@@ -78,7 +79,7 @@ void visit_fields(EvolutionParams& p, V&& v) {
   v(FieldInfo{"tournament_ramp_generations", "generations of the linear ramp [paper: 1000]", Bounds::closed(0, 100000000)}, p.tournament_ramp_generations);
   v(FieldInfo{"generations", "generation cap; 0 = no cap", Bounds::closed(0, 100000000)}, p.generations);
   v(FieldInfo{"stall_generations", "stop after this many generations without improvement [paper: 500]; 0 = never", Bounds::closed(0, 100000000)}, p.stall_generations);
-  v(FieldInfo{"wall_seconds", "wall-clock budget in seconds; 0 = none", Bounds::non_negative()}, p.wall_seconds);
+  v(FieldInfo{"wall_seconds", "wall-clock budget in seconds; 0 = none", Bounds::upto(1e10)}, p.wall_seconds);
   v(FieldInfo{"threads", "OpenMP threads; 0 = all cores", Bounds::closed(0, 1024)}, p.threads);
   v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000)}, p.checkpoint_every);
   v(FieldInfo{"max_init_tries", "tries to find one viable random individual before giving up", Bounds::closed(1, 1000000000)}, p.max_init_tries);
@@ -137,6 +138,24 @@ struct GenerationStats {
 [[nodiscard]] std::size_t tournament(const std::vector<Individual>& population, const std::vector<std::size_t>& eligible,
                                      double p_fitter, Rng& rng);
 
+/// A run (or its initial population, or one generation) stopped by a StopRequest before it finished;
+/// what was completed before it is kept (see Evolution::initialize and Evolution::step).
+struct Interrupted : Error {
+  using Error::Error;
+};
+
+/// Asks a running evolution to stop early. Checked between evaluations and between the random genomes
+/// drawn for the initial population, so a stop is honoured within one evaluation (27 ms at the paper's
+/// setting), not only between generations.
+struct StopRequest {
+  const std::atomic<bool>* flag = nullptr;  ///< set asynchronously (a signal handler, another thread)
+  /// Called on the thread that runs the evolution only, about every 20 ms while it works (e.g. Python's
+  /// PyErr_CheckSignals with the GIL briefly acquired); returning true stops the run. Must not throw.
+  std::function<bool()> poll;
+
+  [[nodiscard]] bool empty() const { return flag == nullptr && !poll; }
+};
+
 /// Calls once, before any parallel region: Box2D's lazily-initialised globals (MODEL.md Traps).
 void prepare_parallel_evaluation();
 
@@ -153,10 +172,16 @@ class Evolution {
   /// none, evaluation.reference_check has no effect.
   Evolution(const Config& config, FitnessFunction fitness, FitnessFunction reference = {});
 
-  /// Draws the initial population: random genomes regenerated until viable.
+  /// Draws the initial population: random genomes regenerated until viable. Throws Interrupted (and
+  /// stays uninitialised) if the stop request fires first.
   void initialize();
-  /// Makes and evaluates the next generation; returns its statistics.
+  /// Makes and evaluates the next generation; returns its statistics. Throws Interrupted if the stop
+  /// request fires before the generation is complete: the state stays at the previous generation
+  /// (resuming recomputes the same generation, every random number derives from (seed, g, i)).
+  /// Throws Error if the fitness function returns a non-finite or negative fitness.
   GenerationStats step();
+  /// Checked by initialize() and step() (see StopRequest); empty = never stop.
+  void set_stop(StopRequest stop) { stop_ = std::move(stop); }
   /// Why the run should stop now ("" = keep going): stall, generation cap or wall-clock budget.
   [[nodiscard]] std::string stop_reason() const;
 
@@ -169,7 +194,11 @@ class Evolution {
   /// Tries per initial individual (paper: "a few hundred").
   [[nodiscard]] std::vector<int> initial_tries() const;
 
-  /// Whole state as JSON text with a checksum; restore() refuses a corrupt or mismatched one.
+  /// Whole state as JSON text with a checksum; restore() refuses a corrupt or mismatched one, and one
+  /// whose content is inconsistent even with a valid checksum (hand-edited): a fitness that is not
+  /// finite and >= 0, a genome that does not validate or is empty, a history that does not count
+  /// 0, 1, ..., generation or whose last row disagrees with the population, a population of the wrong
+  /// size, a best_ever or stall counter that the history contradicts.
   [[nodiscard]] std::string checkpoint() const;
   void restore(std::string_view checkpoint_text, std::string_view source = "checkpoint");
 
@@ -196,11 +225,15 @@ class Evolution {
   std::int64_t evaluations_ = 0;
   double wall_offset_ = 0.0;
   double started_ = 0.0;
+  StopRequest stop_;
 };
 
-/// Hash of what defines a run: the config minus its stopping and resource knobs (generations,
-/// stall_generations, wall_seconds, threads, checkpoint_every), so a resumed run may extend its cap.
+/// Hash of what defines a run: the config minus its stopping and resource knobs (resumable_keys()),
+/// so a resumed run may extend its cap.
 [[nodiscard]] std::uint64_t run_identity(const Config& config);
+/// The config keys that may change when a run is resumed (caps, budgets, threads, checkpoint interval);
+/// every other key is part of run_identity().
+[[nodiscard]] const std::vector<std::string>& resumable_keys();
 
 /// Options of a run on disk (animat_evolve and animat.evolve).
 struct RunOptions {
@@ -209,6 +242,8 @@ struct RunOptions {
   bool quiet = false;
   double progress_interval = 1.0;      ///< seconds between progress lines
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
+  /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint and stop.
+  std::function<bool()> stop_poll;
   /// Called after every generation; return false to stop (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;
 };
@@ -220,6 +255,13 @@ struct RunSummary {
 };
 
 /// Runs (or resumes) an evolution, writing config.toml, history.csv, best/ lineage and checkpoints.
+/// Everything that can refuse the command is checked before any file is written: the run directory
+/// (path length, an existing run, a missing checkpoint), and on resume the checkpoint itself and the
+/// settings, which may differ from the run's config.toml only in resumable_keys() (the others are
+/// named in the ConfigError). Accepted changes are written to config.toml and noted in resume.log.
+/// A stop (stop_flag, stop_poll, or the callback returning false) leaves a checkpoint of the last
+/// complete generation; stop_reason is then "interrupted" (history empty if it came before
+/// generation 0 was complete, and nothing to resume).
 RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {});
 
 }  // namespace animat

@@ -83,9 +83,9 @@ struct MutationParams {
 template <class V>
 void visit_fields(GenomeParams& p, V&& v) {
   v(FieldInfo{"dimensions", "dimension N of the affinity space [paper: 2]", Bounds::closed(1, 16)}, p.dimensions);
-  v(FieldInfo{"coord_range", "random coordinates are uniform in [0, coord_range)^N [choose]", Bounds::positive()}, p.coord_range);
-  v(FieldInfo{"affinity_decay", "exponential decay rate of the affinity with distance [choose]", Bounds::positive()}, p.affinity_decay);
-  v(FieldInfo{"affinity_cutoff", "distance at which the affinity reaches exactly 0 [choose]", Bounds::positive()}, p.affinity_cutoff);
+  v(FieldInfo{"coord_range", "random coordinates are uniform in [0, coord_range)^N [choose]", Bounds::positive_upto(kMaxLength)}, p.coord_range);
+  v(FieldInfo{"affinity_decay", "exponential decay rate of the affinity with distance [choose]", Bounds::closed(1e-6, 1e6)}, p.affinity_decay);
+  v(FieldInfo{"affinity_cutoff", "distance at which the affinity reaches exactly 0 [choose]", Bounds::closed(1e-6, 1e6)}, p.affinity_cutoff);
   v(FieldInfo{"initial_units", "regulatory units (promoter + gene) in a random genome [paper: 10]", Bounds::closed(0, 1000)}, p.initial_units);
   v(FieldInfo{"morphogen_gene_probability", "chance that a random gene codes for a morphogen [choose]", Bounds::unit()}, p.morphogen_gene_probability);
   v(FieldInfo{"max_elements", "safety cap on genome length; longer genomes are rejected [choose]", Bounds::closed(1, 1000000)}, p.max_elements);
@@ -96,7 +96,7 @@ void visit_fields(MutationParams& p, V&& v) {
   v(FieldInfo{"type_rate", "per-element probability of a type change [choose]", Bounds::unit()}, p.type_rate);
   v(FieldInfo{"sign_rate", "per-element probability of a sign flip [choose]", Bounds::unit()}, p.sign_rate);
   v(FieldInfo{"move_rate", "per-element probability of a coordinate move [choose]", Bounds::unit()}, p.move_rate);
-  v(FieldInfo{"move_sigma", "std. dev. of the normally distributed move distance [choose]", Bounds::non_negative()}, p.move_sigma);
+  v(FieldInfo{"move_sigma", "std. dev. of the normally distributed move distance [choose]", Bounds::upto(kMaxLength)}, p.move_sigma);
   v(FieldInfo{"duplicate_rate", "per-genome probability of duplicating a series [choose]", Bounds::unit()}, p.duplicate_rate);
   v(FieldInfo{"delete_rate", "per-genome probability of deleting a series [choose]", Bounds::unit()}, p.delete_rate);
   v(FieldInfo{"max_series_length", "longest series duplicated or deleted at once [choose]", Bounds::closed(1, 1000)}, p.max_series_length);

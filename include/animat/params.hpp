@@ -28,6 +28,10 @@ struct Bounds {
   static constexpr Bounds closed(double a, double b) { return {a, b, false, false}; }
   static constexpr Bounds at_least(double a) { return {a, std::numeric_limits<double>::infinity(), false, false}; }
   static constexpr Bounds unit() { return closed(0.0, 1.0); }
+  /// (0, b]: a strictly positive quantity with a representable maximum.
+  static constexpr Bounds positive_upto(double b) { return {0.0, b, true, false}; }
+  /// [0, b].
+  static constexpr Bounds upto(double b) { return closed(0.0, b); }
 
   [[nodiscard]] bool contains(double x) const {
     if (std::isnan(x)) return false;
@@ -37,6 +41,21 @@ struct Bounds {
   }
   [[nodiscard]] std::string describe() const;
 };
+
+/// Limits derived from what the code can represent (docs/reliability.md, "Bounds from
+/// representation"). Cell positions, forces, masses, damping and time steps reach Box2D as float
+/// (FLT_MAX = 3.4e38, b2Assert(b2IsValid(...)) on positions and damping); a mass below FLT_MIN would
+/// become 0, which Box2D silently replaces by 1. With every length <= kMaxLength, every coefficient
+/// (stiffness, damping, drag, pressure, force cap, frequency) <= kMaxCoefficient and every mass in
+/// [kMinMass, kMaxMass], the largest development force on a cell (4095 neighbours x 1e12 x an overlap
+/// of 2.2e7) is 9e22 and the velocity it adds in one step at most 9e34, below FLT_MAX; the swim checks
+/// every step in double before Box2D sees it (physics.cpp, check_forces).
+inline constexpr double kMaxLength = 1e6;
+inline constexpr double kMaxCoefficient = 1e12;
+inline constexpr double kMinMass = 1e-12;
+inline constexpr double kMaxMass = 1e12;
+/// Shortest Box2D time step: 1/dt stays finite in float, and a step is not rounded to 0.
+inline constexpr double kMinTimeStep = 1e-9;
 
 /// Static description of one field: name, meaning, allowed values.
 struct FieldInfo {

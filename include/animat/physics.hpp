@@ -46,7 +46,7 @@ struct PhysicsParams {
 
 template <class V>
 void visit_fields(PhysicsParams& p, V&& v) {
-  v(FieldInfo{"dt", "control time step in simulated time units [choose]", Bounds{0.0, 1.0, true, false}}, p.dt);
+  v(FieldInfo{"dt", "control time step in simulated time units [choose]", Bounds::closed(kMinTimeStep, 1.0)}, p.dt);
   v(FieldInfo{"substeps", "Box2D steps per control step, forces recomputed each [choose]", Bounds::closed(1, 1000)}, p.substeps);
   v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.velocity_iterations);
   v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.position_iterations);

@@ -56,16 +56,21 @@ class Rng {
   double uniform() { return static_cast<double>((*this)() >> 11) * 0x1.0p-53; }
   /// Uniform double in [a, b).
   double uniform(double a, double b) { return a + (b - a) * uniform(); }
-  /// Uniform integer in [0, n) without modulo bias; n > 0.
+  /// Uniform integer in [0, n) without modulo bias; n > 0 (n = 0 gives 0 and draws nothing).
   std::uint64_t below(std::uint64_t n) {
+    if (n == 0) return 0;
     const std::uint64_t limit = max() - max() % n;
     std::uint64_t x;
     do { x = (*this)(); } while (x >= limit);
     return x % n;
   }
-  /// Uniform integer in [a, b] inclusive.
+  /// Uniform integer in [a, b] inclusive; a <= b (callers check; a > b gives a and draws nothing). The span is
+  /// computed in unsigned arithmetic, so the whole int64 range is allowed.
   std::int64_t integer(std::int64_t a, std::int64_t b) {
-    return a + static_cast<std::int64_t>(below(static_cast<std::uint64_t>(b - a) + 1));
+    if (a > b) return a;
+    const std::uint64_t span = static_cast<std::uint64_t>(b) - static_cast<std::uint64_t>(a);  // b - a, no overflow
+    const std::uint64_t offset = span == max() ? (*this)() : below(span + 1);
+    return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) + offset);  // wraps to the exact result
   }
   bool bernoulli(double p) { return uniform() < p; }
   /// Standard normal deviate (Marsaglia polar method, no cached spare: state is only s_).

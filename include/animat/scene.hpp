@@ -63,18 +63,18 @@ struct SceneParams {
 template <class V>
 void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"effects", "effects simulated while swimming", Bounds::any(), kSceneEffectNames}, p.effects);
-  v(FieldInfo{"cell_mass", "mass of every cell, the mass unit [paper: equal masses; value: choose]", Bounds::positive()}, p.cell_mass);
-  v(FieldInfo{"spring_stiffness", "Hooke stiffness k of every spring [choose]", Bounds::non_negative()}, p.spring_stiffness);
-  v(FieldInfo{"spring_damping", "damping coefficient of every spring, force per unit stretching speed [choose]", Bounds::non_negative()}, p.spring_damping);
-  v(FieldInfo{"pressure", "region pressure coefficient c_p of eq. 3 [choose]", Bounds::non_negative()}, p.pressure);
-  v(FieldInfo{"pressure_area_floor", "eq. 3 uses max(S0, floor*(longest rest edge)^2) as its denominator, so sliver regions stay stable [choose]", Bounds::non_negative()}, p.pressure_area_floor);
-  v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]", Bounds::non_negative()}, p.drag_normal);
-  v(FieldInfo{"drag_tangential", "tangential drag coefficient d_T of eq. 4; negative = drag_normal/200 [paper: d_N/200]", Bounds::at_least(-1.0)}, p.drag_tangential);
+  v(FieldInfo{"cell_mass", "mass of every cell, the mass unit [paper: equal masses; value: choose]", Bounds::closed(kMinMass, kMaxMass)}, p.cell_mass);
+  v(FieldInfo{"spring_stiffness", "Hooke stiffness k of every spring [choose]", Bounds::upto(kMaxCoefficient)}, p.spring_stiffness);
+  v(FieldInfo{"spring_damping", "damping coefficient of every spring, force per unit stretching speed [choose]", Bounds::upto(kMaxCoefficient)}, p.spring_damping);
+  v(FieldInfo{"pressure", "region pressure coefficient c_p of eq. 3 [choose]", Bounds::upto(kMaxCoefficient)}, p.pressure);
+  v(FieldInfo{"pressure_area_floor", "eq. 3 uses max(S0, floor*(longest rest edge)^2) as its denominator, so sliver regions stay stable [choose]", Bounds::upto(kMaxLength)}, p.pressure_area_floor);
+  v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]", Bounds::upto(kMaxCoefficient)}, p.drag_normal);
+  v(FieldInfo{"drag_tangential", "tangential drag coefficient d_T of eq. 4; negative = drag_normal/200 [paper: d_N/200]", Bounds::closed(-1.0, kMaxCoefficient)}, p.drag_tangential);
   v(FieldInfo{"collision_edges", "edges a cell may not cross (effect collisions): all springs, or skin edges only [choose]", Bounds::any(), kCollisionEdgeNames}, p.collision_edges);
   v(FieldInfo{"collision_restitution", "normal restitution of cell-edge collisions: 1 = elastic [paper: elastic]", Bounds::unit()}, p.collision_restitution);
   v(FieldInfo{"collision_tolerance", "a cell closer than this to an edge it is not an end of collides (length units) [choose]", Bounds{0.0, 0.1, true, false}}, p.collision_tolerance);
-  v(FieldInfo{"collision_stiffness", "penalty stiffness of the optional skin_collision effect (a soft force, lets cells through) [choose]", Bounds::non_negative()}, p.collision_stiffness);
-  v(FieldInfo{"collision_radius", "distance from a skin edge where the skin_collision penalty starts [choose]", Bounds::non_negative()}, p.collision_radius);
+  v(FieldInfo{"collision_stiffness", "penalty stiffness of the optional skin_collision effect (a soft force, lets cells through) [choose]", Bounds::upto(kMaxCoefficient)}, p.collision_stiffness);
+  v(FieldInfo{"collision_radius", "distance from a skin edge where the skin_collision penalty starts [choose]", Bounds::upto(kMaxLength)}, p.collision_radius);
 }
 
 [[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {

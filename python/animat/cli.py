@@ -156,6 +156,9 @@ def main(argv: Optional[List[str]] = None) -> int:
                "experiment": cmd_experiment}[args.command]
     try:
         return command(args)
+    except KeyboardInterrupt as e:
+        print(f"animat {args.command}: {e or 'interrupted'}", file=sys.stderr)
+        return 130
     except (FileNotFoundError, NotADirectoryError, ValueError, RuntimeError, OSError) as e:
         print(f"animat {args.command}: error: {e}", file=sys.stderr)
         return 1

@@ -35,9 +35,12 @@ class RunRecord:
     wall_seconds: float
 
 
-def _run_one(config: "_core.Config", out: Path, index: int, quiet: bool) -> RunRecord:
+def _run_one(config: "_core.Config", out: Path, index: int, quiet: bool,
+             stop: Optional[threading.Event] = None) -> Optional[RunRecord]:
     resume = (out / "checkpoint.json").exists()
-    result = _core.evolve(config, out=str(out), resume=resume, quiet=quiet)
+    result = _core.evolve(config, out=str(out), resume=resume, quiet=quiet, stop=stop)
+    if not result.history:  # stopped before its initial population was complete: nothing to record
+        return None
     last = result.history[-1]
     return RunRecord(index=index, seed=int(config["evolution.seed"]), path=str(out), best=last.best,
                      generations=last.generation, best_cells=last.best_cells, stop_reason=result.stop_reason,
@@ -83,32 +86,65 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
     errors: List[BaseException] = []
     lock = threading.Lock()
     pending = list(range(runs))
+    # The runs live in worker threads, where Ctrl-C is not delivered: the main thread catches it and
+    # sets `stop`, which every running evolve polls between evaluations (each writes its checkpoint).
+    stop = threading.Event()
+
+    # Thread.join() interrupted by Ctrl-C can mark a running thread as stopped (CPython issue 90882), so
+    # the main thread waits on this event instead, set by the last worker to finish.
+    active = [0]
+    all_done = threading.Event()
 
     def worker():
+        try:
+            work()
+        finally:
+            with lock:
+                active[0] -= 1
+                if active[0] == 0:
+                    all_done.set()
+
+    def work():
         while True:
             with lock:
-                if not pending or errors:
+                if not pending or errors or stop.is_set():
                     return
                 i = pending.pop(0)
             cfg = base.copy()
             cfg["evolution.seed"] = int(base["evolution.seed"]) + i
             try:
-                records[i] = _run_one(cfg, root / f"run_{i}", i, quiet)
-                if not quiet:
+                records[i] = _run_one(cfg, root / f"run_{i}", i, quiet, stop)
+                if not quiet and records[i] is not None:
                     print(f"run {i}: best {records[i].best:.4f} after {records[i].generations} generations "
                           f"({records[i].stop_reason})", flush=True)
             except BaseException as e:  # noqa: BLE001 - reported after the other runs stop
                 with lock:
                     errors.append(e)
+                stop.set()  # one failed run stops the others cleanly too
 
-    workers = [threading.Thread(target=worker) for _ in range(min(parallel, runs))]
+    workers = [threading.Thread(target=worker, name=f"animat-experiment-{k}") for k in range(min(parallel, runs))]
+    active[0] = len(workers)
     for w in workers:
         w.start()
+    interrupted = False
+    try:
+        while not all_done.wait(0.1):
+            pass
+    except KeyboardInterrupt:
+        interrupted = True
+        stop.set()
+        while not all_done.wait(0.1):
+            pass
     for w in workers:
         w.join()
+    done = [r for r in records if r is not None]
+    if interrupted:
+        if done:
+            write_summary(root, config_path, done)
+        raise KeyboardInterrupt(f"experiment {root}: interrupted; every run stopped with a checkpoint of its last "
+                                f"complete generation; run the same command again to resume")
     if errors:
         raise errors[0]
-    done = [r for r in records if r is not None]
     write_summary(root, config_path, done)
     return done
 

@@ -1,6 +1,7 @@
 // animat_evolve: run an evolution experiment (paper §5) from the embedded default or a TOML config.
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -26,19 +27,31 @@ std::string default_run_dir(std::int64_t seed) {
   return "runs/" + std::string(stamp) + "-seed" + std::to_string(seed);
 }
 
+// The seed as given: digits only, within int64 (an error, never a clamp).
+std::int64_t parse_seed(const std::string& text) {
+  std::int64_t value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec == std::errc::result_out_of_range)
+    throw animat::ConfigError("--seed " + text + ": evolution.seed is out of range: expected an integer in [0, 9223372036854775807]");
+  if (ec != std::errc() || ptr != end || value < 0)
+    throw animat::ConfigError("--seed " + text + ": evolution.seed must be an integer in [0, 9223372036854775807]");
+  return value;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"animat_evolve: co-evolve the morphology and control of soft-bodied swimmers (Joachimczak & Wrobel 2012)"};
-  std::string config_path, out_dir, resume_dir, log_level = "info";
+  std::string config_path, out_dir, resume_dir, log_level = "info", seed_text;
   std::vector<std::string> overrides;
-  std::int64_t seed = -1;
   int generations = -1, threads = -1;
   bool print_config = false, quiet = false;
   app.add_option("--config", config_path, "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
       ->check(CLI::ExistingFile);
   app.add_option("--set", overrides, "override one value: section.key=value (repeatable)");
-  app.add_option("--seed", seed, "run seed (evolution.seed)")->check(CLI::NonNegativeNumber);
+  // Read as text: CLI11 would clamp a seed beyond int64 to 2^63-1 silently.
+  app.add_option("--seed", seed_text, "run seed (evolution.seed), an integer in [0, 2^63-1]");
   app.add_option("--generations", generations, "generation cap, 0 = none (evolution.generations)")->check(CLI::NonNegativeNumber);
   app.add_option("--threads", threads, "OpenMP threads, 0 = all cores (evolution.threads)")->check(CLI::NonNegativeNumber);
   app.add_option("--out", out_dir, "run directory to write (default: runs/<time>-seed<seed>)");
@@ -61,14 +74,16 @@ int main(int argc, char** argv) {
     animat::Config config;
     if (!resume_dir.empty()) {
       const auto base = std::filesystem::path(resume_dir) / "config.toml";
-      if (!std::filesystem::is_directory(resume_dir))
-        throw animat::IoError(resume_dir + ": resume directory does not exist");
+      std::error_code ec;
+      if (!std::filesystem::is_directory(resume_dir, ec))
+        throw animat::IoError(resume_dir + ": resume directory does not exist" +
+                              (ec && ec != std::errc::no_such_file_or_directory ? " (" + ec.message() + ")" : ""));
       config = animat::load_config(base);
     } else if (!config_path.empty()) {
       config = animat::load_config(config_path);
     }
     for (const auto& o : overrides) animat::apply_override(config, o);
-    if (seed >= 0) config.evolution.seed = seed;
+    if (!seed_text.empty()) config.evolution.seed = parse_seed(seed_text);
     if (generations >= 0) config.evolution.generations = generations;
     if (threads >= 0) config.evolution.threads = threads;
     animat::validate(config, "command line");
@@ -89,6 +104,11 @@ int main(int argc, char** argv) {
                    ANIMAT_VERSION, config.evolution.population, config.development.max_cells, config.scene.drag_normal,
                    config.evaluation.steps, config.evolution.seed, options.out.string());
     const animat::RunSummary summary = animat::run_evolution(config, options);
+    if (summary.history.empty()) {  // stopped while the initial population was drawn
+      std::printf("\nStopped: %s, before the initial population was complete; nothing to resume (run the same "
+                  "command again to start over)\n", summary.stop_reason.c_str());
+      return 130;
+    }
     const auto& best = summary.best;
     std::printf("\nBest swimmer: fitness %.4f (distance travelled by the centre of mass), %d cells, generation %d\n",
                 best.result.fitness, best.result.cell_count, summary.history.back().generation);

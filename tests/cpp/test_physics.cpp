@@ -873,9 +873,14 @@ TEST(Errors, SpeedCapIsDetectedNotClamped) {
 }
 
 TEST(Errors, NonFiniteStateIsDetected) {
-  SceneParams scene = scene_with({"springs"});
-  scene.spring_stiffness = 1e308;
-  Simulation sim(two_nodes(3.0, 1.0), scene);
+  // Config bounds keep the built-in effects finite (a stiffness of 1e308 is refused), so a custom
+  // effect plants the non-finite force.
+  struct NanForce : Effect {
+    std::string_view name() const override { return "nan_force"; }
+    void apply(SwimState& s) override { s.fx[0] = std::numeric_limits<double>::quiet_NaN(); }
+  };
+  Simulation sim(two_nodes(3.0, 1.0), scene_with({"springs"}));
+  sim.add_effect(std::make_unique<NanForce>());
   try {
     sim.step();
     FAIL() << "expected SimulationError";

@@ -162,7 +162,7 @@ def test_toml_round_trip_default_and_non_default(tmp_path):
     assert animat.Config.from_toml(c.to_toml()) == c
     c["grn.dt"] = 0.1 + 0.2  # 0.30000000000000004
     c["scene.drag_normal"] = 1.0 / 3.0
-    c["genome.affinity_decay"] = 1e-300
+    c["development.adhesion_range"] = 5e-324  # a tiny value (genome.affinity_decay is >= 1e-6 now)
     c["evolution.seed"] = 2**62
     c["physics.drag_scheme"] = "explicit"
     c["scene.effects"] = []

@@ -71,7 +71,7 @@ def test_run_directory_layout_and_resume(tmp_path):
 
     other = small_config(generations=4)
     other["scene.drag_normal"] = 10.0
-    with pytest.raises(ValueError, match="different run configuration"):
+    with pytest.raises(ValueError, match=r"cannot resume with changed settings: scene\.drag_normal"):
         animat.evolve(other, out=str(out), resume=True)
 
 

@@ -1,0 +1,878 @@
+// Reliability, round 2 (issue 15): no refused command may damage a run, no accepted value may crash,
+// every stop signal is honoured. docs/reliability.md lists each attack with its count and test.
+//
+//   ConfigSweep.*      every config key (iterated through visit_fields, so new keys are covered) at its
+//                      bounds and just beyond: refused values name the key (set_value, TOML, the CLI)
+//                      and change no file of a run; accepted values evaluate and evolve without a
+//                      signal, in a child process
+//   ResumeSettings.*   --resume with changed settings: refused before any write, naming the keys;
+//                      resumable keys accepted and recorded
+//   StopRequests.*     stops honoured within a second: seeding, evaluation, the CLI
+//   CheckpointMeaning.* checkpoints with a valid checksum but a content the engine cannot have written
+//   Rows.*             the other rows of the issue's table
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cfloat>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluate.hpp"
+#include "animat/evolution.hpp"
+#include "animat/genome.hpp"
+#include "animat/random.hpp"
+#include "test_support.hpp"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define ANIMAT_TEST_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define ANIMAT_TEST_SANITIZED 1
+#endif
+#endif
+#ifndef ANIMAT_TEST_SANITIZED
+#define ANIMAT_TEST_SANITIZED 0
+#endif
+
+namespace fs = std::filesystem;
+using namespace animat;
+using nlohmann::json;
+using animat::test::slurp;
+using animat::test::spit;
+using animat::test::stub_fitness;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+fs::path fresh_dir(const std::string& name) { return animat::test::fresh_dir("animat_hard_", name); }
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// Every file under `dir` with its content: a refused command must leave this unchanged.
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    out[fs::relative(e.path(), dir).string()] = e.is_regular_file() ? slurp(e.path()) : std::string("<dir>");
+  return out;
+}
+
+struct Shell {
+  int rc = 0;
+  std::string err;
+  double seconds = 0.0;
+};
+
+/// Runs argv (no shell) with stdout discarded; returns the exit status (128 + signal if killed).
+Shell run_exe(const std::vector<std::string>& args) {
+  const fs::path errfile = fresh_dir("stderr.txt");
+  const auto t0 = Clock::now();
+  std::fflush(nullptr);  // the child must not write the parent's buffered output again
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    if (!freopen("/dev/null", "w", stdout) || !freopen(errfile.c_str(), "w", stderr)) _exit(125);
+    execv(argv[0], argv.data());
+    _exit(126);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  Shell r;
+  r.seconds = seconds_since(t0);
+  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.err = slurp(errfile);
+  fs::remove(errfile);
+  return r;
+}
+
+const std::string kExe = ANIMAT_EVOLVE_EXE;
+
+/// A small real run on disk (the CLI), made once per test process.
+const fs::path& small_run() {
+  static const fs::path dir = [] {
+    const fs::path d = fresh_dir("run");
+    const Shell r = run_exe({kExe, "--quiet", "--threads", "1", "--seed", "3", "--set", "evolution.population=4",
+                             "--set", "evaluation.steps=50", "--generations", "1", "--out", d.string()});
+    EXPECT_EQ(r.rc, 0) << r.err;
+    return d;
+  }();
+  return dir;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Child processes: a crash (signal) in the code under test must fail the test, not kill it.
+
+struct ChildResult {
+  enum Kind { ok, error, foreign, crashed, timed_out } kind = ok;
+  std::string message;  // what the child wrote (an animat::Error message) or the signal
+};
+
+/// Runs f in a forked child with a time limit. The parent must not have used OpenMP before (each test
+/// runs in its own process under ctest), so the child's runtime starts clean.
+template <class F>
+ChildResult in_child(F&& f, double limit_seconds) {
+  int fds[2];
+  if (pipe(fds) != 0) return {ChildResult::foreign, "pipe failed"};
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    int code = 0;
+    std::string msg;
+    try {
+      f();
+    } catch (const Error& e) {
+      code = 3;
+      msg = e.what();
+    } catch (const std::exception& e) {
+      code = 4;
+      msg = std::string("foreign exception: ") + e.what();
+    }
+    if (!msg.empty() && write(fds[1], msg.data(), msg.size()) < 0) code = 5;
+    _exit(code);
+  }
+  close(fds[1]);
+  const auto t0 = Clock::now();
+  int status = 0;
+  bool timed_out = false;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (seconds_since(t0) > limit_seconds) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  std::string msg;
+  char buf[4096];
+  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) msg.append(buf, static_cast<std::size_t>(n));
+  close(fds[0]);
+  if (timed_out) return {ChildResult::timed_out, "time limit"};
+  if (WIFSIGNALED(status)) return {ChildResult::crashed, fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)))};
+  switch (WEXITSTATUS(status)) {
+    case 0: return {ChildResult::ok, ""};
+    case 3: return {ChildResult::error, msg};
+    default: return {ChildResult::foreign, fmt::format("exit {}: {}", WEXITSTATUS(status), msg)};
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The sweep's values for one field.
+
+struct Probe {
+  std::string text;  // as written in TOML and after --set
+  ConfigValue value;
+  bool inside = true;  // within the field's declared bounds
+};
+
+std::string toml_double(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  std::string s = fmt::format("{}", x);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::vector<Probe> probes_for(const FieldInfo& info, double) {
+  std::vector<Probe> out;
+  const Bounds& b = info.bounds;
+  auto add = [&](double x, bool inside) { out.push_back({toml_double(x), x, inside}); };
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  // Every numeric field must state a finite range: an unbounded value reaches arithmetic or Box2D.
+  EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi)) << info.name << " has an unbounded range " << b.describe();
+  const double lo_in = b.lo_open ? std::nextafter(b.lo, inf) : b.lo;
+  const double hi_in = b.hi_open ? std::nextafter(b.hi, -inf) : b.hi;
+  const double lo_out = b.lo_open ? b.lo : std::nextafter(b.lo, -inf);
+  const double hi_out = b.hi_open ? b.hi : std::nextafter(b.hi, inf);
+  if (std::isfinite(lo_in)) add(lo_in, true);
+  if (std::isfinite(hi_in)) add(hi_in, true);
+  if (std::isfinite(lo_out)) add(lo_out, false);
+  if (std::isfinite(hi_out)) add(hi_out, false);
+  for (double x : {inf, -inf, std::nan(""), DBL_MAX, -DBL_MAX}) add(x, false);
+  return out;
+}
+
+std::vector<Probe> probes_for(const FieldInfo& info, std::int64_t) {
+  std::vector<Probe> out;
+  const Bounds& b = info.bounds;
+  auto add = [&](std::int64_t x, bool inside) { out.push_back({std::to_string(x), x, inside}); };
+  constexpr auto kMax = std::numeric_limits<std::int64_t>::max();
+  const auto lo = static_cast<std::int64_t>(std::ceil(b.lo + (b.lo_open ? 0.5 : 0.0)));
+  const bool hi_finite = std::isfinite(b.hi) && b.hi < 9.2e18;
+  const std::int64_t hi = hi_finite ? static_cast<std::int64_t>(std::floor(b.hi - (b.hi_open ? 0.5 : 0.0))) : kMax;
+  add(lo, true);
+  add(hi, true);
+  add(lo - 1, false);
+  if (hi_finite) add(hi + 1, false);
+  return out;
+}
+
+std::vector<Probe> probes_for(const FieldInfo& info, int) {
+  auto out = probes_for(info, std::int64_t{});
+  // An int field also refuses what int cannot hold.
+  out.push_back({"2147483648", std::int64_t{2147483648LL}, false});
+  out.push_back({"-9223372036854775808", std::numeric_limits<std::int64_t>::min(), false});
+  return out;
+}
+
+std::vector<Probe> probes_for(const FieldInfo& info, const std::string&) {
+  std::vector<Probe> out;
+  for (auto c : info.choices) out.push_back({fmt::format("\"{}\"", c), std::string(c), true});
+  out.push_back({"\"no_such_choice\"", std::string("no_such_choice"), false});
+  return out;
+}
+
+std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<std::string>&) {
+  std::vector<Probe> out;
+  out.push_back({"[]", std::vector<std::string>{}, true});
+  std::vector<std::string> all;
+  for (auto c : info.choices) all.emplace_back(c);
+  out.push_back({fmt::format("[\"{}\"]", fmt::join(all, "\", \"")), all, true});
+  out.push_back({"[\"no_such_effect\"]", std::vector<std::string>{"no_such_effect"}, false});
+  if (!all.empty()) out.push_back({fmt::format("[\"{}\", \"{}\"]", all[0], all[0]), std::vector<std::string>{all[0], all[0]}, false});
+  return out;
+}
+
+std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<double>& current) {
+  std::vector<Probe> out;
+  auto with = [&](std::size_t i, double x, bool inside) {
+    std::vector<double> v = current;
+    v[i] = x;
+    std::vector<std::string> parts;
+    for (double d : v) parts.push_back(toml_double(d));
+    out.push_back({fmt::format("[{}]", fmt::join(parts, ", ")), v, inside});
+  };
+  const Bounds& b = info.bounds;
+  for (std::size_t i : {std::size_t{0}, current.size() - 1}) {
+    with(i, b.lo, true);
+    with(i, b.hi, true);
+    with(i, std::nextafter(b.lo, -INFINITY), false);
+    with(i, std::nextafter(b.hi, INFINITY), false);
+    with(i, std::nan(""), false);
+  }
+  out.push_back({"[]", std::vector<double>{}, false});  // the wrong length
+  return out;
+}
+
+[[maybe_unused]] std::vector<Probe> probes_for(const FieldInfo&, bool) {
+  return {{"true", true, true}, {"false", false, true}, {"1", std::int64_t{1}, false}};
+}
+
+struct KeyProbes {
+  std::string section, key;
+  std::vector<Probe> probes;
+};
+
+std::vector<KeyProbes> all_probes() {
+  std::vector<KeyProbes> out;
+  Config c;
+  visit_sections(c, [&](std::string_view section, auto& params) {
+    visit_fields(params, [&](const FieldInfo& info, auto& value) {
+      using T = std::decay_t<decltype(value)>;
+      std::vector<Probe> p;
+      if constexpr (std::is_same_v<T, double>) p = probes_for(info, 0.0);
+      else if constexpr (std::is_same_v<T, std::int64_t>) p = probes_for(info, std::int64_t{});
+      else if constexpr (std::is_same_v<T, int>) p = probes_for(info, 0);
+      else p = probes_for(info, value);
+      out.push_back({std::string(section), std::string(info.name), std::move(p)});
+    });
+  });
+  return out;
+}
+
+/// The base of the sweep's evaluations: small and fast, every stage still runs.
+Config sweep_base() {
+  Config c;
+  c.evaluation.steps = 100;
+  c.evolution.population = 4;
+  c.evolution.elites = 1;
+  c.evolution.threads = 1;
+  c.evolution.seed = 5;
+  return c;
+}
+
+const Genome& viable_genome() {
+  static const Genome g = [] {
+    const Config c = sweep_base();
+    for (int i = 0; i < 20000; ++i) {
+      Rng rng = Rng::derive(2024, i);
+      Genome candidate = random_genome(c.genome, rng);
+      if (evaluate(candidate, c).viable) return candidate;
+    }
+    ADD_FAILURE() << "no viable genome";
+    return Genome{};
+  }();
+  return g;
+}
+
+/// The shared stub (mean first coordinate) can go negative when a sweep moves coordinates far; a
+/// fitness is a distance, so the sweep uses its magnitude.
+Fitness sweep_fitness(const Genome& g) {
+  Fitness f = stub_fitness(g);
+  f.fitness = std::abs(f.fitness);
+  return f;
+}
+
+bool names_key(const std::string& message, const std::string& dotted) { return message.find(dotted) != std::string::npos; }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// The generated sweep
+
+TEST(ConfigSweep, EveryKeyOutsideItsBoundsIsRefusedNamingTheKey) {
+  int refused = 0;
+  for (const auto& kp : all_probes()) {
+    const std::string dotted = kp.section + "." + kp.key;
+    for (const auto& p : kp.probes) {
+      if (p.inside) continue;
+      SCOPED_TRACE(dotted + " = " + p.text);
+      Config c;
+      try {
+        set_value(c, dotted, p.value);
+        validate(c);
+        ADD_FAILURE() << "set_value accepted it";
+      } catch (const ConfigError& e) {
+        EXPECT_TRUE(names_key(e.what(), dotted)) << e.what();
+      }
+      try {
+        (void)config_from_toml(fmt::format("[{}]\n{} = {}\n", kp.section, kp.key, p.text), "sweep.toml");
+        ADD_FAILURE() << "TOML accepted it";
+      } catch (const ConfigError& e) {
+        EXPECT_TRUE(names_key(e.what(), dotted)) << e.what();
+      }
+      ++refused;
+    }
+  }
+  std::printf("[ sweep    ] %d out-of-bounds values refused by set_value and by TOML, each naming its key\n", refused);
+}
+
+TEST(ConfigSweep, RefusedValuesOnTheCommandLineChangeNoFileOfARun) {
+  // `--resume R --set key=value` with every refused value, and with every in-bounds value of a key that
+  // defines the run: exit 2, the key in the message, R byte-for-byte unchanged.
+  const fs::path& run = small_run();
+  const auto before = snapshot(run);
+  const auto& resumable = resumable_keys();
+  const Config stored = load_config(run / "config.toml");
+  int tried = 0;
+  for (const auto& kp : all_probes()) {
+    const std::string dotted = kp.section + "." + kp.key;
+    const bool may_change = std::find(resumable.begin(), resumable.end(), dotted) != resumable.end();
+    for (const auto& p : kp.probes) {
+      if (p.inside && may_change) continue;              // accepted on resume: it would run
+      if (p.inside && get_value(stored, dotted) == p.value) continue;  // no change at all
+      std::string text = p.text;
+      if (text.size() > 1 && text.front() == '"') text = text.substr(1, text.size() - 2);
+      SCOPED_TRACE(dotted + " = " + text);
+      const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--set", dotted + "=" + text});
+      EXPECT_EQ(r.rc, 2) << r.err;
+      EXPECT_TRUE(names_key(r.err, dotted)) << r.err;
+      ++tried;
+    }
+  }
+  EXPECT_EQ(snapshot(run), before);
+  std::printf("[ sweep    ] %d refused --resume --set commands: exit 2, key named, no file changed\n", tried);
+}
+
+TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
+  // In a child per value: evaluate() of a viable genome and two generations of the GA (stub fitness),
+  // a checkpoint and its restore. A signal is a failure; an animat::Error must name something clear
+  // (the genome not fitting the config); a run longer than the limit (e.g. 10^7 swim steps) is counted.
+  const Genome& genome = viable_genome();
+  ASSERT_FALSE(genome.elements.empty());
+  int accepted = 0, cross_refused = 0, errors = 0, timeouts = 0;
+  for (const auto& kp : all_probes()) {
+    const std::string dotted = kp.section + "." + kp.key;
+    for (const auto& p : kp.probes) {
+      if (!p.inside) continue;
+      SCOPED_TRACE(dotted + " = " + p.text);
+      Config c = sweep_base();
+      try {
+        set_value(c, dotted, p.value);
+        validate(c);
+      } catch (const ConfigError& e) {  // a cross-field rule (elites < population, min_cells <= max_cells...)
+        EXPECT_TRUE(names_key(e.what(), dotted)) << e.what();
+        ++cross_refused;
+        continue;
+      }
+      ++accepted;
+      const ChildResult r = in_child([&] {
+        try {
+          const EvaluationResult e = evaluate(genome, c);
+          if (!std::isfinite(e.fitness) || e.fitness < 0.0) _exit(6);
+          if (e.cell_count > c.development.max_cells) _exit(7);
+        } catch (const GenomeError&) {
+          // the sweep's genome does not fit this config (genome.dimensions): refused cleanly
+        }
+        const Config& g = c;
+        Evolution evo(g, sweep_fitness);
+        evo.initialize();
+        (void)evo.step();
+        (void)evo.step();
+        for (const auto& ind : evo.population()) validate(ind.genome, g.genome, "offspring");
+        Evolution again(g, sweep_fitness);
+        again.restore(evo.checkpoint());
+      }, 3.0);
+      switch (r.kind) {
+        case ChildResult::ok: break;
+        case ChildResult::error:  // clean, but it must say which setting caused it
+          ++errors;
+          std::printf("[ sweep    ] %s = %s: %s\n", dotted.c_str(), p.text.c_str(), r.message.c_str());
+          EXPECT_TRUE(names_key(r.message, dotted)) << r.message;
+          break;
+        case ChildResult::timed_out: ++timeouts; std::printf("[ sweep    ] %s = %s: still running after 3 s (no signal)\n", dotted.c_str(), p.text.c_str()); break;
+        default: ADD_FAILURE() << r.message;
+      }
+    }
+  }
+  std::printf("[ sweep    ] %d in-bounds values run in a child (%d animat errors naming the key, %d over 3 s, no signal); "
+              "%d refused by a cross-field rule naming the key\n", accepted, errors, timeouts, cross_refused);
+}
+
+TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
+  // Every key: changing it changes run_identity() if and only if it may not change on resume.
+  const Config base;
+  const auto& resumable = resumable_keys();
+  for (const auto& kp : all_probes()) {
+    const std::string dotted = kp.section + "." + kp.key;
+    const bool may_change = std::find(resumable.begin(), resumable.end(), dotted) != resumable.end();
+    for (const auto& p : kp.probes) {
+      if (!p.inside || get_value(base, dotted) == p.value) continue;
+      Config c = base;
+      set_value(c, dotted, p.value);
+      EXPECT_EQ(run_identity(c) == run_identity(base), may_change) << dotted << " = " << p.text;
+      break;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Rows of the issue's table
+
+TEST(Rows, Box2DAssertValuesAreRefused) {
+  // Both were accepted and then aborted in b2Body's constructor (exit 134).
+  for (const std::string o : {"development.damping=1e39", "development.cell_radius=1e39", "scene.cell_mass=1e-300",
+                              "development.cell_mass=1e39", "physics.dt=1e-300", "development.time_step=1e-300"}) {
+    Config c;
+    EXPECT_THROW(apply_override(c, o), ConfigError) << o;
+  }
+  const Shell r = run_exe({kExe, "--quiet", "--set", "development.damping=1e39", "--out", fresh_dir("damping").string()});
+  EXPECT_EQ(r.rc, 2) << r.err;
+  EXPECT_NE(r.err.find("development.damping"), std::string::npos) << r.err;
+}
+
+TEST(Rows, MoveSigmaCannotOverflowACoordinate) {
+  Config c;
+  EXPECT_THROW(apply_override(c, "mutation.move_sigma=1e308"), ConfigError);
+  // At its bound every mutation keeps coordinates finite (the largest normal deviate is about 12.1).
+  apply_override(c, "mutation.move_sigma=1000000");
+  apply_override(c, "mutation.move_rate=1");
+  Rng rng(3);
+  Genome g = random_genome(c.genome, rng);
+  for (int i = 0; i < 2000; ++i) mutate(g, c.mutation, c.genome, rng);
+  EXPECT_NO_THROW(validate(g, c.genome));
+}
+
+TEST(Rows, SeedBeyondInt64IsAnErrorNotAClamp) {
+  for (const std::string seed : {"99999999999999999999", "9223372036854775808", "-1", "1e3", "12abc"}) {
+    const Shell r = run_exe({kExe, "--print-config", "--seed", seed});
+    EXPECT_NE(r.rc, 0) << seed;
+    EXPECT_NE(r.err.find("--seed"), std::string::npos) << r.err;
+  }
+  const Shell ok = run_exe({kExe, "--print-config", "--seed", "9223372036854775807"});
+  EXPECT_EQ(ok.rc, 0) << ok.err;
+}
+
+TEST(Rows, LongOutPathIsAClearError) {
+  const fs::path base = fresh_dir("long");
+  for (const auto& [out, want] : std::vector<std::pair<fs::path, std::string>>{
+           {base / std::string(300, 'a'), "NAME_MAX"},
+           {base / fs::path(std::string(200, 'b')) / std::string(200, 'c') / std::string(200, 'd') / std::string(200, 'e') /
+                std::string(200, 'f') / std::string(200, 'g') / std::string(200, 'h') / std::string(200, 'i') /
+                std::string(200, 'j') / std::string(200, 'k') / std::string(200, 'l') / std::string(200, 'm') /
+                std::string(200, 'n') / std::string(200, 'o') / std::string(200, 'p') / std::string(200, 'q') /
+                std::string(200, 'r') / std::string(200, 's') / std::string(200, 't') / std::string(200, 'u') /
+                std::string(200, 'v') / std::string(200, 'w'),
+            "PATH_MAX"}}) {
+    const Shell r = run_exe({kExe, "--quiet", "--out", out.string(), "--generations", "1"});
+    EXPECT_EQ(r.rc, 2) << r.err;
+    EXPECT_NE(r.err.find(want), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(base)) << "a refused --out created a directory";
+}
+
+TEST(Rows, RngIntegerCoversTheWholeInt64Range) {
+  Rng rng(1);
+  constexpr auto lo = std::numeric_limits<std::int64_t>::min(), hi = std::numeric_limits<std::int64_t>::max();
+  bool negative = false, positive = false;
+  for (int i = 0; i < 64; ++i) {
+    const std::int64_t x = rng.integer(lo, hi);  // was below(0): SIGFPE
+    negative |= x < 0;
+    positive |= x > 0;
+  }
+  EXPECT_TRUE(negative && positive);
+  for (int i = 0; i < 200; ++i) {
+    const std::int64_t x = rng.integer(lo, lo + 1);
+    EXPECT_TRUE(x == lo || x == lo + 1);
+    const std::int64_t y = rng.integer(hi - 2, hi);
+    EXPECT_TRUE(y >= hi - 2);
+    const std::int64_t z = rng.integer(-3, 3);
+    EXPECT_TRUE(z >= -3 && z <= 3);
+  }
+  EXPECT_EQ(rng.below(0), 0u);
+}
+
+TEST(Rows, LoadConfigOfADirectoryOrUnreadableFileIsAnError) {
+  const fs::path dir = fresh_dir("cfgdir");
+  fs::create_directories(dir);
+  try {
+    (void)load_config(dir);
+    FAIL() << "a directory was read as the default config";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("Is a directory"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)load_config(dir / "missing.toml"), IoError);
+  EXPECT_THROW((void)load_genome(dir), IoError);
+  if (geteuid() != 0) {  // root reads anything
+    const fs::path f = dir / "unreadable.toml";
+    spit(f, "[evolution]\npopulation = 10\n");
+    fs::permissions(f, fs::perms::none);
+    EXPECT_THROW((void)load_config(f), IoError);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Rows, AFitnessFunctionReturningANegativeOrNonFiniteFitnessIsAnError) {
+  // Such a run would write a checkpoint that the semantic checks below refuse to resume.
+  Config c;
+  c.evolution.population = 4;
+  c.evolution.elites = 1;
+  c.evolution.threads = 1;
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    Evolution evo(c, [bad](const Genome&) { return Fitness{bad, true, true, 3}; });
+    try {
+      evo.initialize();
+      FAIL() << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("finite and >= 0"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// --resume with changed settings
+
+TEST(ResumeSettings, ChangedSettingsAreRefusedBeforeAnyWriteAndNamed) {
+  const fs::path run = fresh_dir("resume");
+  fs::copy(small_run(), run, fs::copy_options::recursive);
+  const auto before = snapshot(run);
+  const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--set", "scene.drag_normal=10", "--seed", "99"});
+  EXPECT_EQ(r.rc, 2) << r.err;
+  EXPECT_NE(r.err.find("scene.drag_normal (the run has 2.0, this command gives 10.0)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("evolution.seed (the run has 3, this command gives 99)"), std::string::npos) << r.err;
+  EXPECT_EQ(snapshot(run), before) << "a refused --resume changed the run directory";
+  // ... so the run still resumes, and still repeats from its own config.
+  const Shell again = run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "2"});
+  EXPECT_EQ(again.rc, 0) << again.err;
+  fs::remove_all(run);
+}
+
+TEST(ResumeSettings, ResumableKeysAreAcceptedAndRecorded) {
+  const fs::path run = fresh_dir("resume_ok");
+  fs::copy(small_run(), run, fs::copy_options::recursive);
+  const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "2", "--threads", "2", "--set",
+                           "evolution.checkpoint_every=3", "--set", "evolution.wall_seconds=1000", "--set",
+                           "evolution.stall_generations=7"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const Config recorded = load_config(run / "config.toml");
+  EXPECT_EQ(recorded.evolution.generations, 2);
+  EXPECT_EQ(recorded.evolution.threads, 2);
+  EXPECT_EQ(recorded.evolution.checkpoint_every, 3);
+  EXPECT_EQ(recorded.evolution.stall_generations, 7);
+  const std::string log = slurp(run / "resume.log");
+  for (const char* s : {"resumed at generation 1:", "evolution.generations 1 -> 2", "evolution.threads 1 -> 2",
+                        "evolution.checkpoint_every 1 -> 3", "evolution.wall_seconds 0.0 -> 1000.0",
+                        "evolution.stall_generations 500 -> 7"})
+    EXPECT_NE(log.find(s), std::string::npos) << log;
+  fs::remove_all(run);
+}
+
+TEST(ResumeSettings, InProcessResumeWithAnotherConfigWritesNothing) {
+  const fs::path run = fresh_dir("resume_api");
+  fs::copy(small_run(), run, fs::copy_options::recursive);
+  const auto before = snapshot(run);
+  Config c = load_config(run / "config.toml");
+  c.grn.dt = 0.025;
+  RunOptions opt;
+  opt.out = run;
+  opt.resume = true;
+  opt.quiet = true;
+  try {
+    (void)run_evolution(c, opt, stub_fitness);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("grn.dt (the run has 0.05, this command gives 0.025)"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(snapshot(run), before);
+  fs::remove_all(run);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Stop requests
+
+namespace {
+// A fitness that takes a while (sleeping, so the machine's load hardly matters).
+Fitness slow_fitness(const Genome& g) {
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  return stub_fitness(g);
+}
+}  // namespace
+
+TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNothing) {
+  Config c;
+  c.evolution.population = 16;  // 15 evaluations of 50 ms: 0.75 s for the whole generation
+  c.evolution.elites = 1;
+  c.evolution.threads = 1;
+  c.genome.initial_units = 30;  // no duplicates among offspring: every child is evaluated
+  Evolution reference(c, stub_fitness);
+  reference.initialize();
+  (void)reference.step();
+  (void)reference.step();
+
+  Evolution evo(c, slow_fitness);
+  std::atomic<bool> stop{false};
+  evo.set_stop(StopRequest{&stop, {}});
+  evo.initialize();
+  (void)evo.step();
+  std::thread t([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(120));
+    stop = true;
+  });
+  const auto t0 = Clock::now();
+  EXPECT_THROW((void)evo.step(), Interrupted);
+  const double took = seconds_since(t0);
+  t.join();
+  std::printf("[ stop     ] in-process stop during a generation (50 ms evaluations): step() returned %.3f s after it "
+              "started, %.3f s after the stop\n", took, took - 0.12);
+  EXPECT_LT(took, 0.3) << "the generation ran on after the stop";
+  EXPECT_EQ(evo.generation(), 1) << "an interrupted generation must leave the state at the previous one";
+  stop = false;
+  (void)evo.step();  // the same generation again, from (seed, g, i): identical to the uninterrupted run
+  EXPECT_EQ(evo.history().back().best, reference.history().back().best);
+  EXPECT_EQ(evo.population()[3].genome, reference.population()[3].genome);
+}
+
+TEST(StopRequests, AStopWhileSeedingIsHonouredWithinOneEvaluation) {
+  Config c;
+  c.evolution.population = 4;
+  c.evolution.threads = 2;
+  c.evolution.max_init_tries = 1000000000;
+  Evolution evo(c, [](const Genome&) {  // never viable: seeding would take years
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return Fitness{};
+  });
+  int polls = 0;
+  const auto t0 = Clock::now();
+  evo.set_stop(StopRequest{nullptr, [&] { return ++polls > 0 && seconds_since(t0) > 0.3; }});
+  EXPECT_THROW(evo.initialize(), Interrupted);
+  EXPECT_LT(seconds_since(t0), 0.6);
+  EXPECT_GT(polls, 3) << "the poll runs about every 20 ms";
+  EXPECT_EQ(evo.generation(), -1);
+  EXPECT_TRUE(evo.population().empty());
+}
+
+namespace {
+// Starts the CLI, waits until `ready` (at most 120 s) and then `after` seconds, sends `sig`; returns the exit
+// status and the seconds from the signal to the exit.
+std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig, double after,
+                                  const std::function<bool()>& ready = [] { return true; }) {
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    if (!freopen("/dev/null", "w", stdout)) _exit(125);
+    execv(argv[0], argv.data());
+    _exit(126);
+  }
+  const auto started = Clock::now();
+  while (!ready() && seconds_since(started) < 120) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::duration<double>(after));
+  kill(pid, sig);
+  const auto t0 = Clock::now();
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), seconds_since(t0)};
+}
+}  // namespace
+
+TEST(StopRequests, CliSignalWhileSeedingEndsWithinASecond) {
+  // quiet_steps = steps forbids every division: no random genome is ever viable, seeding runs forever.
+  for (int sig : {SIGTERM, SIGINT}) {
+    const fs::path out = fresh_dir("seed_signal");
+    const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--set", "development.quiet_steps=400",
+                                           "--set", "evolution.population=100", "--out", out.string()},
+                                          sig, 1.0);
+    std::printf("[ stop     ] %s while seeding: exit %d, %.3f s after the signal\n", strsignal(sig), rc, seconds);
+    EXPECT_EQ(rc, 130) << strsignal(sig);
+    // Measured 0.001 to 0.03 s (docs/reliability.md); the machine is shared, so the test allows 3 s.
+    // Before, the signal was ignored until the population was complete: here, never.
+    EXPECT_LT(seconds, 3.0) << strsignal(sig);
+    EXPECT_FALSE(fs::exists(out / "checkpoint.json"));
+    // Nothing to resume, so the same command may start over in the same directory.
+    const Shell again = run_exe({kExe, "--quiet", "--threads", "1", "--set", "evolution.population=4", "--set",
+                                 "evaluation.steps=50", "--generations", "1", "--out", out.string()});
+    EXPECT_EQ(again.rc, 0) << again.err;
+    fs::remove_all(out);
+  }
+}
+
+TEST(StopRequests, CliSignalDuringAGenerationEndsWithinASecondWithAResumableCheckpoint) {
+  if (ANIMAT_TEST_SANITIZED) GTEST_SKIP() << "a latency test: one sanitized evaluation of 40,000 steps takes seconds";
+  // 30 individuals swimming 40,000 steps: about 0.3 s per evaluation, 4 s per generation on 2 idle cores.
+  // Before, the generation was finished first (4 s or more); now one evaluation per thread at most.
+  const fs::path out = fresh_dir("gen_signal");
+  const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--seed", "4", "--set",
+                                         "evolution.population=30", "--set", "evaluation.steps=40000", "--set",
+                                         "evolution.checkpoint_every=5", "--out", out.string()},
+                                        SIGTERM, 0.5, [&] { return fs::exists(out / "checkpoint.json"); });
+  std::printf("[ stop     ] SIGTERM during a generation (population 30, 40000 swim steps): exit %d, %.3f s after the "
+              "signal\n", rc, seconds);
+  EXPECT_EQ(rc, 130);
+  EXPECT_LT(seconds, 2.0) << "the generation ran on after the signal (the test allows 2 s on a shared machine)";
+  ASSERT_TRUE(fs::exists(out / "checkpoint.json"));
+  Config c = load_config(out / "config.toml");
+  Evolution evo(c, stub_fitness);
+  ASSERT_NO_THROW(evo.restore(slurp(out / "checkpoint.json")));
+  // The checkpoint is the last row of history.csv.
+  const std::string hist = slurp(out / "history.csv");
+  const auto last = hist.substr(hist.rfind('\n', hist.size() - 2) + 1);
+  EXPECT_EQ(std::stoi(last), evo.generation()) << hist;
+  fs::remove_all(out);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Checkpoints with a valid checksum and a meaningless content
+
+namespace {
+
+Config cp_config() {
+  Config c;
+  c.evolution.population = 4;
+  c.evolution.elites = 1;
+  c.evolution.threads = 1;
+  c.evolution.seed = 8;
+  return c;
+}
+
+json cp_payload() {
+  Evolution evo(cp_config(), stub_fitness);
+  evo.initialize();
+  for (int i = 0; i < 3; ++i) (void)evo.step();
+  return json::parse(json::parse(evo.checkpoint())["payload"].get<std::string>());
+}
+
+std::string fnv_hex(std::string_view s) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char ch : s) {
+    h ^= ch;
+    h *= 0x100000001b3ULL;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+std::string rewrap(const json& payload) {
+  const std::string body = payload.dump();
+  return json{{"checksum", fnv_hex(body)}, {"payload", body}}.dump();
+}
+
+/// Finds a viable individual's index.
+std::size_t viable_index(const json& p) {
+  for (std::size_t i = 0; i < p["population"].size(); ++i)
+    if (p["population"][i]["viable"].get<bool>()) return i;
+  return 0;
+}
+
+}  // namespace
+
+TEST(CheckpointMeaning, AnUneditedCheckpointIsAccepted) {
+  Evolution evo(cp_config(), stub_fitness);
+  ASSERT_NO_THROW(evo.restore(rewrap(cp_payload()), "good.json"));
+  EXPECT_EQ(evo.generation(), 3);
+}
+
+TEST(CheckpointMeaning, HandEditedContentIsRefusedNamingWhatIsWrong) {
+  const json good = cp_payload();
+  const std::size_t v = viable_index(good);
+  struct Edit {
+    std::string name, expect;
+    std::function<void(json&)> apply;
+  };
+  const std::vector<Edit> edits = {
+      {"negative fitness", "fitness -1", [&](json& p) { p["population"][v]["fitness"] = -1.0; }},
+      {"empty genome of a viable individual", "viable with an empty genome",
+       [&](json& p) { p["population"][v]["genome"]["elements"] = json::array(); }},
+      {"history out of order", "history row 0 is generation 1", [](json& p) { std::swap(p["history"][0], p["history"][1]); }},
+      {"a gap in the history", "history row 2 is generation 3", [](json& p) { p["history"].erase(2); }},
+      {"viable fraction above 1", "viable_fraction 1.5", [](json& p) { p["history"][1]["viable_fraction"] = 1.5; }},
+      {"decreasing evaluations", "evaluations decrease", [](json& p) { p["history"][1]["evaluations"] = 0; }},
+      {"negative wall time", "wall_seconds -1", [](json& p) { p["history"][0]["wall_seconds"] = -1.0; }},
+      {"best_ever above the history", "best_ever is 1000", [](json& p) { p["best_ever"] = 1000.0; }},
+      {"stall counter", "stall is 99", [](json& p) { p["stall"] = 99; }},
+      {"evaluations counter", "evaluations is 1", [](json& p) { p["evaluations"] = 1; }},
+      {"last row not the population", "does not describe the population",
+       [&](json& p) { p["population"][v]["fitness"] = p["population"][v]["fitness"].get<double>() + 0.5; }},
+      {"a genome that does not validate", "sign", [&](json& p) { p["population"][v]["genome"]["elements"][0]["sign"] = 2; }},
+      {"population size", "individuals", [](json& p) { p["population"].erase(0); }},
+  };
+  for (const auto& e : edits) {
+    SCOPED_TRACE(e.name);
+    json p = good;
+    e.apply(p);
+    Evolution evo(cp_config(), stub_fitness);
+    try {
+      evo.restore(rewrap(p), "edited.json");
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& err) {
+      EXPECT_NE(std::string(err.what()).find("edited.json"), std::string::npos) << err.what();
+      EXPECT_NE(std::string(err.what()).find(e.expect), std::string::npos) << err.what();
+    }
+    EXPECT_EQ(evo.generation(), -1) << "a refused checkpoint must leave the engine untouched";
+  }
+}
+
+TEST(CheckpointMeaning, CliResumeOfAHandEditedCheckpointIsRefusedAndChangesNothing) {
+  const fs::path run = fresh_dir("edited_run");
+  fs::copy(small_run(), run, fs::copy_options::recursive);
+  json outer = json::parse(slurp(run / "checkpoint.json"));
+  json p = json::parse(outer["payload"].get<std::string>());
+  p["population"][0]["fitness"] = -3.0;
+  spit(run / "checkpoint.json", rewrap(p));
+  const auto before = snapshot(run);
+  const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "3"});
+  EXPECT_EQ(r.rc, 2) << r.err;
+  EXPECT_NE(r.err.find("inconsistent checkpoint"), std::string::npos) << r.err;
+  EXPECT_EQ(snapshot(run), before);
+  fs::remove_all(run);
+}
