@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "animat/errors.hpp"
+#include "animat/objective.hpp"
 
 namespace animat {
 
@@ -415,6 +416,7 @@ void validate(const Config& config, std::string_view source) {
                      2 * config.genome.initial_units + kInputCount + kOutputCount));
   try {
     validate(config.development);
+    validate(config.evaluation);
   } catch (const ConfigError& e) {
     fail(e.what());
   }

@@ -50,7 +50,8 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 
 }  // namespace
 
-SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps) {
+SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
+                EvaluationObserver* observer) {
   constexpr long kSampleEvery = 16;
   SwimResult r;
   Simulation sim(body, scene, physics);
@@ -58,12 +59,18 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   const Eigen::Vector2d start = sim.center_of_mass();
   const double floor = stretch_floor(body);
   sample(sim, body, floor, r);
+  const long every = observer ? observer->sample_every() : 0;
+  if (every > 0) observer->on_sample(sim);
   try {
     for (long done = 0; done < steps;) {
-      const long chunk = std::min(kSampleEvery, steps - done);
-      sim.step(chunk);
-      done += chunk;
-      sample(sim, body, floor, r);
+      // Stops at the diagnostic samples (every 16 steps and the end) and the observer's frames;
+      // splitting step() changes nothing in the motion.
+      long next = std::min(steps, (done / kSampleEvery + 1) * kSampleEvery);
+      if (every > 0) next = std::min(next, (done / every + 1) * every);
+      sim.step(next - done);
+      done = next;
+      if (done % kSampleEvery == 0 || done == steps) sample(sim, body, floor, r);
+      if (every > 0 && done % every == 0) observer->on_sample(sim);
     }
   } catch (const SimulationError& e) {
     r.stable = false;
@@ -84,7 +91,7 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   return r;
 }
 
-EvaluationResult evaluate(const Genome& genome, const Config& config) {
+EvaluationResult evaluate(const Genome& genome, const Config& config, EvaluationObserver* observer) {
   EvaluationResult out;
   validate(genome, config.genome, "evaluate");  // a genome no loader would accept is an error, not UB
   validate(config.scene);
@@ -125,7 +132,8 @@ EvaluationResult evaluate(const Genome& genome, const Config& config) {
   out.skin_edge_count = static_cast<int>(body.skin.rows());
 
   t0 = Clock::now();
-  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps);
+  if (observer) observer->on_body(body);
+  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, observer);
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
   if (!s.stable) out.reasons.push_back(s.failure);

@@ -12,6 +12,19 @@
 namespace animat {
 
 struct Body;
+class Simulation;
+
+/// Watches one evaluation (objectives that need the body or a trajectory); optional and passive:
+/// an observed evaluation is bit-identical to an unobserved one.
+struct EvaluationObserver {
+  virtual ~EvaluationObserver() = default;
+  /// Control steps between on_sample() calls (0 = none).
+  [[nodiscard]] virtual long sample_every() const { return 0; }
+  /// The body about to swim.
+  virtual void on_body(const Body& body) { (void)body; }
+  /// The simulation at step 0 and after every sample_every() control steps.
+  virtual void on_sample(const Simulation& sim) { (void)sim; }
+};
 
 /// What a swim did.
 struct SwimResult {
@@ -35,7 +48,8 @@ struct SwimResult {
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
 /// simulation failure: it returns stable = false, distance 0 and the message. Throws ConfigError
 /// for invalid params.
-[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps);
+[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
+                              EvaluationObserver* observer = nullptr);
 
 struct EvaluationResult {
   double fitness = 0.0;          ///< straight-line distance of the centre of mass, start -> end
@@ -68,6 +82,7 @@ struct EvaluationResult {
 /// gives fitness 0, stable = false and the reason; nothing is clamped silently. A body the body
 /// stage rejects (e.g. duplicate centres) is non-viable with the reason. Throws ConfigError for an
 /// invalid config.
-[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config);
+[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config,
+                                        EvaluationObserver* observer = nullptr);
 
 }  // namespace animat

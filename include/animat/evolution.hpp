@@ -14,14 +14,22 @@
 
 namespace animat {
 
-/// How an evaluation is run: the swim horizon.
+/// How an evaluation is run and scored: the swim horizon and the objective (objective.hpp).
 struct EvaluationParams {
   int steps = 4000;  ///< swim steps at physics.dt [paper: 4000 or 8000]
+  /// distance (the paper's), distance_per_size, speed_toward, or "python:NAME" (a Python callable).
+  std::string objective = "distance";
+  std::vector<double> direction = {1.0, 0.0};  ///< speed_toward's direction (normalised when used)
 };
 
 template <class V>
 void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
+  v(FieldInfo{"objective", "what the GA maximises: distance (straight-line distance of the centre of mass, the paper's); "
+                           "distance_per_size (distance / body length); speed_toward (centre-of-mass speed along "
+                           "evaluation.direction); python:NAME (a Python callable, set by animat.evolve)"},
+    p.objective);
+  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)"}, p.direction);
 }
 
 struct EvolutionParams {
@@ -72,8 +80,13 @@ struct Fitness {
 /// tests plug in cheap stubs.
 using FitnessFunction = std::function<Fitness(const Genome&)>;
 
-/// genome → development → body → swim, per `config` (see evaluate.hpp).
+class Objective;
+
+/// genome → development → body → swim, per `config` (see evaluate.hpp), scored by the config's
+/// objective (evaluation.objective; objective.hpp).
 [[nodiscard]] FitnessFunction swim_fitness(const Config& config);
+/// The same chain scored by `objective` (e.g. a Python callable) instead of the config's.
+[[nodiscard]] FitnessFunction objective_fitness(const Config& config, std::shared_ptr<const Objective> objective);
 
 struct Individual {
   Genome genome;
@@ -91,7 +104,7 @@ struct GenerationStats {
   int best_cells = 0;
   std::int64_t evaluations = 0;  ///< cumulative fitness evaluations (swims and non-viable developments)
   double wall_seconds = 0.0;     ///< cumulative wall time of the run (the only machine-dependent column)
-  double evaluations_per_second = 0.0;
+  double evaluations_per_second = 0.0;  ///< of this generation alone (its evaluations / its wall time)
   bool best_changed = false;     ///< the best genome differs from the previous generation's
   int crossovers = 0;            ///< offspring made by crossover in this generation
 };
@@ -113,14 +126,35 @@ void prepare_parallel_evaluation();
 
 /// The genetic algorithm (paper §5). Every random number of generation g, offspring i derives from
 /// Rng::derive(seed, g, i), so a run is bit-identical for any thread count and across resumes.
+///
+/// It runs by itself (initialize(), step(): evaluating with its fitness function in parallel) or is
+/// driven from outside by ask()/tell(), for genomes evaluated elsewhere; both are the same engine
+/// and give identical results.
 class Evolution {
  public:
-  Evolution(const Config& config, FitnessFunction fitness);
+  /// `fitness` may be empty for an engine driven only by ask() and tell().
+  explicit Evolution(const Config& config, FitnessFunction fitness = {});
 
-  /// Draws the initial population: random genomes regenerated until viable.
+  /// Draws the initial population: random genomes regenerated until viable (ask/evaluate/tell
+  /// rounds with speculative draws; the result equals one-at-a-time drawing).
   void initialize();
   /// Makes and evaluates the next generation; returns its statistics.
   GenerationStats step();
+
+  /// The genomes that need a fitness next, in order. Before generation 0: the next random draw of
+  /// every initial slot not yet holding a viable individual (slot i draws from
+  /// Rng::derive(seed, initial, i)); with `lookahead` > 1, that many consecutive draws per slot
+  /// (speculative: those after a slot's first viable draw are discarded and not counted, so the run
+  /// does not depend on it). After that: the offspring of the next generation that are not copies of
+  /// an evaluated genome (elites and unchanged copies keep their fitness; the list may be empty).
+  /// ask() again before tell() returns the same genomes.
+  std::vector<Genome> ask(int lookahead = 1);
+  /// The fitness of every genome of the last ask(), in order. Returns true when this completed a
+  /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a
+  /// non-finite fitness, or an initial slot that used up evolution.max_init_tries.
+  bool tell(const std::vector<Fitness>& fitness);
+  /// Whether an ask() awaits its tell().
+  [[nodiscard]] bool asked() const { return pending_; }
   /// Why the run should stop now ("" = keep going): stall, generation cap or wall-clock budget.
   [[nodiscard]] std::string stop_reason() const;
 
@@ -143,10 +177,28 @@ class Evolution {
  private:
   GenerationStats statistics(bool best_changed, double wall_seconds) const;
 
+  std::vector<Genome> ask_initial(int lookahead);
+  std::vector<Genome> ask_generation();
+  bool tell_initial(const std::vector<Fitness>& fitness);
+  bool tell_generation(const std::vector<Fitness>& fitness);
+
+  /// One initial individual being drawn (before generation 0).
+  struct InitialSlot {
+    Rng rng;
+    int tries = 0;
+    bool filled = false;
+  };
+
   std::shared_ptr<const Config> config_;  ///< own copy: the engine outlives no caller state
   std::uint64_t identity_;
   FitnessFunction fitness_;
   std::vector<Individual> population_;
+  std::vector<InitialSlot> slots_;          ///< before generation 0 only
+  bool pending_ = false;                    ///< an ask() awaits its tell()
+  std::vector<Genome> asked_;               ///< the genomes of that ask()
+  std::vector<std::size_t> asked_index_;    ///< their initial slot, or their index in next_
+  std::vector<Individual> next_;            ///< the generation being made
+  int next_crossovers_ = 0;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()
   int stall_ = 0;
@@ -167,7 +219,8 @@ struct RunOptions {
   bool quiet = false;
   double progress_interval = 1.0;      ///< seconds between progress lines
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
-  /// Called after every generation; return false to stop (checkpointed).
+  /// Called after every generation, generation 0 of a new run included; return false to stop
+  /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;
 };
 
@@ -175,9 +228,11 @@ struct RunSummary {
   std::vector<GenerationStats> history;
   Individual best;
   std::string stop_reason;
+  std::vector<Individual> population;  ///< the final population
 };
 
 /// Runs (or resumes) an evolution, writing config.toml, history.csv, best/ lineage and checkpoints.
+/// `fitness` defaults to swim_fitness(config).
 RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {});
 
 }  // namespace animat
