@@ -28,7 +28,7 @@ std::string default_run_dir(std::int64_t seed) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int animat_evolve_main(int argc, char** argv) {
   CLI::App app{"animat_evolve: co-evolve the morphology and control of soft-bodied swimmers (Joachimczak & Wrobel 2012)"};
   std::string config_path, out_dir, resume_dir, log_level = "info";
   std::vector<std::string> overrides;
@@ -106,3 +106,7 @@ int main(int argc, char** argv) {
     return 3;
   }
 }
+
+#ifndef ANIMAT_CLI_NO_MAIN
+int main(int argc, char** argv) { return animat_evolve_main(argc, argv); }
+#endif
