@@ -69,6 +69,12 @@ class LineageEntry:
                 f"cells={self.cell_count}>")
 
 
+def _history_type() -> type:
+    from .evolution import History  # evolution.py imports this module
+
+    return History
+
+
 def read_history(path: PathLike) -> np.ndarray:
     """Read a ``history.csv`` into a structured array of dtype :data:`HISTORY_DTYPE`.
 
@@ -77,7 +83,8 @@ def read_history(path: PathLike) -> np.ndarray:
     ValueError naming the file and the line number. A missing file raises FileNotFoundError.
 
     Returns:
-        numpy structured array, shape (rows,), one row per completed generation; fields
+        :class:`animat.History` (a numpy structured array with ``.to_pandas()``), shape (rows,), one
+        row per completed generation; fields
         ``generation`` (int64), ``best``, ``mean``, ``median``, ``viable_fraction`` (float64),
         ``best_cells``, ``evaluations`` (int64), ``wall_seconds`` (float64).
     """
@@ -92,7 +99,7 @@ def read_history(path: PathLike) -> np.ndarray:
     if not complete:
         if lines[0] and not ",".join(expected).startswith(lines[0]):
             raise ValueError(f"{path}:1: not a history.csv header: {lines[0]!r}")
-        return np.zeros(0, dtype=HISTORY_DTYPE)  # empty or header being written
+        return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())  # empty or header being written
     header = complete[0].strip().split(",")
     if header != expected:
         raise ValueError(f"{path}:1: unexpected header {complete[0].strip()!r}; expected {','.join(expected)!r}")
@@ -107,7 +114,7 @@ def read_history(path: PathLike) -> np.ndarray:
             rows.append(tuple(int(v) if HISTORY_DTYPE[k].kind == "i" else float(v) for k, v in enumerate(fields)))
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
-    return np.array(rows, dtype=HISTORY_DTYPE)
+    return np.array(rows, dtype=HISTORY_DTYPE).view(_history_type())
 
 
 def _read_lineage_file(path: Path) -> LineageEntry:
@@ -199,7 +206,7 @@ class Run:
         """
         path = self.path / "history.csv"
         if not path.exists():
-            return np.zeros(0, dtype=HISTORY_DTYPE)
+            return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())
         return read_history(path)
 
     @property
