@@ -67,8 +67,10 @@ void add_pickle(nb::handle type, const char* format, Save save, Load load) {
                               std::get<1>(state), fmt_name));
     new (&self) T(load(std::get<2>(state)));
   });
-  add_method(type, "__copy__", [](const T& v) { return T(v); });
-  add_method(type, "__deepcopy__", [](const T& v, nb::handle) { return T(v); }, "memo"_a);
+  if (!nb::hasattr(type, "__copy__")) {
+    add_method(type, "__copy__", [](const T& v) { return T(v); });
+    add_method(type, "__deepcopy__", [](const T& v, nb::handle) { return T(v); }, "memo"_a);
+  }
 }
 
 // --- EvaluationResult fields, one list for pickling (a new field: one line here) ---------------

@@ -17,6 +17,8 @@ Every value type pickles and copies. ``animat.plot`` imports matplotlib on first
 """
 from typing import TYPE_CHECKING
 
+from . import _core
+
 from ._core import (
     OBJECTIVES,
     Body,
@@ -39,7 +41,6 @@ from ._core import (
     Scene,
     Simulation,
     SwimResult,
-    __version__,
     actuation_start_time,
     actuation_term,
     affinity,
@@ -89,6 +90,8 @@ from .trajectory import (
     actuation_terms,
     replay,
 )
+
+__version__: str = getattr(_core, "__version__")
 
 if TYPE_CHECKING:  # animat.plot is imported lazily at run time (it pulls in matplotlib)
     from . import plot as plot

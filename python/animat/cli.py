@@ -96,7 +96,8 @@ def cmd_show(args) -> int:
                                                 title=f"Development (paper Fig. 2) of the {label}"),
         "construction": lambda: plot.construction(entry, config=config,
                                                   title=f"From embryo to body (paper Fig. 3): {label}"),
-        "motion_cycle": lambda: plot.motion_cycle(trajectory, count=args.frames),
+        "motion_cycle": lambda: plot.motion_cycle(animat.replay(entry, config, steps=args.steps) if trajectory is None
+                                                  else trajectory, count=args.frames),
         "phase_map": lambda: plot.phase_map(entry, config=config),
         "fitness_history": lambda: plot.fitness_history(run),
     }

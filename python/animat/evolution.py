@@ -26,11 +26,13 @@ __all__ = ["History", "EvolutionResult", "Objective", "GA", "evolve", "evaluate"
 PathLike = Union[str, "os.PathLike[str]"]
 
 
-class History(np.ndarray):
-    """Per-generation statistics: a numpy structured array (one row per generation, the columns of
-    ``history.csv``: ``generation``, ``best``, ``mean``, ``median``, ``viable_fraction``,
-    ``best_cells``, ``evaluations``, ``wall_seconds``). ``h["best"]`` is a column, ``h[-1]`` a row.
-    :attr:`Run.history`, :attr:`EvolutionResult.history` and :attr:`GA.history` are all of this type.
+class History(np.recarray):
+    """Per-generation statistics: a numpy structured (record) array, one row per generation, with the
+    columns of ``history.csv``: ``generation``, ``best``, ``mean``, ``median``, ``viable_fraction``,
+    ``best_cells``, ``evaluations``, ``wall_seconds``. ``h["best"]`` is a column, ``h[-1]`` a row
+    (``h[-1]["best"]``, or ``h[-1].best``; use ``["mean"]`` for the mean column: ``.mean`` is numpy's
+    method). :attr:`Run.history`, :attr:`EvolutionResult.history` and :attr:`GA.history` are all of
+    this type.
     """
 
     def to_pandas(self) -> Any:
@@ -39,17 +41,13 @@ class History(np.ndarray):
             import pandas as pd  # type: ignore[import-not-found]
         except ImportError:
             raise ImportError("History.to_pandas needs pandas: pip install pandas") from None
-        return pd.DataFrame(np.asarray(self).view(np.ndarray))
+        return pd.DataFrame.from_records(np.asarray(self).view(np.ndarray), columns=list(HISTORY_DTYPE.names or ()))
 
     @staticmethod
     def from_rows(rows: Iterable[Any]) -> "History":
         """A History from GenerationStats objects (or anything with those attributes)."""
-        records = [tuple(getattr(r, name) for name in HISTORY_DTYPE.names) for r in rows]  # type: ignore[union-attr]
-        return np.array(records, dtype=HISTORY_DTYPE).view(History)
-
-
-def _as_history(array: np.ndarray) -> History:
-    return array.view(History)
+        records = [tuple(getattr(r, name) for name in HISTORY_DTYPE.names or ()) for r in rows]
+        return np.array(records, dtype=HISTORY_DTYPE).view(History)  # type: ignore[return-value]
 
 
 @dataclass
@@ -246,16 +244,17 @@ class GA:
 
         ``evaluate`` maps a list of genomes to their fitness values (default: :func:`evaluate_population`
         with this GA's config and ``threads``, i.e. exactly what :func:`evolve` does)."""
-        if evaluate is None:
-            cfg = self._config
-            n = int(cfg["evolution.threads"]) if threads is None else threads
+        cfg = self._config
+        n = int(cfg["evolution.threads"]) if threads is None else threads
 
-            def evaluate(genomes: List[Any]) -> Sequence[Any]:
-                return evaluate_population(genomes, cfg, n)
+        def in_parallel(genomes: List[Any]) -> Sequence[Any]:
+            return evaluate_population(genomes, cfg, n)
+
+        fitness_of = in_parallel if evaluate is None else evaluate
         target = self.generation + 1
         while self.generation < target:
             genomes = self.ask(4 if self.generation < 0 else 1)
-            self.tell(list(evaluate(genomes)))
+            self.tell(list(fitness_of(genomes)))
         return self._engine.history[-1]
 
     # --- state ------------------------------------------------------------------------------------

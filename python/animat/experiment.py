@@ -93,10 +93,10 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
             cfg = base.copy()
             cfg["evolution.seed"] = int(base["evolution.seed"]) + i
             try:
-                records[i] = _run_one(cfg, root / f"run_{i}", i, quiet)
+                record = records[i] = _run_one(cfg, root / f"run_{i}", i, quiet)
                 if not quiet:
-                    print(f"run {i}: best {records[i].best:.4f} after {records[i].generations} generations "
-                          f"({records[i].stop_reason})", flush=True)
+                    print(f"run {i}: best {record.best:.4f} after {record.generations} generations "
+                          f"({record.stop_reason})", flush=True)
             except BaseException as e:  # noqa: BLE001 - reported after the other runs stop
                 with lock:
                     errors.append(e)

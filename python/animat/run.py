@@ -95,7 +95,7 @@ def read_history(path: PathLike) -> np.ndarray:
     lines = text.split("\n")
     # `text` ends with "\n" when complete: the last element is then "". Otherwise it is a partial row.
     complete = lines[:-1]
-    expected = list(HISTORY_DTYPE.names)
+    expected = list(HISTORY_DTYPE.names or ())
     if not complete:
         if lines[0] and not ",".join(expected).startswith(lines[0]):
             raise ValueError(f"{path}:1: not a history.csv header: {lines[0]!r}")
