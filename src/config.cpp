@@ -142,7 +142,10 @@ std::string check(const FieldInfo& info, const T& value) {
     return {};
   };
   auto allowed = [&](const std::string& s) {
-    return info.choices.empty() || std::find(info.choices.begin(), info.choices.end(), s) != info.choices.end();
+    // A choice ending in '*' admits every value with that prefix (evaluation.objective = "python:NAME").
+    return info.choices.empty() || std::any_of(info.choices.begin(), info.choices.end(), [&](std::string_view c) {
+             return c == s || (c.ends_with('*') && s.size() >= c.size() && s.starts_with(c.substr(0, c.size() - 1)));
+           });
   };
   if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t> || std::is_same_v<T, double>) {
     return check_number(static_cast<double>(value));

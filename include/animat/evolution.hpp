@@ -7,12 +7,17 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "animat/genome.hpp"
 #include "animat/params.hpp"
 
 namespace animat {
+
+/// Allowed values of evaluation.objective: the built-in objectives (kObjectiveNames in objective.hpp;
+/// a new one is added to both lists) and "python:NAME" (the trailing * is a wildcard).
+inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "python:*"};
 
 /// How an evaluation is run and scored: the swim horizon and the objective (objective.hpp).
 struct EvaluationParams {
@@ -27,7 +32,8 @@ void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
   v(FieldInfo{"objective", "what the GA maximises: distance (straight-line distance of the centre of mass, the paper's); "
                            "distance_per_size (distance / body length); speed_toward (centre-of-mass speed along "
-                           "evaluation.direction); python:NAME (a Python callable, set by animat.evolve)"},
+                           "evaluation.direction); python:NAME (a Python callable, set by animat.evolve)",
+              Bounds::any(), kObjectiveChoices},
     p.objective);
   v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)"}, p.direction);
 }

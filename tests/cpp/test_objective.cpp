@@ -212,13 +212,14 @@ TEST(Objective, ConfigSelectsABuiltInByNameAndRefusesUnknownOnes) {
     apply_override(c, "evaluation.objective=distnce");
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown objective \"distnce\" (expected one of distance, distance_per_size, "
-                                         "speed_toward, or python:NAME)"),
+    EXPECT_NE(std::string(e.what()).find("evaluation.objective = \"distnce\": expected one of distance, "
+                                         "distance_per_size, speed_toward, python:*"),
               std::string::npos)
         << e.what();
   }
   EXPECT_THROW(apply_override(c, "evaluation.direction=[0.0, 0.0]"), ConfigError);
   EXPECT_THROW(apply_override(c, "evaluation.direction=[1.0]"), ConfigError);
+  EXPECT_THROW(apply_override(c, "evaluation.objective=python:"), ConfigError);  // needs a name
   c.evaluation.objective = "python:mine";
   validate(c);  // a valid config...
   EXPECT_THROW((void)make_objective(c.evaluation), ConfigError);  // ...that only Python can run

@@ -57,7 +57,7 @@ def test_builtin_objectives_by_name_and_config_key(viable):
     speed = animat.evaluate(g, c2).fitness
     assert speed == pytest.approx(r.displacement[1] / r.simulated_time, rel=1e-12)
     assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward"}
-    with pytest.raises(ValueError, match="unknown objective \"fastest\""):
+    with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, python:"):
         c2["evaluation.objective"] = "fastest"
 
 
@@ -118,7 +118,7 @@ def test_python_objective_errors_are_clear(viable):
     def broken(record):
         raise KeyError("no such thing")
 
-    with pytest.raises(ValueError, match="objective python:.*broken raised.*no such thing"):
+    with pytest.raises(ValueError, match="(?s)objective python:.*broken raised.*KeyError: 'no such thing'"):
         animat.evaluate_population([g, g], c, threads=2, objective=broken)
 
 
@@ -202,8 +202,11 @@ def test_tell_refuses_what_it_cannot_use():
 def _same(a, b):
     if isinstance(a, np.ndarray):
         return np.array_equal(a, b)
-    if isinstance(a, list):
+    if isinstance(a, (list, tuple)):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if type(a).__eq__ is object.__eq__:  # a value type without ==: compare its properties
+        props = _properties(a)
+        return type(a) is type(b) and all(_same(v, getattr(b, k)) for k, v in props.items())
     return a == b
 
 
@@ -227,6 +230,9 @@ def test_every_value_type_pickles_and_copies(viable, tmp_path):
     for v in values:
         for twin in (pickle.loads(pickle.dumps(v)), copy.copy(v), copy.deepcopy(v)):
             assert type(twin) is type(v)
+            if isinstance(v, animat.Config):
+                assert twin == v and twin.to_toml() == v.to_toml()
+                continue
             props = _properties(v)
             assert props, type(v)
             for name, value in props.items():
@@ -388,7 +394,7 @@ def test_animat_evolve_subcommand_is_animat_evolve(tmp_path):
     assert set(re.findall(r"--[a-z-]+", help_a)) == set(re.findall(r"--[a-z-]+", help_b))
     bad = subprocess.run([sys.executable, "-m", "animat", "evolve", "--set", "evaluation.objective=fast"],
                          capture_output=True, text=True)
-    assert bad.returncode == 2 and "unknown objective \"fast\"" in bad.stderr
+    assert bad.returncode == 2 and "expected one of distance, distance_per_size, speed_toward" in bad.stderr
 
 
 def test_pyproject_declares_the_console_script_extras_and_no_unused_dependency():
