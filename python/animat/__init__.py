@@ -41,16 +41,6 @@ from ._core import (
     Scene,
     Simulation,
     SwimResult,
-    actuation_start_time,
-    actuation_term,
-    affinity,
-    body_length,
-    delaunay_edges,
-    gabriel_graph,
-    polygon_area,
-    set_log_level,
-    tournament_probability,
-    warm_up_box2d,
 )
 from .animation import animate, mp4_available
 from .control import SwimEnv, gymnasium_available
@@ -77,7 +67,7 @@ from .locomotion import (
     phase_spread,
     tries_per_viable,
 )
-from .pipeline import build_body, config_path, develop, load_config, paper_configs, swim
+from .pipeline import build_body, config_path, develop, documented, load_config, paper_configs, swim
 from .run import HISTORY_DTYPE, MORPHOLOGY_TOLERANCE, LineageEntry, Run, morphology_distance, read_history
 from .trajectory import (
     CONTRACTING,
@@ -92,6 +82,18 @@ from .trajectory import (
 )
 
 __version__: str = getattr(_core, "__version__")
+
+# The compiled functions, as Python functions (help() shows their documentation).
+actuation_start_time = documented(_core.actuation_start_time)
+actuation_term = documented(_core.actuation_term)
+affinity = documented(_core.affinity)
+body_length = documented(_core.body_length)
+delaunay_edges = documented(_core.delaunay_edges)
+gabriel_graph = documented(_core.gabriel_graph)
+polygon_area = documented(_core.polygon_area)
+set_log_level = documented(_core.set_log_level)
+tournament_probability = documented(_core.tournament_probability)
+warm_up_box2d = documented(_core.warm_up_box2d)
 
 if TYPE_CHECKING:  # animat.plot is imported lazily at run time (it pulls in matplotlib)
     from . import plot as plot

@@ -2,15 +2,30 @@
 ``animat._core`` with the documentation ``help()`` shows), and the paper's configs."""
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
-from typing import Any, List, Optional, Union
+from typing import Any, Callable, List, Optional, TypeVar, Union, cast
 
 from . import _core
 
 __all__ = ["develop", "build_body", "swim", "load_config", "config_path", "paper_configs"]
 
 _CONFIG_DIR = Path(__file__).resolve().parent / "configs"
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def documented(function: _F, module: str = "animat") -> _F:
+    """A Python function that calls the compiled ``function``, so that ``help()`` shows its signature
+    and documentation (a nanobind function shows as an object), and pickling finds it in ``module``."""
+
+    @functools.wraps(function)
+    def call(*args: Any, **kwargs: Any) -> Any:
+        return function(*args, **kwargs)
+
+    call.__module__ = module
+    return cast(_F, call)
 
 
 def develop(genome: Any, config: Any = None) -> Any:

@@ -26,6 +26,7 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 from numpy.typing import ArrayLike
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.collections import EllipseCollection, LineCollection, PatchCollection, PolyCollection
 from matplotlib.colors import Normalize
@@ -79,7 +80,7 @@ def _loops_closed(positions, loops):
     return [positions[np.append(loop, loop[0])] for loop in loops if len(loop)]
 
 
-def draw_body(ax, body, positions: Optional[np.ndarray] = None, node_colors: Any = "#444444", *,
+def draw_body(ax: Axes, body: Any, positions: Optional[np.ndarray] = None, node_colors: Any = "#444444", *,
               node_radius: Optional[float] = None, fill: bool = True, springs: bool = True,
               spring_colors: Any = SPRING_COLOR, skin_width: float = 2.2, spring_width: float = 0.8,
               node_edge: str = "#222222", zorder: float = 2.0, label: str = "nodes") -> Dict[str, Any]:
@@ -379,7 +380,7 @@ def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None,
 
 # --- Fig. 7: phase map ----------------------------------------------------------------------------------
 
-def phase_map(body: Any, *, config: Optional[Any] = None, ax=None, cmap: str = PHASE_CMAP,
+def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = PHASE_CMAP,
               colorbar: bool = True, title: Optional[str] = None) -> Figure:
     """Paper Fig. 7: the body at rest (its initial, equilibrium state) with every node coloured by
     its oscillation phase shift. The colour range is normalised to the body's phases
@@ -411,7 +412,8 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax=None, cmap: str = P
         fig = plt.figure(figsize=(w, h + 0.5))
         ax = fig.add_subplot()
     else:
-        fig = ax.figure
+        fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
+        assert isinstance(fig, Figure)
     vmin, vmax = (float(phase.min()), float(phase.max())) if len(phase) else (0.0, 1.0)
     # all phases equal: every node is the maximum (red); the colour range is then [max - 1, max]
     norm = Normalize(vmin=vmin if vmax > vmin else vmax - 1.0, vmax=vmax)

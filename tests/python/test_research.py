@@ -416,9 +416,15 @@ def test_public_exports_and_docstrings():
     internal = {"Evolution", "EvolutionSummary", "evolve_cli", "load_config", "develop", "build_body", "swim",
                 "evaluate", "evaluate_population", "record_evaluation", "evolve"}
     assert core_public - internal <= set(animat.__all__), core_public - internal - set(animat.__all__)
+    functions = [getattr(animat, n) for n in animat.__all__ if callable(getattr(animat, n))
+                 and not isinstance(getattr(animat, n), type)]
+    assert len(functions) > 30
+    for fn in functions:
+        assert "nb_func" not in type(fn).__name__, fn
+        assert fn.__doc__ and len(fn.__doc__.strip()) > 30, fn
+    assert pickle.loads(pickle.dumps(animat.gabriel_graph)) is animat.gabriel_graph
     for fn in (animat.evaluate, animat.evolve, animat.develop, animat.build_body, animat.swim,
-               animat.evaluate_population, animat.record_evaluation, animat.load_config):
-        assert "nb_func" not in type(fn).__name__
+               animat.evaluate_population, animat.record_evaluation, animat.load_config, animat.gabriel_graph):
         out = subprocess.run([sys.executable, "-c", f"import animat; help(animat.{fn.__name__})"], capture_output=True,
                              text=True, check=True, env={**os.environ, "PAGER": "cat", "TERM": "dumb"}).stdout
         assert "nanobind" not in out.splitlines()[2] and fn.__doc__.split("\n")[0].strip() in out, fn
