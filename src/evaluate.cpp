@@ -51,7 +51,7 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 }  // namespace
 
 SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
-                EvaluationObserver* observer) {
+                const SwimOptions& options) {
   constexpr long kSampleEvery = 16;
   SwimResult r;
   Simulation sim(body, scene, physics);
@@ -59,6 +59,7 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   const Eigen::Vector2d start = sim.center_of_mass();
   const double floor = stretch_floor(body);
   sample(sim, body, floor, r);
+  EvaluationObserver* observer = options.observer;
   const long every = observer ? observer->sample_every() : 0;
   if (every > 0) observer->on_sample(sim);
   try {
@@ -132,8 +133,10 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   out.skin_edge_count = static_cast<int>(body.skin.rows());
 
   t0 = Clock::now();
+  SwimOptions options;
+  options.observer = observer;
   if (observer) observer->on_body(body);
-  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, observer);
+  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, options);
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
   if (!s.stable) out.reasons.push_back(s.failure);

@@ -48,8 +48,13 @@ struct SwimResult {
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
 /// simulation failure: it returns stable = false, distance 0 and the message. Throws ConfigError
 /// for invalid params.
+/// Options of swim() beyond the scene and physics.
+struct SwimOptions {
+  EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
+};
+
 [[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
-                              EvaluationObserver* observer = nullptr);
+                              const SwimOptions& options = {});
 
 struct EvaluationResult {
   double fitness = 0.0;          ///< straight-line distance of the centre of mass, start -> end

@@ -95,7 +95,8 @@ int animat_evolve_main(int argc, char** argv) {
     std::printf("Stopped: %s\n", summary.stop_reason.c_str());
     std::printf("Results in %s: config.toml, history.csv, best/ (lineage of best genomes), checkpoint.json\n",
                 options.out.c_str());
-    std::printf("View them:  PYTHONPATH=build/python .venv/bin/python -m animat show %s\n", options.out.c_str());
+    std::printf("View them:  animat show %s   (in a source tree: PYTHONPATH=build/python .venv/bin/python -m animat show %s)\n",
+                options.out.c_str(), options.out.c_str());
     std::printf("Resume:     animat_evolve --resume %s --generations N\n", options.out.c_str());
     return summary.stop_reason == "interrupted" ? 130 : 0;
   } catch (const animat::Error& e) {
