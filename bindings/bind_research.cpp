@@ -327,6 +327,25 @@ void bind_research(nb::module_& m) {
               throw nb::attribute_error(("EvaluationRecord has no attribute '" + name + "'").c_str());
             return result.attr(name.c_str());
           }, "name"_a)
+      .def("__getstate__", [](const EvaluationRecord& r) {
+            return nb::make_tuple(std::string("animat.EvaluationRecord"), 1, result_state(r.result), body_state(r.body),
+                                  r.every, r.steps, r.times, r.positions, r.velocities);
+          })
+      .def("__setstate__", [](EvaluationRecord& self, const nb::tuple& t) {
+            if (nb::len(t) != 9 || nb::cast<std::string>(t[0]) != "animat.EvaluationRecord" || nb::cast<int>(t[1]) != 1)
+              throw Error("cannot unpickle this state as animat.EvaluationRecord version 1");
+            EvaluationRecord r;
+            r.result = result_from_state(t[2]);
+            r.body = body_from_state(t[3]);
+            r.every = nb::cast<long>(t[4]);
+            r.steps = nb::cast<std::vector<long>>(t[5]);
+            r.times = nb::cast<std::vector<double>>(t[6]);
+            r.positions = nb::cast<std::vector<double>>(t[7]);
+            r.velocities = nb::cast<std::vector<double>>(t[8]);
+            new (&self) EvaluationRecord(std::move(r));
+          })
+      .def("__copy__", [](const EvaluationRecord& r) { return r; })
+      .def("__deepcopy__", [](const EvaluationRecord& r, nb::handle) { return r; }, "memo"_a)
       .def("__repr__", [](const EvaluationRecord& r) {
         return fmt::format("<animat.EvaluationRecord fitness={:.6g} viable={} cells={} frames={}>", r.result.fitness,
                            r.result.viable ? "True" : "False", r.result.cell_count, r.frame_count());

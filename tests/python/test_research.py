@@ -226,6 +226,7 @@ def test_every_value_type_pickles_and_copies(viable, tmp_path):
     run = animat.Run(out)
     trajectory = animat.replay(g, c, steps=100, every=10)
     values = [c, g, animat.Scene(drag_normal=5.0), body, embryo, embryo.trace, result, animat.Fitness(1.5, True, False, 7),
+              animat.record_evaluation(g, c, every=100),
               evo.population[0], animat.GenerationStats(_core_stats(evo)), animat.Rng(9)]
     for v in values:
         for twin in (pickle.loads(pickle.dumps(v)), copy.copy(v), copy.deepcopy(v)):
