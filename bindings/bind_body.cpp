@@ -156,11 +156,19 @@ void bind_body(nb::module_& m) {
         "Edges of the Delaunay triangulation of points, an (n, 2) float array, as an (m, 2) int64\n"
         "array (i, j), i < j, sorted (paper Fig. 3b). Same validation as gabriel_graph.");
   // The Embryo overload comes first: the array overload accepts any object.
-  m.def("build_body", [](const Embryo& embryo, std::optional<Config> config) {
+  m.def("build_body", [](const Embryo& embryo, std::optional<Config> config, bool allow_nonviable) {
+          if (!embryo.viable && !allow_nonviable) {
+            std::string why;
+            for (const auto& r : embryo.reasons) why += (why.empty() ? "" : "; ") + r;
+            throw GeometryError("build_body: the embryo is not viable (" + std::to_string(embryo.cell_count()) +
+                                " cell(s): " + why + "); draw one with Genome.random_viable(seed, config), or pass "
+                                "allow_nonviable=True to build it anyway");
+          }
           return build_body(embryo, body_params(config));
-        }, "embryo"_a, "config"_a = nb::none(),
+        }, "embryo"_a, "config"_a = nb::none(), "allow_nonviable"_a = false,
         "Build the body of an animat.Embryo: its cell centres (radii are ignored) and its per-cell\n"
-        "amplitude, frequency and phase.");
+        "amplitude, frequency and phase. A non-viable embryo (e.g. one cell) raises ValueError unless\n"
+        "allow_nonviable=True.");
   m.def("build_body", [](nb::handle positions, nb::handle amplitude, nb::handle frequency, nb::handle phase,
                          std::optional<Config> config) {
           const Points p = to_points(positions, "build_body");

@@ -59,7 +59,7 @@ void bind_config(nb::module_& m) {
         } catch (const ConfigError& e) {
           throw nb::attribute_error(e.what());  // so hasattr/getattr(default) follow the protocol
         }
-      })
+      }, nb::sig("def __getattr__(self, arg: str, /) -> typing.Any"))
       .def("__setattr__", [](SectionView& s, const std::string& k, const ConfigValue& v) { set_value(*s.config, s.name + "." + k, v); })
       .def("__dir__", [](const SectionView& s) {
         std::vector<std::string> out;
@@ -93,7 +93,8 @@ void bind_config(nb::module_& m) {
       .def("apply_override", [](Config& c, const std::string& a) { apply_override(c, a); }, "assignment"_a,
            "Apply 'section.key=value' exactly as `animat_evolve --set` does (the value is parsed by the key's type).")
       .def("keys", [](const Config&) { return config_keys(); }, "Every 'section.key', in TOML order.")
-      .def("__getitem__", &get_value, "key"_a)
+      .def("__getitem__", &get_value, "key"_a, nb::sig("def __getitem__(self, key: str) -> typing.Any"),
+           "The value of 'section.key' (bool, int, float, str or a list).")
       .def("__setitem__", &set_value, "key"_a, "value"_a)
       .def("__contains__", [](const Config&, const std::string& k) {
         const auto keys = config_keys();

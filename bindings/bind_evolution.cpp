@@ -1,64 +1,169 @@
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/function.h>
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/shared_ptr.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
+
+#include <fmt/format.h>
 
 #include <atomic>
 
 #include "animat/config.hpp"
+#include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "animat/objective.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
 
 namespace animat::py {
+namespace {
+
+nb::dict stats_dict(const GenerationStats& s) {
+  nb::dict d;
+  d["generation"] = s.generation;
+  d["best"] = s.best;
+  d["mean"] = s.mean;
+  d["median"] = s.median;
+  d["viable_fraction"] = s.viable_fraction;
+  d["best_cells"] = s.best_cells;
+  d["evaluations"] = s.evaluations;
+  d["wall_seconds"] = s.wall_seconds;
+  d["evaluations_per_second"] = s.evaluations_per_second;
+  d["best_changed"] = s.best_changed;
+  d["crossovers"] = s.crossovers;
+  d["best_reference"] = s.best_reference;
+  d["invalid"] = s.invalid;
+  return d;
+}
+
+GenerationStats stats_from_dict(const nb::dict& d) {
+  GenerationStats s;
+  s.generation = nb::cast<int>(d["generation"]);
+  s.best = nb::cast<double>(d["best"]);
+  s.mean = nb::cast<double>(d["mean"]);
+  s.median = nb::cast<double>(d["median"]);
+  s.viable_fraction = nb::cast<double>(d["viable_fraction"]);
+  s.best_cells = nb::cast<int>(d["best_cells"]);
+  s.evaluations = nb::cast<std::int64_t>(d["evaluations"]);
+  s.wall_seconds = nb::cast<double>(d["wall_seconds"]);
+  s.evaluations_per_second = nb::cast<double>(d["evaluations_per_second"]);
+  s.best_changed = nb::cast<bool>(d["best_changed"]);
+  s.crossovers = nb::cast<int>(d["crossovers"]);
+  if (d.contains("best_reference")) s.best_reference = nb::cast<double>(d["best_reference"]);
+  if (d.contains("invalid")) s.invalid = nb::cast<int>(d["invalid"]);
+  return s;
+}
+
+std::string fitness_repr(const Fitness& f) {
+  return fmt::format("animat.Fitness(fitness={}, viable={}, stable={}, cell_count={})", f.fitness,
+                     f.viable ? "True" : "False", f.stable ? "True" : "False", f.cell_count);
+}
+
+}  // namespace
 
 void bind_evolution(nb::module_& m) {
   nb::class_<Fitness>(m, "Fitness", "What the GA knows about one evaluated genome.")
-      .def_ro("fitness", &Fitness::fitness, "Distance travelled by the centre of mass (0 if not viable or unstable).")
+      .def("__init__", [](Fitness* f, double fitness, bool viable, bool stable, int cell_count) {
+            new (f) Fitness{fitness, viable, stable, cell_count};
+          }, "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0,
+          "A fitness to tell() the GA: the objective's value, whether the genome was viable (non-viable ones\n"
+          "are never selected before viable ones), whether its swim was stable, and its cell count.")
+      .def_ro("fitness", &Fitness::fitness, "The objective's value (the paper's: distance travelled by the centre of mass; 0 if not viable).")
       .def_ro("viable", &Fitness::viable, "Development verdict; non-viable genomes are never swum.")
       .def_ro("stable", &Fitness::stable, "False if the swim was flagged unstable.")
-      .def_ro("cell_count", &Fitness::cell_count)
+      .def_ro("cell_count", &Fitness::cell_count, "Cells of the embryo.")
       .def_ro("valid", &Fitness::valid, "False if the swim broke an invariant (embedding, collisions); its fitness is 0.")
-      .def("__repr__", [](const Fitness& f) {
-        return "<animat.Fitness " + std::to_string(f.fitness) + (f.viable ? " viable" : " non-viable") +
-               (f.stable ? "" : " UNSTABLE") + ", " + std::to_string(f.cell_count) + " cells>";
-      });
+      .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
+      .def("__getstate__", [](const Fitness& f) { return std::make_tuple(f.fitness, f.viable, f.stable, f.cell_count, f.valid); })
+      .def("__setstate__", [](Fitness& f, const std::tuple<double, bool, bool, int, bool>& t) {
+            new (&f) Fitness{std::get<0>(t), std::get<1>(t), std::get<2>(t), std::get<3>(t), std::get<4>(t)};
+          })
+      .def("__copy__", [](const Fitness& f) { return f; })
+      .def("__deepcopy__", [](const Fitness& f, nb::handle) { return f; }, "memo"_a)
+      .def("__repr__", &fitness_repr);
 
   nb::class_<GenerationStats>(m, "GenerationStats", "Statistics of one generation (a row of history.csv).")
-      .def_ro("generation", &GenerationStats::generation)
-      .def_ro("best", &GenerationStats::best)
+      .def("__init__", [](GenerationStats* s, const nb::dict& d) { new (s) GenerationStats(stats_from_dict(d)); }, "values"_a,
+           "Statistics from a dict of every field (as to_dict() gives).")
+      .def_ro("generation", &GenerationStats::generation, "Generation number (0 = the initial population).")
+      .def_ro("best", &GenerationStats::best, "Best fitness in the population.")
       .def_ro("mean", &GenerationStats::mean, "Mean fitness of the viable individuals.")
       .def_ro("median", &GenerationStats::median, "Median fitness of the viable individuals.")
-      .def_ro("viable_fraction", &GenerationStats::viable_fraction)
-      .def_ro("best_cells", &GenerationStats::best_cells)
+      .def_ro("viable_fraction", &GenerationStats::viable_fraction, "Share of viable individuals.")
+      .def_ro("best_cells", &GenerationStats::best_cells, "Cells of the best individual.")
       .def_ro("evaluations", &GenerationStats::evaluations, "Cumulative fitness evaluations.")
-      .def_ro("wall_seconds", &GenerationStats::wall_seconds)
-      .def_ro("evaluations_per_second", &GenerationStats::evaluations_per_second)
-      .def_ro("best_changed", &GenerationStats::best_changed)
-      .def_ro("crossovers", &GenerationStats::crossovers)
+      .def_ro("wall_seconds", &GenerationStats::wall_seconds, "Cumulative wall time of the run.")
+      .def_ro("evaluations_per_second", &GenerationStats::evaluations_per_second, "Evaluations per second of this generation alone.")
+      .def_ro("best_changed", &GenerationStats::best_changed, "Whether the best genome changed in this generation.")
+      .def_ro("crossovers", &GenerationStats::crossovers, "Offspring made by crossover in this generation.")
       .def_ro("best_reference", &GenerationStats::best_reference,
               "The best's fitness at the reference step (evaluation.reference_check); NaN when off.")
       .def_ro("invalid", &GenerationStats::invalid,
               "Viable individuals whose swim was unstable or broke an invariant (fitness 0).")
+      .def("to_dict", &stats_dict, "Every field as a dict.")
+      .def("__getstate__", &stats_dict)
+      .def("__setstate__", [](GenerationStats& s, const nb::dict& d) { new (&s) GenerationStats(stats_from_dict(d)); })
+      .def("__copy__", [](const GenerationStats& s) { return s; })
+      .def("__deepcopy__", [](const GenerationStats& s, nb::handle) { return s; }, "memo"_a)
       .def("__repr__", [](const GenerationStats& s) {
         return "<animat.GenerationStats gen " + std::to_string(s.generation) + " best " + std::to_string(s.best) + ">";
       });
 
-  nb::class_<RunSummary>(m, "EvolutionResult", "What animat.evolve returns.")
+  nb::class_<Individual>(m, "Individual", "A member of the population: its genome, Fitness and (initial population) tries.")
+      .def("__init__", [](Individual* i, const Genome& g, const Fitness& f, int tries) { new (i) Individual{g, f, tries}; },
+           "genome"_a, "fitness"_a, "tries"_a = 0)
+      .def_ro("genome", &Individual::genome, "The Genome.")
+      .def_ro("fitness", &Individual::result, "Its Fitness.")
+      .def_ro("tries", &Individual::tries, "Random genomes drawn to find it (initial population only; else 0).")
+      .def("__getstate__", [](const Individual& i) { return nb::make_tuple(i.genome, i.result, i.tries); })
+      .def("__setstate__", [](Individual& i, const std::tuple<Genome, Fitness, int>& t) {
+            new (&i) Individual{std::get<0>(t), std::get<1>(t), std::get<2>(t)};
+          })
+      .def("__copy__", [](const Individual& i) { return i; })
+      .def("__deepcopy__", [](const Individual& i, nb::handle) { return i; }, "memo"_a)
+      .def("__repr__", [](const Individual& i) {
+        return fmt::format("<animat.Individual fitness={:.6g}{} cells={} ({} elements)>", i.result.fitness,
+                           i.result.viable ? "" : " non-viable", i.result.cell_count, i.genome.size());
+      });
+
+  nb::class_<Evolution>(m, "Evolution",
+                        "The GA engine behind animat.evolve, driven by ask()/tell() (animat.GA wraps it).")
+      .def(nb::init<const Config&>(), "config"_a)
+      .def("ask", &Evolution::ask, "lookahead"_a = 1,
+           "The genomes that need a fitness next (see animat.GA.ask).")
+      .def("tell", &Evolution::tell, "fitness"_a,
+           "The Fitness of every genome of the last ask(), in order; True when a generation completed.")
+      .def_prop_ro("asked", &Evolution::asked, "Whether an ask() awaits its tell().")
+      .def_prop_ro("generation", &Evolution::generation, "Last completed generation (-1 while drawing the initial population).")
+      .def_prop_ro("population", [](const Evolution& e) { return e.population(); }, "The population (list of Individual).")
+      .def_prop_ro("best", [](const Evolution& e) { return e.best(); }, "The best Individual (first of the fittest).")
+      .def_prop_ro("history", [](const Evolution& e) { return e.history(); }, "GenerationStats of every generation.")
+      .def_prop_ro("evaluations", &Evolution::evaluations, "Fitness evaluations counted so far.")
+      .def_prop_ro("generations_without_improvement", &Evolution::generations_without_improvement)
+      .def("stop_reason", &Evolution::stop_reason, "Why the run should stop now ('' = keep going).")
+      .def("initial_tries", &Evolution::initial_tries, "Random genomes drawn per initial individual.")
+      .def("checkpoint", &Evolution::checkpoint, "The whole state as checkpoint JSON text (the run directory's format).")
+      .def("restore", [](Evolution& e, const std::string& text, const std::string& source) { e.restore(text, source); },
+           "text"_a, "source"_a = "checkpoint", "Restore a checkpoint (refused if corrupt or of another config).");
+
+  nb::class_<RunSummary>(m, "EvolutionSummary", "What animat._core.evolve returns (animat.evolve wraps it).")
       .def_ro("history", &RunSummary::history, "List of GenerationStats, generation 0 first.")
+      .def_ro("best", &RunSummary::best, "The best Individual of the last generation.")
+      .def_ro("population", &RunSummary::population, "The final population (list of Individual).")
       .def_prop_ro("best_genome", [](const RunSummary& r) { return r.best.genome; }, "The best genome of the last generation.")
       .def_prop_ro("best_fitness", [](const RunSummary& r) { return r.best.result; }, "Its Fitness.")
-      .def_ro("stop_reason", &RunSummary::stop_reason)
+      .def_ro("stop_reason", &RunSummary::stop_reason, "Why the run stopped.")
       .def("__repr__", [](const RunSummary& r) {
-        return "<animat.EvolutionResult " + std::to_string(r.history.size()) + " generations, best " +
+        return "<animat.EvolutionSummary " + std::to_string(r.history.size()) + " generations, best " +
                std::to_string(r.best.result.fitness) + ", stopped: " + r.stop_reason + ">";
       });
 
   m.def("evolve", [](std::optional<Config> config, std::optional<std::filesystem::path> out, bool resume,
-                     std::optional<nb::callable> callback, bool quiet, nb::object stop) {
+                     std::optional<nb::callable> callback, bool quiet, nb::object stop, nb::handle objective) {
           const Config c = config.value_or(Config{});
           RunOptions opt;
           if (out) opt.out = *out;
@@ -111,10 +216,16 @@ void bind_evolution(nb::module_& m) {
             }
             return PyObject_IsTrue(set.ptr()) == 1;
           };
+          // The objective scores every swim; the exploit guard re-evaluates each new best with the same
+          // objective at the reference step.
+          const auto scored_by = objective_from_python(objective, c);
+          FitnessFunction fitness = objective_fitness(c, scored_by);
+          FitnessFunction reference;
+          if (c.evaluation.reference_check != "off") reference = objective_fitness(reference_config(c), scored_by);
           RunSummary summary;
           {
             nb::gil_scoped_release release;
-            summary = run_evolution(c, opt);
+            summary = run_evolution(c, opt, std::move(fitness), std::move(reference));
           }
           if (pending) {
             nb::object result = nb::cast(std::move(summary));
@@ -124,27 +235,30 @@ void bind_evolution(nb::module_& m) {
           }
           return summary;
         }, "config"_a = nb::none(), "out"_a = nb::none(), "resume"_a = false, "callback"_a = nb::none(), "quiet"_a = true,
-        "stop"_a = nb::none(),
-        "Run the paper's genetic algorithm (the engine behind animat_evolve).\n\n"
+        "stop"_a = nb::none(), "objective"_a = nb::none(),
+        "Run the paper's genetic algorithm (the engine behind animat_evolve); animat.evolve wraps it.\n\n"
         "config: animat.Config (default: the embedded paper setting; set evolution.generations!).\n"
         "out: run directory for config.toml, history.csv, best/ and checkpoint.json (None = write nothing).\n"
         "resume: continue the run in `out` (settings other than the caps, threads and checkpoint interval\n"
         "must equal the run's; a difference is a ValueError naming the keys, and nothing is written).\n"
-        "callback: called with each generation's GenerationStats; return False to stop (True or None: go on).\n"
+        "callback: called with each generation's GenerationStats (generation 0 included); return False to stop\n"
+        "(True or None: go on).\n"
         "stop: an object with is_set() (e.g. threading.Event), polled between evaluations; set = stop.\n"
-        "The GIL is released while it runs. Returns an EvolutionResult (history, best_genome, best_fitness);\n"
+        "objective: None (the config's evaluation.objective), a built-in name, or a Python objective.\n"
+        "The GIL is released while it runs. Returns an EvolutionSummary (history, best, population);\n"
         "stop_reason is 'interrupted' when `stop` ended it. Ctrl-C (or an exception from the callback)\n"
         "stops it within one evaluation, leaves a checkpoint of the last complete generation in `out`\n"
         "(resume=True continues), and is raised with the partial EvolutionResult as its `.result`.");
 
-  m.def("evaluate_population", [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads) {
+  m.def("evaluate_population", [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads,
+                                  nb::handle objective) {
           const Config c = config.value_or(Config{});
-          const FitnessFunction f = swim_fitness(c);
+          const FitnessFunction f = objective_fitness(c, objective_from_python(objective, c));
           nb::gil_scoped_release release;
           return evaluate_all(genomes, f, threads);
-        }, "genomes"_a, "config"_a = nb::none(), "threads"_a = 0,
+        }, "genomes"_a, "config"_a = nb::none(), "threads"_a = 0, "objective"_a = nb::none(),
         "Evaluate genomes in parallel (OpenMP, one Box2D world each); returns a list of Fitness in input order,\n"
-        "identical for any thread count.");
+        "identical for any thread count. objective: None (the config's), a built-in name or a Python objective.");
 
   m.def("tournament_probability", [](int generation, std::optional<Config> config) {
           return tournament_probability(config.value_or(Config{}).evolution, generation);

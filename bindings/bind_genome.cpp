@@ -4,6 +4,7 @@
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
 #include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
@@ -13,6 +14,7 @@
 #include <variant>
 
 #include "animat/config.hpp"
+#include "animat/development.hpp"
 #include "animat/errors.hpp"
 #include "animat/genome.hpp"
 #include "animat/grn.hpp"
@@ -116,9 +118,32 @@ void bind_genome(nb::module_& m) {
             Genome g = random_genome(cfg(config, fallback).genome, r);
             write_back(rng, r);
             return g;
-          }, "rng"_a, "config"_a = nb::none(),
+          }, "seed"_a, "config"_a = nb::none(),
           "A random genome as the paper seeds it: genome.initial_units units of one promoter and one gene,\n"
-          "plus one special element per input and output channel. `rng` is an animat.Rng or an int seed.")
+          "plus one special element per input and output channel. `seed` is an int or an animat.Rng\n"
+          "(advanced). Most random genomes are not viable (about 1 in 135): see random_viable.")
+      .def_static("random_viable", [](RngOrSeed rng, std::optional<Config> config, std::optional<int> max_tries) {
+            Config fallback;
+            const Config& c = cfg(config, fallback);
+            Rng r = resolve(rng);
+            const int limit = max_tries.value_or(c.evolution.max_init_tries);
+            if (limit < 1) throw Error("random_viable: max_tries must be >= 1, got " + std::to_string(limit));
+            nb::gil_scoped_release release;
+            for (int tries = 1; tries <= limit; ++tries) {
+              Genome g = random_genome(c.genome, r);
+              if (develop(g, c.genome, c.grn, c.development).viable) {
+                nb::gil_scoped_acquire gil;
+                write_back(rng, r);
+                return std::make_tuple(std::move(g), tries);
+              }
+            }
+            throw Error("random_viable: no viable genome in " + std::to_string(limit) +
+                        " tries (evolution.max_init_tries); the development or genome settings make viability too rare");
+          }, "seed"_a, "config"_a = nb::none(), "max_tries"_a = nb::none(),
+          "The first viable random genome drawn from `seed` (an int or an animat.Rng), as the GA seeds its\n"
+          "initial population: returns (genome, tries), tries = random genomes drawn (the paper: a few\n"
+          "hundred). Viability is the development verdict (paper §5). Raises ValueError after max_tries\n"
+          "(default config.evolution.max_init_tries).")
       .def_static("from_arrays", [](Array1<const std::int64_t> types, Array1<const std::int64_t> signs,
                                     Array1<const std::int64_t> channels, nb::ndarray<const double, nb::ndim<2>, nb::c_contig> coords) {
             const std::size_t n = types.shape(0);

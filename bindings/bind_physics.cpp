@@ -23,6 +23,7 @@
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
+#include "animat/objective.hpp"
 #include "animat/physics.hpp"
 #include "animat/scene.hpp"
 #include "bindings.hpp"
@@ -273,6 +274,10 @@ void bind_physics(nb::module_& m) {
   nb::class_<Simulation>(m, "Simulation", kSimulationDoc)
       .def("__init__", [](Simulation* s, const Body& body, std::optional<SceneParams> scene, std::optional<Config> config) {
         const Config c = config ? *config : Config{};
+        if (body.node_count() < 2)
+          PyErr_WarnEx(PyExc_RuntimeWarning,
+                       fmt::format("Simulation: the body has {} cell(s) and no springs: it cannot swim (a non-viable "
+                                   "embryo? see Genome.random_viable)", body.node_count()).c_str(), 1);
         new (s) Simulation(body, scene ? *scene : c.scene, c.physics);
       }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none())
       .def("step", [](Simulation& s, long n) {
@@ -403,15 +408,16 @@ void bind_physics(nb::module_& m) {
       "check_embedding (default config.evaluation.check_embedding) checks region signs and skin\n"
       "simplicity after every step; stop_when_invalid=False swims on after a broken invariant so that\n"
       "the counts cover the whole horizon.");
-  m.def("evaluate", [](const Genome& genome, std::optional<Config> config) {
+  m.def("evaluate", [](const Genome& genome, std::optional<Config> config, nb::handle objective) {
         const Config c = config ? *config : Config{};
+        const auto scored_by = objective_from_python(objective, c);
         warm_up_box2d();
         nb::gil_scoped_release release;
-        return evaluate(genome, c);
-      }, "genome"_a, "config"_a = nb::none(),
-      "genome -> development -> body -> swim; returns an EvaluationResult (fitness = distance of the\n"
-      "centre of mass). Deterministic. Non-viable genomes are not swum; unstable swims give fitness 0\n"
-      "and stable=False.");
+        return evaluate(genome, c, *scored_by);
+      }, "genome"_a, "config"_a = nb::none(), "objective"_a = nb::none(),
+      "genome -> development -> body -> swim; returns an EvaluationResult whose fitness is the objective\n"
+      "(default: config.evaluation.objective, the paper's distance of the centre of mass). Deterministic.\n"
+      "Non-viable genomes are not swum; unstable swims give fitness 0 and stable=False.");
   m.def("warm_up_box2d", &warm_up_box2d,
         "Initialise Box2D's lazily filled globals; call once before using worlds from several threads.");
   m.def("actuation_start_time", &actuation_start_time, "frequency"_a, "phase"_a,

@@ -14,6 +14,7 @@
 #include <type_traits>
 
 #include "animat/errors.hpp"
+#include "animat/objective.hpp"
 
 namespace animat {
 
@@ -144,7 +145,10 @@ std::string check(const FieldInfo& info, const T& value) {
     return {};
   };
   auto allowed = [&](const std::string& s) {
-    return info.choices.empty() || std::find(info.choices.begin(), info.choices.end(), s) != info.choices.end();
+    // A choice ending in '*' admits every value with that prefix (evaluation.objective = "python:NAME").
+    return info.choices.empty() || std::any_of(info.choices.begin(), info.choices.end(), [&](std::string_view c) {
+             return c == s || (c.ends_with('*') && s.size() >= c.size() && s.starts_with(c.substr(0, c.size() - 1)));
+           });
   };
   if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t> || std::is_same_v<T, double>) {
     return check_number(static_cast<double>(value));
@@ -428,6 +432,7 @@ void validate(const Config& config, std::string_view source) {
                      2 * config.genome.initial_units + kInputCount + kOutputCount));
   try {
     validate(config.development);
+    validate(config.evaluation);
   } catch (const ConfigError& e) {
     fail(e.what());
   }

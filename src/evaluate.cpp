@@ -61,21 +61,31 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   const Eigen::Vector2d start = sim.center_of_mass();
   const double floor = stretch_floor(body);
   sample(sim, body, floor, r);
+  EvaluationObserver* observer = options.observer;
+  const long every = observer ? observer->sample_every() : 0;
+  if (every > 0) observer->on_sample(sim);
+  const bool stop_early = options.stop_when_invalid && options.check_embedding;
   auto broken = [&] {
     return sim.first_broken_step() >= 0 || sim.counters().collisions_unresolved > 0;
   };
   try {
     for (long done = 0; done < steps;) {
-      const long chunk = std::min(kSampleEvery, steps - done);
-      if (options.stop_when_invalid && options.check_embedding) {
-        for (long k = 0; k < chunk && !broken(); ++k) sim.step(1);
-        done += chunk;
-        sample(sim, body, floor, r);
-        if (broken()) break;
+      // Stops at the diagnostic samples (every 16 steps and the end) and the observer's frames;
+      // splitting step() changes nothing in the motion. When an invalid swim ends early, it goes
+      // one step at a time so that it stops at the first broken invariant.
+      long next = std::min(steps, (done / kSampleEvery + 1) * kSampleEvery);
+      if (every > 0) next = std::min(next, (done / every + 1) * every);
+      if (stop_early) {
+        for (; done < next && !broken(); ++done) sim.step(1);
       } else {
-        sim.step(chunk);
-        done += chunk;
+        sim.step(next - done);
+        done = next;
+      }
+      if (done % kSampleEvery == 0 || done == steps) sample(sim, body, floor, r);
+      if (every > 0 && done % every == 0) observer->on_sample(sim);
+      if (stop_early && broken()) {
         sample(sim, body, floor, r);
+        break;
       }
     }
   } catch (const SimulationError& e) {
@@ -121,7 +131,7 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   return r;
 }
 
-EvaluationResult evaluate(const Genome& genome, const Config& config) {
+EvaluationResult evaluate(const Genome& genome, const Config& config, EvaluationObserver* observer) {
   EvaluationResult out;
   validate(genome, config.genome, "evaluate");  // a genome no loader would accept is an error, not UB
   validate(config.scene);
@@ -165,6 +175,8 @@ EvaluationResult evaluate(const Genome& genome, const Config& config) {
   t0 = Clock::now();
   SwimOptions options;
   options.check_embedding = config.evaluation.check_embedding;
+  options.observer = observer;
+  if (observer) observer->on_body(body);
   const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, options);
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;

@@ -168,7 +168,6 @@ Evolution::Evolution(const Config& config, FitnessFunction fitness, FitnessFunct
       fitness_(std::move(fitness)),
       started_(now_seconds()) {
   validate(*config_);
-  if (!fitness_) throw Error("Evolution: no fitness function");
   if (config_->evaluation.reference_check != "off") reference_ = std::move(reference);
 }
 
@@ -198,36 +197,25 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
 }
 
 void Evolution::initialize() {
-  prepare_parallel_evaluation();
+  if (!fitness_) throw Error("Evolution::initialize: no fitness function (drive this engine with ask() and tell())");
+  if (generation_ >= 0) throw Error("Evolution::initialize: the initial population exists already");
   const EvolutionParams& ep = config_->evolution;
-  std::vector<Individual> population(static_cast<std::size_t>(ep.population));
-  StopWatch watch(stop_);
-  parallel_for(population.size(), ep.threads, [&](std::size_t i) {
-    Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i);
-    Individual& ind = population[i];
-    for (ind.tries = 1; ind.tries <= ep.max_init_tries; ++ind.tries) {
-      if (watch.stopped()) return;
-      ind.genome = random_genome(config_->genome, rng);
-      ind.result = fitness_(ind.genome);
-      check_fitness(ind.result, fmt::format("initial population, individual {}", i));
-      if (ind.result.viable) return;
-    }
-    throw Error(fmt::format("initial population: no viable random genome in evolution.max_init_tries = {} tries "
-                            "(individual {}); the development or genome settings make viability too rare",
-                            ep.max_init_tries, i));
-  });
-  if (watch.fired()) throw Interrupted("interrupted while drawing the initial population");
-  population_ = std::move(population);
-  for (const auto& ind : population_) evaluations_ += ind.tries;
-  generation_ = 0;
-  best_ever_ = best().result.fitness;
-  stall_ = 0;
-  history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_));
-  check_reference();
+  while (generation_ < 0) {
+    // Rounds of about four populations of speculative draws: few rounds (each ends at a barrier of
+    // the parallel evaluation), and few discarded draws (about 1% of the initial evaluations).
+    std::size_t open = 0;
+    for (const auto& slot : slots_) open += slot.filled ? 0 : 1;
+    if (slots_.empty()) open = static_cast<std::size_t>(ep.population);
+    const auto width = 4 * static_cast<std::size_t>(ep.population);
+    const int lookahead = static_cast<int>(std::max<std::size_t>(1, (width + open - 1) / std::max<std::size_t>(open, 1)));
+    const std::vector<Genome> genomes = ask(lookahead);
+    tell(evaluate_genomes(genomes, "initial population"));
+  }
 }
 
 const Individual& Evolution::best() const {
-  if (population_.empty()) throw Error("Evolution::best: the population is empty (call initialize first)");
+  if (generation_ < 0 || population_.empty())
+    throw Error("Evolution::best: no generation yet (the initial population is not complete)");
   // The first of the fittest, by index: ties resolve the same way on every machine.
   return *std::min_element(population_.begin(), population_.end(),
                            [](const Individual& a, const Individual& b) { return fitter(a, b); });
@@ -240,7 +228,105 @@ std::vector<int> Evolution::initial_tries() const {
 }
 
 GenerationStats Evolution::step() {
+  if (!fitness_) throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
   if (generation_ < 0) throw Error("Evolution::step: call initialize() first");
+  const std::vector<Genome> genomes = ask();
+  tell(evaluate_genomes(genomes, fmt::format("generation {}", generation_ + 1)));
+  return history_.back();
+}
+
+std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what) {
+  prepare_parallel_evaluation();
+  std::vector<Fitness> out(genomes.size());
+  StopWatch watch(stop_);
+  parallel_for(genomes.size(), config_->evolution.threads, [&](std::size_t k) {
+    if (watch.stopped()) return;
+    out[k] = fitness_(genomes[k]);
+    check_fitness(out[k], fmt::format("{}, genome {}", what, k));
+  });
+  if (watch.fired())
+    throw Interrupted(generation_ < 0 ? std::string("interrupted while drawing the initial population")
+                                      : fmt::format("interrupted during {}", what));
+  return out;
+}
+
+std::vector<Genome> Evolution::ask(int lookahead) {
+  if (lookahead < 1) throw Error(fmt::format("Evolution::ask: lookahead must be >= 1, got {}", lookahead));
+  if (pending_) return asked_;
+  asked_ = generation_ < 0 ? ask_initial(lookahead) : ask_generation();
+  pending_ = true;
+  return asked_;
+}
+
+bool Evolution::tell(const std::vector<Fitness>& fitness) {
+  if (!pending_) throw Error("Evolution::tell: nothing was asked (call ask() first)");
+  if (fitness.size() != asked_.size())
+    throw Error(fmt::format("Evolution::tell: {} fitness values for the {} genomes of the last ask()", fitness.size(),
+                            asked_.size()));
+  for (std::size_t k = 0; k < fitness.size(); ++k)
+    if (!std::isfinite(fitness[k].fitness))
+      throw Error(fmt::format("Evolution::tell: fitness {} of genome {} is not finite", fitness[k].fitness, k));
+  const bool done = generation_ < 0 ? tell_initial(fitness) : tell_generation(fitness);
+  pending_ = false;
+  asked_.clear();
+  asked_index_.clear();
+  return done;
+}
+
+std::vector<Genome> Evolution::ask_initial(int lookahead) {
+  const EvolutionParams& ep = config_->evolution;
+  if (slots_.empty()) {
+    const auto n = static_cast<std::size_t>(ep.population);
+    population_.assign(n, Individual{});
+    slots_.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      slots_.push_back(InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i)});
+  }
+  std::vector<Genome> out;
+  asked_index_.clear();
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    InitialSlot& slot = slots_[i];
+    if (slot.filled) continue;
+    const int draws = std::min(lookahead, ep.max_init_tries - slot.tries);
+    for (int k = 0; k < draws; ++k) {
+      out.push_back(random_genome(config_->genome, slot.rng));
+      asked_index_.push_back(i);
+    }
+  }
+  return out;
+}
+
+bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
+  const EvolutionParams& ep = config_->evolution;
+  for (std::size_t k = 0; k < fitness.size(); ++k) {
+    InitialSlot& slot = slots_[asked_index_[k]];
+    if (slot.filled) continue;  // a speculative draw after this slot's first viable one: discarded
+    ++slot.tries;
+    ++evaluations_;
+    if (!fitness[k].viable) continue;
+    Individual& ind = population_[asked_index_[k]];
+    ind.genome = std::move(asked_[k]);
+    ind.result = fitness[k];
+    ind.tries = slot.tries;
+    slot.filled = true;
+  }
+  for (std::size_t i = 0; i < slots_.size(); ++i)
+    if (!slots_[i].filled && slots_[i].tries >= ep.max_init_tries)
+      throw Error(fmt::format("initial population: no viable random genome in evolution.max_init_tries = {} tries "
+                              "(individual {}); the development or genome settings make viability too rare",
+                              ep.max_init_tries, i));
+  for (const auto& slot : slots_)
+    if (!slot.filled) return false;
+  slots_.clear();
+  generation_ = 0;
+  best_ever_ = best().result.fitness;
+  stall_ = 0;
+  history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_));
+  check_reference();
+  return true;
+}
+
+std::vector<Genome> Evolution::ask_generation() {
   const EvolutionParams& ep = config_->evolution;
   const int g = generation_ + 1;
   const std::size_t n = population_.size();
@@ -256,7 +342,8 @@ GenerationStats Evolution::step() {
     std::iota(eligible.begin(), eligible.end(), 0);
   }
 
-  std::vector<Individual> next(n);
+  std::vector<Individual>& next = next_;
+  next.assign(n, Individual{});
   std::vector<bool> needs_eval(n, false);
   const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), n);
   std::size_t copied = 0;
@@ -300,21 +387,25 @@ GenerationStats Evolution::step() {
         break;
       }
   }
-  std::vector<std::size_t> todo;
+  next_crossovers_ = crossovers;
+  std::vector<Genome> out;
+  asked_index_.clear();
   for (std::size_t i = 0; i < n; ++i)
-    if (needs_eval[i]) todo.push_back(i);
-  StopWatch watch(stop_);
-  parallel_for(todo.size(), ep.threads, [&](std::size_t k) {
-    if (watch.stopped()) return;
-    next[todo[k]].result = fitness_(next[todo[k]].genome);
-    check_fitness(next[todo[k]].result, fmt::format("generation {}, individual {}", g, todo[k]));
-  });
-  if (watch.fired()) throw Interrupted(fmt::format("interrupted during generation {}", g));
-  evaluations_ += static_cast<std::int64_t>(todo.size());
+    if (needs_eval[i]) {
+      out.push_back(next[i].genome);
+      asked_index_.push_back(i);
+    }
+  return out;
+}
+
+bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
+  for (std::size_t k = 0; k < fitness.size(); ++k) next_[asked_index_[k]].result = fitness[k];
+  evaluations_ += static_cast<std::int64_t>(fitness.size());
 
   const Genome previous_best = best().genome;
-  population_ = std::move(next);
-  generation_ = g;
+  population_ = std::move(next_);
+  next_.clear();
+  generation_ += 1;
   const Individual& b = best();
   if (b.result.fitness > best_ever_) {
     best_ever_ = b.result.fitness;
@@ -323,9 +414,9 @@ GenerationStats Evolution::step() {
     ++stall_;
   }
   history_.push_back(statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_));
-  history_.back().crossovers = crossovers;
+  history_.back().crossovers = next_crossovers_;
   check_reference();
-  return history_.back();
+  return true;
 }
 
 namespace {
@@ -359,7 +450,10 @@ GenerationStats Evolution::statistics(bool best_changed, double wall) const {
   s.generation = generation_;
   s.evaluations = evaluations_;
   s.wall_seconds = wall;
-  s.evaluations_per_second = wall > 0 ? static_cast<double>(evaluations_) / wall : 0.0;
+  // The rate of this generation alone (a cumulative average would drag the initial draws along).
+  const double seconds = history_.empty() ? wall : wall - history_.back().wall_seconds;
+  const auto evaluated = evaluations_ - (history_.empty() ? 0 : history_.back().evaluations);
+  s.evaluations_per_second = seconds > 0 ? static_cast<double>(evaluated) / seconds : 0.0;
   s.best_changed = best_changed;
   return s;
 }
@@ -423,7 +517,6 @@ GenerationStats stats_from_json(const json& j) {
   // Fields added with the exploit guard; absent in older checkpoints.
   if (j.contains("invalid")) s.invalid = static_cast<int>(int_field(j, "invalid", 0, kIntMax));
   if (j.contains("best_reference")) s.best_reference = number_field(j, "best_reference");
-  s.evaluations_per_second = s.wall_seconds > 0 ? static_cast<double>(s.evaluations) / s.wall_seconds : 0.0;
   return s;
 }
 
@@ -480,6 +573,7 @@ void check_semantics(const std::vector<Individual>& pop, const std::vector<Gener
 }  // namespace
 
 std::string Evolution::checkpoint() const {
+  if (generation_ < 0) throw Error("Evolution::checkpoint: no generation completed yet (the initial population is being drawn)");
   json payload;
   payload["format"] = "animat.checkpoint";
   payload["version"] = kCheckpointVersion;
@@ -556,7 +650,13 @@ void Evolution::restore(std::string_view text, std::string_view source) {
       throw CheckpointError(fmt::format("{}: checkpoint holds {} individuals, evolution.population is {}", source, pop.size(),
                                         config_->evolution.population));
     std::vector<GenerationStats> hist;
-    for (const json& js : p.at("history")) hist.push_back(stats_from_json(js));
+    for (const json& js : p.at("history")) {
+      GenerationStats st = stats_from_json(js);
+      const double seconds = hist.empty() ? st.wall_seconds : st.wall_seconds - hist.back().wall_seconds;
+      const auto evaluated = st.evaluations - (hist.empty() ? 0 : hist.back().evaluations);
+      st.evaluations_per_second = seconds > 0 ? static_cast<double>(evaluated) / seconds : 0.0;
+      hist.push_back(st);
+    }
     const int generation = static_cast<int>(int_field(p, "generation", 0, kIntMax));
     if (hist.empty()) throw CheckpointError(fmt::format("{}: checkpoint has an empty history", source));
     if (hist.back().generation != generation)
@@ -568,6 +668,11 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     const double wall = number_field(p, "wall_seconds");
     check_semantics(pop, hist, stall, best_ever, evaluations, wall, source);
     population_ = std::move(pop);
+    slots_.clear();
+    next_.clear();
+    pending_ = false;
+    asked_.clear();
+    asked_index_.clear();
     history_ = std::move(hist);
     generation_ = generation;
     stall_ = stall;
@@ -716,9 +821,9 @@ std::string local_time_stamp() {
 
 namespace {
 
-RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
+RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, FitnessFunction fitness,
+                                   FitnessFunction reference) {
   validate(config);
-  FitnessFunction reference;
   if (!fitness) {  // the real swim: its exploit guard re-evaluates each new best at the reference step
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off") reference = swim_fitness(reference_config(config));
@@ -800,6 +905,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
       write_atomically(ckpt, evo.checkpoint());
     }
   }
+  bool stopped_by_callback = false;
+  if (!opt.resume && opt.callback && !opt.callback(evo.history().back(), evo)) stopped_by_callback = true;
 
   RunSummary summary;
   double last_print = 0.0;
@@ -810,10 +917,17 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     if (!force && t - last_print < opt.progress_interval) return;
     last_print = t;
     last_printed = s.generation;
+    // ETA from the last generation's pace (the initial draws are not a generation's pace).
+    const auto& h = evo.history();
+    const double pace = h.size() >= 2 ? h.back().wall_seconds - h[h.size() - 2].wall_seconds : 0.0;
     std::string left;
-    if (config.evolution.wall_seconds > 0) left = fmt::format(", {} left of budget", duration(config.evolution.wall_seconds - s.wall_seconds));
-    else if (config.evolution.generations > 0 && s.generation > 0)
-      left = fmt::format(", ~{} left", duration(s.wall_seconds / s.generation * (config.evolution.generations - s.generation)));
+    if (config.evolution.generations > 0 && s.generation > 0 && pace > 0) {
+      double eta = pace * (config.evolution.generations - s.generation);
+      if (config.evolution.wall_seconds > 0) eta = std::min(eta, config.evolution.wall_seconds - s.wall_seconds);
+      left = fmt::format(", ETA {}", duration(eta));
+    } else if (config.evolution.wall_seconds > 0) {
+      left = fmt::format(", {} left of budget", duration(config.evolution.wall_seconds - s.wall_seconds));
+    }
     spdlog::info("gen {:5d} | best {:8.4f} mean {:8.4f} median {:8.4f} | viable {:5.1f}% | {:6.1f} eval/s | {} elapsed{}",
                  s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.evaluations_per_second,
                  duration(s.wall_seconds), left);
@@ -833,6 +947,10 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
   int since_checkpoint = 0;
   bool dirty = false;
   while (true) {
+    if (stopped_by_callback) {
+      summary.stop_reason = "stopped by callback";
+      break;
+    }
     summary.stop_reason = evo.stop_reason();
     if (summary.stop_reason.empty() && ((opt.stop_flag && opt.stop_flag->load()) || (opt.stop_poll && opt.stop_poll())))
       summary.stop_reason = "interrupted";
@@ -866,14 +984,16 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
   if (!opt.quiet) spdlog::info("stopped: {}", summary.stop_reason);
   summary.history = evo.history();
   summary.best = evo.best();
+  summary.population = evo.population();
   return summary;
 }
 
 }  // namespace
 
-RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
+RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness,
+                         FitnessFunction reference) {
   try {
-    return run_evolution_unchecked(config, opt, std::move(fitness));
+    return run_evolution_unchecked(config, opt, std::move(fitness), std::move(reference));
   } catch (const std::filesystem::filesystem_error& e) {  // never an "internal error": name the path and the reason
     throw IoError(fmt::format("{}: {}", e.path1().string(), e.code().message()));
   }

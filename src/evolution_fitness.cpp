@@ -1,17 +1,23 @@
-// The GA's real fitness: the whole chain of evaluate.hpp.
+// The GA's real fitness: the whole chain of evaluate.hpp, scored by the config's objective.
 #include <memory>
+#include <utility>
 
 #include "animat/config.hpp"
+#include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/objective.hpp"
 
 namespace animat {
 
-FitnessFunction swim_fitness(const Config& config) {
+FitnessFunction swim_fitness(const Config& config) { return objective_fitness(config, make_objective(config.evaluation)); }
+
+FitnessFunction objective_fitness(const Config& config, std::shared_ptr<const Objective> objective) {
   validate(config);
+  if (!objective) throw Error("objective_fitness: no objective");
   auto shared = std::make_shared<const Config>(config);
-  return [shared](const Genome& genome) {
-    const EvaluationResult r = evaluate(genome, *shared);
+  return [shared, objective = std::move(objective)](const Genome& genome) {
+    const EvaluationResult r = evaluate(genome, *shared, *objective);
     return Fitness{r.fitness, r.viable, r.stable, r.cell_count, r.valid};
   };
 }

@@ -12,6 +12,19 @@
 namespace animat {
 
 struct Body;
+class Simulation;
+
+/// Watches one evaluation (objectives that need the body or a trajectory); optional and passive:
+/// an observed evaluation is bit-identical to an unobserved one.
+struct EvaluationObserver {
+  virtual ~EvaluationObserver() = default;
+  /// Control steps between on_sample() calls (0 = none).
+  [[nodiscard]] virtual long sample_every() const { return 0; }
+  /// The body about to swim.
+  virtual void on_body(const Body& body) { (void)body; }
+  /// The simulation at step 0 and after every sample_every() control steps.
+  virtual void on_sample(const Simulation& sim) { (void)sim; }
+};
 
 /// What a swim did.
 struct SwimResult {
@@ -48,6 +61,7 @@ struct SwimResult {
 struct SwimOptions {
   bool check_embedding = true;   ///< check the planar embedding after every Box2D step
   bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
+  EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
 };
 
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
@@ -101,6 +115,7 @@ struct EvaluationResult {
 /// gives fitness 0, stable = false and the reason; nothing is clamped silently. A body the body
 /// stage rejects (e.g. duplicate centres) is non-viable with the reason. Throws ConfigError for an
 /// invalid config.
-[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config);
+[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config,
+                                        EvaluationObserver* observer = nullptr);
 
 }  // namespace animat

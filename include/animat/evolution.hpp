@@ -18,10 +18,17 @@
 namespace animat {
 
 inline constexpr std::string_view kReferenceCheckNames[] = {"record", "select", "off"};
+/// Allowed values of evaluation.objective: the built-in objectives (kObjectiveNames in objective.hpp;
+/// a new one is added to both lists) and "python:NAME" (the trailing * is a wildcard).
+inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "python:*"};
 
-/// How an evaluation is run: the swim horizon, the invariants checked, and the exploit guard.
+/// How an evaluation is run and scored: the swim horizon, the objective (objective.hpp), the
+/// invariants checked, and the exploit guard.
 struct EvaluationParams {
   int steps = 4000;  ///< swim steps at physics.dt [paper: 4000 or 8000]
+  /// distance (the paper's), distance_per_size, speed_toward, or "python:NAME" (a Python callable).
+  std::string objective = "distance";
+  std::vector<double> direction = {1.0, 0.0};  ///< speed_toward's direction (normalised when used)
   /// Check the body's planar embedding after every step (no region inverted, the skin simple); a
   /// swim that breaks it is invalid and gets fitness 0, like an unstable one.
   bool check_embedding = true;
@@ -37,6 +44,12 @@ struct EvaluationParams {
 template <class V>
 void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
+  v(FieldInfo{"objective", "what the GA maximises: distance (straight-line distance of the centre of mass, the paper's); "
+                           "distance_per_size (distance / body length); speed_toward (centre-of-mass speed along "
+                           "evaluation.direction); python:NAME (a Python callable, set by animat.evolve)",
+              Bounds::any(), kObjectiveChoices},
+    p.objective);
+  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)"}, p.direction);
   v(FieldInfo{"check_embedding", "check after every step that no region is inverted and the skin is a simple polygon; a swim that breaks it gets fitness 0", Bounds::any()}, p.check_embedding);
   v(FieldInfo{"reference_check", "exploit guard: re-evaluate each new best at a finer step and record both fitnesses (record), also rank elites by it (select), or off", Bounds::any(), kReferenceCheckNames}, p.reference_check);
   v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
@@ -101,8 +114,13 @@ struct Fitness {
 /// tests plug in cheap stubs.
 using FitnessFunction = std::function<Fitness(const Genome&)>;
 
-/// genome → development → body → swim, per `config` (see evaluate.hpp).
+class Objective;
+
+/// genome → development → body → swim, per `config` (see evaluate.hpp), scored by the config's
+/// objective (evaluation.objective; objective.hpp).
 [[nodiscard]] FitnessFunction swim_fitness(const Config& config);
+/// The same chain scored by `objective` (e.g. a Python callable) instead of the config's.
+[[nodiscard]] FitnessFunction objective_fitness(const Config& config, std::shared_ptr<const Objective> objective);
 
 struct Individual {
   Genome genome;
@@ -123,7 +141,7 @@ struct GenerationStats {
   int best_cells = 0;
   std::int64_t evaluations = 0;  ///< cumulative fitness evaluations (swims and non-viable developments)
   double wall_seconds = 0.0;     ///< cumulative wall time of the run (the only machine-dependent column)
-  double evaluations_per_second = 0.0;
+  double evaluations_per_second = 0.0;  ///< of this generation alone (its evaluations / its wall time)
   bool best_changed = false;     ///< the best genome differs from the previous generation's
   int crossovers = 0;            ///< offspring made by crossover in this generation
   /// The best's fitness at the reference step (evaluation.reference_check); NaN when off.
@@ -166,14 +184,20 @@ void prepare_parallel_evaluation();
 
 /// The genetic algorithm (paper §5). Every random number of generation g, offspring i derives from
 /// Rng::derive(seed, g, i), so a run is bit-identical for any thread count and across resumes.
+///
+/// It runs by itself (initialize(), step(): evaluating with its fitness function in parallel) or is
+/// driven from outside by ask()/tell(), for genomes evaluated elsewhere; both are the same engine
+/// and give identical results.
 class Evolution {
  public:
-  /// `reference` is the exploit guard's fitness at the reference step (reference_config()); with
-  /// none, evaluation.reference_check has no effect.
-  Evolution(const Config& config, FitnessFunction fitness, FitnessFunction reference = {});
+  /// `fitness` may be empty for an engine driven only by ask() and tell(). `reference` is the
+  /// exploit guard's fitness at the reference step (reference_config()); with none,
+  /// evaluation.reference_check has no effect.
+  explicit Evolution(const Config& config, FitnessFunction fitness = {}, FitnessFunction reference = {});
 
-  /// Draws the initial population: random genomes regenerated until viable. Throws Interrupted (and
-  /// stays uninitialised) if the stop request fires first.
+  /// Draws the initial population: random genomes regenerated until viable (ask/evaluate/tell
+  /// rounds with speculative draws; the result equals one-at-a-time drawing). Throws Interrupted
+  /// (and stays uninitialised) if the stop request fires first.
   void initialize();
   /// Makes and evaluates the next generation; returns its statistics. Throws Interrupted if the stop
   /// request fires before the generation is complete: the state stays at the previous generation
@@ -182,6 +206,21 @@ class Evolution {
   GenerationStats step();
   /// Checked by initialize() and step() (see StopRequest); empty = never stop.
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
+
+  /// The genomes that need a fitness next, in order. Before generation 0: the next random draw of
+  /// every initial slot not yet holding a viable individual (slot i draws from
+  /// Rng::derive(seed, initial, i)); with `lookahead` > 1, that many consecutive draws per slot
+  /// (speculative: those after a slot's first viable draw are discarded and not counted, so the run
+  /// does not depend on it). After that: the offspring of the next generation that are not copies of
+  /// an evaluated genome (elites and unchanged copies keep their fitness; the list may be empty).
+  /// ask() again before tell() returns the same genomes.
+  std::vector<Genome> ask(int lookahead = 1);
+  /// The fitness of every genome of the last ask(), in order. Returns true when this completed a
+  /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a
+  /// non-finite fitness, or an initial slot that used up evolution.max_init_tries.
+  bool tell(const std::vector<Fitness>& fitness);
+  /// Whether an ask() awaits its tell().
+  [[nodiscard]] bool asked() const { return pending_; }
   /// Why the run should stop now ("" = keep going): stall, generation cap or wall-clock budget.
   [[nodiscard]] std::string stop_reason() const;
 
@@ -210,14 +249,34 @@ class Evolution {
   /// Exploit guard, after a generation is complete: the best's reference fitness (evaluated once
   /// per genome), recorded in the last history row.
   void check_reference();
+  /// fitness_ of every genome in parallel, honouring the stop request (throws Interrupted).
+  std::vector<Fitness> evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what);
   /// "select": reference fitness of the elite candidates, which are then ranked by it.
   std::vector<std::size_t> reference_ranked(const std::vector<std::size_t>& order, std::size_t elites);
+
+  std::vector<Genome> ask_initial(int lookahead);
+  std::vector<Genome> ask_generation();
+  bool tell_initial(const std::vector<Fitness>& fitness);
+  bool tell_generation(const std::vector<Fitness>& fitness);
+
+  /// One initial individual being drawn (before generation 0).
+  struct InitialSlot {
+    Rng rng;
+    int tries = 0;
+    bool filled = false;
+  };
 
   std::shared_ptr<const Config> config_;  ///< own copy: the engine outlives no caller state
   std::uint64_t identity_;
   FitnessFunction fitness_;
   FitnessFunction reference_;
   std::vector<Individual> population_;
+  std::vector<InitialSlot> slots_;          ///< before generation 0 only
+  bool pending_ = false;                    ///< an ask() awaits its tell()
+  std::vector<Genome> asked_;               ///< the genomes of that ask()
+  std::vector<std::size_t> asked_index_;    ///< their initial slot, or their index in next_
+  std::vector<Individual> next_;            ///< the generation being made
+  int next_crossovers_ = 0;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()
   int stall_ = 0;
@@ -244,7 +303,8 @@ struct RunOptions {
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
   /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint and stop.
   std::function<bool()> stop_poll;
-  /// Called after every generation; return false to stop (checkpointed).
+  /// Called after every generation, generation 0 of a new run included; return false to stop
+  /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;
 };
 
@@ -252,6 +312,7 @@ struct RunSummary {
   std::vector<GenerationStats> history;
   Individual best;
   std::string stop_reason;
+  std::vector<Individual> population;  ///< the final population
 };
 
 /// Runs (or resumes) an evolution, writing config.toml, history.csv, best/ lineage and checkpoints.
@@ -262,6 +323,9 @@ struct RunSummary {
 /// A stop (stop_flag, stop_poll, or the callback returning false) leaves a checkpoint of the last
 /// complete generation; stop_reason is then "interrupted" (history empty if it came before
 /// generation 0 was complete, and nothing to resume).
-RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {});
+/// `fitness` defaults to swim_fitness(config), and then `reference` to the exploit guard's
+/// swim_fitness(reference_config(config)) unless evaluation.reference_check is "off".
+RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {},
+                         FitnessFunction reference = {});
 
 }  // namespace animat

@@ -1,25 +1,62 @@
 """animat: co-evolution of morphology and control of soft-bodied multicellular animats.
 
-The compiled core (``animat._core``) holds the model; this package re-exports it and adds
-analysis, plotting and animation in pure Python:
+The compiled core (``animat._core``) holds the model; this package exports it with a typed layer
+organised by task:
 
-- :class:`Run` reads a run directory (config, history, lineage of best genomes);
-- :func:`replay` swims a genome or body again and returns a :class:`Trajectory` (positions,
-  centre of mass, eq. 2 actuation state of every cell and spring);
-- :mod:`animat.plot` draws the paper's figures (development, construction, motion cycle, phase
-  map, fitness history), each returning a matplotlib Figure;
-- :mod:`animat.locomotion` classifies how a swimmer moves (:func:`classify_locomotion`) and measures
-  the paper's claims about the best individuals (grow output, oscillator spread, tries per viable
-  random individual, last morphological change);
-- :func:`animate` renders a trajectory to GIF (or MP4 where ffmpeg exists);
-- ``python -m animat show|animate|info RUN_DIR`` does it from the shell.
+- the pipeline: :class:`Config`, :class:`Genome` (``Genome.random_viable``), :func:`develop`,
+  :func:`build_body`, :class:`Simulation`, :func:`evaluate`;
+- evolution: :func:`evolve` (the engine of ``animat_evolve``), :class:`GA` (ask/tell), your own
+  :class:`Objective`, :class:`History`;
+- control: :class:`SwimEnv` (Gymnasium API; ``pip install animat[control]``);
+- analysis: :class:`Run` reads a run directory; :func:`replay` returns a :class:`Trajectory`;
+  :mod:`animat.plot` draws the paper's figures; :mod:`animat.locomotion` classifies how a swimmer
+  moves; :func:`animate` renders GIF/MP4;
+- ``animat evolve|show|animate|info|experiment`` (or ``python -m animat``) does it from the shell.
 
-``animat.plot`` and ``animat.animate`` import matplotlib on first use only.
+Every value type pickles and copies. ``animat.plot`` imports matplotlib on first use only.
 """
-from ._core import *  # noqa: F401,F403
-from ._core import __version__  # noqa: F401
-from .animation import animate, mp4_available  # noqa: F401
-from .locomotion import (  # noqa: F401
+from typing import TYPE_CHECKING
+
+from . import _core
+
+from ._core import (
+    OBJECTIVES,
+    Body,
+    Config,
+    ConfigSection,
+    DevelopmentTrace,
+    ElementType,
+    Embryo,
+    EvaluationRecord,
+    EvaluationResult,
+    ExternalActuation,
+    Fitness,
+    GenerationStats,
+    Genome,
+    Grn,
+    Individual,
+    InputChannel,
+    OutputChannel,
+    Rng,
+    Scene,
+    Simulation,
+    SwimResult,
+)
+from .animation import animate, mp4_available
+from .control import SwimEnv, gymnasium_available
+from .evolution import (
+    GA,
+    EvolutionResult,
+    History,
+    Objective,
+    evaluate,
+    evaluate_population,
+    evolve,
+    record_evaluation,
+    to_fitness,
+)
+from .experiment import run_experiment
+from .locomotion import (
     LocomotionMode,
     best_statistics,
     classify_locomotion,
@@ -30,8 +67,9 @@ from .locomotion import (  # noqa: F401
     phase_spread,
     tries_per_viable,
 )
-from .run import HISTORY_DTYPE, MORPHOLOGY_TOLERANCE, LineageEntry, Run, morphology_distance, read_history  # noqa: F401
-from .trajectory import (  # noqa: F401
+from .pipeline import build_body, config_path, develop, documented, load_config, paper_configs, swim
+from .run import HISTORY_DTYPE, MORPHOLOGY_TOLERANCE, LineageEntry, Run, morphology_distance, read_history
+from .trajectory import (
     CONTRACTING,
     DEFAULT_NEUTRAL,
     EXPANDING,
@@ -43,8 +81,45 @@ from .trajectory import (  # noqa: F401
     replay,
 )
 
+__version__: str = getattr(_core, "__version__")
 
-def __getattr__(name):
+# The compiled functions, as Python functions (help() shows their documentation).
+actuation_start_time = documented(_core.actuation_start_time)
+actuation_term = documented(_core.actuation_term)
+affinity = documented(_core.affinity)
+body_length = documented(_core.body_length)
+delaunay_edges = documented(_core.delaunay_edges)
+gabriel_graph = documented(_core.gabriel_graph)
+polygon_area = documented(_core.polygon_area)
+set_log_level = documented(_core.set_log_level)
+tournament_probability = documented(_core.tournament_probability)
+warm_up_box2d = documented(_core.warm_up_box2d)
+
+if TYPE_CHECKING:  # animat.plot is imported lazily at run time (it pulls in matplotlib)
+    from . import plot as plot
+
+__all__ = [
+    # the pipeline
+    "Config", "ConfigSection", "Genome", "Rng", "ElementType", "InputChannel", "OutputChannel", "Grn", "affinity",
+    "develop", "Embryo", "DevelopmentTrace", "build_body", "Body", "gabriel_graph", "delaunay_edges", "polygon_area",
+    "body_length", "Scene", "Simulation", "ExternalActuation", "swim", "SwimResult", "evaluate", "EvaluationResult",
+    "EvaluationRecord", "record_evaluation", "actuation_start_time", "actuation_term", "warm_up_box2d",
+    "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
+    # evolution
+    "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "Fitness", "Individual", "GenerationStats",
+    "History", "evaluate_population", "to_fitness", "tournament_probability", "run_experiment",
+    # control
+    "SwimEnv", "gymnasium_available",
+    # analysis
+    "Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE",
+    "Trajectory", "replay", "actuation_terms", "actuation_rates", "EXPANDING", "CONTRACTING", "NEUTRAL",
+    "STATE_NAMES", "DEFAULT_NEUTRAL", "animate", "mp4_available", "LocomotionMode", "classify_locomotion",
+    "best_statistics", "grow_output", "last_morphology_change", "morphology_changes", "oscillator_spread",
+    "phase_spread", "tries_per_viable", "plot",
+]
+
+
+def __getattr__(name: str):
     # animat.plot is imported lazily: it pulls in matplotlib.
     if name == "plot":
         import importlib
@@ -55,4 +130,3 @@ def __getattr__(name):
 
 def __dir__():
     return sorted(set(globals()) | {"plot"})
-from .experiment import run_experiment  # noqa: E402,F401

@@ -136,9 +136,9 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
     fixed_w = max(span[0], span[1] * aspect) * 1.1
     if follow is None:
         follow = fixed_w > 2.0 * view_w
+    fixed_centre = (lo + hi) / 2
     if not follow:
         view_w = fixed_w
-        fixed_centre = (lo + hi) / 2
     view_h = view_w / aspect
 
     dpi = 100
@@ -212,12 +212,12 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
             travelled = float(np.linalg.norm(tr.com[f] - tr.com[0]))
             image = overlay.apply(rgb, f"t = {tr.times[f]:6.2f}   step {int(tr.steps[f]):5d}\n"
                                        f"distance {travelled:8.3f}", caption, "motion" if align else "")
-            if proc is not None:
+            if proc is not None and proc.stdin is not None:
                 proc.stdin.write(np.asarray(image).tobytes())
             else:
                 images.append(image)
     finally:
-        if proc is not None:
+        if proc is not None and proc.stdin is not None:
             proc.stdin.close()
             proc.wait()
     if proc is not None:
@@ -297,7 +297,7 @@ def _write_gif(path: Path, images, fps: float, colors: int) -> None:
         mosaic.paste(im, (0, k * h))
     rest = mosaic.quantize(colors=colors - len(_KEY_COLORS), method=Image.Quantize.MEDIANCUT,
                            dither=Image.Dither.NONE)
-    extra = rest.getpalette()[: 3 * (colors - len(_KEY_COLORS))]
+    extra = (rest.getpalette() or [])[: 3 * (colors - len(_KEY_COLORS))]
     keys = [int(round(255 * v)) for c in _KEY_COLORS for v in to_rgb(c)]
     palette = Image.new("P", (1, 1))
     palette.putpalette(keys + extra)

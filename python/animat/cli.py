@@ -1,5 +1,6 @@
-"""``python -m animat``: the paper's figures and an animation of a run's best swimmer.
+"""``animat`` (or ``python -m animat``): evolve, and the paper's figures and an animation of a run's best swimmer.
 
+    animat evolve [animat_evolve's flags]   # the engine, flags and output of animat_evolve
     python -m animat show RUN_DIR       # figures/ development, construction, motion_cycle, phase_map, fitness_history
     python -m animat animate RUN_DIR    # figures/best.gif
     python -m animat info RUN_DIR       # a short summary of the run
@@ -27,9 +28,12 @@ def _size(text: str):
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m animat", description=__doc__,
+    p = argparse.ArgumentParser(prog="animat", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", required=True, metavar="{show,animate,info,experiment}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="{evolve,show,animate,info,experiment}")
+
+    sub.add_parser("evolve", add_help=False,
+                   help="run an evolution: animat_evolve's engine and flags (animat evolve --help lists them)")
 
     s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
     s.add_argument("run", metavar="RUN_DIR")
@@ -92,7 +96,8 @@ def cmd_show(args) -> int:
                                                 title=f"Development (paper Fig. 2) of the {label}"),
         "construction": lambda: plot.construction(entry, config=config,
                                                   title=f"From embryo to body (paper Fig. 3): {label}"),
-        "motion_cycle": lambda: plot.motion_cycle(trajectory, count=args.frames),
+        "motion_cycle": lambda: plot.motion_cycle(animat.replay(entry, config, steps=args.steps) if trajectory is None
+                                                  else trajectory, count=args.frames),
         "phase_map": lambda: plot.phase_map(entry, config=config),
         "fitness_history": lambda: plot.fitness_history(run),
     }
@@ -150,7 +155,13 @@ def cmd_experiment(args) -> int:
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    """Entry point of ``python -m animat``; returns the exit status (0 ok, 1 error, 2 usage)."""
+    """Entry point of ``animat`` and ``python -m animat``; returns the exit status (0 ok, 1 error, 2 usage;
+    ``animat evolve`` returns animat_evolve's)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] == "evolve":
+        from . import _core
+
+        return _core.evolve_cli(argv[1:])
     args = _parser().parse_args(argv)
     command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info,
                "experiment": cmd_experiment}[args.command]

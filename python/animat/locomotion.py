@@ -210,7 +210,7 @@ def travelling_index(z: np.ndarray) -> float:
     Independent of the global phase. 0 for an all-zero field.
     """
     z = np.asarray(z, dtype=np.complex128).ravel()
-    P, Q = z.real, z.imag
+    P, Q = np.real(z), np.imag(z)
     M = np.array([[P @ P, P @ Q], [P @ Q, Q @ Q]])
     ev = np.linalg.eigvalsh(M)
     return float(ev[0] / ev[1]) if ev[1] > 0 else 0.0
@@ -249,7 +249,7 @@ class WaveFit:
 
 
 def circular_linear_fit(phases: ArrayLike, weights: ArrayLike, coords: ArrayLike,
-                        max_gradient: float = math.pi, grid: int = 81) -> Tuple[np.ndarray, float]:
+                        max_gradient: float = math.pi, grid: int = 81) -> Tuple[Union[float, np.ndarray], float]:
     """Best linear phase gradient: maximise ``|Σ w_i e^{i(φ_i − g·x_i)}| / Σ w_i`` over g.
 
     Args:
@@ -393,7 +393,7 @@ def _wave_fit(z: np.ndarray, coords: np.ndarray, motion: np.ndarray) -> WaveFit:
         lag, angle = 0.0, float("nan")
     ti = travelling_index(z)
     is_wave = fit >= WAVE_FIT and lag >= WAVE_LAG and ti >= WAVE_TI
-    return WaveFit(g, float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave))
+    return WaveFit(np.asarray(g), float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave))
 
 
 def _no_wave(w: WaveFit) -> str:

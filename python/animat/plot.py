@@ -20,11 +20,14 @@ function               paper        shows
 from __future__ import annotations
 
 import math
-from typing import Any, Dict, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence
 
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
+from numpy.typing import ArrayLike
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from matplotlib.collections import EllipseCollection, LineCollection, PatchCollection, PolyCollection
 from matplotlib.colors import Normalize
 from matplotlib.lines import Line2D
@@ -52,7 +55,7 @@ FILL_COLOR = "#e9eef3"
 
 # --- helpers ------------------------------------------------------------------------------------------
 
-def rotation_to(direction: Sequence[float], target: Sequence[float] = (1.0, 0.0)) -> np.ndarray:
+def rotation_to(direction: ArrayLike, target: ArrayLike = (1.0, 0.0)) -> np.ndarray:
     """The 2×2 rotation matrix R with ``R @ direction`` parallel to ``target`` (default +x).
 
     Use it as ``positions @ R.T`` on (…, 2) arrays."""
@@ -61,6 +64,11 @@ def rotation_to(direction: Sequence[float], target: Sequence[float] = (1.0, 0.0)
     angle = math.atan2(t[1], t[0]) - math.atan2(d[1], d[0])
     c, s = math.cos(angle), math.sin(angle)
     return np.array([[c, -s], [s, c]])
+
+
+def _segments(positions: np.ndarray, pairs: np.ndarray) -> List[np.ndarray]:
+    """Line segments of index pairs, as LineCollection takes them."""
+    return [positions[pair] for pair in np.asarray(pairs).reshape(-1, 2)]
 
 
 def _node_radius(body) -> float:
@@ -72,7 +80,7 @@ def _loops_closed(positions, loops):
     return [positions[np.append(loop, loop[0])] for loop in loops if len(loop)]
 
 
-def draw_body(ax, body, positions: Optional[np.ndarray] = None, node_colors: Any = "#444444", *,
+def draw_body(ax: Axes, body: Any, positions: Optional[np.ndarray] = None, node_colors: Any = "#444444", *,
               node_radius: Optional[float] = None, fill: bool = True, springs: bool = True,
               spring_colors: Any = SPRING_COLOR, skin_width: float = 2.2, spring_width: float = 0.8,
               node_edge: str = "#222222", zorder: float = 2.0, label: str = "nodes") -> Dict[str, Any]:
@@ -100,7 +108,7 @@ def draw_body(ax, body, positions: Optional[np.ndarray] = None, node_colors: Any
                                      zorder=zorder - 0.3)
         ax.add_collection(out["fill"])
     sp = np.asarray(body.springs)
-    out["springs"] = LineCollection(pos[sp] if springs and len(sp) else np.zeros((0, 2, 2)), colors=spring_colors,
+    out["springs"] = LineCollection(_segments(pos, sp if springs else sp[:0]), colors=spring_colors,
                                     linewidths=spring_width, zorder=zorder - 0.2)
     ax.add_collection(out["springs"])
     out["skin"] = LineCollection(_loops_closed(pos, body.skin_loops), colors=SKIN_COLOR, linewidths=skin_width,
@@ -154,7 +162,7 @@ def development_steps(embryo_or_trace) -> list:
 
 
 def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, config: Optional[Any] = None,
-                cols: int = 4, title: Optional[str] = None) -> "matplotlib.figure.Figure":
+                cols: int = 4, title: Optional[str] = None) -> Figure:
     """Paper Fig. 2: the embryo at chosen development steps, cells as circles with a short line
     along each cell's orientation vector, all panels at the same scale.
 
@@ -225,7 +233,7 @@ def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, 
 # --- Fig. 3: construction -------------------------------------------------------------------------------
 
 def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, config: Optional[Any] = None,
-                 title: Optional[str] = None) -> "matplotlib.figure.Figure":
+                 title: Optional[str] = None) -> Figure:
     """Paper Fig. 3: (a) cell centres at the end of development, (b) their Delaunay
     triangulation, (c) the Gabriel graph, the final structure, with its regions shaded (one colour
     each) and the skin (the only edges that feel drag) drawn thick.
@@ -273,7 +281,7 @@ def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, c
     ax.set_title(f"(a) cell centres ({len(pos)} cells)", fontsize=10)
 
     ax = axes[1]
-    ax.add_collection(LineCollection(pos[delaunay] if len(delaunay) else np.zeros((0, 2, 2)), colors="#555555",
+    ax.add_collection(LineCollection(_segments(pos, delaunay), colors="#555555",
                                      linewidths=0.9))
     ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5)
     ax.set_title(f"(b) Delaunay triangulation ({len(delaunay)} edges)", fontsize=10)
@@ -284,10 +292,10 @@ def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, c
         ax.add_collection(PatchCollection([Polygon(pos[r]) for r in body.regions],
                                           facecolor=[cmap(k % 9) for k in range(body.region_count)], edgecolor="none"))
     springs = np.asarray(body.springs)
-    ax.add_collection(LineCollection(pos[springs] if len(springs) else np.zeros((0, 2, 2)), colors="#555555",
+    ax.add_collection(LineCollection(_segments(pos, springs), colors="#555555",
                                      linewidths=0.9))
     skin = np.asarray(body.skin)
-    ax.add_collection(LineCollection(pos[skin] if len(skin) else np.zeros((0, 2, 2)), colors="#b2182b",
+    ax.add_collection(LineCollection(_segments(pos, skin), colors="#b2182b",
                                      linewidths=2.8, capstyle="round"))
     ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5, zorder=3)
     ax.set_title(f"(c) Gabriel graph: {body.spring_count} springs,\n{body.region_count} regions (shaded), "
@@ -301,7 +309,7 @@ def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, c
 
 def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None, *, count: int = 6,
                  align: bool = True, cols: Optional[int] = None, color_springs: bool = False,
-                 title: Optional[str] = None) -> "matplotlib.figure.Figure":
+                 title: Optional[str] = None) -> Figure:
     """Paper Figs. 4–6: snapshots of one motion cycle. Node colour is the cell's actuation state
     from eq. 2 (``trajectory.node_state``): red expanding, blue contracting, green neutral
     (:data:`STATE_COLORS`). The skin is drawn thick, springs thin, and an arrow in each panel
@@ -372,8 +380,8 @@ def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None,
 
 # --- Fig. 7: phase map ----------------------------------------------------------------------------------
 
-def phase_map(body: Any, *, config: Optional[Any] = None, ax=None, cmap: str = PHASE_CMAP,
-              colorbar: bool = True, title: Optional[str] = None) -> "matplotlib.figure.Figure":
+def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = PHASE_CMAP,
+              colorbar: bool = True, title: Optional[str] = None) -> Figure:
     """Paper Fig. 7: the body at rest (its initial, equilibrium state) with every node coloured by
     its oscillation phase shift. The colour range is normalised to the body's phases
     (``vmin = phase.min()``, ``vmax = phase.max()``) and the maximum (the red node) is written
@@ -404,7 +412,8 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax=None, cmap: str = P
         fig = plt.figure(figsize=(w, h + 0.5))
         ax = fig.add_subplot()
     else:
-        fig = ax.figure
+        fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
+        assert isinstance(fig, Figure)
     vmin, vmax = (float(phase.min()), float(phase.max())) if len(phase) else (0.0, 1.0)
     # all phases equal: every node is the maximum (red); the colour range is then [max - 1, max]
     norm = Normalize(vmin=vmin if vmax > vmin else vmax - 1.0, vmax=vmax)
@@ -438,7 +447,7 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax=None, cmap: str = P
 # --- Figs. 8-9: fitness history ------------------------------------------------------------------------
 
 def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MORPHOLOGY_TOLERANCE,
-                    show_mean: bool = True, title: Optional[str] = None) -> "matplotlib.figure.Figure":
+                    show_mean: bool = True, title: Optional[str] = None) -> Figure:
     """Paper Figs. 8–9: the best fitness over generations, with the generations at which the best
     individual's morphology changed marked, and thumbnails of those bodies (at rest, nodes
     coloured by phase shift, each thumbnail normalised like :func:`phase_map`; plain nodes when
@@ -467,6 +476,7 @@ def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MOR
         shown = changes[:k]
 
     fig = plt.figure(figsize=(10, 6.2 if shown else 4.2))
+    gs: Any = None
     if shown:
         gs = fig.add_gridspec(2, max(len(shown), 1), height_ratios=[1.0, 1.5], hspace=0.25, left=0.07, right=0.98,
                               top=0.88, bottom=0.09, wspace=0.12)

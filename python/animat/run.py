@@ -77,6 +77,12 @@ class LineageEntry:
                 f"cells={self.cell_count}>")
 
 
+def _history_type() -> type:
+    from .evolution import History  # evolution.py imports this module
+
+    return History
+
+
 def read_history(path: PathLike) -> np.ndarray:
     """Read a ``history.csv`` into a structured array of dtype :data:`HISTORY_DTYPE`.
 
@@ -85,7 +91,8 @@ def read_history(path: PathLike) -> np.ndarray:
     ValueError naming the file and the line number. A missing file raises FileNotFoundError.
 
     Returns:
-        numpy structured array, shape (rows,), one row per completed generation; fields
+        :class:`animat.History` (a numpy structured array with ``.to_pandas()``), shape (rows,), one
+        row per completed generation; fields
         ``generation`` (int64), ``best``, ``mean``, ``median``, ``viable_fraction`` (float64),
         ``best_cells``, ``evaluations`` (int64), ``best_reference`` (float64: the best's fitness at
         the exploit guard's reference step, NaN when not evaluated), ``invalid`` (int64: viable
@@ -100,11 +107,11 @@ def read_history(path: PathLike) -> np.ndarray:
     lines = text.split("\n")
     # `text` ends with "\n" when complete: the last element is then "". Otherwise it is a partial row.
     complete = lines[:-1]
-    expected = list(HISTORY_DTYPE.names)
+    expected = list(HISTORY_DTYPE.names or ())
     if not complete:
         if lines[0] and not ",".join(expected).startswith(lines[0]):
             raise ValueError(f"{path}:1: not a history.csv header: {lines[0]!r}")
-        return np.zeros(0, dtype=HISTORY_DTYPE)  # empty or header being written
+        return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())  # empty or header being written
     header = complete[0].strip().split(",")
     older = [name for name in expected if name not in _LATER_COLUMNS]
     if header != expected and header != older:
@@ -123,7 +130,7 @@ def read_history(path: PathLike) -> np.ndarray:
                               else float(fields[column[name]]) for name in expected))
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
-    return np.array(rows, dtype=HISTORY_DTYPE)
+    return np.array(rows, dtype=HISTORY_DTYPE).view(_history_type())
 
 
 def _read_lineage_file(path: Path) -> LineageEntry:
@@ -217,7 +224,7 @@ class Run:
         """
         path = self.path / "history.csv"
         if not path.exists():
-            return np.zeros(0, dtype=HISTORY_DTYPE)
+            return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())
         return read_history(path)
 
     @property

@@ -41,7 +41,7 @@ std::int64_t parse_seed(const std::string& text) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int animat_evolve_main(int argc, char** argv) {
   CLI::App app{"animat_evolve: co-evolve the morphology and control of soft-bodied swimmers (Joachimczak & Wrobel 2012)"};
   std::string config_path, out_dir, resume_dir, log_level = "info", seed_text;
   std::vector<std::string> overrides;
@@ -115,7 +115,8 @@ int main(int argc, char** argv) {
     std::printf("Stopped: %s\n", summary.stop_reason.c_str());
     std::printf("Results in %s: config.toml, history.csv, best/ (lineage of best genomes), checkpoint.json\n",
                 options.out.c_str());
-    std::printf("View them:  PYTHONPATH=build/python .venv/bin/python -m animat show %s\n", options.out.c_str());
+    std::printf("View them:  animat show %s   (in a source tree: PYTHONPATH=build/python .venv/bin/python -m animat show %s)\n",
+                options.out.c_str(), options.out.c_str());
     std::printf("Resume:     animat_evolve --resume %s --generations N\n", options.out.c_str());
     return summary.stop_reason == "interrupted" ? 130 : 0;
   } catch (const animat::Error& e) {
@@ -126,3 +127,7 @@ int main(int argc, char** argv) {
     return 3;
   }
 }
+
+#ifndef ANIMAT_CLI_NO_MAIN
+int main(int argc, char** argv) { return animat_evolve_main(argc, argv); }
+#endif

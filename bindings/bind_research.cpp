@@ -1,0 +1,445 @@
+// Python research API pieces that span stages: pickling of every value type (through stable
+// serialised forms), the evaluation record and Python objectives, externally driven actuation,
+// viable random genomes, and `animat evolve` (the animat_evolve command line in-process).
+#include <nanobind/eigen/dense.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/array.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
+#include <nanobind/stl/vector.h>
+
+#include <fmt/format.h>
+
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "animat/body.hpp"
+#include "animat/config.hpp"
+#include "animat/development.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluate.hpp"
+#include "animat/external_actuation.hpp"
+#include "animat/objective.hpp"
+#include "animat/physics.hpp"
+#include "bindings.hpp"
+
+int animat_evolve_main(int argc, char** argv);  // src/cli/animat_evolve.cpp
+
+namespace nb = nanobind;
+using namespace nb::literals;
+
+namespace animat::py {
+namespace {
+
+nb::ndarray<nb::numpy, double> owned(std::vector<double> v, std::initializer_list<std::size_t> shape) {
+  auto* heap = new std::vector<double>(std::move(v));
+  nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<double>*>(p); });
+  return nb::ndarray<nb::numpy, double>(heap->data(), shape.size(), shape.begin(), owner);
+}
+
+nb::ndarray<nb::numpy, std::int64_t> owned_int(std::vector<std::int64_t> v, std::initializer_list<std::size_t> shape) {
+  auto* heap = new std::vector<std::int64_t>(std::move(v));
+  nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<std::int64_t>*>(p); });
+  return nb::ndarray<nb::numpy, std::int64_t>(heap->data(), shape.size(), shape.begin(), owner);
+}
+
+/// Adds a method to a class bound in another file (so each stage's file stays as it is).
+template <class F, class... Extra>
+void add_method(nb::handle type, const char* name, F&& f, const Extra&... extra) {
+  nb::setattr(type, name, nb::cpp_function(std::forward<F>(f), nb::scope(type), nb::name(name), nb::is_method(), extra...));
+}
+
+/// Pickle and copy support from a serialised form: state = (format name, version, payload).
+template <class T, class Save, class Load>
+void add_pickle(nb::handle type, const char* format, Save save, Load load) {
+  const std::string fmt_name = format;
+  add_method(type, "__getstate__", [fmt_name, save](const T& value) {
+    return std::make_tuple(fmt_name, 1, save(value));
+  });
+  add_method(type, "__setstate__", [fmt_name, load](T& self, const std::tuple<std::string, int, nb::object>& state) {
+    if (std::get<0>(state) != fmt_name || std::get<1>(state) != 1)
+      throw Error(fmt::format("cannot unpickle {} version {} as {} (this build reads version 1)", std::get<0>(state),
+                              std::get<1>(state), fmt_name));
+    new (&self) T(load(std::get<2>(state)));
+  });
+  if (!nb::hasattr(type, "__copy__")) {
+    add_method(type, "__copy__", [](const T& v) { return T(v); });
+    add_method(type, "__deepcopy__", [](const T& v, nb::handle) { return T(v); }, "memo"_a);
+  }
+}
+
+// --- EvaluationResult fields, one list for pickling (a new field: one line here) ---------------
+template <class V>
+void visit_result(EvaluationResult& r, V&& v) {
+  v("fitness", r.fitness);
+  v("viable", r.viable);
+  v("stable", r.stable);
+  v("valid", r.valid);
+  v("cell_count", r.cell_count);
+  v("reasons", r.reasons);
+  v("displacement", r.displacement);
+  v("spring_count", r.spring_count);
+  v("region_count", r.region_count);
+  v("skin_edge_count", r.skin_edge_count);
+  v("development_steps", r.development_steps);
+  v("swim_steps", r.swim_steps);
+  v("simulated_time", r.simulated_time);
+  v("max_speed", r.max_speed);
+  v("max_step_displacement", r.max_step_displacement);
+  v("max_stretch", r.max_stretch);
+  v("min_stretch", r.min_stretch);
+  v("max_kinetic_energy", r.max_kinetic_energy);
+  v("final_kinetic_energy", r.final_kinetic_energy);
+  v("max_kinetic_energy_per_cell", r.max_kinetic_energy_per_cell);
+  v("min_area_ratio", r.min_area_ratio);
+  v("inverted_region_steps", r.inverted_region_steps);
+  v("skin_crossing_steps", r.skin_crossing_steps);
+  v("first_invalid_step", r.first_invalid_step);
+  v("collisions", r.collisions);
+  v("collisions_inelastic", r.collisions_inelastic);
+  v("collisions_unresolved", r.collisions_unresolved);
+  v("drag_limited", r.drag_limited);
+  v("seconds_development", r.seconds_development);
+  v("seconds_body", r.seconds_body);
+  v("seconds_swim", r.seconds_swim);
+}
+
+nb::dict result_state(const EvaluationResult& r) {
+  nb::dict d;
+  EvaluationResult copy = r;
+  visit_result(copy, [&](const char* name, auto& value) { d[name] = nb::cast(value); });
+  return d;
+}
+
+EvaluationResult result_from_state(nb::handle state) {
+  const nb::dict d = nb::cast<nb::dict>(state);
+  EvaluationResult r;
+  visit_result(r, [&](const char* name, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if (d.contains(name)) value = nb::cast<T>(d[name]);
+  });
+  return r;
+}
+
+nb::tuple body_state(const Body& b) {
+  return nb::make_tuple(b.positions, b.springs, b.rest_lengths, b.regions, b.rest_areas, b.skin, b.skin_loops,
+                        b.amplitude, b.frequency, b.phase);
+}
+
+Body body_from_state(nb::handle state) {
+  const nb::tuple t = nb::cast<nb::tuple>(state);
+  Body b;
+  b.positions = nb::cast<Points>(t[0]);
+  b.springs = nb::cast<IndexPairs>(t[1]);
+  b.rest_lengths = nb::cast<Vector>(t[2]);
+  b.regions = nb::cast<std::vector<std::vector<int>>>(t[3]);
+  b.rest_areas = nb::cast<Vector>(t[4]);
+  b.skin = nb::cast<IndexPairs>(t[5]);
+  b.skin_loops = nb::cast<std::vector<std::vector<int>>>(t[6]);
+  b.amplitude = nb::cast<Vector>(t[7]);
+  b.frequency = nb::cast<Vector>(t[8]);
+  b.phase = nb::cast<Vector>(t[9]);
+  return b;
+}
+
+nb::tuple trace_state(const DevelopmentTrace& t) { return nb::make_tuple(t.steps, t.positions, t.radii, t.orientations); }
+
+DevelopmentTrace trace_from_state(nb::handle state) {
+  const nb::tuple s = nb::cast<nb::tuple>(state);
+  DevelopmentTrace t;
+  t.steps = nb::cast<std::vector<int>>(s[0]);
+  t.positions = nb::cast<std::vector<Points>>(s[1]);
+  t.radii = nb::cast<std::vector<Vector>>(s[2]);
+  t.orientations = nb::cast<std::vector<Points>>(s[3]);
+  return t;
+}
+
+nb::tuple embryo_state(const Embryo& e) {
+  return nb::make_tuple(e.positions, e.radii, e.orientations, e.outputs, e.amplitude, e.frequency, e.phase,
+                        e.division_steps, e.steps_run, e.viable, e.reasons, trace_state(e.trace));
+}
+
+Embryo embryo_from_state(nb::handle state) {
+  const nb::tuple t = nb::cast<nb::tuple>(state);
+  Embryo e;
+  e.positions = nb::cast<Points>(t[0]);
+  e.radii = nb::cast<Vector>(t[1]);
+  e.orientations = nb::cast<Points>(t[2]);
+  e.outputs = nb::cast<OutputLevels>(t[3]);
+  e.amplitude = nb::cast<Vector>(t[4]);
+  e.frequency = nb::cast<Vector>(t[5]);
+  e.phase = nb::cast<Vector>(t[6]);
+  e.division_steps = nb::cast<std::vector<int>>(t[7]);
+  e.steps_run = nb::cast<int>(t[8]);
+  e.viable = nb::cast<bool>(t[9]);
+  e.reasons = nb::cast<std::vector<std::string>>(t[10]);
+  e.trace = trace_from_state(t[11]);
+  return e;
+}
+
+/// A Python objective: any object with `name` (str), `every` (int, trajectory sampling; 0 = none)
+/// that is callable with an EvaluationRecord and returns a float. Called under the GIL from the
+/// evaluating threads; everything else runs without it.
+class PythonObjective final : public Objective {
+ public:
+  explicit PythonObjective(nb::object obj) : obj_(std::move(obj)) {
+    name_ = nb::cast<std::string>(obj_.attr("name"));
+    every_ = nb::cast<long>(obj_.attr("every"));
+    if (every_ < 0) throw ConfigError(fmt::format("objective {}: every must be >= 0, got {}", name_, every_));
+  }
+  ~PythonObjective() override {
+    nb::gil_scoped_acquire gil;
+    obj_.reset();
+  }
+  std::string name() const override { return name_; }
+  bool needs_body() const override { return true; }
+  long sample_every() const override { return every_; }
+  double value(const EvaluationRecord& record) const override {
+    nb::gil_scoped_acquire gil;
+    try {
+      nb::object out = obj_(nb::cast(record, nb::rv_policy::copy));
+      if (!nb::isinstance<nb::float_>(out) && !nb::isinstance<nb::int_>(out) && !nb::hasattr(out, "__float__"))
+        throw Error(fmt::format("objective {} returned a {}, expected a float", name_,
+                                nb::cast<std::string>(nb::str(out.type().attr("__name__")))));
+      return nb::cast<double>(out.attr("__float__")());
+    } catch (nb::python_error& e) {
+      // Re-raised as a C++ error: a Python exception must not cross the evaluation threads.
+      throw Error(fmt::format("objective {} raised {}", name_, e.what()));
+    }
+  }
+
+ private:
+  nb::object obj_;
+  std::string name_;
+  long every_ = 0;
+};
+
+ExternalActuation::Mode actuation_mode(const std::string& mode) {
+  if (mode == "rest_length") return ExternalActuation::Mode::rest_length;
+  if (mode == "oscillator") return ExternalActuation::Mode::oscillator;
+  throw ConfigError(fmt::format("external actuation: unknown mode '{}' (expected rest_length or oscillator)", mode));
+}
+
+std::vector<double> to_doubles(nb::handle obj) {
+  const nb::module_ np = nb::module_::import_("numpy");
+  nb::object a = np.attr("ascontiguousarray")(obj, "dtype"_a = np.attr("float64")).attr("ravel")();
+  return nb::cast<std::vector<double>>(a.attr("tolist")());
+}
+
+}  // namespace
+
+std::shared_ptr<const Objective> objective_from_python(nb::handle objective, const Config& config) {
+  if (objective.is_none()) return make_objective(config.evaluation);
+  if (nb::isinstance<nb::str>(objective)) {
+    EvaluationParams p = config.evaluation;
+    p.objective = nb::cast<std::string>(objective);
+    validate(p);
+    return make_objective(p);
+  }
+  return std::make_shared<PythonObjective>(nb::borrow(objective));
+}
+
+void bind_research(nb::module_& m) {
+  // --- pickling of the classes bound elsewhere ---------------------------------------------------
+  add_pickle<Config>(nb::type<Config>(), "animat.Config",
+                     [](const Config& c) { return nb::cast(to_toml(c)); },
+                     [](nb::handle s) { return config_from_toml(nb::cast<std::string>(s), "<pickle>"); });
+  add_pickle<Genome>(nb::type<Genome>(), "animat.Genome",
+                     [](const Genome& g) { return nb::cast(to_json(g)); },
+                     [](nb::handle s) { return genome_from_json(nb::cast<std::string>(s), GenomeParams{.max_elements = 1000000}, "<pickle>"); });
+  add_pickle<SceneParams>(nb::type<SceneParams>(), "animat.Scene",
+                          [](const SceneParams& p) {
+                            Config c;
+                            c.scene = p;
+                            return nb::cast(to_toml(c));
+                          },
+                          [](nb::handle s) { return config_from_toml(nb::cast<std::string>(s), "<pickle>").scene; });
+  add_pickle<Body>(nb::type<Body>(), "animat.Body", [](const Body& b) { return nb::object(body_state(b)); }, body_from_state);
+  add_pickle<Embryo>(nb::type<Embryo>(), "animat.Embryo", [](const Embryo& e) { return nb::object(embryo_state(e)); },
+                     embryo_from_state);
+  add_pickle<DevelopmentTrace>(nb::type<DevelopmentTrace>(), "animat.DevelopmentTrace",
+                               [](const DevelopmentTrace& t) { return nb::object(trace_state(t)); }, trace_from_state);
+  add_pickle<EvaluationResult>(nb::type<EvaluationResult>(), "animat.EvaluationResult",
+                               [](const EvaluationResult& r) { return nb::object(result_state(r)); }, result_from_state);
+  add_pickle<SwimResult>(nb::type<SwimResult>(), "animat.SwimResult",
+                         [](const SwimResult& r) {
+                           return nb::object(nb::make_tuple(r.distance, r.displacement, r.stable, r.failure, r.steps,
+                                                            r.simulated_time, r.max_speed, r.max_step_displacement,
+                                                            r.max_stretch, r.min_stretch, r.final_kinetic_energy,
+                                                            r.max_kinetic_energy));
+                         },
+                         [](nb::handle s) {
+                           const nb::tuple t = nb::cast<nb::tuple>(s);
+                           SwimResult r;
+                           r.distance = nb::cast<double>(t[0]);
+                           r.displacement = nb::cast<Eigen::Vector2d>(t[1]);
+                           r.stable = nb::cast<bool>(t[2]);
+                           r.failure = nb::cast<std::string>(t[3]);
+                           r.steps = nb::cast<long>(t[4]);
+                           r.simulated_time = nb::cast<double>(t[5]);
+                           r.max_speed = nb::cast<double>(t[6]);
+                           r.max_step_displacement = nb::cast<double>(t[7]);
+                           r.max_stretch = nb::cast<double>(t[8]);
+                           r.min_stretch = nb::cast<double>(t[9]);
+                           r.final_kinetic_energy = nb::cast<double>(t[10]);
+                           r.max_kinetic_energy = nb::cast<double>(t[11]);
+                           return r;
+                         });
+  add_pickle<Rng>(nb::type<Rng>(), "animat.Rng", [](const Rng& r) { return nb::cast(r.state()); },
+                  [](nb::handle s) {
+                    Rng r;
+                    r.set_state(nb::cast<Rng::State>(s));
+                    return r;
+                  });
+  add_method(nb::type<EvaluationResult>(), "to_dict", [](const EvaluationResult& r) { return result_state(r); });
+
+  // --- the evaluation record ---------------------------------------------------------------------
+  nb::class_<EvaluationRecord>(m, "EvaluationRecord",
+                               "What an objective sees of one evaluation: the EvaluationResult (its fields are also\n"
+                               "attributes of the record: ``record.displacement``, ``record.cell_count``, every\n"
+                               "diagnostic), the Body that swam and its trajectory sampled every ``every`` control\n"
+                               "steps (frame 0 is the start). ``result.fitness`` is the paper's distance.")
+      .def_prop_ro("result", [](const EvaluationRecord& r) { return r.result; }, "The EvaluationResult (a copy).")
+      .def_prop_ro("body", [](const EvaluationRecord& r) -> std::optional<Body> {
+            if (r.body.node_count() == 0) return std::nullopt;
+            return r.body;
+          }, "The Body that swam, or None if the genome was not viable.")
+      .def_ro("every", &EvaluationRecord::every, "Control steps between frames (0: no trajectory).")
+      .def_prop_ro("steps", [](const EvaluationRecord& r) {
+            return owned_int(std::vector<std::int64_t>(r.steps.begin(), r.steps.end()), {r.steps.size()});
+          }, nb::rv_policy::move, "(F,) int64 control step of every frame.")
+      .def_prop_ro("times", [](const EvaluationRecord& r) { return owned(r.times, {r.times.size()}); },
+                   nb::rv_policy::move, "(F,) float64 simulated time of every frame.")
+      .def_prop_ro("positions", [](const EvaluationRecord& r) {
+            const std::size_t f = r.frame_count(), n = f ? r.positions.size() / (2 * f) : 0;
+            return owned(r.positions, {f, n, 2});
+          }, nb::rv_policy::move, "(F, n, 2) float64 cell positions of every frame.")
+      .def_prop_ro("velocities", [](const EvaluationRecord& r) {
+            const std::size_t f = r.frame_count(), n = f ? r.velocities.size() / (2 * f) : 0;
+            return owned(r.velocities, {f, n, 2});
+          }, nb::rv_policy::move, "(F, n, 2) float64 cell velocities of every frame.")
+      .def_prop_ro("com", [](const EvaluationRecord& r) {
+            const std::size_t f = r.frame_count(), n = f ? r.positions.size() / (2 * f) : 0;
+            std::vector<double> c(2 * f, 0.0);
+            for (std::size_t k = 0; k < f; ++k)
+              for (std::size_t i = 0; i < n; ++i)
+                for (std::size_t d = 0; d < 2; ++d) c[2 * k + d] += r.positions[(k * n + i) * 2 + d] / static_cast<double>(n);
+            return owned(std::move(c), {f, 2});
+          }, nb::rv_policy::move, "(F, 2) float64 centre of mass of every frame.")
+      .def("__getattr__", [](const EvaluationRecord& r, const std::string& name) {
+            nb::object result = nb::cast(r.result);
+            if (!nb::hasattr(result, name.c_str()))
+              throw nb::attribute_error(("EvaluationRecord has no attribute '" + name + "'").c_str());
+            return result.attr(name.c_str());
+          }, "name"_a)
+      .def("__getstate__", [](const EvaluationRecord& r) {
+            return nb::make_tuple(std::string("animat.EvaluationRecord"), 1, result_state(r.result), body_state(r.body),
+                                  r.every, r.steps, r.times, r.positions, r.velocities);
+          })
+      .def("__setstate__", [](EvaluationRecord& self, const nb::tuple& t) {
+            if (nb::len(t) != 9 || nb::cast<std::string>(t[0]) != "animat.EvaluationRecord" || nb::cast<int>(t[1]) != 1)
+              throw Error("cannot unpickle this state as animat.EvaluationRecord version 1");
+            EvaluationRecord r;
+            r.result = result_from_state(t[2]);
+            r.body = body_from_state(t[3]);
+            r.every = nb::cast<long>(t[4]);
+            r.steps = nb::cast<std::vector<long>>(t[5]);
+            r.times = nb::cast<std::vector<double>>(t[6]);
+            r.positions = nb::cast<std::vector<double>>(t[7]);
+            r.velocities = nb::cast<std::vector<double>>(t[8]);
+            new (&self) EvaluationRecord(std::move(r));
+          })
+      .def("__copy__", [](const EvaluationRecord& r) { return r; })
+      .def("__deepcopy__", [](const EvaluationRecord& r, nb::handle) { return r; }, "memo"_a)
+      .def("__repr__", [](const EvaluationRecord& r) {
+        return fmt::format("<animat.EvaluationRecord fitness={:.6g} viable={} cells={} frames={}>", r.result.fitness,
+                           r.result.viable ? "True" : "False", r.result.cell_count, r.frame_count());
+      });
+
+  m.def("record_evaluation", [](const Genome& genome, std::optional<Config> config, long every) {
+        const Config c = config.value_or(Config{});
+        nb::gil_scoped_release release;
+        return record_evaluation(genome, c, true, every);
+      }, "genome"_a, "config"_a = nb::none(), "every"_a = 20,
+      "Evaluate a genome as animat.evaluate does and return the EvaluationRecord an objective sees:\n"
+      "the result, the body and the trajectory every `every` control steps (0 = no trajectory).");
+  m.def("body_length", &body_length, "body"_a,
+        "Length of a body along its longest axis: the largest distance between two cell centres at rest plus\n"
+        "one cell diameter (1 length unit). The `distance_per_size` objective divides by it.");
+  m.attr("OBJECTIVES") = [] {
+    std::vector<std::string> out;
+    for (auto n : kObjectiveNames) out.emplace_back(n);
+    return out;
+  }();
+
+  // --- externally driven actuation ------------------------------------------------------------------
+  nb::class_<ExternalActuation>(m, "ExternalActuation",
+                                "Actuation set from outside the simulation (see ``Simulation.add_external_actuation``):\n"
+                                "rest length of spring (i, j) = (1 + u_i + u_j) L0, with the cell terms u_i set directly\n"
+                                "(mode 'rest_length') or u_i = a_i sin(f_i t + phase_i) with amplitudes and phases set\n"
+                                "(mode 'oscillator'; f_i: the body's frequencies unless set). |u_i| < 0.5.")
+      .def_prop_ro("mode", [](const ExternalActuation& a) {
+            return std::string(a.mode() == ExternalActuation::Mode::rest_length ? "rest_length" : "oscillator");
+          }, "'rest_length' or 'oscillator'.")
+      .def_prop_ro("node_count", &ExternalActuation::node_count, "Cells.")
+      .def("set_terms", [](ExternalActuation& a, nb::handle u) { a.set_terms(to_doubles(u)); }, "terms"_a,
+           "Mode 'rest_length': set every cell's term u_i, an (n,) array with |u_i| < 0.5.")
+      .def("set_oscillators", [](ExternalActuation& a, nb::handle amplitude, nb::handle phase) {
+            a.set_oscillators(to_doubles(amplitude), to_doubles(phase));
+          }, "amplitude"_a, "phase"_a,
+          "Mode 'oscillator': set every cell's amplitude (n,) in [0, 0.5) and phase (n,) (radians).")
+      .def_prop_rw("frequency", [](const ExternalActuation& a) { return owned(a.frequency(), {a.frequency().size()}); },
+                   [](ExternalActuation& a, nb::handle f) { a.set_frequency(to_doubles(f)); },
+                   "(n,) oscillator frequencies (mode 'oscillator'; default: the body's).")
+      .def_prop_ro("terms", [](const ExternalActuation& a) { return owned(a.terms(), {a.terms().size()}); },
+                   "(n,) cell terms u_i of the last step.");
+  add_method(nb::type<Simulation>(), "add_external_actuation", [](Simulation& sim, const Body& body, const std::string& mode) {
+        for (const Effect* e : sim.effects())
+          if (e->name() == "actuation" || e->name() == "external_actuation")
+            throw ConfigError(fmt::format("Simulation.add_external_actuation: the scene already has '{}' (both would write "
+                                          "the rest lengths); remove it from the scene's effects", e->name()));
+        if (body.node_count() != sim.node_count())
+          throw GeometryError(fmt::format("Simulation.add_external_actuation: the body has {} cells, the simulation {}",
+                                          body.node_count(), sim.node_count()));
+        auto effect = std::make_unique<ExternalActuation>(body, actuation_mode(mode));
+        ExternalActuation* raw = effect.get();
+        sim.add_effect(std::move(effect));
+        return raw;
+      }, "body"_a, "mode"_a = "rest_length", nb::rv_policy::reference_internal,
+      "Drive the rest lengths from outside (returns the ExternalActuation to set): `body` is the body this\n"
+      "simulation swims; mode 'rest_length' (set u_i) or 'oscillator' (set amplitudes and phases). The\n"
+      "scene must not list 'actuation'.");
+
+  // --- animat evolve ------------------------------------------------------------------------------
+  m.def("evolve_cli", [](std::vector<std::string> args) {
+        std::vector<std::string> argv_store = {"animat evolve"};
+        argv_store.insert(argv_store.end(), args.begin(), args.end());
+        std::vector<char*> argv;
+        for (auto& a : argv_store) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        // animat_evolve installs SIGINT/SIGTERM handlers (finish the generation, checkpoint, exit);
+        // Python's own handlers come back afterwards.
+        auto old_int = std::signal(SIGINT, SIG_DFL);
+        auto old_term = std::signal(SIGTERM, SIG_DFL);
+        std::fflush(stdout);
+        int rc = 0;
+        {
+          nb::gil_scoped_release release;
+          rc = animat_evolve_main(static_cast<int>(argv_store.size()), argv.data());
+          std::fflush(stdout);
+          std::fflush(stderr);
+        }
+        std::signal(SIGINT, old_int);
+        std::signal(SIGTERM, old_term);
+        return rc;
+      }, "args"_a,
+      "Run the animat_evolve command line in this process (the `animat evolve` console script): the same\n"
+      "engine, flags and output. Returns the exit status.");
+}
+
+}  // namespace animat::py

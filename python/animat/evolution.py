@@ -1,0 +1,486 @@
+"""Evolution from Python: :func:`evolve` (the engine of ``animat_evolve``), :class:`GA` (the same
+engine driven by ``ask``/``tell``, for genomes evaluated anywhere), :class:`Objective` (your own
+fitness) and :class:`History` (the one history type: a structured array, ``.to_pandas()``).
+
+Every random number of generation g, individual i derives from (seed, g, i): a run is bit-identical
+for any thread count, across kill/resume, and between ``evolve`` and a ``GA`` loop.
+"""
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, List, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _core
+from .run import HISTORY_DTYPE
+
+__all__ = ["History", "EvolutionResult", "Objective", "GA", "evolve", "evaluate", "evaluate_population",
+           "record_evaluation", "to_fitness"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class History(np.recarray):
+    """Per-generation statistics: a numpy structured (record) array, one row per generation, with the
+    columns of ``history.csv``: ``generation``, ``best``, ``mean``, ``median``, ``viable_fraction``,
+    ``best_cells``, ``evaluations``, ``wall_seconds``. ``h["best"]`` is a column, ``h[-1]`` a row
+    (``h[-1]["best"]``, or ``h[-1].best``; use ``["mean"]`` for the mean column: ``.mean`` is numpy's
+    method). :attr:`Run.history`, :attr:`EvolutionResult.history` and :attr:`GA.history` are all of
+    this type.
+    """
+
+    def to_pandas(self) -> Any:
+        """The history as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
+        try:
+            import pandas as pd  # type: ignore[import-not-found]
+        except ImportError:
+            raise ImportError("History.to_pandas needs pandas: pip install pandas") from None
+        return pd.DataFrame.from_records(np.asarray(self).view(np.ndarray), columns=list(HISTORY_DTYPE.names or ()))
+
+    @staticmethod
+    def from_rows(rows: Iterable[Any]) -> "History":
+        """A History from GenerationStats objects (or anything with those attributes)."""
+        records = [tuple(getattr(r, name) for name in HISTORY_DTYPE.names or ()) for r in rows]
+        return np.array(records, dtype=HISTORY_DTYPE).view(History)  # type: ignore[return-value]
+
+
+@dataclass
+class EvolutionResult:
+    """What :func:`evolve` returns.
+
+    Attributes:
+        history: :class:`History`, generation 0 first.
+        best: the best :class:`animat.Individual` of the last generation (``.genome``, ``.fitness``).
+        population: the final population (list of :class:`animat.Individual`).
+        stop_reason: why the run stopped.
+        config: the :class:`animat.Config` of the run.
+        out: the run directory, or None.
+    """
+
+    history: History
+    best: Any
+    population: List[Any]
+    stop_reason: str
+    config: Any
+    out: Optional[Path] = None
+
+    @property
+    def best_genome(self) -> Any:
+        """The best :class:`animat.Genome` of the last generation."""
+        return self.best.genome
+
+    @property
+    def best_fitness(self) -> Any:
+        """Its :class:`animat.Fitness`."""
+        return self.best.fitness
+
+    def __repr__(self) -> str:
+        return (f"<animat.EvolutionResult {len(self.history)} generations, best {self.best.fitness.fitness:.6g}, "
+                f"stopped: {self.stop_reason}>")
+
+
+@dataclass
+class Objective:
+    """Your own objective: a function of an :class:`animat.EvaluationRecord` (the EvaluationResult's
+    fields, the body, the trajectory every ``every`` control steps) returning a float; larger is better.
+
+    It is called for viable genomes only (a non-viable genome scores 0 and is never selected before a
+    viable one), under the GIL, while the simulations run in parallel without it. Keep it pure (a
+    function of the record alone) and the run stays bit-identical for any thread count. ``name``
+    is recorded in the run's config as ``evaluation.objective = "python:NAME"``; a resume must pass
+    the same objective again.
+
+    Example::
+
+        def rightward(record):            # centre-of-mass displacement along +x
+            return float(record.com[-1, 0] - record.com[0, 0])
+        animat.evolve(config, objective=animat.Objective(rightward, every=50))
+    """
+
+    function: Callable[[Any], float]
+    every: int = 20
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        if not callable(self.function):
+            raise TypeError(f"Objective: function must be callable, got {type(self.function).__name__}")
+        if self.every < 0:
+            raise ValueError(f"Objective: every must be >= 0, got {self.every}")
+        if not self.name:
+            self.name = getattr(self.function, "__qualname__", None) or type(self.function).__name__
+        if not self.name.startswith("python:"):
+            self.name = "python:" + self.name
+
+    def __call__(self, record: Any) -> float:
+        return self.function(record)
+
+
+ObjectiveLike = Union[None, str, Objective, Callable[[Any], float]]
+
+
+def _objective(objective: ObjectiveLike) -> Union[None, str, Objective]:
+    if objective is None or isinstance(objective, (str, Objective)):
+        return objective
+    if callable(objective):
+        return Objective(objective)
+    raise TypeError(f"objective must be a name, a callable or an animat.Objective, got {type(objective).__name__}")
+
+
+def _config_for(config: Any, objective: Union[None, str, Objective]) -> Any:
+    cfg = _core.Config() if config is None else config.copy()
+    if isinstance(objective, str):
+        cfg["evaluation.objective"] = objective
+    elif isinstance(objective, Objective):
+        cfg["evaluation.objective"] = objective.name
+    return cfg
+
+
+def _core_objective(cfg: Any, objective: Union[None, str, Objective]) -> Any:
+    if isinstance(objective, Objective):
+        return objective
+    name = str(cfg["evaluation.objective"])
+    if name.startswith("python:"):
+        raise ValueError(f"evaluation.objective = {name!r} is a Python objective: pass objective=animat.Objective(...) "
+                         "with that name")
+    return None
+
+
+def evaluate(genome: Any, config: Any = None, objective: ObjectiveLike = None) -> Any:
+    """genome -> development -> body -> swim, scored by the objective.
+
+    Returns an :class:`animat.EvaluationResult`: ``fitness`` is the objective's value (default:
+    ``config.evaluation.objective``, the paper's straight-line distance of the centre of mass), plus
+    ``viable``, ``stable``, ``cell_count``, ``displacement`` and every diagnostic. Deterministic.
+    Non-viable genomes are not swum; unstable swims give fitness 0 and ``stable=False``.
+    Picklable, so ``multiprocessing.Pool().map(animat.evaluate, genomes)`` works.
+    """
+    return _core.evaluate(genome, config, _objective(objective))
+
+
+def evaluate_population(genomes: Sequence[Any], config: Any = None, threads: int = 0,
+                        objective: ObjectiveLike = None) -> List[Any]:
+    """Evaluate genomes in parallel (OpenMP threads, the GIL released) and return one
+    :class:`animat.Fitness` per genome, in order, identical for any thread count (0 = all cores)."""
+    return _core.evaluate_population(list(genomes), config, threads, _objective(objective))
+
+
+def record_evaluation(genome: Any, config: Any = None, every: int = 20) -> Any:
+    """Evaluate a genome and return the :class:`animat.EvaluationRecord` an objective sees: the
+    EvaluationResult's fields, the body and the trajectory every ``every`` control steps (0 = none)."""
+    return _core.record_evaluation(genome, config, every)
+
+
+def to_fitness(value: Any) -> Any:
+    """A :class:`animat.Fitness` from what an evaluator returns: a Fitness; an EvaluationResult
+    (its fitness, viable, stable, cell_count); ``None`` (not viable); or a number (a viable
+    genome's fitness; it must be finite)."""
+    if isinstance(value, _core.Fitness):
+        return value
+    if isinstance(value, _core.EvaluationResult):
+        return _core.Fitness(value.fitness, value.viable, value.stable, value.cell_count)
+    if value is None:
+        return _core.Fitness(0.0, False, True, 0)
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError("a fitness must be a number, None, an animat.Fitness or an animat.EvaluationResult, got a bool")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise TypeError("a fitness must be a number, None, an animat.Fitness or an animat.EvaluationResult, got "
+                        f"{type(value).__name__}") from None
+    if not math.isfinite(number):
+        raise ValueError(f"a fitness must be finite, got {number} (tell None for a non-viable genome)")
+    return _core.Fitness(number, True, True, 0)
+
+
+class GA:
+    """The paper's genetic algorithm driven from outside: ``ask()`` for genomes, evaluate them
+    anywhere (a process pool, a cluster, your own simulator), ``tell()`` their fitness.
+
+    It is the engine of :func:`evolve`: a GA loop evaluating with ``animat.evaluate`` gives the very
+    run ``evolve`` gives (same populations, same history). Before generation 0 it asks for random
+    genomes, one per initial slot still lacking a viable individual, until every slot has one; then
+    each ``ask()`` returns the offspring of the next generation that need a fitness (elites and
+    unchanged copies keep theirs; the list may be empty: tell ``[]``).
+
+    Example::
+
+        ga = animat.GA(config)
+        while not ga.done:
+            genomes = ga.ask()
+            ga.tell([animat.evaluate(g, config) for g in genomes])
+        print(ga.best.fitness, ga.history["best"])
+    """
+
+    def __init__(self, config: Any = None) -> None:
+        self._config = _core.Config() if config is None else config.copy()
+        self._engine = _core.Evolution(self._config)
+
+    # --- the loop ---------------------------------------------------------------------------------
+    def ask(self, lookahead: int = 1) -> List[Any]:
+        """The genomes that need a fitness next (a list of :class:`animat.Genome`). Before generation 0,
+        ``lookahead`` > 1 asks that many consecutive random draws per open slot at once (those after a
+        slot's first viable draw are discarded; the run does not depend on it). Asking again before
+        ``tell`` returns the same genomes."""
+        return self._engine.ask(lookahead)
+
+    def tell(self, fitnesses: Sequence[Any]) -> Optional[Any]:
+        """The fitness of every genome of the last ``ask()``, in order: numbers, None (not viable),
+        :class:`animat.Fitness` or :class:`animat.EvaluationResult` (see :func:`to_fitness`).
+        Returns the :class:`animat.GenerationStats` of the generation this completed, or None while
+        the initial population is still being drawn."""
+        values = [to_fitness(v) for v in fitnesses]
+        if self._engine.tell(values):
+            return self._engine.history[-1]
+        return None
+
+    def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None, threads: Optional[int] = None) -> Any:
+        """Ask, evaluate and tell until the next generation is complete; returns its GenerationStats.
+
+        ``evaluate`` maps a list of genomes to their fitness values (default: :func:`evaluate_population`
+        with this GA's config and ``threads``, i.e. exactly what :func:`evolve` does)."""
+        cfg = self._config
+        n = int(cfg["evolution.threads"]) if threads is None else threads
+
+        def in_parallel(genomes: List[Any]) -> Sequence[Any]:
+            return evaluate_population(genomes, cfg, n)
+
+        fitness_of = in_parallel if evaluate is None else evaluate
+        target = self.generation + 1
+        while self.generation < target:
+            genomes = self.ask(4 if self.generation < 0 else 1)
+            self.tell(list(fitness_of(genomes)))
+        return self._engine.history[-1]
+
+    # --- state ------------------------------------------------------------------------------------
+    @property
+    def config(self) -> Any:
+        """The GA's :class:`animat.Config` (a copy)."""
+        return self._config.copy()
+
+    @property
+    def generation(self) -> int:
+        """The last completed generation (-1 while the initial population is being drawn)."""
+        return self._engine.generation
+
+    @property
+    def population(self) -> List[Any]:
+        """The population: a list of :class:`animat.Individual` (``.genome``, ``.fitness``, ``.tries``)."""
+        return self._engine.population if self.generation >= 0 else []
+
+    @property
+    def best(self) -> Any:
+        """The best :class:`animat.Individual` (the first of the fittest); ValueError before generation 0."""
+        return self._engine.best
+
+    @property
+    def history(self) -> History:
+        """Statistics of every completed generation (:class:`History`)."""
+        return History.from_rows(self._engine.history)
+
+    @property
+    def evaluations(self) -> int:
+        """Fitness evaluations counted so far (the initial draws up to each slot's first viable one)."""
+        return self._engine.evaluations
+
+    @property
+    def stop_reason(self) -> str:
+        """Why the run would stop now: the config's generation cap, stall or wall-clock budget ('' = go on)."""
+        return self._engine.stop_reason()
+
+    @property
+    def done(self) -> bool:
+        """True once :attr:`stop_reason` is set."""
+        return bool(self.stop_reason)
+
+    # --- checkpoints ------------------------------------------------------------------------------
+    def checkpoint(self) -> str:
+        """The whole state as checkpoint JSON text (the format of a run directory's checkpoint.json);
+        ValueError before generation 0 is complete. A pending ask() is not saved: ask again after
+        restoring and you get the same genomes."""
+        return self._engine.checkpoint()
+
+    def save(self, path: PathLike) -> Path:
+        """Write :meth:`checkpoint` to ``path`` atomically (a temporary file, then a rename)."""
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(self.checkpoint(), encoding="utf-8")
+        os.replace(tmp, path)
+        return path
+
+    @classmethod
+    def from_checkpoint(cls, text: str, config: Any, source: str = "checkpoint") -> "GA":
+        """A GA restored from checkpoint text; ``config`` must be the run's (only its stopping and
+        resource knobs may differ), else ValueError."""
+        ga = cls(config)
+        ga._engine.restore(text, source)
+        return ga
+
+    @classmethod
+    def load(cls, path: PathLike, config: Any = None) -> "GA":
+        """A GA restored from a checkpoint file: one written by :meth:`save`, or a run directory's
+        ``checkpoint.json`` (or the run directory itself: its config.toml is then the default config)."""
+        path = Path(path)
+        if path.is_dir():
+            if config is None and (path / "config.toml").is_file():
+                config = _core.load_config(str(path / "config.toml"))
+            path = path / "checkpoint.json"
+        if config is None:
+            raise ValueError(f"GA.load({str(path)!r}): pass the run's config (a checkpoint holds only its identity)")
+        return cls.from_checkpoint(path.read_text(encoding="utf-8"), config, str(path))
+
+    def __getstate__(self) -> dict:
+        return {"config": self._config, "checkpoint": self.checkpoint()}
+
+    def __setstate__(self, state: dict) -> None:
+        self._config = state["config"]
+        self._engine = _core.Evolution(self._config)
+        self._engine.restore(state["checkpoint"], "pickle")
+
+    def __repr__(self) -> str:
+        return f"<animat.GA generation {self.generation}, population {int(self._config['evolution.population'])}>"
+
+
+# --- evolve ---------------------------------------------------------------------------------------------
+
+_RUN_FILES = ("config.toml", "history.csv", "checkpoint.json", "checkpoint.json.tmp")
+_RUN_DIRS = ("best", "figures")
+
+
+def _clear_run_directory(out: Path) -> None:
+    """Removes what a run wrote (config, history, checkpoint, lineage, figures); nothing else."""
+    for name in _RUN_FILES:
+        p = out / name
+        if p.is_file():
+            p.unlink()
+    for name in _RUN_DIRS:
+        p = out / name
+        if p.is_dir():
+            shutil.rmtree(p)
+
+
+def _progress_bar(total: Optional[int], enabled: bool) -> Any:
+    if not enabled:
+        return None
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, desc="evolve", unit="gen", dynamic_ncols=True)
+
+
+def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: Optional[int] = None,
+           wall_seconds: Optional[float] = None, seed: Optional[int] = None, threads: Optional[int] = None,
+           objective: ObjectiveLike = None, resume: bool = False, overwrite: bool = False,
+           callback: Optional[Callable[[Any], Optional[bool]]] = None, quiet: bool = False,
+           progress: Optional[bool] = None, stop: Any = None) -> EvolutionResult:
+    """Run the paper's genetic algorithm: the engine, checkpoints and run directory of ``animat_evolve``.
+
+    Args:
+        config: an :class:`animat.Config` (default: the embedded paper setting). With ``resume=True``
+            and no config, the run directory's own ``config.toml`` is used.
+        out: run directory (``config.toml``, ``history.csv``, ``best/``, ``checkpoint.json``); None
+            writes nothing.
+        generations, wall_seconds, seed, threads: set ``evolution.generations`` (the cap),
+            ``evolution.wall_seconds`` (a budget), ``evolution.seed`` and ``evolution.threads``.
+            Without a cap or a budget the run stops only after ``evolution.stall_generations``
+            (500) generations without improvement: hours (a warning says so).
+        objective: a built-in name (``"distance"``, ``"distance_per_size"``, ``"speed_toward"``), a
+            callable of an :class:`animat.EvaluationRecord`, or an :class:`Objective`; None = the
+            config's ``evaluation.objective``.
+        resume: continue the run in ``out`` (its checkpoint).
+        overwrite: start afresh in ``out``, removing the run there (config, history, checkpoint,
+            lineage, figures; nothing else).
+        callback: called with the :class:`animat.GenerationStats` of every generation (generation 0
+            of a new run included); return False to stop (checkpointed).
+        quiet: no progress bar and no log lines.
+        progress: show a tqdm progress bar (default: unless ``quiet``).
+        stop: an object with ``is_set()`` (e.g. a :class:`threading.Event`), polled between
+            evaluations: once set, the run checkpoints its last complete generation and returns
+            (``stop_reason == "interrupted"``).
+
+    Returns:
+        :class:`EvolutionResult` (history, best, population, stop_reason).
+
+    Raises:
+        FileExistsError: ``out`` holds a run and neither ``resume`` nor ``overwrite`` is set.
+        ValueError: an invalid config, or a resume with a different one.
+        KeyboardInterrupt: Ctrl-C; the last complete generation is checkpointed in ``out``
+            (``resume=True`` continues) and the partial :class:`EvolutionResult` is its ``.result``.
+        TypeError: the callback returned something other than True, False or None.
+    """
+    if resume and overwrite:
+        raise ValueError("evolve: resume=True and overwrite=True contradict each other")
+    out_path = Path(out) if out is not None else None
+    if resume:
+        if out_path is None:
+            raise ValueError("evolve: resume=True needs the run directory out=")
+        if not out_path.is_dir():
+            raise FileNotFoundError(f"{out_path}: resume directory does not exist")
+        if config is None:
+            if not (out_path / "config.toml").is_file():
+                raise FileNotFoundError(f"{out_path / 'config.toml'}: missing; {out_path} is not a run directory")
+            config = _core.load_config(str(out_path / "config.toml"))
+    obj = _objective(objective)
+    cfg = _config_for(config, obj)
+    if generations is not None:
+        cfg["evolution.generations"] = int(generations)
+    if wall_seconds is not None:
+        cfg["evolution.wall_seconds"] = float(wall_seconds)
+    if seed is not None:
+        cfg["evolution.seed"] = int(seed)
+    if threads is not None:
+        cfg["evolution.threads"] = int(threads)
+    core_objective = _core_objective(cfg, obj)
+    if int(cfg["evolution.generations"]) == 0 and float(cfg["evolution.wall_seconds"]) == 0:
+        warnings.warn("evolve: no generation cap (generations=) and no wall-clock budget (wall_seconds=): the run stops "
+                      f"only after {int(cfg['evolution.stall_generations'])} generations without improvement (hours)",
+                      UserWarning, stacklevel=2)
+    if out_path is not None and not resume and (out_path / "checkpoint.json").exists():
+        if not overwrite:
+            raise FileExistsError(f"{out_path}: already holds a run (checkpoint.json); pass resume=True to continue it "
+                                  "or overwrite=True to start afresh")
+        _clear_run_directory(out_path)
+
+    show = (not quiet) if progress is None else bool(progress)
+    cap = int(cfg["evolution.generations"])
+    bar = _progress_bar(cap + 1 if cap > 0 else None, show)
+    state = {"last": None}
+
+    def on_generation(stats: Any) -> bool:
+        if bar is not None:
+            bar.n = stats.generation + 1  # generations 0..g done (a resumed run continues the count)
+            bar.set_postfix(best=f"{stats.best:.4g}", viable=f"{100 * stats.viable_fraction:.0f}%",
+                            evals_per_s=f"{stats.evaluations_per_second:.0f}", refresh=False)
+            bar.refresh()
+        state["last"] = stats
+        if callback is not None:
+            answer = callback(stats)
+            if answer is None:
+                return True
+            if not isinstance(answer, (bool, np.bool_)):
+                raise TypeError(f"evolve: the callback must return True, False or None (None = go on), "
+                                f"got {type(answer).__name__} {answer!r:.60}")
+            return bool(answer)
+        return True
+
+    def result_of(summary: Any) -> EvolutionResult:
+        return EvolutionResult(history=History.from_rows(summary.history), best=summary.best,
+                               population=list(summary.population), stop_reason=summary.stop_reason, config=cfg,
+                               out=out_path)
+
+    try:
+        summary = _core.evolve(cfg, None if out_path is None else str(out_path), resume, on_generation,
+                               quiet or bar is not None, stop=stop, objective=core_objective)
+    except KeyboardInterrupt as e:
+        partial = getattr(e, "result", None)
+        if partial is not None:
+            e.result = result_of(partial)
+        raise
+    finally:
+        if bar is not None:
+            bar.close()
+    return result_of(summary)

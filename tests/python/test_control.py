@@ -1,0 +1,102 @@
+"""animat.SwimEnv: the Gymnasium API on a developed body, actions driving the rest lengths."""
+import numpy as np
+import pytest
+
+import animat
+
+gymnasium = pytest.importorskip("gymnasium")
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def body_and_config():
+    c = animat.Config()
+    c["evaluation.steps"] = 400
+    genome, _ = animat.Genome.random_viable(seed=3, config=c)
+    return animat.build_body(animat.develop(genome, c)), c
+
+
+@pytest.mark.parametrize("mode", ["rest_length", "oscillator"])
+def test_passes_gymnasium_env_checker(body_and_config, mode):
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c, mode=mode, frame_skip=4, max_episode_steps=20)
+    check_env(env, skip_render_check=True)
+    n, m = body.node_count, body.spring_count
+    assert env.observation_space.shape == (4 * n + m,)
+    assert env.action_space.shape == ((n,) if mode == "rest_length" else (2 * n,))
+
+
+def test_observations_are_relative_to_the_centre_of_mass_and_start_at_rest(body_and_config):
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c)
+    obs, info = env.reset(seed=1)
+    n = body.node_count
+    rel = obs[: 2 * n].reshape(n, 2)
+    np.testing.assert_allclose(rel.mean(axis=0), 0.0, atol=1e-9)
+    np.testing.assert_allclose(rel + info["com"], np.asarray(body.positions), atol=1e-5)  # float32 Box2D positions
+    np.testing.assert_array_equal(obs[2 * n:4 * n], 0.0)  # at rest
+    np.testing.assert_allclose(obs[4 * n:], 0.0, atol=1e-6)  # springs at their rest length
+    obs2, reward, terminated, truncated, _ = env.step(np.zeros(n))  # no actuation: nothing moves
+    assert reward == 0.0 and not terminated and not truncated
+    np.testing.assert_array_equal(obs2, obs)
+
+
+def test_rewards_add_up_to_the_objective_and_an_episode_truncates(body_and_config):
+    body, c = body_and_config
+    for objective in ("distance", "distance_per_size", "speed_toward"):
+        env = animat.SwimEnv(body, c, objective=objective, max_episode_steps=30)
+        env.reset(seed=0)
+        total, t = 0.0, 0.0
+        for k in range(30):
+            action = 0.15 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0])
+            _, reward, terminated, truncated, info = env.step(action)
+            total += reward
+            t = info["time"]
+            assert not terminated
+            assert truncated == (k == 29)
+        assert total == pytest.approx(env.objective_value(), abs=1e-12)
+        assert info["objective"] == env.objective_value()
+    com = info["com"]
+    horizon = 30 * env.dt
+    assert env.objective_value() == pytest.approx((com - env._com0) @ np.array([1.0, 0.0]) / horizon)
+
+
+def test_actions_outside_the_space_are_refused(body_and_config):
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c)
+    env.reset()
+    n = body.node_count
+    with pytest.raises(ValueError, match=r"action\[0\] = 0.3 is outside the action space \[-0.2, 0.2\]"):
+        env.step(np.full(n, 0.3))
+    with pytest.raises(ValueError, match="action has shape"):
+        env.step(np.zeros(n + 1))
+
+
+def test_oscillator_mode_equals_the_body_oscillating_by_itself_once_started(body_and_config):
+    """Amplitudes and phases set to the body's own reproduce eq. 2 (without the paper's delayed start)."""
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c, mode="oscillator", frame_skip=1)
+    env.reset()
+    action = np.concatenate([np.asarray(body.amplitude), np.mod(np.asarray(body.phase), 2 * np.pi)])
+    env.step(action)
+    sim = env._sim
+    a, f, p = body.amplitude, body.frequency, body.phase
+    u = a * np.sin(f * 0.0 + p)
+    springs = np.asarray(body.springs)
+    expected = (1 + u[springs[:, 0]] + u[springs[:, 1]]) * env._rest0
+    np.testing.assert_allclose(sim.rest_lengths_now, expected, rtol=1e-12)
+
+
+def test_a_sinusoidal_controller_swims_farther_than_a_random_one(body_and_config):
+    body, c = body_and_config
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "control_swimmer.py"
+    spec = importlib.util.spec_from_file_location("control_swimmer", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    env = animat.SwimEnv(body, c, max_episode_steps=100)
+    random_distance = module.episode(env, module.random_controller(env, seed=0))
+    wave_distance = module.episode(env, module.travelling_wave(env))
+    assert wave_distance > 2 * random_distance > 0

@@ -1,0 +1,455 @@
+"""The research API (issue 16): objectives, ask/tell, pickling, process pools, the quickstart, packaging."""
+import copy
+import math
+import multiprocessing
+import os
+import pickle
+import re
+import subprocess
+import sys
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import animat
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def small_config(population=10, steps=600, seed=3, threads=1):
+    c = animat.Config()
+    c["evolution.population"] = population
+    c["evaluation.steps"] = steps
+    c["evolution.seed"] = seed
+    c["evolution.threads"] = threads
+    return c
+
+
+@pytest.fixture(scope="module")
+def viable():
+    """(config, genome) with a viable genome that moves."""
+    c = small_config()
+    genome, tries = animat.Genome.random_viable(seed=1, config=c)
+    assert tries >= 1
+    return c, genome
+
+
+def rightward(record):
+    """Centre-of-mass displacement along +x (a pure objective of the record)."""
+    return float(record.com[-1, 0] - record.com[0, 0])
+
+
+# --- 1. objectives --------------------------------------------------------------------------------------
+
+def test_builtin_objectives_by_name_and_config_key(viable):
+    c, g = viable
+    r = animat.evaluate(g, c)
+    assert r.fitness == pytest.approx(float(np.linalg.norm(r.displacement)), rel=0, abs=1e-12)
+    rec = animat.record_evaluation(g, c, every=0)
+    per_size = animat.evaluate(g, c, objective="distance_per_size").fitness
+    assert per_size == pytest.approx(r.fitness / animat.body_length(rec.body), rel=1e-12)
+    c2 = c.copy()
+    c2.apply_override("evaluation.objective=speed_toward")  # exactly what animat_evolve --set does
+    c2.apply_override("evaluation.direction=[0.0, 1.0]")
+    speed = animat.evaluate(g, c2).fitness
+    assert speed == pytest.approx(r.displacement[1] / r.simulated_time, rel=1e-12)
+    assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward"}
+    with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, python:"):
+        c2["evaluation.objective"] = "fastest"
+
+
+def test_record_exposes_every_evaluation_result_field_and_the_trajectory(viable):
+    c, g = viable
+    rec = animat.record_evaluation(g, c, every=25)
+    result = rec.result
+    fields = [n for n in dir(result) if not n.startswith("_") and not callable(getattr(result, n))]
+    assert len(fields) >= 20
+    for name in fields:  # generic: a field added to EvaluationResult appears on the record
+        a, b = getattr(rec, name), getattr(result, name)
+        assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, name
+    n = rec.body.node_count
+    assert rec.positions.shape == (600 // 25 + 1, n, 2) and rec.velocities.shape == rec.positions.shape
+    assert list(rec.steps[:3]) == [0, 25, 50]
+    np.testing.assert_allclose(rec.com, rec.positions.mean(axis=1))
+    with pytest.raises(AttributeError):
+        rec.no_such_field
+
+
+def test_python_objective_in_evolve_is_deterministic_for_any_thread_count(tmp_path):
+    runs = []
+    for threads in (1, 2):
+        c = small_config(population=8, steps=400, threads=threads)
+        r = animat.evolve(c, generations=2, objective=animat.Objective(rightward, every=50), quiet=True)
+        runs.append(r)
+    assert list(runs[0].history["best"]) == list(runs[1].history["best"])
+    assert [i.genome for i in runs[0].population] == [i.genome for i in runs[1].population]
+    # The objective really scored the GA: the best's fitness is its rightward displacement.
+    best = runs[0].best
+    c = small_config(population=8, steps=400)
+    assert best.fitness.fitness == pytest.approx(rightward(animat.record_evaluation(best.genome, c, every=50)))
+
+
+def test_python_objective_is_recorded_in_the_run_and_needed_to_resume(tmp_path):
+    out = tmp_path / "run"
+    c = small_config(population=8, steps=300)
+    animat.evolve(c, out=out, generations=1, objective=rightward, quiet=True)
+    saved = animat.load_config(out / "config.toml")
+    assert saved["evaluation.objective"] == "python:rightward"
+    with pytest.raises(ValueError, match="python:rightward.*is a Python objective"):
+        animat.evolve(None, out=out, resume=True, generations=2, quiet=True)
+    r = animat.evolve(None, out=out, resume=True, generations=2, objective=rightward, quiet=True)
+    assert int(r.history[-1]["generation"]) == 2
+    exe = os.environ.get("ANIMAT_EVOLVE_EXE")
+    if exe:
+        p = subprocess.run([exe, "--resume", str(out), "--generations", "3", "--quiet"], capture_output=True, text=True)
+        assert p.returncode == 2 and "is a Python objective" in p.stderr, p.stderr
+
+
+def test_python_objective_errors_are_clear(viable):
+    c, g = viable
+    with pytest.raises(ValueError, match="returned nan"):
+        animat.evaluate(g, c, objective=lambda r: float("nan"))
+    with pytest.raises(ValueError, match="returned a str, expected a float"):
+        animat.evaluate(g, c, objective=lambda r: "far")
+
+    def broken(record):
+        raise KeyError("no such thing")
+
+    with pytest.raises(ValueError, match="(?s)objective python:.*broken raised.*KeyError: 'no such thing'"):
+        animat.evaluate_population([g, g], c, threads=2, objective=broken)
+
+
+# --- 2. ask / tell --------------------------------------------------------------------------------------
+
+def test_ga_loop_gives_exactly_the_evolve_run():
+    c = small_config(population=10, steps=400, seed=5)
+    c["evolution.generations"] = 3
+    ref = animat.evolve(c, quiet=True)
+    ga = animat.GA(c)
+    rounds = 0
+    while not ga.done:
+        genomes = ga.ask()
+        ga.tell([animat.evaluate(g, c) for g in genomes])  # EvaluationResult objects are accepted
+        rounds += 1
+    assert rounds > 4 and ga.generation == 3
+    for name in ("best", "mean", "median", "viable_fraction", "best_cells", "evaluations"):
+        assert list(ga.history[name]) == list(ref.history[name]), name
+    assert [i.genome for i in ga.population] == [i.genome for i in ref.population]
+    assert [i.fitness for i in ga.population] == [i.fitness for i in ref.population]
+    assert ga.best.genome == ref.best.genome
+
+
+def test_ga_with_a_process_pool_checkpoint_resume_and_pickle(tmp_path):
+    c = small_config(population=8, steps=300, seed=2)
+    c["evolution.generations"] = 2
+    ga = animat.GA(c)
+    with ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        while not ga.done:
+            genomes = ga.ask()
+            ga.tell(list(pool.map(animat.evaluate, genomes, [c] * len(genomes))))
+    ref = animat.evolve(c, quiet=True)
+    assert list(ga.history["best"]) == list(ref.history["best"])
+
+    ckpt = ga.save(tmp_path / "ga.json")
+    more = c.copy()
+    more["evolution.generations"] = 4
+    resumed = animat.GA.load(ckpt, more)
+    twin = pickle.loads(pickle.dumps(resumed))
+    assert twin.generation == resumed.generation == 2
+    asked = resumed.ask()
+    assert resumed.ask() == asked  # again before tell: the same genomes
+    assert twin.ask() == asked
+    while not resumed.done:
+        resumed.step()
+    straight = animat.evolve(more, quiet=True)
+    assert list(resumed.history["best"]) == list(straight.history["best"])
+
+
+def test_ga_interoperates_with_run_directories(tmp_path):
+    out = tmp_path / "run"
+    c = small_config(population=8, steps=300)
+    animat.evolve(c, out=out, generations=2, quiet=True)
+    ga = animat.GA.load(out)  # the run's own config.toml and checkpoint.json
+    assert ga.generation == 2
+    ga.step()
+    assert ga.generation == 3
+
+
+def test_tell_refuses_what_it_cannot_use():
+    ga = animat.GA(small_config(population=6))
+    with pytest.raises(ValueError, match="nothing was asked"):
+        ga.tell([])
+    genomes = ga.ask()
+    with pytest.raises(ValueError, match="5 fitness values for the 6 genomes"):
+        ga.tell([1.0] * 5)
+    with pytest.raises(ValueError, match="must be finite"):
+        ga.tell([float("nan")] * 6)
+    with pytest.raises(TypeError, match="got a bool"):
+        ga.tell([True] * 6)
+    with pytest.raises(ValueError, match="no generation completed yet"):
+        ga.checkpoint()
+    assert ga.population == [] and ga.generation == -1
+    stats = ga.tell([None, 1.0, animat.Fitness(2.0), 3, None, 0.5])  # None: not viable
+    assert stats is None  # two slots still open
+    assert len(ga.ask()) == 2 and len(genomes) == 6
+
+
+# --- 3. pickle and copy ----------------------------------------------------------------------------------
+
+def _same(a, b):
+    if isinstance(a, np.ndarray):
+        return np.array_equal(a, b)
+    if isinstance(a, (list, tuple)):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if type(a).__eq__ is object.__eq__:  # a value type without ==: compare its properties
+        props = _properties(a)
+        return type(a) is type(b) and all(_same(v, getattr(b, k)) for k, v in props.items())
+    return a == b
+
+
+def _properties(obj):
+    return {n: getattr(obj, n) for n in dir(obj) if not n.startswith("_") and not callable(getattr(obj, n))}
+
+
+def test_every_value_type_pickles_and_copies(viable, tmp_path):
+    c, g = viable
+    ctrace = c.copy()
+    ctrace["development.trace_every"] = 50
+    embryo = animat.develop(g, ctrace)
+    body = animat.build_body(embryo)
+    result = animat.evaluate(g, c)
+    out = tmp_path / "run"
+    evo = animat.evolve(small_config(population=6, steps=200), out=out, generations=1, quiet=True)
+    run = animat.Run(out)
+    trajectory = animat.replay(g, c, steps=100, every=10)
+    values = [c, g, animat.Scene(drag_normal=5.0), body, embryo, embryo.trace, result, animat.Fitness(1.5, True, False, 7),
+              animat.record_evaluation(g, c, every=100),
+              evo.population[0], animat.GenerationStats(_core_stats(evo)), animat.Rng(9)]
+    for v in values:
+        for twin in (pickle.loads(pickle.dumps(v)), copy.copy(v), copy.deepcopy(v)):
+            assert type(twin) is type(v)
+            if isinstance(v, animat.Config):
+                assert twin == v and twin.to_toml() == v.to_toml()
+                continue
+            props = _properties(v)
+            assert props, type(v)
+            for name, value in props.items():
+                assert _same(value, getattr(twin, name)), (type(v).__name__, name)
+    assert pickle.loads(pickle.dumps(c)) == c and pickle.loads(pickle.dumps(g)) == g
+    # Python values holding them
+    r2 = pickle.loads(pickle.dumps(run))
+    assert r2.path == run.path and r2.config == run.config and np.array_equal(r2.history, run.history)
+    t2 = pickle.loads(pickle.dumps(trajectory))
+    np.testing.assert_array_equal(t2.positions, trajectory.positions)
+    assert t2.body.node_count == trajectory.body.node_count and t2.config == trajectory.config
+    h2 = pickle.loads(pickle.dumps(evo.history))
+    assert type(h2) is animat.History and np.array_equal(h2, evo.history)
+    e2 = pickle.loads(pickle.dumps(evo))
+    assert e2.best.genome == evo.best.genome
+
+
+def _core_stats(evo):
+    return {name: float(evo.history[-1][name]) if evo.history.dtype[name].kind == "f" else int(evo.history[-1][name])
+            for name in evo.history.dtype.names} | {"evaluations_per_second": 1.0, "best_changed": True, "crossovers": 2}
+
+
+def test_unpickling_a_foreign_state_is_a_clear_error():
+    state = animat.Genome.random(seed=1).__getstate__()
+    g = animat.Genome.__new__(animat.Genome)
+    with pytest.raises(ValueError, match="cannot unpickle animat.Genome version 2"):
+        g.__setstate__((state[0], 2, state[2]))
+
+
+def test_multiprocessing_pool_and_process_pool_executor_evaluate_a_population(viable):
+    c, _ = viable
+    genomes = [animat.Genome.random_viable(seed=s, config=c)[0] for s in range(4)]
+    expected = [animat.evaluate(g, c).fitness for g in genomes]
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(2) as pool:
+        assert [r.fitness for r in pool.starmap(animat.evaluate, [(g, c) for g in genomes])] == expected
+    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as ex:
+        assert [r.fitness for r in ex.map(animat.evaluate, genomes, [c] * 4)] == expected
+    assert [f.fitness for f in animat.evaluate_population(genomes, c, threads=2)] == expected
+
+
+# --- 5. the quickstart ----------------------------------------------------------------------------------
+
+def test_random_genome_takes_a_seed_keyword_and_random_viable_reports_tries():
+    assert animat.Genome.random(seed=42) == animat.Genome.random(42)
+    c = animat.Config()
+    g, tries = animat.Genome.random_viable(seed=42, config=c)
+    assert animat.develop(g, c).viable
+    rng = animat.Rng(42)
+    drawn = [animat.Genome.random(rng, c) for _ in range(tries)]
+    assert drawn[-1] == g and not any(animat.develop(x, c).viable for x in drawn[:-1])
+    assert tries > 3  # seed 42: most random genomes are not viable
+    with pytest.raises(ValueError, match="no viable genome in 3 tries"):
+        animat.Genome.random_viable(seed=42, config=c, max_tries=3)
+
+
+def test_a_non_viable_embryo_is_refused_loudly():
+    embryo = animat.develop(animat.Genome.random(seed=42))
+    assert not embryo.viable and embryo.cell_count == 1
+    with pytest.raises(ValueError, match="embryo is not viable.*random_viable"):
+        animat.build_body(embryo)
+    body = animat.build_body(embryo, allow_nonviable=True)
+    with pytest.warns(RuntimeWarning, match="1 cell\\(s\\) and no springs: it cannot swim"):
+        animat.Simulation(body)
+
+
+def test_evolve_needs_a_cap_or_says_so_and_handles_existing_runs(tmp_path):
+    c = small_config(population=6, steps=200)
+    c["evolution.stall_generations"] = 1  # keeps this uncapped call short
+    with pytest.warns(UserWarning, match="no generation cap"):
+        animat.evolve(c, quiet=True)
+    out = tmp_path / "nb"
+    first = animat.evolve(c, out=out, generations=2, quiet=True)
+    (out / "figures").mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(FileExistsError, match="resume=True.*overwrite=True"):
+        animat.evolve(c, out=out, generations=2, quiet=True)
+    again = animat.evolve(c, out=out, generations=2, overwrite=True, quiet=True)  # a re-run notebook cell
+    assert list(again.history["best"]) == list(first.history["best"])
+    assert (out / "notes.txt").exists() and not (out / "figures").exists()
+    other = small_config(population=6, steps=200, seed=9)
+    resumed = animat.evolve(None, out=out, resume=True, generations=3, quiet=True)  # the run's own config
+    assert resumed.config["evolution.seed"] == c["evolution.seed"] != other["evolution.seed"]
+    assert len(resumed.population) == 6 and int(resumed.history[-1]["generation"]) == 3
+
+
+def test_progress_bar_unless_quiet(capfd):
+    c = small_config(population=6, steps=200)
+    animat.evolve(c, generations=2)
+    err = capfd.readouterr().err
+    assert "evolve" in err and "3/3" in err and "best=" in err
+    animat.evolve(c, generations=2, quiet=True)
+    assert capfd.readouterr().err == ""
+
+
+def test_one_history_type_with_pandas(tmp_path):
+    out = tmp_path / "run"
+    r = animat.evolve(small_config(population=6, steps=200), out=out, generations=2, quiet=True)
+    h = animat.Run(out).history
+    assert type(h) is type(r.history) is animat.History
+    assert h.dtype.names == r.history.dtype.names == animat.HISTORY_DTYPE.names
+    np.testing.assert_array_equal(h["best"], r.history["best"])
+    assert h[-1].generation == h[-1]["generation"] == 2
+    pd = pytest.importorskip("pandas")
+    frame = h.to_pandas()
+    assert isinstance(frame, pd.DataFrame) and list(frame.columns) == list(animat.HISTORY_DTYPE.names)
+    assert frame["best"].tolist() == h["best"].tolist()
+
+
+def test_log_reports_eval_per_second_of_the_last_generation_and_an_eta(tmp_path):
+    exe = os.environ.get("ANIMAT_EVOLVE_EXE")
+    if not exe:
+        pytest.skip("ANIMAT_EVOLVE_EXE not set")
+    p = subprocess.run([exe, "--set", "evolution.population=6", "--set", "evaluation.steps=200", "--generations", "3",
+                        "--out", str(tmp_path / "r"), "--set", "evolution.threads=1"], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    lines = [l for l in p.stdout.splitlines() if "| gen " in l or "gen     3" in l]
+    assert lines and "ETA" in lines[-1], p.stdout
+
+
+def _python_blocks(path):
+    return re.findall(r"```python\n(.*?)```", path.read_text(encoding="utf-8"), flags=re.S)
+
+
+def test_readme_quickstart_runs(tmp_path, monkeypatch):
+    blocks = _python_blocks(ROOT / "README.md")
+    assert blocks
+    monkeypatch.chdir(tmp_path)
+    namespace = {"__name__": "readme"}
+    for k, block in enumerate(blocks):
+        exec(compile(block, f"README.md block {k + 1}", "exec"), namespace)
+
+
+# --- 6. packaging ---------------------------------------------------------------------------------------
+
+def test_paper_configs_are_package_data():
+    names = animat.paper_configs()
+    assert {"paper_dn10", "paper_dn2", "paper_dn0.5", "paper_dn0.2_64cells"} <= set(names)
+    c = animat.load_config(animat.config_path("paper_dn10"))
+    assert c["scene.drag_normal"] == 10.0
+    assert animat.config_path("paper_dn10").read_text() == (ROOT / "configs" / "paper_dn10.toml").read_text()
+    with pytest.raises(ValueError, match="no config named 'paper_dn3'; shipped: "):
+        animat.config_path("paper_dn3")
+
+
+def test_animat_evolve_subcommand_is_animat_evolve(tmp_path):
+    exe = os.environ.get("ANIMAT_EVOLVE_EXE")
+    if not exe:
+        pytest.skip("ANIMAT_EVOLVE_EXE not set")
+    flags = ["--set", "evolution.population=6", "--set", "evaluation.steps=200", "--generations", "2", "--quiet"]
+    a = subprocess.run([exe, *flags, "--out", str(tmp_path / "a")], capture_output=True, text=True)
+    b = subprocess.run([sys.executable, "-m", "animat", "evolve", *flags, "--out", str(tmp_path / "b")],
+                       capture_output=True, text=True)
+    assert a.returncode == b.returncode == 0, b.stderr
+    strip = lambda p: [row.rsplit(",", 1)[0] for row in (p / "history.csv").read_text().splitlines()]  # noqa: E731
+    assert strip(tmp_path / "a") == strip(tmp_path / "b")
+    help_a = subprocess.run([exe, "--help"], capture_output=True, text=True).stdout
+    help_b = subprocess.run([sys.executable, "-m", "animat", "evolve", "--help"], capture_output=True, text=True).stdout
+    assert set(re.findall(r"--[a-z-]+", help_a)) == set(re.findall(r"--[a-z-]+", help_b))
+    bad = subprocess.run([sys.executable, "-m", "animat", "evolve", "--set", "evaluation.objective=fast"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "expected one of distance, distance_per_size, speed_toward" in bad.stderr
+
+
+def test_pyproject_declares_the_console_script_extras_and_no_unused_dependency():
+    text = (ROOT / "pyproject.toml").read_text()
+    assert 'animat = "animat.cli:main"' in text
+    assert re.search(r'control = \["gymnasium', text)
+    deps = re.search(r"^dependencies = \[(.*?)\]", text, flags=re.M | re.S).group(1)
+    package = "\n".join(p.read_text() for p in (ROOT / "python" / "animat").glob("*.py"))
+    for dep in re.findall(r'"([A-Za-z_-]+)', deps):
+        module = {"pillow": "PIL"}.get(dep, dep)
+        assert re.search(rf"^\s*(import|from) {module}\b", package, flags=re.M), f"{dep} is never imported"
+    assert "build-dir" not in text.split("[tool.scikit-build]")[1].split("[")[0].replace("# No build-dir", "")
+
+
+def test_public_exports_and_docstrings():
+    for name in animat.__all__:
+        assert hasattr(animat, name), name
+    core_public = {n for n in dir(animat._core) if not n.startswith("_")}
+    internal = {"Evolution", "EvolutionSummary", "evolve_cli", "load_config", "develop", "build_body", "swim",
+                "evaluate", "evaluate_population", "record_evaluation", "evolve"}
+    assert core_public - internal <= set(animat.__all__), core_public - internal - set(animat.__all__)
+    functions = [getattr(animat, n) for n in animat.__all__ if callable(getattr(animat, n))
+                 and not isinstance(getattr(animat, n), type)]
+    assert len(functions) > 30
+    for fn in functions:
+        assert "nb_func" not in type(fn).__name__, fn
+        assert fn.__doc__ and len(fn.__doc__.strip()) > 30, fn
+    assert pickle.loads(pickle.dumps(animat.gabriel_graph)) is animat.gabriel_graph
+    for fn in (animat.evaluate, animat.evolve, animat.develop, animat.build_body, animat.swim,
+               animat.evaluate_population, animat.record_evaluation, animat.load_config, animat.gabriel_graph):
+        out = subprocess.run([sys.executable, "-c", f"import animat; help(animat.{fn.__name__})"], capture_output=True,
+                             text=True, check=True, env={**os.environ, "PAGER": "cat", "TERM": "dumb"}).stdout
+        assert "nanobind" not in out.splitlines()[2] and fn.__doc__.split("\n")[0].strip() in out, fn
+    from animat import plot
+    import inspect
+    for fn in (plot.development, plot.construction, plot.motion_cycle, plot.phase_map, plot.fitness_history):
+        assert inspect.signature(fn).return_annotation in ("Figure", "matplotlib.figure.Figure"), fn
+
+
+def test_pyright_reports_no_error_on_the_examples_and_the_package():
+    pyright = Path(sys.executable).parent / "pyright"
+    if not pyright.exists():
+        pytest.skip("pyright is not installed (requirements-dev.txt)")
+    import json
+
+    stage = Path(animat.__file__).resolve().parent.parent  # build/python: the package as installed, with stubs
+    config = stage.parent / "pyrightconfig.json"  # pyright reads "include" relative to its config file
+    config.write_text(json.dumps({
+        "include": [os.path.relpath(ROOT / "examples", config.parent), os.path.relpath(stage / "animat", config.parent)],
+        "extraPaths": [str(stage), str(ROOT / "examples")],
+        "pythonVersion": f"{sys.version_info.major}.{sys.version_info.minor}",
+        "typeCheckingMode": "standard",
+        "exclude": [os.path.relpath(stage / "animat" / "_core.pyi", config.parent)],  # nanobind's generated stub
+    }))
+    p = subprocess.run([str(pyright), "--pythonpath", sys.executable, "-p", str(config)], capture_output=True,
+                       text=True, cwd=ROOT, timeout=600)
+    assert p.returncode == 0 and "0 errors" in p.stdout, p.stdout[-4000:] + p.stderr[-2000:]
