@@ -800,6 +800,8 @@ TEST(SkinCollision, ForcesEqualTheAllPairsComputation) {
   b.phase.setZero();  // the whole body breathes at f = 12: violent, with many skin contacts
   SceneParams scene;
   scene.drag_normal = 0.2;
+  scene.pressure = 100.0;  // the first release's pressure, with which this swim squeezes cells against edges
+  scene.pressure_area_floor = 0.1;
   Simulation sim(b, scene);
   const auto effect = make_effect("skin_collision", b, scene, PhysicsParams{});
   SwimState st;
