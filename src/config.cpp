@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "animat/errors.hpp"
+#include "animat/islands.hpp"
 
 namespace animat {
 
@@ -418,6 +419,7 @@ void validate(const Config& config, std::string_view source) {
   } catch (const ConfigError& e) {
     fail(e.what());
   }
+  if (const std::string e = island_config_error(config.evolution); !e.empty()) fail(e);  // [islands]
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
                      config.development.max_cells));

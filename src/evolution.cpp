@@ -23,6 +23,8 @@
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
+#include "animat/islands.hpp"
 #include "animat/physics.hpp"
 #include "json_util.hpp"
 
@@ -32,7 +34,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::uint64_t kInitialKey = 0xffffffffffffffffULL;  // stream key of the initial population
 constexpr int kCheckpointVersion = 1;
 
 double now_seconds() {
@@ -110,32 +111,31 @@ std::uint64_t run_identity(const Config& config) {
   c.evolution.wall_seconds = defaults.wall_seconds;
   c.evolution.threads = defaults.threads;
   c.evolution.checkpoint_every = defaults.checkpoint_every;
+  // [islands] Without islands the island keys change nothing: hash the config as it was before they
+  // existed (they are the last lines of the TOML), so runs checkpointed by earlier builds resume.
+  if (c.evolution.islands <= 1) {
+    const std::string text = to_toml(c);
+    const auto key = text.find("\nislands = ");
+    const auto cut = key == std::string::npos ? key : text.rfind('\n', key - 1);  // the key's comment line
+    if (cut != std::string::npos) return fnv1a(std::string_view(text).substr(0, cut + 1));
+  }
   return config_hash(c);
 }
 
 // ---------------------------------------------------------------------------------------------------
-Evolution::Evolution(const Config& config, FitnessFunction fitness)
-    : config_(std::make_shared<const Config>(config)), identity_(run_identity(config)), fitness_(std::move(fitness)), started_(now_seconds()) {
+Evolution::Evolution(const Config& config, FitnessFunction fitness, std::shared_ptr<Evaluator> evaluator)
+    : config_(std::make_shared<const Config>(config)), identity_(run_identity(config)), fitness_(std::move(fitness)),
+      evaluator_(std::move(evaluator)), started_(now_seconds()) {
   validate(*config_);
-  if (!fitness_) throw Error("Evolution: no fitness function");
+  if (!evaluator_) {
+    if (!fitness_) throw Error("Evolution: no fitness function");
+    evaluator_ = make_local_evaluator(*config_, fitness_);
+  }
 }
 
 void Evolution::initialize() {
-  prepare_parallel_evaluation();
   const EvolutionParams& ep = config_->evolution;
-  population_.assign(static_cast<std::size_t>(ep.population), Individual{});
-  parallel_for(population_.size(), ep.threads, [&](std::size_t i) {
-    Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i);
-    Individual& ind = population_[i];
-    for (ind.tries = 1; ind.tries <= ep.max_init_tries; ++ind.tries) {
-      ind.genome = random_genome(config_->genome, rng);
-      ind.result = fitness_(ind.genome);
-      if (ind.result.viable) return;
-    }
-    throw Error(fmt::format("initial population: no viable random genome in evolution.max_init_tries = {} tries "
-                            "(individual {}); the development or genome settings make viability too rare",
-                            ep.max_init_tries, i));
-  });
+  population_ = evaluator_->seed(0, static_cast<std::size_t>(ep.population));  // seed_individual(i) for every i
   for (const auto& ind : population_) evaluations_ += ind.tries;
   generation_ = 0;
   best_ever_ = best().result.fitness;
@@ -162,42 +162,45 @@ GenerationStats Evolution::step() {
   const int g = generation_ + 1;
   const std::size_t n = population_.size();
 
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return fitter(population_[a], population_[b]); });
-  std::vector<std::size_t> eligible;
-  for (std::size_t i = 0; i < n; ++i)
-    if (population_[i].result.viable) eligible.push_back(i);
-  if (eligible.empty()) {  // nobody viable (possible only without elites): fall back to everyone
-    eligible.resize(n);
-    std::iota(eligible.begin(), eligible.end(), 0);
-  }
-
+  // [islands] Selection and elitism act within each island; one island is the paper's population.
+  const IslandLayout layout = island_layout(n, ep.islands);
+  std::vector<std::vector<std::size_t>> eligible(layout.count());
+  std::vector<std::size_t> copied(layout.count(), 0);
   std::vector<Individual> next(n);
   std::vector<bool> needs_eval(n, false);
-  const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), n);
-  std::size_t copied = 0;
-  for (std::size_t k = 0; k < n && copied < elites; ++k) {
-    if (!population_[order[k]].result.viable) break;
-    next[copied] = population_[order[k]];
-    next[copied].tries = 0;
-    ++copied;
+  for (std::size_t isl = 0; isl < layout.count(); ++isl) {
+    const std::vector<std::size_t> order = island_ranking(population_, layout, isl);
+    for (std::size_t i = layout.begin(isl); i < layout.end(isl); ++i)
+      if (population_[i].result.viable) eligible[isl].push_back(i);
+    if (eligible[isl].empty()) {  // nobody viable (possible only without elites): fall back to everyone
+      eligible[isl].resize(layout.size(isl));
+      std::iota(eligible[isl].begin(), eligible[isl].end(), layout.begin(isl));
+    }
+    const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), order.size());
+    for (std::size_t k = 0; k < order.size() && copied[isl] < elites; ++k) {
+      if (!population_[order[k]].result.viable) break;
+      Individual& elite = next[layout.begin(isl) + copied[isl]++];
+      elite = population_[order[k]];
+      elite.tries = 0;
+    }
   }
   const double p = tournament_probability(ep, g);
   int crossovers = 0;
   // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated twice).
   std::unordered_multimap<std::uint64_t, std::size_t> known;
   for (std::size_t i = 0; i < n; ++i) known.emplace(genome_hash(population_[i].genome), i);
-  for (std::size_t i = copied; i < n; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t isl = layout.island_of(i);        // [islands]
+    if (i < layout.begin(isl) + copied[isl]) continue;  // an elite
     Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), static_cast<std::uint64_t>(g), i);
     Individual& child = next[i];
     if (rng.bernoulli(ep.crossover_fraction)) {
-      const std::size_t a = tournament(population_, eligible, p, rng);
-      const std::size_t b = tournament(population_, eligible, p, rng);
+      const std::size_t a = tournament(population_, eligible[isl], p, rng);
+      const std::size_t b = tournament(population_, eligible[isl], p, rng);
       ++crossovers;
       child.genome = crossover(population_[a].genome, population_[b].genome, config_->mutation.crossover_points, rng);
     } else {
-      child.genome = population_[tournament(population_, eligible, p, rng)].genome;
+      child.genome = population_[tournament(population_, eligible[isl], p, rng)].genome;
     }
     mutate(child.genome, config_->mutation, config_->genome, rng);
     needs_eval[i] = true;
@@ -212,12 +215,17 @@ GenerationStats Evolution::step() {
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < n; ++i)
     if (needs_eval[i]) todo.push_back(i);
-  parallel_for(todo.size(), ep.threads, [&](std::size_t k) { next[todo[k]].result = fitness_(next[todo[k]].genome); });
+  std::vector<const Genome*> genomes;  // evaluated by the evaluator: this process's threads or MPI ranks
+  for (std::size_t i : todo) genomes.push_back(&next[i].genome);
+  const std::vector<Fitness> results = evaluator_->evaluate(genomes);
+  for (std::size_t k = 0; k < todo.size(); ++k) next[todo[k]].result = results[k];
   evaluations_ += static_cast<std::int64_t>(todo.size());
 
   const Genome previous_best = best().genome;
   population_ = std::move(next);
   generation_ = g;
+  migrations_.clear();  // [islands] copies of evaluated individuals: nothing to evaluate
+  if (is_migration_generation(ep, g)) migrations_ = migrate(population_, layout, ep.migrants, g);
   const Individual& b = best();
   if (b.result.fitness > best_ever_) {
     best_ever_ = b.result.fitness;
@@ -481,8 +489,9 @@ std::string duration(double s) {
 RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness) {
   validate(config);
   if (!fitness) fitness = swim_fitness(config);
-  Evolution evo(config, std::move(fitness));
+  Evolution evo(config, std::move(fitness), opt.evaluator);
   const bool writing = !opt.out.empty();
+  IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);  // [islands] islands.csv
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
   if (writing) {
@@ -507,6 +516,7 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     std::string rows(kHistoryHeader);
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
+    island_log.resume(evo.generation());
     // Lineage files of generations after the checkpoint belong to the lost future; they are rewritten.
     for (const auto& entry : std::filesystem::directory_iterator(opt.out / "best")) {
       const std::string name = entry.path().filename().string();
@@ -525,6 +535,7 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     if (writing) {
       write_atomically(hist, std::string(kHistoryHeader) + history_row(evo.history().back()));
       write_lineage(opt.out, evo);
+      island_log.start(evo);
       write_atomically(ckpt, evo.checkpoint());
     }
   }
@@ -557,6 +568,7 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
     report(s, false);
     if (writing) {
       append(hist, history_row(s));
+      island_log.append(evo);
       if (s.best_changed) write_lineage(opt.out, evo);
       dirty = true;
       if (++since_checkpoint >= config.evolution.checkpoint_every) {
