@@ -55,4 +55,4 @@ def __getattr__(name):
 
 def __dir__():
     return sorted(set(globals()) | {"plot"})
-from .experiment import run_experiment  # noqa: E402,F401
+from .experiment import run_experiment, run_study  # noqa: E402,F401

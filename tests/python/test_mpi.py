@@ -12,6 +12,7 @@ import pathlib
 import shutil
 import signal
 import subprocess
+import sys
 import time
 
 import pytest
@@ -178,3 +179,37 @@ def test_islands_are_deterministic_on_one_and_three_ranks_and_migrate_on_schedul
         # the best of k after migration is k's own best or the immigrant from k-1; either way it is in two islands
         holders = {j for j in range(12) if genomes[j] == genomes[best_of_k]}
         assert len({next(n for n, isl in enumerate(islands) if j in isl) for j in holders}) >= 2, (k, holders)
+
+
+TINY = """
+[evaluation]
+steps = 200
+[evolution]
+population = 8
+generations = 2
+"""
+
+
+def test_study_on_mpi_ranks_equals_the_same_study_run_task_by_task(tmp_path):
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text(TINY)
+    py = [sys.executable, "-m", "animat", "experiment"]
+    study = [f"a={cfg}", f"b={cfg}", "--runs", "2", "--set", "evolution.threads=1", "--quiet"]
+    env = dict(ENV, PYTHONPATH=os.environ.get("PYTHONPATH", ""))
+    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "mpi"), "--mpi"],
+                       capture_output=True, text=True, env=env, timeout=180)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert (tmp_path / "mpi" / "a" / "summary.md").exists() and (tmp_path / "mpi" / "b" / "summary.json").exists()
+    # The four runs as four array tasks, one process each: the same runs wherever they ran.
+    for task in range(4):
+        r = subprocess.run([*py, *study, "--out", str(tmp_path / "array"), "--index", str(task)], capture_output=True,
+                           text=True, env=env, timeout=180)
+        assert r.returncode == 0, r.stderr
+    assert not (tmp_path / "array" / "a" / "summary.md").exists()  # tasks write no summary
+    for env_name in "ab":
+        for i in range(2):
+            assert_same_run(tmp_path / "mpi" / env_name / f"run_{i}", tmp_path / "array" / env_name / f"run_{i}")
+    # Under mpirun without --mpi every rank would run everything: refused.
+    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "x")],
+                       capture_output=True, text=True, env=env, timeout=180)
+    assert r.returncode != 0 and "without --mpi" in r.stderr + r.stdout
