@@ -20,6 +20,7 @@ import csv
 import json
 import os
 import platform
+import resource
 import shutil
 import subprocess
 import sys
@@ -36,9 +37,12 @@ def run(exe: Path, population: int, generations: int, ranks: int, threads: int, 
            "--threads", str(threads), "--out", str(out), "--quiet"]
     if ranks > 0:
         cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks), *cmd]
+    ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     r = subprocess.run(cmd, capture_output=True, text=True, env=ENV)
     wall = time.perf_counter() - t0
+    ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (ru1.ru_utime - ru0.ru_utime) + (ru1.ru_stime - ru0.ru_stime)  # every rank and mpirun
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed: {r.stderr[-2000:]}")
     with open(out / "history.csv", newline="") as f:
@@ -46,7 +50,7 @@ def run(exe: Path, population: int, generations: int, ranks: int, threads: int, 
     t = [float(row["wall_seconds"]) for row in rows]
     later = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else float("nan")
     return {"population": population, "ranks": max(ranks, 1), "threads": threads, "mpirun": ranks > 0,
-            "seeding_s": t[0], "generation_s": later, "process_wall_s": wall,
+            "seeding_s": t[0], "generation_s": later, "process_wall_s": wall, "cpu_s": cpu,
             "best": rows[-1]["best"], "evaluations": rows[-1]["evaluations"]}
 
 
@@ -87,7 +91,8 @@ def main() -> int:
         w.writerows(rows)
 
     md = ["| run | population | ranks x threads | generation 0 s | s per later generation | speedup (later) | "
-          "efficiency | load avg before/after |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+          "efficiency | CPU s in all (every process) | CPU over 1 rank | load avg before/after |",
+          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     base = {}
     for r in rows:
         key = (r["kind"] if r["kind"] != "threads" else "strong", r["population"] if r["kind"] != "weak" else 0)
@@ -104,6 +109,7 @@ def main() -> int:
         label = {"strong": "strong", "weak": "weak", "threads": "OpenMP only"}[r["kind"]]
         md.append(f"| {label} | {r['population']} | {r['ranks']} x {r['threads']}{'' if r['mpirun'] else ' (no mpirun)'} "
                   f"| {r['seeding_s']:.2f} | {r['generation_s']:.2f} | {speed:.2f}x | {speed / workers:.0%} | "
+                  f"{r['cpu_s']:.1f} | {r['cpu_s'] / b['cpu_s'] / (1 if kind != 'weak' else workers):.3f} | "
                   f"{r['load_before']:.1f} / {r['load_after']:.1f} |")
     print("\n".join(md))
 
