@@ -213,3 +213,25 @@ def test_study_on_mpi_ranks_equals_the_same_study_run_task_by_task(tmp_path):
     r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "x")],
                        capture_output=True, text=True, env=env, timeout=180)
     assert r.returncode != 0 and "without --mpi" in r.stderr + r.stdout
+
+
+def test_errors_on_any_rank_reach_rank_0_and_release_the_others(tmp_path):
+    # An evaluation error on another rank: the same message as with threads (the first by index).
+    args = ["--set", "evolution.population=8", "--set", "evolution.max_init_tries=1", "--set", "evaluation.steps=100"]
+    local = evolve(tmp_path / "local", *args)
+    mpi = evolve(tmp_path / "mpi", *args, ranks=3)
+    assert local.returncode == 2 and mpi.returncode != 0
+    message = local.stderr.strip().splitlines()[-1]
+    assert "no viable random genome in evolution.max_init_tries = 1 tries" in message
+    assert message.split("error: ")[-1] in mpi.stderr, mpi.stderr
+    # Rank 0 fails before the ranks got a run (no such directory), and after (a corrupt checkpoint):
+    # both end at once with rank 0's message, no rank left waiting (the timeout would fail the test).
+    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "none")],
+                       capture_output=True, text=True, env=ENV, timeout=60)
+    assert r.returncode != 0 and "resume directory does not exist" in r.stderr
+    ok = evolve(tmp_path / "run", "--set", "evolution.population=8", "--set", "evaluation.steps=100", "--generations", "1")
+    assert ok.returncode == 0, ok.stderr
+    (tmp_path / "run" / "checkpoint.json").write_text("garbage")
+    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "run")],
+                       capture_output=True, text=True, env=ENV, timeout=60)
+    assert r.returncode != 0 and "corrupt checkpoint" in r.stderr
