@@ -331,14 +331,21 @@ std::string Evolution::checkpoint() const {
   payload["best_ever"] = best_ever_;
   payload["evaluations"] = evaluations_;
   payload["wall_seconds"] = history_.empty() ? 0.0 : history_.back().wall_seconds;
+  // The individuals are serialised on the evaluation threads: on many cores the checkpoint is most of
+  // the serial part of a generation, and two thirds of it is this loop (docs/performance.md, issue 20).
+  std::vector<json> individuals(population_.size());
+#pragma omp parallel for schedule(static) num_threads(thread_count(config_->evolution.threads))
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(population_.size()); ++i) {
+    const Individual& ind = population_[static_cast<std::size_t>(i)];
+    individuals[static_cast<std::size_t>(i)] = json{{"genome", json::parse(to_json(ind.genome))},
+                                                    {"fitness", ind.result.fitness},
+                                                    {"viable", ind.result.viable},
+                                                    {"stable", ind.result.stable},
+                                                    {"cell_count", ind.result.cell_count},
+                                                    {"tries", ind.tries}};
+  }
   json pop = json::array();
-  for (const auto& ind : population_)
-    pop.push_back(json{{"genome", json::parse(to_json(ind.genome))},
-                       {"fitness", ind.result.fitness},
-                       {"viable", ind.result.viable},
-                       {"stable", ind.result.stable},
-                       {"cell_count", ind.result.cell_count},
-                       {"tries", ind.tries}});
+  for (auto& j : individuals) pop.push_back(std::move(j));
   payload["population"] = std::move(pop);
   json hist = json::array();
   for (const auto& s : history_) hist.push_back(stats_to_json(s));

@@ -235,3 +235,32 @@ def test_errors_on_any_rank_reach_rank_0_and_release_the_others(tmp_path):
     r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "run")],
                        capture_output=True, text=True, env=ENV, timeout=60)
     assert r.returncode != 0 and "corrupt checkpoint" in r.stderr
+
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def test_paper_study_submits_an_array_and_a_report_and_a_task_runs_its_run(tmp_path):
+    # A stand-in sbatch records what scripts/paper_study.sh --slurm submits.
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    log = tmp_path / "sbatch.log"
+    (bin_dir / "sbatch").write_text(f"#!/bin/sh\necho \"$@\" >> {log}\necho 4242\n")
+    (bin_dir / "sbatch").chmod(0o755)
+    env = dict(ENV, PATH=f"{bin_dir}:{os.environ['PATH']}", ANIMAT_PYTHONPATH=os.environ.get("PYTHONPATH", ""),
+               ANIMAT_PYTHON=sys.executable)
+    out = tmp_path / "study"
+    r = subprocess.run([str(ROOT / "scripts" / "paper_study.sh"), "--slurm", "--runs", "2", "--out", str(out), "--",
+                        "--generations", "1"], capture_output=True, text=True, env=env, timeout=60)
+    assert r.returncode == 0, r.stderr
+    array, report = log.read_text().splitlines()
+    assert "--array=0-7" in array and "scripts/cluster/paper_study.sbatch --runs 2" in array and "-- --generations 1" in array
+    assert "--dependency=afterok:4242" in report and "scripts/cluster/paper_report.sbatch" in report
+    # Array task 5 is run 1 of the third environment (d_N = 10); it writes that run and no summary.
+    r = subprocess.run([str(ROOT / "scripts" / "paper_study.sh"), "--task", "5", "--runs", "2", "--out", str(out), "--",
+                        "--generations", "1", "--set", "evolution.population=8", "--set", "evaluation.steps=100",
+                        "--quiet"], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert (out / "dn10" / "run_1" / "checkpoint.json").exists()
+    assert [p.name for p in out.iterdir() if p.is_dir()] == ["dn10"]
+    assert json.loads(json.loads((out / "dn10" / "run_1" / "checkpoint.json").read_text())["payload"])["generation"] == 1
