@@ -28,7 +28,8 @@ pytestmark = pytest.mark.skipif(not EXE or not os.path.exists(EXE) or not MPIRUN
                                 reason="needs ANIMAT_EVOLVE_EXE and mpirun")
 
 # mpirun refuses root without these (CI and containers run as root); localhost only.
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader",
+           OMPI_MCA_btl_vader_single_copy_mechanism="none")  # no CMA: containers may forbid ptrace
 SMALL = ["--set", "evolution.population=10", "--set", "evaluation.steps=200", "--generations", "4", "--seed", "3"]
 
 
