@@ -111,13 +111,18 @@ std::uint64_t run_identity(const Config& config) {
   c.evolution.wall_seconds = defaults.wall_seconds;
   c.evolution.threads = defaults.threads;
   c.evolution.checkpoint_every = defaults.checkpoint_every;
-  // [islands] Without islands the island keys change nothing: hash the config as it was before they
-  // existed (they are the last lines of the TOML), so runs checkpointed by earlier builds resume.
+  // [islands] Without islands the island keys change nothing: hash the config without their lines
+  // (each key with its comment line), so runs checkpointed before islands existed resume.
   if (c.evolution.islands <= 1) {
-    const std::string text = to_toml(c);
+    std::string text = to_toml(c);
     const auto key = text.find("\nislands = ");
-    const auto cut = key == std::string::npos ? key : text.rfind('\n', key - 1);  // the key's comment line
-    if (cut != std::string::npos) return fnv1a(std::string_view(text).substr(0, cut + 1));
+    const auto last = text.find("\nmigrants = ", key == std::string::npos ? 0 : key);
+    if (key != std::string::npos && last != std::string::npos) {
+      const auto begin = text.rfind('\n', key - 1) + 1;  // the comment line of `islands`
+      const auto end = text.find('\n', last + 1);       // the end of the `migrants` line
+      text.erase(begin, end == std::string::npos ? std::string::npos : end + 1 - begin);
+      return fnv1a(text);
+    }
   }
   return config_hash(c);
 }

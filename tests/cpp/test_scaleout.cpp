@@ -3,6 +3,7 @@
 // tests/python/test_mpi.py (mpirun on localhost).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <set>
 
@@ -245,12 +246,15 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   Config k = a;
   k.evolution.islands = 2;
   EXPECT_NE(run_identity(a), run_identity(k));
-  // The identity is the hash of the TOML without the three island lines (as before islands existed),
-  // with the resource knobs at their defaults.
+  // The identity is the hash of the TOML without the three island keys and their comments (as before
+  // islands existed), with the resource knobs at their defaults; lines after them still count.
   Config plain = a;
   plain.evolution.threads = EvolutionParams{}.threads;
   std::string text = to_toml(plain);
-  text.erase(text.find("# sub-populations evolving apart"));
+  const auto begin = text.find("# sub-populations evolving apart");
+  const auto end = text.find('\n', text.find("\nmigrants = ") + 1) + 1;
+  ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin), text.begin() + static_cast<std::ptrdiff_t>(end), '\n'), 6);
+  text.erase(begin, end - begin);
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (unsigned char ch : text) {
     h ^= ch;
