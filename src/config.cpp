@@ -15,6 +15,7 @@
 
 #include "animat/errors.hpp"
 #include "animat/objective.hpp"
+#include "animat/islands.hpp"
 
 namespace animat {
 
@@ -436,6 +437,7 @@ void validate(const Config& config, std::string_view source) {
   } catch (const ConfigError& e) {
     fail(e.what());
   }
+  if (const std::string e = island_config_error(config.evolution); !e.empty()) fail(e);  // [islands]
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
                      config.development.max_cells));

@@ -25,6 +25,8 @@
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
+#include "animat/islands.hpp"
 #include "animat/physics.hpp"
 #include "json_util.hpp"
 
@@ -34,7 +36,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::uint64_t kInitialKey = 0xffffffffffffffffULL;  // stream key of the initial population
 constexpr int kCheckpointVersion = 1;
 
 double now_seconds() {
@@ -158,14 +159,29 @@ std::uint64_t run_identity(const Config& config) {
   Config c = config;
   const Config defaults;
   for (const auto& key : resumable_keys()) set_value(c, key, get_value(defaults, key));
+  // [islands] Without islands the island keys change nothing: hash the config without their lines
+  // (each key with its comment line), so runs checkpointed before islands existed resume.
+  if (c.evolution.islands <= 1) {
+    std::string text = to_toml(c);
+    const auto key = text.find("\nislands = ");
+    const auto last = text.find("\nmigrants = ", key == std::string::npos ? 0 : key);
+    if (key != std::string::npos && last != std::string::npos) {
+      const auto begin = text.rfind('\n', key - 1) + 1;  // the comment line of `islands`
+      const auto end = text.find('\n', last + 1);       // the end of the `migrants` line
+      text.erase(begin, end == std::string::npos ? std::string::npos : end + 1 - begin);
+      return fnv1a(text);
+    }
+  }
   return config_hash(c);
 }
 
 // ---------------------------------------------------------------------------------------------------
-Evolution::Evolution(const Config& config, FitnessFunction fitness, FitnessFunction reference)
+Evolution::Evolution(const Config& config, FitnessFunction fitness, FitnessFunction reference,
+                     std::shared_ptr<Evaluator> evaluator)
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
       fitness_(std::move(fitness)),
+      evaluator_(std::move(evaluator)),
       started_(now_seconds()) {
   validate(*config_);
   if (config_->evaluation.reference_check != "off") reference_ = std::move(reference);
@@ -197,7 +213,8 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
 }
 
 void Evolution::initialize() {
-  if (!fitness_) throw Error("Evolution::initialize: no fitness function (drive this engine with ask() and tell())");
+  if (!fitness_ && !evaluator_)
+    throw Error("Evolution::initialize: no fitness function (drive this engine with ask() and tell())");
   if (generation_ >= 0) throw Error("Evolution::initialize: the initial population exists already");
   const EvolutionParams& ep = config_->evolution;
   while (generation_ < 0) {
@@ -228,7 +245,7 @@ std::vector<int> Evolution::initial_tries() const {
 }
 
 GenerationStats Evolution::step() {
-  if (!fitness_) throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
+  if (!fitness_ && !evaluator_) throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
   if (generation_ < 0) throw Error("Evolution::step: call initialize() first");
   const std::vector<Genome> genomes = ask();
   tell(evaluate_genomes(genomes, fmt::format("generation {}", generation_ + 1)));
@@ -236,6 +253,11 @@ GenerationStats Evolution::step() {
 }
 
 std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what) {
+  if (evaluator_) {  // another evaluator (MPI ranks): it honours the stop flag itself
+    std::vector<Fitness> out = evaluator_->evaluate(genomes);
+    for (std::size_t k = 0; k < out.size(); ++k) check_fitness(out[k], fmt::format("{}, genome {}", what, k));
+    return out;
+  }
   prepare_parallel_evaluation();
   std::vector<Fitness> out(genomes.size());
   StopWatch watch(stop_);
@@ -331,34 +353,36 @@ std::vector<Genome> Evolution::ask_generation() {
   const int g = generation_ + 1;
   const std::size_t n = population_.size();
 
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return fitter(population_[a], population_[b]); });
-  std::vector<std::size_t> eligible;
-  for (std::size_t i = 0; i < n; ++i)
-    if (population_[i].result.viable) eligible.push_back(i);
-  if (eligible.empty()) {  // nobody viable (possible only without elites): fall back to everyone
-    eligible.resize(n);
-    std::iota(eligible.begin(), eligible.end(), 0);
-  }
-
+  // [islands] Selection and elitism act within each island; one island is the paper's population.
+  const IslandLayout layout = island_layout(n, ep.islands);
+  std::vector<std::vector<std::size_t>> eligible(layout.count());
+  std::vector<std::size_t> copied(layout.count(), 0);
   std::vector<Individual>& next = next_;
   next.assign(n, Individual{});
   std::vector<bool> needs_eval(n, false);
-  const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), n);
-  std::size_t copied = 0;
-  if (reference_ && config_->evaluation.reference_check == "select") {
-    for (std::size_t i : reference_ranked(order, elites)) {
-      next[copied] = population_[i];
-      next[copied].tries = 0;
-      ++copied;
+  const bool select_by_reference = reference_ && config_->evaluation.reference_check == "select";
+  for (std::size_t isl = 0; isl < layout.count(); ++isl) {
+    const std::vector<std::size_t> order = island_ranking(population_, layout, isl);
+    for (std::size_t i = layout.begin(isl); i < layout.end(isl); ++i)
+      if (population_[i].result.viable) eligible[isl].push_back(i);
+    if (eligible[isl].empty()) {  // nobody viable (possible only without elites): fall back to everyone
+      eligible[isl].resize(layout.size(isl));
+      std::iota(eligible[isl].begin(), eligible[isl].end(), layout.begin(isl));
     }
-  } else {
-    for (std::size_t k = 0; k < n && copied < elites; ++k) {
+    const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), order.size());
+    if (select_by_reference) {  // exploit guard "select": the elites are the best at the reference step
+      for (std::size_t i : reference_ranked(order, elites)) {
+        Individual& elite = next[layout.begin(isl) + copied[isl]++];
+        elite = population_[i];
+        elite.tries = 0;
+      }
+      continue;
+    }
+    for (std::size_t k = 0; k < order.size() && copied[isl] < elites; ++k) {
       if (!population_[order[k]].result.viable) break;
-      next[copied] = population_[order[k]];
-      next[copied].tries = 0;
-      ++copied;
+      Individual& elite = next[layout.begin(isl) + copied[isl]++];
+      elite = population_[order[k]];
+      elite.tries = 0;
     }
   }
   const double p = tournament_probability(ep, g);
@@ -366,16 +390,18 @@ std::vector<Genome> Evolution::ask_generation() {
   // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated twice).
   std::unordered_multimap<std::uint64_t, std::size_t> known;
   for (std::size_t i = 0; i < n; ++i) known.emplace(genome_hash(population_[i].genome), i);
-  for (std::size_t i = copied; i < n; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t isl = layout.island_of(i);        // [islands]
+    if (i < layout.begin(isl) + copied[isl]) continue;  // an elite
     Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), static_cast<std::uint64_t>(g), i);
     Individual& child = next[i];
     if (rng.bernoulli(ep.crossover_fraction)) {
-      const std::size_t a = tournament(population_, eligible, p, rng);
-      const std::size_t b = tournament(population_, eligible, p, rng);
+      const std::size_t a = tournament(population_, eligible[isl], p, rng);
+      const std::size_t b = tournament(population_, eligible[isl], p, rng);
       ++crossovers;
       child.genome = crossover(population_[a].genome, population_[b].genome, config_->mutation.crossover_points, rng);
     } else {
-      child.genome = population_[tournament(population_, eligible, p, rng)].genome;
+      child.genome = population_[tournament(population_, eligible[isl], p, rng)].genome;
     }
     mutate(child.genome, config_->mutation, config_->genome, rng);
     needs_eval[i] = true;
@@ -406,6 +432,10 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
   population_ = std::move(next_);
   next_.clear();
   generation_ += 1;
+  const EvolutionParams& ep = config_->evolution;
+  migrations_.clear();  // [islands] copies of evaluated individuals: nothing to evaluate
+  if (is_migration_generation(ep, generation_))
+    migrations_ = migrate(population_, island_layout(population_.size(), ep.islands), ep.migrants, generation_);
   const Individual& b = best();
   if (b.result.fitness > best_ever_) {
     best_ever_ = b.result.fitness;
@@ -583,8 +613,12 @@ std::string Evolution::checkpoint() const {
   payload["best_ever"] = best_ever_;
   payload["evaluations"] = evaluations_;
   payload["wall_seconds"] = history_.empty() ? 0.0 : history_.back().wall_seconds;
-  json pop = json::array();
-  for (const auto& ind : population_) {
+  // The individuals are serialised on the evaluation threads: on many cores the checkpoint is most of
+  // the serial part of a generation, and two thirds of it is this loop (docs/performance.md, issue 20).
+  std::vector<json> individuals(population_.size());
+#pragma omp parallel for schedule(static) num_threads(thread_count(config_->evolution.threads))
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(population_.size()); ++i) {
+    const Individual& ind = population_[static_cast<std::size_t>(i)];
     json ji{{"genome", json::parse(to_json(ind.genome))},
             {"fitness", ind.result.fitness},
             {"viable", ind.result.viable},
@@ -593,8 +627,10 @@ std::string Evolution::checkpoint() const {
             {"cell_count", ind.result.cell_count},
             {"tries", ind.tries}};
     if (!std::isnan(ind.reference)) ji["reference"] = ind.reference;
-    pop.push_back(std::move(ji));
+    individuals[static_cast<std::size_t>(i)] = std::move(ji);
   }
+  json pop = json::array();
+  for (auto& j : individuals) pop.push_back(std::move(j));
   payload["population"] = std::move(pop);
   json hist = json::array();
   for (const auto& s : history_) hist.push_back(stats_to_json(s));
@@ -828,9 +864,10 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off") reference = swim_fitness(reference_config(config));
   }
-  Evolution evo(config, std::move(fitness), std::move(reference));
+  Evolution evo(config, std::move(fitness), std::move(reference), opt.evaluator);
   evo.set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
   const bool writing = !opt.out.empty();
+  IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);  // [islands] islands.csv
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
   // 1. Everything that can refuse the command, before any file is written.
@@ -877,6 +914,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     std::string rows(kHistoryHeader);
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
+    island_log.resume(evo.generation());
     // Lineage files of generations after the checkpoint belong to the lost future; they are rewritten.
     for (const auto& entry : std::filesystem::directory_iterator(opt.out / "best")) {
       const std::string name = entry.path().filename().string();
@@ -902,6 +940,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     if (writing) {
       write_atomically(hist, std::string(kHistoryHeader) + history_row(evo.history().back()));
       write_lineage(opt.out, evo);
+      island_log.start(evo);
       write_atomically(ckpt, evo.checkpoint());
     }
   }
@@ -966,6 +1005,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     guard(s);
     if (writing) {
       append(hist, history_row(s));
+      island_log.append(evo);
       if (s.best_changed) write_lineage(opt.out, evo);
       dirty = true;
       if (++since_checkpoint >= config.evolution.checkpoint_every) {

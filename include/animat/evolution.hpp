@@ -79,6 +79,10 @@ struct EvolutionParams {
   int threads = 0;                        ///< OpenMP threads; 0 = all cores
   int checkpoint_every = 1;               ///< write a checkpoint every k generations
   int max_init_tries = 1000000;           ///< give up seeding one viable individual after this many tries
+  // [islands] islands.hpp; 1 = the paper's single population
+  int islands = 1;                        ///< sub-populations evolving apart [not in the paper; 1 = off]
+  int migration_interval = 10;            ///< generations between ring migrations
+  int migrants = 1;                       ///< best individuals each island sends to the next one
 };
 
 template <class V>
@@ -96,9 +100,22 @@ void visit_fields(EvolutionParams& p, V&& v) {
   v(FieldInfo{"threads", "OpenMP threads; 0 = all cores", Bounds::closed(0, 1024)}, p.threads);
   v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000)}, p.checkpoint_every);
   v(FieldInfo{"max_init_tries", "tries to find one viable random individual before giving up", Bounds::closed(1, 1000000000)}, p.max_init_tries);
+  // [islands] last in the section: run_identity() of a run without islands ignores these lines
+  v(FieldInfo{"islands", "sub-populations evolving apart with ring migration [not in the paper: 1 = off]", Bounds::closed(1, 10000)}, p.islands);
+  v(FieldInfo{"migration_interval", "generations between migrations (islands > 1)", Bounds::closed(1, 100000000)}, p.migration_interval);
+  v(FieldInfo{"migrants", "best individuals each island copies to the next island of the ring (islands > 1)", Bounds::closed(0, 100000)}, p.migrants);
 }
 
 struct Config;
+class Evaluator;  // evaluator.hpp
+
+/// [islands] One migrant (islands.hpp): a copy of population[from] (island from_island) replaced population[to].
+struct Migration {
+  int generation = 0;
+  std::size_t from_island = 0, to_island = 0;
+  std::size_t from = 0, to = 0;
+  friend bool operator==(const Migration&, const Migration&) = default;
+};
 
 /// What the GA needs to know about one evaluated genome.
 struct Fitness {
@@ -192,8 +209,10 @@ class Evolution {
  public:
   /// `fitness` may be empty for an engine driven only by ask() and tell(). `reference` is the
   /// exploit guard's fitness at the reference step (reference_config()); with none,
-  /// evaluation.reference_check has no effect.
-  explicit Evolution(const Config& config, FitnessFunction fitness = {}, FitnessFunction reference = {});
+  /// evaluation.reference_check has no effect. `evaluator` runs the evaluations (evaluator.hpp);
+  /// null = the OpenMP threads of this process with `fitness`.
+  explicit Evolution(const Config& config, FitnessFunction fitness = {}, FitnessFunction reference = {},
+                     std::shared_ptr<Evaluator> evaluator = nullptr);
 
   /// Draws the initial population: random genomes regenerated until viable (ask/evaluate/tell
   /// rounds with speculative draws; the result equals one-at-a-time drawing). Throws Interrupted
@@ -243,6 +262,8 @@ class Evolution {
 
   /// Seconds of wall time consumed before this process (restored from a checkpoint).
   void set_wall_offset(double seconds) { wall_offset_ = seconds; }
+  /// [islands] Migrants that arrived at the end of the last step (empty without islands).
+  [[nodiscard]] const std::vector<Migration>& migrations() const { return migrations_; }
 
  private:
   GenerationStats statistics(bool best_changed, double wall_seconds) const;
@@ -270,6 +291,8 @@ class Evolution {
   std::uint64_t identity_;
   FitnessFunction fitness_;
   FitnessFunction reference_;
+  std::shared_ptr<Evaluator> evaluator_;
+  std::vector<Migration> migrations_;  // [islands]
   std::vector<Individual> population_;
   std::vector<InitialSlot> slots_;          ///< before generation 0 only
   bool pending_ = false;                    ///< an ask() awaits its tell()
@@ -303,6 +326,7 @@ struct RunOptions {
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
   /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint and stop.
   std::function<bool()> stop_poll;
+  std::shared_ptr<Evaluator> evaluator;           ///< how to evaluate (evaluator.hpp); null = OpenMP threads
   /// Called after every generation, generation 0 of a new run included; return false to stop
   /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;

@@ -55,7 +55,7 @@ from .evolution import (
     record_evaluation,
     to_fitness,
 )
-from .experiment import run_experiment
+from .experiment import run_experiment, run_study
 from .locomotion import (
     LocomotionMode,
     best_statistics,
@@ -108,6 +108,7 @@ __all__ = [
     # evolution
     "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "Fitness", "Individual", "GenerationStats",
     "History", "evaluate_population", "to_fitness", "tournament_probability", "run_experiment",
+    "run_study",
     # control
     "SwimEnv", "gymnasium_available",
     # analysis

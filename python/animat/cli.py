@@ -5,6 +5,7 @@
     python -m animat animate RUN_DIR    # figures/best.gif
     python -m animat info RUN_DIR       # a short summary of the run
     python -m animat experiment CONFIG --runs N --out DIR   # N independent seeds, resumable, with a summary
+    mpirun -np R python -m animat experiment NAME=CONFIG ... --runs N --out DIR --mpi   # a study over MPI ranks
 
 Every command exits with status 1 and a one-line message for a missing or malformed run directory.
 """
@@ -59,7 +60,8 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("run", metavar="RUN_DIR")
 
     e = sub.add_parser("experiment", help="run (or resume) N independent seeds of a config and summarise them")
-    e.add_argument("config", metavar="CONFIG", help="TOML config file")
+    e.add_argument("config", metavar="CONFIG", nargs="+",
+                   help="TOML config file; several as NAME=CONFIG make a study in OUT/NAME/ (docs/cluster.md)")
     e.add_argument("--runs", type=int, default=3, help="independent runs, seeds evolution.seed + 0..N-1 (default 3)")
     e.add_argument("--out", required=True, help="experiment directory (run_<i>/ per run, summary.json, summary.md)")
     e.add_argument("--parallel", type=int, default=1, help="runs at once; the cores are split between them")
@@ -68,6 +70,12 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--wall-seconds", type=float, help="per-run wall-clock budget in seconds (overrides the config)")
     e.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a config value")
     e.add_argument("--quiet", action="store_true", help="no per-run lines")
+    e.add_argument("--mpi", action="store_true",
+                   help="place the runs on the ranks of an MPI job: mpirun -np R python -m animat experiment ... --mpi "
+                        "(needs mpi4py)")
+    e.add_argument("--index", type=int, action="append", metavar="I",
+                   help="run only run I of the study, numbered environment-major (one Slurm array task: "
+                        "--index $SLURM_ARRAY_TASK_ID); repeatable; writes no summary")
     return p
 
 
@@ -143,14 +151,22 @@ def cmd_info(args) -> int:
 
 
 def cmd_experiment(args) -> int:
-    from .experiment import run_experiment, summarize
+    from .experiment import run_study, summarize
 
-    records = run_experiment(args.config, args.runs, args.out, parallel=args.parallel, threads=args.threads,
-                             generations=args.generations, wall_seconds=args.wall_seconds, overrides=args.set,
-                             quiet=args.quiet)
-    stats = summarize(records)
-    print(f"{args.out}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
-          f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {args.out}/summary.md")
+    by_env = run_study(args.config, args.runs, args.out, mpi=args.mpi, index=args.index, parallel=args.parallel,
+                       threads=args.threads, generations=args.generations, wall_seconds=args.wall_seconds,
+                       overrides=args.set, quiet=args.quiet, log=lambda m: print(m, flush=True))
+    nested = len(by_env) > 1 or "=" in args.config[0]
+    for name, records in by_env.items():
+        where = f"{args.out}/{name}" if nested else args.out
+        if args.index is not None:
+            for r in records:
+                print(f"{where}/run_{r.index}: best {r.best:.4f} after {r.generations} generations ({r.stop_reason})")
+            continue
+        stats = summarize(records)
+        if stats:
+            print(f"{where}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
+                  f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {where}/summary.md")
     return 0
 
 

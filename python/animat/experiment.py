@@ -7,6 +7,12 @@ Run ``i`` uses seed ``evolution.seed + i`` and lives in ``OUT/run_<i>``. Runs go
 ``threads // K``; results do not depend on it). An interrupted experiment resumes: every run directory
 that holds a checkpoint is continued, and a finished run stops at once. ``OUT/summary.json`` and
 ``OUT/summary.md`` hold the best fitness per run and the median with its spread.
+
+A study (issue 20) is several environments at once, ``NAME=CONFIG`` each, in ``OUT/NAME/run_<i>``, and
+can be spread over many machines (docs/cluster.md): ``--mpi`` places the runs on the ranks of an MPI
+job (``mpirun -np R python -m animat experiment ... --mpi``, needs mpi4py), ``--index I`` runs only
+run I of the study (one task of a Slurm array). Every run depends only on its config and seed, never
+on where it ran.
 """
 from __future__ import annotations
 
@@ -16,7 +22,7 @@ import statistics
 import threading
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from . import _core
 
@@ -162,3 +168,149 @@ def write_summary(root: Path, config_path: str, records: Sequence[RunRecord]) ->
         lines += ["", f"median best fitness {stats['median']:.4f} (min {stats['min']:.4f}, max {stats['max']:.4f}, "
                       f"quartiles {stats['q1']:.4f} to {stats['q3']:.4f}) over {stats['runs']} runs"]
     (root / "summary.md").write_text("\n".join(lines) + "\n")
+
+
+# --- Studies: several environments, on MPI ranks or as array tasks (issue 20) ------------------------
+
+@dataclass
+class _Task:
+    env: str
+    config_path: str
+    index: int  # run index within the environment
+    out: Path
+
+
+def _environments(configs: Sequence[str]) -> List[Tuple[str, str]]:
+    """``NAME=PATH`` or ``PATH`` (named by its file stem) -> [(name, path)], names unique."""
+    envs = []
+    for c in configs:
+        name, sep, path = c.partition("=")
+        if not sep:
+            name, path = Path(c).stem, c
+        if not name or not path:
+            raise ValueError(f"experiment: expected CONFIG or NAME=CONFIG, got {c!r}")
+        envs.append((name, path))
+    names = [n for n, _ in envs]
+    if len(set(names)) != len(names):
+        raise ValueError(f"experiment: environment names must differ, got {names}")
+    return envs
+
+
+def _mpi_world():
+    """mpi4py's COMM_WORLD, or a clear error saying how to get it."""
+    try:
+        from mpi4py import MPI  # noqa: PLC0415 - optional dependency
+    except ImportError as e:
+        raise RuntimeError("--mpi needs mpi4py: .venv/bin/pip install mpi4py (and an MPI: apt-get install "
+                           "libopenmpi-dev openmpi-bin, as scripts/setup.sh does)") from e
+    return MPI.COMM_WORLD
+
+
+def launched_ranks() -> int:
+    """Ranks of the MPI job this process was started in by mpirun/srun (1 when none)."""
+    for var in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE"):
+        if os.environ.get(var, "").isdigit():
+            return int(os.environ[var])
+    return 1
+
+
+def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False, index: Optional[Sequence[int]] = None,
+              parallel: int = 1, threads: int = 0, generations: Optional[int] = None,
+              wall_seconds: Optional[float] = None, overrides: Sequence[str] = (), quiet: bool = True,
+              log=print) -> Dict[str, List[RunRecord]]:
+    """Run (or resume) ``runs`` seeds of every environment; returns the records by environment name.
+
+    configs: ``PATH`` or ``NAME=PATH``; one plain PATH keeps the single-experiment layout OUT/run_<i>,
+    otherwise runs go to OUT/NAME/run_<i>. Runs are numbered env-major over the study (run i of the
+    e-th environment is task e * runs + i); ``index`` runs only those tasks and writes no summary;
+    ``mpi`` deals the tasks round-robin over the ranks of COMM_WORLD (rank 0 writes the summaries).
+    threads: cores per machine in all (0 = all), shared by the ranks on it and their ``parallel`` runs.
+    """
+    if runs < 1:
+        raise ValueError(f"experiment: --runs must be >= 1, got {runs}")
+    if parallel < 1:
+        raise ValueError(f"experiment: --parallel must be >= 1, got {parallel}")
+    envs = _environments(configs)
+    nested = len(envs) > 1 or "=" in configs[0]
+    root = Path(out)
+    tasks = [_Task(name, path, i, (root / name if nested else root) / f"run_{i}")
+             for name, path in envs for i in range(runs)]
+    if index is not None:
+        for t in index:
+            if not 0 <= t < len(tasks):
+                raise ValueError(f"experiment: --index {t} is outside the study's {len(tasks)} runs "
+                                 f"(0 to {len(tasks) - 1}: {len(envs)} environment(s) x {runs} runs)")
+    ranks = launched_ranks()
+    if ranks > 1 and not mpi:
+        raise RuntimeError(f"experiment: started as one of {ranks} MPI ranks without --mpi: every rank would run "
+                           "every run; add --mpi to place the runs on the ranks")
+    comm = _mpi_world() if mpi else None
+    rank, size = (comm.Get_rank(), comm.Get_size()) if comm is not None else (0, 1)
+    local = 1
+    if comm is not None:
+        from mpi4py import MPI  # noqa: PLC0415
+
+        local = comm.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
+    cores = threads if threads > 0 else len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    per_run = max(1, cores // max(1, local) // parallel)
+
+    bases = {}
+    for name, path in envs:
+        base = _core.load_config(path)
+        for o in overrides:
+            base.apply_override(o)
+        if generations is not None:
+            base["evolution.generations"] = int(generations)
+        if wall_seconds is not None:
+            base["evolution.wall_seconds"] = float(wall_seconds)
+        base["evolution.threads"] = per_run
+        bases[name] = base
+    chosen = list(index) if index is not None else list(range(len(tasks)))
+    mine = chosen[rank::size]
+
+    results: List[Tuple[int, Optional[RunRecord], Optional[str]]] = []
+    lock = threading.Lock()
+    pending = list(mine)
+
+    def worker():
+        while True:
+            with lock:
+                if not pending:
+                    return
+                t = pending.pop(0)
+            task = tasks[t]
+            cfg = bases[task.env].copy()
+            cfg["evolution.seed"] = int(bases[task.env]["evolution.seed"]) + task.index
+            task.out.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                rec = _run_one(cfg, task.out, task.index, quiet)
+                if not quiet:
+                    log(f"{task.env} run {task.index} (rank {rank}): best {rec.best:.4f} after {rec.generations} "
+                        f"generations ({rec.stop_reason})")
+                with lock:
+                    results.append((t, rec, None))
+            except Exception as e:  # noqa: BLE001 - reported with the others by rank 0
+                with lock:
+                    results.append((t, None, f"{task.env} run {task.index}: {e}"))
+
+    workers = [threading.Thread(target=worker) for _ in range(min(parallel, max(1, len(mine))))]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join()
+    if comm is not None:
+        gathered = comm.gather(results, root=0)
+        if rank != 0:
+            return {}
+        results = [r for part in gathered for r in part]
+    errors = [e for _, _, e in sorted(results, key=lambda r: r[0]) if e]
+    by_env: Dict[str, List[RunRecord]] = {name: [] for name, _ in envs}
+    for t, rec, _ in sorted(results, key=lambda r: r[0]):
+        if rec is not None:
+            by_env[tasks[t].env].append(rec)
+    if index is None:
+        for name, path in envs:
+            write_summary(root / name if nested else root, path, by_env[name])
+    if errors:
+        raise RuntimeError("; ".join(errors))
+    return by_env

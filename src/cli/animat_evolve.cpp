@@ -1,5 +1,6 @@
 // animat_evolve: run an evolution experiment (paper §5) from the embedded default or a TOML config.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 #include <atomic>
 #include <charconv>
 #include <chrono>
@@ -7,18 +8,45 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <iostream>
+#include <memory>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
 #include "animat/log.hpp"
+#include "animat/mpi.hpp"
 
 namespace {
 
 // Set by SIGINT/SIGTERM; the run finishes its generation, writes a checkpoint and exits cleanly.
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
+
+// [mpi] Rank 0 after a lost rank or a signal mid-evaluation: say what happened and what is on disk,
+// then leave at once (the launcher ends the other ranks; waiting for them could hang). mpirun stops
+// forwarding output as soon as a rank dies, so the message also goes to RUN_DIR/stopped.txt, first.
+[[noreturn]] void mpi_stopped(const animat::Error& e, const std::filesystem::path& out, const animat::Config& config) {
+  std::signal(SIGPIPE, SIG_IGN);  // the launcher may have closed our stderr
+  std::string text = fmt::format("animat_evolve: error: MPI job stopped: {}\n", e.what());
+  const auto ckpt = out / "checkpoint.json";
+  try {
+    animat::Evolution probe(config, [](const animat::Genome&) { return animat::Fitness{}; });
+    std::ifstream in(ckpt, std::ios::binary);
+    probe.restore(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), ckpt.string());
+    text += fmt::format("animat_evolve: {} is intact (generation {}; the generation being evaluated is lost).\n"
+                        "Continue with any number of ranks:  mpirun -np RANKS animat_evolve --resume {}\n",
+                        ckpt.string(), probe.generation(), out.string());
+  } catch (const std::exception& c) {
+    text += fmt::format("animat_evolve: no checkpoint to resume from ({})\n", c.what());
+  }
+  std::ofstream(out / "stopped.txt", std::ios::binary | std::ios::trunc) << text << std::flush;
+  std::fputs(text.c_str(), stderr);
+  animat::mpi::Job::abandon(4);
+}
 
 std::string default_run_dir(std::int64_t seed) {
   const std::time_t t = std::time(nullptr);
@@ -46,23 +74,44 @@ int animat_evolve_main(int argc, char** argv) {
   std::string config_path, out_dir, resume_dir, log_level = "info", seed_text;
   std::vector<std::string> overrides;
   int generations = -1, threads = -1;
-  bool print_config = false, quiet = false;
+  bool print_config = false, quiet = false, use_mpi = false;
   app.add_option("--config", config_path, "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
       ->check(CLI::ExistingFile);
   app.add_option("--set", overrides, "override one value: section.key=value (repeatable)");
   // Read as text: CLI11 would clamp a seed beyond int64 to 2^63-1 silently.
   app.add_option("--seed", seed_text, "run seed (evolution.seed), an integer in [0, 2^63-1]");
   app.add_option("--generations", generations, "generation cap, 0 = none (evolution.generations)")->check(CLI::NonNegativeNumber);
-  app.add_option("--threads", threads, "OpenMP threads, 0 = all cores (evolution.threads)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", threads, "OpenMP threads (per rank under mpirun), 0 = all cores (evolution.threads)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out_dir, "run directory to write (default: runs/<time>-seed<seed>)");
   app.add_option("--resume", resume_dir, "run directory to resume; its config.toml is the base config");
   app.add_flag("--print-config", print_config, "print the resolved config as TOML and exit");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
   app.add_flag("--quiet", quiet, "only warnings and errors");
+  app.add_flag("--mpi", use_mpi, "require an MPI job (mpirun -np R animat_evolve ...; automatic under mpirun)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  }
+
+  // [mpi] Under mpirun rank 0 runs the GA below; every other rank only evaluates (animat/mpi.hpp).
+  std::unique_ptr<animat::mpi::Job> mpi_job;
+  const animat::mpi::Launch launch = animat::mpi::detect_launch();
+  try {
+    if (use_mpi && !launch.launched)
+      throw animat::ConfigError("--mpi: not started by an MPI launcher; run mpirun -np RANKS animat_evolve ...");
+    if ((use_mpi || launch.size > 1) && !animat::mpi::built_with_mpi())
+      throw animat::Error(fmt::format("started as one of {} MPI ranks ({}), but {}", launch.size, launch.variable,
+                                      animat::mpi::how_to_get_mpi()));
+    if (launch.launched && animat::mpi::built_with_mpi()) {
+      mpi_job = std::make_unique<animat::mpi::Job>(argc, argv);
+      if (mpi_job->rank() != 0) return mpi_job->serve();
+    }
+  } catch (const animat::Error& e) {
+    if (launch.rank == 0) std::fprintf(stderr, "animat_evolve: error: %s\n", e.what());
+    else std::fprintf(stderr, "animat_evolve (rank %d): error: %s\n", launch.rank, e.what());
+    return 2;
   }
 
   try {
@@ -103,7 +152,28 @@ int animat_evolve_main(int argc, char** argv) {
       spdlog::info("animat {} | population {} | {} cells max | d_N = {} | {} swim steps | seed {} | run dir {}",
                    ANIMAT_VERSION, config.evolution.population, config.development.max_cells, config.scene.drag_normal,
                    config.evaluation.steps, config.evolution.seed, options.out.string());
-    const animat::RunSummary summary = animat::run_evolution(config, options);
+    if (mpi_job) {  // [mpi]
+      // mpirun closes our output when a rank dies: a hang-up (output on a pty) or a broken pipe must
+      // not kill rank 0 before it has said what is on disk.
+      std::signal(SIGHUP, on_signal);
+      std::signal(SIGPIPE, SIG_IGN);
+      options.evaluator = mpi_job->start(config, &g_stop);
+      if (!quiet) spdlog::info("evaluation: {}", options.evaluator->describe());
+    }
+    if (const auto stopped = options.out / "stopped.txt"; options.resume && std::filesystem::exists(stopped)) {
+      std::ifstream in(stopped, std::ios::binary);
+      spdlog::warn("the last job in {} ended so:\n{}", options.out.string(),
+                   std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+      std::filesystem::remove(stopped);
+    }
+    animat::RunSummary summary;
+    try {
+      summary = animat::run_evolution(config, options);
+    } catch (const animat::mpi::Interrupted& e) {  // [mpi] a rank died or the job was cancelled
+      mpi_stopped(e, options.out, config);
+    } catch (const animat::mpi::RankFailure& e) {
+      mpi_stopped(e, options.out, config);
+    }
     if (summary.history.empty()) {  // stopped while the initial population was drawn
       std::printf("\nStopped: %s, before the initial population was complete; nothing to resume (run the same "
                   "command again to start over)\n", summary.stop_reason.c_str());

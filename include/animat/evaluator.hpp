@@ -1,0 +1,46 @@
+#pragma once
+// How a population is evaluated: one interface over the OpenMP threads of this process
+// (LocalEvaluator) and the ranks of an MPI job (mpi.hpp). The GA (evolution.hpp) sees only this.
+//
+// Every evaluator returns the same results for the same input, whatever its layout: a genome's
+// fitness depends only on the genome and the config, and the initial individual i only on
+// (evolution.seed, i). Results are stored by index, never in arrival order.
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animat/evolution.hpp"
+
+namespace animat {
+
+struct Config;
+
+class Evaluator {
+ public:
+  virtual ~Evaluator() = default;
+
+  /// Fitness of every genome, in input order.
+  [[nodiscard]] virtual std::vector<Fitness> evaluate(std::span<const Genome* const> genomes) = 0;
+  /// Initial individuals `first`, ..., `first + count - 1` (see seed_individual).
+  [[nodiscard]] virtual std::vector<Individual> seed(std::size_t first, std::size_t count) = 0;
+  /// One line for the log: "OpenMP, 2 threads", "MPI, 3 ranks, 6 threads".
+  [[nodiscard]] virtual std::string describe() const = 0;
+
+  /// Convenience overload for a contiguous list of genomes.
+  [[nodiscard]] std::vector<Fitness> evaluate(const std::vector<Genome>& genomes);
+};
+
+/// Initial individual `index`: random genomes drawn from Rng::derive(evolution.seed, initial key,
+/// index) until one is viable. Throws Error after evolution.max_init_tries tries.
+[[nodiscard]] Individual seed_individual(const Config& config, const FitnessFunction& fitness, std::size_t index);
+
+/// The OpenMP threads of this process (evolution.threads; 0 = all cores), dynamic schedule with
+/// one genome per chunk; an exception is rethrown after the loop, the first by index.
+[[nodiscard]] std::shared_ptr<Evaluator> make_local_evaluator(const Config& config, FitnessFunction fitness);
+
+/// Threads that evolution.threads = `requested` means on this machine (0 = all available cores).
+[[nodiscard]] int resolve_threads(int requested);
+
+}  // namespace animat
