@@ -299,10 +299,9 @@ std::vector<Genome> Evolution::ask_initial(int lookahead) {
   const EvolutionParams& ep = config_->evolution;
   if (slots_.empty()) {
     const auto n = static_cast<std::size_t>(ep.population);
-    population_.assign(n, Individual{});
     slots_.clear();
     for (std::size_t i = 0; i < n; ++i)
-      slots_.push_back(InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i)});
+      slots_.push_back(InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i), 0, false, Individual{}});
   }
   std::vector<Genome> out;
   asked_index_.clear();
@@ -326,7 +325,7 @@ bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
     ++slot.tries;
     ++evaluations_;
     if (!fitness[k].viable) continue;
-    Individual& ind = population_[asked_index_[k]];
+    Individual& ind = slot.individual;
     ind.genome = std::move(asked_[k]);
     ind.result = fitness[k];
     ind.tries = slot.tries;
@@ -339,6 +338,8 @@ bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
                               ep.max_init_tries, i));
   for (const auto& slot : slots_)
     if (!slot.filled) return false;
+  population_.clear();
+  for (auto& slot : slots_) population_.push_back(std::move(slot.individual));
   slots_.clear();
   generation_ = 0;
   best_ever_ = best().result.fitness;

@@ -49,7 +49,7 @@ void visit_fields(EvaluationParams& p, V&& v) {
                            "evaluation.direction); python:NAME (a Python callable, set by animat.evolve)",
               Bounds::any(), kObjectiveChoices},
     p.objective);
-  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)"}, p.direction);
+  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)", Bounds::closed(-kMaxLength, kMaxLength)}, p.direction);
   v(FieldInfo{"check_embedding", "check after every step that no region is inverted and the skin is a simple polygon; a swim that breaks it gets fitness 0", Bounds::any()}, p.check_embedding);
   v(FieldInfo{"reference_check", "exploit guard: re-evaluate each new best at a finer step and record both fitnesses (record), also rank elites by it (select), or off", Bounds::any(), kReferenceCheckNames}, p.reference_check);
   v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
@@ -285,6 +285,7 @@ class Evolution {
     Rng rng;
     int tries = 0;
     bool filled = false;
+    Individual individual;  ///< its first viable draw; the population exists only once every slot is filled
   };
 
   std::shared_ptr<const Config> config_;  ///< own copy: the engine outlives no caller state

@@ -262,6 +262,7 @@ std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<double>& 
     out.push_back({fmt::format("[{}]", fmt::join(parts, ", ")), v, inside});
   };
   const Bounds& b = info.bounds;
+  EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi)) << info.name << " has an unbounded range " << b.describe();
   for (std::size_t i : {std::size_t{0}, current.size() - 1}) {
     with(i, b.lo, true);
     with(i, b.hi, true);
