@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
   c.evolution.seed = argc > 3 ? std::atoll(argv[3]) : 1;
   c.evolution.threads = 1;
   auto prof = std::make_shared<ProfilingEvaluator>(c);
-  Evolution evo(c, {}, prof);
+  Evolution evo(c, {}, {}, prof);
   const std::string ckpt_path = fmt::format("/tmp/bench_ga_profile_{}.json", ::getpid());
 
   struct Generation {

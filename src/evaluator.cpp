@@ -12,7 +12,6 @@ namespace animat {
 
 namespace {
 
-constexpr std::uint64_t kInitialKey = 0xffffffffffffffffULL;  // stream key of the initial population
 
 class LocalEvaluator final : public Evaluator {
  public:
@@ -72,7 +71,7 @@ int resolve_threads(int requested) { return requested > 0 ? requested : omp_get_
 
 Individual seed_individual(const Config& config, const FitnessFunction& fitness, std::size_t index) {
   const EvolutionParams& ep = config.evolution;
-  Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, index);
+  Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialStreamKey, index);
   Individual ind;
   for (ind.tries = 1; ind.tries <= ep.max_init_tries; ++ind.tries) {
     ind.genome = random_genome(config.genome, rng);

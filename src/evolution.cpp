@@ -301,7 +301,7 @@ std::vector<Genome> Evolution::ask_initial(int lookahead) {
     const auto n = static_cast<std::size_t>(ep.population);
     slots_.clear();
     for (std::size_t i = 0; i < n; ++i)
-      slots_.push_back(InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialKey, i), 0, false, Individual{}});
+      slots_.push_back(InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialStreamKey, i), 0, false, Individual{}});
   }
   std::vector<Genome> out;
   asked_index_.clear();

@@ -32,8 +32,12 @@ class Evaluator {
   [[nodiscard]] std::vector<Fitness> evaluate(const std::vector<Genome>& genomes);
 };
 
+/// Rng stream key of the initial population: individual i draws from Rng::derive(evolution.seed,
+/// kInitialStreamKey, i), in Evolution's ask/tell seeding and in seed_individual alike.
+inline constexpr std::uint64_t kInitialStreamKey = 0xffffffffffffffffULL;
+
 /// Initial individual `index`: random genomes drawn from Rng::derive(evolution.seed, initial key,
-/// index) until one is viable. Throws Error after evolution.max_init_tries tries.
+/// index) until one is viable (the same individual Evolution::initialize() keeps for slot `index`). Throws Error after evolution.max_init_tries tries.
 [[nodiscard]] Individual seed_individual(const Config& config, const FitnessFunction& fitness, std::size_t index);
 
 /// The OpenMP threads of this process (evolution.threads; 0 = all cores), dynamic schedule with
