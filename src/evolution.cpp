@@ -102,10 +102,17 @@ class StopWatch {
   double last_poll_ = 0.0;  // touched by thread 0 only
 };
 
-// A fitness the GA can rank and a checkpoint can hold: finite and >= 0 (a distance).
-void check_fitness(const Fitness& f, std::string_view where) {
-  if (!std::isfinite(f.fitness) || f.fitness < 0.0)
-    throw Error(fmt::format("{}: the fitness function returned {}; a fitness must be finite and >= 0", where, f.fitness));
+// Objectives whose every value is >= 0 by construction (a distance); others (speed_toward, a Python
+// objective) may be negative.
+bool nonnegative_objective(const Config& c) {
+  return c.evaluation.objective == "distance" || c.evaluation.objective == "distance_per_size";
+}
+
+// A fitness the GA can rank and a checkpoint can hold: finite, and >= 0 for a distance objective.
+void check_fitness(const Fitness& f, std::string_view where, bool nonnegative) {
+  if (!std::isfinite(f.fitness) || (nonnegative && f.fitness < 0.0))
+    throw Error(fmt::format("{}: the fitness function returned {}; a fitness must be finite{}", where, f.fitness,
+                            nonnegative ? " and >= 0" : ""));
   if (f.cell_count < 0) throw Error(fmt::format("{}: the fitness function returned cell_count {} (must be >= 0)", where, f.cell_count));
 }
 
@@ -255,7 +262,7 @@ GenerationStats Evolution::step() {
 std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what) {
   if (evaluator_) {  // another evaluator (MPI ranks): it honours the stop flag itself
     std::vector<Fitness> out = evaluator_->evaluate(genomes);
-    for (std::size_t k = 0; k < out.size(); ++k) check_fitness(out[k], fmt::format("{}, genome {}", what, k));
+    for (std::size_t k = 0; k < out.size(); ++k) check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
     return out;
   }
   prepare_parallel_evaluation();
@@ -264,7 +271,7 @@ std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& geno
   parallel_for(genomes.size(), config_->evolution.threads, [&](std::size_t k) {
     if (watch.stopped()) return;
     out[k] = fitness_(genomes[k]);
-    check_fitness(out[k], fmt::format("{}, genome {}", what, k));
+    check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
   });
   if (watch.fired())
     throw Interrupted(generation_ < 0 ? std::string("interrupted while drawing the initial population")
@@ -554,20 +561,20 @@ GenerationStats stats_from_json(const json& j) {
 // What a checksum cannot catch: a hand-edited checkpoint whose content the engine could never have
 // written. Everything is compared with what the engine computes from the same population and history.
 void check_semantics(const std::vector<Individual>& pop, const std::vector<GenerationStats>& hist, int stall,
-                     double best_ever, std::int64_t evaluations, double wall, std::string_view source) {
+                     double best_ever, std::int64_t evaluations, double wall, bool nonnegative, std::string_view source) {
   auto fail = [&](const std::string& what) { throw CheckpointError(fmt::format("{}: inconsistent checkpoint: {}", source, what)); };
   for (std::size_t i = 0; i < pop.size(); ++i) {
     const Fitness& f = pop[i].result;
-    if (f.fitness < 0.0) fail(fmt::format("individual {} has fitness {} (a fitness is >= 0)", i, f.fitness));
+    if (nonnegative && f.fitness < 0.0) fail(fmt::format("individual {} has fitness {} (a fitness is >= 0)", i, f.fitness));
     if (f.viable && pop[i].genome.elements.empty()) fail(fmt::format("individual {} is viable with an empty genome", i));
   }
-  double best_so_far = -1.0;
+  double best_so_far = -std::numeric_limits<double>::infinity();
   int expected_stall = 0;
   for (std::size_t k = 0; k < hist.size(); ++k) {
     const GenerationStats& s = hist[k];
     if (s.generation != static_cast<int>(k))
       fail(fmt::format("history row {} is generation {}; the history must count 0, 1, 2, ... without gaps", k, s.generation));
-    if (s.best < 0.0 || s.mean < 0.0 || s.median < 0.0)
+    if (nonnegative && (s.best < 0.0 || s.mean < 0.0 || s.median < 0.0))
       fail(fmt::format("history row {} has a negative fitness statistic", k));
     if (!(s.viable_fraction >= 0.0 && s.viable_fraction <= 1.0))
       fail(fmt::format("history row {} has viable_fraction {} (expected in [0, 1])", k, s.viable_fraction));
@@ -703,7 +710,7 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     const double best_ever = number_field(p, "best_ever");
     const std::int64_t evaluations = int_field(p, "evaluations", 0, kInt64Max);
     const double wall = number_field(p, "wall_seconds");
-    check_semantics(pop, hist, stall, best_ever, evaluations, wall, source);
+    check_semantics(pop, hist, stall, best_ever, evaluations, wall, nonnegative_objective(*config_), source);
     population_ = std::move(pop);
     slots_.clear();
     next_.clear();

@@ -221,7 +221,8 @@ class Evolution {
   /// Makes and evaluates the next generation; returns its statistics. Throws Interrupted if the stop
   /// request fires before the generation is complete: the state stays at the previous generation
   /// (resuming recomputes the same generation, every random number derives from (seed, g, i)).
-  /// Throws Error if the fitness function returns a non-finite or negative fitness.
+  /// Throws Error if the fitness function returns a non-finite fitness, or a negative one under a
+  /// distance objective (evaluation.objective = distance or distance_per_size).
   GenerationStats step();
   /// Checked by initialize() and step() (see StopRequest); empty = never stop.
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
@@ -254,7 +255,7 @@ class Evolution {
 
   /// Whole state as JSON text with a checksum; restore() refuses a corrupt or mismatched one, and one
   /// whose content is inconsistent even with a valid checksum (hand-edited): a fitness that is not
-  /// finite and >= 0, a genome that does not validate or is empty, a history that does not count
+  /// finite (and >= 0 under a distance objective), a genome that does not validate or is empty, a history that does not count
   /// 0, 1, ..., generation or whose last row disagrees with the population, a population of the wrong
   /// size, a best_ever or stall counter that the history contradicts.
   [[nodiscard]] std::string checkpoint() const;

@@ -478,7 +478,7 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
     except KeyboardInterrupt as e:
         partial = getattr(e, "result", None)
         if partial is not None:
-            e.result = result_of(partial)
+            setattr(e, "result", result_of(partial))  # noqa: B010 - an attribute KeyboardInterrupt does not declare
         raise
     finally:
         if bar is not None:

@@ -119,10 +119,11 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
             cfg = base.copy()
             cfg["evolution.seed"] = int(base["evolution.seed"]) + i
             try:
-                records[i] = _run_one(cfg, root / f"run_{i}", i, quiet, stop)
-                if not quiet and records[i] is not None:
-                    print(f"run {i}: best {records[i].best:.4f} after {records[i].generations} generations "
-                          f"({records[i].stop_reason})", flush=True)
+                record = _run_one(cfg, root / f"run_{i}", i, quiet, stop)
+                records[i] = record
+                if not quiet and record is not None:
+                    print(f"run {i}: best {record.best:.4f} after {record.generations} generations "
+                          f"({record.stop_reason})", flush=True)
             except BaseException as e:  # noqa: BLE001 - reported after the other runs stop
                 with lock:
                     errors.append(e)
@@ -271,11 +272,19 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
     results: List[Tuple[int, Optional[RunRecord], Optional[str]]] = []
     lock = threading.Lock()
     pending = list(mine)
+    # The runs live in worker threads, where Ctrl-C is not delivered: the main thread catches it and
+    # sets `stop`, which every running evolve polls between evaluations (each writes its checkpoint),
+    # and no new run starts.
+    stop = threading.Event()
+    # Thread.join() interrupted by Ctrl-C can mark a running thread as stopped (CPython issue 90882), so
+    # the main thread waits on this event instead, set by the last worker to finish.
+    active = [0]
+    all_done = threading.Event()
 
-    def worker():
+    def work():
         while True:
             with lock:
-                if not pending:
+                if not pending or stop.is_set():
                     return
                 t = pending.pop(0)
             task = tasks[t]
@@ -283,7 +292,11 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
             cfg["evolution.seed"] = int(bases[task.env]["evolution.seed"]) + task.index
             task.out.parent.mkdir(parents=True, exist_ok=True)
             try:
-                rec = _run_one(cfg, task.out, task.index, quiet)
+                rec = _run_one(cfg, task.out, task.index, quiet, stop)
+                if rec is None:
+                    if stop.is_set():  # stopped while drawing its initial population: nothing to record
+                        return
+                    raise RuntimeError(f"{task.out}: the run ended before its initial population was complete")
                 if not quiet:
                     log(f"{task.env} run {task.index} (rank {rank}): best {rec.best:.4f} after {rec.generations} "
                         f"generations ({rec.stop_reason})")
@@ -293,14 +306,37 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
                 with lock:
                     results.append((t, None, f"{task.env} run {task.index}: {e}"))
 
-    workers = [threading.Thread(target=worker) for _ in range(min(parallel, max(1, len(mine))))]
+    def worker():
+        try:
+            work()
+        finally:
+            with lock:
+                active[0] -= 1
+                if active[0] == 0:
+                    all_done.set()
+
+    workers = [threading.Thread(target=worker, name=f"animat-study-{k}")
+               for k in range(min(parallel, max(1, len(mine))))]
+    active[0] = len(workers)
     for w in workers:
         w.start()
+    interrupted = False
+    try:
+        while not all_done.wait(0.1):
+            pass
+    except KeyboardInterrupt:
+        interrupted = True
+        stop.set()
+        while not all_done.wait(0.1):
+            pass
     for w in workers:
         w.join()
+    if interrupted:
+        raise KeyboardInterrupt(f"experiment {root}: interrupted; every run stopped with a checkpoint of its last "
+                                f"complete generation; run the same command again to resume")
     if comm is not None:
         gathered = comm.gather(results, root=0)
-        if rank != 0:
+        if rank != 0 or gathered is None:  # only rank 0 receives the gathered list
             return {}
         results = [r for part in gathered for r in part]
     errors = [e for _, _, e in sorted(results, key=lambda r: r[0]) if e]

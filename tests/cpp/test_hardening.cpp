@@ -583,6 +583,28 @@ TEST(Rows, AFitnessFunctionReturningANegativeOrNonFiniteFitnessIsAnError) {
   }
 }
 
+TEST(Rows, ASignedObjectiveMayBeNegativeAndItsCheckpointResumes) {
+  // speed_toward (and a Python objective) is signed: a body swimming backwards scores < 0. Such a run
+  // runs, checkpoints and resumes; only non-finite values are refused.
+  Config c;
+  c.evolution.population = 4;
+  c.evolution.elites = 1;
+  c.evolution.threads = 1;
+  c.evaluation.objective = "speed_toward";
+  auto signed_fitness = [](const Genome& g) { return Fitness{-1.0 - 0.01 * static_cast<double>(g.elements.size()), true, true, 3}; };
+  Evolution evo(c, signed_fitness);
+  evo.initialize();
+  (void)evo.step();
+  EXPECT_LT(evo.history().back().best, 0.0);
+  Evolution resumed(c, signed_fitness);
+  resumed.restore(evo.checkpoint());
+  (void)resumed.step();
+  (void)evo.step();
+  EXPECT_EQ(resumed.history().back().best, evo.history().back().best);
+  Evolution nan_run(c, [](const Genome&) { return Fitness{std::nan(""), true, true, 3}; });
+  EXPECT_THROW(nan_run.initialize(), Error);
+}
+
 // ---------------------------------------------------------------------------------------------------
 // --resume with changed settings
 

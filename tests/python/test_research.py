@@ -302,9 +302,10 @@ def test_a_non_viable_embryo_is_refused_loudly():
 
 def test_evolve_needs_a_cap_or_says_so_and_handles_existing_runs(tmp_path):
     c = small_config(population=6, steps=200)
-    c["evolution.stall_generations"] = 1  # keeps this uncapped call short
+    uncapped = c.copy()
+    uncapped["evolution.stall_generations"] = 1  # keeps this uncapped call short
     with pytest.warns(UserWarning, match="no generation cap"):
-        animat.evolve(c, quiet=True)
+        animat.evolve(uncapped, quiet=True)
     out = tmp_path / "nb"
     first = animat.evolve(c, out=out, generations=2, quiet=True)
     (out / "figures").mkdir()
