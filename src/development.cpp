@@ -121,12 +121,18 @@ struct DevelopmentWorld::Impl {
     std::size_t newer, older;
     double frac;
   };
-  [[nodiscard]] Tap tap(double tau) const {
+  [[nodiscard]] Tap tap(double tau) const { return tap_from(slot_of(hist_time), tau); }
+  /// tap() with the current slot given: the slots k and k + 1 back from it, 0 <= k <= max_delay <
+  /// hist_len, wrap with one addition (no integer division in sense()'s pair loop).
+  [[nodiscard]] Tap tap_from(std::size_t now_slot, double tau) const {
     tau = std::min(tau, static_cast<double>(params.morphogen_max_delay));
     const double whole = std::floor(tau);
-    const auto k = static_cast<long long>(whole);
+    const auto k = static_cast<std::size_t>(whole);
     const double frac = tau - whole;
-    return {slot_of(hist_time - k), frac > 0.0 ? slot_of(hist_time - k - 1) : slot_of(hist_time - k), frac};
+    const auto h = static_cast<std::size_t>(hist_len);
+    const std::size_t newer = now_slot >= k ? now_slot - k : now_slot + h - k;
+    if (!(frac > 0.0)) return {newer, newer, frac};
+    return {newer, newer >= 1 ? newer - 1 : h - 1, frac};
   }
 
   b2Body* make_body(const Vec2& position, const Vec2& velocity) {
@@ -221,7 +227,8 @@ void DevelopmentWorld::sense() {
   if (m == 0) return;
   w.sensed.assign(n * m, 0.0);
   // Own level (distance 0, no delay), then every other emitter, pair by pair in index order.
-  const Impl::Tap now = w.tap(0.0);
+  const std::size_t now_slot = w.slot_of(w.hist_time);
+  const Impl::Tap now = w.tap_from(now_slot, 0.0);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t k = 0; k < m; ++k) w.sensed[i * m + k] = w.sample(i, k, now);
   const double inv_lambda = 1.0 / w.params.morphogen_decay_length;
@@ -232,7 +239,7 @@ void DevelopmentWorld::sense() {
     for (std::size_t j = i + 1; j < n; ++j) {
       const double d = (w.cells[j].position - w.cells[i].position).norm();
       const double weight = std::exp(-d * inv_lambda);
-      const Impl::Tap t = w.tap(d * inv_speed);
+      const Impl::Tap t = w.tap_from(now_slot, d * inv_speed);
       const double* i_new = w.hist(i, t.newer);
       const double* j_new = w.hist(j, t.newer);
       double* si = sensed + i * m;

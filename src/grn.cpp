@@ -114,7 +114,10 @@ void Grn::step(GrnState& state, const GrnInputs& in, const GrnParams& params) co
   for (int t = 0; t < nodes; ++t) {
     // tanh rounds to exactly 1 for A > ~38; the paper's range is [0, 1), so the target stays below 1
     // and the convex update keeps the level below it for every dt in (0, 1].
-    const double target = std::min(std::tanh(std::max(act[t], 0.0) * 0.5), kBelowOne);
+    // A silent node (A <= 0) skips the tanh: its target is 0 either way (the level is the same bit
+    // for bit, +0 and -0 alike); a NaN still goes through tanh as before.
+    const double x = act[t];
+    const double target = x <= 0.0 ? 0.0 : std::min(std::tanh(std::max(x, 0.0) * 0.5), kBelowOne);
     state.levels[static_cast<std::size_t>(t)] += (target - state.levels[static_cast<std::size_t>(t)]) * params.dt;
   }
 }
