@@ -71,7 +71,7 @@ def measure(run_path: str) -> list[dict]:
     for label, dt, sub in SETTINGS:
         c = config_for(run, dt, sub)
         embryo = animat.develop(genome, c)
-        body = animat.build_body(embryo, c)
+        body = animat.build_body(embryo, config=c)
         t0 = time.process_time()
         r = animat.swim(body, config=c)
         cpu = time.process_time() - t0
@@ -83,12 +83,12 @@ def measure(run_path: str) -> list[dict]:
     # Chaos: perturbed starts at the default step.
     c = config_for(run, DEFAULT_DT, 1)
     embryo = animat.develop(genome, c)
-    body = animat.build_body(embryo, c)
+    body = animat.build_body(embryo, config=c)
     rng = np.random.default_rng(2026)
     spread = []
     for _ in range(DRAWS):
         p = np.asarray(body.positions) + PERTURBATION * rng.standard_normal(np.asarray(body.positions).shape)
-        b = animat.build_body(p, embryo.amplitude, embryo.frequency, embryo.phase, c)
+        b = animat.build_body(p, embryo.amplitude, embryo.frequency, embryo.phase, config=c)
         spread.append(animat.swim(b, config=c).distance)
     for row in rows:
         row["chaos_min"] = min(spread)

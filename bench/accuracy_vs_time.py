@@ -297,7 +297,7 @@ def main():
     print()
     print(markdown(summary, floors, default_cost))
     print()
-    print("per case (fitness error %, default: stable drag, midpoint velocity forces):")
+    print("per case (fitness error %, default: semi-implicit drag, midpoint velocity forces):")
     for b in bodies:
         for dn in sorted({r["d_N"] for r in rows}):
             sel = {r["h"]: r for r in rows if r["body"] == b[0] and r["d_N"] == dn and r["scheme"] == DEFAULT_SCHEME
