@@ -29,11 +29,17 @@ PathLike = Union[str, "os.PathLike[str]"]
 class History(np.recarray):
     """Per-generation statistics: a numpy structured (record) array, one row per generation, with the
     columns of ``history.csv``: ``generation``, ``best``, ``mean``, ``median``, ``viable_fraction``,
-    ``best_cells``, ``evaluations``, ``wall_seconds``. ``h["best"]`` is a column, ``h[-1]`` a row
+    ``best_cells``, ``evaluations``, ``best_reference`` (the best at the exploit guard's finer step; NaN
+    when not checked), ``invalid`` (swims that broke the body's embedding), ``wall_seconds``. ``h["best"]`` is a column, ``h[-1]`` a row
     (``h[-1]["best"]``, or ``h[-1].best``; use ``["mean"]`` for the mean column: ``.mean`` is numpy's
     method). :attr:`Run.history`, :attr:`EvolutionResult.history` and :attr:`GA.history` are all of
     this type.
     """
+
+    def __bool__(self) -> bool:
+        """True when it has a row (``if run.history:``), as for a list; numpy's elementwise truth of a
+        structured array has no meaning here."""
+        return len(self) > 0
 
     def to_pandas(self) -> Any:
         """The history as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""

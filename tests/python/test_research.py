@@ -335,6 +335,7 @@ def test_one_history_type_with_pandas(tmp_path):
     r = animat.evolve(small_config(population=6, steps=200), out=out, generations=2, quiet=True)
     h = animat.Run(out).history
     assert type(h) is type(r.history) is animat.History
+    assert h and not animat.History.from_rows([])  # truth is "has a row", as for a list
     assert h.dtype.names == r.history.dtype.names == animat.HISTORY_DTYPE.names
     np.testing.assert_array_equal(h["best"], r.history["best"])
     assert h[-1].generation == h[-1]["generation"] == 2
