@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <exception>
+#include <utility>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
@@ -40,17 +41,7 @@ class LocalEvaluator final : public Evaluator {
   template <class Body>
   void parallel_for(std::size_t n, Body&& body) {
     prepare_parallel_evaluation();
-    std::vector<std::exception_ptr> errors(n);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-      try {
-        body(static_cast<std::size_t>(i));
-      } catch (...) {
-        errors[static_cast<std::size_t>(i)] = std::current_exception();
-      }
-    }
-    for (auto& e : errors)
-      if (e) std::rethrow_exception(e);
+    animat::parallel_for(n, threads_, std::forward<Body>(body));
   }
 
   std::shared_ptr<const Config> config_;

@@ -53,24 +53,6 @@ std::uint64_t fnv1a(std::string_view s) {
 
 std::string hex(std::uint64_t x) { return fmt::format("{:016x}", x); }
 
-int thread_count(int requested) { return requested > 0 ? requested : omp_get_num_procs(); }
-
-// Runs body(i) for i in [0, n) in parallel; rethrows the first exception (by index) afterwards.
-template <class Body>
-void parallel_for(std::size_t n, int threads, Body&& body) {
-  std::vector<std::exception_ptr> errors(n);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(thread_count(threads))
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-    try {
-      body(static_cast<std::size_t>(i));
-    } catch (...) {
-      errors[static_cast<std::size_t>(i)] = std::current_exception();
-    }
-  }
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
-}
-
 // Watches a StopRequest during one parallel piece of work. Any thread may ask stopped(); only the
 // thread that created it (OpenMP's thread 0 of the regions it runs) calls the poll, at most every 20 ms.
 class StopWatch {
@@ -624,7 +606,7 @@ std::string Evolution::checkpoint() const {
   // The individuals are serialised on the evaluation threads: on many cores the checkpoint is most of
   // the serial part of a generation, and two thirds of it is this loop (docs/performance.md, issue 20).
   std::vector<json> individuals(population_.size());
-#pragma omp parallel for schedule(static) num_threads(thread_count(config_->evolution.threads))
+#pragma omp parallel for schedule(static) num_threads(resolve_threads(config_->evolution.threads))
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(population_.size()); ++i) {
     const Individual& ind = population_[static_cast<std::size_t>(i)];
     json ji{{"genome", json::parse(to_json(ind.genome))},

@@ -6,6 +6,7 @@
 // fitness depends only on the genome and the config, and the initial individual i only on
 // (evolution.seed, i). Results are stored by index, never in arrival order.
 #include <cstddef>
+#include <exception>
 #include <memory>
 #include <span>
 #include <string>
@@ -46,5 +47,22 @@ inline constexpr std::uint64_t kInitialStreamKey = 0xffffffffffffffffULL;
 
 /// Threads that evolution.threads = `requested` means on this machine (0 = all available cores).
 [[nodiscard]] int resolve_threads(int requested);
+
+/// Runs body(i) for i in [0, n) on `threads` OpenMP threads (resolve_threads), dynamic schedule with
+/// one index per chunk; rethrows the first exception by index after the loop.
+template <class Body>
+void parallel_for(std::size_t n, int threads, Body&& body) {
+  std::vector<std::exception_ptr> errors(n);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(resolve_threads(threads))
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+    try {
+      body(static_cast<std::size_t>(i));
+    } catch (...) {
+      errors[static_cast<std::size_t>(i)] = std::current_exception();
+    }
+  }
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
 
 }  // namespace animat

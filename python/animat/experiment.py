@@ -68,92 +68,14 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
                    overrides: Sequence[str] = (), quiet: bool = True) -> List[RunRecord]:
     """Run (or resume) ``runs`` independent seeds of a config; returns one record per run.
 
-    config_path: TOML file. out: experiment directory. parallel: runs at once. threads: cores in all
-    (0 = all). generations / wall_seconds: per-run cap and budget overriding the config.
-    overrides: "section.key=value" strings applied to the config.
+    config_path: TOML file. out: experiment directory (OUT/run_<i>, summary.json, summary.md).
+    parallel: runs at once. threads: cores in all (0 = all). generations / wall_seconds: per-run cap
+    and budget overriding the config. overrides: "section.key=value" strings applied to the config.
+    One environment of :func:`run_study`.
     """
-    if runs < 1:
-        raise ValueError(f"experiment: --runs must be >= 1, got {runs}")
-    if parallel < 1:
-        raise ValueError(f"experiment: --parallel must be >= 1, got {parallel}")
-    base = _core.load_config(config_path)
-    for o in overrides:
-        base.apply_override(o)
-    if generations is not None:
-        base["evolution.generations"] = int(generations)
-    if wall_seconds is not None:
-        base["evolution.wall_seconds"] = float(wall_seconds)
-    cores = threads if threads > 0 else (os.cpu_count() or 1)
-    base["evolution.threads"] = max(1, cores // parallel)
-    root = Path(out)
-    root.mkdir(parents=True, exist_ok=True)
-
-    records: List[Optional[RunRecord]] = [None] * runs
-    errors: List[BaseException] = []
-    lock = threading.Lock()
-    pending = list(range(runs))
-    # The runs live in worker threads, where Ctrl-C is not delivered: the main thread catches it and
-    # sets `stop`, which every running evolve polls between evaluations (each writes its checkpoint).
-    stop = threading.Event()
-
-    # Thread.join() interrupted by Ctrl-C can mark a running thread as stopped (CPython issue 90882), so
-    # the main thread waits on this event instead, set by the last worker to finish.
-    active = [0]
-    all_done = threading.Event()
-
-    def worker():
-        try:
-            work()
-        finally:
-            with lock:
-                active[0] -= 1
-                if active[0] == 0:
-                    all_done.set()
-
-    def work():
-        while True:
-            with lock:
-                if not pending or errors or stop.is_set():
-                    return
-                i = pending.pop(0)
-            cfg = base.copy()
-            cfg["evolution.seed"] = int(base["evolution.seed"]) + i
-            try:
-                record = _run_one(cfg, root / f"run_{i}", i, quiet, stop)
-                records[i] = record
-                if not quiet and record is not None:
-                    print(f"run {i}: best {record.best:.4f} after {record.generations} generations "
-                          f"({record.stop_reason})", flush=True)
-            except BaseException as e:  # noqa: BLE001 - reported after the other runs stop
-                with lock:
-                    errors.append(e)
-                stop.set()  # one failed run stops the others cleanly too
-
-    workers = [threading.Thread(target=worker, name=f"animat-experiment-{k}") for k in range(min(parallel, runs))]
-    active[0] = len(workers)
-    for w in workers:
-        w.start()
-    interrupted = False
-    try:
-        while not all_done.wait(0.1):
-            pass
-    except KeyboardInterrupt:
-        interrupted = True
-        stop.set()
-        while not all_done.wait(0.1):
-            pass
-    for w in workers:
-        w.join()
-    done = [r for r in records if r is not None]
-    if interrupted:
-        if done:
-            write_summary(root, config_path, done)
-        raise KeyboardInterrupt(f"experiment {root}: interrupted; every run stopped with a checkpoint of its last "
-                                f"complete generation; run the same command again to resume")
-    if errors:
-        raise errors[0]
-    write_summary(root, config_path, done)
-    return done
+    by_env = run_study([config_path], runs, out, parallel=parallel, threads=threads, generations=generations,
+                       wall_seconds=wall_seconds, overrides=overrides, quiet=quiet)
+    return next(iter(by_env.values()))
 
 
 def write_summary(root: Path, config_path: str, records: Sequence[RunRecord]) -> None:
@@ -332,6 +254,11 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
     for w in workers:
         w.join()
     if interrupted:
+        if index is None and comm is None:  # the finished runs are summarised; the others resume
+            for name, path in envs:
+                done = [rec for t, rec, _ in sorted(results, key=lambda r: r[0]) if rec is not None and tasks[t].env == name]
+                if done:
+                    write_summary(root / name if nested else root, path, done)
         raise KeyboardInterrupt(f"experiment {root}: interrupted; every run stopped with a checkpoint of its last "
                                 f"complete generation; run the same command again to resume")
     if comm is not None:
