@@ -1,9 +1,9 @@
 // Development (paper §2.2, Fig. 2): see include/animat/development.hpp for the step order and
 // docs/notes/development.md for every [choose].
 //
-// Cells are fixture-less dynamic Box2D bodies: Box2D integrates them (semi-implicit Euler with
-// linear damping) and never builds contacts, so the only cost of the physics is our own pairwise
-// force loop, which runs only when "repulsion" or "adhesion" is enabled. Pairs are enumerated
+// Cells move as fixture-less dynamic Box2D bodies would (semi-implicit Euler with linear damping,
+// no contacts): CellIntegrator performs b2World::Step's float arithmetic for them bit for bit
+// (src/cell_integrator.hpp), so the only cost of the physics is our own pairwise force loop, which runs only when "repulsion" or "adhesion" is enabled. Pairs are enumerated
 // O(n²): at the paper's 32 (64) cells that is 496 (2016) distance checks per step, less than the
 // GRN steps themselves; the morphogen model needs every pair's distance anyway.
 #include "animat/development.hpp"
@@ -17,7 +17,7 @@
 #include <numbers>
 
 #include "animat/errors.hpp"
-#include "box2d_island.hpp"
+#include "cell_integrator.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"  // has_effect
 
@@ -58,7 +58,6 @@ void validate(const DevelopmentParams& p) {
 // ---------------------------------------------------------------------------------------------
 struct DevelopmentWorld::Impl {
   struct Cell {
-    b2Body* body = nullptr;
     double radius = 0.0;
     Vec2 orientation{1.0, 0.0};
     Vec2 position{0.0, 0.0};  ///< cached from Box2D after every physics step (float → double)
@@ -72,7 +71,7 @@ struct DevelopmentWorld::Impl {
   bool repulsion = false, adhesion = false, morphogens = false;
   std::array<Vec2, 3> sources{};
 
-  std::unique_ptr<b2World> world;
+  CellIntegrator motion;  ///< the cells' Box2D state (position, velocity), index = cell
   std::vector<Cell> cells;
   std::vector<GrnState> states;
   std::vector<int> division_steps;
@@ -85,6 +84,7 @@ struct DevelopmentWorld::Impl {
   std::vector<double> sensed;   ///< [cell][k], written by sense()
   std::vector<std::array<double, 3>> maternal;  ///< per cell, written by sense()
   std::vector<Vec2> forces;     ///< scratch of step_physics
+  std::vector<double> fx, fy;   ///< idem: the forces handed to the integrator
 
   Impl(Grn g, const GrnParams& gp, const DevelopmentParams& p) : grn(std::move(g)), grn_params(gp), params(p) {
     validate(params);
@@ -95,11 +95,10 @@ struct DevelopmentWorld::Impl {
     morph_count = static_cast<int>(grn.morphogen_units().size());
     hist_len = (morphogens && morph_count > 0) ? params.morphogen_max_delay + 1 : 0;
 
-    world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
-    world->SetAllowSleeping(false);
-    world->SetContinuousPhysics(false);
-    world->SetWarmStarting(false);  // no contacts; the island-linking joints carry no impulse to warm-start
+    motion.set_mass(params.cell_mass);
+    motion.damping = static_cast<float>(params.damping);
     const auto reserve = static_cast<std::size_t>(std::min(params.max_cells, 64));
+    motion.reserve(reserve);
     cells.reserve(reserve);
     states.reserve(reserve);
     history.reserve(reserve * static_cast<std::size_t>(hist_len) * static_cast<std::size_t>(morph_count));
@@ -135,29 +134,10 @@ struct DevelopmentWorld::Impl {
     return {newer, newer >= 1 ? newer - 1 : h - 1, frac};
   }
 
-  b2Body* make_body(const Vec2& position, const Vec2& velocity) {
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    def.position.Set(static_cast<float>(position.x()), static_cast<float>(position.y()));
-    def.linearVelocity.Set(static_cast<float>(velocity.x()), static_cast<float>(velocity.y()));
-    def.linearDamping = static_cast<float>(params.damping);
-    def.fixedRotation = true;
-    def.allowSleep = false;
-    b2Body* body = world->CreateBody(&def);
-    b2MassData md;
-    md.mass = static_cast<float>(params.cell_mass);
-    md.center.SetZero();
-    md.I = 0.0f;
-    body->SetMassData(&md);
-    return body;
-  }
-
   int append_cell(const Vec2& position, const Vec2& velocity, double radius, const Vec2& orientation, GrnState state) {
     Cell c;
-    c.body = make_body(position, velocity);
-    if (!cells.empty()) link_bodies(*world, cells.back().body, c.body);  // one island: see box2d_island.hpp
-    const b2Vec2 p = c.body->GetPosition();
-    c.position = Vec2(p.x, p.y);
+    const std::size_t k = motion.add(position.x(), position.y(), velocity.x(), velocity.y());
+    c.position = Vec2(motion.px[k], motion.py[k]);
     c.radius = radius;
     c.orientation = orientation;
     cells.push_back(c);
@@ -310,9 +290,9 @@ int DevelopmentWorld::divide(int cell) {
   }
   const Vec2 position = mother.position + w.params.division_offset * mother.radius * direction;
   const double radius = w.params.cell_radius * (1.0 + w.params.max_growth * grow);
-  const b2Vec2 v = mother.body->GetLinearVelocity();
+  const Vec2 v(w.motion.vx[mi], w.motion.vy[mi]);
   GrnState state = w.states[mi];  // inherits every level
-  const int d = w.append_cell(position, Vec2(v.x, v.y), radius, orientation, std::move(state));
+  const int d = w.append_cell(position, v, radius, orientation, std::move(state));
   if (w.hist_len > 0) {  // the daughter's past is its mother's
     const std::size_t block = static_cast<std::size_t>(w.hist_len) * static_cast<std::size_t>(w.morph_count);
     std::copy_n(w.history.begin() + static_cast<std::ptrdiff_t>(mi * block), block,
@@ -371,6 +351,8 @@ void DevelopmentWorld::step_physics(std::span<const Vec2> external_forces) {
     }
   }
   const double fmax = w.params.max_force;
+  w.fx.resize(n);
+  w.fy.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     Vec2 f = w.forces[i];
     if (fmax > 0.0) {
@@ -378,14 +360,13 @@ void DevelopmentWorld::step_physics(std::span<const Vec2> external_forces) {
       if (norm > fmax) f *= fmax / norm;
     }
     if (!external_forces.empty()) f += external_forces[i];
-    if (f.x() != 0.0 || f.y() != 0.0)
-      w.cells[i].body->ApplyForceToCenter(b2Vec2(static_cast<float>(f.x()), static_cast<float>(f.y())), true);
+    w.fx[i] = f.x();
+    w.fy[i] = f.y();
   }
-  w.world->Step(static_cast<float>(w.params.time_step), 1, 1);
+  w.motion.step(static_cast<float>(w.params.time_step), w.fx.data(), w.fy.data());
   constexpr double kMaxStep = 0.5 * static_cast<double>(b2_maxTranslation);
   for (std::size_t i = 0; i < n; ++i) {
-    const b2Vec2 p = w.cells[i].body->GetPosition();
-    const Vec2 now(p.x, p.y);
+    const Vec2 now(w.motion.px[i], w.motion.py[i]);
     if (!now.allFinite())
       throw SimulationError(fmt::format("development step {}: cell {} has a non-finite position", step_, i));
     const double moved = (now - w.cells[i].position).norm();
@@ -404,8 +385,9 @@ const Grn& DevelopmentWorld::grn() const { return impl_->grn; }
 const DevelopmentParams& DevelopmentWorld::params() const { return impl_->params; }
 DevelopmentWorld::Vec2 DevelopmentWorld::position(int cell) const { return impl_->cells.at(static_cast<std::size_t>(cell)).position; }
 DevelopmentWorld::Vec2 DevelopmentWorld::velocity(int cell) const {
-  const b2Vec2 v = impl_->cells.at(static_cast<std::size_t>(cell)).body->GetLinearVelocity();
-  return {v.x, v.y};
+  const auto i = static_cast<std::size_t>(cell);
+  (void)impl_->cells.at(i);  // range check
+  return {impl_->motion.vx[i], impl_->motion.vy[i]};
 }
 double DevelopmentWorld::radius(int cell) const { return impl_->cells.at(static_cast<std::size_t>(cell)).radius; }
 DevelopmentWorld::Vec2 DevelopmentWorld::orientation(int cell) const {

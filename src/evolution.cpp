@@ -140,18 +140,58 @@ bool reference_disagrees(double fitness, double reference, const EvaluationParam
 const std::vector<std::string>& resumable_keys() {
   static const std::vector<std::string> keys = {"evolution.generations", "evolution.stall_generations",
                                                 "evolution.wall_seconds", "evolution.threads",
-                                                "evolution.checkpoint_every"};
+                                                "evolution.checkpoint_every", "physics.integrator"};
   return keys;
 }
+
+const std::vector<std::string>& late_keys() {
+  // evaluation.objective and .direction came with the research API (issue 16), after the runs of
+  // data/study_issue14; physics.integrator with the native integrator (issue 21).
+  static const std::vector<std::string> keys = {"evaluation.objective", "evaluation.direction", "physics.integrator"};
+  return keys;
+}
+
+namespace {
+
+/// Removes the line of `section.key` and the comment lines just above it from to_toml() text.
+void erase_key_lines(std::string& text, std::string_view dotted) {
+  const auto dot = dotted.find('.');
+  const std::string header = fmt::format("[{}]\n", dotted.substr(0, dot));
+  const std::string line = fmt::format("\n{} = ", dotted.substr(dot + 1));
+  const auto section = text.find(header);
+  if (section == std::string::npos) return;
+  const auto next_section = text.find("\n[", section + header.size());
+  const auto key = text.find(line, section);
+  if (key == std::string::npos || (next_section != std::string::npos && key > next_section)) return;
+  auto begin = key + 1;  // start of the key's line
+  while (begin > 0) {    // and of the comment lines above it
+    const auto prev = text.rfind('\n', begin - 2);
+    const auto start = prev == std::string::npos ? 0 : prev + 1;
+    if (text.compare(start, 1, "#") != 0) break;
+    begin = start;
+  }
+  const auto end = text.find('\n', key + 1);
+  text.erase(begin, end == std::string::npos ? std::string::npos : end + 1 - begin);
+}
+
+}  // namespace
 
 std::uint64_t run_identity(const Config& config) {
   Config c = config;
   const Config defaults;
   for (const auto& key : resumable_keys()) set_value(c, key, get_value(defaults, key));
+  std::string text = to_toml(c);
+  bool erased = false;
+  // Keys added after runs were first checkpointed change nothing at their default value: hash the
+  // config without their lines, so those runs still resume.
+  for (const auto& key : late_keys()) {
+    if (get_value(c, key) != get_value(defaults, key)) continue;
+    erase_key_lines(text, key);
+    erased = true;
+  }
   // [islands] Without islands the island keys change nothing: hash the config without their lines
   // (each key with its comment line), so runs checkpointed before islands existed resume.
   if (c.evolution.islands <= 1) {
-    std::string text = to_toml(c);
     const auto key = text.find("\nislands = ");
     const auto last = text.find("\nmigrants = ", key == std::string::npos ? 0 : key);
     if (key != std::string::npos && last != std::string::npos) {
@@ -161,7 +201,7 @@ std::uint64_t run_identity(const Config& config) {
       return fnv1a(text);
     }
   }
-  return config_hash(c);
+  return erased ? fnv1a(text) : config_hash(c);
 }
 
 // ---------------------------------------------------------------------------------------------------

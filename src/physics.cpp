@@ -17,6 +17,7 @@
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "box2d_island.hpp"
+#include "cell_integrator.hpp"
 
 namespace animat {
 namespace {
@@ -99,8 +100,9 @@ void warm_up_box2d() {
 struct Simulation::Impl {
   SceneParams scene;
   PhysicsParams physics;
-  std::unique_ptr<b2World> world;
-  std::vector<b2Body*> bodies;
+  std::unique_ptr<b2World> world;  // physics.integrator = "box2d" only
+  std::vector<b2Body*> bodies;     // idem
+  CellIntegrator cells;            // the cells' float state (both integrators; "box2d" copies it from the world)
   std::vector<std::unique_ptr<Effect>> effects;  // in run order
   std::vector<Effect*> force_effects;             // modifier and force stages, in run order
   std::vector<Effect*> velocity_effects;          // those with velocity-dependent forces, in run order
@@ -120,13 +122,19 @@ struct Simulation::Impl {
   long first_broken_step = -1;  // control step at the end of which the embedding first broke
 
   void read_state() {
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
+    for (std::size_t i = 0; i < bodies.size(); ++i) {  // a real world: its bodies are the truth
       const b2Vec2 p = bodies[i]->GetPosition();
       const b2Vec2 v = bodies[i]->GetLinearVelocity();
-      state.x[i] = static_cast<double>(p.x);
-      state.y[i] = static_cast<double>(p.y);
-      state.vx[i] = static_cast<double>(v.x);
-      state.vy[i] = static_cast<double>(v.y);
+      cells.px[i] = p.x;
+      cells.py[i] = p.y;
+      cells.vx[i] = v.x;
+      cells.vy[i] = v.y;
+    }
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      state.x[i] = static_cast<double>(cells.px[i]);
+      state.y[i] = static_cast<double>(cells.py[i]);
+      state.vx[i] = static_cast<double>(cells.vx[i]);
+      state.vy[i] = static_cast<double>(cells.vy[i]);
     }
   }
 
@@ -208,17 +216,27 @@ struct Simulation::Impl {
   void box2d_step() {
     run_effects();
     check_forces();
-    for (std::size_t i = 0; i < bodies.size(); ++i)
-      bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(state.fx[i]), static_cast<float>(state.fy[i])), true);
-    world->Step(hf, physics.velocity_iterations, physics.position_iterations);
+    if (world) {
+      for (std::size_t i = 0; i < bodies.size(); ++i)
+        bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(state.fx[i]), static_cast<float>(state.fy[i])), true);
+      world->Step(hf, physics.velocity_iterations, physics.position_iterations);
+    } else {
+      cells.step(hf, state.fx.data(), state.fy.data());
+    }
     ++box2d_steps;
     if (state.position_corrected) {
-      for (std::size_t i = 0; i < bodies.size(); ++i) {
+      for (std::size_t i = 0; i < cells.size(); ++i) {
         if (state.cx[i] == 0.0 && state.cy[i] == 0.0) continue;
-        const b2Vec2 p = bodies[i]->GetPosition();
-        bodies[i]->SetTransform(b2Vec2(static_cast<float>(static_cast<double>(p.x) + state.cx[i]),
-                                       static_cast<float>(static_cast<double>(p.y) + state.cy[i])),
-                                0.0f);
+        // SetTransform(p + c, 0): the body's position (and mass centre) becomes the float sum.
+        const b2Vec2 p = world ? bodies[i]->GetPosition() : b2Vec2(cells.px[i], cells.py[i]);
+        const b2Vec2 q(static_cast<float>(static_cast<double>(p.x) + state.cx[i]),
+                       static_cast<float>(static_cast<double>(p.y) + state.cy[i]));
+        if (world) {
+          bodies[i]->SetTransform(q, 0.0f);
+        } else {
+          cells.px[i] = q.x;
+          cells.py[i] = q.y;
+        }
       }
     }
     read_state();
@@ -252,30 +270,35 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   const Body body = swim_body(body_in);
   const int n = body.node_count();
 
-  s.world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
-  s.world->SetAllowSleeping(false);
-  s.world->SetContinuousPhysics(false);
-  s.world->SetWarmStarting(false);
-  s.bodies.reserve(static_cast<std::size_t>(n));
-  b2MassData mass;
-  mass.mass = static_cast<float>(scene.cell_mass);
-  mass.center.SetZero();
-  mass.I = 0.0f;
-  for (int i = 0; i < n; ++i) {
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    def.position.Set(static_cast<float>(body.positions(i, 0)), static_cast<float>(body.positions(i, 1)));
-    def.allowSleep = false;
-    def.awake = true;
-    def.fixedRotation = true;
-    def.bullet = false;
-    def.linearDamping = 0.0f;
-    def.angularDamping = 0.0f;
-    b2Body* b = s.world->CreateBody(&def);
-    b->SetMassData(&mass);
-    s.bodies.push_back(b);
+  s.cells.set_mass(scene.cell_mass);
+  s.cells.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) s.cells.add(body.positions(i, 0), body.positions(i, 1), 0.0, 0.0);
+  if (physics.integrator == "box2d") {
+    s.world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
+    s.world->SetAllowSleeping(false);
+    s.world->SetContinuousPhysics(false);
+    s.world->SetWarmStarting(false);
+    s.bodies.reserve(static_cast<std::size_t>(n));
+    b2MassData mass;
+    mass.mass = static_cast<float>(scene.cell_mass);
+    mass.center.SetZero();
+    mass.I = 0.0f;
+    for (int i = 0; i < n; ++i) {
+      b2BodyDef def;
+      def.type = b2_dynamicBody;
+      def.position.Set(static_cast<float>(body.positions(i, 0)), static_cast<float>(body.positions(i, 1)));
+      def.allowSleep = false;
+      def.awake = true;
+      def.fixedRotation = true;
+      def.bullet = false;
+      def.linearDamping = 0.0f;
+      def.angularDamping = 0.0f;
+      b2Body* b = s.world->CreateBody(&def);
+      b->SetMassData(&mass);
+      s.bodies.push_back(b);
+    }
+    link_into_one_island(*s.world, s.bodies);
   }
-  link_into_one_island(*s.world, s.bodies);
 
   SwimState& st = s.state;
   st.n = n;
@@ -344,9 +367,12 @@ void Simulation::set_velocities(const Points& v) {
   if (v.rows() != s.state.n)
     throw GeometryError(fmt::format("Simulation::set_velocities: expected {} rows, got {}", s.state.n, v.rows()));
   if (!v.allFinite()) throw GeometryError("Simulation::set_velocities: non-finite velocity");
-  for (int i = 0; i < s.state.n; ++i)
-    s.bodies[static_cast<std::size_t>(i)]->SetLinearVelocity(
-        b2Vec2(static_cast<float>(v(i, 0)), static_cast<float>(v(i, 1))));
+  for (int i = 0; i < s.state.n; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    s.cells.vx[u] = static_cast<float>(v(i, 0));
+    s.cells.vy[u] = static_cast<float>(v(i, 1));
+    if (s.world) s.bodies[u]->SetLinearVelocity(b2Vec2(s.cells.vx[u], s.cells.vy[u]));
+  }
   s.read_state();
 }
 
@@ -357,20 +383,20 @@ double Simulation::time() const { return static_cast<double>(impl_->box2d_steps)
 
 Points Simulation::positions() const {
   Points p(impl_->state.n, 2);
+  const CellIntegrator& c = impl_->cells;
   for (int i = 0; i < impl_->state.n; ++i) {
-    const b2Vec2 v = impl_->bodies[static_cast<std::size_t>(i)]->GetPosition();
-    p(i, 0) = static_cast<double>(v.x);
-    p(i, 1) = static_cast<double>(v.y);
+    p(i, 0) = static_cast<double>(c.px[static_cast<std::size_t>(i)]);
+    p(i, 1) = static_cast<double>(c.py[static_cast<std::size_t>(i)]);
   }
   return p;
 }
 
 Points Simulation::velocities() const {
   Points p(impl_->state.n, 2);
+  const CellIntegrator& c = impl_->cells;
   for (int i = 0; i < impl_->state.n; ++i) {
-    const b2Vec2 v = impl_->bodies[static_cast<std::size_t>(i)]->GetLinearVelocity();
-    p(i, 0) = static_cast<double>(v.x);
-    p(i, 1) = static_cast<double>(v.y);
+    p(i, 0) = static_cast<double>(c.vx[static_cast<std::size_t>(i)]);
+    p(i, 1) = static_cast<double>(c.vy[static_cast<std::size_t>(i)]);
   }
   return p;
 }
@@ -379,28 +405,25 @@ Eigen::Vector2d Simulation::center_of_mass() const {
   Eigen::Vector2d c(0.0, 0.0);
   const int n = impl_->state.n;
   if (n == 0) return c;
-  for (const b2Body* b : impl_->bodies) {
-    const b2Vec2 v = b->GetPosition();
-    c += Eigen::Vector2d(static_cast<double>(v.x), static_cast<double>(v.y));
-  }
+  const CellIntegrator& cells = impl_->cells;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    c += Eigen::Vector2d(static_cast<double>(cells.px[i]), static_cast<double>(cells.py[i]));
   return c / n;
 }
 
 Eigen::Vector2d Simulation::momentum() const {
   Eigen::Vector2d c(0.0, 0.0);
-  for (const b2Body* b : impl_->bodies) {
-    const b2Vec2 v = b->GetLinearVelocity();
-    c += Eigen::Vector2d(static_cast<double>(v.x), static_cast<double>(v.y));
-  }
+  const CellIntegrator& cells = impl_->cells;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    c += Eigen::Vector2d(static_cast<double>(cells.vx[i]), static_cast<double>(cells.vy[i]));
   return c * impl_->state.mass;
 }
 
 double Simulation::kinetic_energy() const {
   double e = 0.0;
-  for (const b2Body* b : impl_->bodies) {
-    const b2Vec2 v = b->GetLinearVelocity();
-    e += static_cast<double>(v.x) * v.x + static_cast<double>(v.y) * v.y;
-  }
+  const CellIntegrator& cells = impl_->cells;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    e += static_cast<double>(cells.vx[i]) * cells.vx[i] + static_cast<double>(cells.vy[i]) * cells.vy[i];
   return 0.5 * impl_->state.mass * e;
 }
 
@@ -427,7 +450,19 @@ bool Simulation::failed() const { return !impl_->failure.empty(); }
 const std::string& Simulation::failure() const { return impl_->failure; }
 const SceneParams& Simulation::scene() const { return impl_->scene; }
 const PhysicsParams& Simulation::physics() const { return impl_->physics; }
-b2World& Simulation::world() { return *impl_->world; }
-const b2World& Simulation::world() const { return *impl_->world; }
+namespace {
+[[noreturn]] void no_world() {
+  throw ConfigError("Simulation::world(): physics.integrator = \"native\" moves the cells without a Box2D world; "
+                    "set physics.integrator = \"box2d\" to get one");
+}
+}  // namespace
+b2World& Simulation::world() {
+  if (!impl_->world) no_world();
+  return *impl_->world;
+}
+const b2World& Simulation::world() const {
+  if (!impl_->world) no_world();
+  return *impl_->world;
+}
 
 }  // namespace animat

@@ -318,6 +318,10 @@ class Evolution {
 /// The config keys that may change when a run is resumed (caps, budgets, threads, checkpoint interval);
 /// every other key is part of run_identity().
 [[nodiscard]] const std::vector<std::string>& resumable_keys();
+/// Keys added to the config after runs were first checkpointed: at their default value they change
+/// nothing, and run_identity() then hashes the config without them, so older runs still resume.
+/// A new key whose default keeps today's results belongs here.
+[[nodiscard]] const std::vector<std::string>& late_keys();
 
 /// Options of a run on disk (animat_evolve and animat.evolve).
 struct RunOptions {

@@ -23,6 +23,7 @@ class EmbeddingMonitor;
 
 inline constexpr std::string_view kDragSchemeNames[] = {"semi_implicit", "explicit", "stable", "implicit"};
 inline constexpr std::string_view kVelocityForceNames[] = {"midpoint", "start"};
+inline constexpr std::string_view kIntegratorNames[] = {"native", "box2d"};
 
 /// The accuracy knobs: what trades accuracy for speed (docs/accuracy.md measures them).
 struct PhysicsParams {
@@ -42,6 +43,11 @@ struct PhysicsParams {
   /// A Box2D step that would move a cell farther than this is reported as unstable (SimulationError)
   /// before Box2D's own cap of b2_maxTranslation = 2 silently clamps it [choose].
   double max_step_displacement = 1.0;
+  /// Who moves the cells: "native" performs Box2D 2.4's integration step for fixture-less bodies
+  /// (the same float operations in the same order, bitwise the same positions and velocities) on
+  /// flat arrays, without Box2D's per-step overhead; "box2d" steps a real b2World (the reference,
+  /// and what world() needs). Results do not depend on it (src/cell_integrator.hpp).
+  std::string integrator = "native";
 };
 
 template <class V>
@@ -53,6 +59,7 @@ void visit_fields(PhysicsParams& p, V&& v) {
   v(FieldInfo{"drag_scheme", "drag integration: semi_implicit (F = -d L |u_start| u_end, second order, never reverses an edge velocity); explicit; stable (explicit, scaled down where it would overshoot, counted); implicit (backward Euler)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
   v(FieldInfo{"velocity_forces", "velocity that damping and drag use: midpoint (predicted, second order) or start (first order) [choose]", Bounds::any(), kVelocityForceNames}, p.velocity_forces);
   v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
+  v(FieldInfo{"integrator", "who moves the cells: native (Box2D's float step for fixture-less bodies, bit for bit, without its overhead) or box2d (a real b2World); same results", Bounds::any(), kIntegratorNames}, p.integrator);
 }
 
 /// Checks what visit_fields bounds cannot say (finite dt, known drag scheme); throws ConfigError.
@@ -140,7 +147,8 @@ class Simulation {
 
   [[nodiscard]] const SceneParams& scene() const;
   [[nodiscard]] const PhysicsParams& physics() const;
-  /// The Box2D world (tests inspect it: bodies, fixtures, contacts).
+  /// The Box2D world (tests inspect it: bodies, fixtures, contacts). Only with physics.integrator
+  /// = "box2d"; throws ConfigError with "native", which has none.
   [[nodiscard]] b2World& world();
   [[nodiscard]] const b2World& world() const;
 

@@ -60,7 +60,9 @@ TEST(SwimWorld, OneFixturelessBodyPerCellEqualMassesNoSleepNoGravity) {
   const Body b = swimmer(lattice_points(8, 4), Drive::wave);
   SceneParams scene;  // every built-in effect, skin collision included
   scene.cell_mass = 2.5;
-  Simulation sim(b, scene);
+  PhysicsParams physics;
+  physics.integrator = "box2d";  // a real world to inspect (the native integrator has none)
+  Simulation sim(b, scene, physics);
   b2World& w = sim.world();
   EXPECT_EQ(w.GetBodyCount(), b.node_count());
   EXPECT_EQ(w.GetContactCount(), 0);
@@ -708,7 +710,9 @@ TEST(Effects, DisabledEffectIsNotInTheLoop) {
     std::vector<std::string> effects;
     for (const auto other : kSceneEffectNames)
       if (other != name) effects.emplace_back(other);
-    Simulation sim(b, scene_with(effects));
+    PhysicsParams physics;
+    physics.integrator = "box2d";  // to look at Box2D's bodies
+    Simulation sim(b, scene_with(effects), physics);
     EXPECT_EQ(sim.effect(name), nullptr) << name;
     EXPECT_EQ(sim.effects().size(), effects.size());
     sim.step(50);
@@ -960,13 +964,25 @@ TEST(Performance, IslandLinkingJointsLeaveTheMotionBitwiseUnchanged) {
 }
 
 TEST(Performance, SwimWorldIsOneIslandWithoutFixturesOrContacts) {
-  Simulation sim(swimmer(lattice_points(8, 4), Drive::wave), SceneParams{}, PhysicsParams{});
+  PhysicsParams physics;
+  physics.integrator = "box2d";
+  Simulation sim(swimmer(lattice_points(8, 4), Drive::wave), SceneParams{}, physics);
   sim.step(10);
   const b2World& w = sim.world();
   EXPECT_EQ(w.GetBodyCount(), 32);
   EXPECT_EQ(w.GetJointCount(), 31);
   EXPECT_EQ(w.GetContactCount(), 0);
   for (const b2Body* b = w.GetBodyList(); b; b = b->GetNext()) EXPECT_EQ(b->GetFixtureList(), nullptr);
+}
+
+TEST(Performance, TheNativeIntegratorHasNoBox2DWorld) {
+  Simulation sim(swimmer(lattice_points(8, 4), Drive::wave));  // physics.integrator = "native" by default
+  try {
+    (void)sim.world();
+    FAIL() << "world() must refuse without a Box2D world";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("physics.integrator"), std::string::npos) << e.what();
+  }
 }
 
 // --- stability suite -----------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <set>
 
 #include "animat/config.hpp"
@@ -259,12 +260,32 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   const auto end = text.find('\n', text.find("\nmigrants = ") + 1) + 1;
   ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin), text.begin() + static_cast<std::ptrdiff_t>(end), '\n'), 6);
   text.erase(begin, end - begin);
+  // So are the late keys at their defaults (evolution.cpp late_keys()), each with its comment line.
+  for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = "}) {
+    const auto at = text.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    const auto from = text.rfind('\n', at - 1) + 1;
+    ASSERT_EQ(text[from], '#') << key;
+    text.erase(from, text.find('\n', at + 1) + 1 - from);
+  }
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (unsigned char ch : text) {
     h ^= ch;
     h *= 0x100000001b3ULL;
   }
   EXPECT_EQ(run_identity(a), h);
+}
+
+TEST(RunIdentity, RunsCheckpointedBeforeTheLateKeysStillResume) {
+  // data/study_issue14 was checkpointed before evaluation.objective, evaluation.direction and
+  // physics.integrator existed; its checkpoints carry these identities (the checkpoint field
+  // "identity"), which the config it was run with must still give.
+  const std::filesystem::path study = std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "study_issue14";
+  EXPECT_EQ(run_identity(load_config(study / "dn2" / "run_1" / "config.toml")), 0xc3f866cda3ad7231ULL);
+  // And a late key away from its default is part of the identity.
+  Config c = load_config(study / "dn2" / "run_1" / "config.toml");
+  c.evaluation.objective = "distance_per_size";
+  EXPECT_NE(run_identity(c), 0xc3f866cda3ad7231ULL);
 }
 
 // ---------------------------------------------------------------------------------------------------
