@@ -37,6 +37,7 @@ nb::dict stats_dict(const GenerationStats& s) {
   d["crossovers"] = s.crossovers;
   d["best_reference"] = s.best_reference;
   d["invalid"] = s.invalid;
+  d["drag_limited"] = s.drag_limited;
   return d;
 }
 
@@ -55,6 +56,7 @@ GenerationStats stats_from_dict(const nb::dict& d) {
   s.crossovers = nb::cast<int>(d["crossovers"]);
   if (d.contains("best_reference")) s.best_reference = nb::cast<double>(d["best_reference"]);
   if (d.contains("invalid")) s.invalid = nb::cast<int>(d["invalid"]);
+  if (d.contains("drag_limited")) s.drag_limited = nb::cast<int>(d["drag_limited"]);
   return s;
 }
 
@@ -67,20 +69,29 @@ std::string fitness_repr(const Fitness& f) {
 
 void bind_evolution(nb::module_& m) {
   nb::class_<Fitness>(m, "Fitness", "What the GA knows about one evaluated genome.")
-      .def("__init__", [](Fitness* f, double fitness, bool viable, bool stable, int cell_count) {
-            new (f) Fitness{fitness, viable, stable, cell_count};
-          }, "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0,
+      .def("__init__", [](Fitness* f, double fitness, bool viable, bool stable, int cell_count, bool valid, long drag_limited) {
+            if (drag_limited < 0) throw nb::value_error("Fitness: drag_limited must be >= 0");
+            new (f) Fitness{fitness, viable, stable, cell_count, valid, drag_limited};
+          }, "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0, "valid"_a = true,
+          "drag_limited"_a = 0,
           "A fitness to tell() the GA: the objective's value, whether the genome was viable (non-viable ones\n"
-          "are never selected before viable ones), whether its swim was stable, and its cell count.")
+          "are never selected before viable ones), whether its swim was stable, its cell count, whether the\n"
+          "swim kept every invariant, and how often the drag limiter altered it (drag_scheme \"stable\" only).")
       .def_ro("fitness", &Fitness::fitness, "The objective's value (the paper's: distance travelled by the centre of mass; 0 if not viable).")
       .def_ro("viable", &Fitness::viable, "Development verdict; non-viable genomes are never swum.")
       .def_ro("stable", &Fitness::stable, "False if the swim was flagged unstable.")
       .def_ro("cell_count", &Fitness::cell_count, "Cells of the embryo.")
       .def_ro("valid", &Fitness::valid, "False if the swim broke an invariant (embedding, collisions); its fitness is 0.")
       .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
-      .def("__getstate__", [](const Fitness& f) { return std::make_tuple(f.fitness, f.viable, f.stable, f.cell_count, f.valid); })
-      .def("__setstate__", [](Fitness& f, const std::tuple<double, bool, bool, int, bool>& t) {
-            new (&f) Fitness{std::get<0>(t), std::get<1>(t), std::get<2>(t), std::get<3>(t), std::get<4>(t)};
+      .def_ro("drag_limited", &Fitness::drag_limited,
+              "Edge-component steps where physics.drag_scheme = \"stable\" scaled eq. 5 down (0 with every other scheme).")
+      .def("__getstate__", [](const Fitness& f) {
+            return std::make_tuple(f.fitness, f.viable, f.stable, f.cell_count, f.valid, f.drag_limited);
+          })
+      .def("__setstate__", [](Fitness& f, const nb::tuple& t) {  // 5 entries: pickled before drag_limited existed
+            if (t.size() != 5 && t.size() != 6) throw nb::value_error("Fitness state: expected 5 or 6 entries");
+            new (&f) Fitness{nb::cast<double>(t[0]), nb::cast<bool>(t[1]), nb::cast<bool>(t[2]), nb::cast<int>(t[3]),
+                             nb::cast<bool>(t[4]), t.size() == 6 ? nb::cast<long>(t[5]) : 0L};
           })
       .def("__copy__", [](const Fitness& f) { return f; })
       .def("__deepcopy__", [](const Fitness& f, nb::handle) { return f; }, "memo"_a)
@@ -104,6 +115,8 @@ void bind_evolution(nb::module_& m) {
               "The best's fitness at the reference step (evaluation.reference_check); NaN when off.")
       .def_ro("invalid", &GenerationStats::invalid,
               "Viable individuals whose swim was unstable or broke an invariant (fitness 0).")
+      .def_ro("drag_limited", &GenerationStats::drag_limited,
+              "Individuals whose swim the drag limiter altered (physics.drag_scheme = \"stable\" only; 0 otherwise).")
       .def("to_dict", &stats_dict, "Every field as a dict.")
       .def("__getstate__", &stats_dict)
       .def("__setstate__", [](GenerationStats& s, const nb::dict& d) { new (&s) GenerationStats(stats_from_dict(d)); })

@@ -487,6 +487,7 @@ GenerationStats population_statistics(const std::vector<Individual>& population)
   for (const auto& ind : population) {
     if (ind.result.viable) viable.push_back(ind.result.fitness);
     if (ind.result.viable && (!ind.result.valid || !ind.result.stable)) ++s.invalid;
+    if (ind.result.drag_limited > 0) ++s.drag_limited;
   }
   // The first of the fittest, by index (as Evolution::best()).
   const Individual& b = *std::min_element(population.begin(), population.end(),
@@ -539,6 +540,7 @@ json stats_to_json(const GenerationStats& s) {
          {"viable_fraction", s.viable_fraction}, {"best_cells", s.best_cells}, {"evaluations", s.evaluations},
          {"wall_seconds", s.wall_seconds}, {"best_changed", s.best_changed}, {"invalid", s.invalid}};
   if (!std::isnan(s.best_reference)) j["best_reference"] = s.best_reference;
+  if (s.drag_limited > 0) j["drag_limited"] = s.drag_limited;  // only the "stable" drag scheme has it
   return j;
 }
 
@@ -577,6 +579,7 @@ GenerationStats stats_from_json(const json& j) {
   // Fields added with the exploit guard; absent in older checkpoints.
   if (j.contains("invalid")) s.invalid = static_cast<int>(int_field(j, "invalid", 0, kIntMax));
   if (j.contains("best_reference")) s.best_reference = number_field(j, "best_reference");
+  if (j.contains("drag_limited")) s.drag_limited = static_cast<int>(int_field(j, "drag_limited", 0, kIntMax));
   return s;
 }
 
@@ -657,6 +660,7 @@ std::string Evolution::checkpoint() const {
             {"cell_count", ind.result.cell_count},
             {"tries", ind.tries}};
     if (!std::isnan(ind.reference)) ji["reference"] = ind.reference;
+    if (ind.result.drag_limited > 0) ji["drag_limited"] = ind.result.drag_limited;
     individuals[static_cast<std::size_t>(i)] = std::move(ji);
   }
   json pop = json::array();
@@ -708,6 +712,7 @@ void Evolution::restore(std::string_view text, std::string_view source) {
       ind.result.stable = bool_field(ji, "stable");
       if (ji.contains("valid")) ind.result.valid = bool_field(ji, "valid");
       if (ji.contains("reference")) ind.reference = number_field(ji, "reference");
+      if (ji.contains("drag_limited")) ind.result.drag_limited = static_cast<long>(int_field(ji, "drag_limited", 0, kInt64Max));
       ind.result.cell_count = static_cast<int>(int_field(ji, "cell_count", 0, kIntMax));
       ind.tries = static_cast<int>(int_field(ji, "tries", 0, kIntMax));
       pop.push_back(std::move(ind));
@@ -798,12 +803,12 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 constexpr std::string_view kHistoryHeader =
-    "generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,wall_seconds\n";
+    "generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,drag_limited,wall_seconds\n";
 
 // wall_seconds stays the last column: the only machine-dependent one.
 std::string history_row(const GenerationStats& s) {
-  return fmt::format("{},{},{},{},{},{},{},{},{},{:.3f}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
-                     s.best_cells, s.evaluations, s.best_reference, s.invalid, s.wall_seconds);
+  return fmt::format("{},{},{},{},{},{},{},{},{},{},{:.3f}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
+                     s.best_cells, s.evaluations, s.best_reference, s.invalid, s.drag_limited, s.wall_seconds);
 }
 
 void append(const std::filesystem::path& path, std::string_view text) {

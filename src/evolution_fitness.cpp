@@ -18,7 +18,7 @@ FitnessFunction objective_fitness(const Config& config, std::shared_ptr<const Ob
   auto shared = std::make_shared<const Config>(config);
   return [shared, objective = std::move(objective)](const Genome& genome) {
     const EvaluationResult r = evaluate(genome, *shared, *objective);
-    return Fitness{r.fitness, r.viable, r.stable, r.cell_count, r.valid};
+    return Fitness{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
   };
 }
 

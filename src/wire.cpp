@@ -30,12 +30,13 @@ void Writer::genome(const Genome& g) {
 }
 
 void Writer::fitness(const Fitness& f) {
-  const auto& [value, viable, stable, cell_count, valid] = f;  // a new Fitness field must be added here (and in Reader)
+  const auto& [value, viable, stable, cell_count, valid, drag_limited] = f;  // a new Fitness field must be added here (and in Reader)
   put(value);
   put(static_cast<std::uint8_t>(viable));
   put(static_cast<std::uint8_t>(stable));
   put(static_cast<std::int32_t>(cell_count));
   put(static_cast<std::uint8_t>(valid));
+  put(static_cast<std::int64_t>(drag_limited));
 }
 
 void Reader::need(std::size_t n) const {
@@ -79,6 +80,7 @@ Fitness Reader::fitness() {
   f.stable = get<std::uint8_t>() != 0;
   f.cell_count = get<std::int32_t>();
   f.valid = get<std::uint8_t>() != 0;
+  f.drag_limited = static_cast<long>(get<std::int64_t>());
   return f;
 }
 

@@ -124,6 +124,9 @@ struct Fitness {
   bool stable = true;   ///< false if the swim was flagged unstable (its fitness is 0)
   int cell_count = 0;
   bool valid = true;    ///< false if the swim broke an invariant (embedding, collisions); fitness 0
+  /// Edge-component steps where drag_scheme "stable" scaled eq. 5 down (0 with every other scheme):
+  /// the swim was not integrated as written there.
+  long drag_limited = 0;
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
@@ -164,6 +167,8 @@ struct GenerationStats {
   /// The best's fitness at the reference step (evaluation.reference_check); NaN when off.
   double best_reference = std::numeric_limits<double>::quiet_NaN();
   int invalid = 0;               ///< viable individuals whose swim was unstable or broke an invariant (fitness 0)
+  /// Individuals whose swim the drag limiter altered (drag_scheme "stable" only; Fitness::drag_limited > 0).
+  int drag_limited = 0;
 };
 
 /// Probability that the fitter of two wins a tournament at generation g (linear ramp, paper §5).

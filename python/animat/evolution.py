@@ -184,12 +184,13 @@ def record_evaluation(genome: Any, config: Any = None, every: int = 20) -> Any:
 
 def to_fitness(value: Any) -> Any:
     """A :class:`animat.Fitness` from what an evaluator returns: a Fitness; an EvaluationResult
-    (its fitness, viable, stable, cell_count); ``None`` (not viable); or a number (a viable
+    (its fitness, viable, stable, cell_count, valid, drag_limited); ``None`` (not viable); or a number (a viable
     genome's fitness; it must be finite)."""
     if isinstance(value, _core.Fitness):
         return value
     if isinstance(value, _core.EvaluationResult):
-        return _core.Fitness(value.fitness, value.viable, value.stable, value.cell_count)
+        return _core.Fitness(value.fitness, value.viable, value.stable, value.cell_count, value.valid,
+                             value.drag_limited)
     if value is None:
         return _core.Fitness(0.0, False, True, 0)
     if isinstance(value, (bool, np.bool_)):

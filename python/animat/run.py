@@ -36,11 +36,14 @@ HISTORY_DTYPE = np.dtype([
     ("evaluations", np.int64),
     ("best_reference", np.float64),
     ("invalid", np.int64),
+    ("drag_limited", np.int64),
     ("wall_seconds", np.float64),
 ])
 
-#: Columns that runs written before the exploit guard do not have, and the value they read as.
-_LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0}
+#: Columns that older runs do not have, and the value they read as.
+_LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0, "drag_limited": 0}
+#: The headers of earlier releases: before the exploit guard, and before the drag limiter's column.
+_OLDER_HEADERS = ({"best_reference", "invalid", "drag_limited"}, {"drag_limited"})
 
 _LINEAGE_NAME = re.compile(r"^gen_(\d+)\.json$")
 
@@ -98,7 +101,7 @@ def read_history(path: PathLike) -> np.ndarray:
         the exploit guard's reference step, NaN when not evaluated), ``invalid`` (int64: viable
         individuals whose swim was unstable or broke an invariant), ``wall_seconds`` (float64, the
         only machine-dependent column, always last). Runs written before ``best_reference`` and
-        ``invalid`` existed read with NaN and 0 there.
+        ``invalid`` existed read with NaN and 0 there, and those before ``drag_limited`` with 0 there.
     """
     path = Path(path)
     if not path.is_file():
@@ -113,8 +116,8 @@ def read_history(path: PathLike) -> np.ndarray:
             raise ValueError(f"{path}:1: not a history.csv header: {lines[0]!r}")
         return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())  # empty or header being written
     header = complete[0].strip().split(",")
-    older = [name for name in expected if name not in _LATER_COLUMNS]
-    if header != expected and header != older:
+    olders = [[name for name in expected if name not in missing] for missing in _OLDER_HEADERS]
+    if header != expected and header not in olders:
         raise ValueError(f"{path}:1: unexpected header {complete[0].strip()!r}; expected {','.join(expected)!r}")
     column = {name: k for k, name in enumerate(header)}
     rows = []

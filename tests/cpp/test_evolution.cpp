@@ -253,7 +253,7 @@ TEST(RunDirectory, WritesConfigHistoryLineageAndCheckpointThenResumes) {
   EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.json"));
   EXPECT_EQ(load_config(dir / "config.toml"), c);
   const std::string hist = slurp(dir / "history.csv");
-  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,wall_seconds\n", 0), 0u);
+  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,drag_limited,wall_seconds\n", 0), 0u);
   EXPECT_EQ(std::count(hist.begin(), hist.end(), '\n'), 1 + 7);  // header + generations 0..6
   EXPECT_TRUE(std::filesystem::exists(dir / "best" / "gen_000000.json"));
 

@@ -125,18 +125,27 @@ def test_malformed_run_directories_give_clear_errors(run_dir, tmp_path):
     (bad / "history.csv").write_text("gen,best\n" + "".join(lines[1:]))
     with pytest.raises(ValueError, match=r"history\.csv:1: unexpected header"):
         run.history
-    (bad / "history.csv").write_text(lines[0] + lines[1] + "1,oops,0,0,1,32,10,nan,0,1.0\n" + "".join(lines[3:]))
+    (bad / "history.csv").write_text(lines[0] + lines[1] + "1,oops,0,0,1,32,10,nan,0,0,1.0\n" + "".join(lines[3:]))
     with pytest.raises(ValueError, match=r"history\.csv:3: not a number"):
         run.history
     (bad / "history.csv").write_text(lines[0] + "1,2,3\n")
-    with pytest.raises(ValueError, match=r"history\.csv:2: expected 10"):
+    with pytest.raises(ValueError, match=r"history\.csv:2: expected 11"):
         run.history
     # A run written before the exploit guard's columns still reads, with NaN and 0 there.
-    old = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 8)) + "\n" for line in lines]
+    old = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 8, 9)) + "\n" for line in lines]
     (bad / "history.csv").write_text("".join(old))
     h = run.history
-    assert np.isnan(h["best_reference"]).all() and (h["invalid"] == 0).all()
+    assert np.isnan(h["best_reference"]).all() and (h["invalid"] == 0).all() and (h["drag_limited"] == 0).all()
     assert h["wall_seconds"][-1] == float(lines[-1].rstrip("\n").split(",")[-1])
+    # One written with the exploit guard but before the drag limiter's column (data/study_issue14).
+    guard = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k != 9) + "\n" for line in lines]
+    (bad / "history.csv").write_text("".join(guard))
+    h = run.history
+    assert (h["drag_limited"] == 0).all() and not np.isnan(h["best_reference"]).any()
+    # The exploit guard's columns without drag_limited but in another order is no format of ours.
+    (bad / "history.csv").write_text(guard[0].replace("best_reference,invalid", "invalid,best_reference") + "".join(guard[1:]))
+    with pytest.raises(ValueError, match="unexpected header"):
+        run.history
 
     newest = sorted((bad / "best").glob("gen_*.json"))[-1]
     newest.write_text("{not json")

@@ -52,7 +52,7 @@ def test_run_directory_layout_and_resume(tmp_path):
     animat.evolve(c, out=str(out))
     assert (out / "config.toml").exists() and (out / "checkpoint.json").exists()
     rows = list(csv.reader(open(out / "history.csv")))
-    assert rows[0] == ["generation", "best", "mean", "median", "viable_fraction", "best_cells", "evaluations", "best_reference", "invalid", "wall_seconds"]
+    assert rows[0] == ["generation", "best", "mean", "median", "viable_fraction", "best_cells", "evaluations", "best_reference", "invalid", "drag_limited", "wall_seconds"]
     assert [r[0] for r in rows[1:]] == ["0", "1", "2"]
     lineage = sorted((out / "best").glob("gen_*.json"))
     assert lineage and lineage[0].name == "gen_000000.json"
