@@ -26,6 +26,7 @@ import json
 import shutil
 import sys
 import tarfile
+import tomllib
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence
 
@@ -61,6 +62,26 @@ def _tar_best(best: Path) -> bytes:
     return _gzip_bytes(raw.getvalue())
 
 
+def _derived_stop(config: Path, history_lines: List[str]) -> str:
+    """The stop rule the history shows as reached (the engine's wording), else "in progress"."""
+    try:
+        evo = tomllib.loads(config.read_text()).get("evolution", {})
+    except (OSError, tomllib.TOMLDecodeError):
+        return "in progress"
+    rows = [ln.split(",") for ln in history_lines[1:]]
+    if not rows:
+        return "in progress"
+    cap, stall = int(evo.get("generations", 0)), int(evo.get("stall_generations", 0))
+    last = int(rows[-1][0])
+    if cap > 0 and last >= cap:
+        return f"generation cap evolution.generations = {cap} reached"
+    best = [float(r[1]) for r in rows]
+    improved = max((int(r[0]) for r, b, prev in zip(rows[1:], best[1:], best[:-1]) if b > prev), default=0)
+    if stall > 0 and last - improved >= stall:
+        return f"no improvement for evolution.stall_generations = {stall} generations"
+    return "in progress"
+
+
 def is_packed_run(path: Path) -> bool:
     """Whether ``path`` holds a packed run (its config and checkpoint)."""
     return (path / "config.toml").is_file() and (path / "checkpoint.json.gz").is_file()
@@ -87,8 +108,9 @@ def pack_run(run_dir: Path, dest: Path, stop_reason: Optional[str] = None) -> Pa
     old = {}
     if (dest / "status.json").is_file():
         old = json.loads((dest / "status.json").read_text())
-    if stop_reason is None:  # unchanged since the last packing: keep its reason; else not known to be finished
-        stop_reason = old.get("stop_reason", "in progress") if old.get("generation") == last else "in progress"
+    if stop_reason is None:  # unchanged since the last packing: keep its reason; else derive it
+        stop_reason = (old.get("stop_reason", "in progress") if old.get("generation") == last
+                       else _derived_stop(run_dir / "config.toml", lines))
     status = {"generation": last, "stop_reason": stop_reason}
     _write_if_changed(dest / "config.toml", (run_dir / "config.toml").read_bytes())
     _write_if_changed(dest / "history.csv.gz", _gzip_bytes(history))
