@@ -42,7 +42,13 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
    - ``deformation < NONE_DEFORMATION`` (0.01): **none**: the body does not deform periodically
      (a rigid or resting body). Swimming bodies deform by 0.1–0.4 (amplitude up to 0.2 per cell,
      two cells per spring); a rigid body gives < 1e-9.
-   - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65): **protrusions**: the rest of the body
+   - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65), or a strain contrast (RMS contraction
+     amplitude of the most strained 20 % of the cells over the median cell's) ``>= LOCAL_CONTRAST``
+     (3.5, issue 19): **protrusions** when those cells (the most strained fifth if the contrast
+     decided, else the most mobile fifth) form two or more groups joined by springs, **tail** when they
+     form one. The contrast rule was added because hand-built protrusion swimmers
+     (:mod:`animat.known_swimmers`) put only 0.44–0.62 of the motion in their top fifth: the passive
+     core of a soft body is pushed around by its appendages. For the old rule: the rest of the body
      moves with less than 37 % of the RMS amplitude of its most mobile fifth. Smooth whole-body
      deformations stay below: a breathing disc puts 0.36 of its energy in the top 20 % (amplitude
      ∝ radius), an elongated body contracting along its axis 0.49 (amplitude ∝ distance from the
@@ -66,9 +72,12 @@ or 2π along the long axis or π across it gave fit ≥ 0.94, lag 2.2–6.3 and 
 108 "other"); random phases gave fit 0.44–0.89 (median 0.60) and concentration up to 0.71 (202 of
 216 "other", 5 "undulation", 9 "protrusions"). Commanded ramps of π/2 came out at lags 0.9–2.2
 (37 "synchronous contraction", 17 mixed): a quarter-period command is at the threshold. The
-protrusion threshold could not be calibrated on real protrusion swimmers (none was at hand); it rests
+concentration threshold could not be calibrated on real protrusion swimmers (none was at hand); it rests
 on the smooth-deformation bounds above and on a synthetic swimmer (two 3-cell appendages on a 19-cell
-blob that sweep and extend as the paper's Fig. 6 describes: 0.86).
+blob that sweep and extend as the paper's Fig. 6 describes: 0.86). Issue 19 swam hand-built swimmers
+of known mode (:mod:`animat.known_swimmers`; the confusion matrices are in docs/replication.md): the
+contrast rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase)
+is still missed (wave fit 0.78–0.80, just under WAVE_FIT).
 
 Statistics (paper §6–§7)
 ------------------------
@@ -111,8 +120,9 @@ PROTRUSION_CONCENTRATION = 0.65
 #: The most mobile fraction of the cells used by the concentration measure.
 TOP_FRACTION = 0.2
 #: RMS contraction amplitude of the most strained 20 % of the cells over the median cell's, from which
-#: the deformation is localised in appendages (protrusions or a tail; issue 19, set on the calibration
-#: set of :mod:`animat.known_swimmers`: whole-body modes 1.2–3.0, appendage swimmers 4.1–7.3).
+#: the deformation is localised in appendages (protrusions or a tail; issue 19, set between the two
+#: groups of the calibration set of :mod:`animat.known_swimmers`, swum 2000 steps at d_N = 0.5 and 2:
+#: undulators and synchronous contractors 1.98–3.01, protrusion and tail swimmers 4.14–7.33).
 LOCAL_CONTRAST = 3.5
 #: Minimum weighted resultant of a circular-linear phase fit to count as a consistent gradient.
 WAVE_FIT = 0.8

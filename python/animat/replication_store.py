@@ -124,7 +124,7 @@ def pack_run(run_dir: Path, dest: Path, stop_reason: Optional[str] = None) -> Pa
 
 def unpack_run(packed: Path, run_dir: Path) -> Path:
     """Unpack a packed run into ``run_dir`` as the runner writes it (config.toml, history.csv, best/,
-    checkpoint.json, resume.log), ready for ``animat_evolve --resume`` / ``python -m animat experiment``.
+    checkpoint.json, resume.log; and status.json, which the runner ignores), ready for ``animat_evolve --resume`` / ``python -m animat experiment``.
     Refuses to overwrite a run directory that already holds a checkpoint."""
     packed, run_dir = Path(packed), Path(run_dir)
     if not is_packed_run(packed):
@@ -142,8 +142,9 @@ def unpack_run(packed: Path, run_dir: Path) -> Path:
                 raise ValueError(f"unpack_run: unexpected member {m.name!r} in {packed / 'best.tar.gz'}")
             data = tar.extractfile(m).read()
             (run_dir / "best" / name.name).write_bytes(data)
-    if (packed / "resume.log").is_file():
-        shutil.copyfile(packed / "resume.log", run_dir / "resume.log")
+    for extra in ("resume.log", "status.json"):
+        if (packed / extra).is_file():
+            shutil.copyfile(packed / extra, run_dir / extra)
     (run_dir / "checkpoint.json").write_bytes(gzip.decompress((packed / "checkpoint.json.gz").read_bytes()))
     return run_dir
 
