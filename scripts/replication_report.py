@@ -492,7 +492,9 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
     w("### Locomotion modes against the paper's counts")
     w("")
     w("Main mode of every best (a mixed best counts under its main mode), ours next to the paper's (of 10 runs; "
-      "\"?\" where the paper gives no count).")
+      "\"?\" where the paper's words give no main-mode count: at d_N = 2 its 2 protrusion swimmers are mixed "
+      "into undulation, at d_N = 0.2 it reports only protrusions and tails; its d_N = 10 counts overlap, 5 + 2 + 4 "
+      "of 10, one best being mixed).")
     w("")
     modes = [m for m in MODE_COLUMNS if m != "none"] + ["none"]
     labels = {e.name: [r.mode.mode for r in e.runs if r.mode is not None] for e in envs}
@@ -629,8 +631,8 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
           f"{fmt_range([float(len(e.runs)) for e in envs], 0)}) of {min(total_gens)}–{max(total_gens)} "
           f"generations (median {statistics.median(total_gens):g}): {len(envs[0].runs) if envs else 0} of the paper's "
           f"{PAPER_RUNS} runs per environment, each {100 * statistics.median(total_gens) / 5000:.1f} % of its "
-          f"typical run length (about 5,000 generations). All runs went "
-          f"at once on one machine, one thread each, with a wall-clock budget per run. Everything the paper "
+          f"typical run length (about 5,000 generations). Wall time per run is the history's wall_seconds "
+          f"(machine- and load-dependent, summed over sessions). Everything the paper "
           f"observed after many hundreds of generations is beyond what these runs can show.")
         w("")
     if data is not None:

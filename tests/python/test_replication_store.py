@@ -42,3 +42,27 @@ def test_pack_tree_takes_stop_reasons_from_the_summary_and_derives_them_otherwis
     status = json.loads((data / "dn2" / "run_0" / "status.json").read_text())
     assert status == {"generation": 100, "stop_reason": "generation cap evolution.generations = 100 reached"}
     assert gzip.decompress((data / "dn2" / "run_0" / "history.csv.gz").read_bytes()).startswith(b"generation,")
+
+
+def test_report_rebuilds_from_packed_data_alone(tmp_path):
+    import subprocess
+    import sys
+
+    data = tmp_path / "data"
+    shutil.copytree(PACKED, data / "dn2" / "run_0")
+    shutil.copytree(ROOT / "data" / "replication" / "dn10" / "run_0", data / "dn10" / "run_0")
+    doc = tmp_path / "docs" / "replication.md"
+    cmd = [sys.executable, str(ROOT / "scripts" / "replication_report.py"), "--data", str(data), "--doc", str(doc),
+           "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
+    out = subprocess.run(cmd, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    text = doc.read_text()
+    assert "**Scale, exactly:** 2 runs: 1 in `dn2`, 1 in `dn10` of the 3 per environment" in text
+    assert "generations reached: 100 " in text
+    assert "Runs not started yet: `dn2` run 1, run 2; `dn10` run 1, run 2." in text
+    assert "Fisher's exact test (Freeman–Halton, r × c) over the three 32-cell environments" in text
+    assert "| `dn2` | 0 | 21.665 | 21.670 | +0.02 % |" in text  # evolved and reference fitness of the best
+    assert text.index("## Statistics") < text.index("## d_N = 2, 32 cells")
+    assert not (data / "dn2" / "run_0" / "checkpoint.json").exists()  # the data is only read
+    subprocess.run(cmd, capture_output=True, text=True, check=True)
+    assert doc.read_text() == text  # deterministic
