@@ -28,6 +28,7 @@ GENERATIONS=${ANIMAT_REPLICATION_GENERATIONS:-1000}
 DATA=${ANIMAT_REPLICATION_DATA:-data/replication}
 WORK=${ANIMAT_REPLICATION_OUT:-runs/replication}
 PARALLEL=${ANIMAT_REPLICATION_PARALLEL:-$(nproc)}
+DOC=${ANIMAT_REPLICATION_DOC:-docs/replication.md}
 PY_PATH=${ANIMAT_PYTHONPATH:-build/python}
 if [[ -z "${ANIMAT_PYTHONPATH:-}" ]]; then
   scripts/setup.sh
@@ -53,5 +54,5 @@ if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then
   echo "replication: the experiment failed (exit $status); see $WORK/experiment.log; packing what ran" >&2
 fi
 "${PY[@]}" -m animat.replication_store pack "$WORK" "$DATA"
-"${PY[@]}" scripts/replication_report.py --data "$DATA" --doc docs/replication.md
+"${PY[@]}" scripts/replication_report.py --data "$DATA" --doc "$DOC"
 if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then exit 1; fi

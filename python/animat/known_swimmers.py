@@ -48,7 +48,7 @@ class KnownSwimmer:
 
     Attributes:
         name: short unique name. expected: the mode it was built to show (one of
-            ``animat.locomotion.MODES`` or "tail"); mixed: a second mode built in (mixtures), else "".
+            ``animat.locomotion.MODES``); mixed: a second mode built in (mixtures), else "".
         positions: (n, 2) cell centres; +x is the intended direction of swimming.
         amplitude, frequency, phase: (n,) per-cell actuation of eq. 2 (frequency in rad per time unit).
         description: how it was built.
@@ -241,7 +241,8 @@ def tail_swimmer(length: int = 4, core_radius: float = 2.3, frequency: float = 8
 
 
 def calibration_set() -> List[KnownSwimmer]:
-    """The swimmers the classifier was checked (and, for protrusions, tuned) on."""
+    """The swimmers the classifier was checked on; its strain-contrast threshold
+    (``animat.locomotion.LOCAL_CONTRAST``) was set between this set's whole-body and appendage swimmers."""
     return [
         undulator("contraction"),
         undulator("bending"),
