@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -44,7 +44,7 @@ def _log_factorial(n: int) -> float:
     return math.lgamma(n + 1)
 
 
-def table_log_probability(table: Sequence[Sequence[int]]) -> float:
+def table_log_probability(table: Union[np.ndarray, Sequence[Sequence[int]]]) -> float:
     """log P of a table under the multivariate hypergeometric law with its own margins:
     ``P = Π R_i! Π C_j! / (N! Π n_ij!)``."""
     t = np.asarray(table, dtype=np.int64)
@@ -65,7 +65,7 @@ def _compositions(total: int, caps: Sequence[int]):
             yield (v,) + tail
 
 
-def fisher_exact(table: Sequence[Sequence[int]], *, max_tables: int = 2_000_000, samples: int = 200_000,
+def fisher_exact(table: Union[np.ndarray, Sequence[Sequence[int]]], *, max_tables: int = 2_000_000, samples: int = 200_000,
                  seed: int = 0) -> FisherResult:
     """Fisher's exact test of independence of an r x c table of counts (rows x columns).
 
@@ -157,7 +157,7 @@ class BootstrapCI:
     n: int
 
 
-def bootstrap_ci(values: Sequence[float], statistic: Callable[[np.ndarray], np.ndarray] = None, *,
+def bootstrap_ci(values: Sequence[float], statistic: Optional[Callable[[np.ndarray], Any]] = None, *,
                  level: float = 0.95, resamples: int = 10_000, seed: int = 0) -> BootstrapCI:
     """Percentile bootstrap interval of ``statistic`` (default: the mean) of ``values``.
 

@@ -140,7 +140,10 @@ def unpack_run(packed: Path, run_dir: Path) -> Path:
             name = Path(m.name)
             if not m.isfile() or name.parent != Path("best") or not name.name.startswith("gen_"):
                 raise ValueError(f"unpack_run: unexpected member {m.name!r} in {packed / 'best.tar.gz'}")
-            data = tar.extractfile(m).read()
+            member = tar.extractfile(m)
+            if member is None:
+                raise ValueError(f"unpack_run: cannot read {m.name!r} in {packed / 'best.tar.gz'}")
+            data = member.read()
             (run_dir / "best" / name.name).write_bytes(data)
     for extra in ("resume.log", "status.json"):
         if (packed / extra).is_file():
@@ -194,7 +197,8 @@ def pack_tree(work: Path, root: Path) -> List[Path]:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m animat.replication_store", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="python -m animat.replication_store",
+                                description="Pack replication runs into data/replication, or unpack them.")
     sub = p.add_subparsers(dest="command", required=True)
     u = sub.add_parser("unpack", help="unpack DATA/<env>/run_<i> into WORK/<env>/run_<i>")
     u.add_argument("data", type=Path)
