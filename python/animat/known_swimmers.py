@@ -13,7 +13,8 @@ amplitude, frequency and phase of eq. 2 of the paper, ``L = (1 + a_i sin(f_i t +
 - :func:`synchronous_contractor`: every cell in phase, on an asymmetric (tear-drop) outline, so
   contraction and expansion meet different drag (paper §6, Fig. 5).
 - :func:`protrusion_swimmer`: a round core with two symmetric appendages (``length`` cells long, one
-  cell or a two-cell-wide strip) that sweep backwards extended and return contracted (paper Fig. 6);
+  cell or a two-cell-wide strip) whose actuation is set to sweep them backwards extended and forwards
+  contracted (paper Fig. 6; :func:`appendage_stroke` measures how far a swim follows);
   only the appendages and the core cells they are anchored to oscillate strongly.
 - :func:`tail_swimmer`: a round core with one two-cell-wide tail at the back that beats with a
   bending wave; the core is passive.
@@ -36,7 +37,7 @@ from . import _core
 
 __all__ = ["KnownSwimmer", "hex_region", "undulator", "synchronous_contractor", "protrusion_swimmer",
            "tail_swimmer", "calibration_set", "held_out_set", "KnownResult", "classify_known",
-           "confusion_matrix", "AMPLITUDE"]
+           "confusion_matrix", "Stroke", "appendage_stroke", "AMPLITUDE"]
 
 #: The paper's largest amplitude (development.amplitude_max): a cell changes its springs by ±20 %.
 AMPLITUDE = 0.2
@@ -167,8 +168,9 @@ def _appendage(base: np.ndarray, direction: np.ndarray, along: np.ndarray, lengt
 def protrusion_swimmer(length: int = 1, wide: bool = False, core_radius: float = 2.3, frequency: float = 8.0,
                        core_amplitude: float = 0.0, anchor_amplitude: float = 0.1, core_wave: float = 0.0,
                        spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
-    """A round core with two symmetric appendages (at ±y) that row: extended while they sweep
-    backwards (-x), contracted on the way forward (paper §6, Fig. 6).
+    """A round core with two symmetric appendages (at ±y) actuated to row: extended while they sweep
+    backwards (-x), contracted on the way forward (paper §6, Fig. 6). The swims follow this only loosely
+    (:func:`appendage_stroke`: the extension correlates weakly with the backward velocity).
 
     The appendage cells oscillate at full amplitude with phase π/2 (their springs are longest when the
     sweep moves backwards fastest); the core cells they are anchored to oscillate with
@@ -276,6 +278,44 @@ def held_out_set() -> List[KnownSwimmer]:
     ]
 
 
+@dataclass(frozen=True)
+class Stroke:
+    """How the appendage cells (those at full amplitude) of a protrusion or tail swimmer move in the body
+    frame, over the classifier's window.
+
+    Attributes:
+        sweep: mean peak-to-peak displacement along the direction of motion (length units).
+        extension: mean peak-to-peak distance from the body's centre.
+        rowing: mean correlation of the extension with the backward velocity: +1 when an appendage is
+            farthest out exactly while it moves backwards (the paper's Fig. 6 stroke), 0 when unrelated.
+    """
+
+    sweep: float
+    extension: float
+    rowing: float
+
+
+def appendage_stroke(swimmer: KnownSwimmer, trajectory: Any, mode: Any) -> Optional[Stroke]:
+    """:class:`Stroke` of ``swimmer``'s full-amplitude cells in a recorded ``trajectory``, using the window
+    (last ``mode.cycles`` periods), body frame and direction of motion of the classifier's ``mode``.
+    None when the swimmer has no appendage cells or the mode has no frequency."""
+    from .locomotion import procrustes_frames  # noqa: PLC0415
+
+    app = np.flatnonzero(swimmer.amplitude >= AMPLITUDE)
+    if swimmer.expected not in ("protrusions", "tail") or len(app) == 0 or not mode.omega > 0:
+        return None
+    t = np.asarray(trajectory.times)
+    sel = t >= t[-1] - mode.cycles * 2 * math.pi / mode.omega - 1e-9
+    Q, _, _ = procrustes_frames(np.asarray(trajectory.positions)[sel])
+    along = Q[:, app] @ np.asarray(mode.direction)
+    radius = np.linalg.norm(Q[:, app], axis=2)
+    backward = -np.gradient(along, axis=0)
+    corr = [float(np.corrcoef(radius[:, k], backward[:, k])[0, 1]) for k in range(len(app))
+            if np.ptp(radius[:, k]) > 0 and np.ptp(backward[:, k]) > 0]
+    return Stroke(float(np.ptp(along, axis=0).mean()), float(np.ptp(radius, axis=0).mean()),
+                  float(np.mean(corr)) if corr else float("nan"))
+
+
 @dataclass(frozen=True, eq=False)
 class KnownResult:
     """One swim of a known swimmer: its name, expected and found modes, drag and the classifier's numbers."""
@@ -286,6 +326,7 @@ class KnownResult:
     mode: Any  # animat.locomotion.LocomotionMode
     distance: float
     stable: bool
+    stroke: Optional[Stroke] = None
 
     @property
     def found(self) -> str:
@@ -311,7 +352,8 @@ def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0
         for s in swimmers:
             tr = replay(s.body(cfg), cfg)
             mode = classify_locomotion(tr) if tr.stable else None
-            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable)))
+            stroke = appendage_stroke(s, tr, mode) if mode is not None else None
+            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke))
     return out
 
 

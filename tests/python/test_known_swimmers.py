@@ -59,3 +59,11 @@ def test_confusion_matrix_counts():
     fake = [K.KnownResult(K.tail_swimmer(), 0.5, 10, None, 0.0, False)]
     m = K.confusion_matrix(fake, ["tail"], ["tail", "unstable"])
     assert m.tolist() == [[0, 1]]
+
+
+def test_appendage_stroke_is_measured_for_appendage_swimmers_only():
+    res = K.classify_known([K.protrusion_swimmer(length=1), K.undulator("contraction")], drags=(0.5,), steps=1500)
+    prot, und = res
+    assert und.stroke is None
+    s = prot.stroke
+    assert s is not None and s.sweep > 0.05 and s.extension > 0.1 and -1.0 <= s.rowing <= 1.0
