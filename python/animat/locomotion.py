@@ -42,7 +42,13 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
    - ``deformation < NONE_DEFORMATION`` (0.01): **none**: the body does not deform periodically
      (a rigid or resting body). Swimming bodies deform by 0.1–0.4 (amplitude up to 0.2 per cell,
      two cells per spring); a rigid body gives < 1e-9.
-   - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65): **protrusions**: the rest of the body
+   - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65), or a strain contrast (RMS contraction
+     amplitude of the most strained 20 % of the cells over the median cell's) ``>= LOCAL_CONTRAST``
+     (3.5, issue 19): **protrusions** when those cells (the most strained fifth if the contrast
+     decided, else the most mobile fifth) form two or more groups joined by springs, **tail** when they
+     form one. The contrast rule was added because hand-built protrusion swimmers
+     (:mod:`animat.known_swimmers`) put only 0.44–0.62 of the motion in their top fifth: the passive
+     core of a soft body is pushed around by its appendages. For the old rule: the rest of the body
      moves with less than 37 % of the RMS amplitude of its most mobile fifth. Smooth whole-body
      deformations stay below: a breathing disc puts 0.36 of its energy in the top 20 % (amplitude
      ∝ radius), an elongated body contracting along its axis 0.49 (amplitude ∝ distance from the
@@ -66,9 +72,12 @@ or 2π along the long axis or π across it gave fit ≥ 0.94, lag 2.2–6.3 and 
 108 "other"); random phases gave fit 0.44–0.89 (median 0.60) and concentration up to 0.71 (202 of
 216 "other", 5 "undulation", 9 "protrusions"). Commanded ramps of π/2 came out at lags 0.9–2.2
 (37 "synchronous contraction", 17 mixed): a quarter-period command is at the threshold. The
-protrusion threshold could not be calibrated on real protrusion swimmers (none was at hand); it rests
+concentration threshold could not be calibrated on real protrusion swimmers (none was at hand); it rests
 on the smooth-deformation bounds above and on a synthetic swimmer (two 3-cell appendages on a 19-cell
-blob that sweep and extend as the paper's Fig. 6 describes: 0.86).
+blob that sweep and extend as the paper's Fig. 6 describes: 0.86). Issue 19 swam hand-built swimmers
+of known mode (:mod:`animat.known_swimmers`; the confusion matrices are in docs/replication.md): the
+contrast rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase)
+is still missed (wave fit 0.78–0.80, just under WAVE_FIT).
 
 Statistics (paper §6–§7)
 ------------------------
@@ -93,7 +102,7 @@ from .trajectory import Trajectory, body_of, replay
 __all__ = [
     "LocomotionMode", "WaveFit", "classify_locomotion", "classify_motion", "MODES",
     "NONE_DEFORMATION", "PROTRUSION_CONCENTRATION", "WAVE_FIT", "WAVE_LAG", "WAVE_TI", "SYNC_COHERENCE",
-    "TOP_FRACTION", "procrustes_frames", "circular_linear_fit", "travelling_index", "phase_coherence",
+    "TOP_FRACTION", "LOCAL_CONTRAST", "procrustes_frames", "circular_linear_fit", "travelling_index", "phase_coherence",
     "harmonic_amplitudes", "GrowOutput", "OscillatorSpread", "PhaseSpread", "BestStatistics",
     "grow_output", "oscillator_spread", "phase_spread", "tries_per_viable", "morphology_changes",
     "last_morphology_change", "best_statistics", "PHASE_DIFFERENTIATED", "AMPLITUDE_DIFFERENTIATED",
@@ -101,7 +110,7 @@ __all__ = [
 ]
 
 #: The modes :func:`classify_locomotion` returns.
-MODES = ("undulation", "synchronous contraction", "protrusions", "other", "none")
+MODES = ("undulation", "synchronous contraction", "protrusions", "tail", "other", "none")
 #: Below this relative deformation amplitude the body is rigid for our purpose: mode "none".
 NONE_DEFORMATION = 0.01
 #: Contraction amplitudes (relative length change) below this are round-off: no spring changes length.
@@ -110,6 +119,11 @@ CONTRACTION_FLOOR = 1e-9
 PROTRUSION_CONCENTRATION = 0.65
 #: The most mobile fraction of the cells used by the concentration measure.
 TOP_FRACTION = 0.2
+#: RMS contraction amplitude of the most strained 20 % of the cells over the median cell's, from which
+#: the deformation is localised in appendages (protrusions or a tail; issue 19, set between the two
+#: groups of the calibration set of :mod:`animat.known_swimmers`, swum 2000 steps at d_N = 0.5 and 2:
+#: undulators and synchronous contractors 1.98–3.01, protrusion and tail swimmers 4.14–7.33).
+LOCAL_CONTRAST = 3.5
 #: Minimum weighted resultant of a circular-linear phase fit to count as a consistent gradient.
 WAVE_FIT = 0.8
 #: Minimum total phase lag (rad) along the body for a wave.
@@ -308,6 +322,11 @@ class LocomotionMode:
             did not move); ``speed``: centre-of-mass speed over the window (length per time unit).
         top_cells: indices of the most mobile 20 % of the cells (the protrusions when mode is "protrusions").
         reason: one sentence saying which criterion decided.
+        phases, amplitudes: (n,) phase and amplitude of every cell's contraction.
+        contrast: RMS contraction amplitude of the most strained 20 % of the cells over the median
+            cell's (localised deformation: appendages).
+        groups: connected groups (along springs) (along springs) of the appendage cells when the mode is "protrusions" or
+            "tail" (the most strained 20 % when the contrast decided, else the most mobile 20 %); else 0.
     """
 
     mode: str
@@ -326,6 +345,8 @@ class LocomotionMode:
     reason: str
     phases: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
     amplitudes: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
+    contrast: float = float("nan")
+    groups: int = 0
 
     @property
     def label(self) -> str:
@@ -394,6 +415,22 @@ def _wave_fit(z: np.ndarray, coords: np.ndarray, motion: np.ndarray) -> WaveFit:
     ti = travelling_index(z)
     is_wave = fit >= WAVE_FIT and lag >= WAVE_LAG and ti >= WAVE_TI
     return WaveFit(np.asarray(g), float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave))
+
+
+def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
+    """Connected components of the spring graph restricted to ``cells``."""
+    parent = {int(c): int(c) for c in cells}
+
+    def find(a: int) -> int:
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for i, j in springs:
+        if int(i) in parent and int(j) in parent:
+            parent[find(int(i))] = find(int(j))
+    return len({find(c) for c in parent})
 
 
 def _no_wave(w: WaveFit) -> str:
@@ -495,13 +532,30 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
     wave = _wave_fit(contraction, centred, motion)
     is_wave = wave.is_wave
     sync = coherence >= SYNC_COHERENCE
-    prot = concentration >= PROTRUSION_CONCENTRATION
+    ca = np.abs(contraction)
+    c_order = np.argsort(-ca, kind="stable")
+    c_top = np.sort(c_order[:n_top])
+    median = float(np.median(ca))
+    contrast = (float(np.sqrt(np.mean(ca[c_top] ** 2))) / median if median > 0
+                else (float("inf") if ca.max(initial=0.0) > 0 else 0.0))
+    local = contrast >= LOCAL_CONTRAST
+    prot = concentration >= PROTRUSION_CONCENTRATION or local
 
     mixed: List[str] = []
+    groups = 0
     if prot:
-        mode = "protrusions"
-        reason = (f"the most mobile {n_top} of {n} cells carry {concentration:.0%} of the motion "
-                  f"(>= {PROTRUSION_CONCENTRATION:.0%})")
+        cells = c_top if local else top
+        groups = _groups(cells, sp)
+        mode = "protrusions" if groups >= 2 else "tail"
+        why = []
+        if local:
+            why.append(f"the most strained {n_top} of {n} cells contract {contrast:.1f} times as much as the "
+                       f"median cell (>= {LOCAL_CONTRAST})")
+        if concentration >= PROTRUSION_CONCENTRATION:
+            why.append(f"the most mobile {n_top} of {n} cells carry {concentration:.0%} of the motion "
+                       f"(>= {PROTRUSION_CONCENTRATION:.0%})")
+        reason = (" and ".join(why) + f"; these cells form {groups} group{'s' if groups != 1 else ''} "
+                  + ("(appendages)" if groups >= 2 else "(one appendage: a tail)"))
         if is_wave:
             mixed.append("undulation")
     elif is_wave:
@@ -519,7 +573,8 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
         mode = "other"
         reason = f"{_no_wave(wave)} and contraction phases incoherent (R = {coherence:.2f} < {SYNC_COHERENCE})"
     return LocomotionMode(mode, tuple(mixed), deformation, coherence, concentration, ti, wave, omega, k,
-                          int(sel.sum()), motion, speed, top, reason, np.angle(contraction), np.abs(contraction))
+                          int(sel.sum()), motion, speed, top, reason, np.angle(contraction), np.abs(contraction),
+                          contrast=contrast, groups=groups)
 
 
 def classify_locomotion(thing: Any, config: Optional[Any] = None, *, times: Optional[ArrayLike] = None,
