@@ -14,10 +14,9 @@
 #     SESSION_SECONDS (SIGINT: each writes the checkpoint of its last complete generation),
 #  3. packs every run back into data/replication (commit it: the study grows across sessions),
 #  4. rewrites docs/replication.md from data/replication alone (scripts/replication_report.py).
-# Known limit (issue 19): runs 0-4 of every environment were made before the [evaluation] objective
-# keys existed and today's build refuses to resume their checkpoints (run identity mismatch; a C++
-# fix in run_identity is needed); until then run only the missing runs, e.g.
-#   ANIMAT_REPLICATION_INDEX="5 6 7 8 9 15 16 17 18 19 25 26 27 28 29 35 36 37 38 39" scripts/replication.sh 5400
+# Runs 0-4 of every environment were made before the [evaluation] objective keys existed; they resume
+# since run_identity() leaves keys added later out of the hash while they hold their default
+# (late_keys() in src/evolution.cpp).
 # ANIMAT_REPLICATION_INDEX="1 2 3" restricts step 2 to those runs of the study (env-major: run i of the
 # e-th environment of dn0.5, dn2, dn10, dn0.2_64cells is e * RUNS + i).
 set -euo pipefail

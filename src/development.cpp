@@ -100,6 +100,14 @@ struct DevelopmentWorld::Impl {
     const auto reserve = static_cast<std::size_t>(std::min(params.max_cells, 64));
     motion.reserve(reserve);
     cells.reserve(reserve);
+    // The per-step scratch buffers at their largest (max_cells <= 4096): a step allocates nothing
+    // unless a cell is born (tests/cpp/test_physics.cpp, DevelopmentAllocatesOnlyWhenACellIsBorn).
+    const auto most = static_cast<std::size_t>(params.max_cells);
+    maternal.reserve(most);
+    sensed.reserve(most * static_cast<std::size_t>(morph_count));
+    forces.reserve(most);
+    fx.reserve(most);
+    fy.reserve(most);
     states.reserve(reserve);
     history.reserve(reserve * static_cast<std::size_t>(hist_len) * static_cast<std::size_t>(morph_count));
   }

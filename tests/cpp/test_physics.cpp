@@ -912,6 +912,34 @@ TEST(Performance, SwimLoopAllocatesNothing) {
   }
 }
 
+/// Issue 21: development allocates only when a cell is born (its GRN state, history rows and slots);
+/// a step without a division allocates nothing, whatever the genome.
+TEST(Performance, DevelopmentAllocatesOnlyWhenACellIsBorn) {
+  const Config config;
+  Rng rng(3);
+  int developed = 0;
+  long quiet_steps = 0;
+  for (int tries = 0; tries < 5000 && developed < 3; ++tries) {
+    const Genome g = random_genome(config.genome, rng);
+    if (!develop(g, config.genome, config.grn, config.development).viable) continue;
+    ++developed;
+    DevelopmentWorld world(Grn(g, config.genome), config.grn, config.development);
+    world.set_symmetry_seed(genome_hash(g));
+    world.add_cell(DevelopmentWorld::Vec2::Zero(), config.development.cell_radius, DevelopmentWorld::Vec2(1.0, 0.0));
+    for (int step = 0; step < config.development.steps; ++step) {
+      g_allocations = 0;
+      g_counting = true;
+      const int divisions = world.step();
+      g_counting = false;
+      if (divisions > 0) continue;
+      ++quiet_steps;
+      ASSERT_EQ(g_allocations.load(), 0) << "step " << step << " of viable genome " << developed;
+    }
+  }
+  EXPECT_EQ(developed, 3);
+  EXPECT_GT(quiet_steps, 900);
+}
+
 // --- one Box2D island --------------------------------------------------------------------------------
 
 /// The island-linking joints (src/box2d_island.hpp) must not change the motion: two worlds with the
