@@ -11,6 +11,7 @@
 //            build/bench_evaluation --benchmark_filter='^BM_Evaluate$' --benchmark_min_time=0.01
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -137,6 +138,35 @@ void BM_RandomTry(benchmark::State& state) {
   state.SetLabel("viable_fraction=" + std::to_string(static_cast<double>(viable) / static_cast<double>(state.iterations())));
 }
 BENCHMARK(BM_RandomTry)->Unit(benchmark::kMicrosecond);
+
+/// One development step with n cells (issue 21's size exponent): the GRN of the first sample genome
+/// that has morphogen products, n cells placed on a triangular lattice of spacing 1 (as grown cells
+/// pack), max_cells = n so that none divides; stepped 50 times before timing.
+void BM_DevelopStep(benchmark::State& state) {
+  const Sample& s = sample();
+  const int n = static_cast<int>(state.range(0));
+  std::size_t pick = 0;
+  for (std::size_t k = 0; k < s.genomes.size(); ++k)
+    if (!Grn(s.genomes[k], s.config.genome).morphogen_units().empty()) {
+      pick = k;
+      break;
+    }
+  DevelopmentParams params = s.config.development;
+  params.max_cells = n;
+  DevelopmentWorld world(Grn(s.genomes[pick], s.config.genome), s.config.grn, params);
+  world.set_symmetry_seed(genome_hash(s.genomes[pick]));
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  for (int i = 0; i < n; ++i) {
+    const int row = i / side, col = i % side;
+    world.add_cell(DevelopmentWorld::Vec2(col + 0.5 * (row % 2), row * 0.8660254037844386), params.cell_radius,
+                   DevelopmentWorld::Vec2(1.0, 0.0));
+  }
+  for (int k = 0; k < 50; ++k) world.step();
+  for (auto _ : state) benchmark::DoNotOptimize(world.step());
+  state.counters["cells"] = n;
+  state.counters["morphogens"] = static_cast<double>(world.grn().morphogen_units().size());
+}
+BENCHMARK(BM_DevelopStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

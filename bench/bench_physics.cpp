@@ -105,6 +105,15 @@ void BM_SwimStep(benchmark::State& state) {
 }
 BENCHMARK(BM_SwimStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 
+/// The same swim step with physics.integrator = "box2d": a real b2World (one island) moves the cells,
+/// bit for bit as the native integrator does (tests/cpp/test_integrator.cpp).
+void BM_SwimStepBox2D(benchmark::State& state) {
+  PhysicsParams physics;
+  physics.integrator = "box2d";
+  run_swim(state, lattice_swimmer(static_cast<int>(state.range(0))), SceneParams{}, physics);
+}
+BENCHMARK(BM_SwimStepBox2D)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
+
 /// One effect alone (index into kSceneEffectNames; 5 = no effect at all, 6 = all), 32 cells.
 void BM_Effect(benchmark::State& state) {
   const int k = static_cast<int>(state.range(0));

@@ -36,7 +36,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 CELLS = [32, 64, 128, 256]
-EFFECTS = ["springs", "actuation", "pressure", "drag", "skin_collision", "none", "all"]
+EFFECTS = ["springs", "actuation", "pressure", "drag", "collisions", "none", "all"]  # BM_Effect/0..6
 
 
 def sh(cmd, **kw) -> str:
@@ -202,15 +202,20 @@ def main() -> int:
     print("bench_physics ...", flush=True)
     phys = run_gbench(build / "bench_physics", results / "bench_physics.csv",
                       "BM_Box2DBareStep|BM_Box2DLinkedStep|BM_SwimStep|BM_Effect", args.repetitions, args.min_time)
+    print("bench_evaluation, development steps ...", flush=True)
+    dev = run_gbench(build / "bench_evaluation", results / "bench_develop_step.csv", "BM_DevelopStep", args.repetitions,
+                     args.min_time)
     print("bench_evaluation ...", flush=True)
-    ev = run_gbench(build / "bench_evaluation", results / "bench_evaluation.csv", ".", args.repetitions,
+    ev = run_gbench(build / "bench_evaluation", results / "bench_evaluation.csv",
+                    "^BM_(Evaluate|Develop|BuildBody|Swim|RandomTry)$", args.repetitions,
                     max(args.min_time, 0.5))
     cg = {}
     if not args.no_callgrind:
         print("callgrind ...", flush=True)
         for n in CELLS:
-            cg[("swim", n)] = callgrind(build / "bench_physics", f"^BM_SwimStep/{n}$", ["animat::Simulation::step(long)",
-                                                                                       "b2World::Step("])
+            cg[("swim", n)] = callgrind(build / "bench_physics", f"^BM_SwimStep/{n}$", ["animat::Simulation::step(long)"])
+            cg[("swim_box2d", n)] = callgrind(build / "bench_physics", f"^BM_SwimStepBox2D/{n}$",
+                                              ["animat::Simulation::step(long)", "b2World::Step("])
             cg[("bare", n)] = callgrind(build / "bench_physics", f"^BM_Box2DBareStep/{n}$", ["b2World::Step("])
             cg[("linked", n)] = callgrind(build / "bench_physics", f"^BM_Box2DLinkedStep/{n}$", ["b2World::Step("])
         for k in range(len(EFFECTS)):
@@ -222,17 +227,21 @@ def main() -> int:
     rows = []
     for n in CELLS:
         s, b, l = phys[f"BM_SwimStep/{n}"]["cpu_us"], phys[f"BM_Box2DBareStep/{n}"]["cpu_us"], phys[f"BM_Box2DLinkedStep/{n}"]["cpu_us"]
-        row = [n, f"{s:.2f}", f"{b:.2f}", f"{s / b:.2f}×", f"{l:.2f}", f"{s / l:.2f}×"]
+        sb = phys[f"BM_SwimStepBox2D/{n}"]["cpu_us"]
+        row = [n, f"{s:.2f}", f"{l:.2f}", f"**{s / l:.2f}×**", f"{sb:.2f}", f"{sb / l:.2f}×", f"{b:.2f}", f"{s / b:.2f}×"]
         if cg:
             si = cg[("swim", n)]["animat::Simulation::step(long)"][0]
-            bi = cg[("bare", n)]["b2World::Step("][0]
-            bx = cg[("swim", n)]["b2World::Step("][0]
-            row += [f"{si / 1e3:.1f}k", f"{bi / 1e3:.1f}k", f"{si / bi:.2f}×", f"{bx / si:.0%}"]
+            li = cg[("linked", n)]["b2World::Step("][0]
+            sbi = cg[("swim_box2d", n)]["animat::Simulation::step(long)"][0]
+            bx = cg[("swim_box2d", n)]["b2World::Step("][0]
+            row += [f"{si / 1e3:.1f}k", f"{li / 1e3:.1f}k", f"{si / li:.2f}×", f"{sbi / 1e3:.1f}k", f"{bx / sbi:.0%}"]
         rows.append(row)
-    header = ["cells", "swim step µs", "bare Box2D Step µs", "ratio (time)", "Box2D Step, one island µs",
-              "swim / one-island"]
+    header = ["cells", "swim step µs (native integrator, the default)", "Box2D Step, one island µs (the honest floor)",
+              "swim / one-island (time)", "swim step with integrator = box2d µs", "box2d swim / one-island",
+              "bare Box2D Step, unlinked µs", "swim / unlinked"]
     if cg:
-        header += ["swim step instr.", "bare Step instr.", "ratio (instr.)", "Box2D share of swim step (instr.)"]
+        header += ["swim step instr.", "one-island Step instr.", "swim / one-island (instr.)",
+                   "swim step instr., integrator = box2d", "Box2D's share of that"]
     md += ["### 1. Swim step versus the Box2D floor", "", table(header, rows), ""]
 
     rows = []
@@ -251,6 +260,14 @@ def main() -> int:
     md += ["### 2. Per-effect cost", "", table(header, rows), "",
            f"A bare Box2D Step of 32 unlinked bodies in the same run: {phys['BM_Box2DBareStep/32']['cpu_us']:.2f} µs; "
            f"of 32 bodies in one island: {phys['BM_Box2DLinkedStep/32']['cpu_us']:.2f} µs.", ""]
+
+    # Development step against cells (issue 21's exponent target).
+    rows = [[n, f"{dev[f'BM_DevelopStep/{n}']['cpu_us']:.1f}"] for n in CELLS]
+    dev_exponent = fit_exponent(CELLS, [dev[f"BM_DevelopStep/{n}"]["cpu_us"] for n in CELLS])
+    md += ["### 2b. Development step against cells", "", table(["cells", "µs per development step"], rows), "",
+           f"Least-squares exponent of the cost in cells, 32 → 256: **{dev_exponent:.2f}** (target ≤ 1.1). "
+           "`BM_DevelopStep/n`: n cells on a triangular lattice, the GRN of the first sample genome with morphogen "
+           "products, max_cells = n (no division).", ""]
 
     e, d, bb, sw, rt = (ev[k]["cpu_us"] for k in ("BM_Evaluate", "BM_Develop", "BM_BuildBody", "BM_Swim", "BM_RandomTry"))
     tries = float(ev["BM_Evaluate"]["tries_per_viable"])
@@ -277,7 +294,7 @@ def main() -> int:
              f"{ce['animat::build_body('][2] / ce['animat::evaluate('][1] / tot:.1%}"],
             ["swim", f"{ce['animat::swim('][2] / ce['animat::evaluate('][1] / 1e6:.1f}M",
              f"{ce['animat::swim('][2] / ce['animat::evaluate('][1] / tot:.0%}"],
-            ["inside Box2D's Step (development + swim)", f"{b2 / 1e6:.1f}M", f"{b2 / tot:.0%}"],
+            ["inside Box2D's Step (development + swim; none with the native integrator)", f"{b2 / 1e6:.1f}M", f"{b2 / tot:.0%}"],
             ["outside Box2D's Step", f"{(tot - b2) / 1e6:.1f}M", f"{(tot - b2) / tot:.0%}"]]), ""]
 
     evo = []
