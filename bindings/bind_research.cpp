@@ -104,6 +104,14 @@ void visit_result(EvaluationResult& r, V&& v) {
   v("collisions_inelastic", r.collisions_inelastic);
   v("collisions_unresolved", r.collisions_unresolved);
   v("drag_limited", r.drag_limited);
+  v("settle_steps", r.settle_steps);
+  v("ground_contacts", r.ground_contacts);
+  v("ground_slips", r.ground_slips);
+  v("actuation_work", r.actuation_work);
+  v("actuation_work_positive", r.actuation_work_positive);
+  v("actuation_work_absolute", r.actuation_work_absolute);
+  v("cell_work_positive", r.cell_work_positive);
+  v("cell_work_absolute", r.cell_work_absolute);
   v("seconds_development", r.seconds_development);
   v("seconds_body", r.seconds_body);
   v("seconds_swim", r.seconds_swim);
