@@ -56,7 +56,8 @@ def test_builtin_objectives_by_name_and_config_key(viable):
     c2.apply_override("evaluation.direction=[0.0, 1.0]")
     speed = animat.evaluate(g, c2).fitness
     assert speed == pytest.approx(r.displacement[1] / r.simulated_time, rel=1e-12)
-    assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward"}
+    assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward", "distance_x",
+                                      "distance_minus_energy", "distance_per_energy"}
     with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, python:"):
         c2["evaluation.objective"] = "fastest"
 
