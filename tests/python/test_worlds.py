@@ -46,7 +46,7 @@ def test_crawl_preset_swims_on_the_floor_and_reports_work():
 def test_simulation_counters_include_floor_and_work():
     cfg = animat.load_config(CRAWL)
     body = wave_body()
-    sim = animat.Simulation(body, cfg.scene)
+    sim = animat.Simulation(body, config=cfg)
     sim.step(200)
     c = sim.counters
     for key in ("ground_contacts", "ground_slips", "actuation_work", "actuation_work_positive",
@@ -57,9 +57,9 @@ def test_simulation_counters_include_floor_and_work():
 
 def test_bad_friction_is_a_clear_error():
     cfg = animat.load_config(CRAWL)
-    cfg.scene.ground_friction_kinetic = 2.0
     with pytest.raises(ValueError, match="ground_friction_kinetic"):
-        animat.Simulation(wave_body(), cfg.scene)
+        cfg.scene.ground_friction_kinetic = 2.0
+        animat.Simulation(wave_body(), config=cfg)
     with pytest.raises(ValueError, match="gravity"):
         animat.Scene(gravity=-1.0)
 
