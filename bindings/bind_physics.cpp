@@ -429,6 +429,22 @@ void bind_physics(nb::module_& m) {
       "the counts cover the whole horizon. settle_steps (default config.evaluation.settle_steps) control\n"
       "steps are simulated first with actuation off (crawl world: with effect 'ground' the body is\n"
       "placed with its lowest cell on the floor first); the distance is measured from there.");
+  m.def("start_state", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config,
+                          std::optional<long> settle_steps) {
+        const Config c = config ? *config : Config{};
+        const long n = settle_steps ? *settle_steps : c.evaluation.settle_steps;
+        StartState s;
+        warm_up_box2d();
+        {
+          nb::gil_scoped_release release;
+          s = start_state(body, scene ? *scene : c.scene, c.physics, n);
+        }
+        return nb::make_tuple(s.body, s.velocities, s.settled);
+      }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "settle_steps"_a = nb::none(),
+      "Where a swim starts (crawl world, docs/worlds.md): returns (body, velocities, settled). With effect\n"
+      "'ground' the body is moved vertically so that its lowest cell lies on the floor; then settle_steps\n"
+      "(default config.evaluation.settle_steps) control steps without actuation are simulated from rest.\n"
+      "Without ground and settling: the body unchanged, zero velocities, settled 0.");
   m.def("evaluate", [](const Genome& genome, std::optional<Config> config, nb::handle objective) {
         const Config c = config ? *config : Config{};
         const auto scored_by = objective_from_python(objective, c);

@@ -51,45 +51,44 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 
 }  // namespace
 
+StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long settle_steps) {
+  if (settle_steps < 0)
+    throw ConfigError(fmt::format("evaluation.settle_steps: {} is out of range (expected >= 0)", settle_steps));
+  StartState out;
+  out.body = body;
+  if (has_effect(scene.effects, "ground") && body.node_count() > 0)
+    out.body.positions.col(1).array() += scene.ground_height - body.positions.col(1).minCoeff();
+  out.velocities = Points::Zero(body.node_count(), 2);
+  if (settle_steps > 0) {
+    SceneParams quiet = scene;
+    std::erase(quiet.effects, std::string("actuation"));
+    Simulation settle(out.body, quiet, physics);
+    settle.step(settle_steps);
+    out.body.positions = settle.positions();
+    out.velocities = settle.velocities();
+    out.settled = settle_steps;
+  }
+  return out;
+}
+
 SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsParams& physics, long steps,
                 const SwimOptions& options) {
   constexpr long kSampleEvery = 16;
   SwimResult r;
-  if (options.settle_steps < 0)
-    throw ConfigError(fmt::format("evaluation.settle_steps: {} is out of range (expected >= 0)", options.settle_steps));
-  // Crawl world: the body starts with its lowest cell on the floor, then (settle_steps > 0) settles
-  // with actuation off; the swim starts from there. Neither happens in the default scene.
-  const Body* start_body = &body_in;
-  Body placed;
-  if (has_effect(scene.effects, "ground") && body_in.node_count() > 0) {
-    placed = body_in;
-    placed.positions.col(1).array() += scene.ground_height - body_in.positions.col(1).minCoeff();
-    start_body = &placed;
+  StartState begin;
+  try {
+    begin = start_state(body_in, scene, physics, options.settle_steps);
+  } catch (const SimulationError& e) {
+    r.stable = false;
+    r.valid = false;
+    r.failure = fmt::format("while settling: {}", e.what());
+    r.min_stretch = 0.0;
+    return r;
   }
-  Points settled_velocities;
-  if (options.settle_steps > 0) {
-    SceneParams quiet = scene;
-    std::erase(quiet.effects, std::string("actuation"));
-    Simulation settle(*start_body, quiet, physics);
-    try {
-      settle.step(options.settle_steps);
-    } catch (const SimulationError& e) {
-      r.stable = false;
-      r.valid = false;
-      r.failure = fmt::format("while settling: {}", e.what());
-      r.settle_steps = settle.steps_done();
-      r.min_stretch = 0.0;
-      return r;
-    }
-    r.settle_steps = options.settle_steps;
-    if (start_body != &placed) placed = body_in;
-    placed.positions = settle.positions();
-    settled_velocities = settle.velocities();
-    start_body = &placed;
-  }
-  const Body& body = *start_body;
+  r.settle_steps = begin.settled;
+  const Body& body = begin.body;
   Simulation sim(body, scene, physics);
-  if (settled_velocities.rows() > 0) sim.set_velocities(settled_velocities);
+  if (begin.settled > 0) sim.set_velocities(begin.velocities);
   if (options.check_embedding) sim.monitor_embedding(body);
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   const Eigen::Vector2d start = sim.center_of_mass();

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "animat/body.hpp"
 #include "animat/config.hpp"
 #include "animat/genome.hpp"
 
@@ -77,6 +78,21 @@ struct SwimOptions {
   bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
   EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
 };
+
+/// Where a swim starts (the crawl world, docs/worlds.md): the body and its velocities.
+struct StartState {
+  Body body;            ///< the body at its starting positions (rest lengths and areas as given)
+  Points velocities;    ///< n × 2 starting velocities (zeros unless settled)
+  long settled = 0;     ///< control steps settled
+};
+
+/// The start of a swim: with effect "ground" in the scene, `body` moved vertically so that its
+/// lowest cell centre lies on the floor; then, if settle_steps > 0, settle_steps control steps of
+/// the scene without actuation from rest, whose end positions and velocities are the start. Without
+/// ground and settling: the body unchanged, at rest. Throws SimulationError if settling leaves the
+/// valid domain, ConfigError for settle_steps < 0. swim() and animat.replay start here.
+[[nodiscard]] StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics,
+                                     long settle_steps);
 
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
 /// simulation failure: it returns stable = false, distance 0 and the message. A swim that breaks

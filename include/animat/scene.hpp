@@ -8,17 +8,17 @@
 // structure-of-arrays SwimState (positions, velocities, zeroed forces) and calls:
 //   1. apply() of every enabled effect in stage order: modifiers first (actuation writes the spring
 //      rest lengths), then force effects, which add their position-dependent forces (spring
-//      elasticity, pressure, skin collision; future: gravity, ground);
+//      elasticity, pressure, skin collision, gravity);
 //   2. apply_velocity() of the velocity-dependent effects (spring damping, drag), which add forces
 //      evaluated at the velocity s.ux, s.uy chosen by physics.velocity_forces: the velocity at the
 //      start of the step, or (default) a prediction of the velocity at the middle of the step, for
 //      which the stepper runs them twice (predictor, then corrector). An effect sees the forces of
 //      the effects before it in s.fx, s.fy, so an implicit scheme (drag) can solve for the
 //      velocity at the end of the step, v + h·F/m;
-//   3. apply() of the constraint effects (collisions), which see every force and change the
-//      end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h).
+//   3. apply() of the constraint effects (collisions, then ground), which see every force and change
+//      the end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h).
 // Effects loop over their own elements inside apply(): one virtual call per effect per pass, never
-// one per element. New effects (gravity, ground friction, active control) are new Effect
+// one per element. New effects (like gravity and ground, docs/worlds.md) are new Effect
 // subclasses (one file each in src/effects/) plus a name in make_effect(); the stepper does not
 // change.
 #include <memory>
