@@ -141,6 +141,11 @@ nb::ndarray<nb::numpy, double> owned_array(std::vector<double> v, std::initializ
   return nb::ndarray<nb::numpy, double>(heap->data(), shape.size(), shape.begin(), owner);
 }
 
+/// A numpy copy of an Eigen vector (owned by the array: safe whatever the lifetime of the source).
+nb::ndarray<nb::numpy, double> owned_vector(const Eigen::VectorXd& v) {
+  return owned_array(std::vector<double>(v.data(), v.data() + v.size()), {static_cast<std::size_t>(v.size())});
+}
+
 const char* kSceneDoc =
     "The effects a swim simulates, with their coefficients (paper §4; MODEL.md §5).\n\n"
     "``Scene()`` is the default swim scene (all five effects, d_N = 2). Keywords set fields by their\n"
@@ -228,10 +233,10 @@ void bind_physics(nb::module_& m) {
                 "Positive actuation work, summed per spring and Box2D step (what the actuators spend).")
         .def_ro("actuation_work_absolute", &R::actuation_work_absolute,
                 "Absolute actuation work, summed per spring and Box2D step.")
-        .def_prop_ro("cell_work_positive", [](const R& r) -> Eigen::VectorXd { return r.cell_work_positive; },
-                     "Per cell (n,): half the positive actuation work of each spring it ends.")
-        .def_prop_ro("cell_work_absolute", [](const R& r) -> Eigen::VectorXd { return r.cell_work_absolute; },
-                     "Per cell (n,): half the absolute actuation work of each spring it ends.");
+        .def_prop_ro("cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
+                     nb::rv_policy::move, "Per cell (n,): half the positive actuation work of each spring it ends.")
+        .def_prop_ro("cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
+                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.");
   };
   invariant_fields(swim_result, std::type_identity<SwimResult>{});
   invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});

@@ -120,7 +120,7 @@ void visit_result(EvaluationResult& r, V&& v) {
 nb::dict result_state(const EvaluationResult& r) {
   nb::dict d;
   EvaluationResult copy = r;
-  visit_result(copy, [&](const char* name, auto& value) { d[name] = nb::cast(value); });
+  visit_result(copy, [&](const char* name, auto& value) { d[name] = nb::cast(value, nb::rv_policy::copy); });
   return d;
 }
 
@@ -343,7 +343,7 @@ void bind_research(nb::module_& m) {
             nb::object result = nb::cast(r.result);
             if (!nb::hasattr(result, name.c_str()))
               throw nb::attribute_error(("EvaluationRecord has no attribute '" + name + "'").c_str());
-            return result.attr(name.c_str());
+            return nb::object(result.attr(name.c_str()));  // resolved now, while `result` lives
           }, "name"_a)
       .def("__getstate__", [](const EvaluationRecord& r) {
             return nb::make_tuple(std::string("animat.EvaluationRecord"), 1, result_state(r.result), body_state(r.body),
