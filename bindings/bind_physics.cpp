@@ -141,6 +141,11 @@ nb::ndarray<nb::numpy, double> owned_array(std::vector<double> v, std::initializ
   return nb::ndarray<nb::numpy, double>(heap->data(), shape.size(), shape.begin(), owner);
 }
 
+/// A numpy copy of an Eigen vector (owned by the array: safe whatever the lifetime of the source).
+nb::ndarray<nb::numpy, double> owned_vector(const Eigen::VectorXd& v) {
+  return owned_array(std::vector<double>(v.data(), v.data() + v.size()), {static_cast<std::size_t>(v.size())});
+}
+
 const char* kSceneDoc =
     "The effects a swim simulates, with their coefficients (paper §4; MODEL.md §5).\n\n"
     "``Scene()`` is the default swim scene (all five effects, d_N = 2). Keywords set fields by their\n"
@@ -219,7 +224,19 @@ void bind_physics(nb::module_& m) {
         .def_ro("collisions", &R::collisions, "Cell-edge collisions resolved by an impulse.")
         .def_ro("collisions_inelastic", &R::collisions_inelastic, "Collisions resolved by the inelastic fallback.")
         .def_ro("collisions_unresolved", &R::collisions_unresolved, "Steps with a crossing no impulse prevented (must be 0).")
-        .def_ro("drag_limited", &R::drag_limited, "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.");
+        .def_ro("drag_limited", &R::drag_limited, "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.")
+        .def_ro("settle_steps", &R::settle_steps, "Control steps settled (actuation off) before the fitness clock started.")
+        .def_ro("ground_contacts", &R::ground_contacts, "(cell, Box2D step) contacts with the floor (effect ground).")
+        .def_ro("ground_slips", &R::ground_slips, "Of the floor contacts, those that slid (kinetic friction).")
+        .def_ro("actuation_work", &R::actuation_work, "Net mechanical work of actuation on the springs (docs/worlds.md).")
+        .def_ro("actuation_work_positive", &R::actuation_work_positive,
+                "Positive actuation work, summed per spring and Box2D step (what the actuators spend).")
+        .def_ro("actuation_work_absolute", &R::actuation_work_absolute,
+                "Absolute actuation work, summed per spring and Box2D step.")
+        .def_prop_ro("cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
+                     nb::rv_policy::move, "Per cell (n,): half the positive actuation work of each spring it ends.")
+        .def_prop_ro("cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
+                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.");
   };
   invariant_fields(swim_result, std::type_identity<SwimResult>{});
   invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});
@@ -366,9 +383,15 @@ void bind_physics(nb::module_& m) {
         d["collisions_unresolved"] = c.collisions_unresolved;
         d["collision_max_passes"] = c.collision_max_passes;
         d["drag_limited"] = c.drag_limited;
+        d["ground_contacts"] = c.ground_contacts;
+        d["ground_slips"] = c.ground_slips;
+        d["actuation_work"] = c.actuation_work;
+        d["actuation_work_positive"] = c.actuation_work_positive;
+        d["actuation_work_absolute"] = c.actuation_work_absolute;
         return d;
       }, "What the effects counted so far: collisions (resolved, inelastic, unresolved, most passes in a\n"
-         "step) and drag limiter engagements, as a dict.")
+         "step), drag limiter engagements, floor contacts and slips, and the actuation work (net,\n"
+         "positive, absolute), as a dict.")
       .def("monitor_embedding", &Simulation::monitor_embedding, "body"_a,
            "Check the planar embedding of `body` (the body this simulation swims) now and after every step:\n"
            "region signs and skin simplicity; see `embedding`.")
@@ -391,23 +414,42 @@ void bind_physics(nb::module_& m) {
       });
 
   m.def("swim", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config, std::optional<long> steps,
-                   std::optional<bool> check_embedding, bool stop_when_invalid) {
+                   std::optional<bool> check_embedding, bool stop_when_invalid, std::optional<long> settle_steps) {
         const Config c = config ? *config : Config{};
         const long n = steps ? *steps : c.evaluation.steps;
         if (n < 0) throw ConfigError(fmt::format("swim: steps must be >= 0, got {}", n));
         SwimOptions options;
         options.check_embedding = check_embedding ? *check_embedding : c.evaluation.check_embedding;
         options.stop_when_invalid = stop_when_invalid;
+        options.settle_steps = settle_steps ? *settle_steps : c.evaluation.settle_steps;
         warm_up_box2d();  // Box2D's lazily filled globals, before other threads may run worlds too
         nb::gil_scoped_release release;
         return swim(body, scene ? *scene : c.scene, c.physics, n, options);
       }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "steps"_a = nb::none(),
-      "check_embedding"_a = nb::none(), "stop_when_invalid"_a = true,
+      "check_embedding"_a = nb::none(), "stop_when_invalid"_a = true, "settle_steps"_a = nb::none(),
       "Swim a body for `steps` control steps (default config.evaluation.steps) and return a SwimResult.\n"
       "Never raises for an unstable or invalid swim: it returns stable/valid=False and distance 0.\n"
       "check_embedding (default config.evaluation.check_embedding) checks region signs and skin\n"
       "simplicity after every step; stop_when_invalid=False swims on after a broken invariant so that\n"
-      "the counts cover the whole horizon.");
+      "the counts cover the whole horizon. settle_steps (default config.evaluation.settle_steps) control\n"
+      "steps are simulated first with actuation off (crawl world: with effect 'ground' the body is\n"
+      "placed with its lowest cell on the floor first); the distance is measured from there.");
+  m.def("start_state", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config,
+                          std::optional<long> settle_steps) {
+        const Config c = config ? *config : Config{};
+        const long n = settle_steps ? *settle_steps : c.evaluation.settle_steps;
+        StartState s;
+        warm_up_box2d();
+        {
+          nb::gil_scoped_release release;
+          s = start_state(body, scene ? *scene : c.scene, c.physics, n);
+        }
+        return nb::make_tuple(s.body, s.velocities, s.settled);
+      }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "settle_steps"_a = nb::none(),
+      "Where a swim starts (crawl world, docs/worlds.md): returns (body, velocities, settled). With effect\n"
+      "'ground' the body is moved vertically so that its lowest cell lies on the floor; then settle_steps\n"
+      "(default config.evaluation.settle_steps) control steps without actuation are simulated from rest.\n"
+      "Without ground and settling: the body unchanged, zero velocities, settled 0.");
   m.def("evaluate", [](const Genome& genome, std::optional<Config> config, nb::handle objective) {
         const Config c = config ? *config : Config{};
         const auto scored_by = objective_from_python(objective, c);

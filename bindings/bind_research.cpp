@@ -104,6 +104,14 @@ void visit_result(EvaluationResult& r, V&& v) {
   v("collisions_inelastic", r.collisions_inelastic);
   v("collisions_unresolved", r.collisions_unresolved);
   v("drag_limited", r.drag_limited);
+  v("settle_steps", r.settle_steps);
+  v("ground_contacts", r.ground_contacts);
+  v("ground_slips", r.ground_slips);
+  v("actuation_work", r.actuation_work);
+  v("actuation_work_positive", r.actuation_work_positive);
+  v("actuation_work_absolute", r.actuation_work_absolute);
+  v("cell_work_positive", r.cell_work_positive);
+  v("cell_work_absolute", r.cell_work_absolute);
   v("seconds_development", r.seconds_development);
   v("seconds_body", r.seconds_body);
   v("seconds_swim", r.seconds_swim);
@@ -112,7 +120,7 @@ void visit_result(EvaluationResult& r, V&& v) {
 nb::dict result_state(const EvaluationResult& r) {
   nb::dict d;
   EvaluationResult copy = r;
-  visit_result(copy, [&](const char* name, auto& value) { d[name] = nb::cast(value); });
+  visit_result(copy, [&](const char* name, auto& value) { d[name] = nb::cast(value, nb::rv_policy::copy); });
   return d;
 }
 
@@ -335,7 +343,7 @@ void bind_research(nb::module_& m) {
             nb::object result = nb::cast(r.result);
             if (!nb::hasattr(result, name.c_str()))
               throw nb::attribute_error(("EvaluationRecord has no attribute '" + name + "'").c_str());
-            return result.attr(name.c_str());
+            return nb::object(result.attr(name.c_str()));  // resolved now, while `result` lives
           }, "name"_a)
       .def("__getstate__", [](const EvaluationRecord& r) {
             return nb::make_tuple(std::string("animat.EvaluationRecord"), 1, result_state(r.result), body_state(r.body),

@@ -51,11 +51,44 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 
 }  // namespace
 
-SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
+StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long settle_steps) {
+  if (settle_steps < 0)
+    throw ConfigError(fmt::format("evaluation.settle_steps: {} is out of range (expected >= 0)", settle_steps));
+  StartState out;
+  out.body = body;
+  if (has_effect(scene.effects, "ground") && body.node_count() > 0)
+    out.body.positions.col(1).array() += scene.ground_height - body.positions.col(1).minCoeff();
+  out.velocities = Points::Zero(body.node_count(), 2);
+  if (settle_steps > 0) {
+    SceneParams quiet = scene;
+    std::erase(quiet.effects, std::string("actuation"));
+    Simulation settle(out.body, quiet, physics);
+    settle.step(settle_steps);
+    out.body.positions = settle.positions();
+    out.velocities = settle.velocities();
+    out.settled = settle_steps;
+  }
+  return out;
+}
+
+SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsParams& physics, long steps,
                 const SwimOptions& options) {
   constexpr long kSampleEvery = 16;
   SwimResult r;
+  StartState begin;
+  try {
+    begin = start_state(body_in, scene, physics, options.settle_steps);
+  } catch (const SimulationError& e) {
+    r.stable = false;
+    r.valid = false;
+    r.failure = fmt::format("while settling: {}", e.what());
+    r.min_stretch = 0.0;
+    return r;
+  }
+  r.settle_steps = begin.settled;
+  const Body& body = begin.body;
   Simulation sim(body, scene, physics);
+  if (begin.settled > 0) sim.set_velocities(begin.velocities);
   if (options.check_embedding) sim.monitor_embedding(body);
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   const Eigen::Vector2d start = sim.center_of_mass();
@@ -108,6 +141,22 @@ SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams&
   r.collisions_inelastic = c.collisions_inelastic;
   r.collisions_unresolved = c.collisions_unresolved;
   r.drag_limited = c.drag_limited;
+  r.ground_contacts = c.ground_contacts;
+  r.ground_slips = c.ground_slips;
+  r.actuation_work = c.actuation_work;
+  r.actuation_work_positive = c.actuation_work_positive;
+  r.actuation_work_absolute = c.actuation_work_absolute;
+  if (const Effect* springs = sim.effect("springs")) {
+    std::vector<double> pos, abs;
+    if (actuation_work_per_cell(*springs, pos, abs)) {
+      r.cell_work_positive = Eigen::Map<const Eigen::VectorXd>(pos.data(), static_cast<Eigen::Index>(pos.size()));
+      r.cell_work_absolute = Eigen::Map<const Eigen::VectorXd>(abs.data(), static_cast<Eigen::Index>(abs.size()));
+    }
+  }
+  if (r.cell_work_positive.size() == 0) {
+    r.cell_work_positive = Eigen::VectorXd::Zero(body.node_count());
+    r.cell_work_absolute = Eigen::VectorXd::Zero(body.node_count());
+  }
   if (const EmbeddingMonitor* m = sim.embedding_monitor()) {
     r.embedding_checked = true;
     r.min_area_ratio = m->min_area_ratio();
@@ -176,6 +225,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   SwimOptions options;
   options.check_embedding = config.evaluation.check_embedding;
   options.observer = observer;
+  options.settle_steps = config.evaluation.settle_steps;
   if (observer) observer->on_body(body);
   const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, options);
   out.seconds_swim = seconds_since(t0);
@@ -201,6 +251,14 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   out.collisions_inelastic = s.collisions_inelastic;
   out.collisions_unresolved = s.collisions_unresolved;
   out.drag_limited = s.drag_limited;
+  out.settle_steps = s.settle_steps;
+  out.ground_contacts = s.ground_contacts;
+  out.ground_slips = s.ground_slips;
+  out.actuation_work = s.actuation_work;
+  out.actuation_work_positive = s.actuation_work_positive;
+  out.actuation_work_absolute = s.actuation_work_absolute;
+  out.cell_work_positive = s.cell_work_positive;
+  out.cell_work_absolute = s.cell_work_absolute;
   return out;
 }
 

@@ -146,8 +146,13 @@ const std::vector<std::string>& resumable_keys() {
 
 const std::vector<std::string>& late_keys() {
   // evaluation.objective and .direction came with the research API (issue 16), after the runs of
-  // data/study_issue14; physics.integrator with the native integrator (issue 21).
-  static const std::vector<std::string> keys = {"evaluation.objective", "evaluation.direction", "physics.integrator"};
+  // data/study_issue14; physics.integrator with the native integrator (issue 21); the crawl world's
+  // keys with issue 17 (their defaults leave a swim as it was).
+  static const std::vector<std::string> keys = {
+      "evaluation.objective",     "evaluation.direction",  "physics.integrator",
+      "scene.gravity",            "scene.ground_height",   "scene.ground_friction_static",
+      "scene.ground_friction_kinetic", "evaluation.settle_steps", "evaluation.energy_weight",
+      "evaluation.energy_offset"};
   return keys;
 }
 

@@ -52,6 +52,41 @@ class SpeedToward final : public Objective {
   double dx_ = 1.0, dy_ = 0.0;
 };
 
+/// The crawl world's objective: |horizontal displacement| of the centre of mass, start to end
+/// (either direction, like the paper's distance; vertical motion, e.g. falling, does not count).
+class DistanceX final : public Objective {
+ public:
+  std::string name() const override { return "distance_x"; }
+  double value(const EvaluationRecord& r) const override { return std::abs(r.result.displacement.x()); }
+};
+
+/// The paper's distance minus λ times the positive mechanical work of actuation (evaluation.energy_weight).
+class DistanceMinusEnergy final : public Objective {
+ public:
+  explicit DistanceMinusEnergy(double weight) : weight_(weight) {}
+  std::string name() const override { return "distance_minus_energy"; }
+  double value(const EvaluationRecord& r) const override {
+    return r.result.fitness - weight_ * r.result.actuation_work_positive;
+  }
+
+ private:
+  double weight_;
+};
+
+/// The paper's distance per unit of positive actuation work, distance / (W+ + W0) (W0 =
+/// evaluation.energy_offset > 0 keeps a body that barely works from scoring a ratio of round-off).
+class DistancePerEnergy final : public Objective {
+ public:
+  explicit DistancePerEnergy(double offset) : offset_(offset) {}
+  std::string name() const override { return "distance_per_energy"; }
+  double value(const EvaluationRecord& r) const override {
+    return r.result.fitness / (r.result.actuation_work_positive + offset_);
+  }
+
+ private:
+  double offset_;
+};
+
 /// Copies the body and the sampled frames an objective asked for.
 class Recorder final : public EvaluationObserver {
  public:
@@ -87,7 +122,16 @@ std::shared_ptr<const Objective> make_objective(const EvaluationParams& p) {
     validate(p);
     return std::make_shared<SpeedToward>(p.direction);
   }
-  // Register new built-ins here (distance_minus_energy: once the swim reports actuation energy).
+  if (p.objective == "distance_x") return std::make_shared<DistanceX>();
+  if (p.objective == "distance_minus_energy") {
+    validate(p);
+    return std::make_shared<DistanceMinusEnergy>(p.energy_weight);
+  }
+  if (p.objective == "distance_per_energy") {
+    validate(p);
+    return std::make_shared<DistancePerEnergy>(p.energy_offset);
+  }
+  // Register new built-ins here.
   if (std::string_view(p.objective).starts_with(kPythonObjectivePrefix))
     throw ConfigError(fmt::format("evaluation.objective = \"{}\" is a Python objective: run it from Python with "
                                   "animat.evolve(config, objective=...) (the C++ engine cannot call it)",
@@ -111,6 +155,10 @@ void validate(const EvaluationParams& p) {
   if (!std::isfinite(p.direction[0]) || !std::isfinite(p.direction[1]) || (p.direction[0] == 0.0 && p.direction[1] == 0.0))
     throw ConfigError(fmt::format("evaluation.direction = [{}, {}]: must be finite and not both 0", p.direction[0],
                                   p.direction[1]));
+  if (!(p.energy_weight >= 0.0) || !std::isfinite(p.energy_weight))
+    throw ConfigError(fmt::format("evaluation.energy_weight = {}: must be finite and >= 0", p.energy_weight));
+  if (!(p.energy_offset > 0.0) || !std::isfinite(p.energy_offset))
+    throw ConfigError(fmt::format("evaluation.energy_offset = {}: must be finite and > 0", p.energy_offset));
 }
 
 double body_length(const Body& body) {

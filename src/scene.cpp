@@ -106,7 +106,13 @@ double implicit_quadratic_drag(double w, double c_dt) {
   return 2.0 * w / (1.0 + std::sqrt(1.0 + 4.0 * c_dt * std::abs(w)));
 }
 
-void validate(const SceneParams& params) { check_fields(params, "scene"); }
+void validate(const SceneParams& params) {
+  check_fields(params, "scene");
+  if (params.ground_friction_kinetic > params.ground_friction_static)
+    throw ConfigError(fmt::format("scene.ground_friction_kinetic: {} is above scene.ground_friction_static = {} "
+                                  "(Coulomb friction needs mu_k <= mu_s)",
+                                  params.ground_friction_kinetic, params.ground_friction_static));
+}
 
 void validate(const PhysicsParams& params) { check_fields(params, "physics"); }
 
@@ -118,6 +124,8 @@ std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body, con
   if (name == "drag") return effects::make_drag(body, scene, physics);
   if (name == "collisions") return effects::make_collisions(body, scene);
   if (name == "skin_collision") return effects::make_skin_collision(body, scene);
+  if (name == "gravity") return effects::make_gravity(scene);
+  if (name == "ground") return effects::make_ground(scene);
   throw ConfigError(fmt::format("scene.effects: unknown effect '{}' (expected any of {})", name,
                                 fmt::join(kSceneEffectNames, ", ")));
 }

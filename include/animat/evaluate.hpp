@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "animat/body.hpp"
 #include "animat/config.hpp"
 #include "animat/genome.hpp"
 
@@ -55,14 +56,43 @@ struct SwimResult {
   long collisions_inelastic = 0;
   long collisions_unresolved = 0;
   long drag_limited = 0;              ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
+  // Crawl world and cost of actuation (docs/worlds.md).
+  long settle_steps = 0;              ///< control steps settled (actuation off) before the fitness clock started
+  long ground_contacts = 0;           ///< (cell, Box2D step) contacts with the floor (effect ground; SwimCounters)
+  long ground_slips = 0;              ///< of those, sliding ones (kinetic friction)
+  double actuation_work = 0.0;        ///< net mechanical work of actuation on the springs (measured phase)
+  double actuation_work_positive = 0.0;  ///< positive work, per spring and Box2D step (what an actuator spends)
+  double actuation_work_absolute = 0.0;  ///< absolute work, per spring and Box2D step
+  Eigen::VectorXd cell_work_positive;    ///< per cell: half the positive work of each spring it ends (n)
+  Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each spring it ends (n)
 };
 
 /// Options of swim() beyond the scene and physics.
 struct SwimOptions {
+  /// Control steps simulated before the fitness clock starts, with the scene minus actuation
+  /// (evaluation.settle_steps): the swim then starts from the settled positions and velocities, at
+  /// time 0. With effect "ground" the body is first moved vertically so that its lowest cell lies on
+  /// the floor (whatever settle_steps).
+  long settle_steps = 0;
   bool check_embedding = true;   ///< check the planar embedding after every Box2D step
   bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
   EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
 };
+
+/// Where a swim starts (the crawl world, docs/worlds.md): the body and its velocities.
+struct StartState {
+  Body body;            ///< the body at its starting positions (rest lengths and areas as given)
+  Points velocities;    ///< n × 2 starting velocities (zeros unless settled)
+  long settled = 0;     ///< control steps settled
+};
+
+/// The start of a swim: with effect "ground" in the scene, `body` moved vertically so that its
+/// lowest cell centre lies on the floor; then, if settle_steps > 0, settle_steps control steps of
+/// the scene without actuation from rest, whose end positions and velocities are the start. Without
+/// ground and settling: the body unchanged, at rest. Throws SimulationError if settling leaves the
+/// valid domain, ConfigError for settle_steps < 0. swim() and animat.replay start here.
+[[nodiscard]] StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics,
+                                     long settle_steps);
 
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
 /// simulation failure: it returns stable = false, distance 0 and the message. A swim that breaks
@@ -104,6 +134,14 @@ struct EvaluationResult {
   long collisions_inelastic = 0;    ///< of those, by the inelastic fallback
   long collisions_unresolved = 0;   ///< steps with a crossing no impulse could prevent (must be 0)
   long drag_limited = 0;            ///< drag limiter engagements (drag_scheme "stable" only)
+  long settle_steps = 0;            ///< control steps settled before the fitness clock started
+  long ground_contacts = 0;         ///< (cell, Box2D step) contacts with the floor (effect ground)
+  long ground_slips = 0;            ///< of those, sliding ones
+  double actuation_work = 0.0;           ///< net mechanical work of actuation (docs/worlds.md)
+  double actuation_work_positive = 0.0;  ///< positive actuation work (per spring and Box2D step)
+  double actuation_work_absolute = 0.0;  ///< absolute actuation work (per spring and Box2D step)
+  Eigen::VectorXd cell_work_positive;    ///< per cell: half the positive work of each of its springs
+  Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each of its springs
   double seconds_development = 0.0;  ///< wall time per stage (not deterministic; diagnostics only)
   double seconds_body = 0.0;
   double seconds_swim = 0.0;

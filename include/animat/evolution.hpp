@@ -20,7 +20,8 @@ namespace animat {
 inline constexpr std::string_view kReferenceCheckNames[] = {"record", "select", "off"};
 /// Allowed values of evaluation.objective: the built-in objectives (kObjectiveNames in objective.hpp;
 /// a new one is added to both lists) and "python:NAME" (the trailing * is a wildcard).
-inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "python:*"};
+inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "distance_x",
+                                                         "distance_minus_energy", "distance_per_energy", "python:*"};
 
 /// How an evaluation is run and scored: the swim horizon, the objective (objective.hpp), the
 /// invariants checked, and the exploit guard.
@@ -39,6 +40,15 @@ struct EvaluationParams {
   int reference_substeps = 16;             ///< refinement factor of the reference evaluation
   double reference_tolerance = 0.01;       ///< relative fitness difference that is warned about...
   double reference_abs_tolerance = 0.05;   ///< ...when it also exceeds this many length units
+  /// Control steps simulated before the fitness clock starts, with actuation off (the crawl world:
+  /// the body settles onto the ground); 0 = none, today's swims bit for bit (docs/worlds.md).
+  int settle_steps = 0;
+  /// λ of distance_minus_energy: distance − λ·(positive actuation work) [choose: docs/worlds.md; a
+  /// 20-generation d_N = 2 best swims 12.8 for W⁺ = 6.5e4, so λ = 1e-4 weighs both alike]
+  double energy_weight = 1e-4;
+  /// W₀ of distance_per_energy: distance / (positive actuation work + W₀) [choose: docs/worlds.md; of
+  /// the order of a swimmer's W⁺, so that barely moving bodies do not win on the ratio]
+  double energy_offset = 1e4;
 };
 
 template <class V>
@@ -46,7 +56,10 @@ void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
   v(FieldInfo{"objective", "what the GA maximises: distance (straight-line distance of the centre of mass, the paper's); "
                            "distance_per_size (distance / body length); speed_toward (centre-of-mass speed along "
-                           "evaluation.direction); python:NAME (a Python callable, set by animat.evolve)",
+                           "evaluation.direction); distance_x (|horizontal displacement| of the centre of mass, the "
+                           "crawl world's); distance_minus_energy (distance - energy_weight * positive actuation work); "
+                           "distance_per_energy (distance / (positive actuation work + energy_offset)); python:NAME (a "
+                           "Python callable, set by animat.evolve)",
               Bounds::any(), kObjectiveChoices},
     p.objective);
   v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)", Bounds::closed(-kMaxLength, kMaxLength)}, p.direction);
@@ -55,6 +68,9 @@ void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
   v(FieldInfo{"reference_tolerance", "warn when the best's fitness and its reference differ by more than this fraction...", Bounds::upto(1e6)}, p.reference_tolerance);
   v(FieldInfo{"reference_abs_tolerance", "...and by more than this many length units", Bounds::upto(kMaxLength)}, p.reference_abs_tolerance);
+  v(FieldInfo{"settle_steps", "control steps simulated with actuation off before the fitness clock starts (crawl world: the body settles onto the ground; docs/worlds.md); 0 = none", Bounds::closed(0, 10000000)}, p.settle_steps);
+  v(FieldInfo{"energy_weight", "lambda of objective distance_minus_energy: distance - lambda * positive actuation work, length per energy unit [choose]", Bounds::upto(1e6)}, p.energy_weight);
+  v(FieldInfo{"energy_offset", "W0 of objective distance_per_energy: distance / (positive actuation work + W0), energy units, > 0 [choose]", Bounds::positive_upto(1e12)}, p.energy_offset);
 }
 
 struct Config;

@@ -4,8 +4,8 @@
 // by name (evaluation.objective) and Python can bring its own callable (named "python:NAME").
 //
 // Adding a built-in objective: a name in kObjectiveNames, a class below Objective in
-// src/objective.cpp and one line in make_objective(). The next one is `distance_minus_energy`
-// (waits for the actuation energy diagnostic of the new-worlds issue).
+// src/objective.cpp and one line in make_objective(). The energy objectives (distance_minus_energy,
+// distance_per_energy) read the positive actuation work of the swim (docs/worlds.md).
 #include <memory>
 #include <string>
 #include <string_view>
@@ -21,7 +21,8 @@ struct Config;
 struct EvaluationParams;
 
 /// The built-in objectives, selectable as evaluation.objective.
-inline constexpr std::string_view kObjectiveNames[] = {"distance", "distance_per_size", "speed_toward"};
+inline constexpr std::string_view kObjectiveNames[] = {"distance",   "distance_per_size",     "speed_toward",
+                                                       "distance_x", "distance_minus_energy", "distance_per_energy"};
 /// evaluation.objective of a run whose objective is a Python callable: "python:" + its name.
 inline constexpr std::string_view kPythonObjectivePrefix = "python:";
 

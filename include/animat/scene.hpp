@@ -8,17 +8,17 @@
 // structure-of-arrays SwimState (positions, velocities, zeroed forces) and calls:
 //   1. apply() of every enabled effect in stage order: modifiers first (actuation writes the spring
 //      rest lengths), then force effects, which add their position-dependent forces (spring
-//      elasticity, pressure, skin collision; future: gravity, ground);
+//      elasticity, pressure, skin collision, gravity);
 //   2. apply_velocity() of the velocity-dependent effects (spring damping, drag), which add forces
 //      evaluated at the velocity s.ux, s.uy chosen by physics.velocity_forces: the velocity at the
 //      start of the step, or (default) a prediction of the velocity at the middle of the step, for
 //      which the stepper runs them twice (predictor, then corrector). An effect sees the forces of
 //      the effects before it in s.fx, s.fy, so an implicit scheme (drag) can solve for the
 //      velocity at the end of the step, v + h·F/m;
-//   3. apply() of the constraint effects (collisions), which see every force and change the
-//      end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h).
+//   3. apply() of the constraint effects (collisions, then ground), which see every force and change
+//      the end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h).
 // Effects loop over their own elements inside apply(): one virtual call per effect per pass, never
-// one per element. New effects (gravity, ground friction, active control) are new Effect
+// one per element. New effects (like gravity and ground, docs/worlds.md) are new Effect
 // subclasses (one file each in src/effects/) plus a name in make_effect(); the stepper does not
 // change.
 #include <memory>
@@ -34,7 +34,7 @@ struct Body;
 struct PhysicsParams;
 
 inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation", "pressure", "drag", "collisions",
-                                                         "skin_collision"};
+                                                         "skin_collision", "gravity", "ground"};
 inline constexpr std::string_view kCollisionEdgeNames[] = {"all", "skin"};
 
 /// Units (docs/notes/physics.md): length = the cell spacing at the end of development (cell
@@ -58,6 +58,11 @@ struct SceneParams {
   double collision_tolerance = 1e-3;
   double collision_stiffness = 500.0; ///< penalty stiffness of the optional "skin_collision" effect [choose]
   double collision_radius = 0.25;     ///< distance from a skin edge at which that penalty starts [choose]
+  // The crawl world (docs/worlds.md): effects "gravity" and "ground", off in the default scene.
+  double gravity = 1.0;                  ///< g of effect "gravity": force −m·g along y on every cell [choose]
+  double ground_height = 0.0;            ///< y of the floor of effect "ground" (cell centres stay at or above it) [choose]
+  double ground_friction_static = 0.8;   ///< Coulomb static coefficient μ_s of the floor [choose]
+  double ground_friction_kinetic = 0.5;  ///< Coulomb kinetic coefficient μ_k of the floor, <= μ_s [choose]
 };
 
 template <class V>
@@ -75,6 +80,10 @@ void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"collision_tolerance", "a cell closer than this to an edge it is not an end of collides (length units) [choose]", Bounds{0.0, 0.1, true, false}}, p.collision_tolerance);
   v(FieldInfo{"collision_stiffness", "penalty stiffness of the optional skin_collision effect (a soft force, lets cells through) [choose]", Bounds::upto(kMaxCoefficient)}, p.collision_stiffness);
   v(FieldInfo{"collision_radius", "distance from a skin edge where the skin_collision penalty starts [choose]", Bounds::upto(kMaxLength)}, p.collision_radius);
+  v(FieldInfo{"gravity", "g of effect gravity: force -m*g along y on every cell, length/time^2 (crawl world, docs/worlds.md) [choose]", Bounds::upto(kMaxCoefficient)}, p.gravity);
+  v(FieldInfo{"ground_height", "y of the floor of effect ground, length units; the body is placed with its lowest cell on it [choose]", Bounds::closed(-kMaxLength, kMaxLength)}, p.ground_height);
+  v(FieldInfo{"ground_friction_static", "Coulomb static friction coefficient mu_s of the floor: a contact sticks while the tangential impulse needed is <= mu_s * normal impulse [choose]", Bounds::upto(100.0)}, p.ground_friction_static);
+  v(FieldInfo{"ground_friction_kinetic", "Coulomb kinetic friction coefficient mu_k of the floor (sliding contacts), at most ground_friction_static [choose]", Bounds::upto(100.0)}, p.ground_friction_kinetic);
 }
 
 [[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {
@@ -100,6 +109,14 @@ struct SwimCounters {
   long collisions_unresolved = 0;  ///< Box2D steps after which a crossing could not be prevented
   long collision_max_passes = 0;   ///< most resolution passes one step needed
   long drag_limited = 0;           ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
+  long ground_contacts = 0;        ///< (cell, Box2D step) pairs in which the floor pushed a cell (effect ground)
+  long ground_slips = 0;           ///< of those, contacts that slid (kinetic friction)
+  /// Mechanical work of actuation (effect springs, while actuation changes the rest lengths): per
+  /// spring and Box2D step ΔW = k·(r_k − r_{k−1})·((r_k + r_{k−1})/2 − (ℓ_k + ℓ_{k−1})/2), the
+  /// midpoint rule of ∫ k·(r − ℓ)·dr/dt dt (r rest length, ℓ length; docs/worlds.md).
+  double actuation_work = 0.0;           ///< Σ ΔW (net)
+  double actuation_work_positive = 0.0;  ///< Σ max(ΔW, 0) per spring and step
+  double actuation_work_absolute = 0.0;  ///< Σ |ΔW| per spring and step
 };
 
 /// The state every effect reads and writes during one Box2D step, structure-of-arrays, sized once
@@ -155,6 +172,11 @@ class Effect {
  protected:
   long calls_ = 0;
 };
+
+/// Actuation work per cell accumulated so far by effect `springs` (any other effect: false, outputs
+/// untouched): each spring's positive and absolute work (SwimCounters) split evenly between its two
+/// end cells. Resizes the outputs to the cell count.
+bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positive, std::vector<double>& absolute);
 
 /// The built-in effect `name` (one of kSceneEffectNames) for `body`; throws ConfigError for an
 /// unknown name.

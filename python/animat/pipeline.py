@@ -57,11 +57,14 @@ def build_body(embryo_or_positions: Any, *args: Any, config: Any = None, allow_n
     return _core.build_body(embryo_or_positions, *args, config=config, **kwargs)
 
 
-def swim(body: Any, scene: Any = None, config: Any = None, steps: Optional[int] = None) -> Any:
+def swim(body: Any, scene: Any = None, config: Any = None, steps: Optional[int] = None,
+         settle_steps: Optional[int] = None) -> Any:
     """Swim a body for ``steps`` control steps (default ``config.evaluation.steps``) and return an
     :class:`animat.SwimResult` (distance, displacement, stability and diagnostics). Never raises for
-    an unstable swim: it returns ``stable=False`` and distance 0."""
-    return _core.swim(body, scene, config, steps)
+    an unstable swim: it returns ``stable=False`` and distance 0. ``settle_steps`` (default
+    ``config.evaluation.settle_steps``) control steps are simulated first with actuation off (the
+    crawl world, docs/worlds.md); the distance is measured from there."""
+    return _core.swim(body, scene, config, steps, settle_steps=settle_steps)
 
 
 def load_config(path: Union[str, "os.PathLike[str]"]) -> Any:

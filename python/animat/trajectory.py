@@ -262,7 +262,8 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
     """Swim a genome (or a developed embryo, or a body) again and record it.
 
     The swim is the one ``animat.evaluate`` does: ``develop`` → ``build_body`` → ``Simulation``
-    with ``config``'s scene and physics, so a full replay of a run's best genome with the run's
+    with ``config``'s scene and physics (in the crawl world placed on the floor and settled first,
+    ``animat._core.start_state``; frame 0 is the settled start), so a full replay of a run's best genome with the run's
     config travels exactly its recorded fitness (``trajectory.distance``).
 
     Args:
@@ -293,7 +294,11 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
     if n_steps < 0:
         raise ValueError(f"replay: steps must be >= 0, got {n_steps}")
     body = body_of(genome_or_body, cfg)
+    # The crawl world (docs/worlds.md): placed on the floor and settled, exactly as evaluate() does.
+    body, start_velocities, settled = _core.start_state(body, scene, cfg)
     sim = _core.Simulation(body, scene, cfg)
+    if settled:
+        sim.velocities = start_velocities
     frames = n_steps // every + 1
     n = body.node_count
     pos = np.empty((frames, n, 2))

@@ -12,6 +12,11 @@ namespace {
 
 /// Damped Hooke springs: f = k·(len − rest) + c·(relative velocity along the spring), equal and
 /// opposite on the two ends. Reads the current rest lengths from the state (actuation writes them).
+/// It also meters the mechanical work of actuation: when a rest length changes from r₀ (previous
+/// step) to r while the length goes from ℓ₀ to ℓ, the elastic energy ½k(ℓ − r)² receives
+/// ΔW = k·(r − r₀)·((r + r₀)/2 − (ℓ + ℓ₀)/2) from the actuator: the midpoint rule of the power
+/// k·(r − ℓ)·dr/dt over the step (second order; exactly zero over a period whenever ℓ is an affine
+/// function of r, e.g. an undamped spring in its periodic forced response). docs/worlds.md.
 /// apply() adds the elastic part and keeps the unit vectors; apply_velocity() adds the damping part
 /// at the evaluation velocity s.ux, s.uy.
 class Springs final : public Effect {
@@ -26,6 +31,17 @@ class Springs final : public Effect {
     }
     ex_.assign(at(m), 0.0);
     ey_.assign(at(m), 0.0);
+    n_ = body.node_count();
+    prev_rest_.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
+    prev_rest_.resize(at(m), 0.0);
+    prev_len_.assign(at(m), 0.0);
+    for (int s = 0; s < m; ++s) {
+      const int i = a_[at(s)], j = b_[at(s)];
+      if (i < 0 || j < 0 || i >= n_ || j >= n_) continue;
+      prev_len_[at(s)] = std::hypot(body.positions(j, 0) - body.positions(i, 0), body.positions(j, 1) - body.positions(i, 1));
+    }
+    work_positive_.assign(at(m), 0.0);
+    work_absolute_.assign(at(m), 0.0);
   }
   std::string_view name() const override { return "springs"; }
   void apply(SwimState& s) override {
@@ -39,11 +55,27 @@ class Springs final : public Effect {
     double* fy = s.fy.data();
     double* ex = ex_.data();
     double* ey = ey_.data();
+    double* prev_rest = prev_rest_.data();
+    double* prev_len = prev_len_.data();
+    double net = 0.0, positive = 0.0, absolute = 0.0;
     const std::size_t m = a_.size();
     for (std::size_t e = 0; e < m; ++e) {
       const int i = a[e], j = b[e];
       const double dx = x[j] - x[i], dy = y[j] - y[i];
       const double len = std::sqrt(dx * dx + dy * dy);
+      // Actuation work (SwimCounters::actuation_work): only where the rest length changed.
+      const double r = rest[e], r0 = prev_rest[e];
+      if (r != r0) {
+        const double dw = k_ * (r - r0) * (0.5 * (r + r0) - 0.5 * (len + prev_len[e]));
+        const double pos = dw > 0.0 ? dw : 0.0;
+        net += dw;
+        positive += pos;
+        absolute += std::abs(dw);
+        work_positive_[e] += pos;
+        work_absolute_[e] += std::abs(dw);
+        prev_rest[e] = r;
+      }
+      prev_len[e] = len;
       if (!(len > 0.0)) {  // coincident ends: no direction, no force
         ex[e] = 0.0;
         ey[e] = 0.0;
@@ -59,6 +91,11 @@ class Springs final : public Effect {
       fy[i] += gy;
       fx[j] -= gx;
       fy[j] -= gy;
+    }
+    if (absolute != 0.0) {
+      s.counters.actuation_work += net;
+      s.counters.actuation_work_positive += positive;
+      s.counters.actuation_work_absolute += absolute;
     }
   }
   bool velocity_dependent() const override { return c_ != 0.0; }
@@ -83,10 +120,28 @@ class Springs final : public Effect {
     }
   }
 
+  /// Each spring's work split evenly between its two end cells.
+  void work_per_cell(std::vector<double>& positive, std::vector<double>& absolute) const {
+    positive.assign(at(n_), 0.0);
+    absolute.assign(at(n_), 0.0);
+    for (std::size_t e = 0; e < a_.size(); ++e) {
+      for (const int v : {a_[e], b_[e]}) {
+        if (v < 0 || v >= n_) continue;
+        positive[at(v)] += 0.5 * work_positive_[e];
+        absolute[at(v)] += 0.5 * work_absolute_[e];
+      }
+    }
+  }
+
  private:
   double k_, c_;
+  int n_ = 0;
   std::vector<int> a_, b_;
   std::vector<double> ex_, ey_;  // unit vectors of the current step
+  // Actuation work: rest length and length of every spring at the previous step, and each spring's
+  // positive and absolute work so far.
+  std::vector<double> prev_rest_, prev_len_;
+  std::vector<double> work_positive_, work_absolute_;
 };
 
 }  // namespace
@@ -96,3 +151,14 @@ std::unique_ptr<Effect> make_springs(const Body& body, const SceneParams& scene)
 }
 
 }  // namespace animat::effects
+
+namespace animat {
+
+bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positive, std::vector<double>& absolute) {
+  const auto* s = dynamic_cast<const effects::Springs*>(&springs);
+  if (s == nullptr) return false;
+  s->work_per_cell(positive, absolute);
+  return true;
+}
+
+}  // namespace animat

@@ -387,7 +387,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadTomlCase{"config_malformed.toml", 5, {"malformed TOML"}},
         BadTomlCase{"config_section_not_table.toml", 3, {"'grn' must be a table"}},
         BadTomlCase{"config_bad_choice.toml", 6, {"physics.drag_scheme = \"magic\"", "expected one of semi_implicit, explicit, stable"}},
-        BadTomlCase{"config_bad_list_entry.toml", 6, {"scene.effects", "\"gravity\""}},
+        BadTomlCase{"config_bad_list_entry.toml", 6, {"scene.effects", "\"buoyancy\""}},
         BadTomlCase{"config_elites_not_below_population.toml", 0, {"evolution.elites = 10", "evolution.population = 10"}},
         BadTomlCase{"config_duplicate_key.toml", 7, {"malformed TOML", "dt"}}),
     [](const ::testing::TestParamInfo<BadTomlCase>& info) {

@@ -213,7 +213,8 @@ TEST(Objective, ConfigSelectsABuiltInByNameAndRefusesUnknownOnes) {
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("evaluation.objective = \"distnce\": expected one of distance, "
-                                         "distance_per_size, speed_toward, python:*"),
+                                         "distance_per_size, speed_toward, distance_x, distance_minus_energy, "
+                                         "distance_per_energy, python:*"),
               std::string::npos)
         << e.what();
   }

@@ -83,7 +83,7 @@ TEST(SwimWorld, OneFixturelessBodyPerCellEqualMassesNoSleepNoGravity) {
 
 TEST(SwimWorld, RejectsInvalidParamsAndBodies) {
   const Body b = two_nodes(1.0, 1.0);
-  EXPECT_THROW(Simulation(b, scene_with({"springs", "gravity"})), ConfigError);
+  EXPECT_THROW(Simulation(b, scene_with({"springs", "buoyancy"})), ConfigError);
   EXPECT_THROW(Simulation(b, scene_with({"springs", "springs"})), ConfigError);
   PhysicsParams p;
   p.drag_scheme = "magic";
@@ -101,9 +101,9 @@ TEST(SwimWorld, RejectsInvalidParamsAndBodies) {
   bad.springs(0, 1) = 5;
   EXPECT_THROW(Simulation(bad, SceneParams{}), GeometryError);
   try {
-    Simulation(b, scene_with({"springs", "gravity"}));
+    Simulation(b, scene_with({"springs", "buoyancy"}));
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("gravity"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("buoyancy"), std::string::npos) << e.what();
   }
 }
 
@@ -747,6 +747,9 @@ TEST(Effects, ZeroCoefficientTrajectoryEqualsEffectAbsent) {
       {"skin_collision", [](SceneParams& s) { s.collision_stiffness = 0.0; }, false},
       // Collisions have no coefficient to zero; on a body that never collides they add nothing.
       {"collisions", [](SceneParams&) {}, false},
+      {"gravity", [](SceneParams& s) { s.gravity = 0.0; }, false},
+      // The floor far below a body that never reaches it adds nothing.
+      {"ground", [](SceneParams& s) { s.ground_height = -1000.0; }, false},
   };
   for (const Case& c : cases) {
     const Body& b = c.still_body ? still : moving;
@@ -938,6 +941,24 @@ TEST(Performance, DevelopmentAllocatesOnlyWhenACellIsBorn) {
   }
   EXPECT_EQ(developed, 3);
   EXPECT_GT(quiet_steps, 900);
+}
+
+TEST(Performance, CrawlLoopAllocatesNothing) {
+  // The crawl world's effects (gravity, ground with contacts every step) and the actuation work
+  // metering allocate nothing either.
+  SceneParams scene;
+  scene.effects = {"springs", "actuation", "pressure", "collisions", "gravity", "ground"};
+  Body b = swimmer(lattice_points(8, 4, 0.1, 2), Drive::random);
+  b.positions.col(1).array() -= b.positions.col(1).minCoeff();
+  Simulation sim(b, scene);
+  sim.step(10);
+  g_allocations = 0;
+  g_counting = true;
+  sim.step(2000);
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_GT(sim.counters().ground_contacts, 0);
+  EXPECT_GT(sim.counters().actuation_work_absolute, 0.0);
 }
 
 // --- one Box2D island --------------------------------------------------------------------------------

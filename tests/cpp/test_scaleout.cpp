@@ -261,7 +261,9 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin), text.begin() + static_cast<std::ptrdiff_t>(end), '\n'), 6);
   text.erase(begin, end - begin);
   // So are the late keys at their defaults (evolution.cpp late_keys()), each with its comment line.
-  for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = "}) {
+  for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = ", "\ngravity = ", "\nground_height = ",
+                          "\nground_friction_static = ", "\nground_friction_kinetic = ", "\nsettle_steps = ",
+                          "\nenergy_weight = ", "\nenergy_offset = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;

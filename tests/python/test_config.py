@@ -64,7 +64,7 @@ def test_item_get_set_with_types():
         ("grn.dt", float("inf"), ["grn.dt", "finite"]),
         ("grn.dt", "0.05", ["grn.dt", "wrong type", "expected a number"]),
         ("physics.drag_scheme", "magic", ["physics.drag_scheme", "expected one of", "explicit", "stable"]),
-        ("scene.effects", ["springs", "gravity"], ["scene.effects", "gravity"]),
+        ("scene.effects", ["springs", "buoyancy"], ["scene.effects", "buoyancy"]),
         ("evolution.populaton", 5, ["unknown config key 'evolution.populaton'", "did you mean 'evolution.population'"]),
     ],
 )
@@ -207,7 +207,7 @@ BAD_TOML = [
     ("config_malformed.toml", 5, ["malformed TOML"]),
     ("config_section_not_table.toml", 3, ["'grn' must be a table"]),
     ("config_bad_choice.toml", 6, ['physics.drag_scheme = "magic"', "expected one of"]),
-    ("config_bad_list_entry.toml", 6, ["scene.effects", '"gravity"']),
+    ("config_bad_list_entry.toml", 6, ["scene.effects", '"buoyancy"']),
     ("config_elites_not_below_population.toml", 0, ["evolution.elites = 10", "evolution.population = 10"]),
     ("config_duplicate_key.toml", 7, ["malformed TOML", "dt"]),
 ]

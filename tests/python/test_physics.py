@@ -61,8 +61,8 @@ def test_scene_from_keywords_and_dict():
 def test_scene_rejects_unknown_keywords_effects_and_ranges():
     with pytest.raises(ValueError, match="drag_nromal"):
         animat.Scene(drag_nromal=2.0)
-    with pytest.raises(ValueError, match="gravity"):
-        animat.Scene(effects=["springs", "gravity"])
+    with pytest.raises(ValueError, match="buoyancy"):
+        animat.Scene(effects=["springs", "buoyancy"])
     with pytest.raises(ValueError, match="drag_normal"):
         animat.Scene(drag_normal=-1.0)
     with pytest.raises(ValueError, match="twice"):

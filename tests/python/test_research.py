@@ -56,8 +56,10 @@ def test_builtin_objectives_by_name_and_config_key(viable):
     c2.apply_override("evaluation.direction=[0.0, 1.0]")
     speed = animat.evaluate(g, c2).fitness
     assert speed == pytest.approx(r.displacement[1] / r.simulated_time, rel=1e-12)
-    assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward"}
-    with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, python:"):
+    assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward", "distance_x",
+                                      "distance_minus_energy", "distance_per_energy"}
+    with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, distance_x, "
+                                         "distance_minus_energy, distance_per_energy, python:"):
         c2["evaluation.objective"] = "fastest"
 
 
@@ -417,7 +419,7 @@ def test_public_exports_and_docstrings():
         assert hasattr(animat, name), name
     core_public = {n for n in dir(animat._core) if not n.startswith("_")}
     internal = {"Evolution", "EvolutionSummary", "evolve_cli", "load_config", "develop", "build_body", "swim",
-                "evaluate", "evaluate_population", "record_evaluation", "evolve"}
+                "evaluate", "evaluate_population", "record_evaluation", "evolve", "start_state"}
     assert core_public - internal <= set(animat.__all__), core_public - internal - set(animat.__all__)
     functions = [getattr(animat, n) for n in animat.__all__ if callable(getattr(animat, n))
                  and not isinstance(getattr(animat, n), type)]
