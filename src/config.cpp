@@ -434,6 +434,8 @@ void validate(const Config& config, std::string_view source) {
   try {
     validate(config.development);
     validate(config.evaluation);
+    validate(config.scene);  // its cross-key rules too (e.g. ground friction: mu_k <= mu_s)
+    validate(config.physics);
   } catch (const ConfigError& e) {
     fail(e.what());
   }
