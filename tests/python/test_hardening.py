@@ -197,6 +197,12 @@ def test_evolve_stop_event_returns_an_interrupted_result(tmp_path):
         assert again.history[0].generation == 0
 
 
+def _ctrl_c_as_in_a_terminal():
+    # A job started in the background by a non-interactive shell (`cmd &`) inherits SIGINT ignored, and
+    # Python then installs no KeyboardInterrupt handler: the child would ignore the test's Ctrl-C.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_checkpoint(tmp_path):
     # Was ignored until every generation was done, then the result was lost.
     out = tmp_path / "run"
@@ -215,7 +221,8 @@ def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_ch
         print("not interrupted")
         sys.exit(1)
     """
-    p = subprocess.Popen([PY, "-c", textwrap.dedent(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen([PY, "-c", textwrap.dedent(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         preexec_fn=_ctrl_c_as_in_a_terminal)
     deadline = time.time() + 120
     while not (out / "checkpoint.json").exists() and time.time() < deadline and p.poll() is None:
         time.sleep(0.05)
@@ -251,7 +258,7 @@ def test_experiment_stops_every_run_on_one_ctrl_c(tmp_path):
     out = tmp_path / "exp"
     p = subprocess.Popen([PY, "-m", "animat", "experiment", str(cfg), "--runs", "3", "--parallel", "2", "--threads", "2",
                           "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         cwd=str(tmp_path))
+                         cwd=str(tmp_path), preexec_fn=_ctrl_c_as_in_a_terminal)
     deadline = time.time() + 120
     while time.time() < deadline and p.poll() is None and not all(
             (out / f"run_{i}" / "checkpoint.json").exists() for i in (0, 1)):
