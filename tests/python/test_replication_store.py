@@ -10,7 +10,9 @@ import animat
 from animat import replication_store as R
 
 ROOT = Path(__file__).resolve().parents[2]
-PACKED = ROOT / "data" / "replication" / "dn2" / "run_0"
+# Frozen copies of two packed runs at generation 100 (data/replication itself grows across sessions).
+FIXTURES = ROOT / "tests" / "data" / "replication"
+PACKED = FIXTURES / "dn2_run_0"
 
 
 def test_unpack_then_pack_gives_the_same_bytes(tmp_path):
@@ -50,7 +52,7 @@ def test_report_rebuilds_from_packed_data_alone(tmp_path):
 
     data = tmp_path / "data"
     shutil.copytree(PACKED, data / "dn2" / "run_0")
-    shutil.copytree(ROOT / "data" / "replication" / "dn10" / "run_0", data / "dn10" / "run_0")
+    shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
     doc = tmp_path / "docs" / "replication.md"
     cmd = [sys.executable, str(ROOT / "scripts" / "replication_report.py"), "--data", str(data), "--doc", str(doc),
            "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
