@@ -3,7 +3,8 @@
 //
 // Cells move as fixture-less dynamic Box2D bodies would (semi-implicit Euler with linear damping,
 // no contacts): CellIntegrator performs b2World::Step's float arithmetic for them bit for bit
-// (src/cell_integrator.hpp), so the only cost of the physics is our own pairwise force loop, which runs only when "repulsion" or "adhesion" is enabled. Pairs are enumerated
+// (src/cell_integrator.hpp), so the only cost of the physics is our own pairwise force loop, which
+// runs only when "repulsion" or "adhesion" is enabled. Pairs are enumerated
 // O(n²): at the paper's 32 (64) cells that is 496 (2016) distance checks per step, less than the
 // GRN steps themselves; the morphogen model needs every pair's distance anyway.
 #include "animat/development.hpp"
@@ -60,7 +61,7 @@ struct DevelopmentWorld::Impl {
   struct Cell {
     double radius = 0.0;
     Vec2 orientation{1.0, 0.0};
-    Vec2 position{0.0, 0.0};  ///< cached from Box2D after every physics step (float → double)
+    Vec2 position{0.0, 0.0};  ///< motion's float position after the last physics step, widened (the step checks how far it moved)
     long long last_division = kNever;
   };
   std::uint64_t symmetry_seed = 0;
