@@ -36,7 +36,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 CELLS = [32, 64, 128, 256]
-EFFECTS = ["springs", "actuation", "pressure", "drag", "collisions", "none", "all"]  # BM_Effect/0..6
+EFFECTS = ["springs", "actuation", "pressure", "drag", "collisions", "none", "all (default scene)", "skin_collision",
+           "gravity", "ground (no contact)", "crawl scene (configs/crawl.toml, on the floor)"]  # BM_Effect/0..10
 
 
 def sh(cmd, **kw) -> str:
