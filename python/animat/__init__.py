@@ -43,7 +43,7 @@ from ._core import (
     SwimResult,
 )
 from .animation import animate, mp4_available
-from .control import SwimEnv, gymnasium_available
+from .control import SWIM_ENV_OBJECTIVES, SwimEnv, gymnasium_available
 from .evolution import (
     GA,
     EvolutionResult,
@@ -110,7 +110,7 @@ __all__ = [
     "History", "evaluate_population", "to_fitness", "tournament_probability", "run_experiment",
     "run_study",
     # control
-    "SwimEnv", "gymnasium_available",
+    "SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available",
     # analysis
     "Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE",
     "Trajectory", "replay", "actuation_terms", "actuation_rates", "EXPANDING", "CONTRACTING", "NEUTRAL",

@@ -16,9 +16,13 @@ Actions set every cell's actuation (eq. 2: the rest length of spring (i, j) is
 An action holds for ``frame_skip`` control steps. Observations, shape (4n + m,), float64: the cell
 positions relative to the centre of mass (n × 2, flattened), the cell velocities relative to the
 centre-of-mass velocity (n × 2) and the spring strains ``length / L0 - 1`` (m). The reward is the
-increment of the objective over the step (``distance``, ``distance_per_size`` or ``speed_toward``
-of the config, or ``objective=``), so an episode's return is the objective of its whole swim
-(speed_toward over the episode's full duration). An episode ends (``terminated``) when the swim
+increment of the objective over the step (any objective of the config that a swim alone decides:
+``distance``, ``distance_per_size``, ``speed_toward``, ``distance_x``, ``distance_minus_energy``,
+``distance_per_energy``; or ``objective=``), so an episode's return is the objective of its whole
+swim (speed_toward over the episode's full duration; the energy objectives with the actuation work
+the springs metered since ``reset``, docs/worlds.md). In the crawl world (effect ``ground`` in the
+scene) every episode starts where an evaluation does: the body placed on the floor and settled for
+``evaluation.settle_steps`` steps without actuation (``animat._core.start_state``). An episode ends (``terminated``) when the swim
 leaves the simulator's valid domain, and is truncated after ``max_episode_steps`` steps.
 """
 from __future__ import annotations
@@ -31,7 +35,11 @@ import numpy as np
 from . import _core
 from .trajectory import body_of
 
-__all__ = ["SwimEnv", "gymnasium_available"]
+__all__ = ["SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available"]
+
+#: The objectives SwimEnv can reward: those a swim alone decides (src/objective.cpp's built-ins).
+SWIM_ENV_OBJECTIVES = ("distance", "distance_per_size", "speed_toward", "distance_x", "distance_minus_energy",
+                       "distance_per_energy")
 
 try:  # optional dependency
     import gymnasium as _gym
@@ -59,8 +67,8 @@ class SwimEnv(_EnvBase):
         mode: ``"rest_length"`` or ``"oscillator"``.
         frame_skip: control steps per environment step (each ``physics.dt``).
         max_episode_steps: steps before truncation (default: ``evaluation.steps // frame_skip``).
-        objective: ``"distance"``, ``"distance_per_size"`` or ``"speed_toward"`` (default: the
-            config's ``evaluation.objective``, which must be one of these).
+        objective: one of :data:`SWIM_ENV_OBJECTIVES` (default: the config's
+            ``evaluation.objective``, which must be one of these).
         frequency: oscillator mode: (n,) frequencies or one number (default: the body's).
         velocity_noise: standard deviation of random initial cell velocities drawn at ``reset``
             from the environment's seeded generator (default 0: every episode starts at rest).
@@ -92,8 +100,10 @@ class SwimEnv(_EnvBase):
         if self.max_episode_steps < 1:
             raise ValueError(f"SwimEnv: max_episode_steps must be >= 1, got {self.max_episode_steps}")
         self.objective = str(self.config["evaluation.objective"]) if objective is None else objective
-        if self.objective not in ("distance", "distance_per_size", "speed_toward"):
-            raise ValueError(f"SwimEnv: objective must be distance, distance_per_size or speed_toward, got {self.objective!r}")
+        if self.objective not in SWIM_ENV_OBJECTIVES:
+            raise ValueError(f"SwimEnv: objective must be one of {', '.join(SWIM_ENV_OBJECTIVES)}, got {self.objective!r}")
+        self._energy_weight = float(self.config["evaluation.energy_weight"])
+        self._energy_offset = float(self.config["evaluation.energy_offset"])
         direction = np.asarray(self.config["evaluation.direction"], dtype=np.float64)
         self._direction = direction / np.linalg.norm(direction)
         self._length = float(_core.body_length(self.body))
@@ -102,6 +112,9 @@ class SwimEnv(_EnvBase):
         self.amplitude_max = float(self.config["development.amplitude_max"])
         scene_effects = [e for e in self.config["scene.effects"] if e != "actuation"]
         self._scene = _core.Scene.from_config(self.config).replace(effects=scene_effects)
+        # Crawl world: on the floor and settled, as swim() starts (without ground: the body at rest).
+        self._start_body, self._start_velocities, self.settled = _core.start_state(self.body, None, self.config)
+        self._start_velocities = np.asarray(self._start_velocities)
         n = self.body.node_count
         m = self.body.spring_count
         self._springs = np.asarray(self.body.springs)
@@ -138,6 +151,13 @@ class SwimEnv(_EnvBase):
             return float(np.linalg.norm(disp))
         if self.objective == "distance_per_size":
             return float(np.linalg.norm(disp)) / self._length
+        if self.objective == "distance_x":
+            return float(abs(disp[0]))
+        if self.objective in ("distance_minus_energy", "distance_per_energy"):
+            work = float(self._sim.counters["actuation_work_positive"])
+            if self.objective == "distance_minus_energy":
+                return float(np.linalg.norm(disp)) - self._energy_weight * work
+            return float(np.linalg.norm(disp)) / (work + self._energy_offset)
         horizon = self.max_episode_steps * self.dt
         return float(disp @ self._direction) / horizon
 
@@ -149,13 +169,16 @@ class SwimEnv(_EnvBase):
     def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None) -> Tuple[np.ndarray, Dict[str, Any]]:
         """Start an episode: the body at rest (plus ``velocity_noise``), actuation off. Returns (obs, info)."""
         super().reset(seed=seed)
-        self._sim = _core.Simulation(self.body, self._scene, self.config)
-        self._actuation = self._sim.add_external_actuation(self.body, self.mode)
+        self._sim = _core.Simulation(self._start_body, self._scene, self.config)
+        self._actuation = self._sim.add_external_actuation(self._start_body, self.mode)
         if self._frequency is not None:
             f = np.broadcast_to(np.asarray(self._frequency, dtype=np.float64), (self.body.node_count,))
             self._actuation.frequency = f
+        velocities = self._start_velocities.copy()
         if self.velocity_noise > 0:
-            self._sim.velocities = self.np_random.normal(0.0, self.velocity_noise, size=(self.body.node_count, 2))
+            velocities += self.np_random.normal(0.0, self.velocity_noise, size=(self.body.node_count, 2))
+        if self.settled or self.velocity_noise > 0:
+            self._sim.velocities = velocities
         self._rest0 = np.asarray(self._sim.rest_lengths_now)
         self._steps = 0
         self._com0 = np.asarray(self._sim.center_of_mass())

@@ -100,3 +100,53 @@ def test_a_sinusoidal_controller_swims_farther_than_a_random_one(body_and_config
     random_distance = module.episode(env, module.random_controller(env, seed=0))
     wave_distance = module.episode(env, module.travelling_wave(env))
     assert wave_distance > 2 * random_distance > 0
+
+
+def test_energy_and_horizontal_objectives_are_rewarded_as_the_metered_work_says(body_and_config):
+    """distance_x, distance_minus_energy and distance_per_energy (docs/worlds.md) from the springs' meter."""
+    body, c = body_and_config
+    values = {}
+    for objective in ("distance_x", "distance_minus_energy", "distance_per_energy"):
+        env = animat.SwimEnv(body, c, objective=objective, max_episode_steps=30)
+        env.reset(seed=0)
+        total, t = 0.0, 0.0
+        for _ in range(30):
+            _, reward, terminated, _, info = env.step(0.15 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0]))
+            total += reward
+            t = info["time"]
+            assert not terminated
+        assert total == pytest.approx(env.objective_value(), abs=1e-12)
+        disp = info["com"] - env._com0
+        work = env._sim.counters["actuation_work_positive"]
+        assert work > 0
+        values[objective] = (env.objective_value(), disp, work)
+    value, disp, _ = values["distance_x"]
+    assert value == pytest.approx(abs(disp[0]), rel=1e-12)
+    value, disp, work = values["distance_minus_energy"]
+    assert value == pytest.approx(np.linalg.norm(disp) - c["evaluation.energy_weight"] * work, rel=1e-12)
+    value, disp, work = values["distance_per_energy"]
+    assert value == pytest.approx(np.linalg.norm(disp) / (work + c["evaluation.energy_offset"]), rel=1e-12)
+    with pytest.raises(ValueError, match="objective must be one of"):
+        animat.SwimEnv(body, c, objective="farthest")
+
+
+def test_crawl_episodes_start_on_the_floor_settled_as_an_evaluation_does(body_and_config):
+    from pathlib import Path
+
+    body, _ = body_and_config
+    cfg = animat.load_config(Path(__file__).resolve().parents[2] / "configs" / "crawl.toml")
+    env = animat.SwimEnv(body, cfg, objective="distance_x", max_episode_steps=50)
+    assert env.settled == cfg.evaluation.settle_steps == 300
+    start_body, start_velocities, settled = animat._core.start_state(body, None, cfg)
+    obs, info = env.reset(seed=0)
+    np.testing.assert_array_equal(env._sim.positions, start_body.positions)
+    np.testing.assert_array_equal(env._sim.velocities, start_velocities)
+    floor = cfg.scene.ground_height
+    assert np.asarray(start_body.positions)[:, 1].min() >= floor - 1e-6
+    t = 0.0
+    for _ in range(50):
+        _, _, terminated, _, info = env.step(0.15 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0]))
+        t = info["time"]
+        assert not terminated
+        assert np.asarray(env._sim.positions)[:, 1].min() >= floor - 1e-6  # never below the floor
+    assert env._sim.counters["ground_contacts"] > 0
