@@ -594,7 +594,8 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
 
 def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, commit: str,
               discussion: Optional[Path] = None, calibration: Optional[Dict[str, List[KS.KnownResult]]] = None,
-              data: Optional[Path] = None, target_runs: int = PAPER_RUNS) -> None:
+              data: Optional[Path] = None, target_runs: int = PAPER_RUNS,
+              causes: Optional[List[str]] = None) -> None:
     rel_img = Path(os.path.relpath(images, doc.parent))
     img = lambda name: f"{rel_img.as_posix()}/{name}"  # noqa: E731
     all_runs = [r for e in envs for r in e.runs]
@@ -864,6 +865,8 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
     else:
         w("Nothing measured here differs from the paper's claims.")
     w("")
+    if causes:
+        lines.extend(causes)
     w("<!-- DISCUSSION -->")
     w("")
     if discussion is not None and discussion.exists():
@@ -875,6 +878,66 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
 
     doc.parent.mkdir(parents=True, exist_ok=True)
     doc.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+CAUSE_BASELINE = "dn0.5"
+CAUSE_TITLES = {
+    "frequency_max_12": "frequency bound doubled (`development.frequency_max = 12`)",
+    "substeps_2": "half the physics step (`physics.substeps = 2`)",
+    "no_collisions": "no collision handling (`scene.effects` without `collisions`)",
+    "drag_tangential_x10": "tangential drag ×10 (`scene.drag_tangential = 0.025`, d_T = d_N/20)",
+}
+
+
+def _best_until(run: animat.Run, generation: int) -> Optional[animat.LineageEntry]:
+    lineage = [e for e in run.best_genomes if e.generation <= generation]
+    return lineage[-1] if lineage else None
+
+
+def _cause_row(label: str, index: int, entry: animat.LineageEntry, cfg: animat.Config) -> List[str]:
+    tr = animat.replay(entry, cfg)
+    mode = L.classify_locomotion(tr)
+    body = tr.body
+    f = np.asarray(body.frequency)
+    fmin, fmax = float(cfg["development.frequency_min"]), float(cfg["development.frequency_max"])
+    at_bound = float(np.mean(f >= fmax - 0.02 * (fmax - fmin)))  # the output saturates: within 2 % of the range
+    ph = L.phase_spread(np.asarray(body.phase))
+    return [label, str(index), str(entry.generation), f"{entry.fitness:.2f}", mode.label, f"{f.max():.2f}",
+            f"{at_bound:.0%}", f"{ph.range:.2f}", f"{mode.contrast:.2f}"]
+
+
+def causes_lines(causes: Path, baseline_runs: Path, generation: int = 100) -> List[str]:
+    """Issue 19 item 5: small controlled runs at d_N = 0.5 (seeds 1-3, `generation` generations), one change each,
+    against the study's own runs of the same seeds at the same generation."""
+    header = ["variant", "run", "best of generation", "fitness", "mode", "highest frequency", "cells within 2 % of the frequency bound",
+              "phase range (rad)", "strain contrast"]
+    rows: List[List[str]] = []
+    summary: Dict[str, List[str]] = {}
+    variants = [("baseline (the study's dn0.5 runs)", baseline_runs)] + [
+        (CAUSE_TITLES.get(d.name, d.name), d) for d in sorted(causes.iterdir()) if d.is_dir()]
+    for label, root in variants:
+        for run_dir in sorted(root.glob("run_*"), key=lambda q: int(q.name[4:])):
+            index = int(run_dir.name[4:])
+            if index > 2 or not (run_dir / "config.toml").is_file():
+                continue
+            run = animat.Run(run_dir)
+            entry = _best_until(run, generation)
+            if entry is None:
+                continue
+            row = _cause_row(label, index, entry, run.config)
+            rows.append(row)
+            summary.setdefault(label, []).append(row[4])
+    lines = ["## Controlled runs: what changes the mode at low drag", "",
+             f"Issue 19 asks to test the likely causes of the differences at low drag with small controlled runs. Each "
+             f"variant changes one thing in `configs/paper_dn0.5.toml` and evolves seeds 1–3 for {generation} "
+             "generations; the baseline is the study's own runs of the same seeds, their best at the same generation. "
+             "Packed in `data/replication_causes/<variant>/run_<i>` (run i has seed i + 1); this table is rebuilt from "
+             "there by `scripts/replication_report.py --causes data/replication_causes`. Three runs of 100 generations "
+             "per variant can show a large effect only: they are a screen, not a test.", "",
+             "| " + " | ".join(header) + " |", "| " + " | ".join("---" for _ in header) + " |"]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    lines += ["", "Modes per variant: " + "; ".join(f"{k}: {', '.join(v)}" for k, v in summary.items()) + ".", ""]
+    return lines
 
 
 def main(argv: Optional[List[str]] = None) -> int:
@@ -889,6 +952,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--target-runs", type=int, default=PAPER_RUNS, help="runs per environment the study aims at")
     p.add_argument("--discussion", type=Path, default=Path("docs/notes/replication_discussion.md"),
                    help="hand-written discussion inserted after the tables (if the file exists)")
+    p.add_argument("--causes", type=Path, default=None,
+                   help="packed controlled runs (data/replication_causes): adds their section (issue 19 item 5)")
     args = p.parse_args(argv)
     if args.runs is None and args.data is None:
         args.data = Path("data/replication")
@@ -934,8 +999,13 @@ def main(argv: Optional[List[str]] = None) -> int:
             }
         commit_file = runs_dir / "commit.txt"
         commit = commit_file.read_text().strip() if commit_file.is_file() else "unknown"
+        causes = None
+        if args.causes is not None:
+            causes_dir = Path(tmp) / "_causes"
+            replication_store.unpack_tree(args.causes, causes_dir)
+            causes = causes_lines(causes_dir, runs_dir / CAUSE_BASELINE)
         write_doc(envs, args.runs or runs_dir, args.doc, images, commit, args.discussion, calibration=calibration,
-                  data=args.data, target_runs=args.target_runs)
+                  data=args.data, target_runs=args.target_runs, causes=causes)
     print(f"{args.doc} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
     return 0
 
