@@ -9,7 +9,7 @@
 as actuators. For the best of every run of every objective (data/worlds/energy/<objective>/run_<i>,
 run i has seed i + 1) it develops the best genome, swims it with the run's own config and prints a
 Markdown table: cells, distance, positive actuation work W+, the fraction of cells with a near-zero
-amplitude (a_i < 5 % of development.amplitude_max) and the fraction of cells that do almost no
+amplitude (a_i < 5 % of development.amplitude_max), the mean amplitude over the maximum, and the fraction of cells that do almost no
 positive work (less than 10 % of the body's mean per-cell W+), then the mean of each per objective.
 
 ``crawl``: the crawl world's best: its history, the re-measured fitness and floor counters, the
@@ -61,18 +61,21 @@ def energy(args) -> int:
                 near_zero = float(np.mean(a < NEAR_ZERO_AMPLITUDE * cfg["development.amplitude_max"]))
                 idle = float(np.mean(w < IDLE_WORK * w.mean())) if w.size and w.mean() > 0 else 1.0
                 gens = int(run.history[-1]["generation"])
-                acc.append((r.distance, r.actuation_work_positive, near_zero, idle, body.node_count))
+                rel = float(a.mean() / cfg["development.amplitude_max"])
+                acc.append((r.distance, r.actuation_work_positive, near_zero, idle, rel))
                 rows.append(f"| {group} | {index} | {gens} | {entry.fitness:.6g} | {body.node_count} | {r.distance:.2f} | "
-                            f"{r.actuation_work_positive:.3g} | {near_zero:.2f} | {idle:.2f} |")
+                            f"{r.actuation_work_positive:.3g} | {rel:.2f} | {near_zero:.2f} | {idle:.2f} |")
             means[group] = np.mean(np.asarray(acc), axis=0)
-    print("| objective | run | generations | best fitness | cells | distance | W+ | near-zero amplitude | idle cells |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| objective | run | generations | best fitness | cells | distance | W+ | mean amplitude / max | "
+          "near-zero amplitude | idle cells |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     print("\n".join(rows))
     print()
-    print("| objective | runs | mean distance | mean W+ | mean fraction near-zero amplitude | mean fraction idle |")
-    print("| --- | --- | --- | --- | --- | --- |")
+    print("| objective | runs | mean distance | mean W+ | mean fraction near-zero amplitude | mean fraction idle | "
+          "mean amplitude / max |")
+    print("| --- | --- | --- | --- | --- | --- | --- |")
     for group, m in means.items():
-        print(f"| {group} | {len(groups[group])} | {m[0]:.2f} | {m[1]:.3g} | {m[2]:.2f} | {m[3]:.2f} |")
+        print(f"| {group} | {len(groups[group])} | {m[0]:.2f} | {m[1]:.3g} | {m[2]:.2f} | {m[3]:.2f} | {m[4]:.2f} |")
     return 0
 
 
