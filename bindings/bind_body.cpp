@@ -131,6 +131,11 @@ void bind_body(nb::module_& m) {
       .def_prop_ro("phase", [](const Body& b) { return vector_to_numpy(b.phase); },
                    nb::rv_policy::move,
                    "(n,) float64 oscillator phase per node (rad).")
+      .def_prop_ro("stiffness", [](const Body& b) { return vector_to_numpy(b.stiffness); },
+                   nb::rv_policy::move,
+                   "(n,) float64 stiffness factor per node (GRN output `stiffness`), or (0,) when the body has\n"
+                   "the paper's uniform stiffness. Spring (i, j) has scene.spring_stiffness times the harmonic\n"
+                   "mean 2 f_i f_j / (f_i + f_j).")
       .def_prop_ro("node_count", &Body::node_count, "Number of nodes (cells).")
       .def_prop_ro("spring_count", &Body::spring_count, "Number of springs (Gabriel edges).")
       .def_prop_ro("region_count", &Body::region_count, "Number of regions (bounded faces).")

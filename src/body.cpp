@@ -303,7 +303,16 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
 }
 
 Body build_body(const Embryo& embryo, const BodyParams& params) {
-  return build_body(embryo.positions, embryo.amplitude, embryo.frequency, embryo.phase, params);
+  Body body = build_body(embryo.positions, embryo.amplitude, embryo.frequency, embryo.phase, params);
+  if (embryo.stiffness.size() != 0) {
+    body.stiffness = oscillator(embryo.stiffness, body.node_count(), "stiffness", "build_body");
+    for (int i = 0; i < body.node_count(); ++i) {
+      if (!(body.stiffness(i) > 0.0)) {
+        throw GeometryError(fmt::format("build_body: stiffness[{}] = {} is not > 0", i, body.stiffness(i)));
+      }
+    }
+  }
+  return body;
 }
 
 }  // namespace animat

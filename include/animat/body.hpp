@@ -54,11 +54,20 @@ struct Body {
   /// walk per hole (clockwise around the hole), sorted; none for n <= 1.
   std::vector<std::vector<int>> skin_loops;
   Vector amplitude, frequency, phase;        ///< per-node oscillator parameters (zeros if none given)
+  /// Per-node stiffness factor f (issue 17 part 3, GRN output `stiffness`); empty = every spring has
+  /// scene.spring_stiffness (the paper's uniform stiffness). Spring (i, j) then has stiffness
+  /// k·spring_stiffness_factor(f_i, f_j).
+  Vector stiffness;
 
   [[nodiscard]] int node_count() const { return static_cast<int>(positions.rows()); }
   [[nodiscard]] int spring_count() const { return static_cast<int>(springs.rows()); }
   [[nodiscard]] int region_count() const { return static_cast<int>(regions.size()); }
 };
+
+/// Stiffness factor of a spring between cells with factors fi and fj: their harmonic mean
+/// 2·fi·fj/(fi + fj). Each cell owns half the spring; the halves (stiffness 2k·fi and 2k·fj) act in
+/// series, so 1/k_spring = 1/(2k·fi) + 1/(2k·fj). Exactly 1 when fi = fj = 1.
+[[nodiscard]] inline double spring_stiffness_factor(double fi, double fj) { return 2.0 * fi * fj / (fi + fj); }
 
 /// Delaunay edges (i < j, sorted) of the points; for Fig. 3(b). Same validation as gabriel_graph.
 [[nodiscard]] IndexPairs delaunay_edges(const Points& points, const BodyParams& params = {});

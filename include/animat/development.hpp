@@ -112,6 +112,9 @@ struct Embryo {
   Points orientations;                  ///< unit orientation vectors, n × 2
   OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase)
   Vector amplitude, frequency, phase;   ///< oscillator parameters derived from the outputs
+  /// Stiffness factor per cell from the `stiffness` output (issue 17 part 3); empty unless the
+  /// genome has that output channel enabled (genome.stiffness_output).
+  Vector stiffness;
   std::vector<int> division_steps;      ///< step (1-based) of every division, in order
   int steps_run = 0;                    ///< < params.steps when stopped early (verdict certain)
   bool viable = false;
