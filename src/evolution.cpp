@@ -153,7 +153,11 @@ const std::vector<std::string>& late_keys() {
       "evaluation.objective",     "evaluation.direction",  "physics.integrator",
       "scene.gravity",            "scene.ground_height",   "scene.ground_friction_static",
       "scene.ground_friction_kinetic", "evaluation.settle_steps", "evaluation.energy_weight",
-      "evaluation.energy_offset", "body.graph", "body.distance_threshold", "body.alpha"};
+      "evaluation.energy_offset",
+      // The genome's extension channels (issue 18; docs/model.md): at "" a genome is the paper's.
+      "genome.extra_inputs",      "genome.extra_outputs",
+      // The body graphs (issue 17 part 4): at "gabriel" the body is the paper's.
+      "body.graph", "body.distance_threshold", "body.alpha"};
   return keys;
 }
 
