@@ -424,6 +424,9 @@ void validate(const Config& config, std::string_view source) {
   if (config.evolution.elites >= config.evolution.population)
     fail(fmt::format("evolution.elites = {} must be smaller than evolution.population = {}", config.evolution.elites,
                      config.evolution.population));
+  if (config.development.stiffness_min > config.development.stiffness_max)
+    fail(fmt::format("development.stiffness_min = {} exceeds development.stiffness_max = {}",
+                     config.development.stiffness_min, config.development.stiffness_max));
   if (config.development.frequency_min > config.development.frequency_max)
     fail(fmt::format("development.frequency_min = {} exceeds development.frequency_max = {}",
                      config.development.frequency_min, config.development.frequency_max));

@@ -157,7 +157,9 @@ const std::vector<std::string>& late_keys() {
       // The genome's extension channels (issue 18; docs/model.md): at "" a genome is the paper's.
       "genome.extra_inputs",      "genome.extra_outputs",
       // The body graphs (issue 17 part 4): at "gabriel" the body is the paper's.
-      "body.graph", "body.distance_threshold", "body.alpha"};
+      "body.graph", "body.distance_threshold", "body.alpha",
+      // Evolvable stiffness (issue 17 part 3): used only when genome.extra_outputs has stiffness.
+      "development.stiffness_min", "development.stiffness_max"};
   return keys;
 }
 

@@ -40,6 +40,10 @@ struct DevelopmentParams {
   double frequency_min = 0.5;     ///< oscillator frequency at output 0, rad per unit time [choose]
   double frequency_max = 6.0;     ///< oscillator frequency at output 1 [choose: docs/model.md]
   double amplitude_max = 0.2;     ///< amplitude scale [paper: 0.2]
+  /// Stiffness factor at stiffness output 0 and 1 (issue 17 part 3; only when genome.extra_outputs
+  /// enables `stiffness`): f = stiffness_min·(stiffness_max/stiffness_min)^level, geometric [choose]
+  double stiffness_min = 0.25;
+  double stiffness_max = 4.0;
   // Physics of the development world [choose].
   double time_step = 0.1;             ///< Box2D time step of one development step
   double cell_mass = 1.0;             ///< mass of every cell body (equal masses)
@@ -73,6 +77,8 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"frequency_min", "oscillator frequency (rad per time unit) at frequency output 0 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_min);
   v(FieldInfo{"frequency_max", "oscillator frequency (rad per time unit) at frequency output 1 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_max);
   v(FieldInfo{"amplitude_max", "oscillator amplitude at amplitude output 1 [paper: 0.2]", Bounds::closed(0, 0.45)}, p.amplitude_max);
+  v(FieldInfo{"stiffness_min", "spring stiffness factor of a cell at stiffness output 0 (used only when genome.extra_outputs has stiffness), dimensionless multiple of scene.spring_stiffness, [1e-6, 1e6] [issue 17]", Bounds::closed(1e-6, 1e6)}, p.stiffness_min);
+  v(FieldInfo{"stiffness_max", "stiffness factor at stiffness output 1; the factor is stiffness_min*(stiffness_max/stiffness_min)^output (geometric), [1e-6, 1e6], >= stiffness_min [issue 17]", Bounds::closed(1e-6, 1e6)}, p.stiffness_max);
   v(FieldInfo{"time_step", "Box2D time step of one development step [choose]", Bounds::closed(kMinTimeStep, 1.0)}, p.time_step);
   v(FieldInfo{"cell_mass", "mass of every cell body during development [choose]", Bounds::closed(kMinMass, kMaxMass)}, p.cell_mass);
   v(FieldInfo{"damping", "Box2D linear damping of cells, fluid-like [choose]", Bounds::upto(kMaxCoefficient)}, p.damping);
@@ -115,7 +121,7 @@ struct Embryo {
   OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase; + stiffness, actuation when the genome has extension outputs)
   Vector amplitude, frequency, phase;   ///< oscillator parameters derived from the outputs
   /// Stiffness factor per cell from the `stiffness` output (issue 17 part 3); empty unless the
-  /// genome has that output channel enabled (genome.stiffness_output).
+  /// config enables that output channel (genome.extra_outputs has `stiffness`).
   Vector stiffness;
   std::vector<int> division_steps;      ///< step (1-based) of every division, in order
   int steps_run = 0;                    ///< < params.steps when stopped early (verdict certain)

@@ -41,7 +41,7 @@ inline constexpr int kPaperInputCount = 4;
 /// (channels 0-5), then the extension channels.
 enum class OutputChannel : int {
   divide = 0, rotate = 1, grow = 2, amplitude = 3, frequency = 4, phase = 5,
-  stiffness = 6,  ///< reserved for per-cell spring stiffness (body graphs work); no effect here
+  stiffness = 6,  ///< per-cell spring stiffness factor (issue 17 part 3; development.stiffness_min/max)
   actuation = 7,  ///< the cell's actuation term u_i under control.mode = "grn"
 };
 /// Every known output channel (the paper's and the extensions).
