@@ -133,7 +133,7 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
   std::vector<std::pair<int, int>> delaunay_edges, gabriel_edges, kept_edges;
   delaunay_edges.reserve(3 * static_cast<std::size_t>(n));
   gabriel_edges.reserve(3 * static_cast<std::size_t>(n));
-  infos.reserve(3 * static_cast<std::size_t>(n));
+  if (spec.kind != GraphKind::gabriel) infos.reserve(3 * static_cast<std::size_t>(n));
   for (auto e = dt.finite_edges_begin(); e != dt.finite_edges_end(); ++e) {
     const Face_handle f = e->first;
     const int i = e->second;
@@ -153,9 +153,10 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
       }
     }
     if (gabriel) gabriel_edges.push_back(edge);
-    infos.push_back({edge, f, i, gabriel});
+    if (spec.kind != GraphKind::gabriel) infos.push_back({edge, f, i, gabriel});
   }
-  g.scale = mean_nearest_neighbour(points, delaunay_edges);
+  // The Gabriel graph (the default) needs no length unit: nothing more to compute for it.
+  if (spec.kind != GraphKind::gabriel) g.scale = mean_nearest_neighbour(points, delaunay_edges);
 
   std::vector<std::pair<int, int>> holes;
   if (spec.kind == GraphKind::gabriel) {

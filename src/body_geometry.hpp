@@ -36,6 +36,7 @@ struct GabrielGeometry {
   /// triangle outside the alpha complex, i.e. whose face is a hole. Sorted.
   std::vector<std::pair<int, int>> hole_halfedges;
   /// Mean nearest-neighbour distance of the points (0 for n <= 1): the unit of the graph lengths.
+  /// Not computed (0) for GraphKind::gabriel with 3 or more non-collinear points.
   double scale = 0.0;
 };
 
