@@ -499,7 +499,9 @@ def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes]
     springs.set_array(fs)
     springs.set_cmap(cmap)
     springs.set_norm(norm)
-    springs.update_scalarmappable()
+    # draw_body gave the springs an explicit colour, which matplotlib keeps over the mapping: set the
+    # mapped colours explicitly.
+    springs.set_edgecolor(plt.get_cmap(cmap)(norm(fs)) if len(fs) else "none")
     nodes = artists["nodes"]
     nodes.set_array(f)
     nodes.set_cmap(cmap)

@@ -86,3 +86,24 @@ def test_body_graph_from_config(graph):
     assert np.all(np.asarray(body.rest_areas) > 0)
     with pytest.raises(ValueError, match="body.graph"):
         c["body.graph"] = "voronoi"
+
+
+def test_stiffness_map_colours_springs_by_their_harmonic_mean():
+    pos = np.array([[0, 0], [1, 0], [0.5, 0.9], [1.5, 0.9]], dtype=float)
+    plain = animat.build_body(pos)
+    kind, version, state = plain.__getstate__()  # a Body with evolved factors, through its pickled state
+    f = np.array([0.5, 1.0, 2.0, 4.0])
+    body = animat.Body.__new__(animat.Body)
+    body.__setstate__((kind, version, tuple(state[:10]) + (f,)))
+    assert np.array_equal(body.stiffness, f)
+    old = animat.Body.__new__(animat.Body)  # a state pickled before issue 17 part 3 (10 fields) still loads
+    old.__setstate__((kind, version, tuple(state[:10])))
+    assert len(old.stiffness) == 0 and np.array_equal(old.springs, plain.springs)
+    fig = plot.stiffness_map(body)
+    ax = fig.axes[0]
+    springs = [c for c in ax.collections if c.get_array() is not None and c.get_label() != "nodes"][0]
+    sp = np.asarray(body.springs)
+    expected = 2 * f[sp[:, 0]] * f[sp[:, 1]] / (f[sp[:, 0]] + f[sp[:, 1]])
+    assert np.allclose(springs.get_array(), expected)
+    cmap = plt.get_cmap(plot.STIFFNESS_CMAP)
+    assert np.allclose(springs.get_edgecolor(), cmap(springs.norm(expected)))
