@@ -17,6 +17,8 @@
 #include "animat/body.hpp"
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/physics.hpp"
+#include "animat/scene.hpp"
 #include "animat/random.hpp"
 
 namespace animat {
@@ -524,6 +526,28 @@ TEST(BodyGraphAlpha, AnnulusIsHollow) {
   // A large alpha fills the middle too.
   const Body solid = build_body(p, {}, {}, {}, graph_params("alpha_shape", 100.0));
   EXPECT_EQ(solid.skin_loops.size(), 1U);
+}
+
+TEST(BodyGraphAlpha, HollowBodySwimsInThePapersScene) {
+  // The annulus with a travelling wave of actuation in the default scene (springs, actuation,
+  // pressure, drag, collisions): the hole's boundary is skin and feels drag, the hole has no
+  // pressure, and nothing in the physics assumes one skin loop.
+  std::vector<std::pair<double, double>> xy;
+  for (int k = 0; k < 24; ++k) xy.emplace_back(6.0 * std::cos(k * std::numbers::pi / 12), 6.0 * std::sin(k * std::numbers::pi / 12));
+  for (int k = 0; k < 18; ++k)
+    xy.emplace_back(5.0 * std::cos((k + 0.5) * std::numbers::pi / 9), 5.0 * std::sin((k + 0.5) * std::numbers::pi / 9));
+  const Points p = make_points(xy);
+  const int n = static_cast<int>(p.rows());
+  Vector amplitude = Vector::Constant(n, 0.15), frequency = Vector::Constant(n, 3.0), phase(n);
+  for (int i = 0; i < n; ++i) phase(i) = std::atan2(p(i, 1), p(i, 0)) + std::numbers::pi;
+  const Body body = build_body(p, amplitude, frequency, phase, graph_params("alpha_shape", 2.0));
+  ASSERT_EQ(body.skin_loops.size(), 2U);
+  Simulation sim(body, SceneParams{}, PhysicsParams{});
+  ASSERT_NO_THROW(sim.step(3000));
+  for (int i = 0; i < n; ++i) {
+    ASSERT_TRUE(std::isfinite(sim.state().x[static_cast<std::size_t>(i)]));
+    ASSERT_TRUE(std::isfinite(sim.state().y[static_cast<std::size_t>(i)]));
+  }
 }
 
 TEST(BodyGraphAlpha, CircleIsARingOrADisc) {
