@@ -94,8 +94,9 @@ BodyParams body_params(const std::optional<Config>& config) { return config ? co
 void bind_body(nb::module_& m) {
   nb::class_<Body>(m, "Body",
                    "The spring-mass structure an embryo becomes (paper §3, Fig. 3).\n\n"
-                   "Node i is cell i. Springs are the Gabriel edges of the cell centres; regions are the bounded\n"
-                   "faces of the planar Gabriel graph; the skin is the boundary of the unbounded face. Loops are\n"
+                   "Node i is cell i. Springs are the edges of config.body.graph (default: the Gabriel graph) of the\n"
+                   "cell centres; regions are the bounded faces of that planar graph (for alpha_shape, except the\n"
+                   "holes); the skin is the boundary of the unbounded face and of the holes. Loops are\n"
                    "vertex index arrays with an implicit closing edge (last -> first), each starting at its\n"
                    "lexicographically smallest directed edge. Properties return fresh numpy copies.")
       // Array getters return owned copies, so they must not use the default reference_internal policy.
@@ -104,7 +105,7 @@ void bind_body(nb::module_& m) {
                    "(n, 2) float64 node (cell centre) positions at rest.")
       .def_prop_ro("springs", [](const Body& b) { return pairs_to_numpy(b.springs); },
                    nb::rv_policy::move,
-                   "(m, 2) int64 Gabriel edges (i, j), i < j, sorted lexicographically.")
+                   "(m, 2) int64 body-graph edges (i, j), i < j, sorted lexicographically.")
       .def_prop_ro("rest_lengths", [](const Body& b) { return vector_to_numpy(b.rest_lengths); },
                    nb::rv_policy::move,
                    "(m,) float64 rest length L0 of each spring (its length at construction).")
@@ -117,11 +118,12 @@ void bind_body(nb::module_& m) {
                    "(r,) float64 rest area S0 of each region (> 0, shoelace formula).")
       .def_prop_ro("skin", [](const Body& b) { return pairs_to_numpy(b.skin); },
                    nb::rv_policy::move,
-                   "(k, 2) int64 edges bordering the unbounded face, each once, (i, j) with i < j, sorted.")
+                   "(k, 2) int64 edges bordering the unbounded face or a hole, each once, (i, j) with i < j, sorted.")
       .def_prop_ro("skin_loops", [](const Body& b) { return loops_to_numpy(b.skin_loops); },
                    nb::rv_policy::move,
-                   "list of (l,) int64 arrays: closed walks of the outer boundary, counter-clockwise around the\n"
-                   "body; a dangling edge appears twice. One walk for n >= 2, none for n <= 1.")
+                   "list of (l,) int64 arrays: closed walks of the boundary, body on the left; a dangling edge\n"
+                   "appears twice. The first is the outer boundary (counter-clockwise around the body, one for\n"
+                   "n >= 2, none for n <= 1), then one per hole of an alpha_shape body (clockwise around it).")
       .def_prop_ro("amplitude", [](const Body& b) { return vector_to_numpy(b.amplitude); },
                    nb::rv_policy::move,
                    "(n,) float64 oscillator amplitude per node.")
@@ -131,8 +133,13 @@ void bind_body(nb::module_& m) {
       .def_prop_ro("phase", [](const Body& b) { return vector_to_numpy(b.phase); },
                    nb::rv_policy::move,
                    "(n,) float64 oscillator phase per node (rad).")
+      .def_prop_ro("stiffness", [](const Body& b) { return vector_to_numpy(b.stiffness); },
+                   nb::rv_policy::move,
+                   "(n,) float64 stiffness factor per node (GRN output `stiffness`), or (0,) when the body has\n"
+                   "the paper's uniform stiffness. Spring (i, j) has scene.spring_stiffness times the harmonic\n"
+                   "mean 2 f_i f_j / (f_i + f_j).")
       .def_prop_ro("node_count", &Body::node_count, "Number of nodes (cells).")
-      .def_prop_ro("spring_count", &Body::spring_count, "Number of springs (Gabriel edges).")
+      .def_prop_ro("spring_count", &Body::spring_count, "Number of springs (body-graph edges).")
       .def_prop_ro("region_count", &Body::region_count, "Number of regions (bounded faces).")
       .def("__copy__", [](const Body& b) { return Body(b); })
       .def("__deepcopy__", [](const Body& b, nb::handle) { return Body(b); }, "memo"_a)
@@ -177,8 +184,9 @@ void bind_body(nb::module_& m) {
         }, "positions"_a, "amplitude"_a = nb::none(), "frequency"_a = nb::none(), "phase"_a = nb::none(),
         "config"_a = nb::none(),
         "Build a body from cell centres, an (n, 2) float array, and optional (n,) float arrays of\n"
-        "oscillator amplitude, frequency and phase (None = zeros). Springs are the Gabriel edges,\n"
-        "regions the bounded faces, the skin the outer boundary. Raises ValueError for a wrong shape or\n"
+        "oscillator amplitude, frequency and phase (None = zeros). Springs are the edges of\n"
+        "config.body.graph (default: Gabriel), regions the bounded faces (alpha_shape: except holes), the\n"
+        "skin the outer boundary and the holes' boundaries. Raises ValueError for a wrong shape or\n"
         "length, NaN/inf, coordinates beyond config.body.max_coordinate, or points closer than\n"
         "config.body.merge_distance.");
   m.def("polygon_area", [](nb::handle points, std::vector<int> loop) {

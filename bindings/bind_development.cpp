@@ -65,6 +65,9 @@ void bind_development(nb::module_& m) {
                    "frequency_min) × frequency output.")
       .def_prop_ro("phase", [](const Embryo& e) -> Vector { return e.phase; },
                    "Oscillator phase per cell: 2π × phase output, in [0, 2π).")
+      .def_prop_ro("stiffness", [](const Embryo& e) -> Vector { return e.stiffness; },
+                   "Spring stiffness factor per cell, development.stiffness_min·(stiffness_max/stiffness_min)^output\n"
+                   "(issue 17); empty unless genome.extra_outputs enables the stiffness output.")
       .def_prop_ro("division_steps", [](const Embryo& e) { return e.division_steps; },
                    "Step (1-based) of every division, in order (list of int); len == cell_count - 1.")
       .def_prop_ro("steps_run", [](const Embryo& e) { return e.steps_run; },

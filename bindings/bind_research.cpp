@@ -136,7 +136,7 @@ EvaluationResult result_from_state(nb::handle state) {
 
 nb::tuple body_state(const Body& b) {
   return nb::make_tuple(b.positions, b.springs, b.rest_lengths, b.regions, b.rest_areas, b.skin, b.skin_loops,
-                        b.amplitude, b.frequency, b.phase);
+                        b.amplitude, b.frequency, b.phase, b.stiffness);
 }
 
 Body body_from_state(nb::handle state) {
@@ -152,6 +152,7 @@ Body body_from_state(nb::handle state) {
   b.amplitude = nb::cast<Vector>(t[7]);
   b.frequency = nb::cast<Vector>(t[8]);
   b.phase = nb::cast<Vector>(t[9]);
+  if (t.size() > 10) b.stiffness = nb::cast<Vector>(t[10]);  // absent in states pickled before issue 17 part 3
   return b;
 }
 
@@ -169,7 +170,7 @@ DevelopmentTrace trace_from_state(nb::handle state) {
 
 nb::tuple embryo_state(const Embryo& e) {
   return nb::make_tuple(e.positions, e.radii, e.orientations, e.outputs, e.amplitude, e.frequency, e.phase,
-                        e.division_steps, e.steps_run, e.viable, e.reasons, trace_state(e.trace));
+                        e.division_steps, e.steps_run, e.viable, e.reasons, trace_state(e.trace), e.stiffness);
 }
 
 Embryo embryo_from_state(nb::handle state) {
@@ -187,6 +188,7 @@ Embryo embryo_from_state(nb::handle state) {
   e.viable = nb::cast<bool>(t[9]);
   e.reasons = nb::cast<std::vector<std::string>>(t[10]);
   e.trace = trace_from_state(t[11]);
+  if (t.size() > 12) e.stiffness = nb::cast<Vector>(t[12]);  // absent in states pickled before issue 17 part 3
   return e;
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -33,6 +34,27 @@ void check_params(const BodyParams& params, std::string_view who) {
     throw ConfigError(
         fmt::format("{}: body.max_coordinate must be > 0, got {}", who, params.max_coordinate));
   }
+  if (std::find(std::begin(kBodyGraphNames), std::end(kBodyGraphNames), params.graph) == std::end(kBodyGraphNames)) {
+    throw ConfigError(fmt::format("{}: body.graph must be one of gabriel, distance, alpha_shape, got \"{}\"", who,
+                                  params.graph));
+  }
+  if (!(params.distance_threshold > 0.0) || !(params.distance_threshold <= kMaxLength)) {
+    throw ConfigError(fmt::format("{}: body.distance_threshold must be in (0, {}], got {}", who, kMaxLength,
+                                  params.distance_threshold));
+  }
+  if (!(params.alpha > 0.0) || !(params.alpha <= kMaxLength)) {
+    throw ConfigError(fmt::format("{}: body.alpha must be in (0, {}], got {}", who, kMaxLength, params.alpha));
+  }
+}
+
+detail::GraphSpec graph_spec(const BodyParams& params) {
+  detail::GraphSpec spec;
+  spec.kind = params.graph == "distance"      ? detail::GraphKind::distance
+              : params.graph == "alpha_shape" ? detail::GraphKind::alpha_shape
+                                              : detail::GraphKind::gabriel;
+  spec.distance_threshold = params.distance_threshold;
+  spec.alpha = params.alpha;
+  return spec;
 }
 
 /// Finite, in range, and no two points at exactly the same place. O(n log n).
@@ -98,9 +120,10 @@ void check_merge_distance(const Points& points, const IndexPairs& delaunay, cons
   }
 }
 
-detail::GabrielGeometry checked_geometry(const Points& points, const BodyParams& params, std::string_view who) {
+detail::GabrielGeometry checked_geometry(const Points& points, const BodyParams& params, std::string_view who,
+                                         bool body_graph = false) {
   check_points(points, params, who);
-  detail::GabrielGeometry g = detail::compute_gabriel_geometry(points);
+  detail::GabrielGeometry g = detail::compute_gabriel_geometry(points, body_graph ? graph_spec(params) : detail::GraphSpec{});
   check_merge_distance(points, g.delaunay, params, who);
   return g;
 }
@@ -159,13 +182,13 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
                 const BodyParams& params) {
   constexpr std::string_view who = "build_body";
   const int n = static_cast<int>(positions.rows());
-  const detail::GabrielGeometry g = checked_geometry(positions, params, who);
+  const detail::GabrielGeometry g = checked_geometry(positions, params, who, true);
   Body body;
   body.amplitude = oscillator(amplitude, n, "amplitude", who);
   body.frequency = oscillator(frequency, n, "frequency", who);
   body.phase = oscillator(phase, n, "phase", who);
   body.positions = positions;
-  body.springs = g.gabriel;
+  body.springs = g.edges;
   const Eigen::Index m = body.springs.rows();
   body.rest_lengths.resize(m);
   for (Eigen::Index e = 0; e < m; ++e) body.rest_lengths(e) = distance(positions, body.springs(e, 0), body.springs(e, 1));
@@ -210,17 +233,26 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
   const int outer_start = find_halfedge(g.outer_from, g.outer_to);
   std::vector<int> face_of(static_cast<size_t>(halfedges), -1);
   std::vector<int> outer_walk;
+  std::vector<std::vector<int>> hole_walks;  // alpha_shape: bounded faces outside the alpha complex
+  const auto is_hole_halfedge = [&](int h) {
+    return std::binary_search(g.hole_halfedges.begin(), g.hole_halfedges.end(),
+                              std::pair{from[static_cast<size_t>(h)], to[static_cast<size_t>(h)]});
+  };
   for (int h0 = 0; h0 < halfedges; ++h0) {
     if (face_of[static_cast<size_t>(h0)] >= 0) continue;
     std::vector<int> walk;
+    bool hole = false;
     int h = h0;
     do {
       face_of[static_cast<size_t>(h)] = h0;
       walk.push_back(from[static_cast<size_t>(h)]);
+      hole = hole || (!g.hole_halfedges.empty() && is_hole_halfedge(h));
       h = next[static_cast<size_t>(h)];
     } while (h != h0);
     if (face_of[static_cast<size_t>(outer_start)] == h0) {
       outer_walk = std::move(walk);
+    } else if (hole) {
+      hole_walks.push_back(std::move(walk));
     } else {
       canonical_start(walk);
       body.regions.push_back(std::move(walk));
@@ -240,14 +272,24 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
     body.rest_areas(static_cast<Eigen::Index>(r)) = area;
   }
 
-  // Skin: the outer walk reversed, so that it goes CCW around the body (body on its left).
+  // Skin: the outer walk reversed, so that it goes CCW around the body (body on its left); then the
+  // walk of each hole reversed (clockwise around the hole, body on its left), sorted.
   std::reverse(outer_walk.begin() + 1, outer_walk.end());
   canonical_start(outer_walk);
-  std::vector<std::pair<int, int>> skin_edges;
-  for (size_t i = 0; i < outer_walk.size(); ++i) {
-    const int a = outer_walk[i], b = outer_walk[(i + 1) % outer_walk.size()];
-    skin_edges.emplace_back(std::min(a, b), std::max(a, b));
+  for (auto& walk : hole_walks) {
+    std::reverse(walk.begin() + 1, walk.end());
+    canonical_start(walk);
   }
+  std::sort(hole_walks.begin(), hole_walks.end());
+  std::vector<std::pair<int, int>> skin_edges;
+  const auto add_skin = [&](const std::vector<int>& loop) {
+    for (size_t i = 0; i < loop.size(); ++i) {
+      const int a = loop[i], b = loop[(i + 1) % loop.size()];
+      skin_edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  };
+  add_skin(outer_walk);
+  for (const auto& loop : hole_walks) add_skin(loop);
   std::sort(skin_edges.begin(), skin_edges.end());
   skin_edges.erase(std::unique(skin_edges.begin(), skin_edges.end()), skin_edges.end());
   body.skin.resize(static_cast<Eigen::Index>(skin_edges.size()), 2);
@@ -256,11 +298,21 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
     body.skin(static_cast<Eigen::Index>(k), 1) = skin_edges[k].second;
   }
   body.skin_loops.push_back(std::move(outer_walk));
+  for (auto& walk : hole_walks) body.skin_loops.push_back(std::move(walk));
   return body;
 }
 
 Body build_body(const Embryo& embryo, const BodyParams& params) {
-  return build_body(embryo.positions, embryo.amplitude, embryo.frequency, embryo.phase, params);
+  Body body = build_body(embryo.positions, embryo.amplitude, embryo.frequency, embryo.phase, params);
+  if (embryo.stiffness.size() != 0) {
+    body.stiffness = oscillator(embryo.stiffness, body.node_count(), "stiffness", "build_body");
+    for (int i = 0; i < body.node_count(); ++i) {
+      if (!(body.stiffness(i) > 0.0)) {
+        throw GeometryError(fmt::format("build_body: stiffness[{}] = {} is not > 0", i, body.stiffness(i)));
+      }
+    }
+  }
+  return body;
 }
 
 }  // namespace animat

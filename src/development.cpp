@@ -458,9 +458,11 @@ Points DevelopmentWorld::orientations() const {
   return o;
 }
 OutputLevels DevelopmentWorld::outputs() const {
-  OutputLevels out(cell_count(), kOutputCount);
+  // The paper's 6 columns, or all kOutputCount when the genome has an extension output.
+  const int columns = impl_->grn.output_count();
+  OutputLevels out(cell_count(), columns);
   for (int i = 0; i < cell_count(); ++i)
-    for (int c = 0; c < kOutputCount; ++c) out(i, c) = output(i, static_cast<OutputChannel>(c));
+    for (int c = 0; c < columns; ++c) out(i, c) = output(i, static_cast<OutputChannel>(c));
   return out;
 }
 
@@ -546,6 +548,14 @@ Embryo develop(const Genome& genome, const GenomeParams& genome_params, const Gr
                  (params.frequency_max - params.frequency_min) * e.outputs.col(static_cast<int>(OutputChannel::frequency)).array())
                     .matrix();
   e.phase = 2.0 * std::numbers::pi * e.outputs.col(static_cast<int>(OutputChannel::phase));
+  // Evolvable stiffness (issue 17 part 3): only when the config enables the output; a genome without
+  // a stiffness element has level 0 there (stiffness_min), as a missing amplitude element gives 0.
+  const auto enabled = enabled_output_channels(genome_params);
+  if (std::find(enabled.begin(), enabled.end(), static_cast<int>(OutputChannel::stiffness)) != enabled.end()) {
+    e.stiffness.resize(n);
+    const double ratio = params.stiffness_max / params.stiffness_min;
+    for (int i = 0; i < n; ++i) e.stiffness(i) = params.stiffness_min * std::pow(ratio, world.output(i, OutputChannel::stiffness));
+  }
   e.division_steps = world.division_steps();
   e.viable = e.reasons.empty();
   return e;

@@ -147,12 +147,19 @@ const std::vector<std::string>& resumable_keys() {
 const std::vector<std::string>& late_keys() {
   // evaluation.objective and .direction came with the research API (issue 16), after the runs of
   // data/study_issue14; physics.integrator with the native integrator (issue 21); the crawl world's
-  // keys with issue 17 (their defaults leave a swim as it was).
+  // keys with issue 17 (their defaults leave a swim as it was), as did the body graph keys of issue 17
+  // part 4 (the default graph is the paper's Gabriel graph).
   static const std::vector<std::string> keys = {
       "evaluation.objective",     "evaluation.direction",  "physics.integrator",
       "scene.gravity",            "scene.ground_height",   "scene.ground_friction_static",
       "scene.ground_friction_kinetic", "evaluation.settle_steps", "evaluation.energy_weight",
-      "evaluation.energy_offset"};
+      "evaluation.energy_offset",
+      // The genome's extension channels (issue 18; docs/model.md): at "" a genome is the paper's.
+      "genome.extra_inputs",      "genome.extra_outputs",
+      // The body graphs (issue 17 part 4): at "gabriel" the body is the paper's.
+      "body.graph", "body.distance_threshold", "body.alpha",
+      // Evolvable stiffness (issue 17 part 3): used only when genome.extra_outputs has stiffness.
+      "development.stiffness_min", "development.stiffness_max"};
   return keys;
 }
 

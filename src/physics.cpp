@@ -51,6 +51,11 @@ void check_body(const Body& b) {
     check_index(b.skin(e, 0), "a skin edge");
     check_index(b.skin(e, 1), "a skin edge");
   }
+  if (b.stiffness.size() != 0 && b.stiffness.size() != n)
+    fail(fmt::format("stiffness must have {} entries (or none), got {}", n, b.stiffness.size()));
+  for (Eigen::Index i = 0; i < b.stiffness.size(); ++i)
+    if (!(b.stiffness(i) > 0.0) || !std::isfinite(b.stiffness(i)))
+      fail(fmt::format("node {} has stiffness factor {} (must be finite and > 0)", i, b.stiffness(i)));
   for (const Vector* v : {&b.amplitude, &b.frequency, &b.phase}) {
     if (v->size() != 0 && v->size() != n)
       fail(fmt::format("oscillator vectors must have {} entries (or none), got {}", n, v->size()));

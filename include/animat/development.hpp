@@ -40,6 +40,10 @@ struct DevelopmentParams {
   double frequency_min = 0.5;     ///< oscillator frequency at output 0, rad per unit time [choose]
   double frequency_max = 6.0;     ///< oscillator frequency at output 1 [choose: docs/model.md]
   double amplitude_max = 0.2;     ///< amplitude scale [paper: 0.2]
+  /// Stiffness factor at stiffness output 0 and 1 (issue 17 part 3; only when genome.extra_outputs
+  /// enables `stiffness`): f = stiffness_min·(stiffness_max/stiffness_min)^level, geometric [choose]
+  double stiffness_min = 0.25;
+  double stiffness_max = 4.0;
   // Physics of the development world [choose].
   double time_step = 0.1;             ///< Box2D time step of one development step
   double cell_mass = 1.0;             ///< mass of every cell body (equal masses)
@@ -73,6 +77,8 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"frequency_min", "oscillator frequency (rad per time unit) at frequency output 0 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_min);
   v(FieldInfo{"frequency_max", "oscillator frequency (rad per time unit) at frequency output 1 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_max);
   v(FieldInfo{"amplitude_max", "oscillator amplitude at amplitude output 1 [paper: 0.2]", Bounds::closed(0, 0.45)}, p.amplitude_max);
+  v(FieldInfo{"stiffness_min", "spring stiffness factor of a cell at stiffness output 0 (used only when genome.extra_outputs has stiffness), dimensionless multiple of scene.spring_stiffness, [1e-6, 1e6] [issue 17]", Bounds::closed(1e-6, 1e6)}, p.stiffness_min);
+  v(FieldInfo{"stiffness_max", "stiffness factor at stiffness output 1; the factor is stiffness_min*(stiffness_max/stiffness_min)^output (geometric), [1e-6, 1e6], >= stiffness_min [issue 17]", Bounds::closed(1e-6, 1e6)}, p.stiffness_max);
   v(FieldInfo{"time_step", "Box2D time step of one development step [choose]", Bounds::closed(kMinTimeStep, 1.0)}, p.time_step);
   v(FieldInfo{"cell_mass", "mass of every cell body during development [choose]", Bounds::closed(kMinMass, kMaxMass)}, p.cell_mass);
   v(FieldInfo{"damping", "Box2D linear damping of cells, fluid-like [choose]", Bounds::upto(kMaxCoefficient)}, p.damping);
@@ -103,15 +109,20 @@ struct DevelopmentTrace {
   [[nodiscard]] bool empty() const { return steps.empty(); }
 };
 
-using OutputLevels = Eigen::Matrix<double, Eigen::Dynamic, kOutputCount, Eigen::RowMajor>;
+/// n × (Grn::output_count()) output levels: the paper's 6 columns, or kOutputCount (8) when the
+/// genome has an extension output element.
+using OutputLevels = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// The grown embryo.
 struct Embryo {
   Points positions;                     ///< cell centres, n × 2
   Vector radii;                         ///< n
   Points orientations;                  ///< unit orientation vectors, n × 2
-  OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase)
+  OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase; + stiffness, actuation when the genome has extension outputs)
   Vector amplitude, frequency, phase;   ///< oscillator parameters derived from the outputs
+  /// Stiffness factor per cell from the `stiffness` output (issue 17 part 3); empty unless the
+  /// config enables that output channel (genome.extra_outputs has `stiffness`).
+  Vector stiffness;
   std::vector<int> division_steps;      ///< step (1-based) of every division, in order
   int steps_run = 0;                    ///< < params.steps when stopped early (verdict certain)
   bool viable = false;

@@ -11,6 +11,7 @@ function               paper        shows
 :func:`construction`   Fig. 3       centres → Delaunay → Gabriel graph (regions, skin)
 :func:`motion_cycle`   Figs. 4–6    snapshots of one motion cycle, nodes red / blue / green
 :func:`phase_map`      Fig. 7       nodes coloured by phase shift, maximum indicated
+:func:`stiffness_map`  (Fig. 7)     nodes and springs coloured by evolved stiffness (issue 17)
 :func:`fitness_history` Figs. 8–9   best fitness per generation, morphology changes marked
 =====================  ===========  ==========================================================
 
@@ -39,14 +40,16 @@ from .run import MORPHOLOGY_TOLERANCE, Run
 from .trajectory import CONTRACTING, EXPANDING, NEUTRAL, STATE_NAMES, Trajectory, body_of
 
 __all__ = [
-    "development", "construction", "motion_cycle", "phase_map", "fitness_history", "draw_body",
-    "STATE_COLORS", "PHASE_CMAP", "rotation_to", "development_steps",
+    "development", "construction", "motion_cycle", "phase_map", "stiffness_map", "fitness_history", "draw_body",
+    "STATE_COLORS", "PHASE_CMAP", "STIFFNESS_CMAP", "rotation_to", "development_steps",
 ]
 
 #: Node colours of the motion figures (paper Figs. 4–6): red expanding, blue contracting, green neutral.
 STATE_COLORS = {EXPANDING: "#d62728", CONTRACTING: "#1f77b4", NEUTRAL: "#2ca02c"}
 #: Colour map of :func:`phase_map` (low phase blue, maximum red, as in paper Fig. 7).
 PHASE_CMAP = "jet"
+#: Colour map of :func:`stiffness_map` (soft light, stiff dark).
+STIFFNESS_CMAP = "viridis_r"
 
 SPRING_COLOR = "#8c8c8c"
 SKIN_COLOR = "#111111"
@@ -439,6 +442,89 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = N
         cb.ax.tick_params(labelsize=7)
     ax.set_title(title if title is not None else (f"Phase shifts (paper Fig. 7)\nmax φ = {vmax:.2f} rad" + (
         " (all equal)" if vmax == vmin else f", min {vmin:.2f} rad")), fontsize=9)
+    if standalone:
+        fig.tight_layout()
+    return fig
+
+
+# --- stiffness map (issue 17 part 3), the phase map's sibling ---------------------------------------------
+
+def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = STIFFNESS_CMAP,
+                  colorbar: bool = True, title: Optional[str] = None) -> Figure:
+    """The sibling of :func:`phase_map` (paper Fig. 7 style) for evolved stiffness: the body at rest
+    with every node coloured by its stiffness factor f (GRN output ``stiffness``) and every spring by
+    its own factor, the harmonic mean 2 f_i f_j / (f_i + f_j) of its two cells (its stiffness is
+    ``scene.spring_stiffness`` times that). Colours are on a logarithmic scale over the body's
+    factors; the stiffest node is annotated. A body without evolved stiffness (``body.stiffness``
+    empty: the paper's uniform springs) is drawn with factor 1 everywhere and says so in the title.
+
+    Args:
+        body: an :class:`animat.Body`, Embryo, Genome / LineageEntry (developed with ``config``)
+            or a Trajectory.
+        ax: draw into this Axes (default: a new Figure).
+        cmap: matplotlib colour map name (default ``"viridis_r"``: soft light, stiff dark).
+        colorbar: add a colour bar (factor, log scale).
+    Returns:
+        The Figure. The node collection (label ``"nodes"``) carries the node factors as its array,
+        the spring collection the spring factors; both share one LogNorm.
+    """
+    from matplotlib.colors import LogNorm
+
+    body = body_of(body, config)
+    pos = np.asarray(body.positions)
+    n = len(pos)
+    f = np.asarray(getattr(body, "stiffness", np.empty(0)), dtype=float)
+    uniform = len(f) != n
+    if uniform:
+        f = np.ones(n)
+    sp = np.asarray(body.springs, dtype=np.int64).reshape(-1, 2)
+    fs = 2.0 * f[sp[:, 0]] * f[sp[:, 1]] / (f[sp[:, 0]] + f[sp[:, 1]]) if len(sp) else np.empty(0)
+    standalone = ax is None
+    r = _node_radius(body)
+    pad = r + 0.5
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    if ax is None:
+        ext = hi - lo + 2 * pad
+        h = 3.6
+        w = float(np.clip(h * ext[0] / max(ext[1], 1e-9), 2.5, 8.0)) + (1.1 if colorbar else 0.2)
+        fig = plt.figure(figsize=(w, h + 0.5))
+        ax = fig.add_subplot()
+    else:
+        fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
+        assert isinstance(fig, Figure)
+    vmin, vmax = (float(f.min()), float(f.max())) if n else (1.0, 1.0)
+    norm = LogNorm(vmin=vmin if vmax > vmin else vmax / 2.0, vmax=vmax)
+    artists = draw_body(ax, body, pos, "#ffffff", spring_width=2.0)
+    springs = artists["springs"]
+    springs.set_array(fs)
+    springs.set_cmap(cmap)
+    springs.set_norm(norm)
+    # draw_body gave the springs an explicit colour, which matplotlib keeps over the mapping: set the
+    # mapped colours explicitly.
+    springs.set_edgecolor(plt.get_cmap(cmap)(norm(fs)) if len(fs) else "none")
+    nodes = artists["nodes"]
+    nodes.set_array(f)
+    nodes.set_cmap(cmap)
+    nodes.set_norm(norm)
+    nodes.update_scalarmappable()
+    _frame_axes(ax, lo, hi, pad)
+    if n and not uniform:
+        k = int(np.argmax(f))
+        toward = (lo + hi) / 2 - pos[k]
+        toward = toward / (np.linalg.norm(toward) or 1.0)
+        ax.annotate(f"max {vmax:.2f}", xy=pos[k], xytext=tuple(22 * toward), textcoords="offset points", fontsize=8,
+                    ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
+                    va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
+                    arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
+                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9), zorder=5)
+    if colorbar:
+        cb = fig.colorbar(nodes, ax=ax, fraction=0.045, pad=0.03)
+        cb.set_label("stiffness factor f (× k)", fontsize=8)
+        cb.ax.tick_params(labelsize=7)
+    if title is None:
+        title = ("Stiffness (uniform: no evolved stiffness)" if uniform else
+                 f"Evolved stiffness\nfactor {vmin:.2f} to {vmax:.2f} (× spring_stiffness)")
+    ax.set_title(title, fontsize=9)
     if standalone:
         fig.tight_layout()
     return fig

@@ -1,4 +1,5 @@
-// Effect "springs": damped Hooke springs, the same stiffness and damping for all [paper §4].
+// Effect "springs": damped Hooke springs, the same stiffness and damping for all [paper §4], or a
+// stiffness per spring from the cells' evolved stiffness factors (issue 17 part 3).
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -42,6 +43,14 @@ class Springs final : public Effect {
     }
     work_positive_.assign(at(m), 0.0);
     work_absolute_.assign(at(m), 0.0);
+    if (body.stiffness.size() == n_) {  // evolved stiffness: k per spring from its two end cells
+      ks_.assign(at(m), k_);
+      for (int s = 0; s < m; ++s) {
+        const int i = a_[at(s)], j = b_[at(s)];
+        if (i < 0 || j < 0 || i >= n_ || j >= n_) continue;
+        ks_[at(s)] = k_ * spring_stiffness_factor(body.stiffness(i), body.stiffness(j));
+      }
+    }
   }
   std::string_view name() const override { return "springs"; }
   void apply(SwimState& s) override {
@@ -59,14 +68,16 @@ class Springs final : public Effect {
     double* prev_len = prev_len_.data();
     double net = 0.0, positive = 0.0, absolute = 0.0;
     const std::size_t m = a_.size();
+    const double* ks = ks_.empty() ? nullptr : ks_.data();
     for (std::size_t e = 0; e < m; ++e) {
       const int i = a[e], j = b[e];
+      const double k = ks != nullptr ? ks[e] : k_;
       const double dx = x[j] - x[i], dy = y[j] - y[i];
       const double len = std::sqrt(dx * dx + dy * dy);
       // Actuation work (SwimCounters::actuation_work): only where the rest length changed.
       const double r = rest[e], r0 = prev_rest[e];
       if (r != r0) {
-        const double dw = k_ * (r - r0) * (0.5 * (r + r0) - 0.5 * (len + prev_len[e]));
+        const double dw = k * (r - r0) * (0.5 * (r + r0) - 0.5 * (len + prev_len[e]));
         const double pos = dw > 0.0 ? dw : 0.0;
         net += dw;
         positive += pos;
@@ -85,7 +96,7 @@ class Springs final : public Effect {
       const double ux = dx * inv, uy = dy * inv;
       ex[e] = ux;
       ey[e] = uy;
-      const double f = k_ * (len - rest[e]);
+      const double f = k * (len - rest[e]);
       const double gx = f * ux, gy = f * uy;
       fx[i] += gx;
       fy[i] += gy;
@@ -135,6 +146,7 @@ class Springs final : public Effect {
 
  private:
   double k_, c_;
+  std::vector<double> ks_;  // per-spring stiffness; empty = k_ for every spring
   int n_ = 0;
   std::vector<int> a_, b_;
   std::vector<double> ex_, ey_;  // unit vectors of the current step
