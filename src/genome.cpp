@@ -395,11 +395,15 @@ Genome genome_from_json(std::string_view text, const GenomeParams& params, std::
         const int c = !ch.is_string() ? -1
                       : e.type == ElementType::input ? index_of(kInputNames, ch.get<std::string>())
                                                      : index_of(kOutputNames, ch.get<std::string>());
-        if (c < 0)
+        if (c < 0) {
+          const std::string names = e.type == ElementType::input ? fmt::format("{}", fmt::join(kInputNames, ", "))
+                                                                 : fmt::format("{}", fmt::join(kOutputNames, ", "));
+          if (!ch.is_string())  // a number is not accepted even where it is a channel's index: names only
+            throw GenomeError(fmt::format("{}: channel {} must be a name, one of the {} channels ({})", at, describe(ch),
+                                          element_type_name(e.type), names));
           throw GenomeError(fmt::format("{}: channel {} is not a valid {} channel ({})", at, describe(ch),
-                                        element_type_name(e.type),
-                                        e.type == ElementType::input ? fmt::format("{}", fmt::join(kInputNames, ", "))
-                                                                     : fmt::format("{}", fmt::join(kOutputNames, ", "))));
+                                        element_type_name(e.type), names));
+        }
         e.channel = c;
       } else if (je.contains("channel")) {
         throw GenomeError(fmt::format("{}: {} {} has no channel", at,
