@@ -55,6 +55,18 @@ class Springs final : public Effect {
   std::string_view name() const override { return "springs"; }
   void apply(SwimState& s) override {
     ++calls_;
+    if (ks_.empty())
+      apply_elastic<false>(s);
+    else
+      apply_elastic<true>(s);
+  }
+  bool velocity_dependent() const override { return c_ != 0.0; }
+
+ private:
+  /// The elastic pass; kPerSpring: evolved stiffness (ks_), else the paper's uniform k_ (two loops,
+  /// so the uniform default pays nothing for the option).
+  template <bool kPerSpring>
+  void apply_elastic(SwimState& s) {
     const int* a = a_.data();
     const int* b = b_.data();
     const double* x = s.x.data();
@@ -68,10 +80,10 @@ class Springs final : public Effect {
     double* prev_len = prev_len_.data();
     double net = 0.0, positive = 0.0, absolute = 0.0;
     const std::size_t m = a_.size();
-    const double* ks = ks_.empty() ? nullptr : ks_.data();
+    const double* ks = ks_.data();
     for (std::size_t e = 0; e < m; ++e) {
       const int i = a[e], j = b[e];
-      const double k = ks != nullptr ? ks[e] : k_;
+      const double k = kPerSpring ? ks[e] : k_;
       const double dx = x[j] - x[i], dy = y[j] - y[i];
       const double len = std::sqrt(dx * dx + dy * dy);
       // Actuation work (SwimCounters::actuation_work): only where the rest length changed.
@@ -109,7 +121,8 @@ class Springs final : public Effect {
       s.counters.actuation_work_absolute += absolute;
     }
   }
-  bool velocity_dependent() const override { return c_ != 0.0; }
+
+ public:
   void apply_velocity(SwimState& s) override {
     const int* a = a_.data();
     const int* b = b_.data();
