@@ -119,8 +119,8 @@ def crawl(args) -> int:
                     fig.savefig(out / f"{group}_run{index}_motion_cycle.png", dpi=90)
                     fig = plot.phase_map(body, config=cfg)
                     fig.savefig(out / f"{group}_run{index}_phase_map.png", dpi=90)
-                    animat.animate(full, out / f"{group}_run{index}.gif", align=False, max_frames=160,
-                                   size=(480, 300), colors=48)
+                    animat.animate(full, out / f"{group}_run{index}.gif", align=False, fps=16, max_frames=64,
+                                   size=(360, 220), colors=16, progress=False)
                     print(f"  images: {out}/{group}_run{index}_motion_cycle.png, _phase_map.png, .gif")
     return 0
 
