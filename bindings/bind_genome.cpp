@@ -99,14 +99,19 @@ void bind_genome(nb::module_& m) {
       .value("bias", InputChannel::bias)
       .value("maternal0", InputChannel::maternal0)
       .value("maternal1", InputChannel::maternal1)
-      .value("maternal2", InputChannel::maternal2);
+      .value("maternal2", InputChannel::maternal2)
+      .value("strain", InputChannel::strain, "Extension (beyond the paper): mean relative stretch of the cell's springs while swimming.")
+      .value("pressure", InputChannel::pressure, "Extension: mean S/S0 of the cell's regions while swimming.")
+      .value("chemical", InputChannel::chemical, "Extension: the scene's chemical field at the cell while swimming.");
   nb::enum_<OutputChannel>(m, "OutputChannel", nb::is_arithmetic(), "Special outputs: divide, rotate, grow and the oscillator's amplitude, frequency, phase.")
       .value("divide", OutputChannel::divide)
       .value("rotate", OutputChannel::rotate)
       .value("grow", OutputChannel::grow)
       .value("amplitude", OutputChannel::amplitude)
       .value("frequency", OutputChannel::frequency)
-      .value("phase", OutputChannel::phase);
+      .value("phase", OutputChannel::phase)
+      .value("stiffness", OutputChannel::stiffness, "Extension (beyond the paper): reserved for per-cell spring stiffness.")
+      .value("actuation", OutputChannel::actuation, "Extension: the cell's actuation term under control.mode = \"grn\".");
 
   nb::class_<Genome>(m, "Genome",
                      "A linear genome (paper §2.1): elements with a type, a sign (+1/-1), a channel for special\n"
@@ -238,7 +243,7 @@ void bind_genome(nb::module_& m) {
             new (self) Grn(g, cfg(config, fallback).genome);
           }, "genome"_a, "config"_a = nb::none())
       .def_prop_ro("unit_count", &Grn::unit_count)
-      .def_prop_ro("node_count", &Grn::node_count, "Units plus the 6 outputs: the length of a level vector.")
+      .def_prop_ro("node_count", &Grn::node_count, "Units plus the outputs (6, or 8 when the genome has an extension output): the length of a level vector.")
       .def_prop_ro("morphogen_units", &Grn::morphogen_units, "Units that make a diffusible product.")
       .def("output_index", [](const Grn& g, OutputChannel c) { return g.output_node(c); }, "channel"_a,
            "Index of an output in a level vector.")
@@ -249,7 +254,8 @@ void bind_genome(nb::module_& m) {
             const std::size_t k = w.size();
             return nb::make_tuple(to_numpy(std::move(src), {k}), to_numpy(std::move(dst), {k}), to_numpy(std::move(w), {k}));
           }, "Edge list (sources, targets, weights). Sources: 0-3 inputs, 4..4+U internal products,\n"
-             "4+U..4+2U diffusible products. Targets: 0..U units, U..U+6 outputs.")
+             "4+U..4+2U diffusible products, 4+2U..4+2U+3 the extension inputs strain, pressure, chemical.\n"
+             "Targets: 0..U units, U..node_count outputs.")
       .def("reaches", &Grn::reaches, "channel"_a, "Is there a path from an input to this output?")
       .def("has_required_paths", &Grn::has_required_paths,
            "Viability criterion 1: paths from the inputs to divide, amplitude, frequency and phase.")

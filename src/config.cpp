@@ -427,10 +427,16 @@ void validate(const Config& config, std::string_view source) {
   if (config.development.frequency_min > config.development.frequency_max)
     fail(fmt::format("development.frequency_min = {} exceeds development.frequency_max = {}",
                      config.development.frequency_min, config.development.frequency_max));
-  if (config.genome.max_elements < 2 * config.genome.initial_units + kInputCount + kOutputCount)
+  std::size_t specials = 0;
+  try {
+    specials = enabled_input_channels(config.genome).size() + enabled_output_channels(config.genome).size();
+  } catch (const ConfigError& e) {
+    fail(e.what());  // names genome.extra_inputs / extra_outputs and the value
+  }
+  if (config.genome.max_elements < 2 * config.genome.initial_units + static_cast<int>(specials))
     fail(fmt::format("genome.max_elements = {} cannot hold a random genome of genome.initial_units = {} units "
                      "(needs at least {} elements)", config.genome.max_elements, config.genome.initial_units,
-                     2 * config.genome.initial_units + kInputCount + kOutputCount));
+                     2 * config.genome.initial_units + static_cast<int>(specials)));
   try {
     validate(config.development);
     validate(config.evaluation);

@@ -458,9 +458,11 @@ Points DevelopmentWorld::orientations() const {
   return o;
 }
 OutputLevels DevelopmentWorld::outputs() const {
-  OutputLevels out(cell_count(), kOutputCount);
+  // The paper's 6 columns, or all kOutputCount when the genome has an extension output.
+  const int columns = impl_->grn.output_count();
+  OutputLevels out(cell_count(), columns);
   for (int i = 0; i < cell_count(); ++i)
-    for (int c = 0; c < kOutputCount; ++c) out(i, c) = output(i, static_cast<OutputChannel>(c));
+    for (int c = 0; c < columns; ++c) out(i, c) = output(i, static_cast<OutputChannel>(c));
   return out;
 }
 

@@ -152,7 +152,9 @@ const std::vector<std::string>& late_keys() {
       "evaluation.objective",     "evaluation.direction",  "physics.integrator",
       "scene.gravity",            "scene.ground_height",   "scene.ground_friction_static",
       "scene.ground_friction_kinetic", "evaluation.settle_steps", "evaluation.energy_weight",
-      "evaluation.energy_offset"};
+      "evaluation.energy_offset",
+      // The genome's extension channels (issue 18; docs/model.md): at "" a genome is the paper's.
+      "genome.extra_inputs",      "genome.extra_outputs"};
   return keys;
 }
 

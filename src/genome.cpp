@@ -120,6 +120,52 @@ Element random_element(ElementType type, int channel, const GenomeParams& p, Rng
 
 }  // namespace
 
+namespace {
+
+/// Parses a comma-separated list of extension channel names (`names[first..]`) into ascending
+/// channel numbers appended to the paper's channels 0..first-1.
+template <class Names>
+std::vector<int> enabled_channels(const std::string& list, const Names& names, int first, std::string_view key) {
+  std::vector<bool> on(names.size(), false);
+  const bool blank = list.find_first_not_of(' ') == std::string::npos;  // "" or spaces: none
+  std::size_t begin = 0;
+  while (!blank && begin <= list.size()) {
+    std::size_t end = list.find(',', begin);
+    if (end == std::string::npos) end = list.size();
+    std::string_view word(list.data() + begin, end - begin);
+    while (!word.empty() && word.front() == ' ') word.remove_prefix(1);
+    while (!word.empty() && word.back() == ' ') word.remove_suffix(1);
+    {
+      int c = -1;
+      for (int i = first; i < static_cast<int>(names.size()); ++i)
+        if (names[static_cast<std::size_t>(i)] == word) c = i;
+      if (c < 0)
+        throw ConfigError(fmt::format("genome.{} = \"{}\": unknown channel \"{}\" (expected a comma-separated list of {})",
+                                      key, list, word,
+                                      fmt::join(std::vector<std::string_view>(names.begin() + first, names.end()), ", ")));
+      if (on[static_cast<std::size_t>(c)])
+        throw ConfigError(fmt::format("genome.{} = \"{}\": channel \"{}\" is listed twice", key, list, word));
+      on[static_cast<std::size_t>(c)] = true;
+    }
+    begin = end + 1;
+  }
+  std::vector<int> out;
+  for (int c = 0; c < first; ++c) out.push_back(c);
+  for (int c = first; c < static_cast<int>(names.size()); ++c)
+    if (on[static_cast<std::size_t>(c)]) out.push_back(c);
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> enabled_input_channels(const GenomeParams& p) {
+  return enabled_channels(p.extra_inputs, kInputNames, kPaperInputCount, "extra_inputs");
+}
+
+std::vector<int> enabled_output_channels(const GenomeParams& p) {
+  return enabled_channels(p.extra_outputs, kOutputNames, kPaperOutputCount, "extra_outputs");
+}
+
 Genome random_genome(const GenomeParams& p, Rng& rng) {
   // Units first, then every special element is inserted at a random unit boundary.
   std::vector<std::vector<Element>> blocks;
@@ -132,8 +178,9 @@ Genome random_genome(const GenomeParams& p, Rng& rng) {
     const auto at = static_cast<std::ptrdiff_t>(rng.below(blocks.size() + 1));
     blocks.insert(blocks.begin() + at, std::vector<Element>{random_element(type, channel, p, rng)});
   };
-  for (int c = 0; c < kInputCount; ++c) insert_special(ElementType::input, c);
-  for (int c = 0; c < kOutputCount; ++c) insert_special(ElementType::output, c);
+  // Paper channels first, extensions after: with none enabled, the draws are the paper's.
+  for (int c : enabled_input_channels(p)) insert_special(ElementType::input, c);
+  for (int c : enabled_output_channels(p)) insert_special(ElementType::output, c);
   Genome g;
   g.dimensions = p.dimensions;
   for (auto& b : blocks)
@@ -141,7 +188,11 @@ Genome random_genome(const GenomeParams& p, Rng& rng) {
   return g;
 }
 
-int mutate_types(Genome& g, const MutationParams& m, Rng& rng) {
+int mutate_types(Genome& g, const MutationParams& m, Rng& rng) { return mutate_types(g, m, GenomeParams{}, rng); }
+
+int mutate_types(Genome& g, const MutationParams& m, const GenomeParams& p, Rng& rng) {
+  const std::vector<int> inputs = enabled_input_channels(p);
+  const std::vector<int> outputs = enabled_output_channels(p);
   int changes = 0;
   for (Element& e : g.elements) {
     if (!rng.bernoulli(m.type_rate)) continue;
@@ -149,8 +200,8 @@ int mutate_types(Genome& g, const MutationParams& m, Rng& rng) {
     const int old_type = static_cast<int>(e.type);
     const int new_type = (old_type + 1 + static_cast<int>(rng.below(kElementTypeCount - 1))) % kElementTypeCount;
     e.type = static_cast<ElementType>(new_type);
-    e.channel = e.type == ElementType::input    ? static_cast<int>(rng.below(kInputCount))
-                : e.type == ElementType::output ? static_cast<int>(rng.below(kOutputCount))
+    e.channel = e.type == ElementType::input    ? inputs[rng.below(inputs.size())]
+                : e.type == ElementType::output ? outputs[rng.below(outputs.size())]
                                                 : 0;
     ++changes;
   }
@@ -199,7 +250,7 @@ void delete_series(Genome& g, std::size_t start, std::size_t length) {
 }
 
 int mutate(Genome& g, const MutationParams& m, const GenomeParams& p, Rng& rng) {
-  int changes = mutate_types(g, m, rng) + mutate_signs(g, m, rng) + mutate_coordinates(g, m, rng);
+  int changes = mutate_types(g, m, p, rng) + mutate_signs(g, m, rng) + mutate_coordinates(g, m, rng);
   if (!g.elements.empty() && rng.bernoulli(m.duplicate_rate)) {
     const std::size_t start = rng.below(g.elements.size());
     const std::size_t length = 1 + rng.below(static_cast<std::uint64_t>(m.max_series_length));

@@ -14,6 +14,9 @@ constexpr double kBelowOne = 1.0 - 0x1.0p-53;  // the largest double below 1
 
 Grn::Grn(const Genome& genome, const GenomeParams& params) : layout_(parse_units(genome)) {
   units_ = static_cast<int>(layout_.units.size());
+  for (int oi : layout_.outputs)
+    if (genome.elements[static_cast<std::size_t>(oi)].channel >= kPaperOutputCount) outputs_ = kOutputCount;
+  for (int ei : layout_.inputs) has_input_[static_cast<std::size_t>(genome.elements[static_cast<std::size_t>(ei)].channel)] = true;
   morphogen_index_.assign(static_cast<std::size_t>(units_), -1);
   has_internal_.assign(static_cast<std::size_t>(units_), false);
   for (int u = 0; u < units_; ++u) {
@@ -30,12 +33,17 @@ Grn::Grn(const Genome& genome, const GenomeParams& params) : layout_(parse_units
 
   // (source element, source node) and (acceptor element, target node) lists.
   std::vector<std::pair<int, int>> products, acceptors;
-  for (int ei : layout_.inputs)
-    products.emplace_back(ei, genome.elements[static_cast<std::size_t>(ei)].channel);
+  // Source numbering: the paper's inputs 0-3, internal products 4..4+U, diffusible products
+  // 4+U..4+2U, then the extension inputs (strain, pressure, chemical) 4+2U..4+2U+3, so that a paper
+  // genome's sources (and the edge order) are what they always were.
+  for (int ei : layout_.inputs) {
+    const int c = genome.elements[static_cast<std::size_t>(ei)].channel;
+    products.emplace_back(ei, c < kPaperInputCount ? c : c + 2 * units_);
+  }
   for (int u = 0; u < units_; ++u) {
     for (int gi : layout_.units[static_cast<std::size_t>(u)].genes) {
       const bool morph = genome.elements[static_cast<std::size_t>(gi)].type == ElementType::morphogen_gene;
-      products.emplace_back(gi, kInputCount + (morph ? units_ : 0) + u);
+      products.emplace_back(gi, kPaperInputCount + (morph ? units_ : 0) + u);
     }
     for (int pi : layout_.units[static_cast<std::size_t>(u)].promoters) acceptors.emplace_back(pi, u);
   }
@@ -61,7 +69,7 @@ Grn::Grn(const Genome& genome, const GenomeParams& params) : layout_(parse_units
   // sources of that unit.
   std::vector<bool> node_reached(static_cast<std::size_t>(node_count()), false);
   std::vector<bool> source_reached(static_cast<std::size_t>(source_count()), false);
-  for (int c = 0; c < kInputCount; ++c) source_reached[static_cast<std::size_t>(c)] = true;
+  for (int c = 0; c < kInputCount; ++c) source_reached[static_cast<std::size_t>(c < kPaperInputCount ? c : c + 2 * units_)] = true;
   for (bool changed = true; changed;) {
     changed = false;
     for (const Edge& e : edges_) {
@@ -69,22 +77,23 @@ Grn::Grn(const Genome& genome, const GenomeParams& params) : layout_(parse_units
       node_reached[static_cast<std::size_t>(e.target)] = true;
       changed = true;
       if (e.target < units_) {
-        source_reached[static_cast<std::size_t>(kInputCount + e.target)] = true;
-        source_reached[static_cast<std::size_t>(kInputCount + units_ + e.target)] = true;
+        source_reached[static_cast<std::size_t>(kPaperInputCount + e.target)] = true;
+        source_reached[static_cast<std::size_t>(kPaperInputCount + units_ + e.target)] = true;
       }
     }
   }
-  for (int c = 0; c < kOutputCount; ++c) reachable_[static_cast<std::size_t>(c)] = node_reached[static_cast<std::size_t>(units_ + c)];
+  for (int c = 0; c < outputs_; ++c) reachable_[static_cast<std::size_t>(c)] = node_reached[static_cast<std::size_t>(units_ + c)];
 }
 
 Grn::SourceKind Grn::source_kind(int s) const {
-  if (s < kInputCount) return SourceKind::input;
-  return s < kInputCount + units_ ? SourceKind::internal_product : SourceKind::diffusible_product;
+  if (s < kPaperInputCount || s >= kPaperInputCount + 2 * units_) return SourceKind::input;
+  return s < kPaperInputCount + units_ ? SourceKind::internal_product : SourceKind::diffusible_product;
 }
 
 int Grn::source_unit(int s) const {
-  if (s < kInputCount) return s;
-  return (s - kInputCount) % std::max(units_, 1);
+  if (s < kPaperInputCount) return s;
+  if (s >= kPaperInputCount + 2 * units_) return s - 2 * units_;  // an extension input's channel
+  return (s - kPaperInputCount) % std::max(units_, 1);
 }
 
 GrnState Grn::initial_state() const {
@@ -98,9 +107,10 @@ void Grn::step(GrnState& state, const GrnInputs& in, const GrnParams& params) co
   const double* level = state.levels.data();
   double* act = state.activation.data();
   auto concentration = [&](int s) -> double {
-    if (s < kInputCount) return s == 0 ? 1.0 : in.maternal[static_cast<std::size_t>(s - 1)];
-    if (s < kInputCount + units_) return level[s - kInputCount];
-    const int u = s - kInputCount - units_;
+    if (s < kPaperInputCount) return s == 0 ? 1.0 : in.maternal[static_cast<std::size_t>(s - 1)];
+    if (s < kPaperInputCount + units_) return level[s - kPaperInputCount];
+    if (s >= kPaperInputCount + 2 * units_) return in.sensors[static_cast<std::size_t>(s - kPaperInputCount - 2 * units_)];
+    const int u = s - kPaperInputCount - units_;
     const int m = morphogen_index_[static_cast<std::size_t>(u)];
     return in.morphogens.empty() ? level[u] : in.morphogens[static_cast<std::size_t>(m)];
   };
@@ -132,13 +142,15 @@ bool Grn::has_required_paths() const {
 std::string Grn::to_dot() const {
   std::string out = "digraph grn {\n  rankdir=LR;\n";
   for (int c = 0; c < kInputCount; ++c)
-    out += fmt::format("  in{} [label=\"{}\", shape=box, style=filled, fillcolor=lightblue];\n", c, kInputNames[static_cast<std::size_t>(c)]);
+    if (c < kPaperInputCount || has_input_[static_cast<std::size_t>(c)])  // extension inputs only when used
+      out += fmt::format("  in{} [label=\"{}\", shape=box, style=filled, fillcolor=lightblue];\n", c, kInputNames[static_cast<std::size_t>(c)]);
   for (int u = 0; u < units_; ++u)
     out += fmt::format("  u{} [label=\"unit {}{}\"];\n", u, u, morphogen_index_[static_cast<std::size_t>(u)] >= 0 ? " (morphogen)" : "");
-  for (int c = 0; c < kOutputCount; ++c)
+  for (int c = 0; c < outputs_; ++c)
     out += fmt::format("  out{} [label=\"{}\", shape=box, style=filled, fillcolor=lightyellow];\n", c, kOutputNames[static_cast<std::size_t>(c)]);
   for (const Edge& e : edges_) {
-    const std::string src = e.source < kInputCount ? fmt::format("in{}", e.source) : fmt::format("u{}", source_unit(e.source));
+    const std::string src = source_kind(e.source) == SourceKind::input ? fmt::format("in{}", source_unit(e.source))
+                                                                       : fmt::format("u{}", source_unit(e.source));
     const std::string dst = e.target < units_ ? fmt::format("u{}", e.target) : fmt::format("out{}", e.target - units_);
     out += fmt::format("  {} -> {} [label=\"{:.3g}\", color={}{}];\n", src, dst, e.weight, e.weight < 0 ? "red" : "black",
                        source_kind(e.source) == SourceKind::diffusible_product ? ", style=dashed" : "");

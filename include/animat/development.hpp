@@ -103,14 +103,16 @@ struct DevelopmentTrace {
   [[nodiscard]] bool empty() const { return steps.empty(); }
 };
 
-using OutputLevels = Eigen::Matrix<double, Eigen::Dynamic, kOutputCount, Eigen::RowMajor>;
+/// n × (Grn::output_count()) output levels: the paper's 6 columns, or kOutputCount (8) when the
+/// genome has an extension output element.
+using OutputLevels = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// The grown embryo.
 struct Embryo {
   Points positions;                     ///< cell centres, n × 2
   Vector radii;                         ///< n
   Points orientations;                  ///< unit orientation vectors, n × 2
-  OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase)
+  OutputLevels outputs;                 ///< n × 6 output levels (divide, rotate, grow, amplitude, frequency, phase; + stiffness, actuation when the genome has extension outputs)
   Vector amplitude, frequency, phase;   ///< oscillator parameters derived from the outputs
   std::vector<int> division_steps;      ///< step (1-based) of every division, in order
   int steps_run = 0;                    ///< < params.steps when stopped early (verdict certain)

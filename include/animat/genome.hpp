@@ -23,19 +23,38 @@ enum class ElementType : std::uint8_t {
 };
 inline constexpr int kElementTypeCount = 5;
 
-/// Special inputs [paper §2.1]: a constant 1 and three maternal morphogens.
-enum class InputChannel : int { bias = 0, maternal0 = 1, maternal1 = 2, maternal2 = 3 };
-inline constexpr int kInputCount = 4;
-/// Special outputs [paper §2.1]: three developmental actions and three oscillator parameters.
-enum class OutputChannel : int { divide = 0, rotate = 1, grow = 2, amplitude = 3, frequency = 4, phase = 5 };
-inline constexpr int kOutputCount = 6;
+/// Special inputs [paper §2.1]: a constant 1 and three maternal morphogens (channels 0-3), then the
+/// extension channels beyond the paper (docs/model.md, "Genome channels"): sensors a cell reads while
+/// it swims under control.mode = "grn" (docs/control.md). Channel numbers are fixed forever: genome
+/// files name channels, and run identity depends on which are enabled.
+enum class InputChannel : int {
+  bias = 0, maternal0 = 1, maternal1 = 2, maternal2 = 3,
+  strain = 4,    ///< mean relative stretch of the cell's springs (swim only)
+  pressure = 5,  ///< mean S/S0 of the cell's regions (swim only)
+  chemical = 6,  ///< the scene's chemical field at the cell (swim only)
+};
+/// Every known input channel (the paper's and the extensions).
+inline constexpr int kInputCount = 7;
+/// The paper's input channels: 0 .. kPaperInputCount-1. Always enabled.
+inline constexpr int kPaperInputCount = 4;
+/// Special outputs [paper §2.1]: three developmental actions and three oscillator parameters
+/// (channels 0-5), then the extension channels.
+enum class OutputChannel : int {
+  divide = 0, rotate = 1, grow = 2, amplitude = 3, frequency = 4, phase = 5,
+  stiffness = 6,  ///< reserved for per-cell spring stiffness (body graphs work); no effect here
+  actuation = 7,  ///< the cell's actuation term u_i under control.mode = "grn"
+};
+/// Every known output channel (the paper's and the extensions).
+inline constexpr int kOutputCount = 8;
+/// The paper's output channels: 0 .. kPaperOutputCount-1. Always enabled.
+inline constexpr int kPaperOutputCount = 6;
 
 inline constexpr std::array<std::string_view, kElementTypeCount> kElementTypeNames = {
     "promoter", "internal_gene", "morphogen_gene", "input", "output"};
-inline constexpr std::array<std::string_view, kInputCount> kInputNames = {"bias", "maternal0", "maternal1",
-                                                                          "maternal2"};
-inline constexpr std::array<std::string_view, kOutputCount> kOutputNames = {"divide",    "rotate",    "grow",
-                                                                            "amplitude", "frequency", "phase"};
+inline constexpr std::array<std::string_view, kInputCount> kInputNames = {
+    "bias", "maternal0", "maternal1", "maternal2", "strain", "pressure", "chemical"};
+inline constexpr std::array<std::string_view, kOutputCount> kOutputNames = {
+    "divide", "rotate", "grow", "amplitude", "frequency", "phase", "stiffness", "actuation"};
 
 /// One genetic element. `channel` names the input or output of a special element and is 0 otherwise.
 struct Element {
@@ -66,6 +85,12 @@ struct GenomeParams {
   int initial_units = 10;         ///< regulatory units of a random genome [paper: 10]
   double morphogen_gene_probability = 0.25;  ///< chance that a random gene codes for a morphogen
   int max_elements = 10000;       ///< safety cap: longer genomes are rejected as absurd
+  /// Extension input channels (beyond the paper's 4) that random genomes and mutations may create:
+  /// comma-separated names from strain, pressure, chemical; "" = none (the paper's genome).
+  std::string extra_inputs;
+  /// Extension output channels that random genomes and mutations may create: comma-separated names
+  /// from stiffness, actuation; "" = none.
+  std::string extra_outputs;
 };
 
 /// Rates of the genetic operators (paper §5). Per-element rates apply to every element independently.
@@ -89,7 +114,16 @@ void visit_fields(GenomeParams& p, V&& v) {
   v(FieldInfo{"initial_units", "regulatory units (promoter + gene) in a random genome [paper: 10]", Bounds::closed(0, 1000)}, p.initial_units);
   v(FieldInfo{"morphogen_gene_probability", "chance that a random gene codes for a morphogen [choose]", Bounds::unit()}, p.morphogen_gene_probability);
   v(FieldInfo{"max_elements", "safety cap on genome length; longer genomes are rejected [choose]", Bounds::closed(1, 1000000)}, p.max_elements);
+  v(FieldInfo{"extra_inputs", "extension input channels random genomes and mutations may create, comma-separated: strain, pressure, chemical; \"\" = the paper's 4 inputs only (docs/model.md) [beyond the paper]"}, p.extra_inputs);
+  v(FieldInfo{"extra_outputs", "extension output channels random genomes and mutations may create, comma-separated: stiffness, actuation; \"\" = the paper's 6 outputs only (docs/model.md) [beyond the paper]"}, p.extra_outputs);
 }
+
+/// The input channels random genomes and mutations draw from: the paper's 0-3, then the enabled
+/// extension channels in ascending channel order (whatever order genome.extra_inputs lists them).
+/// Throws ConfigError naming genome.extra_inputs and the value for an unknown or repeated name.
+[[nodiscard]] std::vector<int> enabled_input_channels(const GenomeParams& params);
+/// The same for outputs: 0-5, then the enabled extensions (genome.extra_outputs).
+[[nodiscard]] std::vector<int> enabled_output_channels(const GenomeParams& params);
 
 template <class V>
 void visit_fields(MutationParams& p, V&& v) {
@@ -131,11 +165,15 @@ struct GenomeLayout {
 void validate(const Genome& genome, const GenomeParams& params, std::string_view source = "genome");
 
 /// A random genome as the paper seeds it: `initial_units` units of one promoter and one gene, with one
-/// special element per input and per output channel inserted at random places between units.
+/// special element per enabled input and output channel (enabled_input_channels,
+/// enabled_output_channels) inserted at random places between units.
 [[nodiscard]] Genome random_genome(const GenomeParams& params, Rng& rng);
 
 // Genetic operators (paper §5). Each keeps the genome valid; each returns how many changes it made.
+/// A new special element gets a channel drawn uniformly from the enabled channels of `params`
+/// (the overload without params: the paper's channels).
 int mutate_types(Genome& g, const MutationParams& m, Rng& rng);
+int mutate_types(Genome& g, const MutationParams& m, const GenomeParams& params, Rng& rng);
 int mutate_signs(Genome& g, const MutationParams& m, Rng& rng);
 int mutate_coordinates(Genome& g, const MutationParams& m, Rng& rng);
 /// Copies elements [start, start+length) and inserts the copy right after the series.

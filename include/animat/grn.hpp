@@ -23,7 +23,7 @@ void visit_fields(GrnParams& p, V&& v) {
   v(FieldInfo{"dt", "time step of eq. 1, dL = (tanh(A/2) - L) dt [paper: 0.05]", Bounds{0.0, 1.0, true, false}}, p.dt);
 }
 
-/// Levels of one cell's network: units first, then the 6 outputs. All in [0, 1).
+/// Levels of one cell's network: units first, then the outputs (Grn::output_count()). All in [0, 1).
 struct GrnState {
   std::vector<double> levels;
   std::vector<double> activation;  ///< scratch for step(); kept here so stepping never allocates
@@ -35,6 +35,9 @@ struct GrnState {
 struct GrnInputs {
   std::array<double, 3> maternal{};
   std::span<const double> morphogens{};
+  /// Extension inputs strain, pressure, chemical (InputChannel 4-6): 0 during development and
+  /// open-loop swims; set by the GRN controller while swimming (docs/control.md).
+  std::array<double, kInputCount - kPaperInputCount> sensors{};
 };
 
 class Grn {
@@ -42,7 +45,7 @@ class Grn {
   enum class SourceKind { input, internal_product, diffusible_product };
   struct Edge {
     int source;  ///< see source_kind()/source_unit()
-    int target;  ///< [0, units) unit, [units, units + 6) output
+    int target;  ///< [0, units) unit, [units, units + output_count()) output
     double weight;
   };
 
@@ -50,7 +53,10 @@ class Grn {
   Grn(const Genome& genome, const GenomeParams& params);
 
   [[nodiscard]] int unit_count() const { return units_; }
-  [[nodiscard]] int node_count() const { return units_ + kOutputCount; }
+  [[nodiscard]] int node_count() const { return units_ + outputs_; }
+  /// Output nodes: the paper's 6, or all kOutputCount when the genome has an extension output
+  /// element (so that paper genomes keep their level vectors, units + 6, bit for bit).
+  [[nodiscard]] int output_count() const { return outputs_; }
   /// Units with at least one morphogen gene, in unit order; GrnInputs::morphogens follows this order.
   [[nodiscard]] const std::vector<int>& morphogen_units() const { return morphogen_units_; }
   [[nodiscard]] const std::vector<Edge>& edges() const { return edges_; }
@@ -64,8 +70,9 @@ class Grn {
   /// One step of eq. 1 for every unit and output, synchronously. A is clamped at 0 from below, so
   /// each level relaxes towards tanh(max(A,0)/2) ∈ [0, 1) and stays in [0, 1). Allocation-free.
   void step(GrnState& state, const GrnInputs& inputs, const GrnParams& params) const;
+  /// The level of output `c`; 0 for an extension output this network has no node for.
   [[nodiscard]] double output(const GrnState& state, OutputChannel c) const {
-    return state.levels[static_cast<std::size_t>(output_node(c))];
+    return static_cast<int>(c) < outputs_ ? state.levels[static_cast<std::size_t>(output_node(c))] : 0.0;
   }
 
   /// Is there a directed path from at least one input to this output?
@@ -77,6 +84,8 @@ class Grn {
 
  private:
   int units_ = 0;
+  int outputs_ = kPaperOutputCount;
+  std::array<bool, kInputCount> has_input_{};  ///< the genome has an element of this input channel
   GenomeLayout layout_;
   std::vector<int> morphogen_units_;
   std::vector<int> morphogen_index_;   ///< unit -> index in morphogen_units_, or -1

@@ -289,14 +289,14 @@ TEST(Validate, AcceptsWellFormedAndRejectsEachDefectNamingIt) {
             std::string::npos);
 
   Genome bad_input_channel = ok;
-  bad_input_channel.elements[2].channel = 4;
+  bad_input_channel.elements[2].channel = 7;  // 0-3 the paper's, 4-6 the extensions (strain, pressure, chemical)
   const std::string m1 = message_of([&] { validate(bad_input_channel, GenomeParams{}); });
   EXPECT_NE(m1.find("element 2"), std::string::npos) << m1;
-  EXPECT_NE(m1.find("channel 4 out of range [0, 4)"), std::string::npos) << m1;
+  EXPECT_NE(m1.find("channel 7 out of range [0, 7)"), std::string::npos) << m1;
 
   Genome bad_output_channel = ok;
-  bad_output_channel.elements[3].channel = 6;
-  EXPECT_NE(message_of([&] { validate(bad_output_channel, GenomeParams{}); }).find("channel 6 out of range [0, 6)"),
+  bad_output_channel.elements[3].channel = 8;  // 0-5 the paper's, 6-7 stiffness and actuation
+  EXPECT_NE(message_of([&] { validate(bad_output_channel, GenomeParams{}); }).find("channel 8 out of range [0, 8)"),
             std::string::npos);
 
   Genome channel_on_promoter = ok;
@@ -337,7 +337,7 @@ TEST(RandomGenome, HasThePaperLayout) {
     const Genome g = random_with(seed, p);
     ASSERT_NO_THROW(validate(g, p));
     EXPECT_EQ(g.dimensions, 2);
-    EXPECT_EQ(g.size(), static_cast<std::size_t>(2 * p.initial_units + kInputCount + kOutputCount));
+    EXPECT_EQ(g.size(), static_cast<std::size_t>(2 * p.initial_units + kPaperInputCount + kPaperOutputCount));
     const GenomeLayout l = parse_units(g);
     ASSERT_EQ(l.units.size(), static_cast<std::size_t>(p.initial_units)) << "seed " << seed;
     for (const auto& u : l.units) {
@@ -446,7 +446,112 @@ TEST(Operators, MutateTypesReachesEveryTypeAndChannel) {
     mutate_types(g, m, rng);
     for (const Element& e : g.elements) seen.insert({static_cast<int>(e.type), e.channel});
   }
-  EXPECT_EQ(seen.size(), 3u + kInputCount + kOutputCount);
+  EXPECT_EQ(seen.size(), 3u + kPaperInputCount + kPaperOutputCount);  // the paper's channels only
+}
+
+// --- Extension channels (genome.extra_inputs / extra_outputs, docs/model.md "Genome channels") ----
+
+TEST(GenomeChannels, FixedNumbersAndNames) {
+  EXPECT_EQ(static_cast<int>(InputChannel::strain), 4);
+  EXPECT_EQ(static_cast<int>(InputChannel::pressure), 5);
+  EXPECT_EQ(static_cast<int>(InputChannel::chemical), 6);
+  EXPECT_EQ(static_cast<int>(OutputChannel::stiffness), 6);
+  EXPECT_EQ(static_cast<int>(OutputChannel::actuation), 7);
+  EXPECT_EQ(kInputNames[6], "chemical");
+  EXPECT_EQ(kOutputNames[6], "stiffness");
+  EXPECT_EQ(kOutputNames[7], "actuation");
+  EXPECT_EQ(kPaperInputCount, 4);
+  EXPECT_EQ(kPaperOutputCount, 6);
+}
+
+TEST(GenomeChannels, EnabledListsParseInChannelOrderAndRejectBadNames) {
+  GenomeParams p;
+  EXPECT_EQ(enabled_input_channels(p), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(enabled_output_channels(p), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  p.extra_inputs = "chemical, strain";
+  p.extra_outputs = "actuation";
+  EXPECT_EQ(enabled_input_channels(p), (std::vector<int>{0, 1, 2, 3, 4, 6}));
+  EXPECT_EQ(enabled_output_channels(p), (std::vector<int>{0, 1, 2, 3, 4, 5, 7}));
+  p.extra_outputs = "stiffness,actuation";
+  EXPECT_EQ(enabled_output_channels(p), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  for (const char* bad : {"bias", "strain,strain", "strian", "strain,", ",strain"}) {
+    p.extra_inputs = bad;
+    try {
+      (void)enabled_input_channels(p);
+      ADD_FAILURE() << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("genome.extra_inputs"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    }
+  }
+  Config c;
+  c.genome.extra_outputs = "divide";
+  try {
+    validate(c);
+    ADD_FAILURE() << "a paper channel is not an extension";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("genome.extra_outputs = \"divide\""), std::string::npos) << e.what();
+  }
+  apply_override(c, "genome.extra_outputs=actuation");
+  EXPECT_NO_THROW(validate(c));
+  EXPECT_EQ(std::get<std::string>(get_value(c, "genome.extra_outputs")), "actuation");
+}
+
+TEST(GenomeChannels, RandomGenomesAndMutationsDrawOnlyEnabledChannels) {
+  GenomeParams p;
+  p.extra_inputs = "chemical";
+  p.extra_outputs = "actuation";
+  MutationParams m;
+  m.type_rate = 1.0;
+  std::set<int> ins, outs;
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    Rng rng(seed);
+    Genome g = random_genome(p, rng);
+    ASSERT_EQ(g.size(), static_cast<std::size_t>(2 * p.initial_units + 5 + 7));
+    const GenomeLayout l = parse_units(g);
+    std::set<int> gi, go;
+    for (int i : l.inputs) gi.insert(g.elements[static_cast<std::size_t>(i)].channel);
+    for (int o : l.outputs) go.insert(g.elements[static_cast<std::size_t>(o)].channel);
+    EXPECT_EQ(gi, (std::set<int>{0, 1, 2, 3, 6}));
+    EXPECT_EQ(go, (std::set<int>{0, 1, 2, 3, 4, 5, 7}));
+    mutate_types(g, m, p, rng);
+    for (const Element& e : g.elements) {
+      if (e.type == ElementType::input) ins.insert(e.channel);
+      if (e.type == ElementType::output) outs.insert(e.channel);
+    }
+  }
+  EXPECT_EQ(ins, (std::set<int>{0, 1, 2, 3, 6}));
+  EXPECT_EQ(outs, (std::set<int>{0, 1, 2, 3, 4, 5, 7}));
+}
+
+TEST(GenomeChannels, DefaultsDrawExactlyThePapersStream) {
+  // With no extension enabled, random genomes and mutations consume the RNG exactly as before:
+  // the explicit-params overload equals the paper's one, draw for draw.
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    Rng a(seed), b(seed);
+    Genome ga = random_genome(GenomeParams{}, a);
+    Genome gb = random_genome(GenomeParams{}, b);
+    MutationParams m;
+    m.type_rate = 0.3;
+    mutate_types(ga, m, a);
+    mutate_types(gb, m, GenomeParams{}, b);
+    EXPECT_EQ(ga, gb);
+    EXPECT_EQ(a(), b());
+  }
+}
+
+TEST(GenomeChannels, JsonWithExtensionChannelNamesRoundTrips) {
+  Genome g = make({I, P, G, O, O});
+  g.elements[0].channel = static_cast<int>(InputChannel::strain);
+  g.elements[3].channel = static_cast<int>(OutputChannel::actuation);
+  g.elements[4].channel = static_cast<int>(OutputChannel::stiffness);
+  const std::string text = to_json(g);
+  EXPECT_NE(text.find("\"strain\""), std::string::npos);
+  EXPECT_NE(text.find("\"actuation\""), std::string::npos);
+  EXPECT_NE(text.find("\"stiffness\""), std::string::npos);
+  EXPECT_EQ(genome_from_json(text), g);  // loads whatever genome.extra_* say (docs/model.md)
+  g.elements[3].channel = kOutputCount;
+  EXPECT_THROW(validate(g, GenomeParams{}), GenomeError);
 }
 
 TEST(Operators, MutateSignsFlipsAtItsRate) {

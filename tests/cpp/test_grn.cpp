@@ -30,8 +30,8 @@ Element out(OutputChannel c, double x, double y, int sign = 1) {
 Genome genome(std::vector<Element> els) { return Genome{2, std::move(els)}; }
 
 // Source indices as documented: 0-3 inputs, 4+u internal product of unit u, 4+U+u diffusible product.
-int internal_src(int u) { return kInputCount + u; }
-int diffusible_src(const Grn& g, int u) { return kInputCount + g.unit_count() + u; }
+int internal_src(int u) { return kPaperInputCount + u; }
+int diffusible_src(const Grn& g, int u) { return kPaperInputCount + g.unit_count() + u; }
 
 double weight(const Grn& g, int source, int target) {
   double w = 0.0;
@@ -80,7 +80,7 @@ TEST(GrnStructure, NodesAreUnitsThenOutputs) {
                            out(OutputChannel::divide, 9, 9)});
   const Grn grn(g, GenomeParams{});
   EXPECT_EQ(grn.unit_count(), 2);
-  EXPECT_EQ(grn.node_count(), 2 + kOutputCount);
+  EXPECT_EQ(grn.node_count(), 2 + kPaperOutputCount);  // no extension output: the paper's 6
   EXPECT_EQ(grn.output_node(OutputChannel::divide), 2);
   EXPECT_EQ(grn.output_node(OutputChannel::phase), 7);
   EXPECT_EQ(grn.source_count(), kInputCount + 4);
@@ -92,7 +92,7 @@ TEST(GrnStructure, NodesAreUnitsThenOutputs) {
 TEST(GrnStructure, EmptyGenome) {
   const Grn grn(Genome{}, GenomeParams{});
   EXPECT_EQ(grn.unit_count(), 0);
-  EXPECT_EQ(grn.node_count(), kOutputCount);
+  EXPECT_EQ(grn.node_count(), kPaperOutputCount);
   EXPECT_TRUE(grn.edges().empty());
   EXPECT_FALSE(grn.has_required_paths());
   GrnState s = grn.initial_state();
@@ -492,4 +492,44 @@ TEST(GrnDot, ContainsNodesAndEdges) {
   for (std::size_t pos = dot.find("->"); pos != std::string::npos; pos = dot.find("->", pos + 2)) ++arrows;
   EXPECT_EQ(arrows, grn.edges().size());
   EXPECT_EQ(arrows, 3u);
+}
+
+// --- Extension channels (docs/model.md "Genome channels") ----------------------------------------
+
+TEST(GrnChannels, PaperGenomesKeepSixOutputNodesExtensionOutputsAddTwo) {
+  const Grn paper(genome({in(InputChannel::bias, 0, 0), out(OutputChannel::divide, 0, 0)}), GenomeParams{});
+  EXPECT_EQ(paper.output_count(), kPaperOutputCount);
+  EXPECT_EQ(paper.node_count(), kPaperOutputCount);
+  EXPECT_EQ(paper.output(paper.initial_state(), OutputChannel::actuation), 0.0);
+  const Grn ext(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 9, 9), out(OutputChannel::actuation, 0, 0)}),
+                GenomeParams{});
+  EXPECT_EQ(ext.output_count(), kOutputCount);
+  EXPECT_EQ(ext.node_count(), 1 + kOutputCount);
+  EXPECT_EQ(ext.output_node(OutputChannel::actuation), 1 + 7);
+  EXPECT_TRUE(ext.reaches(OutputChannel::actuation));
+}
+
+TEST(GrnChannels, SensorInputsComeAfterTheProductsAndFollowTheirValue) {
+  // strain -> actuation at distance 0: weight 10, A = 10·strain, level -> tanh(5·strain).
+  const Grn grn(genome({el(P, 5, 5), el(G, 9, 9), in(InputChannel::strain, 0, 0), out(OutputChannel::actuation, 0, 0)}),
+                GenomeParams{});
+  ASSERT_EQ(grn.unit_count(), 1);
+  ASSERT_EQ(grn.edges().size(), 1u);
+  const auto& e = grn.edges()[0];
+  EXPECT_EQ(e.source, kPaperInputCount + 2 * 1 + 0);  // after internal and diffusible products
+  EXPECT_EQ(grn.source_kind(e.source), Grn::SourceKind::input);
+  EXPECT_EQ(grn.source_unit(e.source), static_cast<int>(InputChannel::strain));
+  EXPECT_EQ(e.weight, 10.0);
+  GrnState s = grn.initial_state();
+  GrnInputs inputs;
+  inputs.sensors[0] = 0.1;
+  GrnParams gp;
+  double expected = 0.0;
+  for (int k = 0; k < 50; ++k) {
+    grn.step(s, inputs, gp);
+    expected += (std::tanh(10.0 * 0.1 / 2) - expected) * gp.dt;
+  }
+  EXPECT_NEAR(grn.output(s, OutputChannel::actuation), expected, 1e-15);
+  EXPECT_NE(grn.to_dot().find("in4 [label=\"strain\""), std::string::npos);
+  EXPECT_NE(grn.to_dot().find("in4 -> out7"), std::string::npos);
 }

@@ -263,7 +263,7 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   // So are the late keys at their defaults (evolution.cpp late_keys()), each with its comment line.
   for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = ", "\ngravity = ", "\nground_height = ",
                           "\nground_friction_static = ", "\nground_friction_kinetic = ", "\nsettle_steps = ",
-                          "\nenergy_weight = ", "\nenergy_offset = "}) {
+                          "\nenergy_weight = ", "\nenergy_offset = ", "\nextra_inputs = ", "\nextra_outputs = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;

@@ -180,10 +180,12 @@ def test_units_of_hand_built_genomes(types, expected):
 def test_from_arrays_validates():
     with pytest.raises(ValueError, match="sign"):
         make([P, G], signs=[1, 0])
-    with pytest.raises(ValueError, match="channel 4 out of range"):
-        make([I], channels=[4])
-    with pytest.raises(ValueError, match="channel 6 out of range"):
-        make([O], channels=[6])
+    # Channels 4-6 (inputs) and 6-7 (outputs) are the extensions of issue 18 (docs/model.md).
+    with pytest.raises(ValueError, match=r"channel 7 out of range \[0, 7\)"):
+        make([I], channels=[7])
+    with pytest.raises(ValueError, match=r"channel 8 out of range \[0, 8\)"):
+        make([O], channels=[8])
+    assert make([I, O], channels=[int(animat.InputChannel.chemical), int(animat.OutputChannel.actuation)]) is not None
     with pytest.raises(ValueError, match="unknown type 9"):
         make([9])
     with pytest.raises(ValueError, match="must be finite"):
