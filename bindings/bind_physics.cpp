@@ -1,6 +1,8 @@
 // Python bindings of the swim stage: Scene (effects + coefficients), Simulation, swim() and evaluate().
+#include <array>
 #include <nanobind/eigen/dense.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/array.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/string_view.h>
@@ -85,9 +87,18 @@ SceneParams scene_with(SceneParams base, const nb::handle& mapping, const char* 
       throw ConfigError(fmt::format("{}: unknown keyword '{}' (expected any of {})", who, key, fmt::join(keys, ", ")));
     ConfigValue v;
     if (nb::isinstance<nb::tuple>(item.second) || nb::isinstance<nb::list>(item.second)) {
-      std::vector<std::string> words;
-      for (auto w : item.second) words.push_back(nb::cast<std::string>(w));
-      v = std::move(words);
+      // A list of numbers (scene.chemical_source) or of words (scene.effects).
+      bool numbers = nb::len(item.second) > 0;
+      for (auto w : item.second) numbers = numbers && (nb::isinstance<nb::float_>(w) || nb::isinstance<nb::int_>(w));
+      if (numbers) {
+        std::vector<double> xs;
+        for (auto w : item.second) xs.push_back(nb::cast<double>(w));
+        v = std::move(xs);
+      } else {
+        std::vector<std::string> words;
+        for (auto w : item.second) words.push_back(nb::cast<std::string>(w));
+        v = std::move(words);
+      }
     } else {
       v = nb::cast<ConfigValue>(item.second);
     }
@@ -236,7 +247,10 @@ void bind_physics(nb::module_& m) {
         .def_prop_ro("cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
                      nb::rv_policy::move, "Per cell (n,): half the positive actuation work of each spring it ends.")
         .def_prop_ro("cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
-                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.");
+                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.")
+        .def_ro("grn_updates", &R::grn_updates, "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).")
+        .def_prop_ro("displacement_at_push", [](const R& r) -> Eigen::Vector2d { return r.displacement_at_push; },
+                     "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).");
   };
   invariant_fields(swim_result, std::type_identity<SwimResult>{});
   invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});
@@ -261,6 +275,9 @@ void bind_physics(nb::module_& m) {
 
   evaluation_result
       .def_ro("fitness", &EvaluationResult::fitness, "Straight-line distance of the centre of mass, start to end (0 if not viable or unstable).")
+      .def_ro("source_progress", &EvaluationResult::source_progress,
+              "Objective chemotaxis: mean progress toward the chemical source over evaluation.source_directions swims "
+              "(|x_s| - |x_s - displacement|; 0 otherwise).")
       .def_ro("viable", &EvaluationResult::viable, "Development verdict; non-viable genomes are never swum.")
       .def_ro("stable", &EvaluationResult::stable, "False if the development or the swim left the valid domain.")
       .def_ro("cell_count", &EvaluationResult::cell_count, "Cells of the embryo.")
@@ -347,6 +364,12 @@ void bind_physics(nb::module_& m) {
       .def_prop_rw("velocities", [](const Simulation& s) -> Points { Lease l(s, "velocities"); return s.velocities(); },
                    [](Simulation& s, const Points& v) { Lease l(s, "velocities"); s.set_velocities(v); },
                    "(n, 2) cell velocities; assign an (n, 2) array to set them (e.g. to launch a body).")
+      .def("push", [](Simulation& s, const std::vector<int>& cells, std::array<double, 2> impulse) {
+            Lease l(s, "push");
+            s.push(cells, Eigen::Vector2d(impulse[0], impulse[1]));
+          }, "cells"_a, "impulse"_a,
+          "A disruption (docs/control.md): add impulse / cell_mass to the velocity of every listed cell now\n"
+          "(impulse = [Jx, Jy] per cell). ValueError for a cell out of range or a non-finite impulse.")
       .def("center_of_mass", [](const Simulation& s) -> Eigen::Vector2d { Lease l(s, "center_of_mass"); return s.center_of_mass(); },
            "The centre of mass (equal masses: the mean position) as a (2,) array.")
       .def("momentum", [](const Simulation& s) -> Eigen::Vector2d { Lease l(s, "momentum"); return s.momentum(); },

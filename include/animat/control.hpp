@@ -29,7 +29,7 @@ struct ControlParams {
   std::string mode = "open_loop";
   /// k: Box2D steps between two GRN updates (sensors, signalling and eq. 1 advance together) [choose:
   /// the bench of docs/control.md]
-  int update_interval = 5;
+  int update_interval = 10;
   /// Rate of eq. 1 in swim time: one update advances eq. 1 by dt = grn_rate·k·h (h the Box2D step),
   /// so a level relaxes with time constant 1/grn_rate whatever k. k·h·grn_rate must be <= 1 [choose]
   double grn_rate = 3.0;
@@ -54,8 +54,8 @@ void visit_fields(ControlParams& p, V&& v) {
   v(FieldInfo{"start_ramp", "time units over which the GRN's actuation terms ramp in from 0 at the start of a swim (rest lengths do not jump), 0 = none [choose]", Bounds::upto(1e6)}, p.start_ramp);
 }
 
-/// Checks what bounds cannot: the eq. 1 step grn_rate·k·h <= 1 and a stable signalling step
-/// (k·h·(D·max degree + λ) <= 1 is checked per body by the effect). Throws ConfigError naming the keys.
+/// Checks what bounds cannot: the eq. 1 step grn_rate·k·h <= 1 (signalling stays stable by taking
+/// substeps, GrnControl::signal_substeps()). Throws ConfigError naming the keys.
 void validate(const ControlParams& control, const PhysicsParams& physics);
 
 /// The scene's chemical field at a point (scene.chemical): "point": exp(−|x − x_s|/ℓ); "plane":
@@ -80,7 +80,7 @@ struct GrnControlStart {
 class GrnControl final : public Effect {
  public:
   /// `body` must be the body the simulation swims (springs in order, rest lengths as swim_body()
-  /// measures them); its cells are the GRN's cells. Throws ConfigError for an unstable signalling step.
+  /// measures them); its cells are the GRN's cells.
   GrnControl(const Body& body, GrnControlStart start, const ControlParams& control, const SceneParams& scene,
              const PhysicsParams& physics);
 
@@ -98,6 +98,8 @@ class GrnControl final : public Effect {
   /// Sensor values of the last update: strain, pressure, chemical (n × 3, row-major).
   [[nodiscard]] const std::vector<double>& sensors() const { return sensors_; }
   [[nodiscard]] long updates() const { return updates_; }
+  /// Signalling substeps per update: the smallest count that keeps δ·(D·max degree + λ) <= 1.
+  [[nodiscard]] int signal_substeps() const { return signal_substeps_; }
   [[nodiscard]] const Grn& grn() const { return start_.grn; }
   /// u = amplitude_max·(2L − 1) for an actuation level L ∈ [0, 1) (docs/model.md).
   [[nodiscard]] static double term_of_level(double level, double amplitude_max) {
@@ -124,6 +126,7 @@ class GrnControl final : public Effect {
   std::vector<GrnState> states_;
   std::string chemical_;
   double source_x_ = 0, source_y_ = 0, normal_x_ = 1, normal_y_ = 0, decay_length_ = 1;
+  int signal_substeps_ = 1;
   long updates_ = 0;
   long last_update_step_ = -1;
 };

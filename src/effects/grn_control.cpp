@@ -92,16 +92,15 @@ GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const Control
   }
   csr(n_, cell_springs, spring_begin_, spring_list_);
   csr(n_, cell_regions, region_begin_, region_list_);
-  // Explicit signalling is stable and keeps the field in [0, 1) when Δ·(D·deg + λ) <= 1 everywhere.
+  // Explicit signalling is stable and keeps the field in [0, 1) when δ·(D·deg + λ) <= 1 everywhere:
+  // an update takes as many equal signalling substeps δ = Δ/substeps as this body needs (1 unless
+  // a cell has many springs or D is large).
   if (morph_ > 0) {
     std::size_t most = 0;
     for (const auto& l : cell_springs) most = std::max(most, l.size());
     const double worst = update_dt_ * (control_.signal_rate * static_cast<double>(most) + control_.signal_decay);
-    if (!(worst <= 1.0))
-      throw ConfigError(fmt::format("control.signal_rate = {} and control.signal_decay = {}: the signalling step "
-                                    "k*h*(D*degree + lambda) = {} exceeds 1 on this body (a cell has {} springs); "
-                                    "lower them or control.update_interval",
-                                    control_.signal_rate, control_.signal_decay, worst, most));
+    if (!std::isfinite(worst)) throw ConfigError("control.signal_rate / signal_decay: non-finite signalling step");
+    signal_substeps_ = std::max(1, static_cast<int>(std::ceil(worst)));
   }
 
   states_.resize(n);
@@ -179,9 +178,10 @@ void GrnControl::update(const SwimState& s) {
   // 2. Signalling: relaxation towards the own product, then the Laplacian spring by spring.
   const auto m = static_cast<std::size_t>(morph_);
   if (m > 0) {
-    const double relax = update_dt_ * control_.signal_decay;
-    const double flow = update_dt_ * control_.signal_rate;
+    const double relax = update_dt_ / signal_substeps_ * control_.signal_decay;
+    const double flow = update_dt_ / signal_substeps_ * control_.signal_rate;
     const auto& units = start_.grn.morphogen_units();
+    for (int sub = 0; sub < signal_substeps_; ++sub) {
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t k = 0; k < m; ++k) {
         const double f = field_[i * m + k];
@@ -197,6 +197,7 @@ void GrnControl::update(const SwimState& s) {
         }
       }
     field_.swap(next_field_);
+    }
   }
   // 3. Eq. 1 in every cell; 4. the terms.
   const double ramp = control_.start_ramp > 0.0 ? std::min(1.0, s.time / control_.start_ramp) : 1.0;

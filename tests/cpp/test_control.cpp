@@ -230,18 +230,29 @@ TEST(ControlSignalling, ChainMatchesTheDiscreteHeatEquation) {
   EXPECT_NEAR(total, 1.5, 1e-14);  // the Laplacian conserves the total
 }
 
-TEST(ControlSignalling, UnstableStepIsAConfigErrorNamingTheKeys) {
+TEST(ControlSignalling, FastDiffusionTakesSubstepsAndStaysBounded) {
+  // D = 100 with k·h = 5/60: Δ·(D·2 + λ) = 16.75 -> 17 substeps of Δ/17; the field stays in [0, 1]
+  // and conserves its total (λ = 0) on the way to the uniform mean.
   const Body chain = build_body(points({{0, 0}, {1, 0}, {2, 0}}), Vector(), Vector(), Vector());
   const Genome g{2, {el(ElementType::promoter, 0, 0), el(ElementType::morphogen_gene, 9, 9)}};
+  GrnControlStart start = start_for(g, 3);
+  start.sensed = {1.0, 0.0, 0.0};
   ControlParams control;
   control.mode = "grn";
   control.signal_rate = 100.0;
-  try {
-    GrnControl c(chain, start_for(g, 3), control, SceneParams{}, PhysicsParams{});
-    FAIL();
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("control.signal_rate = 100"), std::string::npos) << e.what();
+  control.signal_decay = 1.0;
+  control.update_interval = 5;
+  GrnControl c(chain, start, control, SceneParams{}, PhysicsParams{});
+  EXPECT_EQ(c.signal_substeps(), 17);
+  control.signal_decay = 0.0;
+  GrnControl d(chain, start, control, SceneParams{}, PhysicsParams{});
+  SwimState s = state_of(chain, 0, PhysicsParams{}.dt);
+  for (long step = 0; step < 100; ++step) {
+    s.step = step;
+    d.apply(s);
+    for (double v : d.signals()) ASSERT_TRUE(v >= 0.0 && v <= 1.0) << v;
   }
+  for (double v : d.signals()) EXPECT_NEAR(v, 1.0 / 3.0, 1e-12);
 }
 
 TEST(ControlConfig, KeysValidateAndNameTheValue) {
