@@ -22,6 +22,8 @@
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
+#include "animat/control.hpp"
+#include "animat/development.hpp"
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
@@ -483,6 +485,60 @@ void bind_physics(nb::module_& m) {
       "genome -> development -> body -> swim; returns an EvaluationResult whose fitness is the objective\n"
       "(default: config.evaluation.objective, the paper's distance of the centre of mass). Deterministic.\n"
       "Non-viable genomes are not swum; unstable swims give fitness 0 and stable=False.");
+  m.def("grn_swim", [](const Genome& genome, std::optional<Config> config, long steps, long every,
+                       std::optional<std::vector<double>> source) {
+        Config c = config ? *config : Config{};
+        c.control.mode = "grn";
+        validate(c);
+        if (steps < 0 || every < 1) throw ConfigError("grn_swim: steps must be >= 0 and every >= 1");
+        if (source) {
+          if (source->size() != 2) throw ConfigError("grn_swim: source must be [x, y]");
+          c.scene.chemical_source = *source;
+        }
+        warm_up_box2d();
+        std::vector<double> times, terms, levels, sensors, com;
+        int n = 0;
+        {
+          nb::gil_scoped_release release;
+          const Embryo e = develop(genome, c.genome, c.grn, c.development);
+          if (!e.viable) throw ConfigError("grn_swim: the genome is not viable");
+          const StartState st = start_state(build_body(e, c.body), c.scene, c.physics, c.evaluation.settle_steps);
+          SceneParams scene = c.scene;
+          std::erase(scene.effects, std::string("actuation"));
+          Simulation sim(st.body, scene, c.physics);
+          if (st.settled > 0) sim.set_velocities(st.velocities);
+          auto effect = std::make_unique<GrnControl>(st.body, grn_control_start(genome, e, c), c.control, c.scene, c.physics);
+          const GrnControl* ctl = effect.get();
+          sim.add_effect(std::move(effect));
+          n = sim.node_count();
+          auto sample = [&] {
+            times.push_back(sim.time());
+            terms.insert(terms.end(), ctl->terms().begin(), ctl->terms().end());
+            for (int i = 0; i < n; ++i) levels.push_back(ctl->grn().output(ctl->state(i), OutputChannel::actuation));
+            sensors.insert(sensors.end(), ctl->sensors().begin(), ctl->sensors().end());
+            const Eigen::Vector2d p = sim.center_of_mass();
+            com.push_back(p.x());
+            com.push_back(p.y());
+          };
+          sample();
+          for (long done = 0; done + every <= steps; done += every) {
+            sim.step(every);
+            sample();
+          }
+        }
+        const std::size_t f = times.size(), cells = static_cast<std::size_t>(n);
+        nb::dict d;
+        d["times"] = owned_array(std::move(times), {f});
+        d["terms"] = owned_array(std::move(terms), {f, cells});
+        d["actuation"] = owned_array(std::move(levels), {f, cells});
+        d["sensors"] = owned_array(std::move(sensors), {f, cells, 3});
+        d["com"] = owned_array(std::move(com), {f, 2});
+        return d;
+      }, "genome"_a, "config"_a = nb::none(), "steps"_a = 4000, "every"_a = 10, "source"_a = nb::none(),
+      "Swim `genome` under control.mode = 'grn' (forced) and record, every `every` control steps: 'times'\n"
+      "(F,), the cells' actuation terms u_i 'terms' (F, n), their actuation output levels 'actuation' (F, n),\n"
+      "the sensors 'sensors' (F, n, 3: strain, pressure, chemical) and the centre of mass 'com' (F, 2).\n"
+      "`source` overrides scene.chemical_source (relative to the start centre). docs/control.md.");
   m.def("warm_up_box2d", &warm_up_box2d,
         "Initialise Box2D's lazily filled globals; call once before using worlds from several threads.");
   m.def("actuation_start_time", &actuation_start_time, "frequency"_a, "phase"_a,

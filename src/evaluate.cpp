@@ -72,11 +72,14 @@ GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo, co
 }
 
 std::vector<double> source_direction(const Config& config, int trial) {
-  // Trial t's angle: uniform in [0, 2π) from its own stream of evaluation.source_seed, so every
-  // genome of a run meets the same directions and adding trials keeps the earlier ones.
+  // T = source_directions evenly spaced directions turned by one random offset, uniform in [0, 2π)
+  // from evaluation.source_seed: every genome of a run meets the same directions, and a body that
+  // swims straight, whatever its heading, gains nothing on average (Σ_t cos(θ_t − heading) = 0 for
+  // T >= 2), so only sensing and turning pays.
   Rng rng(static_cast<std::uint64_t>(config.evaluation.source_seed));
-  Rng stream = rng.split(static_cast<std::uint64_t>(trial));
-  const double angle = stream.uniform(0.0, 2.0 * 3.14159265358979323846);
+  const double offset = rng.uniform(0.0, 2.0 * 3.14159265358979323846);
+  const int count = std::max(1, config.evaluation.source_directions);
+  const double angle = offset + 2.0 * 3.14159265358979323846 * static_cast<double>(trial) / count;
   const double x = config.scene.chemical_source[0], y = config.scene.chemical_source[1];
   const double c = std::cos(angle), s = std::sin(angle);
   return {c * x - s * y, s * x + c * y};

@@ -159,7 +159,8 @@ struct EvaluationResult {
   Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each of its springs
   /// Objective chemotaxis: the mean over evaluation.source_directions swims (the source at
   /// scene.chemical_source rotated to a random angle each, deterministic from evaluation.source_seed)
-  /// of the progress toward the source, |x_s| − |x_s − displacement| (length units; 0 unless chemotaxis).
+  /// of the progress toward the source, |x_s| − |x_s − displacement| (length units; 0 unless
+  /// chemotaxis). The directions are evenly spaced, turned by a random offset (source_direction()).
   double source_progress = 0.0;
   long grn_updates = 0;            ///< GRN updates while swimming (control.mode = "grn"), first swim
   Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (evaluation.push_step >= 0)
@@ -170,8 +171,9 @@ struct EvaluationResult {
 
 /// Where control.mode = "grn" starts: the genome's GRN and every cell's state at the end of `embryo`.
 [[nodiscard]] GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo, const Config& config);
-/// Objective chemotaxis: the source of trial `trial`, scene.chemical_source rotated by an angle
-/// uniform in [0, 2π) drawn from evaluation.source_seed (the same for every genome).
+/// Objective chemotaxis: the source of trial `trial`, scene.chemical_source rotated by
+/// offset + 2π·trial/source_directions, the offset uniform in [0, 2π) drawn from
+/// evaluation.source_seed (the same for every genome): an evenly spaced fan at a random angle.
 [[nodiscard]] std::vector<double> source_direction(const Config& config, int trial);
 
 /// genome -> develop -> build_body -> swim(config.evaluation.steps). Deterministic (same genome and

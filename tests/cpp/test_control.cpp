@@ -368,11 +368,15 @@ TEST(ControlEvaluation, ChemotaxisAveragesProgressOverSeededDirections) {
   config.evaluation.source_directions = 3;
   const auto d0 = source_direction(config, 0), d1 = source_direction(config, 1);
   EXPECT_NEAR(std::hypot(d0[0], d0[1]), 20.0, 1e-12);  // |scene.chemical_source|
-  EXPECT_NE(d0, d1);
   EXPECT_EQ(source_direction(config, 1), d1);  // deterministic
-  Config more = config;
-  more.evaluation.source_directions = 5;
-  EXPECT_EQ(source_direction(more, 1), d1);  // adding trials keeps the earlier directions
+  // An evenly spaced fan: 120° apart, so the sources sum to 0 (straight swimming gains nothing).
+  const auto d2 = source_direction(config, 2);
+  EXPECT_NEAR(d0[0] * d1[0] + d0[1] * d1[1], 400.0 * std::cos(2.0 * 3.14159265358979323846 / 3.0), 1e-9);
+  EXPECT_NEAR(d0[0] + d1[0] + d2[0], 0.0, 1e-12);
+  EXPECT_NEAR(d0[1] + d1[1] + d2[1], 0.0, 1e-12);
+  Config other = config;
+  other.evaluation.source_seed = 2;
+  EXPECT_NE(source_direction(other, 0), d0);  // the offset comes from the seed
   EXPECT_EQ(make_objective(config.evaluation)->name(), "chemotaxis");
 }
 

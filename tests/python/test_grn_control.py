@@ -60,3 +60,24 @@ def test_grn_mode_evaluation_updates_the_grn_and_chemotaxis_scores_progress():
     c = animat.evaluate(genome, cfg)
     assert c.fitness == c.source_progress
     assert math.isfinite(c.source_progress) and abs(c.source_progress) < 20.0
+
+
+def test_grn_swim_records_terms_levels_sensors_and_the_centre():
+    cfg = animat.Config()
+    cfg["genome.extra_inputs"] = "chemical"
+    cfg["genome.extra_outputs"] = "actuation"
+    cfg["scene.chemical"] = "point"
+    genome, _ = animat.Genome.random_viable(3, cfg)
+    t = animat.grn_swim(genome, cfg, steps=100, every=10)
+    n = t["terms"].shape[1]
+    assert t["times"].shape == (11,) and t["actuation"].shape == (11, n) and t["sensors"].shape == (11, n, 3)
+    assert t["com"].shape == (11, 2)
+    a = cfg["development.amplitude_max"]
+    assert cfg["control.update_interval"] == 10 and cfg["physics.substeps"] == 1
+    # Frame j (j >= 1) follows the update at Box2D step 10 (j - 1), time t_j - 10 h:
+    # u = a_max (2 L - 1) min(1, t / start_ramp).
+    h = cfg["physics.dt"]
+    ramp = np.minimum(1.0, (t["times"][1:] - 10 * h) / cfg["control.start_ramp"])[:, None]
+    np.testing.assert_allclose(t["terms"][1:], a * (2 * t["actuation"][1:] - 1) * ramp, rtol=0, atol=1e-15)
+    assert np.all(np.abs(t["terms"]) <= a + 1e-15)
+    assert np.all((t["sensors"][1:, :, 2] > 0) & (t["sensors"][1:, :, 2] <= 1))  # exp(-r/l)
