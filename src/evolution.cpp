@@ -157,7 +157,7 @@ const std::vector<std::string>& late_keys() {
       "genome.extra_inputs",      "genome.extra_outputs",
       // Active control, the chemical field (issue 18; docs/control.md): the defaults are the paper's swim.
       "scene.chemical",           "scene.chemical_source", "scene.chemical_decay_length",
-      "control.mode",             "control.update_interval", "control.grn_rate",
+      "control.mode",             "control.actuation",     "control.update_interval", "control.grn_rate",
       "control.signal_rate",      "control.signal_decay",  "control.start_ramp",
       "evaluation.source_directions", "evaluation.source_seed", "evaluation.push_step",
       "evaluation.push_impulse",  "evaluation.push_cells"};

@@ -21,12 +21,17 @@ struct Body;
 struct PhysicsParams;
 
 inline constexpr std::string_view kControlModeNames[] = {"open_loop", "grn"};
+inline constexpr std::string_view kControlActuationNames[] = {"direct", "amplitude"};
 
 /// [control]: what drives the actuation while swimming.
 struct ControlParams {
   /// "open_loop" (paper: sinusoids with the GRN's final amplitude, frequency and phase) or "grn"
   /// (the GRN keeps running; its actuation output sets u_i).
   std::string mode = "open_loop";
+  /// What the actuation output L sets in mode "grn": "direct": u_i = amplitude_max·(2L − 1);
+  /// "amplitude": u_i = amplitude_max·L·sin(f_i·t + φ_i), the paper's oscillator (f_i, φ_i from
+  /// development, the same phase-delayed start) with its amplitude under the GRN's control.
+  std::string actuation = "direct";
   /// k: Box2D steps between two GRN updates (sensors, signalling and eq. 1 advance together) [choose:
   /// the bench of docs/control.md]
   int update_interval = 10;
@@ -47,6 +52,7 @@ struct ControlParams {
 template <class V>
 void visit_fields(ControlParams& p, V&& v) {
   v(FieldInfo{"mode", "what drives actuation while swimming: open_loop (the paper's sinusoids) or grn (the GRN keeps running, its actuation output sets u_i; docs/control.md) [beyond the paper]", Bounds::any(), kControlModeNames}, p.mode);
+  v(FieldInfo{"actuation", "what the GRN's actuation output L sets in mode grn: direct (u_i = amplitude_max*(2L-1)) or amplitude (u_i = amplitude_max*L*sin(f_i t + phi_i), the developed oscillator with a GRN-controlled amplitude) [choose]", Bounds::any(), kControlActuationNames}, p.actuation);
   v(FieldInfo{"update_interval", "k, Box2D steps between GRN updates in mode grn (sensors, signalling and eq. 1 advance together), 1 to 1000 [choose]", Bounds::closed(1, 1000)}, p.update_interval);
   v(FieldInfo{"grn_rate", "rate of eq. 1 while swimming, per time unit: an update advances eq. 1 by grn_rate*k*h (h = physics.dt/substeps, must be <= 1) [choose]", Bounds::positive_upto(1e6)}, p.grn_rate);
   v(FieldInfo{"signal_rate", "D, diffusion rate of cell products along the springs while swimming (graph Laplacian), per time unit, >= 0 [choose]", Bounds::upto(1e6)}, p.signal_rate);
@@ -105,6 +111,8 @@ class GrnControl final : public Effect {
   [[nodiscard]] static double term_of_level(double level, double amplitude_max) {
     return amplitude_max * (2.0 * level - 1.0);
   }
+  /// control.actuation = "amplitude": the cells' current amplitudes amplitude_max·L·ramp.
+  [[nodiscard]] const std::vector<double>& amplitudes() const { return amplitude_; }
   /// Moves the chemical source (absolute coordinates) and the plane normal (normalised here).
   void set_chemical_source(double x, double y);
 
@@ -127,6 +135,8 @@ class GrnControl final : public Effect {
   std::string chemical_;
   double source_x_ = 0, source_y_ = 0, normal_x_ = 1, normal_y_ = 0, decay_length_ = 1;
   int signal_substeps_ = 1;
+  bool modulate_ = false;                        ///< control.actuation = "amplitude"
+  std::vector<double> amplitude_, frequency_, phase_, start_time_;
   long updates_ = 0;
   long last_update_step_ = -1;
 };

@@ -122,6 +122,17 @@ GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const Control
   sensors_.assign(n * 3, 0.0);
   terms_.assign(n, 0.0);
   region_ratio_.assign(regions_.size(), 1.0);
+  modulate_ = control_.actuation == "amplitude";
+  amplitude_.assign(n, 0.0);
+  frequency_.assign(n, 0.0);
+  phase_.assign(n, 0.0);
+  start_time_.assign(n, 0.0);
+  for (int i = 0; i < n_; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    if (body.frequency.size() == n_) frequency_[u] = body.frequency(i);
+    if (body.phase.size() == n_) phase_[u] = body.phase(i);
+    start_time_[u] = actuation_start_time(frequency_[u], phase_[u]);
+  }
 
   chemical_ = scene.chemical;
   decay_length_ = scene.chemical_decay_length;
@@ -208,7 +219,9 @@ void GrnControl::update(const SwimState& s) {
     if (m > 0) in.morphogens = std::span<const double>(field_.data() + i * m, m);
     in.sensors = {sensors_[3 * i], sensors_[3 * i + 1], sensors_[3 * i + 2]};
     start_.grn.step(states_[i], in, step_params_);
-    terms_[i] = ramp * term_of_level(start_.grn.output(states_[i], OutputChannel::actuation), amax);
+    const double level = start_.grn.output(states_[i], OutputChannel::actuation);
+    if (modulate_) amplitude_[i] = ramp * amax * level;
+    else terms_[i] = ramp * term_of_level(level, amax);
   }
   ++updates_;
 }
@@ -219,6 +232,9 @@ void GrnControl::apply(SwimState& s) {
     update(s);
     last_update_step_ = s.step;
   }
+  if (modulate_)  // eq. 2's oscillator with the GRN's amplitude, from the cell's start time on
+    for (std::size_t i = 0; i < terms_.size(); ++i)
+      terms_[i] = s.time >= start_time_[i] ? amplitude_[i] * std::sin(frequency_[i] * s.time + phase_[i]) : 0.0;
   const double* t = terms_.data();
   double* rest = s.rest.data();
   for (std::size_t e = 0; e < a_.size(); ++e)

@@ -403,3 +403,36 @@ TEST(ControlEvaluation, PushScheduleChangesTheSwimOnlyWhenOn) {
   EXPECT_GT(p.displacement.x() - plain.displacement.x(), 0.0);  // shoved along +x
   EXPECT_NE(p.displacement_at_push.norm(), 0.0);
 }
+
+TEST(ControlGrn, AmplitudeModeModulatesTheDevelopedOscillator) {
+  // control.actuation = "amplitude": u_i = a_max·L·sin(f_i·t + φ_i) from the cell's start time on,
+  // L the bias-driven actuation level (eq. 1 towards tanh(5)).
+  const Points p = points({{0.0, 0.0}, {1.0, 0.0}, {0.5, 0.75}});
+  Vector a(3), f(3), ph(3);
+  a << 0.1, 0.1, 0.1;
+  f << 2.0, 3.0, 4.0;
+  ph << 0.0, 1.0, 4.0;
+  const Body body = build_body(p, a, f, ph);
+  ControlParams control;
+  control.mode = "grn";
+  control.actuation = "amplitude";
+  control.update_interval = 3;
+  control.start_ramp = 0.0;
+  const PhysicsParams physics;
+  const double h = physics.dt, delta = control.grn_rate * 3 * h;
+  GrnControl c(body, start_for(follower(InputChannel::bias), 3, 0.2), control, SceneParams{}, physics);
+  SwimState s = state_of(body, 0, h);
+  double level = 0.0;
+  for (long step = 0; step < 300; ++step) {
+    s.step = step;
+    s.time = step * h;
+    c.apply(s);
+    if (step % 3 == 0) level += (std::tanh(5.0) - level) * delta;
+    for (int i = 0; i < 3; ++i) {
+      const double t0 = actuation_start_time(f(i), ph(i));
+      const double expected = s.time >= t0 ? 0.2 * level * std::sin(f(i) * s.time + ph(i)) : 0.0;
+      ASSERT_NEAR(c.terms()[static_cast<std::size_t>(i)], expected, 1e-13) << "step " << step << " cell " << i;
+    }
+  }
+  EXPECT_GT(actuation_start_time(f(2), ph(2)), 0.0);  // one cell starts late, as in open loop
+}

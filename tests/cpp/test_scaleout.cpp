@@ -264,7 +264,7 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = ", "\ngravity = ", "\nground_height = ",
                           "\nground_friction_static = ", "\nground_friction_kinetic = ", "\nsettle_steps = ",
                           "\nenergy_weight = ", "\nenergy_offset = ", "\nextra_inputs = ", "\nextra_outputs = ",
-                          "\nchemical = ", "\nchemical_source = ", "\nchemical_decay_length = ", "\nmode = ",
+                          "\nchemical = ", "\nchemical_source = ", "\nchemical_decay_length = ", "\nmode = ", "\nactuation = ",
                           "\nupdate_interval = ", "\ngrn_rate = ", "\nsignal_rate = ", "\nsignal_decay = ",
                           "\nstart_ramp = ", "\nsource_directions = ", "\nsource_seed = ", "\npush_step = ",
                           "\npush_impulse = ", "\npush_cells = "}) {
