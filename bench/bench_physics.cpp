@@ -18,7 +18,10 @@
 #include <vector>
 
 #include "animat/body.hpp"
+#include "animat/control.hpp"
 #include "animat/errors.hpp"
+#include "animat/genome.hpp"
+#include "animat/grn.hpp"
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
@@ -153,6 +156,58 @@ void BM_VelocityForces(benchmark::State& state) {
   run_swim(state, lattice_swimmer(32), SceneParams{}, physics);
 }
 BENCHMARK(BM_VelocityForces)->DenseRange(0, 1);
+
+/// Issue 18 (docs/control.md): the swim step under control.mode = "grn" at update interval k
+/// (Arg = k) against open loop (Arg = 0: the default scene with its oscillators), 32 cells. The
+/// controller's GRN is a random genome with every extension channel (10 units, the paper's size),
+/// signalling on (D = 1, one diffusible product or more), a point chemical source.
+void BM_ControlStep(benchmark::State& state) {
+  const int k = static_cast<int>(state.range(0));
+  const Body body = lattice_swimmer(32);
+  if (k == 0) {
+    state.SetLabel("open_loop");
+    run_swim(state, body, SceneParams{}, PhysicsParams{});
+    return;
+  }
+  GenomeParams gp;
+  gp.extra_inputs = "strain,pressure,chemical";
+  gp.extra_outputs = "actuation";
+  Rng rng(7);
+  Genome g = random_genome(gp, rng);
+  for (int tries = 0; tries < 1000 && Grn(g, gp).morphogen_units().empty(); ++tries) g = random_genome(gp, rng);
+  GrnControlStart start;
+  start.grn = Grn(g, gp);
+  start.levels.assign(static_cast<std::size_t>(body.node_count() * start.grn.node_count()), 0.0);
+  start.maternal.assign(static_cast<std::size_t>(body.node_count()) * 3, 0.0);
+  SceneParams scene;
+  std::erase(scene.effects, std::string("actuation"));
+  scene.chemical = "point";
+  ControlParams control;
+  control.mode = "grn";
+  control.update_interval = k;
+  control.signal_rate = 1.0;
+  const PhysicsParams physics;
+  state.SetLabel("grn k=" + std::to_string(k));
+  auto make = [&] {
+    auto sim = std::make_unique<Simulation>(body, scene, physics);
+    sim->add_effect(std::make_unique<GrnControl>(body, start, control, scene, physics));
+    return sim;
+  };
+  auto sim = make();
+  for (auto _ : state) {
+    try {
+      sim->step(1);
+    } catch (const SimulationError&) {
+      state.PauseTiming();
+      sim = make();
+      state.ResumeTiming();
+    }
+  }
+  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["cells"] = body.node_count();
+  state.counters["grn_units"] = start.grn.unit_count();
+}
+BENCHMARK(BM_ControlStep)->Arg(0)->Arg(1)->Arg(5)->Arg(10)->Arg(20);
 
 }  // namespace
 

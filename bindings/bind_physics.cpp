@@ -1,6 +1,8 @@
 // Python bindings of the swim stage: Scene (effects + coefficients), Simulation, swim() and evaluate().
+#include <array>
 #include <nanobind/eigen/dense.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/array.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/string_view.h>
@@ -20,6 +22,8 @@
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
+#include "animat/control.hpp"
+#include "animat/development.hpp"
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
@@ -85,9 +89,18 @@ SceneParams scene_with(SceneParams base, const nb::handle& mapping, const char* 
       throw ConfigError(fmt::format("{}: unknown keyword '{}' (expected any of {})", who, key, fmt::join(keys, ", ")));
     ConfigValue v;
     if (nb::isinstance<nb::tuple>(item.second) || nb::isinstance<nb::list>(item.second)) {
-      std::vector<std::string> words;
-      for (auto w : item.second) words.push_back(nb::cast<std::string>(w));
-      v = std::move(words);
+      // A list of numbers (scene.chemical_source) or of words (scene.effects).
+      bool numbers = nb::len(item.second) > 0;
+      for (auto w : item.second) numbers = numbers && (nb::isinstance<nb::float_>(w) || nb::isinstance<nb::int_>(w));
+      if (numbers) {
+        std::vector<double> xs;
+        for (auto w : item.second) xs.push_back(nb::cast<double>(w));
+        v = std::move(xs);
+      } else {
+        std::vector<std::string> words;
+        for (auto w : item.second) words.push_back(nb::cast<std::string>(w));
+        v = std::move(words);
+      }
     } else {
       v = nb::cast<ConfigValue>(item.second);
     }
@@ -236,7 +249,10 @@ void bind_physics(nb::module_& m) {
         .def_prop_ro("cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
                      nb::rv_policy::move, "Per cell (n,): half the positive actuation work of each spring it ends.")
         .def_prop_ro("cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
-                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.");
+                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.")
+        .def_ro("grn_updates", &R::grn_updates, "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).")
+        .def_prop_ro("displacement_at_push", [](const R& r) -> Eigen::Vector2d { return r.displacement_at_push; },
+                     "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).");
   };
   invariant_fields(swim_result, std::type_identity<SwimResult>{});
   invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});
@@ -261,6 +277,9 @@ void bind_physics(nb::module_& m) {
 
   evaluation_result
       .def_ro("fitness", &EvaluationResult::fitness, "Straight-line distance of the centre of mass, start to end (0 if not viable or unstable).")
+      .def_ro("source_progress", &EvaluationResult::source_progress,
+              "Objective chemotaxis: mean progress toward the chemical source over evaluation.source_directions swims "
+              "(|x_s| - |x_s - displacement|; 0 otherwise).")
       .def_ro("viable", &EvaluationResult::viable, "Development verdict; non-viable genomes are never swum.")
       .def_ro("stable", &EvaluationResult::stable, "False if the development or the swim left the valid domain.")
       .def_ro("cell_count", &EvaluationResult::cell_count, "Cells of the embryo.")
@@ -347,6 +366,12 @@ void bind_physics(nb::module_& m) {
       .def_prop_rw("velocities", [](const Simulation& s) -> Points { Lease l(s, "velocities"); return s.velocities(); },
                    [](Simulation& s, const Points& v) { Lease l(s, "velocities"); s.set_velocities(v); },
                    "(n, 2) cell velocities; assign an (n, 2) array to set them (e.g. to launch a body).")
+      .def("push", [](Simulation& s, const std::vector<int>& cells, std::array<double, 2> impulse) {
+            Lease l(s, "push");
+            s.push(cells, Eigen::Vector2d(impulse[0], impulse[1]));
+          }, "cells"_a, "impulse"_a,
+          "A disruption (docs/control.md): add impulse / cell_mass to the velocity of every listed cell now\n"
+          "(impulse = [Jx, Jy] per cell). ValueError for a cell out of range or a non-finite impulse.")
       .def("center_of_mass", [](const Simulation& s) -> Eigen::Vector2d { Lease l(s, "center_of_mass"); return s.center_of_mass(); },
            "The centre of mass (equal masses: the mean position) as a (2,) array.")
       .def("momentum", [](const Simulation& s) -> Eigen::Vector2d { Lease l(s, "momentum"); return s.momentum(); },
@@ -460,6 +485,60 @@ void bind_physics(nb::module_& m) {
       "genome -> development -> body -> swim; returns an EvaluationResult whose fitness is the objective\n"
       "(default: config.evaluation.objective, the paper's distance of the centre of mass). Deterministic.\n"
       "Non-viable genomes are not swum; unstable swims give fitness 0 and stable=False.");
+  m.def("grn_swim", [](const Genome& genome, std::optional<Config> config, long steps, long every,
+                       std::optional<std::vector<double>> source) {
+        Config c = config ? *config : Config{};
+        c.control.mode = "grn";
+        validate(c);
+        if (steps < 0 || every < 1) throw ConfigError("grn_swim: steps must be >= 0 and every >= 1");
+        if (source) {
+          if (source->size() != 2) throw ConfigError("grn_swim: source must be [x, y]");
+          c.scene.chemical_source = *source;
+        }
+        warm_up_box2d();
+        std::vector<double> times, terms, levels, sensors, com;
+        int n = 0;
+        {
+          nb::gil_scoped_release release;
+          const Embryo e = develop(genome, c.genome, c.grn, c.development);
+          if (!e.viable) throw ConfigError("grn_swim: the genome is not viable");
+          const StartState st = start_state(build_body(e, c.body), c.scene, c.physics, c.evaluation.settle_steps);
+          SceneParams scene = c.scene;
+          std::erase(scene.effects, std::string("actuation"));
+          Simulation sim(st.body, scene, c.physics);
+          if (st.settled > 0) sim.set_velocities(st.velocities);
+          auto effect = std::make_unique<GrnControl>(st.body, grn_control_start(genome, e, c), c.control, c.scene, c.physics);
+          const GrnControl* ctl = effect.get();
+          sim.add_effect(std::move(effect));
+          n = sim.node_count();
+          auto sample = [&] {
+            times.push_back(sim.time());
+            terms.insert(terms.end(), ctl->terms().begin(), ctl->terms().end());
+            for (int i = 0; i < n; ++i) levels.push_back(ctl->grn().output(ctl->state(i), OutputChannel::actuation));
+            sensors.insert(sensors.end(), ctl->sensors().begin(), ctl->sensors().end());
+            const Eigen::Vector2d p = sim.center_of_mass();
+            com.push_back(p.x());
+            com.push_back(p.y());
+          };
+          sample();
+          for (long done = 0; done + every <= steps; done += every) {
+            sim.step(every);
+            sample();
+          }
+        }
+        const std::size_t f = times.size(), cells = static_cast<std::size_t>(n);
+        nb::dict d;
+        d["times"] = owned_array(std::move(times), {f});
+        d["terms"] = owned_array(std::move(terms), {f, cells});
+        d["actuation"] = owned_array(std::move(levels), {f, cells});
+        d["sensors"] = owned_array(std::move(sensors), {f, cells, 3});
+        d["com"] = owned_array(std::move(com), {f, 2});
+        return d;
+      }, "genome"_a, "config"_a = nb::none(), "steps"_a = 4000, "every"_a = 10, "source"_a = nb::none(),
+      "Swim `genome` under control.mode = 'grn' (forced) and record, every `every` control steps: 'times'\n"
+      "(F,), the cells' actuation terms u_i 'terms' (F, n), their actuation output levels 'actuation' (F, n),\n"
+      "the sensors 'sensors' (F, n, 3: strain, pressure, chemical) and the centre of mass 'com' (F, 2).\n"
+      "`source` overrides scene.chemical_source (relative to the start centre). docs/control.md.");
   m.def("warm_up_box2d", &warm_up_box2d,
         "Initialise Box2D's lazily filled globals; call once before using worlds from several threads.");
   m.def("actuation_start_time", &actuation_start_time, "frequency"_a, "phase"_a,

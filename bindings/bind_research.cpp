@@ -112,6 +112,9 @@ void visit_result(EvaluationResult& r, V&& v) {
   v("actuation_work_absolute", r.actuation_work_absolute);
   v("cell_work_positive", r.cell_work_positive);
   v("cell_work_absolute", r.cell_work_absolute);
+  v("source_progress", r.source_progress);
+  v("grn_updates", r.grn_updates);
+  v("displacement_at_push", r.displacement_at_push);
   v("seconds_development", r.seconds_development);
   v("seconds_body", r.seconds_body);
   v("seconds_swim", r.seconds_swim);

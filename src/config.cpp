@@ -445,6 +445,7 @@ void validate(const Config& config, std::string_view source) {
     validate(config.evaluation);
     validate(config.scene);  // its cross-key rules too (e.g. ground friction: mu_k <= mu_s)
     validate(config.physics);
+    validate(config.control, config.physics);
   } catch (const ConfigError& e) {
     fail(e.what());
   }

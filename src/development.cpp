@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -558,6 +559,24 @@ Embryo develop(const Genome& genome, const GenomeParams& genome_params, const Gr
   }
   e.division_steps = world.division_steps();
   e.viable = e.reasons.empty();
+  const int nodes = world.grn().node_count();
+  const auto morph = static_cast<int>(world.grn().morphogen_units().size());
+  e.grn_levels.resize(n, nodes);
+  e.grn_maternal.resize(n, 3);
+  e.grn_sensed.resize(n, world.has("morphogens") ? morph : 0);
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < nodes; ++k) e.grn_levels(i, k) = world.state(i).levels[static_cast<std::size_t>(k)];
+    // A cell born after the last sense() has sensed nothing yet: 0, as sense() would start it.
+    std::array<double, 3> maternal{};
+    try {
+      maternal = world.sensed_maternal(i);
+    } catch (const std::out_of_range&) {
+    }
+    for (int k = 0; k < 3; ++k) e.grn_maternal(i, k) = maternal[static_cast<std::size_t>(k)];
+    const auto sensed = world.sensed_morphogens(i);
+    for (int k = 0; k < e.grn_sensed.cols(); ++k)
+      e.grn_sensed(i, k) = static_cast<std::size_t>(k) < sensed.size() ? sensed[static_cast<std::size_t>(k)] : 0.0;
+  }
   return e;
 }
 

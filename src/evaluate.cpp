@@ -16,6 +16,7 @@
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/physics.hpp"
+#include "animat/random.hpp"
 
 namespace animat {
 namespace {
@@ -50,6 +51,39 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 }
 
 }  // namespace
+
+GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo, const Config& config) {
+  GrnControlStart start;
+  start.grn = Grn(genome, config.genome);
+  start.grn_params = config.grn;
+  start.amplitude_max = config.development.amplitude_max;
+  const int n = embryo.cell_count();
+  if (embryo.grn_levels.rows() == n && embryo.grn_levels.cols() == start.grn.node_count()) {
+    start.levels.assign(embryo.grn_levels.data(), embryo.grn_levels.data() + embryo.grn_levels.size());
+  } else {
+    start.levels.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(start.grn.node_count()), 0.0);
+  }
+  if (embryo.grn_maternal.rows() == n && embryo.grn_maternal.cols() == 3)
+    start.maternal.assign(embryo.grn_maternal.data(), embryo.grn_maternal.data() + embryo.grn_maternal.size());
+  const auto morph = static_cast<Eigen::Index>(start.grn.morphogen_units().size());
+  if (morph > 0 && embryo.grn_sensed.rows() == n && embryo.grn_sensed.cols() == morph)
+    start.sensed.assign(embryo.grn_sensed.data(), embryo.grn_sensed.data() + embryo.grn_sensed.size());
+  return start;
+}
+
+std::vector<double> source_direction(const Config& config, int trial) {
+  // T = source_directions evenly spaced directions turned by one random offset, uniform in [0, 2π)
+  // from evaluation.source_seed: every genome of a run meets the same directions, and a body that
+  // swims straight, whatever its heading, gains nothing on average (Σ_t cos(θ_t − heading) = 0 for
+  // T >= 2), so only sensing and turning pays.
+  Rng rng(static_cast<std::uint64_t>(config.evaluation.source_seed));
+  const double offset = rng.uniform(0.0, 2.0 * 3.14159265358979323846);
+  const int count = std::max(1, config.evaluation.source_directions);
+  const double angle = offset + 2.0 * 3.14159265358979323846 * static_cast<double>(trial) / count;
+  const double x = config.scene.chemical_source[0], y = config.scene.chemical_source[1];
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * x - s * y, s * x + c * y};
+}
 
 StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long settle_steps) {
   if (settle_steps < 0)
@@ -87,8 +121,20 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   }
   r.settle_steps = begin.settled;
   const Body& body = begin.body;
-  Simulation sim(body, scene, physics);
+  // control.mode = "grn": the GRN drives eq. 2 instead of the scene's oscillators.
+  SceneParams swim_scene = scene;
+  if (options.control_start) std::erase(swim_scene.effects, std::string("actuation"));
+  Simulation sim(body, swim_scene, physics);
+  const GrnControl* controller = nullptr;
+  if (options.control_start) {
+    if (!options.control) throw ConfigError("swim: SwimOptions::control_start needs SwimOptions::control");
+    auto effect = std::make_unique<GrnControl>(body, *options.control_start, *options.control, scene, physics);
+    controller = effect.get();
+    sim.add_effect(std::move(effect));
+  }
   if (begin.settled > 0) sim.set_velocities(begin.velocities);
+  std::vector<int> pushed;  // sized before the loop: pushing allocates nothing there
+  pushed.reserve(static_cast<std::size_t>(body.node_count()));
   if (options.check_embedding) sim.monitor_embedding(body);
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   const Eigen::Vector2d start = sim.center_of_mass();
@@ -108,6 +154,16 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
       // one step at a time so that it stops at the first broken invariant.
       long next = std::min(steps, (done / kSampleEvery + 1) * kSampleEvery);
       if (every > 0) next = std::min(next, (done / every + 1) * every);
+      if (options.push_step >= 0 && done < options.push_step) next = std::min(next, options.push_step);
+      if (options.push_step >= 0 && done == options.push_step && sim.steps_done() == options.push_step) {
+        const SwimState& st = sim.state();
+        const Eigen::Vector2d com = sim.center_of_mass();
+        r.displacement_at_push = com - start;
+        pushed.clear();
+        for (int i = 0; i < st.n; ++i)
+          if (!options.push_front_only || st.x[static_cast<std::size_t>(i)] >= com.x()) pushed.push_back(i);
+        sim.push(pushed, options.push_impulse);
+      }
       if (stop_early) {
         for (; done < next && !broken(); ++done) sim.step(1);
       } else {
@@ -126,6 +182,7 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
     r.failure = e.what();
   }
   r.steps = sim.steps_done();
+  if (controller) r.grn_updates = controller->updates();
   r.simulated_time = sim.time();
   r.max_speed = sim.max_speed_seen();
   r.max_step_displacement = sim.max_step_displacement_seen();
@@ -226,8 +283,45 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   options.check_embedding = config.evaluation.check_embedding;
   options.observer = observer;
   options.settle_steps = config.evaluation.settle_steps;
+  options.push_step = config.evaluation.push_step;
+  if (config.evaluation.push_impulse.size() != 2)
+    throw ConfigError(fmt::format("evaluation.push_impulse: expected 2 numbers [Jx, Jy], got {}",
+                                  config.evaluation.push_impulse.size()));
+  options.push_impulse = Eigen::Vector2d(config.evaluation.push_impulse[0], config.evaluation.push_impulse[1]);
+  options.push_front_only = config.evaluation.push_cells == "front";
+  GrnControlStart control_start;
+  if (config.control.mode == "grn") {
+    control_start = grn_control_start(genome, embryo, config);
+    options.control_start = &control_start;
+    options.control = &config.control;
+  }
   if (observer) observer->on_body(body);
-  const SwimResult s = swim(body, config.scene, config.physics, config.evaluation.steps, options);
+  // Objective chemotaxis: one swim per source direction (the first is observed and gives the
+  // diagnostics), the fitness their mean progress toward the source.
+  const bool chemotaxis = config.evaluation.objective == "chemotaxis";
+  const int trials = chemotaxis ? config.evaluation.source_directions : 1;
+  SwimResult s;
+  double progress = 0.0;
+  for (int t = 0; t < trials; ++t) {
+    SceneParams scene = config.scene;
+    if (chemotaxis) scene.chemical_source = source_direction(config, t);
+    const SwimResult st = swim(body, scene, config.physics, config.evaluation.steps, options);
+    if (chemotaxis) {
+      const Eigen::Vector2d src(scene.chemical_source[0], scene.chemical_source[1]);
+      progress += st.valid ? src.norm() - (src - st.displacement).norm() : 0.0;
+    }
+    if (t == 0) {
+      s = st;
+      options.observer = nullptr;
+    } else if (!st.valid) {
+      s.valid = false;
+      s.stable = s.stable && st.stable;
+      s.failure = fmt::format("source direction {}: {}", t, st.failure);
+    }
+  }
+  out.source_progress = chemotaxis && s.valid ? progress / trials : 0.0;
+  out.grn_updates = s.grn_updates;
+  out.displacement_at_push = s.displacement_at_push;
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
   out.valid = s.valid;

@@ -159,7 +159,13 @@ const std::vector<std::string>& late_keys() {
       // The body graphs (issue 17 part 4): at "gabriel" the body is the paper's.
       "body.graph", "body.distance_threshold", "body.alpha",
       // Evolvable stiffness (issue 17 part 3): used only when genome.extra_outputs has stiffness.
-      "development.stiffness_min", "development.stiffness_max"};
+      "development.stiffness_min", "development.stiffness_max",
+      // Active control, the chemical field (issue 18; docs/control.md): the defaults are the paper's swim.
+      "scene.chemical",           "scene.chemical_source", "scene.chemical_decay_length",
+      "control.mode",             "control.actuation",     "control.update_interval", "control.grn_rate",
+      "control.signal_rate",      "control.signal_decay",  "control.start_ramp",
+      "evaluation.source_directions", "evaluation.source_seed", "evaluation.push_step",
+      "evaluation.push_impulse",  "evaluation.push_cells"};
   return keys;
 }
 
@@ -200,6 +206,17 @@ std::uint64_t run_identity(const Config& config) {
     if (get_value(c, key) != get_value(defaults, key)) continue;
     erase_key_lines(text, key);
     erased = true;
+  }
+  // A section left without keys ([control] at its defaults) goes with its header.
+  for (auto at = text.find("\n["); at != std::string::npos;) {
+    const auto close = text.find("]\n", at);
+    const auto after = close == std::string::npos ? std::string::npos : close + 2;
+    if (after != std::string::npos && (after == text.size() || text.compare(after, 2, "\n[") == 0)) {
+      text.erase(at, after - at);
+      at = text.find("\n[", at);
+    } else {
+      at = text.find("\n[", at + 1);
+    }
   }
   // [islands] Without islands the island keys change nothing: hash the config without their lines
   // (each key with its comment line), so runs checkpointed before islands existed resume.

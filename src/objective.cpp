@@ -52,6 +52,14 @@ class SpeedToward final : public Objective {
   double dx_ = 1.0, dy_ = 0.0;
 };
 
+/// Issue 18: the mean progress toward the chemical source over evaluation.source_directions swims
+/// (EvaluationResult::source_progress, computed by evaluate()).
+class Chemotaxis final : public Objective {
+ public:
+  std::string name() const override { return "chemotaxis"; }
+  double value(const EvaluationRecord& r) const override { return r.result.source_progress; }
+};
+
 /// The crawl world's objective: |horizontal displacement| of the centre of mass, start to end
 /// (either direction, like the paper's distance; vertical motion, e.g. falling, does not count).
 class DistanceX final : public Objective {
@@ -123,6 +131,7 @@ std::shared_ptr<const Objective> make_objective(const EvaluationParams& p) {
     return std::make_shared<SpeedToward>(p.direction);
   }
   if (p.objective == "distance_x") return std::make_shared<DistanceX>();
+  if (p.objective == "chemotaxis") return std::make_shared<Chemotaxis>();
   if (p.objective == "distance_minus_energy") {
     validate(p);
     return std::make_shared<DistanceMinusEnergy>(p.energy_weight);
@@ -159,6 +168,8 @@ void validate(const EvaluationParams& p) {
     throw ConfigError(fmt::format("evaluation.energy_weight = {}: must be finite and >= 0", p.energy_weight));
   if (!(p.energy_offset > 0.0) || !std::isfinite(p.energy_offset))
     throw ConfigError(fmt::format("evaluation.energy_offset = {}: must be finite and > 0", p.energy_offset));
+  if (p.push_impulse.size() != 2)
+    throw ConfigError(fmt::format("evaluation.push_impulse: expected 2 numbers [Jx, Jy], got {}", p.push_impulse.size()));
 }
 
 double body_length(const Body& body) {

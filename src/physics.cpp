@@ -381,6 +381,22 @@ void Simulation::set_velocities(const Points& v) {
   s.read_state();
 }
 
+void Simulation::push(std::span<const int> cells, const Eigen::Vector2d& impulse) {
+  Impl& s = *impl_;
+  if (!impulse.allFinite()) throw GeometryError("Simulation::push: non-finite impulse");
+  for (int c : cells)
+    if (c < 0 || c >= s.state.n)
+      throw GeometryError(fmt::format("Simulation::push: cell {} out of range [0, {})", c, s.state.n));
+  const double inv_mass = s.state.inv_mass;
+  for (int c : cells) {
+    const auto u = static_cast<std::size_t>(c);
+    s.cells.vx[u] = static_cast<float>(static_cast<double>(s.cells.vx[u]) + impulse.x() * inv_mass);
+    s.cells.vy[u] = static_cast<float>(static_cast<double>(s.cells.vy[u]) + impulse.y() * inv_mass);
+    if (s.world) s.bodies[u]->SetLinearVelocity(b2Vec2(s.cells.vx[u], s.cells.vy[u]));
+  }
+  s.read_state();
+}
+
 int Simulation::node_count() const { return impl_->state.n; }
 long Simulation::steps_done() const { return impl_->control_steps; }
 long Simulation::substeps_done() const { return impl_->box2d_steps; }

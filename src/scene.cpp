@@ -112,6 +112,12 @@ void validate(const SceneParams& params) {
     throw ConfigError(fmt::format("scene.ground_friction_kinetic: {} is above scene.ground_friction_static = {} "
                                   "(Coulomb friction needs mu_k <= mu_s)",
                                   params.ground_friction_kinetic, params.ground_friction_static));
+  if (params.chemical_source.size() != 2)
+    throw ConfigError(fmt::format("scene.chemical_source: expected [x, y] (2 numbers), got {} numbers",
+                                  params.chemical_source.size()));
+  for (double v : params.chemical_source)
+    if (!std::isfinite(v) || std::abs(v) > kMaxLength)
+      throw ConfigError(fmt::format("scene.chemical_source: {} is out of range (finite, |x| <= {})", v, kMaxLength));
 }
 
 void validate(const PhysicsParams& params) { check_fields(params, "physics"); }

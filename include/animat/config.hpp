@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "animat/body.hpp"
+#include "animat/control.hpp"
 #include "animat/development.hpp"
 #include "animat/evolution.hpp"
 #include "animat/genome.hpp"
@@ -27,6 +28,7 @@ struct Config {
   PhysicsParams physics;
   EvaluationParams evaluation;
   EvolutionParams evolution;
+  ControlParams control;
 };
 
 /// Calls v(section_name, params) for every section, in TOML order.
@@ -41,6 +43,7 @@ void visit_sections(C& c, V&& v) {
   v("physics", c.physics);
   v("evaluation", c.evaluation);
   v("evolution", c.evolution);
+  v("control", c.control);  // last: a run at the defaults hashes as before [control] existed
 }
 
 /// A config value, as seen by --set and the Python dict view.

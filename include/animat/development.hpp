@@ -128,6 +128,11 @@ struct Embryo {
   bool viable = false;
   std::vector<std::string> reasons;     ///< why not viable; empty when viable
   DevelopmentTrace trace;               ///< filled when params.trace_every > 0
+  /// Every cell's GRN at the end of development, where control.mode = "grn" starts the swim
+  /// (docs/control.md): levels n × node_count (units, then outputs), the maternal levels sensed
+  /// last (n × 3) and the cell-made products sensed last (n × morphogen units; 0 columns when the
+  /// morphogens effect is off). Empty for a genome that was not simulated.
+  OutputLevels grn_levels, grn_maternal, grn_sensed;
 
   [[nodiscard]] int cell_count() const { return static_cast<int>(positions.rows()); }
 };

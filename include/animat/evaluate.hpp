@@ -8,6 +8,7 @@
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
+#include "animat/control.hpp"
 #include "animat/genome.hpp"
 
 namespace animat {
@@ -65,6 +66,8 @@ struct SwimResult {
   double actuation_work_absolute = 0.0;  ///< absolute work, per spring and Box2D step
   Eigen::VectorXd cell_work_positive;    ///< per cell: half the positive work of each spring it ends (n)
   Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each spring it ends (n)
+  long grn_updates = 0;                  ///< GRN updates while swimming (control.mode = "grn")
+  Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (push_step >= 0)
 };
 
 /// Options of swim() beyond the scene and physics.
@@ -77,6 +80,18 @@ struct SwimOptions {
   bool check_embedding = true;   ///< check the planar embedding after every Box2D step
   bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
   EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
+  /// control.mode = "grn": where every cell's GRN starts (nullptr: open loop, the scene's own
+  /// actuation). With it, "actuation" is dropped from the scene and a GrnControl effect drives eq. 2.
+  const GrnControlStart* control_start = nullptr;
+  const ControlParams* control = nullptr;  ///< the controller's params (required with control_start)
+  /// A disruption (evaluation.push_step, push_impulse, push_cells): at the start of control step
+  /// push_step (counted from the fitness clock's start; -1 = never) every pushed cell gets
+  /// push_impulse (per cell; velocity change impulse/m). push_cells: "all", or "front" (the cells
+  /// whose x is at least the centre of mass's x at that moment: a push that also turns the body;
+  /// push_front_only = true).
+  long push_step = -1;
+  Eigen::Vector2d push_impulse{0.0, 0.0};
+  bool push_front_only = false;
 };
 
 /// Where a swim starts (the crawl world, docs/worlds.md): the body and its velocities.
@@ -142,10 +157,24 @@ struct EvaluationResult {
   double actuation_work_absolute = 0.0;  ///< absolute actuation work (per spring and Box2D step)
   Eigen::VectorXd cell_work_positive;    ///< per cell: half the positive work of each of its springs
   Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each of its springs
+  /// Objective chemotaxis: the mean over evaluation.source_directions swims (the source at
+  /// scene.chemical_source rotated to a random angle each, deterministic from evaluation.source_seed)
+  /// of the progress toward the source, |x_s| − |x_s − displacement| (length units; 0 unless
+  /// chemotaxis). The directions are evenly spaced, turned by a random offset (source_direction()).
+  double source_progress = 0.0;
+  long grn_updates = 0;            ///< GRN updates while swimming (control.mode = "grn"), first swim
+  Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (evaluation.push_step >= 0)
   double seconds_development = 0.0;  ///< wall time per stage (not deterministic; diagnostics only)
   double seconds_body = 0.0;
   double seconds_swim = 0.0;
 };
+
+/// Where control.mode = "grn" starts: the genome's GRN and every cell's state at the end of `embryo`.
+[[nodiscard]] GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo, const Config& config);
+/// Objective chemotaxis: the source of trial `trial`, scene.chemical_source rotated by
+/// offset + 2π·trial/source_directions, the offset uniform in [0, 2π) drawn from
+/// evaluation.source_seed (the same for every genome): an evenly spaced fan at a random angle.
+[[nodiscard]] std::vector<double> source_direction(const Config& config, int trial);
 
 /// genome -> develop -> build_body -> swim(config.evaluation.steps). Deterministic (same genome and
 /// config give a bit-identical fitness), thread-safe. A non-viable genome is never swum (fitness 0,

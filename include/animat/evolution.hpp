@@ -21,7 +21,9 @@ inline constexpr std::string_view kReferenceCheckNames[] = {"record", "select", 
 /// Allowed values of evaluation.objective: the built-in objectives (kObjectiveNames in objective.hpp;
 /// a new one is added to both lists) and "python:NAME" (the trailing * is a wildcard).
 inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "distance_x",
-                                                         "distance_minus_energy", "distance_per_energy", "python:*"};
+                                                         "distance_minus_energy", "distance_per_energy", "chemotaxis",
+                                                         "python:*"};
+inline constexpr std::string_view kPushCellNames[] = {"all", "front"};
 
 /// How an evaluation is run and scored: the swim horizon, the objective (objective.hpp), the
 /// invariants checked, and the exploit guard.
@@ -49,6 +51,12 @@ struct EvaluationParams {
   /// W₀ of distance_per_energy: distance / (positive actuation work + W₀) [choose: docs/worlds.md; of
   /// the order of a swimmer's W⁺, so that barely moving bodies do not win on the ratio]
   double energy_offset = 1e4;
+  // Directional tasks and disruption (issue 18, docs/control.md).
+  int source_directions = 4;   ///< objective chemotaxis: swims per evaluation, one per source direction [choose]
+  int source_seed = 1;         ///< objective chemotaxis: seed of the source directions (the same for every genome) [choose]
+  int push_step = -1;          ///< control step (from the fitness clock's start) of a push; -1 = none
+  std::vector<double> push_impulse = {0.0, 0.0};  ///< impulse [Jx, Jy] given to every pushed cell
+  std::string push_cells = "all";  ///< pushed cells: all, or front (x >= the centre of mass's x)
 };
 
 template <class V>
@@ -71,6 +79,11 @@ void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"settle_steps", "control steps simulated with actuation off before the fitness clock starts (crawl world: the body settles onto the ground; docs/worlds.md); 0 = none", Bounds::closed(0, 10000000)}, p.settle_steps);
   v(FieldInfo{"energy_weight", "lambda of objective distance_minus_energy: distance - lambda * positive actuation work, length per energy unit [choose]", Bounds::upto(1e6)}, p.energy_weight);
   v(FieldInfo{"energy_offset", "W0 of objective distance_per_energy: distance / (positive actuation work + W0), energy units, > 0 [choose]", Bounds::positive_upto(1e12)}, p.energy_offset);
+  v(FieldInfo{"source_directions", "objective chemotaxis: swims per evaluation, each with scene.chemical_source rotated to a random direction; fitness = mean progress toward the source (docs/control.md) [choose]", Bounds::closed(1, 64)}, p.source_directions);
+  v(FieldInfo{"source_seed", "objective chemotaxis: seed of the source directions, the same for every genome [choose]", Bounds::closed(0, 2147483647)}, p.source_seed);
+  v(FieldInfo{"push_step", "disruption: control step (from the fitness clock's start) at which the pushed cells get push_impulse; -1 = never (docs/control.md)", Bounds::closed(-1, 10000000)}, p.push_step);
+  v(FieldInfo{"push_impulse", "disruption: impulse [Jx, Jy] given to every pushed cell (velocity change impulse / cell_mass), mass * length / time", Bounds::closed(-kMaxCoefficient, kMaxCoefficient)}, p.push_impulse);
+  v(FieldInfo{"push_cells", "disruption: which cells are pushed: all, or front (x >= the centre of mass's x, a push that also turns the body)", Bounds::any(), kPushCellNames}, p.push_cells);
 }
 
 struct Config;

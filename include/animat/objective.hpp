@@ -22,7 +22,8 @@ struct EvaluationParams;
 
 /// The built-in objectives, selectable as evaluation.objective.
 inline constexpr std::string_view kObjectiveNames[] = {"distance",   "distance_per_size",     "speed_toward",
-                                                       "distance_x", "distance_minus_energy", "distance_per_energy"};
+                                                       "distance_x", "distance_minus_energy", "distance_per_energy",
+                                                       "chemotaxis"};
 /// evaluation.objective of a run whose objective is a Python callable: "python:" + its name.
 inline constexpr std::string_view kPythonObjectivePrefix = "python:";
 

@@ -36,6 +36,7 @@ struct PhysicsParams;
 inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation", "pressure", "drag", "collisions",
                                                          "skin_collision", "gravity", "ground"};
 inline constexpr std::string_view kCollisionEdgeNames[] = {"all", "skin"};
+inline constexpr std::string_view kChemicalNames[] = {"none", "point", "plane"};
 
 /// Units (docs/notes/physics.md): length = the cell spacing at the end of development (cell
 /// radius 0.5, so neighbouring centres are about 1 apart); mass = one cell; time = the unit of the
@@ -63,6 +64,13 @@ struct SceneParams {
   double ground_height = 0.0;            ///< y of the floor of effect "ground" (cell centres stay at or above it) [choose]
   double ground_friction_static = 0.8;   ///< Coulomb static coefficient μ_s of the floor [choose]
   double ground_friction_kinetic = 0.5;  ///< Coulomb kinetic coefficient μ_k of the floor, <= μ_s [choose]
+  // A chemical field the cells sense under control.mode = "grn" (docs/control.md).
+  /// "none", "point" (exp(−|x − x_s|/ℓ)) or "plane" (exp(−max(0, (x_s − x)·n)/ℓ), n from the body's
+  /// start centre towards x_s) [beyond the paper]
+  std::string chemical = "none";
+  /// x_s relative to the body's centre at the start of the swim (length units) [choose]
+  std::vector<double> chemical_source = {20.0, 0.0};
+  double chemical_decay_length = 20.0;  ///< ℓ of the chemical field (length units) [choose]
 };
 
 template <class V>
@@ -84,6 +92,9 @@ void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"ground_height", "y of the floor of effect ground, length units; the body is placed with its lowest cell on it [choose]", Bounds::closed(-kMaxLength, kMaxLength)}, p.ground_height);
   v(FieldInfo{"ground_friction_static", "Coulomb static friction coefficient mu_s of the floor: a contact sticks while the tangential impulse needed is <= mu_s * normal impulse [choose]", Bounds::upto(100.0)}, p.ground_friction_static);
   v(FieldInfo{"ground_friction_kinetic", "Coulomb kinetic friction coefficient mu_k of the floor (sliding contacts), at most ground_friction_static [choose]", Bounds::upto(100.0)}, p.ground_friction_kinetic);
+  v(FieldInfo{"chemical", "chemical field sensed by the GRN's chemical input under control.mode = grn: none, point (exp(-|x - x_s|/l)) or plane (exp(-max(0, (x_s - x).n)/l), n from the start centre to x_s) (docs/control.md) [beyond the paper]", Bounds::any(), kChemicalNames}, p.chemical);
+  v(FieldInfo{"chemical_source", "source x_s [x, y] of the chemical field, relative to the body's centre at the start of the swim, length units [choose]", Bounds::closed(-kMaxLength, kMaxLength)}, p.chemical_source);
+  v(FieldInfo{"chemical_decay_length", "decay length l of the chemical field, length units, > 0 [choose]", Bounds::positive_upto(kMaxLength)}, p.chemical_decay_length);
 }
 
 [[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {

@@ -90,6 +90,7 @@ affinity = documented(_core.affinity)
 body_length = documented(_core.body_length)
 delaunay_edges = documented(_core.delaunay_edges)
 gabriel_graph = documented(_core.gabriel_graph)
+grn_swim = documented(_core.grn_swim)
 polygon_area = documented(_core.polygon_area)
 set_log_level = documented(_core.set_log_level)
 tournament_probability = documented(_core.tournament_probability)
@@ -110,7 +111,7 @@ __all__ = [
     "History", "evaluate_population", "to_fitness", "tournament_probability", "run_experiment",
     "run_study",
     # control
-    "SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available",
+    "SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available", "grn_swim",
     # analysis
     "Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE",
     "Trajectory", "replay", "actuation_terms", "actuation_rates", "EXPANDING", "CONTRACTING", "NEUTRAL",

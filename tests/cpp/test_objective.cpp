@@ -214,7 +214,7 @@ TEST(Objective, ConfigSelectsABuiltInByNameAndRefusesUnknownOnes) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("evaluation.objective = \"distnce\": expected one of distance, "
                                          "distance_per_size, speed_toward, distance_x, distance_minus_energy, "
-                                         "distance_per_energy, python:*"),
+                                         "distance_per_energy, chemotaxis, python:*"),
               std::string::npos)
         << e.what();
   }

@@ -111,7 +111,8 @@ def test_attribute_section_missing_attribute_follows_python_protocol():
 
 def test_to_dict_nested_and_typed():
     d = animat.Config().to_dict()
-    assert list(d) == ["genome", "mutation", "grn", "development", "body", "scene", "physics", "evaluation", "evolution"]
+    assert list(d) == ["genome", "mutation", "grn", "development", "body", "scene", "physics", "evaluation", "evolution",
+                       "control"]
     assert d["grn"]["dt"] == 0.05 and isinstance(d["grn"]["dt"], float)
     assert isinstance(d["evolution"]["population"], int)
     assert isinstance(d["physics"]["drag_scheme"], str)

@@ -57,9 +57,9 @@ def test_builtin_objectives_by_name_and_config_key(viable):
     speed = animat.evaluate(g, c2).fitness
     assert speed == pytest.approx(r.displacement[1] / r.simulated_time, rel=1e-12)
     assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward", "distance_x",
-                                      "distance_minus_energy", "distance_per_energy"}
+                                      "distance_minus_energy", "distance_per_energy", "chemotaxis"}
     with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, distance_x, "
-                                         "distance_minus_energy, distance_per_energy, python:"):
+                                         "distance_minus_energy, distance_per_energy, chemotaxis, python:"):
         c2["evaluation.objective"] = "fastest"
 
 
