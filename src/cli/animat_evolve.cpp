@@ -180,8 +180,11 @@ int animat_evolve_main(int argc, char** argv) {
       return 130;
     }
     const auto& best = summary.best;
-    std::printf("\nBest swimmer: fitness %.4f (distance travelled by the centre of mass), %d cells, generation %d\n",
-                best.result.fitness, best.result.cell_count, summary.history.back().generation);
+    const std::string& objective = config.evaluation.objective;
+    const std::string meaning = objective == "distance" ? "distance travelled by the centre of mass"
+                                                        : "evaluation.objective = " + objective;
+    std::printf("\nBest swimmer: fitness %.4f (%s), %d cells, generation %d\n", best.result.fitness,
+                meaning.c_str(), best.result.cell_count, summary.history.back().generation);
     std::printf("Stopped: %s\n", summary.stop_reason.c_str());
     std::printf("Results in %s: config.toml, history.csv, best/ (lineage of best genomes), checkpoint.json\n",
                 options.out.c_str());
