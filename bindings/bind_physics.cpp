@@ -496,7 +496,7 @@ void bind_physics(nb::module_& m) {
           c.scene.chemical_source = *source;
         }
         warm_up_box2d();
-        std::vector<double> times, terms, levels, sensors, com;
+        std::vector<double> times, terms, levels, sensors, com, positions;
         int n = 0;
         {
           nb::gil_scoped_release release;
@@ -519,6 +519,11 @@ void bind_physics(nb::module_& m) {
             const Eigen::Vector2d p = sim.center_of_mass();
             com.push_back(p.x());
             com.push_back(p.y());
+            const Points x = sim.positions();
+            for (int i = 0; i < n; ++i) {
+              positions.push_back(x(i, 0));
+              positions.push_back(x(i, 1));
+            }
           };
           sample();
           for (long done = 0; done + every <= steps; done += every) {
@@ -533,11 +538,13 @@ void bind_physics(nb::module_& m) {
         d["actuation"] = owned_array(std::move(levels), {f, cells});
         d["sensors"] = owned_array(std::move(sensors), {f, cells, 3});
         d["com"] = owned_array(std::move(com), {f, 2});
+        d["positions"] = owned_array(std::move(positions), {f, cells, 2});
         return d;
       }, "genome"_a, "config"_a = nb::none(), "steps"_a = 4000, "every"_a = 10, "source"_a = nb::none(),
       "Swim `genome` under control.mode = 'grn' (forced) and record, every `every` control steps: 'times'\n"
       "(F,), the cells' actuation terms u_i 'terms' (F, n), their actuation output levels 'actuation' (F, n),\n"
-      "the sensors 'sensors' (F, n, 3: strain, pressure, chemical) and the centre of mass 'com' (F, 2).\n"
+      "the sensors 'sensors' (F, n, 3: strain, pressure, chemical), the centre of mass 'com' (F, 2) and the\n"
+      "cell positions 'positions' (F, n, 2).\n"
       "`source` overrides scene.chemical_source (relative to the start centre). docs/control.md.");
   m.def("warm_up_box2d", &warm_up_box2d,
         "Initialise Box2D's lazily filled globals; call once before using worlds from several threads.");

@@ -71,7 +71,8 @@ def test_grn_swim_records_terms_levels_sensors_and_the_centre():
     t = animat.grn_swim(genome, cfg, steps=100, every=10)
     n = t["terms"].shape[1]
     assert t["times"].shape == (11,) and t["actuation"].shape == (11, n) and t["sensors"].shape == (11, n, 3)
-    assert t["com"].shape == (11, 2)
+    assert t["com"].shape == (11, 2) and t["positions"].shape == (11, n, 2)
+    np.testing.assert_allclose(t["positions"].mean(axis=1), t["com"], rtol=0, atol=1e-12)  # equal masses
     a = cfg["development.amplitude_max"]
     assert cfg["control.update_interval"] == 10 and cfg["physics.substeps"] == 1
     # Frame j (j >= 1) follows the update at Box2D step 10 (j - 1), time t_j - 10 h:
