@@ -902,14 +902,14 @@ def _cause_row(label: str, index: int, entry: animat.LineageEntry, cfg: animat.C
     fmin, fmax = float(cfg["development.frequency_min"]), float(cfg["development.frequency_max"])
     at_bound = float(np.mean(f >= fmax - 0.02 * (fmax - fmin)))  # the output saturates: within 2 % of the range
     ph = L.phase_spread(np.asarray(body.phase))
-    return [label, str(index), str(entry.generation), f"{entry.fitness:.2f}", mode.label, f"{f.max():.2f}",
+    return [label, str(index), str(entry.generation), f"{entry.fitness:.2f}", f"{entry.reference_fitness:.2f}", mode.label, f"{f.max():.2f}",
             f"{at_bound:.0%}", f"{ph.range:.2f}", f"{mode.contrast:.2f}"]
 
 
 def causes_lines(causes: Path, baseline_runs: Path, generation: int = 100) -> List[str]:
     """Issue 19 item 5: small controlled runs at d_N = 0.5 (seeds 1-3, `generation` generations), one change each,
     against the study's own runs of the same seeds at the same generation."""
-    header = ["variant", "run", "best of generation", "fitness", "mode", "highest frequency", "cells within 2 % of the frequency bound",
+    header = ["variant", "run", "best of generation", "fitness", "fitness at dt/16", "mode", "highest frequency", "cells within 2 % of the frequency bound",
               "phase range (rad)", "strain contrast"]
     rows: List[List[str]] = []
     summary: Dict[str, List[str]] = {}
@@ -926,7 +926,7 @@ def causes_lines(causes: Path, baseline_runs: Path, generation: int = 100) -> Li
                 continue
             row = _cause_row(label, index, entry, run.config)
             rows.append(row)
-            summary.setdefault(label, []).append(row[4])
+            summary.setdefault(label, []).append(row[5])
     lines = ["## Controlled runs: what changes the mode at low drag", "",
              f"Issue 19 asks to test the likely causes of the differences at low drag with small controlled runs. Each "
              f"variant changes one thing in `configs/paper_dn0.5.toml` and evolves seeds 1–3 for {generation} "
