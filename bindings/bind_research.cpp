@@ -20,6 +20,7 @@
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
+#include "animat/control.hpp"
 #include "animat/development.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
@@ -407,10 +408,10 @@ void bind_research(nb::module_& m) {
           }, "amplitude"_a, "phase"_a,
           "Mode 'oscillator': set every cell's amplitude (n,) in [0, 0.5) and phase (n,) (radians).")
       .def_prop_rw("frequency", [](const ExternalActuation& a) { return owned(a.frequency(), {a.frequency().size()}); },
-                   [](ExternalActuation& a, nb::handle f) { a.set_frequency(to_doubles(f)); },
+                   [](ExternalActuation& a, nb::handle f) { a.set_frequency(to_doubles(f)); }, nb::rv_policy::move,
                    "(n,) oscillator frequencies (mode 'oscillator'; default: the body's).")
       .def_prop_ro("terms", [](const ExternalActuation& a) { return owned(a.terms(), {a.terms().size()}); },
-                   "(n,) cell terms u_i of the last step.");
+                   nb::rv_policy::move, "(n,) cell terms u_i of the last step.");
   add_method(nb::type<Simulation>(), "add_external_actuation", [](Simulation& sim, const Body& body, const std::string& mode) {
         for (const Effect* e : sim.effects())
           if (e->name() == "actuation" || e->name() == "external_actuation")
@@ -427,6 +428,50 @@ void bind_research(nb::module_& m) {
       "Drive the rest lengths from outside (returns the ExternalActuation to set): `body` is the body this\n"
       "simulation swims; mode 'rest_length' (set u_i) or 'oscillator' (set amplitudes and phases). The\n"
       "scene must not list 'actuation'.");
+
+  // --- GRN control added to a Python-built simulation (issue 18, docs/control.md) ---------------------
+  nb::class_<GrnControl>(m, "GrnControl",
+                         "The GRN running while the body swims (control.mode = 'grn'; see ``Simulation.add_grn_control``):\n"
+                         "every control.update_interval Box2D steps it reads the sensors, diffuses the cells' products\n"
+                         "along the springs, steps eq. 1 and sets the cells' actuation. Read-only views of its state.")
+      .def_prop_ro("cell_count", &GrnControl::cell_count, "Cells.")
+      .def_prop_ro("terms", [](const GrnControl& g) { return owned(g.terms(), {g.terms().size()}); },
+                   nb::rv_policy::move, "(n,) the cells' terms u_i of eq. 2 as of the last update.")
+      .def_prop_ro("sensors", [](const GrnControl& g) {
+            return owned(g.sensors(), {static_cast<std::size_t>(g.cell_count()), 3});
+          }, nb::rv_policy::move, "(n, 3) sensor values of the last update: strain, pressure S/S0, chemical.")
+      .def_prop_ro("actuation_levels", [](const GrnControl& g) {
+            std::vector<double> v;
+            for (int i = 0; i < g.cell_count(); ++i) v.push_back(g.grn().output(g.state(i), OutputChannel::actuation));
+            return owned(std::move(v), {static_cast<std::size_t>(g.cell_count())});
+          }, nb::rv_policy::move, "(n,) the cells' actuation output levels L (u_i = amplitude_max (2L - 1), ramped in).")
+      .def_prop_ro("updates", &GrnControl::updates, "GRN updates done so far.")
+      .def("set_chemical_source", &GrnControl::set_chemical_source, "x"_a, "y"_a,
+           "Move the chemical source (absolute coordinates) while swimming.");
+  add_method(nb::type<Simulation>(), "add_grn_control", [](Simulation& sim, const Body& body, const Genome& genome,
+                                                         std::optional<Config> config) {
+        const Config c = config ? *config : Config{};
+        for (const Effect* e : sim.effects())
+          if (e->name() == "actuation" || e->name() == "external_actuation" || e->name() == "grn_control")
+            throw ConfigError(fmt::format("Simulation.add_grn_control: the scene already has '{}' (both would write "
+                                          "the rest lengths); remove it from the scene's effects", e->name()));
+        if (body.node_count() != sim.node_count())
+          throw GeometryError(fmt::format("Simulation.add_grn_control: the body has {} cells, the simulation {}",
+                                          body.node_count(), sim.node_count()));
+        const Embryo embryo = develop(genome, c.genome, c.grn, c.development);
+        if (!embryo.viable) throw ConfigError("Simulation.add_grn_control: the genome is not viable");
+        if (embryo.cell_count() != body.node_count())
+          throw GeometryError(fmt::format("Simulation.add_grn_control: the genome develops {} cells, the body has {}",
+                                          embryo.cell_count(), body.node_count()));
+        auto effect = std::make_unique<GrnControl>(body, grn_control_start(genome, embryo, c), c.control, c.scene, c.physics);
+        GrnControl* raw = effect.get();
+        sim.add_effect(std::move(effect));
+        return raw;
+      }, "body"_a, "genome"_a, "config"_a = nb::none(), nb::rv_policy::reference_internal,
+      "Run `genome`'s GRN while this simulation swims (issue 18): `body` is the body it swims (developed\n"
+      "from `genome` with `config`), whose cells start from their end-of-development GRN states; the\n"
+      "control keys (control.*, scene.chemical*) come from `config`. The scene must not list 'actuation'.\n"
+      "Returns the GrnControl, whose terms, sensors and actuation levels can be read while stepping.");
 
   // --- animat evolve ------------------------------------------------------------------------------
   m.def("evolve_cli", [](std::vector<std::string> args) {

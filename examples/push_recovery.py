@@ -7,8 +7,10 @@ at the paper's d_N = 2 setting, 4000 steps:
      all``), or the cells at x >= the centre's x (``--cells front``, a torque), gets the impulse J
      perpendicular to the direction the body swam over steps 1000-2000 (to its left);
 and reports, from the centre of mass: the speed over steps 1000-2000 (before) and 3000-4000 (after)
-in the pushed swim, their ratio (recovery of speed) beside the same ratio undisturbed, and the
-turn of the heading between the two windows (degrees).
+in the pushed swim, their ratio (recovery of speed) beside the same ratio undisturbed, the pushed
+swim's speed after over the undisturbed one's, the turn of the heading between the two windows
+(degrees), and the deflection: the angle between the pushed and the undisturbed swims' headings over
+steps 3000-4000 (what the push changed for good).
 
     PYTHONPATH=build/python .venv/bin/python examples/push_recovery.py \
         open_loop=data/replication/dn2:0,1,2@60 grn=data/control/push/grn_amplitude_dn2:0,1,2 [--impulse 1.0]
@@ -48,7 +50,7 @@ def analyse(entry, cfg, impulse, cells):
     base = animat.record_evaluation(entry.genome, cfg, every=10)
     seg = windows(base)
     d_before, v_before = seg(1000, PUSH_STEP)
-    _, v_after0 = seg(3000, 4000)
+    d_after0, v_after0 = seg(3000, 4000)
     heading = d_before / np.linalg.norm(d_before)
     left = np.array([-heading[1], heading[0]])
     pushed_cfg = cfg.copy()
@@ -59,9 +61,12 @@ def analyse(entry, cfg, impulse, cells):
     seg2 = windows(rec)
     d_after, v_after = seg2(3000, 4000)
     turn = math.degrees(math.atan2(heading[0] * d_after[1] - heading[1] * d_after[0], heading @ d_after))
+    # What the push changed: the pushed swim's heading over steps 3000-4000 against the undisturbed one's.
+    deflection = math.degrees(math.atan2(d_after0[0] * d_after[1] - d_after0[1] * d_after[0], d_after0 @ d_after))
     sp_b, sp_a, sp_a0 = (float(np.linalg.norm(v)) for v in (v_before, v_after, v_after0))
     return {"valid": bool(rec.result.valid), "speed_before": sp_b, "speed_after": sp_a,
-            "recovery": sp_a / sp_b, "recovery_undisturbed": sp_a0 / sp_b, "turn": turn}
+            "recovery": sp_a / sp_b, "recovery_undisturbed": sp_a0 / sp_b, "turn": turn,
+            "speed_vs_undisturbed": sp_a / sp_a0, "deflection": deflection}
 
 
 def main(argv=None) -> int:
@@ -74,8 +79,8 @@ def main(argv=None) -> int:
     print(f"push at step {PUSH_STEP} of 4000, impulse {args.impulse} per cell ({args.cells} cells), perpendicular "
           "to the heading of steps 1000-2000")
     print("| controller | run | best of generation | fitness | speed before | speed after | after / before "
-          "| same, undisturbed | heading turn (°) |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+          "| same, undisturbed | speed after, pushed / undisturbed | heading turn (°) | deflection by the push (°) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     summary = {}
     with tempfile.TemporaryDirectory() as tmp:
         for g in args.groups:
@@ -93,12 +98,13 @@ def main(argv=None) -> int:
                 summary.setdefault(label, []).append(r)
                 print(f"| {label} | {i} | {entry.generation} | {entry.fitness:.2f} | {r['speed_before']:.3f} | "
                       f"{r['speed_after']:.3f} | {r['recovery']:.2f} | {r['recovery_undisturbed']:.2f} | "
-                      f"{r['turn']:+.0f} |" + ("" if r["valid"] else " invalid swim"))
+                      f"{r['speed_vs_undisturbed']:.3f} | {r['turn']:+.0f} | {r['deflection']:+.0f} |" + ("" if r["valid"] else " invalid swim"))
     print()
     for label, rs in summary.items():
         print(f"{label}: mean after/before {np.mean([r['recovery'] for r in rs]):.2f} (undisturbed "
               f"{np.mean([r['recovery_undisturbed'] for r in rs]):.2f}), mean |turn| "
-              f"{np.mean([abs(r['turn']) for r in rs]):.0f}°")
+              f"{np.mean([abs(r['turn']) for r in rs]):.0f}°, mean |deflection by the push| "
+              f"{np.mean([abs(r['deflection']) for r in rs]):.0f}°")
     return 0
 
 

@@ -150,3 +150,15 @@ def test_crawl_episodes_start_on_the_floor_settled_as_an_evaluation_does(body_an
         assert not terminated
         assert np.asarray(env._sim.positions)[:, 1].min() >= floor - 1e-6  # never below the floor
     assert env._sim.counters["ground_contacts"] > 0
+
+
+def test_external_actuation_terms_and_frequencies_can_be_read(body_and_config):
+    """The ExternalActuation's array properties (they raised a nanobind ownership error before)."""
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c, mode="oscillator", frame_skip=1)
+    env.reset()
+    np.testing.assert_array_equal(env._actuation.frequency, np.asarray(body.frequency))
+    n = body.node_count
+    amplitude, phase = np.full(n, 0.1), np.linspace(0.0, 1.0, n)
+    env.step(np.concatenate([amplitude, phase]))
+    np.testing.assert_allclose(env._actuation.terms, amplitude * np.sin(phase), rtol=0, atol=1e-15)

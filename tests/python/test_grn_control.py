@@ -82,3 +82,30 @@ def test_grn_swim_records_terms_levels_sensors_and_the_centre():
     np.testing.assert_allclose(t["terms"][1:], a * (2 * t["actuation"][1:] - 1) * ramp, rtol=0, atol=1e-15)
     assert np.all(np.abs(t["terms"]) <= a + 1e-15)
     assert np.all((t["sensors"][1:, :, 2] > 0) & (t["sensors"][1:, :, 2] <= 1))  # exp(-r/l)
+
+
+def test_a_grn_control_added_in_python_drives_the_swim_as_grn_swim_does():
+    cfg = animat.Config()
+    cfg["genome.extra_inputs"] = "chemical,strain"
+    cfg["genome.extra_outputs"] = "actuation"
+    cfg["scene.chemical"] = "point"
+    cfg["control.mode"] = "grn"
+    genome, _ = animat.Genome.random_viable(3, cfg)
+    body = animat.build_body(animat.develop(genome, cfg), config=cfg)
+    scene = animat.Scene.from_config(cfg).replace(effects=[e for e in cfg["scene.effects"] if e != "actuation"])
+    sim = animat.Simulation(body, scene, cfg)
+    ctl = sim.add_grn_control(body, genome, cfg)
+    assert ctl.cell_count == body.node_count
+    reference = animat.grn_swim(genome, cfg, steps=100, every=10)
+    for j in range(1, 11):
+        sim.step(10)
+        np.testing.assert_array_equal(ctl.terms, reference["terms"][j])
+        np.testing.assert_array_equal(ctl.sensors, reference["sensors"][j])
+        np.testing.assert_array_equal(ctl.actuation_levels, reference["actuation"][j])
+        np.testing.assert_array_equal(sim.positions, reference["positions"][j])
+    assert ctl.updates == 10
+    with pytest.raises(ValueError, match="already has 'grn_control'"):
+        sim.add_grn_control(body, genome, cfg)
+    with_actuation = animat.Simulation(body, animat.Scene.from_config(cfg), cfg)
+    with pytest.raises(ValueError, match="already has 'actuation'"):
+        with_actuation.add_grn_control(body, genome, cfg)
