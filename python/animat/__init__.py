@@ -30,6 +30,7 @@ from ._core import (
     EvaluationRecord,
     EvaluationResult,
     ExternalActuation,
+    GrnControl,
     Fitness,
     GenerationStats,
     Genome,
@@ -103,7 +104,7 @@ __all__ = [
     # the pipeline
     "Config", "ConfigSection", "Genome", "Rng", "ElementType", "InputChannel", "OutputChannel", "Grn", "affinity",
     "develop", "Embryo", "DevelopmentTrace", "build_body", "Body", "gabriel_graph", "delaunay_edges", "polygon_area",
-    "body_length", "Scene", "Simulation", "ExternalActuation", "swim", "SwimResult", "evaluate", "EvaluationResult",
+    "body_length", "Scene", "Simulation", "ExternalActuation", "GrnControl", "swim", "SwimResult", "evaluate", "EvaluationResult",
     "EvaluationRecord", "record_evaluation", "actuation_start_time", "actuation_term", "warm_up_box2d",
     "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
     # evolution
