@@ -44,7 +44,7 @@ def main() -> None:
     images = []
     for k in range(0, frames, 2):
         fig = plt.figure(figsize=(9.0, 2.7), dpi=64)
-        FigureCanvasAgg(fig)
+        canvas = FigureCanvasAgg(fig)
         for j, (src, t) in enumerate(swims):
             ax = fig.add_subplot(1, len(swims), j + 1)
             p = t["positions"][k]
@@ -66,8 +66,8 @@ def main() -> None:
             ax.set_yticks([])
             ax.set_title(f"source at {ANGLES[j]:+.0f}°", fontsize=8)
         fig.suptitle(f"GRN control (amplitude mode), t = {swims[0][1]['times'][k]:.1f}", fontsize=9)
-        fig.canvas.draw()
-        images.append(Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[:, :, :3]).quantize(colors=16))
+        canvas.draw()
+        images.append(Image.fromarray(np.asarray(canvas.buffer_rgba())[:, :, :3]).quantize(colors=16))
         plt.close(fig)
     out = ROOT / "docs" / "images" / f"control_{RUN}.gif"
     images[0].save(out, save_all=True, append_images=images[1:], duration=80, loop=0, optimize=True)

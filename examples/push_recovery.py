@@ -70,7 +70,7 @@ def analyse(entry, cfg, impulse, cells):
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
     p.add_argument("groups", nargs="+", help="LABEL=PACKED_ENV_DIR:RUNS[@GENERATION]")
     p.add_argument("--impulse", type=float, default=1.0, help="impulse per cell (cell mass 1: the velocity change)")
     p.add_argument("--cells", choices=("all", "front"), default="all",

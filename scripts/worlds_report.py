@@ -126,7 +126,7 @@ def crawl(args) -> int:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
     sub = p.add_subparsers(dest="what", required=True)
     e = sub.add_parser("energy")
     e.add_argument("--data", default="data/worlds/energy")
