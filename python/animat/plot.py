@@ -21,7 +21,7 @@ function               paper        shows
 from __future__ import annotations
 
 import math
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import matplotlib
 import matplotlib.pyplot as plt
@@ -383,6 +383,19 @@ def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None,
 
 # --- Fig. 7: phase map ----------------------------------------------------------------------------------
 
+def _map_axes(ax: Optional[Axes], extent: np.ndarray, colorbar: bool) -> Tuple[Figure, Axes]:
+    """The figure and axes of a body map (phase_map, stiffness_map): ``ax`` and its figure, or a new
+    figure sized to the body's ``extent`` (width, height incl. padding) with room for a colour bar."""
+    if ax is None:
+        h = 3.6
+        w = float(np.clip(h * extent[0] / max(extent[1], 1e-9), 2.5, 8.0)) + (1.1 if colorbar else 0.2)
+        fig = plt.figure(figsize=(w, h + 0.5))
+        return fig, fig.add_subplot()
+    fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
+    assert isinstance(fig, Figure)
+    return fig, ax
+
+
 def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = PHASE_CMAP,
               colorbar: bool = True, title: Optional[str] = None) -> Figure:
     """Paper Fig. 7: the body at rest (its initial, equilibrium state) with every node coloured by
@@ -408,15 +421,7 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = N
     r = _node_radius(body)
     pad = r + 0.5
     lo, hi = pos.min(axis=0), pos.max(axis=0)
-    if ax is None:
-        ext = hi - lo + 2 * pad
-        h = 3.6
-        w = float(np.clip(h * ext[0] / max(ext[1], 1e-9), 2.5, 8.0)) + (1.1 if colorbar else 0.2)
-        fig = plt.figure(figsize=(w, h + 0.5))
-        ax = fig.add_subplot()
-    else:
-        fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
-        assert isinstance(fig, Figure)
+    fig, ax = _map_axes(ax, hi - lo + 2 * pad, colorbar)
     vmin, vmax = (float(phase.min()), float(phase.max())) if len(phase) else (0.0, 1.0)
     # all phases equal: every node is the maximum (red); the colour range is then [max - 1, max]
     norm = Normalize(vmin=vmin if vmax > vmin else vmax - 1.0, vmax=vmax)
@@ -483,15 +488,7 @@ def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes]
     r = _node_radius(body)
     pad = r + 0.5
     lo, hi = pos.min(axis=0), pos.max(axis=0)
-    if ax is None:
-        ext = hi - lo + 2 * pad
-        h = 3.6
-        w = float(np.clip(h * ext[0] / max(ext[1], 1e-9), 2.5, 8.0)) + (1.1 if colorbar else 0.2)
-        fig = plt.figure(figsize=(w, h + 0.5))
-        ax = fig.add_subplot()
-    else:
-        fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
-        assert isinstance(fig, Figure)
+    fig, ax = _map_axes(ax, hi - lo + 2 * pad, colorbar)
     vmin, vmax = (float(f.min()), float(f.max())) if n else (1.0, 1.0)
     norm = LogNorm(vmin=vmin if vmax > vmin else vmax / 2.0, vmax=vmax)
     artists = draw_body(ax, body, pos, "#ffffff", spring_width=2.0)
