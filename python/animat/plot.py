@@ -396,6 +396,17 @@ def _map_axes(ax: Optional[Axes], extent: np.ndarray, colorbar: bool) -> Tuple[F
     return fig, ax
 
 
+def _label_max(ax: Axes, pos: np.ndarray, k: int, lo: np.ndarray, hi: np.ndarray, value: float) -> None:
+    """Label node k of a body map "max <value>", the label pushed outward from the body's centre."""
+    toward = (lo + hi) / 2 - pos[k]
+    toward = toward / (np.linalg.norm(toward) or 1.0)
+    ax.annotate(f"max {value:.2f}", xy=pos[k], xytext=tuple(22 * toward), textcoords="offset points", fontsize=8,
+                ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
+                va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
+                arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
+                bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9), zorder=5)
+
+
 def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = PHASE_CMAP,
               colorbar: bool = True, title: Optional[str] = None) -> Figure:
     """Paper Fig. 7: the body at rest (its initial, equilibrium state) with every node coloured by
@@ -434,13 +445,7 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = N
     _frame_axes(ax, lo, hi, pad)
     if len(phase):
         k = int(np.argmax(phase))
-        toward = (lo + hi) / 2 - pos[k]
-        toward = toward / (np.linalg.norm(toward) or 1.0)
-        ax.annotate(f"max {vmax:.2f}", xy=pos[k], xytext=tuple(22 * toward), textcoords="offset points", fontsize=8,
-                    ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
-                    va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
-                    arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
-                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9), zorder=5)
+        _label_max(ax, pos, k, lo, hi, vmax)
     if colorbar:
         cb = fig.colorbar(nodes, ax=ax, fraction=0.045, pad=0.03)
         cb.set_label("phase shift φ (rad)", fontsize=8)
@@ -507,13 +512,7 @@ def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes]
     _frame_axes(ax, lo, hi, pad)
     if n and not uniform:
         k = int(np.argmax(f))
-        toward = (lo + hi) / 2 - pos[k]
-        toward = toward / (np.linalg.norm(toward) or 1.0)
-        ax.annotate(f"max {vmax:.2f}", xy=pos[k], xytext=tuple(22 * toward), textcoords="offset points", fontsize=8,
-                    ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
-                    va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
-                    arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
-                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9), zorder=5)
+        _label_max(ax, pos, k, lo, hi, vmax)
     if colorbar:
         cb = fig.colorbar(nodes, ax=ax, fraction=0.045, pad=0.03)
         cb.set_label("stiffness factor f (× k)", fontsize=8)
