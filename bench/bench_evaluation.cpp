@@ -141,7 +141,8 @@ BENCHMARK(BM_RandomTry)->Unit(benchmark::kMicrosecond);
 
 /// One development step with n cells (issue 21's size exponent): the GRN of the first sample genome
 /// that has morphogen products, n cells placed on a triangular lattice of spacing 1 (as grown cells
-/// pack), max_cells = n so that none divides; stepped 50 times before timing.
+/// pack), max_cells = n so that none divides; stepped 50 times before timing. Second argument:
+/// development.morphogen_cutoff in tenths (0 = none, the paper's every-pair field).
 void BM_DevelopStep(benchmark::State& state) {
   const Sample& s = sample();
   const int n = static_cast<int>(state.range(0));
@@ -153,6 +154,7 @@ void BM_DevelopStep(benchmark::State& state) {
     }
   DevelopmentParams params = s.config.development;
   params.max_cells = n;
+  params.morphogen_cutoff = 0.1 * static_cast<double>(state.range(1));
   DevelopmentWorld world(Grn(s.genomes[pick], s.config.genome), s.config.grn, params);
   world.set_symmetry_seed(genome_hash(s.genomes[pick]));
   const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
@@ -164,9 +166,12 @@ void BM_DevelopStep(benchmark::State& state) {
   for (int k = 0; k < 50; ++k) world.step();
   for (auto _ : state) benchmark::DoNotOptimize(world.step());
   state.counters["cells"] = n;
+  state.counters["cutoff"] = params.morphogen_cutoff;
   state.counters["morphogens"] = static_cast<double>(world.grn().morphogen_units().size());
 }
-BENCHMARK(BM_DevelopStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DevelopStep)
+    ->ArgsProduct({{32, 64, 128, 256}, {0, 40, 80}})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -4,9 +4,12 @@
 // Cells move as fixture-less dynamic Box2D bodies would (semi-implicit Euler with linear damping,
 // no contacts): CellIntegrator performs b2World::Step's float arithmetic for them bit for bit
 // (src/cell_integrator.hpp), so the only cost of the physics is our own pairwise force loop, which
-// runs only when "repulsion" or "adhesion" is enabled. Pairs are enumerated
-// O(n²): at the paper's 32 (64) cells that is 496 (2016) distance checks per step, less than the
-// GRN steps themselves; the morphogen model needs every pair's distance anyway.
+// runs only when "repulsion" or "adhesion" is enabled. From 64 cells on (set_pair_grid_from), the contact pairs
+// come from a uniform grid (src/neighbour_grid.hpp) in the all-pairs order, so the forces are
+// bitwise those of the all-pairs loop; below it, every pair is checked (496 at the paper's 32 cells,
+// cheaper than the grid). The morphogen field is a sum over every pair unless
+// development.morphogen_cutoff is set; then it uses the grid as well and development is linear in
+// cells.
 #include "animat/development.hpp"
 
 #include <box2d/box2d.h>
@@ -20,6 +23,7 @@
 
 #include "animat/errors.hpp"
 #include "cell_integrator.hpp"
+#include "neighbour_grid.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"  // has_effect
 
@@ -51,6 +55,8 @@ void validate(const DevelopmentParams& p) {
     fail("morphogen_decay_length", fmt::format("must be > 0, got {}", p.morphogen_decay_length));
   if (!(p.maternal_decay_length > 0.0))
     fail("maternal_decay_length", fmt::format("must be > 0, got {}", p.maternal_decay_length));
+  if (!(p.morphogen_cutoff >= 0.0))
+    fail("morphogen_cutoff", fmt::format("must be >= 0 (0 = no cut-off), got {}", p.morphogen_cutoff));
   if (p.morphogen_max_delay < 0) fail("morphogen_max_delay", fmt::format("must be >= 0, got {}", p.morphogen_max_delay));
   if (!(p.max_force >= 0.0)) fail("max_force", fmt::format("must be >= 0, got {}", p.max_force));
   if (!(p.repulsion_stiffness >= 0.0) || !(p.adhesion_stiffness >= 0.0) || !(p.adhesion_range >= 0.0))
@@ -87,6 +93,9 @@ struct DevelopmentWorld::Impl {
   std::vector<std::array<double, 3>> maternal;  ///< per cell, written by sense()
   std::vector<Vec2> forces;     ///< scratch of step_physics
   std::vector<double> fx, fy;   ///< idem: the forces handed to the integrator
+  std::vector<double> px, py;   ///< scratch of sense() and step_physics(): the positions, flat
+  detail::NeighbourGrid grid;   ///< scratch of the pair loops from grid_from cells on
+  std::size_t grid_from = 64;   ///< below this many cells every pair is checked (cheaper than the grid: BM_DevelopStep)
 
   Impl(Grn g, const GrnParams& gp, const DevelopmentParams& p) : grn(std::move(g)), grn_params(gp), params(p) {
     validate(params);
@@ -110,6 +119,9 @@ struct DevelopmentWorld::Impl {
     forces.reserve(most);
     fx.reserve(most);
     fy.reserve(most);
+    px.reserve(most);
+    py.reserve(most);
+    grid.reserve(most);
     states.reserve(reserve);
     history.reserve(reserve * static_cast<std::size_t>(hist_len) * static_cast<std::size_t>(morph_count));
   }
@@ -135,9 +147,9 @@ struct DevelopmentWorld::Impl {
   /// hist_len, wrap with one addition (no integer division in sense()'s pair loop).
   [[nodiscard]] Tap tap_from(std::size_t now_slot, double tau) const {
     tau = std::min(tau, static_cast<double>(params.morphogen_max_delay));
-    const double whole = std::floor(tau);
-    const auto k = static_cast<std::size_t>(whole);
-    const double frac = tau - whole;
+    // tau is a distance over a speed, >= 0 and finite: truncation is floor(), without its bit tricks.
+    const auto k = static_cast<std::size_t>(tau);
+    const double frac = tau - static_cast<double>(k);
     const auto h = static_cast<std::size_t>(hist_len);
     const std::size_t newer = now_slot >= k ? now_slot - k : now_slot + h - k;
     if (!(frac > 0.0)) return {newer, newer, frac};
@@ -156,6 +168,15 @@ struct DevelopmentWorld::Impl {
     return static_cast<int>(cells.size()) - 1;
   }
 
+  void flatten_positions() {
+    px.resize(cells.size());
+    py.resize(cells.size());
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      px[i] = cells[i].position.x();
+      py[i] = cells[i].position.y();
+    }
+  }
+
   double sample(std::size_t cell, std::size_t k, const Tap& t) const {
     const double a = hist(cell, t.newer)[k];
     if (t.frac == 0.0) return a;
@@ -171,6 +192,7 @@ DevelopmentWorld::DevelopmentWorld(DevelopmentWorld&&) noexcept = default;
 DevelopmentWorld& DevelopmentWorld::operator=(DevelopmentWorld&&) noexcept = default;
 
 void DevelopmentWorld::set_symmetry_seed(std::uint64_t seed) { impl_->symmetry_seed = seed; }
+void DevelopmentWorld::set_pair_grid_from(std::size_t cells) { impl_->grid_from = std::max<std::size_t>(cells, 2); }
 
 int DevelopmentWorld::add_cell(const Vec2& position, double radius, const Vec2& orientation, const GrnState* state) {
   Impl& w = *impl_;
@@ -204,6 +226,26 @@ int DevelopmentWorld::step() {
   return divisions;
 }
 
+namespace {
+// One pair's contribution to both cells' sensed levels; si and sj are different cells' rows, the
+// history rows are read only.
+inline void accumulate_pair(double* __restrict si, double* __restrict sj, const double* __restrict i_new,
+                            const double* __restrict j_new, double weight, std::size_t m) {
+  for (std::size_t k = 0; k < m; ++k) {
+    si[k] += weight * j_new[k];
+    sj[k] += weight * i_new[k];
+  }
+}
+inline void accumulate_pair(double* __restrict si, double* __restrict sj, const double* __restrict i_new,
+                            const double* __restrict j_new, const double* __restrict i_old,
+                            const double* __restrict j_old, double weight, double frac, std::size_t m) {
+  for (std::size_t k = 0; k < m; ++k) {
+    si[k] += weight * (j_new[k] + frac * (j_old[k] - j_new[k]));
+    sj[k] += weight * (i_new[k] + frac * (i_old[k] - i_new[k]));
+  }
+}
+}  // namespace
+
 void DevelopmentWorld::sense() {
   Impl& w = *impl_;
   const std::size_t n = w.cells.size();
@@ -223,31 +265,30 @@ void DevelopmentWorld::sense() {
     for (std::size_t k = 0; k < m; ++k) w.sensed[i * m + k] = w.sample(i, k, now);
   const double inv_lambda = 1.0 / w.params.morphogen_decay_length;
   const double inv_speed = 1.0 / w.params.morphogen_speed;
-  // Same arithmetic as w.sample(), with the four history rows of a pair located once.
+  // Same arithmetic as w.sample(), with the four history rows of a pair located once, over flat
+  // copies of the positions, and rows that the compiler knows do not overlap (no alias checks).
+  // Pairs in the all-pairs order (the grid keeps it): every cell adds its terms in the same order.
+  w.flatten_positions();
   double* sensed = w.sensed.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const double d = (w.cells[j].position - w.cells[i].position).norm();
-      const double weight = std::exp(-d * inv_lambda);
-      const Impl::Tap t = w.tap_from(now_slot, d * inv_speed);
-      const double* i_new = w.hist(i, t.newer);
-      const double* j_new = w.hist(j, t.newer);
-      double* si = sensed + i * m;
-      double* sj = sensed + j * m;
-      if (t.frac == 0.0) {
-        for (std::size_t k = 0; k < m; ++k) {
-          si[k] += weight * j_new[k];
-          sj[k] += weight * i_new[k];
-        }
-      } else {
-        const double* i_old = w.hist(i, t.older);
-        const double* j_old = w.hist(j, t.older);
-        for (std::size_t k = 0; k < m; ++k) {
-          si[k] += weight * (j_new[k] + t.frac * (j_old[k] - j_new[k]));
-          sj[k] += weight * (i_new[k] + t.frac * (i_old[k] - i_new[k]));
-        }
-      }
-    }
+  const double cutoff = w.params.morphogen_cutoff;
+  auto pair = [&](std::size_t i, std::size_t j) {
+    const double dx = w.px[j] - w.px[i], dy = w.py[j] - w.py[i];
+    const double d = std::sqrt(dx * dx + dy * dy);  // Eigen's norm(), operation for operation
+    if (cutoff > 0.0 && d > cutoff) return;
+    const double weight = std::exp(-d * inv_lambda);
+    const Impl::Tap t = w.tap_from(now_slot, d * inv_speed);
+    if (t.frac == 0.0)
+      accumulate_pair(sensed + i * m, sensed + j * m, w.hist(i, t.newer), w.hist(j, t.newer), weight, m);
+    else
+      accumulate_pair(sensed + i * m, sensed + j * m, w.hist(i, t.newer), w.hist(j, t.newer), w.hist(i, t.older),
+                      w.hist(j, t.older), weight, t.frac, m);
+  };
+  if (cutoff > 0.0 && n >= w.grid_from) {
+    w.grid.build(w.px.data(), w.py.data(), n, cutoff);
+    w.grid.for_each_pair(n, pair);
+  } else {
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = i + 1; j < n; ++j) pair(i, j);
   }
   for (double& s : w.sensed) s = std::min(s, 1.0);
 }
@@ -338,26 +379,34 @@ void DevelopmentWorld::step_physics(std::span<const Vec2> external_forces) {
   if (w.repulsion || w.adhesion) {
     const double krep = w.params.repulsion_stiffness, kadh = w.params.adhesion_stiffness;
     const double range = w.adhesion ? w.params.adhesion_range : 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t j = i + 1; j < n; ++j) {
-        const Vec2 dx = w.cells[j].position - w.cells[i].position;
-        const double contact = w.cells[i].radius + w.cells[j].radius;
-        const double reach = contact + range;
-        const double d2 = dx.squaredNorm();
-        if (d2 >= reach * reach) continue;
-        const double d = std::sqrt(d2);
-        // Unit vector i → j; coincident centres get a fixed direction (deterministic).
-        const Vec2 u = d > 1e-12 ? Vec2(dx / d) : Vec2(1.0, 0.0);
-        double f = 0.0;  // > 0 pushes apart
-        if (d < contact) {
-          if (w.repulsion) f = krep * (contact - d);
-        } else if (w.adhesion) {
-          const double gap = d - contact;
-          f = -kadh * std::min(gap, range - gap);  // rises to kadh·range/2 at half range, then fades to 0
-        }
-        w.forces[i] -= f * u;
-        w.forces[j] += f * u;
+    auto contact_pair = [&](std::size_t i, std::size_t j) {
+      const Vec2 dx = w.cells[j].position - w.cells[i].position;
+      const double contact = w.cells[i].radius + w.cells[j].radius;
+      const double reach = contact + range;
+      const double d2 = dx.squaredNorm();
+      if (d2 >= reach * reach) return;
+      const double d = std::sqrt(d2);
+      // Unit vector i → j; coincident centres get a fixed direction (deterministic).
+      const Vec2 u = d > 1e-12 ? Vec2(dx / d) : Vec2(1.0, 0.0);
+      double f = 0.0;  // > 0 pushes apart
+      if (d < contact) {
+        if (w.repulsion) f = krep * (contact - d);
+      } else if (w.adhesion) {
+        const double gap = d - contact;
+        f = -kadh * std::min(gap, range - gap);  // rises to kadh·range/2 at half range, then fades to 0
       }
+      w.forces[i] -= f * u;
+      w.forces[j] += f * u;
+    };
+    if (n >= w.grid_from) {
+      double largest = 0.0;
+      for (const auto& c : w.cells) largest = std::max(largest, c.radius);
+      w.flatten_positions();
+      w.grid.build(w.px.data(), w.py.data(), n, 2.0 * largest + range);
+      w.grid.for_each_pair(n, contact_pair);
+    } else {
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j) contact_pair(i, j);
     }
   }
   const double fmax = w.params.max_force;
@@ -426,6 +475,7 @@ double DevelopmentWorld::sensed_morphogen(int cell, int k) const {
   for (std::size_t j = 0; j < w.cells.size(); ++j) {
     if (j == i) continue;
     const double d = (w.cells[j].position - w.cells[i].position).norm();
+    if (w.params.morphogen_cutoff > 0.0 && d > w.params.morphogen_cutoff) continue;
     sum += std::exp(-d / w.params.morphogen_decay_length) * w.sample(j, kk, w.tap(d / w.params.morphogen_speed));
   }
   return std::min(sum, 1.0);

@@ -165,7 +165,9 @@ const std::vector<std::string>& late_keys() {
       "control.mode",             "control.actuation",     "control.update_interval", "control.grn_rate",
       "control.signal_rate",      "control.signal_decay",  "control.start_ramp",
       "evaluation.source_directions", "evaluation.source_seed", "evaluation.push_step",
-      "evaluation.push_impulse",  "evaluation.push_cells"};
+      "evaluation.push_impulse",  "evaluation.push_cells",
+      // The morphogen cut-off (issue 21): at 0 the field is the paper's, every pair.
+      "development.morphogen_cutoff"};
   return keys;
 }
 

@@ -58,6 +58,9 @@ struct DevelopmentParams {
   double morphogen_speed = 0.25;        ///< v: length units per development step
   double morphogen_decay_length = 2.0;  ///< λ of e^(−d/λ) for cell-made morphogens
   int morphogen_max_delay = 64;         ///< longest delay d/v kept in the history (steps); longer delays read the oldest sample
+  /// Cells farther apart than this do not sense each other's morphogens; 0 = no cut-off, every pair
+  /// (the paper's field). A cut-off makes development linear in cells (issue 21) [choose]
+  double morphogen_cutoff = 0.0;
   std::vector<std::string> effects = {"repulsion", "adhesion", "morphogens"};
   int trace_every = 0;            ///< record a trace snapshot every k steps; 0 = off
 };
@@ -90,6 +93,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"maternal_decay_length", "maternal level at distance d from its source is exp(-d/length) [choose]", Bounds::positive_upto(kMaxLength)}, p.maternal_decay_length);
   v(FieldInfo{"morphogen_speed", "speed v of cell-made morphogens, length units per step: delay = d/v [choose]", Bounds::positive_upto(kMaxLength)}, p.morphogen_speed);
   v(FieldInfo{"morphogen_decay_length", "cell-made morphogen level falls as exp(-d/length) [choose]", Bounds::positive_upto(kMaxLength)}, p.morphogen_decay_length);
+  v(FieldInfo{"morphogen_cutoff", "distance beyond which cells do not sense each other's morphogens; 0 = no cut-off, every pair (the paper's field); a cut-off makes development linear in cells [choose, issue 21]", Bounds::upto(kMaxLength)}, p.morphogen_cutoff);
   v(FieldInfo{"morphogen_max_delay", "longest morphogen delay kept in the per-cell history, in steps [choose]", Bounds::closed(0, 100000)}, p.morphogen_max_delay);
   v(FieldInfo{"effects", "effects of the development world", Bounds::any(), kDevelopmentEffectNames}, p.effects);
   v(FieldInfo{"trace_every", "record positions every k steps for plotting; 0 = off", Bounds::closed(0, 100000)}, p.trace_every);
@@ -167,6 +171,10 @@ class DevelopmentWorld {
   int step();
   /// Seeds the placement jitter (develop() uses genome_hash), so results depend only on genome + params.
   void set_symmetry_seed(std::uint64_t seed);
+  /// From how many cells on the pair loops (contact forces; the morphogen field with a cut-off) take
+  /// their pairs from a neighbour grid instead of checking every pair; default 64. Results do not
+  /// depend on it, bit for bit (the grid keeps the all-pairs order); tests and benchmarks set it.
+  void set_pair_grid_from(std::size_t cells);
 
   // --- The pieces of a step, in order -------------------------------------------------------
   /// Computes what every cell senses (maternal levels and cell-made morphogens) now.

@@ -13,6 +13,8 @@
 #include "animat/grn.hpp"
 #include "animat/random.hpp"
 
+#include "../../src/neighbour_grid.hpp"
+
 using namespace animat;
 using Vec2 = DevelopmentWorld::Vec2;
 
@@ -456,6 +458,165 @@ TEST(Development, DeterministicBitIdentical) {
   const Embryo b = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
   ASSERT_EQ(a.cell_count(), 32);
   EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), sizeof(double) * static_cast<std::size_t>(a.positions.size())));
+}
+
+// --- the pair grid (issue 21) ---------------------------------------------------------------------
+
+/// The grid must hand out, in the all-pairs order, a superset of the pairs closer than the reach:
+/// uniform, clustered, collinear, coincident and widely spread points.
+TEST(NeighbourGrid, EveryClosePairInTheAllPairsOrder) {
+  Rng rng(5);
+  struct Set {
+    const char* name;
+    std::vector<double> x, y;
+  };
+  std::vector<Set> sets;
+  auto add = [&](const char* name, int n, auto&& point) {
+    Set s{name, {}, {}};
+    for (int i = 0; i < n; ++i) {
+      const auto [x, y] = point(i);
+      s.x.push_back(x);
+      s.y.push_back(y);
+    }
+    sets.push_back(std::move(s));
+  };
+  add("uniform", 300, [&](int) { return std::pair{rng.uniform(0.0, 10.0), rng.uniform(0.0, 10.0)}; });
+  add("cluster", 100, [&](int) { return std::pair{rng.uniform(0.0, 0.01), rng.uniform(-0.01, 0.0)}; });
+  add("line", 200, [&](int i) { return std::pair{0.37 * i, 0.0}; });  // pairs exactly at bucket edges
+  add("coincident", 70, [&](int) { return std::pair{1.5, -2.5}; });
+  add("spread", 60, [&](int i) { return std::pair{i % 2 ? 1e6 : -1e6, rng.uniform(-1e6, 1e6)}; });
+  add("two", 2, [&](int i) { return std::pair{0.0, 0.999 * i}; });
+  for (const Set& s : sets) {
+    for (double reach : {0.37, 1.0, 5.0}) {
+      const std::size_t n = s.x.size();
+      detail::NeighbourGrid grid;
+      grid.reserve(n);
+      grid.build(s.x.data(), s.y.data(), n, reach);
+      std::vector<std::pair<std::size_t, std::size_t>> seen;
+      grid.for_each_pair(n, [&](std::size_t i, std::size_t j) { seen.emplace_back(i, j); });
+      ASSERT_TRUE(std::is_sorted(seen.begin(), seen.end())) << s.name;
+      ASSERT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << s.name;  // each pair once
+      std::vector<std::pair<std::size_t, std::size_t>> close, close_seen;
+      auto near = [&](std::size_t i, std::size_t j) {
+        const double dx = s.x[j] - s.x[i], dy = s.y[j] - s.y[i];
+        return std::sqrt(dx * dx + dy * dy) <= reach;
+      };
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j)
+          if (near(i, j)) close.emplace_back(i, j);
+      for (const auto& [i, j] : seen)
+        if (i < j && near(i, j)) close_seen.emplace_back(i, j);
+      EXPECT_EQ(close_seen, close) << s.name << " reach " << reach;
+      if (std::string(s.name) == "uniform" && reach == 0.37) {  // and it is a filter: far fewer than all pairs
+        EXPECT_LT(seen.size(), n * (n - 1) / 20);
+      }
+    }
+  }
+}
+
+namespace {
+/// Two development worlds with the same many cells (jittered, overlapping lattice) and a random
+/// genome with morphogen products; `setup` configures each.
+struct GridTwins {
+  std::unique_ptr<DevelopmentWorld> a, b;
+  GridTwins(DevelopmentParams p, int cells) {
+    Rng rng(17);
+    Genome g;
+    for (;;) {
+      g = random_genome(GenomeParams{}, rng);
+      if (Grn(g, GenomeParams{}).morphogen_units().size() >= 2) break;
+    }
+    p.max_cells = cells;
+    a = std::make_unique<DevelopmentWorld>(Grn(g, GenomeParams{}), GrnParams{}, p);
+    b = std::make_unique<DevelopmentWorld>(Grn(g, GenomeParams{}), GrnParams{}, p);
+    // Cell indices in random order over the lattice (so that index order and grid order differ),
+    // random GRN levels (so that morphogen sums stay below the cap of 1 and depend on their order).
+    Rng jitter(23);
+    const int side = static_cast<int>(std::ceil(std::sqrt(cells)));
+    std::vector<int> slot(static_cast<std::size_t>(cells));
+    for (int i = 0; i < cells; ++i) slot[static_cast<std::size_t>(i)] = i;
+    for (int i = cells - 1; i > 0; --i)
+      std::swap(slot[static_cast<std::size_t>(i)], slot[static_cast<std::size_t>(jitter.below(static_cast<std::uint64_t>(i) + 1))]);
+    for (int i = 0; i < cells; ++i) {
+      const int k = slot[static_cast<std::size_t>(i)];
+      const Vec2 at(0.9 * (k % side) + jitter.uniform(-0.2, 0.2), 0.8 * (k / side) + jitter.uniform(-0.2, 0.2));
+      const double radius = 0.5 * (1.0 + 0.5 * jitter.uniform(0.0, 1.0));
+      GrnState state = a->grn().initial_state();
+      for (double& level : state.levels) level = jitter.uniform(0.0, 0.3);
+      a->add_cell(at, radius, Vec2(1, 0), &state);
+      b->add_cell(at, radius, Vec2(1, 0), &state);
+    }
+  }
+  /// Steps both and checks that every cell's position, velocity and GRN levels are the same bits.
+  void expect_bitwise_equal_for(int steps) {
+    for (int t = 0; t < steps; ++t) {
+      a->step();
+      b->step();
+      ASSERT_EQ(a->cell_count(), b->cell_count());
+      for (int i = 0; i < a->cell_count(); ++i) {
+        ASSERT_EQ(0, std::memcmp(a->position(i).data(), b->position(i).data(), 2 * sizeof(double))) << "step " << t << " cell " << i;
+        ASSERT_EQ(0, std::memcmp(a->velocity(i).data(), b->velocity(i).data(), 2 * sizeof(double))) << "step " << t << " cell " << i;
+        ASSERT_EQ(a->state(i).levels, b->state(i).levels) << "step " << t << " cell " << i;
+      }
+    }
+  }
+};
+}  // namespace
+
+/// The grid leaves every result bitwise what the all-pairs loops give: contact forces, and the
+/// morphogen field with a cut-off; a cut-off beyond every distance is the paper's field itself.
+TEST(Development, PairGridGivesBitwiseTheAllPairsDevelopment) {
+  for (double cutoff : {0.0, 2.5, 6.0}) {
+    DevelopmentParams p;
+    p.morphogen_decay_length = 0.4;  // sums of many terms, below the cap
+    p.morphogen_cutoff = cutoff;
+    GridTwins twins(p, 150);
+    twins.a->set_pair_grid_from(2);
+    twins.b->set_pair_grid_from(100000);
+    twins.expect_bitwise_equal_for(40);
+  }
+  DevelopmentParams none, beyond;
+  beyond.morphogen_cutoff = 1e6;
+  GridTwins paper(none, 150), cut(beyond, 150);
+  cut.a->set_pair_grid_from(2);
+  for (int t = 0; t < 30; ++t) {
+    paper.a->step();
+    cut.a->step();
+    for (int i = 0; i < paper.a->cell_count(); ++i) {
+      ASSERT_EQ(0, std::memcmp(paper.a->position(i).data(), cut.a->position(i).data(), 2 * sizeof(double)));
+      ASSERT_EQ(paper.a->state(i).levels, cut.a->state(i).levels);
+    }
+  }
+}
+
+TEST(Development, MorphogenCutoffSilencesOnlyFartherPairs) {
+  DevelopmentParams p = with_effects({"morphogens"});
+  p.morphogen_cutoff = 3.0;
+  DevelopmentWorld cut(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, p);
+  DevelopmentWorld all(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"morphogens"}));
+  for (DevelopmentWorld* w : {&cut, &all}) {
+    GrnState s = w->grn().initial_state();
+    s.levels[0] = 0.5;
+    w->add_cell(Vec2(0, 0), 0.5, Vec2(1, 0), &s);  // the only emitter
+    s.levels[0] = 0.0;
+    w->add_cell(Vec2(2.0, 0), 0.5, Vec2(1, 0), &s);   // within the cut-off
+    w->add_cell(Vec2(0, -3.0), 0.5, Vec2(1, 0), &s);  // exactly at it: still sensed
+    w->add_cell(Vec2(-3.5, 0), 0.5, Vec2(1, 0), &s);  // beyond it
+    w->sense();
+  }
+  EXPECT_EQ(cut.sensed_morphogens(1)[0], all.sensed_morphogens(1)[0]);
+  EXPECT_NEAR(cut.sensed_morphogens(1)[0], 0.5 * std::exp(-1.0), 1e-12);
+  EXPECT_EQ(cut.sensed_morphogens(2)[0], all.sensed_morphogens(2)[0]);
+  EXPECT_NEAR(all.sensed_morphogens(3)[0], 0.5 * std::exp(-1.75), 1e-12);
+  EXPECT_EQ(cut.sensed_morphogens(3)[0], 0.0);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(cut.sensed_morphogens(c)[0], cut.sensed_morphogen(c, 0), 1e-12);
+  p.morphogen_cutoff = -1.0;
+  try {
+    validate(p);
+    FAIL() << "a negative cut-off was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("development.morphogen_cutoff"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Development, InvalidParamsAreRejected) {
