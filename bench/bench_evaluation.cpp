@@ -170,7 +170,7 @@ void BM_DevelopStep(benchmark::State& state) {
   state.counters["morphogens"] = static_cast<double>(world.grn().morphogen_units().size());
 }
 BENCHMARK(BM_DevelopStep)
-    ->ArgsProduct({{32, 64, 128, 256}, {0, 40, 80}})
+    ->ArgsProduct({{32, 64, 128, 256, 512, 1024}, {0, 40, 80}})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
