@@ -38,6 +38,10 @@ class NeighbourGrid {
     // rounding of their bucket coordinates; a spread-out set gets larger buckets, not more of them.
     double size = reach * (1.0 + 1e-6);
     const double most = static_cast<double>(kBucketsPerPoint * n + 1);
+    const bool finite = std::isfinite(x1 - x0) && std::isfinite(y1 - y0) && std::isfinite(size) && size > 0.0;
+    for (std::size_t i = 0; finite && i < n; ++i)
+      if (!std::isfinite(x[i]) || !std::isfinite(y[i])) return single_bucket(n);  // every pair, as all-pairs would
+    if (!finite) return single_bucket(n);
     for (;;) {
       const double fx = std::floor((x1 - x0) / size) + 1.0, fy = std::floor((y1 - y0) / size) + 1.0;
       if (fx * fy <= most) {
@@ -64,6 +68,17 @@ class NeighbourGrid {
     sorted_.resize(n);
     next_.assign(start_.begin(), start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) sorted_[static_cast<std::size_t>(next_[static_cast<std::size_t>(bucket_[i])]++)] = static_cast<long>(i);
+  }
+
+  /// Every point in one bucket: for_each_pair() then hands out every pair.
+  void single_bucket(std::size_t n) {
+    x0_ = y0_ = 0.0;
+    inv_ = 0.0;
+    nx_ = ny_ = 1;
+    start_.assign({0, static_cast<long>(n)});
+    bucket_.assign(n, 0);
+    sorted_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) sorted_[i] = static_cast<long>(i);
   }
 
   /// visit(i, j) for every pair i < j in the same or adjacent buckets: i ascending, then j ascending.

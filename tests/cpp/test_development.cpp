@@ -512,6 +512,18 @@ TEST(NeighbourGrid, EveryClosePairInTheAllPairsOrder) {
       }
     }
   }
+  // Points the grid cannot bucket (a NaN; an extent beyond double range): every pair, in order.
+  for (const std::vector<double>& xs : {std::vector<double>{0.0, 1.0, std::nan(""), 2.0, 3.0},
+                                        std::vector<double>{-1.7e308, 0.0, 1.7e308, 5.0, 6.0}}) {
+    const std::vector<double> ys(xs.size(), 0.0);
+    detail::NeighbourGrid grid;
+    grid.build(xs.data(), ys.data(), xs.size(), 1.0);
+    std::vector<std::pair<std::size_t, std::size_t>> seen, all;
+    grid.for_each_pair(xs.size(), [&](std::size_t i, std::size_t j) { seen.emplace_back(i, j); });
+    for (std::size_t i = 0; i < xs.size(); ++i)
+      for (std::size_t j = i + 1; j < xs.size(); ++j) all.emplace_back(i, j);
+    EXPECT_EQ(seen, all);
+  }
 }
 
 namespace {
