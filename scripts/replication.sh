@@ -19,6 +19,11 @@
 # (late_keys() in src/evolution.cpp).
 # ANIMAT_REPLICATION_INDEX="1 2 3" restricts step 2 to those runs of the study (env-major: run i of the
 # e-th environment of dn0.5, dn2, dn10, dn0.2_64cells is e * RUNS + i).
+# ANIMAT_REPLICATION_ROUND=150 grows the study breadth first: step 2 runs in rounds, each taking every
+# open run to ROUND generations past the least advanced one (python -m animat.replication_store
+# next-cap), so that a short session leaves the runs at comparable lengths instead of finishing the
+# first few. Default 0: every run straight to the cap. (With an INDEX, the rounds stop as soon as the
+# least advanced run is one outside it.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SESSION=${1:-5400}
@@ -41,14 +46,37 @@ mkdir -p "$WORK"
 "${PY[@]}" -m animat.replication_store unpack "$DATA" "$WORK"
 git rev-parse HEAD > "$WORK/commit.txt" 2>/dev/null || true
 rm -f "$WORK"/*/summary.json  # stop reasons of this session only (an --index session writes none)
-status=0
+: > "$WORK/experiment.log"
+ROUND=${ANIMAT_REPLICATION_ROUND:-0}
+ENVS=(dn0.5 dn2 dn10 dn0.2_64cells)
+START=$SECONDS
+# One call of the runner up to generation cap $1, within what is left of the session's budget.
 # --wall-seconds 0: no cumulative budget (evolution.wall_seconds counts over resumes); the session's
-# budget is the SIGINT that `timeout` sends after SESSION seconds.
-timeout -s INT "$SESSION" "${PY[@]}" -m animat experiment \
-  dn0.5=configs/paper_dn0.5.toml dn2=configs/paper_dn2.toml dn10=configs/paper_dn10.toml \
-  dn0.2_64cells=configs/paper_dn0.2_64cells.toml \
-  --runs "$RUNS" --parallel "$PARALLEL" --threads "$PARALLEL" --generations "$GENERATIONS" --wall-seconds 0 \
-  "${INDEX_ARGS[@]}" --out "$WORK" > "$WORK/experiment.log" 2>&1 || status=$?
+# budget is the SIGINT that `timeout` sends when it is spent.
+experiment() {
+  local left=$(( SESSION - (SECONDS - START) ))
+  (( left > 0 )) || return 124
+  timeout -s INT "$left" "${PY[@]}" -m animat experiment \
+    dn0.5=configs/paper_dn0.5.toml dn2=configs/paper_dn2.toml dn10=configs/paper_dn10.toml \
+    dn0.2_64cells=configs/paper_dn0.2_64cells.toml \
+    --runs "$RUNS" --parallel "$PARALLEL" --threads "$PARALLEL" --generations "$1" --wall-seconds 0 \
+    "${INDEX_ARGS[@]}" --out "$WORK" >> "$WORK/experiment.log" 2>&1
+}
+status=0
+if (( ROUND > 0 )); then
+  previous=""
+  while :; do
+    cap=$("${PY[@]}" -m animat.replication_store next-cap "$WORK" --envs "${ENVS[@]}" --runs "$RUNS" \
+          --generations "$GENERATIONS" --round "$ROUND")
+    # Every run finished, or the last round did not move the least advanced run (a failed run).
+    [[ "$cap" == "-1" || "$cap" == "$previous" ]] && break
+    previous=$cap
+    echo "replication: round to generation $cap" >&2
+    experiment "$cap" || { status=$?; break; }
+  done
+else
+  experiment "$GENERATIONS" || status=$?
+fi
 if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then
   echo "replication: the experiment failed (exit $status); see $WORK/experiment.log; packing what ran" >&2
 fi

@@ -665,6 +665,8 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
         w(f"PYTHONPATH=build/python .venv/bin/python scripts/replication_report.py --data {data.as_posix()} "
           f"--doc {doc.as_posix()}")
         w("scripts/replication.sh 5400    # one session of 5400 s; cap 1000 generations or 500 without improvement")
+        w("ANIMAT_REPLICATION_ROUND=150 scripts/replication.sh 5400    # the same, breadth first: rounds of 150 "
+          "generations past the least advanced run")
         w("```")
     else:
         w(f"Commit of the runs: `{commit}` (`{runs_dir.as_posix()}/commit.txt`). To regenerate:")

@@ -196,6 +196,30 @@ def pack_tree(work: Path, root: Path) -> List[Path]:
     return done
 
 
+def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int, round_size: int) -> int:
+    """Breadth-first growth (``ANIMAT_REPLICATION_ROUND`` of scripts/replication.sh): the generation cap of
+    the next round, ``round_size`` generations past the least advanced run that is still open, at most
+    ``generations``; -1 when every run is finished. A run is open when it has not reached ``generations``
+    and has not stopped by the stall rule of its config; a run not started yet counts as generation 0."""
+    if round_size < 1:
+        raise ValueError(f"next_round_cap: round_size must be >= 1, got {round_size}")
+    lowest: Optional[int] = None
+    for env in envs:
+        for i in range(runs):
+            run = Path(work) / env / f"run_{i}"
+            history = run / "history.csv"
+            last = 0
+            if history.is_file():
+                lines = [ln for ln in history.read_text().splitlines() if ln.strip()]
+                last = int(lines[-1].split(",")[0]) if len(lines) > 1 else 0
+                if "no improvement" in _derived_stop(run / "config.toml", lines):
+                    continue
+            if last >= generations:
+                continue
+            lowest = last if lowest is None else min(lowest, last)
+    return -1 if lowest is None else min(lowest + round_size, generations)
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(prog="python -m animat.replication_store",
                                 description="Pack replication runs into data/replication, or unpack them.")
@@ -206,7 +230,16 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     k = sub.add_parser("pack", help="pack WORK/<env>/run_<i> into DATA/<env>/run_<i>")
     k.add_argument("work", type=Path)
     k.add_argument("data", type=Path)
+    c = sub.add_parser("next-cap", help="print the generation cap of the next breadth-first round (-1: all finished)")
+    c.add_argument("work", type=Path)
+    c.add_argument("--envs", nargs="+", required=True)
+    c.add_argument("--runs", type=int, required=True)
+    c.add_argument("--generations", type=int, required=True)
+    c.add_argument("--round", type=int, required=True, dest="round_size")
     args = p.parse_args(argv)
+    if args.command == "next-cap":
+        print(next_round_cap(args.work, args.envs, args.runs, args.generations, args.round_size))
+        return 0
     if args.command == "unpack":
         if not args.data.is_dir():
             print(f"replication_store: {args.data}: no such directory (nothing to resume)", file=sys.stderr)

@@ -46,6 +46,31 @@ def test_pack_tree_takes_stop_reasons_from_the_summary_and_derives_them_otherwis
     assert gzip.decompress((data / "dn2" / "run_0" / "history.csv.gz").read_bytes()).startswith(b"generation,")
 
 
+def _run(work: Path, env: str, i: int, bests: list, generations: int = 1000, stall: int = 500) -> None:
+    """A run directory with a config and a history whose best is bests[g] at generation g."""
+    run = work / env / f"run_{i}"
+    run.mkdir(parents=True)
+    (run / "config.toml").write_text(f"[evolution]\ngenerations = {generations}\nstall_generations = {stall}\n")
+    rows = ["generation,best"] + [f"{g},{b}" for g, b in enumerate(bests)]
+    (run / "history.csv").write_text("\n".join(rows) + "\n")
+
+
+def test_next_round_cap_grows_the_least_advanced_open_run(tmp_path):
+    work = tmp_path / "work"
+    _run(work, "a", 0, [1.0 + g for g in range(301)])  # at 300, improving
+    _run(work, "a", 1, [1.0 + g for g in range(151)])  # at 150: the least advanced
+    _run(work, "b", 0, [5.0] * 700)                    # 699 generations without improvement: stalled
+    _run(work, "b", 1, [1.0 + g for g in range(1001)])  # at the cap
+    assert R.next_round_cap(work, ["a", "b"], 2, 1000, 150) == 300
+    assert R.next_round_cap(work, ["a", "b"], 2, 1000, 1000) == 1000  # never past the cap
+    assert R.next_round_cap(work, ["a", "b", "c"], 2, 1000, 150) == 150  # runs of "c" not started: generation 0
+    assert R.next_round_cap(work, ["a", "b"], 3, 1000, 150) == 150  # nor is run 2 of each
+    assert R.next_round_cap(work, ["b"], 2, 1000, 150) == -1  # stalled or at the cap: finished
+    assert R.main(["next-cap", str(work), "--envs", "a", "b", "--runs", "2", "--generations", "1000", "--round", "150"]) == 0
+    with pytest.raises(ValueError):
+        R.next_round_cap(work, ["a"], 2, 1000, 0)
+
+
 def test_report_rebuilds_from_packed_data_alone(tmp_path):
     import subprocess
     import sys
