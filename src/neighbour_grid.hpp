@@ -25,7 +25,9 @@ class NeighbourGrid {
     next_.reserve(kBucketsPerPoint * most + 2);
   }
 
-  /// Buckets the n points (finite coordinates) for pairs closer than `reach` (> 0).
+  /// Buckets the n >= 1 points for pairs closer than `reach`. Points it cannot bucket (a non-finite
+  /// coordinate, an extent beyond double range, a reach that is not a positive number) all go to one
+  /// bucket: every pair is then handed out.
   void build(const double* x, const double* y, std::size_t n, double reach) {
     double x0 = x[0], x1 = x[0], y0 = y[0], y1 = y[0];
     for (std::size_t i = 1; i < n; ++i) {
@@ -70,17 +72,6 @@ class NeighbourGrid {
     for (std::size_t i = 0; i < n; ++i) sorted_[static_cast<std::size_t>(next_[static_cast<std::size_t>(bucket_[i])]++)] = static_cast<long>(i);
   }
 
-  /// Every point in one bucket: for_each_pair() then hands out every pair.
-  void single_bucket(std::size_t n) {
-    x0_ = y0_ = 0.0;
-    inv_ = 0.0;
-    nx_ = ny_ = 1;
-    start_.assign({0, static_cast<long>(n)});
-    bucket_.assign(n, 0);
-    sorted_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) sorted_[i] = static_cast<long>(i);
-  }
-
   /// visit(i, j) for every pair i < j in the same or adjacent buckets: i ascending, then j ascending.
   /// A point's later neighbours are marked in a bit set and read back in index order (no sort): one
   /// word test per 64 points between the first and the last neighbour.
@@ -115,6 +106,18 @@ class NeighbourGrid {
 
  private:
   static constexpr std::size_t kBucketsPerPoint = 4;
+
+  /// Every point in one bucket: for_each_pair() then hands out every pair.
+  void single_bucket(std::size_t n) {
+    x0_ = y0_ = 0.0;
+    inv_ = 0.0;
+    nx_ = ny_ = 1;
+    start_.assign({0, static_cast<long>(n)});
+    bucket_.assign(n, 0);
+    sorted_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) sorted_[i] = static_cast<long>(i);
+  }
+
   double x0_ = 0.0, y0_ = 0.0, inv_ = 1.0;
   long nx_ = 1, ny_ = 1;
   std::vector<long> bucket_;  ///< per point: its bucket
