@@ -542,14 +542,16 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
           f"({res.method}, {res.tables} tables with the observed margins; {res.shape[0]} modes × {res.shape[1]} "
           f"environments, {int(table.sum())} bests).")
         w("")
-    w("With 5 runs per environment a p-value above 0.05 says little: the test has little power. "
+    counts = sorted({len(labels[e.name]) for e in envs}) or [0]
+    per_env = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}–{counts[-1]}"
+    w(f"With {per_env} runs per environment a p-value above 0.05 says little: the test has little power. "
       "The paper's counts are quoted, not tested: its modes were judged by eye from videos.")
     w("")
     w("### Best fitness")
     w("")
     w("Distance travelled by each environment's final bests: median and mean with percentile bootstrap 95 % "
-      "intervals (10,000 resamples, seed 0; with 5 runs the interval cannot reach beyond the sample's range and "
-      "is narrower than its nominal level).")
+      f"intervals (10,000 resamples, seed 0; with {per_env} runs the interval cannot reach beyond the sample's "
+      "range and is narrower than its nominal level).")
     w("")
     w("| environment | runs | bests | median [95 % CI] | mean [95 % CI] |")
     w("| --- | --- | --- | --- | --- |")
