@@ -24,6 +24,8 @@ from animat.replication_store import unpack_run
 
 def compare(label: str, cases: list, cutoffs: list[float]) -> None:
     print(f"{label}: {len(cases)} genomes")
+    if not cases:
+        return
     reference = [animat.evaluate(genome, config) for genome, config in cases]
     for cut in cutoffs:
         same_cells = same_fitness = 0
