@@ -30,8 +30,17 @@ bool segments_intersect(double ax, double ay, double bx, double by, double cx, d
   return false;
 }
 
-EmbeddingMonitor::EmbeddingMonitor(const Body& body) : regions_(body.regions) {
-  for (int r = 0; r < body.region_count(); ++r) rest_twice_.push_back(2.0 * body.rest_areas(r));
+EmbeddingMonitor::EmbeddingMonitor(const Body& body) {
+  // Regions with a rest area, flattened (their vertices one after another), in the body's order.
+  region_start_.push_back(0);
+  for (int r = 0; r < body.region_count(); ++r) {
+    const double rest_twice = 2.0 * body.rest_areas(r);
+    if (!(rest_twice != 0.0)) continue;
+    const auto& loop = body.regions[effects::at(r)];
+    region_nodes_.insert(region_nodes_.end(), loop.begin(), loop.end());
+    region_start_.push_back(static_cast<int>(region_nodes_.size()));
+    rest_twice_.push_back(rest_twice);
+  }
   for (int e = 0; e < static_cast<int>(body.skin.rows()); ++e) {
     sa_.push_back(body.skin(e, 0));
     sb_.push_back(body.skin(e, 1));
@@ -72,11 +81,21 @@ int EmbeddingMonitor::count_skin_crossings(std::span<const double> x, std::span<
 bool EmbeddingMonitor::observe(std::span<const double> x, std::span<const double> y) {
   ++frames_;
   bool ok = true;
-  const auto px = [&](int i) { return x[effects::at(i)]; };
-  const auto py = [&](int i) { return y[effects::at(i)]; };
-  for (std::size_t r = 0; r < regions_.size(); ++r) {
-    if (!(rest_twice_[r] != 0.0)) continue;
-    const double ratio = effects::twice_area(px, py, regions_[r]) / rest_twice_[r];
+  const double* px = x.data();
+  const double* py = y.data();
+  const int* nodes = region_nodes_.data();
+  for (std::size_t r = 0; r < rest_twice_.size(); ++r) {
+    // Doubled signed area, as effects::twice_area computes it (the same operations, so the same bits).
+    const int* loop = nodes + region_start_[r];
+    const auto k = static_cast<std::size_t>(region_start_[r + 1] - region_start_[r]);
+    double twice = 0.0;
+    if (k == 3) {
+      const int a = loop[0], b = loop[1], c = loop[2];
+      twice = (px[b] - px[a]) * (py[c] - py[a]) - (px[c] - px[a]) * (py[b] - py[a]);
+    } else {
+      for (std::size_t q = 0; q < k; ++q) twice += px[loop[q]] * (py[loop[(q + 1) % k]] - py[loop[(q + k - 1) % k]]);
+    }
+    const double ratio = twice / rest_twice_[r];
     min_ratio_ = std::min(min_ratio_, ratio);
     if (!(ratio > 0.0)) {
       ++inverted_;

@@ -34,8 +34,9 @@ class EmbeddingMonitor {
   [[nodiscard]] int count_skin_crossings(std::span<const double> x, std::span<const double> y);
 
  private:
-  std::vector<std::vector<int>> regions_;
-  std::vector<double> rest_twice_;   // 2·S0 per region
+  std::vector<int> region_nodes_;    // the vertices of every region with a rest area, one after another
+  std::vector<int> region_start_;    // where each such region starts in region_nodes_ (and the end)
+  std::vector<double> rest_twice_;   // 2·S0 per such region
   std::vector<int> sa_, sb_;         // skin edges
   std::vector<int> order_;           // skin edges sorted by their smallest x (kept between frames)
   std::vector<double> lo_, hi_;      // per skin edge, x extent of this frame
