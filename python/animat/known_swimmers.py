@@ -327,6 +327,7 @@ class KnownResult:
     distance: float
     stable: bool
     stroke: Optional[Stroke] = None
+    paddling: Any = None  # animat.locomotion.Paddling of the swim (None when unstable)
 
     @property
     def found(self) -> str:
@@ -341,7 +342,7 @@ def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0
                    config: Optional[Any] = None) -> List[KnownResult]:
     """Swim every swimmer ``steps`` steps at every normal drag (d_T = d_N / 200, the paper's ratio, via the
     config default) and classify the recorded swim with :func:`animat.classify_locomotion`."""
-    from .locomotion import classify_locomotion  # noqa: PLC0415 - avoids an import cycle
+    from .locomotion import classify_locomotion, paddling  # noqa: PLC0415 - avoids an import cycle
     from .trajectory import replay  # noqa: PLC0415
 
     out = []
@@ -353,7 +354,9 @@ def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0
             tr = replay(s.body(cfg), cfg)
             mode = classify_locomotion(tr) if tr.stable else None
             stroke = appendage_stroke(s, tr, mode) if mode is not None else None
-            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke))
+            paddle = paddling(tr, mode) if mode is not None else None
+            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke,
+                                   paddle))
     return out
 
 

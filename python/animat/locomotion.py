@@ -79,6 +79,25 @@ of known mode (:mod:`animat.known_swimmers`; the confusion matrices are in docs/
 contrast rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase)
 is still missed (wave fit 0.78–0.80, just under WAVE_FIT).
 
+The paper's stroke, tested directly (issue 19)
+----------------------------------------------
+:func:`paddling` asks of a swim what the paper (§6) says of its protrusion swimmers, without a mode:
+"protrusions are fully extended when moving backwards (generating thrust) but are contracted during
+their return", "a clear tendency to place the protrusions symmetrically", and "in 32-cell structures
+protrusions are often built from one cell extending beyond the main outline". Over the classifier's
+window, in the body frame: a skin cell *protrudes* when its height above the chord of its two skin
+neighbours reaches ``PADDLE_SPIKE`` (0.9) median rest spring lengths at some time (at rest, a cell on a
+straight stretch of skin has 0, a 120° corner of the triangular lattice 0.5, one cell standing out of a
+straight edge 0.87; a dangling cell counts its whole distance from its neighbour); it *rows* with the correlation of its distance from the body's centre
+with its backward velocity along the direction of motion (+1 when it is farthest out exactly while it
+moves backwards fastest: a loop traversed out, back, in, forward; 0 for a purely radial or a purely
+sweeping motion, which are a quarter period apart; −1 for the loop the other way round). The *pair
+score* is the best min(rowing) over two protruding cells on opposite sides of the axis of motion; a
+swim *paddles* when it reaches ``PADDLE_ROWING`` (0.6). On the hand-built swimmers of
+:mod:`animat.known_swimmers` the whole-body ones (undulators, synchronous contractors) score at most
+0.49 (docs/replication.md); the hand-built protrusion swimmers do not paddle either (their appendages
+are driven to row but follow it only loosely), so the test has negative controls only.
+
 Statistics (paper §6–§7)
 ------------------------
 :func:`grow_output`, :func:`oscillator_spread`, :func:`phase_spread`, :func:`tries_per_viable`,
@@ -106,7 +125,8 @@ __all__ = [
     "harmonic_amplitudes", "GrowOutput", "OscillatorSpread", "PhaseSpread", "BestStatistics",
     "grow_output", "oscillator_spread", "phase_spread", "tries_per_viable", "morphology_changes",
     "last_morphology_change", "best_statistics", "PHASE_DIFFERENTIATED", "AMPLITUDE_DIFFERENTIATED",
-    "FREQUENCY_DIFFERENTIATED", "CONTRACTION_FLOOR",
+    "FREQUENCY_DIFFERENTIATED", "CONTRACTION_FLOOR", "Paddling", "paddling", "paddling_motion",
+    "PADDLE_SPIKE", "PADDLE_ROWING",
 ]
 
 #: The modes :func:`classify_locomotion` returns.
@@ -124,6 +144,12 @@ TOP_FRACTION = 0.2
 #: groups of the calibration set of :mod:`animat.known_swimmers`, swum 2000 steps at d_N = 0.5 and 2:
 #: undulators and synchronous contractors 1.98–3.01, protrusion and tail swimmers 4.14–7.33).
 LOCAL_CONTRAST = 3.5
+#: Height above the chord of its two skin neighbours, in median rest spring lengths, from which a skin
+#: cell protrudes from the outline (:func:`paddling`).
+PADDLE_SPIKE = 0.9
+#: Pair score (min rowing correlation of two protruding cells on opposite sides of the axis of motion)
+#: from which a swim paddles as the paper's protrusion swimmers do (:func:`paddling`).
+PADDLE_ROWING = 0.6
 #: Minimum weighted resultant of a circular-linear phase fit to count as a consistent gradient.
 WAVE_FIT = 0.8
 #: Minimum total phase lag (rad) along the body for a wave.
@@ -612,6 +638,114 @@ def classify_locomotion(thing: Any, config: Optional[Any] = None, *, times: Opti
     if tr.frame_count < 8:
         raise ValueError(f"classify_locomotion: trajectory too short ({tr.frame_count} frames)")
     return classify_motion(tr.positions, tr.times, springs=tr.body.springs, omega=omega, cycles=cycles)
+
+
+# --- the paper's stroke -------------------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class Paddling:
+    """How the skin cells of a swim move against the paper's description of a protrusion stroke
+    (module docstring, "The paper's stroke").
+
+    Attributes:
+        cells: (k,) the skin cells (outer outline), ascending.
+        spike: (k,) each one's largest height above the chord of its skin neighbours over the window, in
+            median rest spring lengths.
+        rowing: (k,) correlation of its distance from the body's centre with its backward velocity (nan
+            when either is constant).
+        side: (k,) its mean body-frame coordinate across the direction of motion (sign: which side).
+        pair: the two protruding cells on opposite sides with the best min(rowing), or () if none.
+        score: that min(rowing); nan without such a pair.
+    """
+
+    cells: np.ndarray
+    spike: np.ndarray
+    rowing: np.ndarray
+    side: np.ndarray
+    pair: Tuple[int, ...]
+    score: float
+
+    @property
+    def paddles(self) -> bool:
+        """Whether the pair score reaches :data:`PADDLE_ROWING`."""
+        return bool(self.score >= PADDLE_ROWING)
+
+    @property
+    def protruding(self) -> np.ndarray:
+        """The skin cells whose spike reaches :data:`PADDLE_SPIKE`."""
+        return self.cells[self.spike >= PADDLE_SPIKE]
+
+
+def paddling_motion(positions: ArrayLike, skin_loop: Sequence[int], rest_length: float, direction: ArrayLike,
+                    spike: float = PADDLE_SPIKE) -> Paddling:
+    """:class:`Paddling` of a window of frames.
+
+    Args:
+        positions: (F, n, 2) positions over the window (any rigid motion; removed by Procrustes).
+        skin_loop: the outer boundary walk, body on the left (``Body.skin_loops[0]``).
+        rest_length: the length unit of the spike (the body's median rest spring length).
+        direction: (2,) direction of motion in the body frame of :func:`procrustes_frames` (the classifier's
+            ``LocomotionMode.direction``).
+        spike: protrusion threshold in rest lengths.
+    """
+    Q, _, _ = procrustes_frames(positions)
+    loop = [int(v) for v in skin_loop]
+    m = len(loop)
+    if m < 3 or not rest_length > 0:
+        raise ValueError(f"paddling_motion: need a skin loop of 3 or more cells and a rest length > 0, "
+                         f"got {m} cells and {rest_length}")
+    heights: dict = {}
+    for p in range(m):
+        i, j, k = loop[p], loop[p - 1], loop[(p + 1) % m]
+        rel = Q[:, i] - Q[:, j]
+        if j == k:  # the tip of a dangling edge: its whole distance from its neighbour
+            h = np.linalg.norm(rel, axis=1)
+        else:
+            chord = Q[:, k] - Q[:, j]
+            norm = np.linalg.norm(chord, axis=1)
+            # body on the left of j -> k: a convex cell lies to the right of the chord
+            cross = chord[:, 0] * rel[:, 1] - chord[:, 1] * rel[:, 0]
+            h = -cross / np.where(norm > 0, norm, np.inf)
+        h = float(h.max()) / rest_length
+        heights[i] = max(heights.get(i, -np.inf), h)  # a cell met twice (a pinch): its larger height
+    cells = np.array(sorted(heights), dtype=np.int64)
+    spikes = np.array([heights[int(c)] for c in cells])
+    d = np.asarray(direction, dtype=np.float64)
+    d = d / np.linalg.norm(d)
+    along = Q[:, cells] @ d
+    radius = np.linalg.norm(Q[:, cells], axis=2)
+    backward = -np.gradient(along, axis=0)
+    rowing = np.full(len(cells), np.nan)
+    for q in range(len(cells)):
+        if np.ptp(radius[:, q]) > 0 and np.ptp(backward[:, q]) > 0:
+            rowing[q] = float(np.corrcoef(radius[:, q], backward[:, q])[0, 1])
+    side = Q[:, cells].mean(axis=0) @ np.array([-d[1], d[0]])
+    pair: Tuple[int, ...] = ()
+    score = float("nan")
+    cand = [q for q in range(len(cells)) if spikes[q] >= spike and np.isfinite(rowing[q])]
+    for a in cand:
+        for b in cand:
+            if a < b and side[a] * side[b] < 0:
+                s = min(rowing[a], rowing[b])
+                if not s <= score:  # first pair, or a better one
+                    pair, score = (int(cells[a]), int(cells[b])), float(s)
+    return Paddling(cells, spikes, rowing, side, pair, score)
+
+
+def paddling(trajectory: Trajectory, mode: Optional[LocomotionMode] = None) -> Paddling:
+    """:class:`Paddling` of a recorded swim over the window of the classifier's ``mode`` (last
+    ``mode.cycles`` periods; its direction of motion). ``mode`` defaults to
+    :func:`classify_locomotion` of the trajectory."""
+    if mode is None:
+        mode = classify_locomotion(trajectory)
+    t = np.asarray(trajectory.times)
+    if mode.omega > 0:
+        sel = t >= t[-1] - mode.cycles * 2 * math.pi / mode.omega - 1e-9
+    else:
+        sel = t >= t[len(t) // 2]
+    rest = float(np.median(np.asarray(trajectory.body.rest_lengths)))
+    return paddling_motion(np.asarray(trajectory.positions)[sel], trajectory.body.skin_loops[0], rest,
+                           mode.direction)
 
 
 # --- statistics of the best individuals ------------------------------------------------------------------
