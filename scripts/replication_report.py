@@ -498,6 +498,12 @@ def calibration_lines(results: Dict[str, List[KS.KnownResult]]) -> List[str]:
         return sum(1 for r in allres if r.swimmer.expected in kinds and r.paddling is not None
                    and r.paddling.score != r.paddling.score)
 
+    def score_range(kinds: Tuple[str, ...]) -> str:
+        v, none = scores(kinds), unscored(kinds)
+        if not v:
+            return f"no pair in any of {none} swims"
+        return f"{min(v):+.2f} to {max(v):+.2f}" + (f" ({none} swims without a pair)" if none else "")
+
     whole = ("undulation", "synchronous contraction")
     w("**The paper's stroke, tested without a classifier** (`animat.locomotion.paddling`, the column *paddle pair "
       "score* above and in the table of evolved bests): the paper says its protrusions are \"fully extended when "
@@ -509,9 +515,8 @@ def calibration_lines(results: Dict[str, List[KS.KnownResult]]) -> List[str]:
       "from the centre with its backward velocity (+1: a loop traversed out, back, in, forward). The pair score is "
       "the best min(rowing) of two protruding cells on opposite sides of the axis of motion (— where there is no "
       f"such pair); a swim *paddles* from {L.PADDLE_ROWING:g}. On the hand-built swims: undulators and "
-      f"synchronous contractors {rng(scores(whole))} ({unscored(whole)} without a pair), protrusion swimmers "
-      f"{rng(scores(('protrusions',)))} ({unscored(('protrusions',))} without a pair), tails "
-      f"{rng(scores(('tail',)))} ({unscored(('tail',))} without a pair). So no whole-body swim paddles (the "
+      f"synchronous contractors {score_range(whole)}, protrusion swimmers {score_range(('protrusions',))}, tails "
+      f"{score_range(('tail',))}. So no whole-body swim paddles (the "
       "threshold lies above all of them), but neither does any hand-built protrusion swimmer: their appendages "
       "follow the commanded stroke only loosely (table above). The test has negative controls only: a best that "
       "paddles moves as the paper's words describe, no more is calibrated.")
