@@ -738,14 +738,9 @@ def paddling(trajectory: Trajectory, mode: Optional[LocomotionMode] = None) -> P
     :func:`classify_locomotion` of the trajectory."""
     if mode is None:
         mode = classify_locomotion(trajectory)
-    t = np.asarray(trajectory.times)
-    if mode.omega > 0:
-        sel = t >= t[-1] - mode.cycles * 2 * math.pi / mode.omega - 1e-9
-    else:
-        sel = t >= t[len(t) // 2]
+    window = np.asarray(trajectory.positions)[-max(int(mode.frames), 2):]  # the classifier's window: a suffix
     rest = float(np.median(np.asarray(trajectory.body.rest_lengths)))
-    return paddling_motion(np.asarray(trajectory.positions)[sel], trajectory.body.skin_loops[0], rest,
-                           mode.direction)
+    return paddling_motion(window, trajectory.body.skin_loops[0], rest, mode.direction)
 
 
 # --- statistics of the best individuals ------------------------------------------------------------------
