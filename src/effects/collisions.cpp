@@ -16,6 +16,8 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string_view>
@@ -120,6 +122,7 @@ class Collisions final : public Effect {
             opposite_[at(t.e[c])] = t.v[c];
           }
           t.band_max = std::max({t.band[0], t.band[1], t.band[2]});
+          t.band4 = 4.0 * t.band_max * (1.0 + 1e-12);
           tris_.push_back(t);
           continue;
         }
@@ -158,7 +161,7 @@ class Collisions final : public Effect {
     for (int e : skin_edges) items_.push_back({0, 0, 0, 0, -1, e});
     for (std::size_t k = 0; k < items_.size(); ++k) order_.push_back(static_cast<int>(k));
 
-    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_}) v->assign(at(n_), 0.0);
+    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &wmax_}) v->assign(at(n_), 0.0);
     kicked_.assign(at(n_), 0);
     const std::size_t skin_vertices = items_.size() - skin_edges.size();
     candidates_.reserve(3 * tris_.size() + fixed_.size() + skin_vertices * skin_edges.size());
@@ -245,6 +248,7 @@ class Collisions final : public Effect {
     std::array<int, 3> e;        // e[c]: the edge opposite v[c]
     std::array<double, 3> band;  // band of the pair (v[c], e[c])
     double band_max;
+    double band4;                // 4·band_max·(1 + 1e-12): the cheaper test's bound on band_max·lmax per (reach + d)
   };
   struct Item {  // a skin vertex (vertex >= 0) or a skin edge (edge >= 0) in the sort and sweep
     double lo, hi, ylo, yhi;
@@ -264,13 +268,31 @@ class Collisions final : public Effect {
     const double* qy = qy_.data();
     const double* wx = wx_.data();
     const double* wy = wy_.data();
+    double* wmax = wmax_.data();
+    for (int i = 0; i < n_; ++i) wmax[i] = span * (std::abs(wx[i]) + std::abs(wy[i]));  // (a sum: NaN stays NaN)
     for (const Triangle& t : tris_) {
       const int a = t.v[0], b = t.v[1], c = t.v[2];
       const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
+      const double c0 = abx * acy - aby * acx;
+      {
+        // A cheaper test first, which only ever rejects triangles the full test below rejects too
+        // (so the candidates are the same): every coordinate difference |·| <= reach now, every
+        // span·(w_j − w_i) component of the triangle <= d; then c1 and c2 below are at most 4·reach·d and 2·d² in
+        // size, the minimum area over the step at least c0 − (|c1| + |c2|), and lmax at most
+        // 4·reach + 4·d. The factors 1 ± 1e-12 cover the rounding of both tests (~1e-15 relative).
+        const double reach = std::max(std::max(std::abs(abx), std::abs(aby)), std::max(std::abs(acx), std::abs(acy)));
+        const double d = wmax[a] + wmax[b] + wmax[c];
+        const double change = 4.0 * reach * d + 2.0 * d * d;
+        if (c0 * (1.0 - 1e-12) > change * (1.0 + 1e-12) + t.band4 * (reach + d)) {
+#if ANIMAT_SELF_CHECK
+          if (!full_test_rejects(t, span)) self_check_failed(t, span);
+#endif
+          continue;
+        }
+      }
       const double dbx = span * (wx[b] - wx[a]), dby = span * (wy[b] - wy[a]);
       const double dcx = span * (wx[c] - wx[a]), dcy = span * (wy[c] - wy[a]);
       // Doubled signed area over the step: c0 + c1·u + c2·u², and its minimum on [0, 1].
-      const double c0 = abx * acy - aby * acx;
       const double c1 = abx * dcy - aby * dcx + dbx * acy - dby * acx;
       const double c2 = dbx * dcy - dby * dcx;
       double lowest = std::min(c0, c0 + c1 + c2);
@@ -323,6 +345,35 @@ class Collisions final : public Effect {
       }
     }
   }
+
+#if ANIMAT_SELF_CHECK
+  /// The full triangle test of gather() (the same operations): whether it rejects the triangle.
+  bool full_test_rejects(const Triangle& t, double span) const {
+    const double* qx = qx_.data();
+    const double* qy = qy_.data();
+    const double* wx = wx_.data();
+    const double* wy = wy_.data();
+    const int a = t.v[0], b = t.v[1], c = t.v[2];
+    const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
+    const double c0 = abx * acy - aby * acx;
+    const double dbx = span * (wx[b] - wx[a]), dby = span * (wy[b] - wy[a]);
+    const double dcx = span * (wx[c] - wx[a]), dcy = span * (wy[c] - wy[a]);
+    const double c1 = abx * dcy - aby * dcx + dbx * acy - dby * acx;
+    const double c2 = dbx * dcy - dby * dcx;
+    double lowest = std::min(c0, c0 + c1 + c2);
+    if (c2 > 0.0 && c1 < 0.0 && -c1 < 2.0 * c2) lowest = std::min(lowest, c0 - c1 * c1 / (4.0 * c2));
+    const double bcx = acx - abx, bcy = acy - aby, dbcx = dcx - dbx, dbcy = dcy - dby;
+    const double lmax = std::max(std::abs(abx) + std::abs(aby) + std::abs(dbx) + std::abs(dby),
+                                 std::max(std::abs(acx) + std::abs(acy) + std::abs(dcx) + std::abs(dcy),
+                                          std::abs(bcx) + std::abs(bcy) + std::abs(dbcx) + std::abs(dbcy)));
+    return lowest > t.band_max * lmax;
+  }
+  [[noreturn]] static void self_check_failed(const Triangle& t, double span) {
+    std::fprintf(stderr, "collisions: the cheaper triangle test rejected triangle (%d, %d, %d) at span %.17g, the full test does not\n",
+                 t.v[0], t.v[1], t.v[2], span);
+    std::abort();
+  }
+#endif
 
   /// Whether the swept boxes of a pair's cell and edge (widened by the band) overlap.
   bool boxes_meet(const Pair& p, double span) const {
@@ -443,6 +494,7 @@ class Collisions final : public Effect {
   std::vector<double> w0x_, w0y_;   // end-of-step velocities before any bounce
   std::vector<double> wx_, wy_;     // current velocities while the events are processed
   std::vector<double> qx_, qy_;     // positions at the current event time
+  std::vector<double> wmax_;        // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
   std::vector<char> kicked_;        // cells whose velocity a bounce changed this step
   double tau_ = 0.0;                // fraction of the step done
 };
