@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "effect_support.hpp"
+#include "triangle_filter.hpp"
 
 namespace animat::effects {
 namespace {
@@ -122,7 +123,7 @@ class Collisions final : public Effect {
             opposite_[at(t.e[c])] = t.v[c];
           }
           t.band_max = std::max({t.band[0], t.band[1], t.band[2]});
-          t.band4 = 4.0 * t.band_max * (1.0 + 1e-12);
+          t.band4 = triangle_band4(t.band_max);
           tris_.push_back(t);
           continue;
         }
@@ -273,37 +274,16 @@ class Collisions final : public Effect {
     for (const Triangle& t : tris_) {
       const int a = t.v[0], b = t.v[1], c = t.v[2];
       const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
-      const double c0 = abx * acy - aby * acx;
-      {
-        // A cheaper test first, which only ever rejects triangles the full test below rejects too
-        // (so the candidates are the same): every coordinate difference |·| <= reach now, every
-        // span·(w_j − w_i) component of the triangle <= d; then c1 and c2 below are at most 4·reach·d and 2·d² in
-        // size, the minimum area over the step at least c0 − (|c1| + |c2|), and lmax at most
-        // 4·reach + 4·d. The factors 1 ± 1e-12 cover the rounding of both tests (~1e-15 relative).
-        const double reach = std::max(std::max(std::abs(abx), std::abs(aby)), std::max(std::abs(acx), std::abs(acy)));
-        const double d = wmax[a] + wmax[b] + wmax[c];
-        const double change = 4.0 * reach * d + 2.0 * d * d;
-        if (c0 * (1.0 - 1e-12) > change * (1.0 + 1e-12) + t.band4 * (reach + d)) {
+      // The cheaper test first: it only rejects triangles the full test rejects too.
+      if (triangle_surely_clear(abx, aby, acx, acy, wmax[a] + wmax[b] + wmax[c], t.band4)) {
 #if ANIMAT_SELF_CHECK
-          if (!full_test_rejects(t, span)) self_check_failed(t, span);
+        if (!full_test_rejects(t, span)) self_check_failed(t, span);
 #endif
-          continue;
-        }
+        continue;
       }
       const double dbx = span * (wx[b] - wx[a]), dby = span * (wy[b] - wy[a]);
       const double dcx = span * (wx[c] - wx[a]), dcy = span * (wy[c] - wy[a]);
-      // Doubled signed area over the step: c0 + c1·u + c2·u², and its minimum on [0, 1].
-      const double c1 = abx * dcy - aby * dcx + dbx * acy - dby * acx;
-      const double c2 = dbx * dcy - dby * dcx;
-      double lowest = std::min(c0, c0 + c1 + c2);
-      if (c2 > 0.0 && c1 < 0.0 && -c1 < 2.0 * c2) lowest = std::min(lowest, c0 - c1 * c1 / (4.0 * c2));
-      // A vertex is within the band of its opposite edge only if 2·area <= band·|edge|; bound every
-      // edge length over the step by its L1 length now plus its L1 change.
-      const double bcx = acx - abx, bcy = acy - aby, dbcx = dcx - dbx, dbcy = dcy - dby;
-      const double lmax = std::max(std::abs(abx) + std::abs(aby) + std::abs(dbx) + std::abs(dby),
-                                   std::max(std::abs(acx) + std::abs(acy) + std::abs(dcx) + std::abs(dcy),
-                                            std::abs(bcx) + std::abs(bcy) + std::abs(dbcx) + std::abs(dbcy)));
-      if (lowest > t.band_max * lmax) continue;
+      if (triangle_stays_clear(abx, aby, acx, acy, dbx, dby, dcx, dcy, t.band_max)) continue;
       for (std::size_t k = 0; k < 3; ++k) candidates_.push_back({t.v[k], t.e[k], t.band[k]});
     }
     for (const Pair& p : fixed_)
@@ -347,26 +327,12 @@ class Collisions final : public Effect {
   }
 
 #if ANIMAT_SELF_CHECK
-  /// The full triangle test of gather() (the same operations): whether it rejects the triangle.
+  /// The full triangle test of gather(): whether it rejects the triangle.
   bool full_test_rejects(const Triangle& t, double span) const {
-    const double* qx = qx_.data();
-    const double* qy = qy_.data();
-    const double* wx = wx_.data();
-    const double* wy = wy_.data();
     const int a = t.v[0], b = t.v[1], c = t.v[2];
-    const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
-    const double c0 = abx * acy - aby * acx;
-    const double dbx = span * (wx[b] - wx[a]), dby = span * (wy[b] - wy[a]);
-    const double dcx = span * (wx[c] - wx[a]), dcy = span * (wy[c] - wy[a]);
-    const double c1 = abx * dcy - aby * dcx + dbx * acy - dby * acx;
-    const double c2 = dbx * dcy - dby * dcx;
-    double lowest = std::min(c0, c0 + c1 + c2);
-    if (c2 > 0.0 && c1 < 0.0 && -c1 < 2.0 * c2) lowest = std::min(lowest, c0 - c1 * c1 / (4.0 * c2));
-    const double bcx = acx - abx, bcy = acy - aby, dbcx = dcx - dbx, dbcy = dcy - dby;
-    const double lmax = std::max(std::abs(abx) + std::abs(aby) + std::abs(dbx) + std::abs(dby),
-                                 std::max(std::abs(acx) + std::abs(acy) + std::abs(dcx) + std::abs(dcy),
-                                          std::abs(bcx) + std::abs(bcy) + std::abs(dbcx) + std::abs(dbcy)));
-    return lowest > t.band_max * lmax;
+    return triangle_stays_clear(qx_[b] - qx_[a], qy_[b] - qy_[a], qx_[c] - qx_[a], qy_[c] - qy_[a],
+                                span * (wx_[b] - wx_[a]), span * (wy_[b] - wy_[a]), span * (wx_[c] - wx_[a]),
+                                span * (wy_[c] - wy_[a]), t.band_max);
   }
   [[noreturn]] static void self_check_failed(const Triangle& t, double span) {
     std::fprintf(stderr, "collisions: the cheaper triangle test rejected triangle (%d, %d, %d) at span %.17g, the full test does not\n",

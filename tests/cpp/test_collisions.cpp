@@ -27,6 +27,7 @@
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
 #include "physics_support.hpp"
+#include "../../src/effects/triangle_filter.hpp"
 
 namespace animat {
 namespace {
@@ -214,6 +215,89 @@ TEST(Collisions, RestitutionZeroStopsTheApproachAndCostsEnergy) {
 }
 
 // --- the planar embedding --------------------------------------------------------------------------
+
+/// The collisions effect's cheaper triangle test only rejects triangles its full test rejects too
+/// (so the candidates, and every result, stay the same): random triangles from fat to nearly flat,
+/// bands from 0 to the tolerance, vertex velocities random or signed to shrink the area fastest,
+/// their quantities derived as Collisions::gather derives them; for each, the motion is scaled to the
+/// edge of what the cheaper test still rejects (bisection), where its bound is tightest.
+TEST(Collisions, CheaperTriangleTestRejectsOnlyWhatTheFullTestRejects) {
+  using animat::effects::triangle_band4;
+  using animat::effects::triangle_stays_clear;
+  using animat::effects::triangle_surely_clear;
+  struct Case {
+    std::array<double, 3> qx, qy, wx, wy;
+    double span, band_max;
+  };
+  // Both tests on the case with every velocity scaled by `scale`: {cheaper rejects, full rejects}.
+  auto tests = [](const Case& c, double scale) {
+    const double abx = c.qx[1] - c.qx[0], aby = c.qy[1] - c.qy[0], acx = c.qx[2] - c.qx[0], acy = c.qy[2] - c.qy[0];
+    std::array<double, 3> wx{}, wy{}, wmax{};
+    for (int v = 0; v < 3; ++v) {
+      wx[v] = scale * c.wx[v];
+      wy[v] = scale * c.wy[v];
+      wmax[v] = c.span * (std::abs(wx[v]) + std::abs(wy[v]));
+    }
+    const double dbx = c.span * (wx[1] - wx[0]), dby = c.span * (wy[1] - wy[0]);
+    const double dcx = c.span * (wx[2] - wx[0]), dcy = c.span * (wy[2] - wy[0]);
+    return std::pair{triangle_surely_clear(abx, aby, acx, acy, wmax[0] + wmax[1] + wmax[2], triangle_band4(c.band_max)),
+                     triangle_stays_clear(abx, aby, acx, acy, dbx, dby, dcx, dcy, c.band_max)};
+  };
+  animat::Rng rng(20261125);
+  long cheap = 0, left_to_full = 0, probed = 0;
+  for (int k = 0; k < 20000; ++k) {
+    Case c{};
+    const double size = std::pow(10.0, rng.uniform(-2.0, 1.0));
+    for (int v = 0; v < 3; ++v) {
+      c.qx[static_cast<std::size_t>(v)] = 50.0 + size * rng.uniform(-1.0, 1.0);
+      c.qy[static_cast<std::size_t>(v)] = -20.0 + size * rng.uniform(-1.0, 1.0);
+    }
+    if (k % 3 == 0) {  // nearly flat: c between a and b, lifted off the line by a little
+      const double s = rng.uniform(0.0, 1.0), lift = size * std::pow(10.0, rng.uniform(-6.0, -1.0));
+      c.qx[2] = c.qx[0] + s * (c.qx[1] - c.qx[0]) + lift;
+      c.qy[2] = c.qy[0] + s * (c.qy[1] - c.qy[0]) - lift;
+    }
+    for (int v = 0; v < 3; ++v) {
+      c.wx[static_cast<std::size_t>(v)] = size * rng.uniform(-1.0, 1.0);
+      c.wy[static_cast<std::size_t>(v)] = size * rng.uniform(-1.0, 1.0);
+    }
+    if (k % 2 == 0) {  // a stands still, b and c move to shrink the doubled area fastest (c1 < 0)
+      const double abx = c.qx[1] - c.qx[0], aby = c.qy[1] - c.qy[0], acx = c.qx[2] - c.qx[0], acy = c.qy[2] - c.qy[0];
+      c.wx[0] = c.wy[0] = 0.0;
+      c.wx[1] = -std::copysign(size, acy);
+      c.wy[1] = std::copysign(size, acx);
+      c.wx[2] = std::copysign(size, aby);
+      c.wy[2] = -std::copysign(size, abx);
+    }
+    c.span = 1.0 / 60.0;
+    c.band_max = k % 4 == 1 ? 0.0 : 0.05 * size * rng.uniform(0.0, 1.0);
+    if (tests(c, 0.0).second && !tests(c, 0.0).first) ++left_to_full;
+    // The largest motion the cheaper test still rejects (it rejects less as the motion grows).
+    double lo = 0.0, hi = 1e6;
+    if (!tests(c, lo).first) continue;
+    for (int it = 0; it < 80; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (tests(c, mid).first ? lo : hi) = mid;
+    }
+    ++probed;
+    for (const double scale : {0.0, 0.5 * lo, lo}) {
+      const auto [surely, stays] = tests(c, scale);
+      cheap += surely;
+      if (surely && !stays) {
+        ADD_FAILURE() << "case " << k << " at motion scale " << scale
+                      << ": the cheaper test rejects a triangle the full test keeps";
+        return;
+      }
+    }
+  }
+  EXPECT_GT(probed, 5000);       // a third of the triangles are clear of their band at rest
+  EXPECT_EQ(cheap, 3 * probed);  // every probe checks three motions the cheaper test rejects
+  EXPECT_GT(left_to_full, 100);  // at rest, some are rejected by the full test only
+  // NaN anywhere: the cheaper test never rejects.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(triangle_surely_clear(nan, 0.0, 0.0, 1.0, 0.0, 0.1));
+  EXPECT_FALSE(triangle_surely_clear(1.0, 0.0, 0.0, 1.0, nan, 0.1));
+}
 
 TEST(Embedding, SegmentsIntersectIncludingTouchingAndCollinearOverlap) {
   EXPECT_TRUE(segments_intersect(0, 0, 1, 1, 0, 1, 1, 0));
