@@ -162,7 +162,7 @@ class Collisions final : public Effect {
     for (int e : skin_edges) items_.push_back({0, 0, 0, 0, -1, e});
     for (std::size_t k = 0; k < items_.size(); ++k) order_.push_back(static_cast<int>(k));
 
-    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &wmax_}) v->assign(at(n_), 0.0);
+    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &wmax_, &ex_, &ey_}) v->assign(at(n_), 0.0);
     kicked_.assign(at(n_), 0);
     const std::size_t skin_vertices = items_.size() - skin_edges.size();
     candidates_.reserve(3 * tris_.size() + fixed_.size() + skin_vertices * skin_edges.size());
@@ -270,7 +270,13 @@ class Collisions final : public Effect {
     const double* wx = wx_.data();
     const double* wy = wy_.data();
     double* wmax = wmax_.data();
-    for (int i = 0; i < n_; ++i) wmax[i] = span * (std::abs(wx[i]) + std::abs(wy[i]));  // (a sum: NaN stays NaN)
+    double* ex = ex_.data();
+    double* ey = ey_.data();
+    for (int i = 0; i < n_; ++i) {
+      wmax[i] = span * (std::abs(wx[i]) + std::abs(wy[i]));  // (a sum: NaN stays NaN)
+      ex[i] = qx[i] + span * wx[i];                           // where the cell is at the end of the span
+      ey[i] = qy[i] + span * wy[i];
+    }
     for (const Triangle& t : tris_) {
       const int a = t.v[0], b = t.v[1], c = t.v[2];
       const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
@@ -287,21 +293,21 @@ class Collisions final : public Effect {
       for (std::size_t k = 0; k < 3; ++k) candidates_.push_back({t.v[k], t.e[k], t.band[k]});
     }
     for (const Pair& p : fixed_)
-      if (boxes_meet(p, span)) candidates_.push_back(p);
+      if (boxes_meet(p)) candidates_.push_back(p);
     if (items_.empty()) return;
     // Skin: sort and sweep the swept x-extents (insertion sort: the order barely changes).
     for (Item& it : items_) {
       if (it.vertex >= 0) {
         const auto v = at(it.vertex);
-        const double x1 = qx[v] + span * wx[v], y1 = qy[v] + span * wy[v];
+        const double x1 = ex[v], y1 = ey[v];
         it.lo = std::min(qx[v], x1) - tol_;
         it.hi = std::max(qx[v], x1) + tol_;
         it.ylo = std::min(qy[v], y1) - tol_;
         it.yhi = std::max(qy[v], y1) + tol_;
       } else {
         const auto a = at(a_[at(it.edge)]), b = at(b_[at(it.edge)]);
-        const double ax1 = qx[a] + span * wx[a], ay1 = qy[a] + span * wy[a];
-        const double bx1 = qx[b] + span * wx[b], by1 = qy[b] + span * wy[b];
+        const double ax1 = ex[a], ay1 = ey[a];
+        const double bx1 = ex[b], by1 = ey[b];
         it.lo = std::min(std::min(qx[a], ax1), std::min(qx[b], bx1));
         it.hi = std::max(std::max(qx[a], ax1), std::max(qx[b], bx1));
         it.ylo = std::min(std::min(qy[a], ay1), std::min(qy[b], by1));
@@ -342,11 +348,11 @@ class Collisions final : public Effect {
 #endif
 
   /// Whether the swept boxes of a pair's cell and edge (widened by the band) overlap.
-  bool boxes_meet(const Pair& p, double span) const {
+  bool boxes_meet(const Pair& p) const {
     const auto i = at(p.cell), a = at(a_[at(p.edge)]), b = at(b_[at(p.edge)]);
-    const double px1 = qx_[i] + span * wx_[i], py1 = qy_[i] + span * wy_[i];
-    const double ax1 = qx_[a] + span * wx_[a], ay1 = qy_[a] + span * wy_[a];
-    const double bx1 = qx_[b] + span * wx_[b], by1 = qy_[b] + span * wy_[b];
+    const double px1 = ex_[i], py1 = ey_[i];
+    const double ax1 = ex_[a], ay1 = ey_[a];
+    const double bx1 = ex_[b], by1 = ey_[b];
     const double band = p.band;
     return !(std::max(qx_[i], px1) < std::min({qx_[a], ax1, qx_[b], bx1}) - band ||
              std::min(qx_[i], px1) > std::max({qx_[a], ax1, qx_[b], bx1}) + band ||
@@ -461,6 +467,7 @@ class Collisions final : public Effect {
   std::vector<double> wx_, wy_;     // current velocities while the events are processed
   std::vector<double> qx_, qy_;     // positions at the current event time
   std::vector<double> wmax_;        // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
+  std::vector<double> ex_, ey_;     // per cell, q + span·w: its position at the end of the span (gather)
   std::vector<char> kicked_;        // cells whose velocity a bounce changed this step
   double tau_ = 0.0;                // fraction of the step done
 };
