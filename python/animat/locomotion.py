@@ -656,6 +656,7 @@ class Paddling:
         side: (k,) its mean body-frame coordinate across the direction of motion (sign: which side).
         pair: the two protruding cells on opposite sides with the best min(rowing), or () if none.
         score: that min(rowing); nan without such a pair.
+        spike_threshold: the height from which a cell protrudes (``PADDLE_SPIKE`` unless given).
     """
 
     cells: np.ndarray
@@ -664,6 +665,7 @@ class Paddling:
     side: np.ndarray
     pair: Tuple[int, ...]
     score: float
+    spike_threshold: float = PADDLE_SPIKE
 
     @property
     def paddles(self) -> bool:
@@ -672,8 +674,8 @@ class Paddling:
 
     @property
     def protruding(self) -> np.ndarray:
-        """The skin cells whose spike reaches :data:`PADDLE_SPIKE`."""
-        return self.cells[self.spike >= PADDLE_SPIKE]
+        """The skin cells whose spike reaches ``spike_threshold``."""
+        return self.cells[self.spike >= self.spike_threshold]
 
 
 def paddling_motion(positions: ArrayLike, skin_loop: Sequence[int], rest_length: float, direction: ArrayLike,
@@ -729,7 +731,7 @@ def paddling_motion(positions: ArrayLike, skin_loop: Sequence[int], rest_length:
                 s = min(rowing[a], rowing[b])
                 if not s <= score:  # first pair, or a better one
                     pair, score = (int(cells[a]), int(cells[b])), float(s)
-    return Paddling(cells, spikes, rowing, side, pair, score)
+    return Paddling(cells, spikes, rowing, side, pair, score, float(spike))
 
 
 def paddling(trajectory: Trajectory, mode: Optional[LocomotionMode] = None) -> Paddling:

@@ -162,7 +162,7 @@ class Collisions final : public Effect {
     for (int e : skin_edges) items_.push_back({0, 0, 0, 0, -1, e});
     for (std::size_t k = 0; k < items_.size(); ++k) order_.push_back(static_cast<int>(k));
 
-    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &wmax_, &ex_, &ey_}) v->assign(at(n_), 0.0);
+    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &motion_, &ex_, &ey_}) v->assign(at(n_), 0.0);
     kicked_.assign(at(n_), 0);
     const std::size_t skin_vertices = items_.size() - skin_edges.size();
     candidates_.reserve(3 * tris_.size() + fixed_.size() + skin_vertices * skin_edges.size());
@@ -269,11 +269,11 @@ class Collisions final : public Effect {
     const double* qy = qy_.data();
     const double* wx = wx_.data();
     const double* wy = wy_.data();
-    double* wmax = wmax_.data();
+    double* motion = motion_.data();
     double* ex = ex_.data();
     double* ey = ey_.data();
     for (int i = 0; i < n_; ++i) {
-      wmax[i] = span * (std::abs(wx[i]) + std::abs(wy[i]));  // (a sum: NaN stays NaN)
+      motion[i] = span * (std::abs(wx[i]) + std::abs(wy[i]));  // (a sum: NaN stays NaN)
       ex[i] = qx[i] + span * wx[i];                           // where the cell is at the end of the span
       ey[i] = qy[i] + span * wy[i];
     }
@@ -281,7 +281,7 @@ class Collisions final : public Effect {
       const int a = t.v[0], b = t.v[1], c = t.v[2];
       const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
       // The cheaper test first: it only rejects triangles the full test rejects too.
-      if (triangle_surely_clear(abx, aby, acx, acy, wmax[a] + wmax[b] + wmax[c], t.band4)) {
+      if (triangle_surely_clear(abx, aby, acx, acy, motion[a] + motion[b] + motion[c], t.band4)) {
 #if ANIMAT_SELF_CHECK
         if (!full_test_rejects(t, span)) self_check_failed(t, span);
 #endif
@@ -466,7 +466,7 @@ class Collisions final : public Effect {
   std::vector<double> w0x_, w0y_;   // end-of-step velocities before any bounce
   std::vector<double> wx_, wy_;     // current velocities while the events are processed
   std::vector<double> qx_, qy_;     // positions at the current event time
-  std::vector<double> wmax_;        // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
+  std::vector<double> motion_;      // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
   std::vector<double> ex_, ey_;     // per cell, q + span·w: its position at the end of the span (gather)
   std::vector<char> kicked_;        // cells whose velocity a bounce changed this step
   double tau_ = 0.0;                // fraction of the step done
