@@ -304,9 +304,8 @@ def appendage_stroke(swimmer: KnownSwimmer, trajectory: Any, mode: Any) -> Optio
     app = np.flatnonzero(swimmer.amplitude >= AMPLITUDE)
     if swimmer.expected not in ("protrusions", "tail") or len(app) == 0 or not mode.omega > 0:
         return None
-    t = np.asarray(trajectory.times)
-    sel = t >= t[-1] - mode.cycles * 2 * math.pi / mode.omega - 1e-9
-    Q, _, _ = procrustes_frames(np.asarray(trajectory.positions)[sel])
+    # the classifier's own window (a suffix of mode.frames frames), as paddling() takes it
+    Q, _, _ = procrustes_frames(np.asarray(trajectory.positions)[-max(int(mode.frames), 2):])
     along = Q[:, app] @ np.asarray(mode.direction)
     radius = np.linalg.norm(Q[:, app], axis=2)
     backward = -np.gradient(along, axis=0)
