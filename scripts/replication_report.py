@@ -636,6 +636,28 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             diff = f"{100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %" if ref == ref and r.best.fitness else "—"
             w(f"| `{e.name}` | {r.index} | {r.best.fitness:.3f} | {ref:.3f} | {diff} |")
     w("")
+    # The guard's own rule (reference_disagrees in src/evolution.cpp), with each run's tolerances.
+    checked, outside = 0, []
+    for e in envs:
+        for r in e.runs:
+            ref = r.reference if r.reference == r.reference else r.history_reference
+            if r.best is None or ref != ref:
+                continue
+            checked += 1
+            cfg = e.config  # one config per environment (the runs differ only in their seed)
+            rel, absolute = float(cfg["evaluation.reference_tolerance"]), float(cfg["evaluation.reference_abs_tolerance"])
+            gap = abs(r.best.fitness - ref)
+            if gap > absolute and gap > rel * abs(ref):
+                side = "farther at the finer step: the default step costs it distance" if ref > r.best.fitness \
+                    else "**shorter at the finer step: the default step gives it distance**"
+                outside.append(f"`{e.name}` run {r.index} ({100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %, "
+                               f"{side})")
+    if checked:
+        w(f"Within the guard's tolerance (it warns where the two differ by more than both "
+          f"`evaluation.reference_tolerance` = {100 * rel:g} % and `evaluation.reference_abs_tolerance` = {absolute:g}): "
+          f"{checked - len(outside)} of {checked} bests"
+          + (f"; outside it: {'; '.join(outside)}." if outside else "."))
+        w("")
     return out
 
 
