@@ -277,6 +277,12 @@ void bind_evolution(nb::module_& m) {
           return tournament_probability(config.value_or(Config{}).evolution, generation);
         }, "generation"_a, "config"_a = nb::none(),
         "Probability that the fitter of two wins a tournament at a generation (0.8 rising to 1 over 1000).");
+
+  m.def("reference_disagrees", [](double fitness, double reference, std::optional<Config> config) {
+          return reference_disagrees(fitness, reference, config.value_or(Config{}).evaluation);
+        }, "fitness"_a, "reference"_a, "config"_a = nb::none(),
+        "The exploit guard's rule: whether a fitness and its reference-step fitness differ by more than both\n"
+        "evaluation.reference_tolerance (relative to the reference) and evaluation.reference_abs_tolerance.");
 }
 
 }  // namespace animat::py

@@ -636,7 +636,7 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             diff = f"{100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %" if ref == ref and r.best.fitness else "—"
             w(f"| `{e.name}` | {r.index} | {r.best.fitness:.3f} | {ref:.3f} | {diff} |")
     w("")
-    # The guard's own rule (reference_disagrees in src/evolution.cpp), with each run's tolerances.
+    # The guard's own rule (animat.reference_disagrees), with the environment's tolerances.
     checked, outside = 0, []
     for e in envs:
         for r in e.runs:
@@ -646,8 +646,7 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             checked += 1
             cfg = e.config  # one config per environment (the runs differ only in their seed)
             rel, absolute = float(cfg["evaluation.reference_tolerance"]), float(cfg["evaluation.reference_abs_tolerance"])
-            gap = abs(r.best.fitness - ref)
-            if gap > absolute and gap > rel * abs(ref):
+            if animat.reference_disagrees(r.best.fitness, ref, cfg):
                 side = "farther at the finer step: the default step costs it distance" if ref > r.best.fitness \
                     else "**shorter at the finer step: the default step gives it distance**"
                 outside.append(f"`{e.name}` run {r.index} ({100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %, "

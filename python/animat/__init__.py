@@ -95,6 +95,7 @@ grn_swim = documented(_core.grn_swim)
 polygon_area = documented(_core.polygon_area)
 set_log_level = documented(_core.set_log_level)
 tournament_probability = documented(_core.tournament_probability)
+reference_disagrees = documented(_core.reference_disagrees)
 warm_up_box2d = documented(_core.warm_up_box2d)
 
 if TYPE_CHECKING:  # animat.plot is imported lazily at run time (it pulls in matplotlib)
@@ -109,7 +110,7 @@ __all__ = [
     "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
     # evolution
     "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "Fitness", "Individual", "GenerationStats",
-    "History", "evaluate_population", "to_fitness", "tournament_probability", "run_experiment",
+    "History", "evaluate_population", "to_fitness", "tournament_probability", "reference_disagrees", "run_experiment",
     "run_study",
     # control
     "SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available", "grn_swim",

@@ -23,6 +23,19 @@ def test_tournament_probability_ramps_from_0_8_to_1():
     assert animat.tournament_probability(4000) == pytest.approx(1.0)
 
 
+def test_reference_disagrees_needs_both_tolerances_exceeded():
+    # Defaults: 1 % of the reference and 0.05 length units; both must be exceeded, on either side.
+    assert animat.reference_disagrees(10.0, 10.2)          # 0.2 > 0.05 and 2 % > 1 %
+    assert animat.reference_disagrees(10.2, 10.0)
+    assert not animat.reference_disagrees(100.0, 100.9)    # 0.9 > 0.05 but 0.9 % < 1 %
+    assert not animat.reference_disagrees(1.0, 1.04)       # 4 % > 1 % but 0.04 < 0.05
+    cfg = animat.Config()
+    cfg["evaluation.reference_tolerance"] = 0.001
+    assert animat.reference_disagrees(100.0, 100.9, cfg)   # 0.9 % > 0.1 % with the config's tolerance
+    cfg["evaluation.reference_abs_tolerance"] = 1.0
+    assert not animat.reference_disagrees(100.0, 100.9, cfg)
+
+
 def test_evolve_returns_history_and_best_and_elitism_holds():
     r = animat.evolve(small_config(generations=4))
     assert [h.generation for h in r.history] == [0, 1, 2, 3, 4]
