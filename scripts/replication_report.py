@@ -637,7 +637,7 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             w(f"| `{e.name}` | {r.index} | {r.best.fitness:.3f} | {ref:.3f} | {diff} |")
     w("")
     # The guard's own rule (animat.reference_disagrees), with the environment's tolerances.
-    checked, outside = 0, []
+    checked, outside, tolerances = 0, [], {}
     for e in envs:
         for r in e.runs:
             ref = r.reference if r.reference == r.reference else r.history_reference
@@ -645,15 +645,24 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
                 continue
             checked += 1
             cfg = e.config  # one config per environment (the runs differ only in their seed)
-            rel, absolute = float(cfg["evaluation.reference_tolerance"]), float(cfg["evaluation.reference_abs_tolerance"])
+            tolerances[e.name] = (float(cfg["evaluation.reference_tolerance"]),
+                                  float(cfg["evaluation.reference_abs_tolerance"]))
             if animat.reference_disagrees(r.best.fitness, ref, cfg):
                 side = "farther at the finer step: the default step costs it distance" if ref > r.best.fitness \
                     else "**shorter at the finer step: the default step gives it distance**"
                 outside.append(f"`{e.name}` run {r.index} ({100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %, "
                                f"{side})")
     if checked:
+        # One statement when every environment uses the same tolerances, else one per environment.
+        if len(set(tolerances.values())) == 1:
+            rel, absolute = next(iter(tolerances.values()))
+            tol = (f"`evaluation.reference_tolerance` = {100 * rel:g} % and "
+                   f"`evaluation.reference_abs_tolerance` = {absolute:g}")
+        else:
+            tol = ("the environment's `evaluation.reference_tolerance` and `evaluation.reference_abs_tolerance`: "
+                   + ", ".join(f"`{n}` {100 * t[0]:g} % and {t[1]:g}" for n, t in tolerances.items()))
         w(f"Within the guard's tolerance (it warns where the two differ by more than both "
-          f"`evaluation.reference_tolerance` = {100 * rel:g} % and `evaluation.reference_abs_tolerance` = {absolute:g}): "
+          f"{tol}): "
           f"{checked - len(outside)} of {checked} bests"
           + (f"; outside it: {'; '.join(outside)}." if outside else "."))
         w("")
@@ -723,7 +732,7 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
           f"{PAPER_RUNS} runs per environment, each {100 * statistics.median(total_gens) / 5000:.1f} % of its "
           f"typical run length (about 5,000 generations). Wall time per run is the history's wall_seconds "
           f"(machine- and load-dependent, summed over sessions). Everything the paper "
-          f"observed after many hundreds of generations is beyond what these runs can show.")
+          f"observed after {max(total_gens)} generations is beyond what these runs can show.")
         w("")
     if data is not None:
         w("To regenerate this page from the data alone, and to grow the study (resume every run, start the "

@@ -93,3 +93,28 @@ def test_report_rebuilds_from_packed_data_alone(tmp_path):
     assert not (data / "dn2" / "run_0" / "checkpoint.json").exists()  # the data is only read
     subprocess.run(cmd, capture_output=True, text=True, check=True)
     assert doc.read_text() == text  # deterministic
+
+
+def test_report_states_the_guard_tolerances_per_environment_when_they_differ(tmp_path):
+    import subprocess
+    import sys
+
+    data = tmp_path / "data"
+    shutil.copytree(PACKED, data / "dn2" / "run_0")
+    shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
+    doc = tmp_path / "docs" / "replication.md"
+    cmd = [sys.executable, str(ROOT / "scripts" / "replication_report.py"), "--data", str(data), "--doc", str(doc),
+           "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
+    subprocess.run(cmd, capture_output=True, text=True, check=True)
+    same = ("Within the guard's tolerance (it warns where the two differ by more than both "
+            "`evaluation.reference_tolerance` = 1 % and `evaluation.reference_abs_tolerance` = 0.05): 2 of 2 bests.")
+    assert same in doc.read_text()
+    config = data / "dn10" / "run_0" / "config.toml"
+    text = config.read_text()
+    assert "reference_tolerance = 0.01\n" in text
+    config.write_text(text.replace("reference_tolerance = 0.01\n", "reference_tolerance = 0.02\n"))
+    subprocess.run(cmd, capture_output=True, text=True, check=True)
+    page = doc.read_text()
+    assert same not in page
+    assert ("`evaluation.reference_abs_tolerance`: `dn2` 1 % and 0.05, `dn10` 2 % and 0.05): 2 of 2 bests."
+            in page)
