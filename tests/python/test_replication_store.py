@@ -2,6 +2,8 @@
 import gzip
 import json
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -71,16 +73,19 @@ def test_next_round_cap_grows_the_least_advanced_open_run(tmp_path):
         R.next_round_cap(work, ["a"], 2, 1000, 0)
 
 
-def test_report_rebuilds_from_packed_data_alone(tmp_path):
-    import subprocess
-    import sys
-
+def _two_packed_runs_and_report_command(tmp_path):
+    """Data with the two frozen packed runs (dn2 and dn10, 100 generations) and the report command over it."""
     data = tmp_path / "data"
     shutil.copytree(PACKED, data / "dn2" / "run_0")
     shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
     doc = tmp_path / "docs" / "replication.md"
     cmd = [sys.executable, str(ROOT / "scripts" / "replication_report.py"), "--data", str(data), "--doc", str(doc),
            "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
+    return data, doc, cmd
+
+
+def test_report_rebuilds_from_packed_data_alone(tmp_path):
+    data, doc, cmd = _two_packed_runs_and_report_command(tmp_path)
     out = subprocess.run(cmd, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     text = doc.read_text()
@@ -96,15 +101,7 @@ def test_report_rebuilds_from_packed_data_alone(tmp_path):
 
 
 def test_report_states_the_guard_tolerances_per_environment_when_they_differ(tmp_path):
-    import subprocess
-    import sys
-
-    data = tmp_path / "data"
-    shutil.copytree(PACKED, data / "dn2" / "run_0")
-    shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
-    doc = tmp_path / "docs" / "replication.md"
-    cmd = [sys.executable, str(ROOT / "scripts" / "replication_report.py"), "--data", str(data), "--doc", str(doc),
-           "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
+    data, doc, cmd = _two_packed_runs_and_report_command(tmp_path)
     subprocess.run(cmd, capture_output=True, text=True, check=True)
     same = ("Within the guard's tolerance (it warns where the two differ by more than both "
             "`evaluation.reference_tolerance` = 1 % and `evaluation.reference_abs_tolerance` = 0.05): 2 of 2 bests.")
