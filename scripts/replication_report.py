@@ -628,30 +628,27 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
     w("")
     w("| environment | run | evolved fitness | reference fitness | difference |")
     w("| --- | --- | --- | --- | --- |")
+    # Each best against the guard's own rule (animat.reference_disagrees), with its environment's tolerances.
+    checked, outside, tolerances = 0, [], {}
     for e in envs:
+        cfg = e.config  # one config per environment (the runs differ only in their seed)
         for r in e.runs:
             if r.best is None:
                 continue
             ref = r.reference if r.reference == r.reference else r.history_reference
-            diff = f"{100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %" if ref == ref and r.best.fitness else "—"
+            rel_diff = 100 * (ref - r.best.fitness) / r.best.fitness if ref == ref and r.best.fitness else None
+            diff = f"{rel_diff:+.2f} %" if rel_diff is not None else "—"
             w(f"| `{e.name}` | {r.index} | {r.best.fitness:.3f} | {ref:.3f} | {diff} |")
-    w("")
-    # The guard's own rule (animat.reference_disagrees), with the environment's tolerances.
-    checked, outside, tolerances = 0, [], {}
-    for e in envs:
-        for r in e.runs:
-            ref = r.reference if r.reference == r.reference else r.history_reference
-            if r.best is None or ref != ref:
+            if ref != ref:
                 continue
             checked += 1
-            cfg = e.config  # one config per environment (the runs differ only in their seed)
             tolerances[e.name] = (float(cfg["evaluation.reference_tolerance"]),
                                   float(cfg["evaluation.reference_abs_tolerance"]))
             if animat.reference_disagrees(r.best.fitness, ref, cfg):
                 side = "farther at the finer step: the default step costs it distance" if ref > r.best.fitness \
                     else "**shorter at the finer step: the default step gives it distance**"
-                outside.append(f"`{e.name}` run {r.index} ({100 * (ref - r.best.fitness) / r.best.fitness:+.2f} %, "
-                               f"{side})")
+                outside.append(f"`{e.name}` run {r.index} ({rel_diff:+.2f} %, {side})")
+    w("")
     if checked:
         # One statement when every environment uses the same tolerances, else one per environment.
         if len(set(tolerances.values())) == 1:
