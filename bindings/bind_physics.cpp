@@ -25,6 +25,7 @@
 #include "animat/control.hpp"
 #include "animat/development.hpp"
 #include "animat/embedding.hpp"
+#include "animat/energy.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/objective.hpp"
@@ -220,6 +221,59 @@ void bind_physics(nb::module_& m) {
       .def("__deepcopy__", [](const SceneParams& p, nb::handle) { return SceneParams(p); }, "memo"_a)
       .def("__repr__", &scene_repr);
 
+  // EnergyAccount: every field from its one descriptor (visit_fields in animat/energy.hpp).
+  nb::class_<EnergyAccount> energy(m, "EnergyAccount",
+                                   "Where the energy of a swim went (evaluation.energy_accounting; include/animat/energy.hpp):\n"
+                                   "actuation (and pushes) in; drag (normal, tangential), spring damping, collisions, ground\n"
+                                   "and other forces out; kinetic and potential energies stored. `residual` is what the books\n"
+                                   "leave unexplained (integration error), small against the energy that flowed.");
+  energy.def(nb::init<>());
+  {
+    EnergyAccount probe;
+    visit_fields(probe, [&](const char* name, const char* doc, auto& field) {
+      using T = std::decay_t<decltype(field)>;
+      const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
+      energy.def_prop_ro(name, [offset](const EnergyAccount& a) {
+        return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&a) + offset);
+      }, doc);
+    });
+  }
+  energy.def_prop_ro("fluid", &EnergyAccount::fluid, "Dissipated by the fluid: drag_normal + drag_tangential.")
+      .def_prop_ro("dissipated", &EnergyAccount::dissipated, "Everything dissipated.")
+      .def_prop_ro("stored_change", &EnergyAccount::stored_change, "Change of kinetic plus potential energy.")
+      .def_prop_ro("residual", &EnergyAccount::residual, "actuation + external - dissipated - stored_change.")
+      .def_prop_ro("fluid_share", &EnergyAccount::fluid_share, "fluid / dissipated (0 when nothing was dissipated).")
+      .def("as_dict", [](const EnergyAccount& a) {
+        nb::dict d;
+        EnergyAccount c = a;
+        visit_fields(c, [&](const char* name, const char*, auto& field) { d[name] = field; });
+        for (const auto& [k, v] : {std::pair{"fluid", a.fluid()}, std::pair{"dissipated", a.dissipated()},
+                                   std::pair{"stored_change", a.stored_change()}, std::pair{"residual", a.residual()},
+                                   std::pair{"fluid_share", a.fluid_share()}})
+          d[k] = v;
+        return d;
+      }, "Every field and the derived totals as a dict.")
+      .def("__getstate__", [](const EnergyAccount& a) {
+        nb::dict d;
+        EnergyAccount c = a;
+        visit_fields(c, [&](const char* name, const char*, auto& field) { d[name] = field; });
+        return d;
+      })
+      .def("__setstate__", [](EnergyAccount& self, const nb::dict& d) {
+        new (&self) EnergyAccount();
+        visit_fields(self, [&](const char* name, const char*, auto& field) {
+          if (d.contains(name)) field = nb::cast<std::decay_t<decltype(field)>>(d[name]);
+        });
+      })
+      .def("__repr__", [](const EnergyAccount& a) {
+        if (!a.measured) return std::string("EnergyAccount(measured=False)");
+        return fmt::format("EnergyAccount(actuation={:.6g}, fluid={:.6g} (normal {:.6g}, tangential {:.6g}), "
+                           "spring_damping={:.6g}, collisions={:.6g}, ground={:.6g}, other={:.6g}, "
+                           "stored_change={:.6g}, residual={:.3g})",
+                           a.actuation, a.fluid(), a.drag_normal, a.drag_tangential, a.spring_damping, a.collisions,
+                           a.ground, a.other, a.stored_change(), a.residual());
+      });
+
   nb::class_<SwimResult> swim_result(m, "SwimResult", "What one swim did (see ``animat.swim``).");
   nb::class_<EvaluationResult> evaluation_result(m, "EvaluationResult",
                                                  "Fitness and diagnostics of one genome (see ``animat.evaluate``).");
@@ -252,7 +306,9 @@ void bind_physics(nb::module_& m) {
                      nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.")
         .def_ro("grn_updates", &R::grn_updates, "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).")
         .def_prop_ro("displacement_at_push", [](const R& r) -> Eigen::Vector2d { return r.displacement_at_push; },
-                     "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).");
+                     "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).")
+        .def_ro("energy", &R::energy,
+                "Where the energy went (an EnergyAccount; measured only with evaluation.energy_accounting).");
   };
   invariant_fields(swim_result, std::type_identity<SwimResult>{});
   invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});
@@ -417,6 +473,10 @@ void bind_physics(nb::module_& m) {
       }, "What the effects counted so far: collisions (resolved, inelastic, unresolved, most passes in a\n"
          "step), drag limiter engagements, floor contacts and slips, and the actuation work (net,\n"
          "positive, absolute), as a dict.")
+      .def("account_energy", [](Simulation& s) { Lease l(s, "account_energy"); s.account_energy(); },
+           "Open the energy books now: from here on every step books each effect's work (see `energy`).")
+      .def_prop_ro("energy", [](const Simulation& s) { Lease l(s, "energy"); return s.energy_account(); },
+                   "The EnergyAccount since account_energy() (measured False before).")
       .def("monitor_embedding", &Simulation::monitor_embedding, "body"_a,
            "Check the planar embedding of `body` (the body this simulation swims) now and after every step:\n"
            "region signs and skin simplicity; see `embedding`.")
@@ -439,7 +499,8 @@ void bind_physics(nb::module_& m) {
       });
 
   m.def("swim", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config, std::optional<long> steps,
-                   std::optional<bool> check_embedding, bool stop_when_invalid, std::optional<long> settle_steps) {
+                   std::optional<bool> check_embedding, bool stop_when_invalid, std::optional<long> settle_steps,
+                   std::optional<bool> account_energy) {
         const Config c = config ? *config : Config{};
         const long n = steps ? *steps : c.evaluation.steps;
         if (n < 0) throw ConfigError(fmt::format("swim: steps must be >= 0, got {}", n));
@@ -447,18 +508,22 @@ void bind_physics(nb::module_& m) {
         options.check_embedding = check_embedding ? *check_embedding : c.evaluation.check_embedding;
         options.stop_when_invalid = stop_when_invalid;
         options.settle_steps = settle_steps ? *settle_steps : c.evaluation.settle_steps;
+        options.account_energy = account_energy ? *account_energy : c.evaluation.energy_accounting;
         warm_up_box2d();  // Box2D's lazily filled globals, before other threads may run worlds too
         nb::gil_scoped_release release;
         return swim(body, scene ? *scene : c.scene, c.physics, n, options);
       }, "body"_a, "scene"_a = nb::none(), "config"_a = nb::none(), "steps"_a = nb::none(),
       "check_embedding"_a = nb::none(), "stop_when_invalid"_a = true, "settle_steps"_a = nb::none(),
+      "account_energy"_a = nb::none(),
       "Swim a body for `steps` control steps (default config.evaluation.steps) and return a SwimResult.\n"
       "Never raises for an unstable or invalid swim: it returns stable/valid=False and distance 0.\n"
       "check_embedding (default config.evaluation.check_embedding) checks region signs and skin\n"
       "simplicity after every step; stop_when_invalid=False swims on after a broken invariant so that\n"
       "the counts cover the whole horizon. settle_steps (default config.evaluation.settle_steps) control\n"
       "steps are simulated first with actuation off (crawl world: with effect 'ground' the body is\n"
-      "placed with its lowest cell on the floor first); the distance is measured from there.");
+      "placed with its lowest cell on the floor first); the distance is measured from there.\n"
+      "account_energy (default config.evaluation.energy_accounting) keeps the energy books of the swim\n"
+      "(SwimResult.energy, an EnergyAccount).");
   m.def("start_state", [](const Body& body, std::optional<SceneParams> scene, std::optional<Config> config,
                           std::optional<long> settle_steps) {
         const Config c = config ? *config : Config{};

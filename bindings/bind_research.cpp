@@ -116,6 +116,7 @@ void visit_result(EvaluationResult& r, V&& v) {
   v("source_progress", r.source_progress);
   v("grn_updates", r.grn_updates);
   v("displacement_at_push", r.displacement_at_push);
+  v("energy", r.energy);
   v("seconds_development", r.seconds_development);
   v("seconds_body", r.seconds_body);
   v("seconds_swim", r.seconds_swim);

@@ -136,6 +136,7 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   std::vector<int> pushed;  // sized before the loop: pushing allocates nothing there
   pushed.reserve(static_cast<std::size_t>(body.node_count()));
   if (options.check_embedding) sim.monitor_embedding(body);
+  if (options.account_energy) sim.account_energy();
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   const Eigen::Vector2d start = sim.center_of_mass();
   const double floor = stretch_floor(body);
@@ -203,6 +204,7 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   r.actuation_work = c.actuation_work;
   r.actuation_work_positive = c.actuation_work_positive;
   r.actuation_work_absolute = c.actuation_work_absolute;
+  r.energy = sim.energy_account();
   if (const Effect* springs = sim.effect("springs")) {
     std::vector<double> pos, abs;
     if (actuation_work_per_cell(*springs, pos, abs)) {
@@ -281,6 +283,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   t0 = Clock::now();
   SwimOptions options;
   options.check_embedding = config.evaluation.check_embedding;
+  options.account_energy = config.evaluation.energy_accounting;
   options.observer = observer;
   options.settle_steps = config.evaluation.settle_steps;
   options.push_step = config.evaluation.push_step;
@@ -353,6 +356,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   out.actuation_work_absolute = s.actuation_work_absolute;
   out.cell_work_positive = s.cell_work_positive;
   out.cell_work_absolute = s.cell_work_absolute;
+  out.energy = s.energy;
   return out;
 }
 

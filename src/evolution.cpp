@@ -140,7 +140,8 @@ bool reference_disagrees(double fitness, double reference, const EvaluationParam
 const std::vector<std::string>& resumable_keys() {
   static const std::vector<std::string> keys = {"evolution.generations", "evolution.stall_generations",
                                                 "evolution.wall_seconds", "evolution.threads",
-                                                "evolution.checkpoint_every", "physics.integrator"};
+                                                "evolution.checkpoint_every", "physics.integrator",
+                                                "evaluation.energy_accounting"};
   return keys;
 }
 
@@ -167,7 +168,9 @@ const std::vector<std::string>& late_keys() {
       "evaluation.source_directions", "evaluation.source_seed", "evaluation.push_step",
       "evaluation.push_impulse",  "evaluation.push_cells",
       // The morphogen cut-off (issue 21): at 0 the field is the paper's, every pair.
-      "development.morphogen_cutoff"};
+      "development.morphogen_cutoff",
+      // Energy accounting changes no result (and is resumable).
+      "evaluation.energy_accounting"};
   return keys;
 }
 

@@ -15,6 +15,7 @@
 
 #include "animat/body.hpp"
 #include "animat/embedding.hpp"
+#include "animat/energy.hpp"
 #include "animat/errors.hpp"
 #include "box2d_island.hpp"
 #include "cell_integrator.hpp"
@@ -102,6 +103,31 @@ void warm_up_box2d() {
   });
 }
 
+namespace {
+
+/// The books of energy accounting (Simulation::account_energy): per effect pass a bucket of the
+/// per-cell forces it added in the current Box2D step, and each bucket's work so far. Sized when
+/// the books open, never in the step loop.
+/// Energy accounting: where an effect pass's work is booked.
+enum class Sink : int { none, drag, drag_normal, spring_damping, collisions, ground, other };
+
+struct EnergyBooks {
+  bool on = false;
+  std::vector<int> force_bucket, velocity_bucket, constraint_bucket;  // per effect of each list; -1: not booked
+  std::vector<double> work;                  // per bucket: the work of its forces so far
+  std::vector<double> step_work;             // per bucket: in the current step
+  std::vector<double> fx, fy;                // buckets × n: this step's forces per bucket
+  std::vector<double> prev_fx, prev_fy;      // state.fx, fy before the current effect pass
+  std::vector<double> ux, uy;                // per cell: the end velocity v' of the step
+  std::vector<double> wx, wy;                // per cell: v' without the collisions' impulses
+  double external = 0.0;                     // kinetic energy added by pushes
+  double actuation_start = 0.0;
+  double kinetic_start = 0.0, elastic_start = 0.0, pressure_start = 0.0, gravity_start = 0.0, other_start = 0.0;
+  std::vector<Sink> sink;                    // per bucket: where its work goes
+};
+
+}  // namespace
+
 struct Simulation::Impl {
   SceneParams scene;
   PhysicsParams physics;
@@ -125,6 +151,181 @@ struct Simulation::Impl {
   bool monitoring = false;
   EmbeddingMonitor monitor;
   long first_broken_step = -1;  // control step at the end of which the embedding first broke
+  EnergyBooks books;            // energy accounting (account_energy()); off: never touched
+
+  /// The sink of an effect's apply() (position or constraint forces) or apply_velocity() forces.
+  static Sink sink_of(const Effect& e, bool velocity_pass) {
+    if (velocity_pass) {
+      if (e.name() == "drag") return Sink::drag;
+      if (e.name() == "springs") return Sink::spring_damping;
+      return Sink::other;
+    }
+    if (e.has_potential_energy()) return Sink::none;  // work accounted by the potential
+    if (e.name() == "collisions") return Sink::collisions;
+    if (e.name() == "ground") return Sink::ground;
+    if (e.name() == "actuation") return Sink::none;  // a modifier: it adds no force
+    return Sink::other;
+  }
+
+  /// Assigns every effect pass a bucket of per-cell forces (once, and again when an effect is
+  /// added while the books are kept).
+  void layout_books() {
+    EnergyBooks& b = books;
+    const auto n = static_cast<std::size_t>(state.n);
+    b.force_bucket.assign(force_effects.size(), -1);
+    b.velocity_bucket.assign(velocity_effects.size(), -1);
+    b.constraint_bucket.assign(constraint_effects.size(), -1);
+    std::vector<Sink> sinks;
+    auto bucket = [&](const Effect& e, bool velocity_pass) {
+      const Sink k = sink_of(e, velocity_pass);
+      if (k == Sink::none) return -1;
+      sinks.push_back(k);
+      return static_cast<int>(sinks.size()) - 1;
+    };
+    for (std::size_t k = 0; k < force_effects.size(); ++k) b.force_bucket[k] = bucket(*force_effects[k], false);
+    for (std::size_t k = 0; k < velocity_effects.size(); ++k) b.velocity_bucket[k] = bucket(*velocity_effects[k], true);
+    for (std::size_t k = 0; k < constraint_effects.size(); ++k)
+      b.constraint_bucket[k] = bucket(*constraint_effects[k], false);
+    sinks.push_back(Sink::drag_normal);  // the last bucket: drag's normal part (state.normal_drag_fx)
+    const std::size_t buckets = sinks.size();
+    b.sink = std::move(sinks);
+    b.work.resize(buckets, 0.0);  // keeps what was booked so far
+    b.step_work.assign(buckets, 0.0);
+    b.fx.assign(buckets * n, 0.0);
+    b.fy.assign(buckets * n, 0.0);
+    for (auto* v : {&b.prev_fx, &b.prev_fy, &b.ux, &b.uy, &b.wx, &b.wy}) v->assign(n, 0.0);
+  }
+
+  /// Books the forces the last effect pass added to state.fx, fy into bucket `k` (-1: none).
+  void book(int k) {
+    EnergyBooks& b = books;
+    const auto n = static_cast<std::size_t>(state.n);
+    if (k >= 0) {
+      double* bx = b.fx.data() + static_cast<std::size_t>(k) * n;
+      double* by = b.fy.data() + static_cast<std::size_t>(k) * n;
+      for (std::size_t i = 0; i < n; ++i) {
+        bx[i] = state.fx[i] - b.prev_fx[i];
+        by[i] = state.fy[i] - b.prev_fy[i];
+      }
+    }
+    std::copy(state.fx.begin(), state.fx.end(), b.prev_fx.begin());
+    std::copy(state.fy.begin(), state.fy.end(), b.prev_fy.begin());
+  }
+
+  /// run_effects() that also books each effect pass's work (energy accounting): the works add up
+  /// to the step's change of kinetic energy exactly (before Box2D rounds the velocities to float).
+  void run_effects_booked() {
+    EnergyBooks& b = books;
+    const auto n = static_cast<std::size_t>(state.n);
+    state.step = box2d_steps;
+    state.time = static_cast<double>(box2d_steps) * h;
+    state.position_corrected = false;
+    std::fill(state.fx.begin(), state.fx.end(), 0.0);
+    std::fill(state.fy.begin(), state.fy.end(), 0.0);
+    std::fill(b.prev_fx.begin(), b.prev_fx.end(), 0.0);
+    std::fill(b.prev_fy.begin(), b.prev_fy.end(), 0.0);
+    std::fill(b.step_work.begin(), b.step_work.end(), 0.0);
+    for (std::size_t k = 0; k < force_effects.size(); ++k) {
+      force_effects[k]->apply(state);
+      book(b.force_bucket[k]);
+    }
+    const std::size_t normal = b.sink.size() - 1;
+    double* nx = b.fx.data() + normal * n;
+    double* ny = b.fy.data() + normal * n;
+    std::fill(nx, nx + n, 0.0);
+    std::fill(ny, ny + n, 0.0);
+    if (!velocity_effects.empty()) {
+      std::copy(state.vx.begin(), state.vx.end(), state.ux.begin());
+      std::copy(state.vy.begin(), state.vy.end(), state.uy.begin());
+      if (midpoint) {  // the predictor pass, as in velocity_forces(): nothing booked
+        std::copy(state.fx.begin(), state.fx.end(), fx_pos.begin());
+        std::copy(state.fy.begin(), state.fy.end(), fy_pos.begin());
+        state.predictor = true;
+        for (Effect* e : velocity_effects) e->apply_velocity(state);
+        state.predictor = false;
+        const double kh = 0.5 * h * state.inv_mass;
+        for (std::size_t i = 0; i < n; ++i) {
+          state.ux[i] = state.vx[i] + kh * state.fx[i];
+          state.uy[i] = state.vy[i] + kh * state.fy[i];
+        }
+        std::copy(fx_pos.begin(), fx_pos.end(), state.fx.begin());
+        std::copy(fy_pos.begin(), fy_pos.end(), state.fy.begin());
+      }
+      for (std::size_t k = 0; k < velocity_effects.size(); ++k) {
+        const int bucket = b.velocity_bucket[k];
+        if (bucket >= 0 && b.sink[static_cast<std::size_t>(bucket)] == Sink::drag) {
+          state.normal_drag_fx = nx;
+          state.normal_drag_fy = ny;
+        }
+        velocity_effects[k]->apply_velocity(state);
+        state.normal_drag_fx = nullptr;
+        state.normal_drag_fy = nullptr;
+        book(bucket);
+      }
+    }
+    for (std::size_t k = 0; k < constraint_effects.size(); ++k) {
+      constraint_effects[k]->apply(state);
+      book(b.constraint_bucket[k]);
+    }
+    // Every force and impulse is known. The collisions' impulses J_c act at an instant (a cell turns
+    // back when it meets an edge); every other force, the floor's included, acts over the step. So
+    // with v' = v + h·ΣF/m the end velocity and u = v' − J_c/m the end velocity without the
+    // collisions, a force's work is h·F·(v + u)/2 and a collision impulse's J_c·(u + v')/2 (zero for
+    // an elastic one). Together they are ½m(v'² − v²) exactly.
+    const double kv = h * state.inv_mass;
+    for (std::size_t i = 0; i < n; ++i) {
+      b.ux[i] = state.vx[i] + kv * state.fx[i];  // v'
+      b.uy[i] = state.vy[i] + kv * state.fy[i];
+    }
+    std::copy(b.ux.begin(), b.ux.end(), b.wx.begin());  // u
+    std::copy(b.uy.begin(), b.uy.end(), b.wy.begin());
+    for (std::size_t k = 0; k < b.sink.size(); ++k) {
+      if (b.sink[k] != Sink::collisions) continue;
+      const double* bx = b.fx.data() + k * n;
+      const double* by = b.fy.data() + k * n;
+      for (std::size_t i = 0; i < n; ++i) {
+        b.wx[i] -= kv * bx[i];
+        b.wy[i] -= kv * by[i];
+      }
+    }
+    for (std::size_t k = 0; k < b.sink.size(); ++k) {
+      const double* bx = b.fx.data() + k * n;
+      const double* by = b.fy.data() + k * n;
+      const bool instant = b.sink[k] == Sink::collisions;
+      double w = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double mx = instant ? b.wx[i] + b.ux[i] : state.vx[i] + b.wx[i];
+        const double my = instant ? b.wy[i] + b.uy[i] : state.vy[i] + b.wy[i];
+        w += bx[i] * mx + by[i] * my;
+      }
+      b.step_work[k] = 0.5 * h * w;
+    }
+  }
+
+  /// After Box2D's step: the step's work goes into the books (a step that failed books nothing).
+  void close_books_of_step() {
+    EnergyBooks& b = books;
+    for (std::size_t k = 0; k < b.sink.size(); ++k) b.work[k] += b.step_work[k];
+  }
+
+  /// Potentials of the conservative effects at the current state: elastic, pressure, gravity, other.
+  void potentials(double& elastic, double& pressure, double& gravity, double& other) const {
+    elastic = pressure = gravity = other = 0.0;
+    for (const auto& e : effects) {
+      if (!e->has_potential_energy()) continue;
+      (e->name() == "springs"    ? elastic
+       : e->name() == "pressure" ? pressure
+       : e->name() == "gravity"  ? gravity
+                                 : other) += e->potential_energy(state);
+    }
+  }
+
+  double kinetic() const {
+    double e = 0.0;
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      e += static_cast<double>(cells.vx[i]) * cells.vx[i] + static_cast<double>(cells.vy[i]) * cells.vy[i];
+    return 0.5 * state.mass * e;
+  }
 
   void read_state() {
     for (std::size_t i = 0; i < bodies.size(); ++i) {  // a real world: its bodies are the truth
@@ -219,7 +420,10 @@ struct Simulation::Impl {
 
   /// One Box2D step from the current state (read after the previous step).
   void box2d_step() {
-    run_effects();
+    if (books.on)
+      run_effects_booked();
+    else
+      run_effects();
     check_forces();
     if (world) {
       for (std::size_t i = 0; i < bodies.size(); ++i)
@@ -245,6 +449,7 @@ struct Simulation::Impl {
       }
     }
     read_state();
+    if (books.on) close_books_of_step();
     if (monitoring && !monitor.observe(state.x, state.y) && first_broken_step < 0) first_broken_step = control_steps;
   }
 
@@ -259,6 +464,7 @@ struct Simulation::Impl {
       (x->stage() == Effect::Stage::constraint ? constraint_effects : force_effects).push_back(x.get());
       if (x->velocity_dependent()) velocity_effects.push_back(x.get());
     }
+    if (books.on) layout_books();
   }
 };
 
@@ -388,13 +594,58 @@ void Simulation::push(std::span<const int> cells, const Eigen::Vector2d& impulse
     if (c < 0 || c >= s.state.n)
       throw GeometryError(fmt::format("Simulation::push: cell {} out of range [0, {})", c, s.state.n));
   const double inv_mass = s.state.inv_mass;
+  const double kinetic_before = s.books.on ? s.kinetic() : 0.0;
   for (int c : cells) {
     const auto u = static_cast<std::size_t>(c);
     s.cells.vx[u] = static_cast<float>(static_cast<double>(s.cells.vx[u]) + impulse.x() * inv_mass);
     s.cells.vy[u] = static_cast<float>(static_cast<double>(s.cells.vy[u]) + impulse.y() * inv_mass);
     if (s.world) s.bodies[u]->SetLinearVelocity(b2Vec2(s.cells.vx[u], s.cells.vy[u]));
   }
+  if (s.books.on) s.books.external += s.kinetic() - kinetic_before;
   s.read_state();
+}
+
+void Simulation::account_energy() {
+  Impl& s = *impl_;
+  EnergyBooks& b = s.books;
+  b = EnergyBooks{};
+  b.on = true;
+  b.actuation_start = s.state.counters.actuation_work;
+  b.kinetic_start = s.kinetic();
+  s.potentials(b.elastic_start, b.pressure_start, b.gravity_start, b.other_start);
+  s.layout_books();
+}
+
+EnergyAccount Simulation::energy_account() const {
+  const Impl& s = *impl_;
+  const EnergyBooks& b = s.books;
+  EnergyAccount a;
+  if (!b.on) return a;
+  a.measured = true;
+  a.actuation = s.state.counters.actuation_work - b.actuation_start;
+  a.external = b.external;
+  double drag = 0.0;
+  for (std::size_t k = 0; k < b.sink.size(); ++k) {
+    const double d = -b.work[k];  // dissipated = minus the work of the forces
+    switch (b.sink[k]) {
+      case Sink::drag: drag += d; break;
+      case Sink::drag_normal: a.drag_normal += d; break;
+      case Sink::spring_damping: a.spring_damping += d; break;
+      case Sink::collisions: a.collisions += d; break;
+      case Sink::ground: a.ground += d; break;
+      case Sink::other: a.other += d; break;
+      case Sink::none: break;
+    }
+  }
+  a.drag_tangential = drag - a.drag_normal;
+  a.kinetic_start = b.kinetic_start;
+  a.kinetic_end = s.kinetic();
+  a.elastic_start = b.elastic_start;
+  a.pressure_start = b.pressure_start;
+  a.gravity_start = b.gravity_start;
+  a.other_potential_start = b.other_start;
+  s.potentials(a.elastic_end, a.pressure_end, a.gravity_end, a.other_potential_end);
+  return a;
 }
 
 int Simulation::node_count() const { return impl_->state.n; }

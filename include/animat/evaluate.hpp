@@ -9,6 +9,7 @@
 #include "animat/body.hpp"
 #include "animat/config.hpp"
 #include "animat/control.hpp"
+#include "animat/energy.hpp"
 #include "animat/genome.hpp"
 
 namespace animat {
@@ -68,6 +69,7 @@ struct SwimResult {
   Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each spring it ends (n)
   long grn_updates = 0;                  ///< GRN updates while swimming (control.mode = "grn")
   Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (push_step >= 0)
+  EnergyAccount energy;                  ///< where the energy went (SwimOptions::account_energy)
 };
 
 /// Options of swim() beyond the scene and physics.
@@ -79,6 +81,8 @@ struct SwimOptions {
   long settle_steps = 0;
   bool check_embedding = true;   ///< check the planar embedding after every Box2D step
   bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
+  /// Keep the energy books of the measured swim (SwimResult::energy; settling is not included).
+  bool account_energy = false;
   EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
   /// control.mode = "grn": where every cell's GRN starts (nullptr: open loop, the scene's own
   /// actuation). With it, "actuation" is dropped from the scene and a GrnControl effect drives eq. 2.
@@ -164,6 +168,8 @@ struct EvaluationResult {
   double source_progress = 0.0;
   long grn_updates = 0;            ///< GRN updates while swimming (control.mode = "grn"), first swim
   Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (evaluation.push_step >= 0)
+  /// Where the actuation work went in the (first) swim, with evaluation.energy_accounting.
+  EnergyAccount energy;
   double seconds_development = 0.0;  ///< wall time per stage (not deterministic; diagnostics only)
   double seconds_body = 0.0;
   double seconds_swim = 0.0;

@@ -57,6 +57,8 @@ struct EvaluationParams {
   int push_step = -1;          ///< control step (from the fitness clock's start) of a push; -1 = none
   std::vector<double> push_impulse = {0.0, 0.0};  ///< impulse [Jx, Jy] given to every pushed cell
   std::string push_cells = "all";  ///< pushed cells: all, or front (x >= the centre of mass's x)
+  /// Keep the energy books of every swim (EvaluationResult::energy): slower, results unchanged.
+  bool energy_accounting = false;
 };
 
 template <class V>
@@ -84,6 +86,7 @@ void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"push_step", "disruption: control step (from the fitness clock's start) at which the pushed cells get push_impulse; -1 = never (docs/control.md)", Bounds::closed(-1, 10000000)}, p.push_step);
   v(FieldInfo{"push_impulse", "disruption: impulse [Jx, Jy] given to every pushed cell (velocity change impulse / cell_mass), mass * length / time", Bounds::closed(-kMaxCoefficient, kMaxCoefficient)}, p.push_impulse);
   v(FieldInfo{"push_cells", "disruption: which cells are pushed: all, or front (x >= the centre of mass's x, a push that also turns the body)", Bounds::any(), kPushCellNames}, p.push_cells);
+  v(FieldInfo{"energy_accounting", "keep the energy books of every swim: actuation work in; fluid drag (normal, tangential), spring damping, collisions and ground out; kinetic and potential energies stored (include/animat/energy.hpp). Slower; fitness unchanged", Bounds::any()}, p.energy_accounting);
 }
 
 struct Config;

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "animat/energy.hpp"
 #include "animat/params.hpp"
 #include "animat/scene.hpp"
 #include "animat/types.hpp"
@@ -144,6 +145,12 @@ class Simulation {
   void monitor_embedding(const Body& body);
   /// The monitor, or nullptr if monitor_embedding() was not called.
   [[nodiscard]] const EmbeddingMonitor* embedding_monitor() const;
+  /// Opens the books of energy accounting now (EnergyAccount, include/animat/energy.hpp): from now
+  /// on every Box2D step also books the work of each effect's forces. Off until called, and then
+  /// the step loop is exactly the one without books (results do not depend on it).
+  void account_energy();
+  /// The books since account_energy() (measured = false if it was never called).
+  [[nodiscard]] EnergyAccount energy_account() const;
   /// Control step at the end of which the embedding was first seen broken (-1: never, or no monitor).
   [[nodiscard]] long first_broken_step() const;
   [[nodiscard]] bool failed() const;

@@ -152,6 +152,10 @@ struct SwimState {
   /// τ, not at the start of the step, so its end position differs from x + h·v by this much.
   std::vector<double> cx, cy;
   bool position_corrected = false;
+  /// Energy accounting only (null otherwise): drag adds the normal part of its forces here too, so
+  /// that the books can split the fluid's dissipation into its normal and tangential parts (n each).
+  double* normal_drag_fx = nullptr;
+  double* normal_drag_fy = nullptr;
   SwimCounters counters;
 };
 
@@ -174,6 +178,14 @@ class Effect {
   /// Adds the forces that depend on velocity, evaluated at s.ux, s.uy (positions as in apply()).
   /// Called after every effect's apply(), once or twice per step (physics.velocity_forces).
   virtual void apply_velocity(SwimState& s) { (void)s; }
+  /// Energy accounting (Simulation::account_energy): whether the forces apply() adds derive from a
+  /// potential, potential_energy(), so that their work is stored energy, not dissipated.
+  [[nodiscard]] virtual bool has_potential_energy() const { return false; }
+  /// That potential at the state's positions and rest lengths (0 for effects without one).
+  [[nodiscard]] virtual double potential_energy(const SwimState& s) const {
+    (void)s;
+    return 0.0;
+  }
   /// Whether Box2D needs circle fixtures (and contacts) for this effect. None of the built-in
   /// effects does.
   [[nodiscard]] virtual bool needs_box2d_collisions() const { return false; }

@@ -152,6 +152,7 @@ class Drag final : public Effect {
       fy[i] += gy;
       fx[j] += gx;
       fy[j] += gy;
+      if (s.normal_drag_fx != nullptr && !s.predictor) add_normal_part(s, i, j, fn, tx, ty);
     }
     if (!s.predictor) s.counters.drag_limited += limited;
   }
@@ -233,6 +234,18 @@ class Drag final : public Effect {
       fx[j] += gx;
       fy[j] += gy;
     }
+    if (s.normal_drag_fx != nullptr && !s.predictor)
+      for (std::size_t e = 0; e < a_.size(); ++e) add_normal_part(s, a_[e], b_[e], fn_[e], tx_[e], ty_[e]);
+  }
+
+  /// Energy accounting: the normal part of one edge's force, half to each end, into the state's
+  /// normal-drag buffer.
+  static void add_normal_part(SwimState& s, int i, int j, double fn, double tx, double ty) {
+    const double gx = -0.5 * fn * ty, gy = 0.5 * fn * tx;
+    s.normal_drag_fx[i] += gx;
+    s.normal_drag_fy[i] += gy;
+    s.normal_drag_fx[j] += gx;
+    s.normal_drag_fy[j] += gy;
   }
 
   double dn_, dt_;

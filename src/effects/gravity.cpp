@@ -13,6 +13,14 @@ class Gravity final : public Effect {
  public:
   explicit Gravity(const SceneParams& p) : g_(p.gravity) {}
   std::string_view name() const override { return "gravity"; }
+  /// Σ m·g·y.
+  bool has_potential_energy() const override { return true; }
+  double potential_energy(const SwimState& s) const override {
+    double u = 0.0;
+    for (int i = 0; i < s.n; ++i) u += s.y[static_cast<std::size_t>(i)];
+    u *= s.mass * g_;
+    return u;
+  }
   void apply(SwimState& s) override {
     ++calls_;
     const double w = s.mass * g_;

@@ -51,6 +51,26 @@ class Pressure final : public Effect {
     }
   }
   std::string_view name() const override { return "pressure"; }
+  /// Σ c_p·(S − S0)²/(2A), whose gradient apply() adds (with the opposite sign).
+  bool has_potential_energy() const override { return true; }
+  double potential_energy(const SwimState& s) const override {
+    double u = 0.0;
+    const double* x = s.x.data();
+    const double* y = s.y.data();
+    for (std::size_t r = 0; r < tri_.size(); ++r) {
+      const auto [a, b, c] = tri_[r];
+      const double twice = (x[b] - x[a]) * (y[c] - y[a]) - (x[c] - x[a]) * (y[b] - y[a]);
+      const double d = twice - tri_area_[r];
+      u += 0.25 * tri_coef_[r] * d * d;
+    }
+    for (std::size_t r = 0; r < rest_area_.size(); ++r) {
+      double twice_area = 0.0;
+      for (int q = offset_[r]; q < offset_[r + 1]; ++q) twice_area += x[node_[at(q)]] * (y[next_[at(q)]] - y[prev_[at(q)]]);
+      const double d = 0.5 * twice_area - rest_area_[r];
+      u += 0.5 * coef_[r] * d * d;
+    }
+    return u;
+  }
   void apply(SwimState& s) override {
     ++calls_;
     const double* x = s.x.data();

@@ -61,6 +61,18 @@ class Springs final : public Effect {
       apply_elastic<true>(s);
   }
   bool velocity_dependent() const override { return c_ != 0.0; }
+  /// Σ ½·k·(ℓ − r)² at the current rest lengths.
+  bool has_potential_energy() const override { return true; }
+  double potential_energy(const SwimState& s) const override {
+    double u = 0.0;
+    for (std::size_t e = 0; e < a_.size(); ++e) {
+      const int i = a_[e], j = b_[e];
+      const double dx = s.x[at(j)] - s.x[at(i)], dy = s.y[at(j)] - s.y[at(i)];
+      const double d = std::sqrt(dx * dx + dy * dy) - s.rest[e];
+      u += 0.5 * (ks_.empty() ? k_ : ks_[e]) * d * d;
+    }
+    return u;
+  }
 
  private:
   /// The elastic pass; kPerSpring: evolved stiffness (ks_), else the paper's uniform k_ (two loops,

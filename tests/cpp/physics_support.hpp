@@ -69,7 +69,7 @@ Body square() {
 }
 
 /// Triangular lattice of nx × ny cells (spacing 1) through build_body, with oscillators.
-Points lattice_points(int nx, int ny, double jitter = 0.0, std::uint64_t seed = 1) {
+[[maybe_unused]] Points lattice_points(int nx, int ny, double jitter = 0.0, std::uint64_t seed = 1) {
   Rng rng(seed);
   Points p(nx * ny, 2);
   for (int j = 0; j < ny; ++j)
@@ -82,7 +82,7 @@ Points lattice_points(int nx, int ny, double jitter = 0.0, std::uint64_t seed = 
 
 enum class Drive { none, wave, random };
 
-Body swimmer(const Points& p, Drive drive, double amplitude = 0.2, double frequency = 4.0, std::uint64_t seed = 7) {
+[[maybe_unused]] Body swimmer(const Points& p, Drive drive, double amplitude = 0.2, double frequency = 4.0, std::uint64_t seed = 7) {
   const int n = static_cast<int>(p.rows());
   Vector a = Vector::Constant(n, drive == Drive::none ? 0.0 : amplitude);
   Vector f = Vector::Constant(n, frequency);
