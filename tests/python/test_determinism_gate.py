@@ -122,13 +122,17 @@ def _evolved(name: str) -> animat.Genome:
     return animat.Genome.from_json(json.dumps(data["genome"]))
 
 
-def _replication_best(run: str) -> animat.Genome:
+def _replication_record(run: str) -> Dict[str, Any]:
+    """The last lineage entry of a committed replication run: its best genome and stored fitness."""
     with tarfile.open(REPO / "tests" / "data" / "replication" / run / "best.tar.gz") as tar:
         last = sorted(n for n in tar.getnames() if n.endswith(".json"))[-1]
         member = tar.extractfile(last)
         assert member is not None
-        data = json.loads(member.read())
-    return animat.Genome.from_json(json.dumps(data["genome"]))
+        return json.loads(member.read())
+
+
+def _replication_best(run: str) -> animat.Genome:
+    return animat.Genome.from_json(json.dumps(_replication_record(run)["genome"]))
 
 
 def _chemotaxis_config() -> animat.Config:
@@ -385,6 +389,16 @@ def test_the_gate_exercises_the_model() -> None:
     assert pins["evaluation/drag_stable"]["replication_dn10_best"]["drag_limited"] > 0
     assert len({v["fitness"] for v in pins["evaluation/grn_direct"].values()}) == len(CONTROLLED)
     assert pins["ga/default"]["generation_3"]["best"] != pins["ga/default"]["generation_0"]["best"]
+
+
+def test_the_pins_agree_with_the_committed_runs() -> None:
+    # The replication runs stored their bests' fitness when they were evolved: the pins of those
+    # genomes in their own runs' configs are those very numbers.
+    pins = _load_pins()
+    for run, scene, name in (("dn2_run_0", "replication_dn2_run", "replication_dn2_best"),
+                             ("dn10_run_0", "replication_dn10_run", "replication_dn10_best")):
+        stored = float(_replication_record(run)["fitness"])
+        assert pins[f"evaluation/{scene}"][name]["fitness"] == stored.hex(), (run, stored)
 
 
 def main(argv: List[str]) -> int:
