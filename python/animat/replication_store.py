@@ -178,8 +178,8 @@ def _gunzip(src: Path, sink: _Sink, where: str) -> Dict[str, object]:
     return {"sha256": sha.hexdigest(), "size": size}
 
 
-def _gunzip_bytes(src: Path, where: str, limit: int = MAX_UNPACKED_BYTES) -> bytes:
-    sink = _Sink(where, limit)
+def _gunzip_bytes(src: Path, where: str) -> bytes:
+    sink = _Sink(where, MAX_UNPACKED_BYTES)
     _gunzip(src, sink, where)
     return sink.data()
 
