@@ -335,3 +335,14 @@ def test_a_gzip_bomb_is_refused_at_the_size_limit_in_bounded_memory(tmp_path, mo
     assert f"{packed / 'history.csv.gz'}: expands past {1 << 20} bytes" in message
     assert peak < 8 << 20
     assert not (tmp_path / "work" / "dn2" / "run_0").exists()
+
+
+def test_every_committed_packed_run_has_a_manifest_and_unpacks_verified(tmp_path):
+    runs = [p for group in R.packed_runs(ROOT / "data" / "replication").values() for p in group]
+    assert len(runs) >= 40
+    assert [p for p in runs if not (p / R.MANIFEST).is_file()] == []
+    done = R.unpack_tree(ROOT / "data" / "replication", tmp_path)
+    assert len(done) == len(runs)
+    for p in runs:
+        target = tmp_path / p.parent.name / p.name
+        assert (target / "checkpoint.json").read_bytes() == gzip.decompress((p / "checkpoint.json.gz").read_bytes())
