@@ -227,7 +227,7 @@ def _checkpoint_generation(text: bytes, where: str) -> int:
         outer = json.loads(text)
     except (ValueError, RecursionError) as e:
         raise StoreError(f"{where}: not valid JSON (truncated?): {e}") from None
-    if not isinstance(outer, dict) or not isinstance(outer.get("payload"), str) or not isinstance(outer.get("checksum"), str):
+    if not (isinstance(outer, dict) and isinstance(outer.get("payload"), str) and isinstance(outer.get("checksum"), str)):
         raise StoreError(f"{where}: not an animat checkpoint (no checksum and payload)")
     body = outer["payload"].encode("utf-8")
     if f"{_fnv1a(body):016x}" != outer["checksum"]:
@@ -237,14 +237,16 @@ def _checkpoint_generation(text: bytes, where: str) -> int:
     except (ValueError, RecursionError) as e:
         raise StoreError(f"{where}: payload is not valid JSON: {e}") from None
     if not isinstance(p, dict) or p.get("format") != "animat.checkpoint":
-        raise StoreError(f"{where}: not an animat checkpoint (format {p.get('format') if isinstance(p, dict) else None!r})")
+        fmt = p.get("format") if isinstance(p, dict) else None
+        raise StoreError(f"{where}: not an animat checkpoint (format {fmt!r})")
     gen, hist, pop = p.get("generation"), p.get("history"), p.get("population")
     if not isinstance(gen, int) or isinstance(gen, bool) or gen < 0:
         raise StoreError(f"{where}: no generation")
     if not isinstance(hist, list) or not hist or not isinstance(hist[-1], dict):
         raise StoreError(f"{where}: no history")
     if hist[-1].get("generation") != gen:
-        raise StoreError(f"{where}: generation {gen} does not match its history, which ends at {hist[-1].get('generation')}")
+        raise StoreError(f"{where}: generation {gen} does not match its history, which ends at "
+                         f"{hist[-1].get('generation')}")
     if not isinstance(pop, list) or not pop:
         raise StoreError(f"{where}: no population")
     return gen
@@ -257,6 +259,8 @@ def _history_generation(data: bytes, where: str) -> int:
         text = data.decode("utf-8")
     except UnicodeDecodeError as e:
         raise StoreError(f"{where}: not UTF-8 text ({e})") from None
+    if not text:
+        raise StoreError(f"{where}: empty")
     if not text.endswith("\n"):
         raise StoreError(f"{where}: the last line is incomplete (no newline; truncated?)")
     lines = text.split("\n")[:-1]
@@ -421,7 +425,8 @@ def pack_run(run_dir: Path, dest: Path, stop_reason: Optional[str] = None) -> Pa
 
 
 def _is_digest(e: object) -> bool:
-    return (isinstance(e, dict) and isinstance(e.get("sha256"), str) and re.fullmatch(r"[0-9a-f]{64}", e["sha256"]) is not None
+    return (isinstance(e, dict) and isinstance(e.get("sha256"), str)
+            and re.fullmatch(r"[0-9a-f]{64}", e["sha256"]) is not None
             and isinstance(e.get("size"), int) and not isinstance(e.get("size"), bool) and e["size"] >= 0)
 
 
@@ -590,7 +595,8 @@ def _unpack_one(packed: Path, run_dir: Path) -> bool:
                 except StoreError as e:
                     raise StoreError(f"{e}; nor is it part of the packed run {packed}: move {run_dir} away to "
                                      f"unpack it") from None
-                theirs = _checkpoint_generation(staged["checkpoint.json"].read_bytes(), str(packed / "checkpoint.json.gz"))
+                theirs = _checkpoint_generation(staged["checkpoint.json"].read_bytes(),
+                                                str(packed / "checkpoint.json.gz"))
                 if ours < theirs:
                     raise StoreError(f"{ckpt}: at generation {ours}, behind the packed run {packed} at generation "
                                      f"{theirs}: move {run_dir} away to unpack it")

@@ -165,15 +165,25 @@ def _cut(path: Path, keep: int) -> None:
     path.write_bytes(path.read_bytes()[:keep])
 
 
-DAMAGES = {
-    "checkpoint.json": lambda run: _cut(run / "checkpoint.json", (run / "checkpoint.json").stat().st_size // 2),
-    "checkpoint.json checksum": lambda run: (run / "checkpoint.json").write_text(json.dumps(dict(
-        json.loads((run / "checkpoint.json").read_text()),
-        payload=json.loads((run / "checkpoint.json").read_text())["payload"].replace('"evaluations":', '"evaluations":1', 1)))),
-    "best/gen_000000.json": lambda run: _cut(run / "best" / "gen_000000.json", 100),
-    "history.csv": lambda run: (run / "history.csv").unlink(),
-    "history.csv cut": lambda run: _cut(run / "history.csv", (run / "history.csv").stat().st_size - 5),
-    "config.toml": lambda run: (run / "config.toml").write_text((run / "config.toml").read_text() + "[[[\n"),
+def _edit_payload(ckpt: Path) -> None:
+    """Valid JSON whose checksum no longer matches: one number of the payload changed."""
+    outer = json.loads(ckpt.read_text())
+    outer["payload"] = outer["payload"].replace('"evaluations":', '"evaluations":1', 1)
+    ckpt.write_text(json.dumps(outer))
+
+
+DAMAGES = {  # what is damaged, and the file and the words the refusal names
+    "truncated checkpoint": (lambda run: _cut(run / "checkpoint.json", (run / "checkpoint.json").stat().st_size // 2),
+                             "checkpoint.json: not valid JSON"),
+    "edited checkpoint": (lambda run: _edit_payload(run / "checkpoint.json"),
+                          "checkpoint.json: checksum"),
+    "best file not JSON": (lambda run: _cut(run / "best" / "gen_000000.json", 100),
+                           "best/gen_000000.json: not a JSON genome record"),
+    "history missing": (lambda run: (run / "history.csv").unlink(), "history.csv: missing"),
+    "history cut mid-row": (lambda run: _cut(run / "history.csv", (run / "history.csv").stat().st_size - 5),
+                            "history.csv: the last line is incomplete"),
+    "config not TOML": (lambda run: (run / "config.toml").write_text((run / "config.toml").read_text() + "[[[\n"),
+                        "config.toml: not a TOML config"),
 }
 
 
@@ -185,11 +195,12 @@ def test_pack_refuses_a_run_that_would_not_restore_naming_it_and_changes_no_file
     work = tmp_path / "work"
     R.unpack_tree(data, work)
     run = work / "dn10" / "run_0"
-    DAMAGES[damage](run)
+    damage_run, message = DAMAGES[damage]
+    damage_run(run)
     before = _tree(data)
     assert R.main(["pack", str(work), str(data)]) == 1
     err = capsys.readouterr().err
-    assert f"{run / damage.split()[0]}" in err, err
+    assert f"{run}/{message}" in err, err
     assert _tree(data) == before  # not even the good dn2 run got its manifest
 
 
