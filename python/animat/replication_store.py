@@ -1,4 +1,4 @@
-"""The replication study's runs, kept in the repository (issue 19): pack a run directory into
+"""The replication study's runs, kept in the repository: pack a run directory into
 ``data/replication/<env>/run_<i>/`` and unpack it again to resume it.
 
 A packed run holds what is needed to check and to continue it, compressed:
@@ -9,31 +9,68 @@ A packed run holds what is needed to check and to continue it, compressed:
 - ``checkpoint.json.gz``: the population, random state and history to resume from;
 - ``resume.log`` when the run was resumed with other caps;
 - ``status.json``: the stop reason of its last session (``"in progress"`` when unknown) and the
-  last generation.
+  last generation;
+- ``manifest.json``: the sha256 and size of every file above, of every decompressed stream and of
+  every file unpacking writes (``history.csv``, ``checkpoint.json``, ``best/gen_*.json``...).
 
 Packing is deterministic (sorted members, fixed times and owners, gzip without a time stamp), so
-packing an unchanged run gives the same bytes and git sees no change. Command line::
+packing an unchanged run gives the same bytes and git sees no change.
+
+Packing refuses, before writing anything, a run that would not restore (config.toml not TOML,
+history.csv cut short or out of order, a best/ file that is not JSON, a checkpoint that is not JSON,
+fails its checksum or does not match its history) and a run behind the one already packed at the
+destination (a lower checkpoint generation). Unpacking verifies every size and checksum of the
+manifest, decompresses in a streaming way with a size limit (the manifest's sizes, else
+``MAX_UNPACKED_BYTES`` per stream), stages the run next to its directory and renames the verified
+files into place, the checkpoint last; a run that fails verification writes nothing. A packed run
+without ``manifest.json`` (packed before manifests existed) is checked only by the gzip CRC-32 and
+length of each stream, read to its end: a change to its plain files (config.toml, resume.log,
+status.json) or a consistent re-compression of other content is not detected. Command line::
 
     python -m animat.replication_store unpack data/replication runs/replication   # into work dirs
     python -m animat.replication_store pack runs/replication data/replication     # back into the repository
+
+Both exit 1 with one line per refused run (naming the run and the file) when something is wrong.
 """
 from __future__ import annotations
 
 import argparse
 import gzip
+import hashlib
 import io
 import json
+import os
+import re
 import shutil
 import sys
 import tarfile
+import tempfile
 import tomllib
+import zlib
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
-__all__ = ["PACKED_FILES", "pack_run", "unpack_run", "pack_tree", "unpack_tree", "packed_runs", "is_packed_run",
-           "main"]
+__all__ = ["PACKED_FILES", "MANIFEST", "MAX_UNPACKED_BYTES", "StoreError", "pack_run", "unpack_run", "pack_tree",
+           "unpack_tree", "packed_runs", "is_packed_run", "next_round_cap", "main"]
 
 PACKED_FILES = ("config.toml", "history.csv.gz", "best.tar.gz", "checkpoint.json.gz", "status.json")
+OPTIONAL_FILES = ("resume.log",)
+MANIFEST = "manifest.json"
+MANIFEST_FORMAT = "animat.replication_store.manifest"
+# Per decompressed stream of a packed run without a manifest (a run's checkpoint is a few MB).
+MAX_UNPACKED_BYTES = 4 << 30
+_CHUNK = 1 << 16
+_BEST_NAME = re.compile(r"gen_[0-9]+\.json")
+# What unpacking writes from each compressed file.
+_GUNZIPPED = {"history.csv.gz": "history.csv", "checkpoint.json.gz": "checkpoint.json"}
+
+
+class StoreError(ValueError):
+    """A run that cannot be packed or unpacked as it is; the message names the run and the file."""
+
+
+def _digest(data: bytes) -> Dict[str, object]:
+    return {"sha256": hashlib.sha256(data).hexdigest(), "size": len(data)}
 
 
 def _gzip_bytes(data: bytes) -> bytes:
@@ -43,23 +80,202 @@ def _gzip_bytes(data: bytes) -> bytes:
     return buf.getvalue()
 
 
+def _sync_dir(path: Path) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _write_atomically(path: Path, data: bytes) -> None:
+    """``path`` holds either its old content or ``data``, never a part: a unique temporary file in the same
+    directory, fsync, rename."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        os.fchmod(fd, path.stat().st_mode & 0o7777 if path.exists() else 0o666 & ~_umask())  # mkstemp's is 0600
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
 def _write_if_changed(path: Path, data: bytes) -> None:
     if path.is_file() and path.read_bytes() == data:
         return
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(data)
-    tmp.replace(path)
+    _write_atomically(path, data)
 
 
-def _tar_best(best: Path) -> bytes:
+class _Sink:
+    """Collects a decompressed stream (in memory, or into a file when ``path`` is given) with its sha256 and
+    size, refusing to go past ``limit`` bytes."""
+
+    def __init__(self, where: str, limit: int, path: Optional[Path] = None):
+        self.where, self.limit, self.path = where, limit, path
+        self.sha, self.size = hashlib.sha256(), 0
+        self.parts: List[bytes] = []
+        self.file = open(path, "xb") if path is not None else None
+
+    def write(self, data: bytes) -> None:
+        self.size += len(data)
+        if self.size > self.limit:
+            raise StoreError(f"{self.where}: expands past {self.limit} bytes; refused (corrupt, or a gzip bomb)")
+        self.sha.update(data)
+        if self.file is not None:
+            self.file.write(data)
+        else:
+            self.parts.append(data)
+
+    def close(self) -> None:
+        if self.file is not None and not self.file.closed:
+            self.file.flush()
+            os.fsync(self.file.fileno())
+            self.file.close()
+
+    def digest(self) -> Dict[str, object]:
+        return {"sha256": self.sha.hexdigest(), "size": self.size}
+
+    def data(self) -> bytes:
+        return b"".join(self.parts)
+
+
+def _gunzip(src: Path, sink: _Sink, where: str) -> Dict[str, object]:
+    """Decompress the single-member gzip file ``src`` into ``sink`` chunk by chunk (memory bounded), checking
+    its CRC-32 and length (zlib does, at the end of the stream), that it is complete and that nothing follows
+    it. Returns the sha256 and size of ``src`` itself."""
+    d = zlib.decompressobj(16 + zlib.MAX_WBITS)
+    sha, size = hashlib.sha256(), 0
+    with open(src, "rb") as f:
+        while chunk := f.read(_CHUNK):
+            sha.update(chunk)
+            size += len(chunk)
+            if d.eof:
+                raise StoreError(f"{where}: bytes after the end of the gzip stream (corrupt)")
+            buf = chunk
+            while True:
+                try:
+                    out = d.decompress(buf, _CHUNK)
+                except zlib.error as e:
+                    raise StoreError(f"{where}: corrupt gzip stream ({e})") from None
+                sink.write(out)
+                buf = d.unconsumed_tail
+                if d.eof:
+                    if buf or d.unused_data:
+                        raise StoreError(f"{where}: bytes after the end of the gzip stream (corrupt)")
+                    break
+                if not buf and len(out) < _CHUNK:  # input used up and no output pending
+                    break
+    if not d.eof:
+        raise StoreError(f"{where}: the gzip stream ends early (truncated)")
+    return {"sha256": sha.hexdigest(), "size": size}
+
+
+def _gunzip_bytes(src: Path, where: str) -> bytes:
+    sink = _Sink(where, MAX_UNPACKED_BYTES)
+    _gunzip(src, sink, where)
+    return sink.data()
+
+
+def _file_digest(path: Path, sink: Optional[_Sink] = None) -> Dict[str, object]:
+    sha, size = hashlib.sha256(), 0
+    with open(path, "rb") as f:
+        while chunk := f.read(_CHUNK):
+            sha.update(chunk)
+            size += len(chunk)
+            if sink is not None:
+                sink.write(chunk)
+    return {"sha256": sha.hexdigest(), "size": size}
+
+
+def _tar_best(members: Sequence[Tuple[str, bytes]]) -> bytes:
     raw = io.BytesIO()
     with tarfile.open(fileobj=raw, mode="w", format=tarfile.PAX_FORMAT) as tar:
-        for f in sorted(best.glob("gen_*.json")):
-            data = f.read_bytes()
-            info = tarfile.TarInfo(f"best/{f.name}")
+        for name, data in members:
+            info = tarfile.TarInfo(f"best/{name}")
             info.size, info.mtime, info.mode, info.uid, info.gid, info.uname, info.gname = len(data), 0, 0o644, 0, 0, "", ""
             tar.addfile(info, io.BytesIO(data))
-    return _gzip_bytes(raw.getvalue())
+    return raw.getvalue()
+
+
+def _fnv1a(data: bytes) -> int:
+    h = 0xCBF29CE484222325
+    for c in data:
+        h = ((h ^ c) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    return h
+
+
+def _checkpoint_generation(text: bytes, where: str) -> int:
+    """The generation of a checkpoint that passes the engine's structural checks (JSON, checksum, format, a
+    history ending at its generation, a population); StoreError naming ``where`` otherwise. The engine checks
+    more on restore (the config's identity, the meaning of every field)."""
+    try:
+        outer = json.loads(text)
+    except (ValueError, RecursionError) as e:
+        raise StoreError(f"{where}: not valid JSON (truncated?): {e}") from None
+    if not (isinstance(outer, dict) and isinstance(outer.get("payload"), str) and isinstance(outer.get("checksum"), str)):
+        raise StoreError(f"{where}: not an animat checkpoint (no checksum and payload)")
+    body = outer["payload"].encode("utf-8")
+    if f"{_fnv1a(body):016x}" != outer["checksum"]:
+        raise StoreError(f"{where}: checksum {outer['checksum']} does not match its content ({_fnv1a(body):016x})")
+    try:
+        p = json.loads(body)
+    except (ValueError, RecursionError) as e:
+        raise StoreError(f"{where}: payload is not valid JSON: {e}") from None
+    if not isinstance(p, dict) or p.get("format") != "animat.checkpoint":
+        fmt = p.get("format") if isinstance(p, dict) else None
+        raise StoreError(f"{where}: not an animat checkpoint (format {fmt!r})")
+    gen, hist, pop = p.get("generation"), p.get("history"), p.get("population")
+    if not isinstance(gen, int) or isinstance(gen, bool) or gen < 0:
+        raise StoreError(f"{where}: no generation")
+    if not isinstance(hist, list) or not hist or not isinstance(hist[-1], dict):
+        raise StoreError(f"{where}: no history")
+    if hist[-1].get("generation") != gen:
+        raise StoreError(f"{where}: generation {gen} does not match its history, which ends at "
+                         f"{hist[-1].get('generation')}")
+    if not isinstance(pop, list) or not pop:
+        raise StoreError(f"{where}: no population")
+    return gen
+
+
+def _history_generation(data: bytes, where: str) -> int:
+    """The last generation of a history.csv with a header, complete rows of as many fields and the
+    generations 0, 1, 2, ... in order; StoreError naming the line otherwise."""
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise StoreError(f"{where}: not UTF-8 text ({e})") from None
+    if not text:
+        raise StoreError(f"{where}: empty")
+    if not text.endswith("\n"):
+        raise StoreError(f"{where}: the last line is incomplete (no newline; truncated?)")
+    lines = text.split("\n")[:-1]
+    header = lines[0].split(",")
+    if header[0] != "generation":
+        raise StoreError(f"{where}: line 1 is not the header (generation,...)")
+    if len(lines) < 2:
+        raise StoreError(f"{where}: no generation")
+    for n, line in enumerate(lines[1:], start=2):
+        fields = line.split(",")
+        if len(fields) != len(header):
+            raise StoreError(f"{where} line {n}: {len(fields)} fields, the header has {len(header)}")
+        if fields[0] != str(n - 2):
+            raise StoreError(f"{where} line {n}: generation {fields[0]!r}, expected {n - 2}")
+    return len(lines) - 2
 
 
 def _derived_stop(config: Path, history_lines: List[str]) -> str:
@@ -87,68 +303,331 @@ def is_packed_run(path: Path) -> bool:
     return (path / "config.toml").is_file() and (path / "checkpoint.json.gz").is_file()
 
 
-def pack_run(run_dir: Path, dest: Path, stop_reason: Optional[str] = None) -> Path:
-    """Pack the run directory ``run_dir`` (config.toml, history.csv, best/, checkpoint.json or
-    checkpoint.json.gz, optional resume.log) into ``dest``; returns ``dest``. ``stop_reason`` goes to
-    status.json (default: the one already there if the run has not moved since, else "in progress")."""
-    run_dir, dest = Path(run_dir), Path(dest)
+def _packed_generation(dest: Path) -> Optional[Tuple[int, str]]:
+    """The generation of the run packed at ``dest`` and the file that gives it (its checkpoint; its status.json
+    when the checkpoint does not read); None when nothing is packed there. StoreError when files are there but
+    neither tells a generation: what is there is not replaced unseen."""
+    if not dest.is_dir() or not any(dest.iterdir()):
+        return None
+    why = []
+    ckpt = dest / "checkpoint.json.gz"
+    try:
+        return _checkpoint_generation(_gunzip_bytes(ckpt, str(ckpt)), str(ckpt)), "checkpoint.json.gz"
+    except (OSError, StoreError) as e:
+        why.append(str(e))
+    status = dest / "status.json"
+    try:
+        gen = json.loads(status.read_text()).get("generation")
+        if isinstance(gen, int) and not isinstance(gen, bool):
+            return gen, "status.json"
+        why.append(f"{status}: no generation")
+    except (OSError, ValueError, AttributeError) as e:
+        why.append(f"{status}: {e}")
+    raise StoreError(f"{dest}: holds files but no readable packed run ({'; '.join(why)}); refusing to pack over it "
+                     f"(move it away first)")
+
+
+def _prepare_pack(run_dir: Path, dest: Path, stop_reason: Optional[str]) -> Dict[str, bytes]:
+    """Every file of the packed run (manifest.json included), after checking that the run restores and is
+    not behind what ``dest`` holds; StoreError naming the run and the file otherwise. Writes nothing."""
     for need in ("config.toml", "history.csv"):
         if not (run_dir / need).is_file():
-            raise FileNotFoundError(f"pack_run: {run_dir / need} is missing")
-    if (run_dir / "checkpoint.json").is_file():
-        ckpt = _gzip_bytes((run_dir / "checkpoint.json").read_bytes())
-    elif (run_dir / "checkpoint.json.gz").is_file():
-        ckpt = _gzip_bytes(gzip.decompress((run_dir / "checkpoint.json.gz").read_bytes()))
-    else:
-        raise FileNotFoundError(f"pack_run: {run_dir} has no checkpoint.json(.gz)")
-    dest.mkdir(parents=True, exist_ok=True)
+            raise StoreError(f"{run_dir / need}: missing; refusing to pack {run_dir}")
+    config = (run_dir / "config.toml").read_bytes()
+    try:
+        tomllib.loads(config.decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+        raise StoreError(f"{run_dir / 'config.toml'}: not a TOML config ({e}); refusing to pack {run_dir}") from None
     history = (run_dir / "history.csv").read_bytes()
+    last_row = _history_generation(history, str(run_dir / "history.csv"))
+    if (run_dir / "checkpoint.json").is_file():
+        ckpt_path = run_dir / "checkpoint.json"
+        ckpt = ckpt_path.read_bytes()
+    elif (run_dir / "checkpoint.json.gz").is_file():
+        ckpt_path = run_dir / "checkpoint.json.gz"
+        ckpt = _gunzip_bytes(ckpt_path, str(ckpt_path))
+    else:
+        raise StoreError(f"{run_dir}: no checkpoint.json(.gz); refusing to pack it")
+    generation = _checkpoint_generation(ckpt, str(ckpt_path))
+    if last_row < generation:
+        raise StoreError(f"{run_dir / 'history.csv'}: ends at generation {last_row}, before the checkpoint's "
+                         f"{generation}; refusing to pack {run_dir}")
+    best_dir = run_dir / "best"
+    if not best_dir.is_dir():
+        raise StoreError(f"{best_dir}: missing (the lineage of best individuals); refusing to pack {run_dir}")
+    best = []
+    for f in sorted(p for p in best_dir.iterdir() if _BEST_NAME.fullmatch(p.name)):
+        data = f.read_bytes()
+        try:
+            if not isinstance(json.loads(data), dict):
+                raise ValueError("not a JSON object")
+        except (ValueError, RecursionError) as e:
+            raise StoreError(f"{f}: not a JSON genome record ({e}); refusing to pack {run_dir}") from None
+        best.append((f.name, data))
+    if not best:
+        raise StoreError(f"{best_dir}: no gen_*.json (the lineage of best individuals); refusing to pack {run_dir}")
+    old = _packed_generation(dest)
+    if old is not None:
+        ours, ours_from = (generation, ckpt_path.name) if old[1] == "checkpoint.json.gz" else (last_row, "history.csv")
+        if ours < old[0]:
+            raise StoreError(f"{run_dir}: at generation {ours} ({ours_from}), behind the run packed in {dest} at "
+                             f"generation {old[0]} ({old[1]}); refusing to replace it")
     lines = [ln for ln in history.decode().splitlines() if ln.strip()]
-    last = int(lines[-1].split(",")[0]) if len(lines) > 1 else -1
-    old = {}
-    if (dest / "status.json").is_file():
-        old = json.loads((dest / "status.json").read_text())
+    try:
+        old_status = json.loads((dest / "status.json").read_text()) if (dest / "status.json").is_file() else {}
+    except (OSError, ValueError):
+        old_status = {}
+    if not isinstance(old_status, dict):
+        old_status = {}
     if stop_reason is None:  # unchanged since the last packing: keep its reason; else derive it
-        stop_reason = (old.get("stop_reason", "in progress") if old.get("generation") == last
+        stop_reason = (old_status.get("stop_reason", "in progress") if old_status.get("generation") == last_row
                        else _derived_stop(run_dir / "config.toml", lines))
-    status = {"generation": last, "stop_reason": stop_reason}
-    _write_if_changed(dest / "config.toml", (run_dir / "config.toml").read_bytes())
-    _write_if_changed(dest / "history.csv.gz", _gzip_bytes(history))
-    _write_if_changed(dest / "best.tar.gz", _tar_best(run_dir / "best"))
-    _write_if_changed(dest / "checkpoint.json.gz", ckpt)
-    _write_if_changed(dest / "status.json", (json.dumps(status, indent=1, sort_keys=True) + "\n").encode())
+    status = {"generation": last_row, "stop_reason": stop_reason}
+    tar = _tar_best(best)
+    files = {"config.toml": config, "history.csv.gz": _gzip_bytes(history), "best.tar.gz": _gzip_bytes(tar),
+             "checkpoint.json.gz": _gzip_bytes(ckpt),
+             "status.json": (json.dumps(status, indent=1, sort_keys=True) + "\n").encode()}
     if (run_dir / "resume.log").is_file():
-        _write_if_changed(dest / "resume.log", (run_dir / "resume.log").read_bytes())
+        files["resume.log"] = (run_dir / "resume.log").read_bytes()
+    gunzipped = {"history.csv.gz": history, "best.tar.gz": tar, "checkpoint.json.gz": ckpt}
+    packed = {}
+    for name, data in files.items():
+        packed[name] = _digest(data)
+        if name in gunzipped:
+            packed[name]["gunzipped"] = _digest(gunzipped[name])
+    unpacked = {"config.toml": _digest(config), "history.csv": _digest(history), "checkpoint.json": _digest(ckpt),
+                "status.json": _digest(files["status.json"])}
+    unpacked.update({f"best/{name}": _digest(data) for name, data in best})
+    if "resume.log" in files:
+        unpacked["resume.log"] = _digest(files["resume.log"])
+    manifest = {"format": MANIFEST_FORMAT, "version": 1, "packed": packed, "unpacked": unpacked}
+    files[MANIFEST] = (json.dumps(manifest, indent=1, sort_keys=True) + "\n").encode()
+    return files
+
+
+def _write_pack(dest: Path, files: Dict[str, bytes]) -> Path:
+    dest.mkdir(parents=True, exist_ok=True)
+    # The manifest last: a pack cut short leaves content the old manifest does not match, which unpack reports.
+    for name in sorted(files, key=lambda n: (n == MANIFEST, n == "status.json", n)):
+        _write_if_changed(dest / name, files[name])
+    _sync_dir(dest)
     return dest
+
+
+def pack_run(run_dir: Path, dest: Path, stop_reason: Optional[str] = None) -> Path:
+    """Pack the run directory ``run_dir`` (config.toml, history.csv, best/, checkpoint.json or
+    checkpoint.json.gz, optional resume.log) into ``dest`` with its manifest; returns ``dest``. ``stop_reason``
+    goes to status.json (default: the one already there if the run has not moved since, else "in progress").
+    Raises StoreError, writing nothing, when the run would not restore or is behind the run packed in ``dest``
+    (see the module docstring)."""
+    run_dir, dest = Path(run_dir), Path(dest)
+    return _write_pack(dest, _prepare_pack(run_dir, dest, stop_reason))
+
+
+def _is_digest(e: object) -> bool:
+    return (isinstance(e, dict) and isinstance(e.get("sha256"), str)
+            and re.fullmatch(r"[0-9a-f]{64}", e["sha256"]) is not None
+            and isinstance(e.get("size"), int) and not isinstance(e.get("size"), bool) and e["size"] >= 0)
+
+
+def _read_manifest(packed: Path) -> dict:
+    path = packed / MANIFEST
+    if path.stat().st_size > 64 << 20:
+        raise StoreError(f"{path}: {path.stat().st_size} bytes, too large for a manifest")
+    try:
+        m = json.loads(path.read_bytes())
+    except (ValueError, RecursionError) as e:
+        raise StoreError(f"{path}: not valid JSON ({e})") from None
+    ok = (isinstance(m, dict) and m.get("format") == MANIFEST_FORMAT and m.get("version") == 1
+          and isinstance(m.get("packed"), dict) and isinstance(m.get("unpacked"), dict)
+          and all(_is_digest(e) for e in m["packed"].values()) and all(_is_digest(e) for e in m["unpacked"].values())
+          and all(_is_digest(m["packed"][n].get("gunzipped")) for n in m["packed"] if n.endswith(".gz")))
+    if not ok:
+        raise StoreError(f"{path}: not a manifest of format {MANIFEST_FORMAT} version 1")
+    return m
+
+
+def _check_digest(where: str, what: str, got: Dict[str, object], want: Dict[str, object]) -> None:
+    if got["size"] != want["size"]:
+        raise StoreError(f"{where}: {what}size {got['size']} bytes, the manifest says {want['size']}")
+    if got["sha256"] != want["sha256"]:
+        raise StoreError(f"{where}: {what}sha256 {got['sha256']} does not match the manifest's {want['sha256']}")
+
+
+def _stage(packed: Path, staging: Path) -> Dict[str, Path]:
+    """Verify the packed run ``packed`` and write the files unpacking installs into ``staging``; returns
+    ``{path in the run directory: staged file}``. StoreError naming the run and the file on any mismatch."""
+    manifest = _read_manifest(packed) if (packed / MANIFEST).is_file() else None
+    present = [n for n in PACKED_FILES + OPTIONAL_FILES if (packed / n).is_file()]
+    for need in ("config.toml", "history.csv.gz", "best.tar.gz", "checkpoint.json.gz"):
+        if need not in present:
+            raise StoreError(f"{packed / need}: missing from the packed run {packed}")
+    if manifest is not None:
+        for name in sorted(set(manifest["packed"]) - set(present)):
+            raise StoreError(f"{packed / name}: listed in {MANIFEST} but missing")
+        for name in sorted(set(present) - set(manifest["packed"])):
+            raise StoreError(f"{packed / name}: not listed in {MANIFEST}")
+    staged: Dict[str, Path] = {}
+    (staging / "best").mkdir()
+    for name in present:
+        src, where = packed / name, str(packed / name)
+        want = manifest["packed"][name] if manifest is not None else None
+        if want is not None:
+            _check_digest(where, "", _file_digest(src), want)
+        rel = _GUNZIPPED.get(name, "best.tar" if name == "best.tar.gz" else name)
+        gunzip = name.endswith(".gz")
+        want_out = (want["gunzipped"] if gunzip else want) if want is not None else None
+        limit = MAX_UNPACKED_BYTES if want_out is None else min(want_out["size"], MAX_UNPACKED_BYTES)
+        sink = _Sink(where, limit, staging / rel)
+        try:
+            if gunzip:
+                _gunzip(src, sink, where)
+            else:
+                _file_digest(src, sink)
+        finally:
+            sink.close()
+        if want_out is not None:
+            _check_digest(where, "decompressed " if gunzip else "", sink.digest(), want_out)
+        staged[rel] = staging / rel
+    tar_path = staged.pop("best.tar")
+    where = str(packed / "best.tar.gz")
+    try:
+        with tarfile.open(tar_path, mode="r:") as tar:
+            for m in tar:
+                base = m.name[len("best/"):] if m.name.startswith("best/") else ""
+                if not m.isfile() or not _BEST_NAME.fullmatch(base):
+                    raise StoreError(f"{where}: unexpected member {m.name!r}")
+                if f"best/{base}" in staged:
+                    raise StoreError(f"{where}: member {m.name!r} appears twice")
+                member = tar.extractfile(m)
+                if member is None:
+                    raise StoreError(f"{where}: cannot read member {m.name!r}")
+                sink = _Sink(f"{where} member {m.name}", MAX_UNPACKED_BYTES, staging / "best" / base)
+                try:
+                    while chunk := member.read(_CHUNK):
+                        sink.write(chunk)
+                finally:
+                    sink.close()
+                if sink.size != m.size:
+                    raise StoreError(f"{where}: member {m.name!r} holds {sink.size} bytes, its header says {m.size}")
+                staged[f"best/{base}"] = staging / "best" / base
+    except tarfile.TarError as e:
+        raise StoreError(f"{where}: not a readable tar archive ({e})") from None
+    tar_path.unlink()
+    if manifest is not None:
+        want_files = manifest["unpacked"]
+        for rel in sorted(set(want_files) - set(staged)):
+            raise StoreError(f"{packed}: {rel} is listed in {MANIFEST} but not in the packed files")
+        for rel in sorted(set(staged) - set(want_files)):
+            raise StoreError(f"{packed}: {rel} is in the packed files but not listed in {MANIFEST}")
+        for rel, path in staged.items():
+            _check_digest(f"{packed}: {rel}", "", _file_digest(path), want_files[rel])
+    return staged
+
+
+def _compare(a: Path, b: Path) -> str:
+    """``"equal"`` when the files hold the same bytes, ``"prefix"`` when ``a`` is a strict beginning of ``b``
+    (what a write cut short leaves), else ``"other"``."""
+    if a.stat().st_size > b.stat().st_size:
+        return "other"
+    with open(a, "rb") as fa, open(b, "rb") as fb:
+        while True:
+            ca = fa.read(_CHUNK)
+            cb = fb.read(len(ca)) if ca else fb.read(1)
+            if not ca:
+                return "equal" if not cb else "prefix"
+            if ca != cb:
+                return "other"
+
+
+def _install(staged: Dict[str, Path], run_dir: Path, only: Optional[set]) -> bool:
+    """Rename the staged files into ``run_dir`` (those in ``only`` when given; each only where it differs),
+    the checkpoint last: a run directory with a checkpoint has all its other files."""
+    changed = False
+    for rel in sorted(staged, key=lambda r: (r == "checkpoint.json", r)):
+        if only is not None and rel not in only:
+            continue
+        target = run_dir / rel
+        if target.is_file() and _compare(target, staged[rel]) == "equal":
+            continue
+        target.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(staged[rel], target)
+        changed = True
+    if changed:
+        _sync_dir(run_dir / "best")
+        _sync_dir(run_dir)
+    return changed
+
+
+def _mkdirs(path: Path) -> List[Path]:
+    """mkdir -p; returns the directories it created, outermost first."""
+    missing = []
+    while not path.exists():
+        missing.append(path)
+        path = path.parent
+    for d in reversed(missing):
+        d.mkdir(exist_ok=True)
+    return list(reversed(missing))
+
+
+def _unpack_one(packed: Path, run_dir: Path) -> bool:
+    """Bring ``run_dir`` to the packed run ``packed``, or leave it when it holds a run that is further on;
+    returns whether a file was written. A checkpoint.json that is a strict beginning of the packed one was
+    left by an unpack cut short: the run is unpacked again. Files missing next to a checkpoint equal to the
+    packed one, or cut short, are restored; other differing files are the work copy's and are kept."""
+    created = _mkdirs(run_dir.parent)
+    for stale in run_dir.parent.glob(f".{run_dir.name}.unpack-*"):  # left by an unpack that was killed
+        shutil.rmtree(stale, ignore_errors=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{run_dir.name}.unpack-", dir=run_dir.parent))
+    installing = False
+    try:
+        staged = _stage(packed, staging)
+        ckpt = run_dir / "checkpoint.json"
+        only = None
+        if ckpt.exists():
+            state = _compare(ckpt, staged["checkpoint.json"])
+            if state == "equal":
+                only = {rel for rel, path in staged.items()
+                        if not (run_dir / rel).is_file() or _compare(run_dir / rel, path) == "prefix"}
+            elif state == "other":
+                try:
+                    ours = _checkpoint_generation(ckpt.read_bytes(), str(ckpt))
+                except StoreError as e:
+                    raise StoreError(f"{e}; nor is it part of the packed run {packed}: move {run_dir} away to "
+                                     f"unpack it") from None
+                theirs = _checkpoint_generation(staged["checkpoint.json"].read_bytes(),
+                                                str(packed / "checkpoint.json.gz"))
+                if ours < theirs:
+                    raise StoreError(f"{ckpt}: at generation {ours}, behind the packed run {packed} at generation "
+                                     f"{theirs}: move {run_dir} away to unpack it")
+                return False  # a work directory is newer than the repository's copy until it is packed
+        installing = True
+        return _install(staged, run_dir, only)
+    except OSError as e:
+        raise OSError(e.errno, f"unpacking {packed} into {run_dir}: {e.strerror or e}"
+                      + (f" ({e.filename})" if e.filename else "")) from e
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+        if not installing:
+            for d in reversed(created):
+                try:
+                    d.rmdir()
+                except OSError:
+                    break
 
 
 def unpack_run(packed: Path, run_dir: Path) -> Path:
     """Unpack a packed run into ``run_dir`` as the runner writes it (config.toml, history.csv, best/,
-    checkpoint.json, resume.log; and status.json, which the runner ignores), ready for ``animat_evolve --resume`` / ``python -m animat experiment``.
-    Refuses to overwrite a run directory that already holds a checkpoint."""
+    checkpoint.json, resume.log; and status.json, which the runner ignores), ready for ``animat_evolve --resume``
+    / ``python -m animat experiment``, after verifying it (see the module docstring): StoreError naming the run
+    and the file, and nothing written, when it does not verify. Refuses to overwrite a run directory that
+    already holds a checkpoint."""
     packed, run_dir = Path(packed), Path(run_dir)
     if not is_packed_run(packed):
         raise FileNotFoundError(f"unpack_run: {packed} is not a packed run (config.toml, checkpoint.json.gz)")
     if (run_dir / "checkpoint.json").exists():
         raise FileExistsError(f"unpack_run: {run_dir} already holds a run (checkpoint.json)")
-    run_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(packed / "config.toml", run_dir / "config.toml")
-    (run_dir / "history.csv").write_bytes(gzip.decompress((packed / "history.csv.gz").read_bytes()))
-    (run_dir / "best").mkdir(exist_ok=True)
-    with tarfile.open(packed / "best.tar.gz", mode="r:gz") as tar:
-        for m in tar.getmembers():
-            name = Path(m.name)
-            if not m.isfile() or name.parent != Path("best") or not name.name.startswith("gen_"):
-                raise ValueError(f"unpack_run: unexpected member {m.name!r} in {packed / 'best.tar.gz'}")
-            member = tar.extractfile(m)
-            if member is None:
-                raise ValueError(f"unpack_run: cannot read {m.name!r} in {packed / 'best.tar.gz'}")
-            data = member.read()
-            (run_dir / "best" / name.name).write_bytes(data)
-    for extra in ("resume.log", "status.json"):
-        if (packed / extra).is_file():
-            shutil.copyfile(packed / extra, run_dir / extra)
-    (run_dir / "checkpoint.json").write_bytes(gzip.decompress((packed / "checkpoint.json.gz").read_bytes()))
+    _unpack_one(packed, run_dir)
     return run_dir
 
 
@@ -164,16 +643,25 @@ def packed_runs(root: Path) -> Dict[str, List[Path]]:
 
 
 def unpack_tree(root: Path, work: Path) -> List[Path]:
-    """Unpack every packed run ``root/<env>/run_<i>`` into ``work/<env>/run_<i>`` unless that already holds a
-    checkpoint (a work directory is newer than the repository's copy until it is packed). Returns the
-    directories unpacked."""
-    done = []
+    """Unpack every packed run ``root/<env>/run_<i>`` into ``work/<env>/run_<i>``, verifying each. A work
+    directory that already equals its packed run is left as it is; one further on than its packed run is kept
+    (a work directory is newer than the repository's copy until it is packed); what an unpack cut short left
+    is repaired. Returns the directories written to. A run that does not verify, or a work directory behind
+    its packed run or with a damaged checkpoint, is not unpacked; the others are, then StoreError lists every
+    such run (its ``done`` attribute holds the directories written to)."""
+    done, errors = [], []
     for env, runs in packed_runs(root).items():
         for p in runs:
             target = Path(work) / env / p.name
-            if (target / "checkpoint.json").exists():
-                continue
-            done.append(unpack_run(p, target))
+            try:
+                if _unpack_one(p, target):
+                    done.append(target)
+            except (StoreError, OSError) as e:
+                errors.append(str(e))
+    if errors:
+        err = StoreError(f"{len(errors)} run(s) not unpacked:\n" + "\n".join(errors))
+        err.done = done  # type: ignore[attr-defined]
+        raise err
     return done
 
 
@@ -186,14 +674,22 @@ def _stop_reasons(env_dir: Path) -> Dict[int, str]:
 
 def pack_tree(work: Path, root: Path) -> List[Path]:
     """Pack every run ``work/<env>/run_<i>`` with a checkpoint into ``root/<env>/run_<i>`` (stop reasons from
-    ``work/<env>/summary.json`` when the experiment wrote one). Returns the packed directories."""
-    done = []
+    ``work/<env>/summary.json`` when the experiment wrote one). Returns the packed directories. Every run is
+    checked first: when one is refused (see ``pack_run``), StoreError lists each refused run and no file is
+    written."""
+    plans, errors = [], []
     for env in sorted(p for p in Path(work).iterdir() if p.is_dir()):
         reasons = _stop_reasons(env)
         for run in sorted(env.glob("run_*")):
             if run.name[4:].isdigit() and (run / "checkpoint.json").is_file():
-                done.append(pack_run(run, Path(root) / env.name / run.name, reasons.get(int(run.name[4:]))))
-    return done
+                dest = Path(root) / env.name / run.name
+                try:
+                    plans.append((dest, _prepare_pack(run, dest, reasons.get(int(run.name[4:])))))
+                except (StoreError, OSError) as e:
+                    errors.append(str(e))
+    if errors:
+        raise StoreError(f"{len(errors)} run(s) refused, nothing packed:\n" + "\n".join(errors))
+    return [_write_pack(dest, files) for dest, files in plans]
 
 
 def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int, round_size: int) -> int:
@@ -244,10 +740,19 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         if not args.data.is_dir():
             print(f"replication_store: {args.data}: no such directory (nothing to resume)", file=sys.stderr)
             return 0
-        done = unpack_tree(args.data, args.work)
+        try:
+            done = unpack_tree(args.data, args.work)
+        except StoreError as e:
+            print(f"unpacked {len(getattr(e, 'done', []))} run(s) into {args.work}", file=sys.stderr)
+            print(f"replication_store: error: {e}", file=sys.stderr)
+            return 1
         print(f"unpacked {len(done)} run(s) into {args.work}", file=sys.stderr)
     else:
-        done = pack_tree(args.work, args.data)
+        try:
+            done = pack_tree(args.work, args.data)
+        except (StoreError, OSError) as e:
+            print(f"replication_store: error: {e}", file=sys.stderr)
+            return 1
         print(f"packed {len(done)} run(s) into {args.data}", file=sys.stderr)
     return 0
 

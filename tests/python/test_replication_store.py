@@ -1,9 +1,14 @@
-"""animat.replication_store (issue 19): packed runs unpack into run directories and pack back to the same bytes."""
+"""animat.replication_store: packed runs unpack into run directories and pack back to the same bytes; pack
+refuses runs that would not restore or are behind, unpack verifies every checksum and size."""
 import gzip
+import hashlib
 import json
+import resource
 import shutil
+import signal
 import subprocess
 import sys
+import tracemalloc
 from pathlib import Path
 
 import pytest
@@ -27,6 +32,12 @@ def test_unpack_then_pack_gives_the_same_bytes(tmp_path):
     again = R.pack_run(work, tmp_path / "packed" / "run_0")
     for name in R.PACKED_FILES:
         assert (again / name).read_bytes() == (PACKED / name).read_bytes(), name
+    manifest = (again / R.MANIFEST).read_bytes()
+    assert json.loads(manifest)["unpacked"]["checkpoint.json"] == {
+        "sha256": hashlib.sha256((work / "checkpoint.json").read_bytes()).hexdigest(),
+        "size": (work / "checkpoint.json").stat().st_size}
+    R.pack_run(work, again)
+    assert (again / R.MANIFEST).read_bytes() == manifest  # the manifest is deterministic too
     with pytest.raises(FileExistsError):
         R.unpack_run(PACKED, work)  # never overwrites a work directory that holds a run
 
@@ -115,3 +126,234 @@ def test_report_states_the_guard_tolerances_per_environment_when_they_differ(tmp
     assert same not in page
     assert ("`evaluation.reference_abs_tolerance`: `dn2` 1 % and 0.05, `dn10` 2 % and 0.05): 2 of 2 bests."
             in page)
+
+
+def _tree(root: Path) -> dict:
+    """Every file under root with its bytes."""
+    return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def _fnv1a(data: bytes) -> str:
+    h = 0xCBF29CE484222325
+    for c in data:
+        h = ((h ^ c) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    return f"{h:016x}"
+
+
+def _checkpoint_at(text: bytes, generation: int) -> bytes:
+    """The checkpoint ``text`` with its history cut (or extended by copies of its last row) to end at
+    ``generation``, with a valid checksum."""
+    payload = json.loads(json.loads(text)["payload"])
+    hist = [h for h in payload["history"] if h["generation"] <= generation]
+    while hist[-1]["generation"] < generation:
+        hist.append(dict(hist[-1], generation=hist[-1]["generation"] + 1))
+    payload.update(history=hist, generation=generation)
+    body = json.dumps(payload, separators=(",", ":"), sort_keys=True)
+    return json.dumps({"checksum": _fnv1a(body.encode()), "payload": body}, separators=(",", ":")).encode()
+
+
+def _packed_with_manifest(tmp_path: Path):
+    """data/dn2/run_0: the frozen dn2 run packed by today's pack (with its manifest)."""
+    work = R.unpack_run(PACKED, tmp_path / "scratch" / "dn2" / "run_0")
+    data = tmp_path / "data"
+    R.pack_run(work, data / "dn2" / "run_0")
+    shutil.rmtree(tmp_path / "scratch")
+    return data, data / "dn2" / "run_0"
+
+
+def _cut(path: Path, keep: int) -> None:
+    path.write_bytes(path.read_bytes()[:keep])
+
+
+def _edit_payload(ckpt: Path) -> None:
+    """Valid JSON whose checksum no longer matches: one number of the payload changed."""
+    outer = json.loads(ckpt.read_text())
+    outer["payload"] = outer["payload"].replace('"evaluations":', '"evaluations":1', 1)
+    ckpt.write_text(json.dumps(outer))
+
+
+DAMAGES = {  # what is damaged, and the file and the words the refusal names
+    "truncated checkpoint": (lambda run: _cut(run / "checkpoint.json", (run / "checkpoint.json").stat().st_size // 2),
+                             "checkpoint.json: not valid JSON"),
+    "edited checkpoint": (lambda run: _edit_payload(run / "checkpoint.json"),
+                          "checkpoint.json: checksum"),
+    "best file not JSON": (lambda run: _cut(run / "best" / "gen_000000.json", 100),
+                           "best/gen_000000.json: not a JSON genome record"),
+    "history missing": (lambda run: (run / "history.csv").unlink(), "history.csv: missing"),
+    "history cut mid-row": (lambda run: _cut(run / "history.csv", (run / "history.csv").stat().st_size - 5),
+                            "history.csv: the last line is incomplete"),
+    "config not TOML": (lambda run: (run / "config.toml").write_text((run / "config.toml").read_text() + "[[[\n"),
+                        "config.toml: not a TOML config"),
+}
+
+
+@pytest.mark.parametrize("damage", sorted(DAMAGES))
+def test_pack_refuses_a_run_that_would_not_restore_naming_it_and_changes_no_file(tmp_path, capsys, damage):
+    data = tmp_path / "data"
+    shutil.copytree(PACKED, data / "dn2" / "run_0")
+    shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
+    work = tmp_path / "work"
+    R.unpack_tree(data, work)
+    run = work / "dn10" / "run_0"
+    damage_run, message = DAMAGES[damage]
+    damage_run(run)
+    before = _tree(data)
+    assert R.main(["pack", str(work), str(data)]) == 1
+    err = capsys.readouterr().err
+    assert f"{run}/{message}" in err, err
+    assert _tree(data) == before  # not even the good dn2 run got its manifest
+
+
+def test_pack_never_replaces_a_packed_run_with_one_behind_it(tmp_path, capsys):
+    data, packed = _packed_with_manifest(tmp_path)
+    work = tmp_path / "work"
+    run = R.unpack_run(packed, work / "dn2" / "run_0")
+    (run / "checkpoint.json").write_bytes(_checkpoint_at((run / "checkpoint.json").read_bytes(), 50))
+    (run / "history.csv").write_text("".join((run / "history.csv").read_text().splitlines(keepends=True)[:52]))
+    for f in (run / "best").glob("gen_*.json"):
+        if int(f.stem[4:]) > 50:
+            f.unlink()
+    before = _tree(data)
+    assert R.main(["pack", str(work), str(data)]) == 1
+    err = capsys.readouterr().err
+    assert (f"{run}: at generation 50 (checkpoint.json), behind the run packed in {packed} at generation 100 "
+            f"(checkpoint.json.gz); refusing to replace it") in err
+    assert _tree(data) == before
+    with pytest.raises(R.StoreError):
+        R.pack_run(run, packed)
+    assert _tree(data) == before
+
+
+def test_unpack_repairs_what_an_unpack_cut_short_left(tmp_path):
+    data = tmp_path / "data"
+    shutil.copytree(PACKED, data / "dn2" / "run_0")
+    work = tmp_path / "work"
+    ckpt = work / "dn2" / "run_0" / "checkpoint.json"
+    want = gzip.decompress((PACKED / "checkpoint.json.gz").read_bytes())
+    R.unpack_tree(data, work)
+    _cut(ckpt, len(want) // 3)  # what a write stopped by a full disk leaves
+    stale = work / "dn2" / ".run_0.unpack-killed"  # the staging directory of a killed unpack
+    stale.mkdir()
+    (stale / "checkpoint.json").write_bytes(want[:10])
+    assert R.main(["unpack", str(data), str(work)]) == 0
+    assert ckpt.read_bytes() == want
+    assert not stale.exists()
+    assert R.unpack_tree(data, work) == []  # now equal to the packed run: nothing to do
+    (work / "dn2" / "run_0" / "best" / "gen_000000.json").unlink()
+    assert R.unpack_tree(data, work) == [work / "dn2" / "run_0"]
+    assert _tree(work / "dn2" / "run_0") == _tree(R.unpack_run(PACKED, tmp_path / "fresh"))
+
+
+def test_unpack_on_a_full_disk_writes_nothing_and_a_retry_completes_it(tmp_path):
+    data = tmp_path / "data"
+    shutil.copytree(PACKED, data / "dn2" / "run_0")
+    work = tmp_path / "work"
+    cmd = [sys.executable, "-m", "animat.replication_store", "unpack", str(data), str(work)]
+
+    def file_size_limit():  # every other file fits; the checkpoint (440 KB) does not
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
+
+    full = subprocess.run(cmd, capture_output=True, text=True, preexec_fn=file_size_limit)
+    assert full.returncode == 1, full.stderr
+    assert f"unpacking {data / 'dn2' / 'run_0'} into {work / 'dn2' / 'run_0'}: File too large" in full.stderr
+    assert not work.exists() or _tree(work) == {}
+    retry = subprocess.run(cmd, capture_output=True, text=True)
+    assert retry.returncode == 0, retry.stderr
+    assert _tree(work / "dn2" / "run_0") == _tree(R.unpack_run(PACKED, tmp_path / "fresh"))
+
+
+def test_unpack_keeps_a_work_run_further_on_and_refuses_one_behind(tmp_path):
+    data = tmp_path / "data"
+    shutil.copytree(PACKED, data / "dn2" / "run_0")
+    work = tmp_path / "work"
+    (target,) = R.unpack_tree(data, work)
+    ckpt = target / "checkpoint.json"
+    good = ckpt.read_bytes()
+    ckpt.write_bytes(_checkpoint_at(good, 101))
+    newer = _tree(target)
+    assert R.unpack_tree(data, work) == [] and _tree(target) == newer
+    ckpt.write_bytes(_checkpoint_at(good, 50))
+    with pytest.raises(R.StoreError) as e:
+        R.unpack_tree(data, work)
+    assert f"{ckpt}: at generation 50, behind the packed run {data / 'dn2' / 'run_0'} at generation 100" in str(e.value)
+    ckpt.write_bytes(b'{"checksum": "x", ' + good[:50])  # damaged, and not a part of the packed one
+    with pytest.raises(R.StoreError) as e:
+        R.unpack_tree(data, work)
+    assert f"{ckpt}: not valid JSON" in str(e.value) and f"move {target} away" in str(e.value)
+
+
+@pytest.mark.parametrize("name", ["checkpoint.json.gz", "best.tar.gz", "history.csv.gz", "config.toml", "status.json",
+                                  "manifest.json"])
+def test_one_flipped_bit_in_a_packed_file_is_an_error_naming_it_and_writes_nothing(tmp_path, name):
+    data, packed = _packed_with_manifest(tmp_path)
+    f = packed / name
+    b = bytearray(f.read_bytes())
+    b[len(b) // 2] ^= 0x10
+    f.write_bytes(bytes(b))
+    work = tmp_path / "work"
+    with pytest.raises(R.StoreError) as e:
+        R.unpack_tree(data, work)
+    assert f"{packed / name}:" in str(e.value)
+    assert not (work / "dn2" / "run_0").exists()
+    with pytest.raises(R.StoreError):
+        R.unpack_run(packed, tmp_path / "single")
+    assert not (tmp_path / "single").exists()
+
+
+def test_a_packed_run_without_manifest_is_checked_by_its_gzip_crc(tmp_path):
+    """A best.tar.gz whose deflate data decodes to other numbers than its CRC-32 describes (what one flipped bit
+    can do): the tar reads fine, only the CRC at the end of the stream tells."""
+    data = tmp_path / "data"
+    packed = data / "dn2" / "run_0"
+    shutil.copytree(PACKED, packed)
+    original = (packed / "best.tar.gz").read_bytes()
+    tar = gzip.decompress(original)
+    i = tar.index(b'"fitness": 4.9') + len(b'"fitness": 4.9')
+    altered = gzip.compress(tar[:i] + b"8" + tar[i + 1:], compresslevel=9, mtime=0)
+    (packed / "best.tar.gz").write_bytes(altered[:-8] + original[-8:])  # the original CRC-32 and length
+    with pytest.raises(R.StoreError) as e:
+        R.unpack_tree(data, tmp_path / "work")
+    assert f"{packed / 'best.tar.gz'}: corrupt gzip stream" in str(e.value)
+    assert "incorrect data check" in str(e.value)
+    assert not (tmp_path / "work" / "dn2" / "run_0").exists()
+
+
+def test_a_gzip_bomb_is_refused_at_the_size_limit_in_bounded_memory(tmp_path, monkeypatch):
+    bomb = gzip.compress(b"0" * (64 << 20), compresslevel=9, mtime=0)  # 64 MiB from about 64 KiB
+    data, packed = _packed_with_manifest(tmp_path)
+    (packed / "history.csv.gz").write_bytes(bomb)
+    manifest = json.loads((packed / R.MANIFEST).read_text())  # made to agree with the bomb's packed bytes
+    manifest["packed"]["history.csv.gz"].update(sha256=hashlib.sha256(bomb).hexdigest(), size=len(bomb))
+    (packed / R.MANIFEST).write_text(json.dumps(manifest))
+    limit = manifest["packed"]["history.csv.gz"]["gunzipped"]["size"]
+
+    def unpack_peak() -> tuple:
+        tracemalloc.start()
+        try:
+            with pytest.raises(R.StoreError) as e:
+                R.unpack_tree(data, tmp_path / "work")
+            return str(e.value), tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+
+    message, peak = unpack_peak()  # capped at the manifest's size
+    assert f"{packed / 'history.csv.gz'}: expands past {limit} bytes" in message
+    assert peak < 8 << 20
+    (packed / R.MANIFEST).unlink()  # no manifest: capped at MAX_UNPACKED_BYTES, here lowered to 1 MiB
+    monkeypatch.setattr(R, "MAX_UNPACKED_BYTES", 1 << 20)
+    message, peak = unpack_peak()
+    assert f"{packed / 'history.csv.gz'}: expands past {1 << 20} bytes" in message
+    assert peak < 8 << 20
+    assert not (tmp_path / "work" / "dn2" / "run_0").exists()
+
+
+def test_every_committed_packed_run_has_a_manifest_and_unpacks_verified(tmp_path):
+    runs = [p for group in R.packed_runs(ROOT / "data" / "replication").values() for p in group]
+    assert len(runs) >= 40
+    assert [p for p in runs if not (p / R.MANIFEST).is_file()] == []
+    done = R.unpack_tree(ROOT / "data" / "replication", tmp_path)
+    assert len(done) == len(runs)
+    for p in runs:
+        target = tmp_path / p.parent.name / p.name
+        assert (target / "checkpoint.json").read_bytes() == gzip.decompress((p / "checkpoint.json.gz").read_bytes())
