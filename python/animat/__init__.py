@@ -27,6 +27,7 @@ from ._core import (
     DevelopmentTrace,
     ElementType,
     Embryo,
+    EnergyAccount,
     EvaluationRecord,
     EvaluationResult,
     ExternalActuation,
@@ -106,6 +107,7 @@ __all__ = [
     "Config", "ConfigSection", "Genome", "Rng", "ElementType", "InputChannel", "OutputChannel", "Grn", "affinity",
     "develop", "Embryo", "DevelopmentTrace", "build_body", "Body", "gabriel_graph", "delaunay_edges", "polygon_area",
     "body_length", "Scene", "Simulation", "ExternalActuation", "GrnControl", "swim", "SwimResult", "evaluate", "EvaluationResult",
+    "EnergyAccount",
     "EvaluationRecord", "record_evaluation", "actuation_start_time", "actuation_term", "warm_up_box2d",
     "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
     # evolution

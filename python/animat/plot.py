@@ -13,6 +13,7 @@ function               paper        shows
 :func:`phase_map`      Fig. 7       nodes coloured by phase shift, maximum indicated
 :func:`stiffness_map`  (Fig. 7)     nodes and springs coloured by evolved stiffness (issue 17)
 :func:`fitness_history` Figs. 8–9   best fitness per generation, morphology changes marked
+:func:`energy_split`   (§4)         where the actuation work went: fluid, dampers, collisions...
 =====================  ===========  ==========================================================
 
 :func:`draw_body` draws one body into an existing Axes (used by all of the above and by
@@ -41,8 +42,21 @@ from .trajectory import CONTRACTING, EXPANDING, NEUTRAL, STATE_NAMES, Trajectory
 
 __all__ = [
     "development", "construction", "motion_cycle", "phase_map", "stiffness_map", "fitness_history", "draw_body",
-    "STATE_COLORS", "PHASE_CMAP", "STIFFNESS_CMAP", "rotation_to", "development_steps",
+    "STATE_COLORS", "PHASE_CMAP", "STIFFNESS_CMAP", "rotation_to", "development_steps", "energy_split",
+    "ENERGY_SINKS",
 ]
+
+#: The sinks of :class:`animat.EnergyAccount` that :func:`energy_split` draws, with their labels and colours.
+ENERGY_SINKS = (
+    ("drag_normal", "fluid drag, normal", "#1f77b4"),
+    ("drag_tangential", "fluid drag, tangential", "#9ecae1"),
+    ("spring_damping", "spring damping", "#d62728"),
+    ("collisions", "collisions", "#9467bd"),
+    ("ground", "ground", "#8c564b"),
+    ("other", "other forces", "#7f7f7f"),
+    ("stored_change", "stored (kinetic + potential)", "#2ca02c"),
+    ("residual", "residual (integration)", "#000000"),
+)
 
 #: Node colours of the motion figures (paper Figs. 4–6): red expanding, blue contracting, green neutral.
 STATE_COLORS = {EXPANDING: "#d62728", CONTRACTING: "#1f77b4", NEUTRAL: "#2ca02c"}
@@ -620,4 +634,48 @@ def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MOR
                           f"{f' ({len(shown)} shown, nodes coloured by phase)' if shown else ''}", fontsize=10)
     if not shown:
         fig.tight_layout()
+    return fig
+
+
+def energy_split(accounts: Any, labels: Optional[Sequence[str]] = None, *, ax: Optional[Axes] = None,
+                 title: str = "Where the actuation work goes") -> Figure:
+    """One horizontal bar per swim: the share of the energy that came in (actuation plus pushes)
+    taken by each sink of its :class:`animat.EnergyAccount` (``evaluation.energy_accounting``), in
+    the order of :data:`ENERGY_SINKS`; the fluid's share is printed at the end of each bar.
+
+    ``accounts``: one EnergyAccount, an EvaluationResult or SwimResult (its ``.energy``), or a
+    sequence of them; ``labels``: one per bar (default ``swim 1``, ``swim 2``...). Raises
+    ``ValueError`` for an account that was not measured or that took in no energy.
+    """
+    items = list(accounts) if isinstance(accounts, (list, tuple)) else [accounts]
+    books = [getattr(a, "energy", a) for a in items]
+    for k, b in enumerate(books):
+        if not getattr(b, "measured", False):
+            raise ValueError(f"energy_split: swim {k + 1} has no energy books (set evaluation.energy_accounting = true)")
+        if not b.actuation + b.external > 0.0:
+            raise ValueError(f"energy_split: swim {k + 1} took in no energy (actuation {b.actuation}, pushes {b.external})")
+    names = list(labels) if labels is not None else [f"swim {k + 1}" for k in range(len(books))]
+    if len(names) != len(books):
+        raise ValueError(f"energy_split: {len(names)} labels for {len(books)} swims")
+    if ax is None:
+        fig = plt.figure(figsize=(8.0, 1.2 + 0.45 * len(books)))
+        ax = fig.add_subplot(1, 1, 1)
+    else:
+        fig = ax.figure
+    y = np.arange(len(books))[::-1]
+    left = np.zeros(len(books))
+    for key, label, color in ENERGY_SINKS:
+        share = np.array([getattr(b, key) / (b.actuation + b.external) for b in books])
+        ax.barh(y, share, left=left, color=color, label=label, height=0.7)
+        left += share
+    for yy, b in zip(y, books):
+        ax.text(1.01, yy, f"fluid {100.0 * b.fluid / (b.actuation + b.external):.0f} %", va="center", fontsize=8,
+                transform=ax.get_yaxis_transform())
+    ax.set_yticks(y, names)
+    ax.set_xlim(min(0.0, float(left.min()) - 0.02), max(1.0, float(left.max())) + 0.02)
+    ax.set_xlabel("share of the energy that came in (actuation + pushes)")
+    ax.set_title(title)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.35 if len(books) < 4 else -0.12), ncol=4, fontsize=7,
+              frameon=False)
+    fig.tight_layout()
     return fig
