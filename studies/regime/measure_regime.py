@@ -7,6 +7,7 @@ oscillators sit to their bounds. The criteria are defined in docs/regime.md.
         --data data/replication --out studies/regime/results/replication_today.csv
 
 writes one row per best and prints the per-environment medians that docs/regime.md quotes.
+``--set scene.spring_damping=1`` re-swims the same bodies with a constant changed.
 """
 from __future__ import annotations
 
@@ -98,7 +99,16 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data", type=Path, default=Path("data/replication"))
     ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="re-swim every best with this config value changed (e.g. scene.spring_damping=1): how "
+                         "the constants move the split for the same bodies")
     args = ap.parse_args(argv)
+    overrides = []
+    for item in args.set:
+        key, sep, value = item.partition("=")
+        if not sep:
+            ap.error(f"--set {item!r}: expected KEY=VALUE")
+        overrides.append((key, float(value)))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for env, runs in sorted(packed_runs(args.data).items()):
@@ -106,8 +116,11 @@ def main(argv=None) -> int:
                 work = Path(tmp) / env / packed.name
                 unpack_run(packed, work)
                 run = animat.Run(work)
+                config = run.config
+                for key, value in overrides:
+                    config[key] = value
                 row = {"environment": env, "run": packed.name}
-                row.update(measure(run.best().genome, run.config))
+                row.update(measure(run.best().genome, config))
                 rows.append(row)
                 print(f"{env} {packed.name}: fluid {row['fluid_share']:.3f} damping {row['damping_share']:.3f} "
                       f"f {row['frequency_median']:.2f} lowest mode {row['mode_lowest']:.2f}", file=sys.stderr)
