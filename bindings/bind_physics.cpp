@@ -265,6 +265,7 @@ void bind_physics(nb::module_& m) {
           if (d.contains(name)) field = nb::cast<std::decay_t<decltype(field)>>(d[name]);
         });
       })
+      .def("__eq__", [](const EnergyAccount& a, const EnergyAccount& b) { return a == b; })
       .def("__repr__", [](const EnergyAccount& a) {
         if (!a.measured) return std::string("EnergyAccount(measured=False)");
         return fmt::format("EnergyAccount(actuation={:.6g}, fluid={:.6g} (normal {:.6g}, tangential {:.6g}), "

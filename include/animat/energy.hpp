@@ -39,6 +39,8 @@ struct EnergyAccount {
   double gravity_start = 0.0, gravity_end = 0.0;      ///< gravity: Σ m·g·y
   double other_potential_start = 0.0, other_potential_end = 0.0;  ///< custom effects with a potential
 
+  bool operator==(const EnergyAccount&) const = default;
+
   [[nodiscard]] double fluid() const { return drag_normal + drag_tangential; }
   [[nodiscard]] double dissipated() const {
     return drag_normal + drag_tangential + spring_damping + collisions + ground + other;

@@ -661,7 +661,8 @@ def energy_split(accounts: Any, labels: Optional[Sequence[str]] = None, *, ax: O
         fig = plt.figure(figsize=(8.0, 1.2 + 0.45 * len(books)))
         ax = fig.add_subplot(1, 1, 1)
     else:
-        fig = ax.figure
+        fig = ax.get_figure(root=True) if matplotlib.__version_info__ >= (3, 10) else ax.figure  # type: ignore[call-arg]
+        assert isinstance(fig, Figure)
     y = np.arange(len(books))[::-1]
     left = np.zeros(len(books))
     for key, label, color in ENERGY_SINKS:
