@@ -425,7 +425,8 @@ def describe(positions: Any, outline: Optional[Sequence[int]], springs: Any = No
         links += [(i, j) for i in protruding for j in protruding if i < j and d[i, j] < 1.5 * s]
     found = []
     for g in _groups(protruding, links):
-        found.append(Protrusion(tuple(g), float(max(heights[g])), tuple(map(float, p[g].mean(axis=0)))))
+        cx, cy = p[g].mean(axis=0)
+        found.append(Protrusion(tuple(g), float(max(heights[g])), (float(cx), float(cy))))
     found.sort(key=lambda pr: (-pr.size, -pr.height, pr.cells))
     _, axes = _moments(p, (params.cell_diameter * s) ** 2 / 16.0)
     pairs = _symmetric_pairs(p, found, params, s, axes)

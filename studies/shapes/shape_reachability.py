@@ -172,6 +172,55 @@ def r4(x: Any) -> Any:
     return x
 
 
+def report(out: Path) -> str:
+    """Markdown tables of every summary_*.json under `out` (the README's results)."""
+    head = ("| config | population | n | elongation median / p90 / max | concavity median / p90 / max | "
+            "protrusions median / max | largest protrusion max | ≥1 protrusion | multi-cell protrusion | "
+            "symmetric pair | elongation ≥ 2 |\n|" + "---|" * 11)
+    lines = [head]
+    for path in sorted(out.glob("summary_*.json")):
+        s = json.loads(path.read_text())
+        label = path.stem[len("summary_"):]
+        groups = [("random viable", s["random"])] if "random" in s else []
+        for objective, res in s.get("selection", {}).items():
+            if isinstance(res, dict) and "bests" in res:
+                groups.append((f"bests, select {objective}", res["bests"]))
+                groups.append((f"final pops, select {objective}", res["final_populations"]))
+        for name, d in groups:
+            e, c, p = d["elongation"], d["concavity"], d["protrusions"]
+            lines.append(f"| {label} | {name} | {d['n']} | {e['median']:.2f} / {e['p90']:.2f} / {e['max']:.2f} | "
+                         f"{c['median']:.2f} / {c['p90']:.2f} / {c['max']:.2f} | {p['median']:g} / {p['max']:g} | "
+                         f"{d['largest_protrusion']['max']:g} | {d['fraction_with_protrusion']:.2f} | "
+                         f"{d['fraction_with_multicell_protrusion']:.2f} | {d['fraction_with_symmetric_pair']:.2f} | "
+                         f"{d['fraction_elongation_ge_2']:.2f} |")
+    return "\n".join(lines)
+
+
+def replication_bests(out: Path) -> List[Dict[str, Any]]:
+    """Descriptors of the last best genome of every run in data/replication (results/replication_bests.csv)."""
+    import tarfile
+
+    rows = []
+    for run in sorted((ROOT / "data/replication").glob("*/run_*")):
+        config = animat.load_config(run / "config.toml")
+        with tarfile.open(run / "best.tar.gz") as tar:
+            last = sorted(m.name for m in tar.getmembers() if m.name.endswith(".json"))[-1]
+            member = tar.extractfile(last)
+            assert member is not None
+            genome = animat.Genome.from_json(json.dumps(json.loads(member.read())["genome"]))
+        sh = S.genome_shape(genome, config)
+        assert sh is not None
+        row = {"environment": run.parent.name, "run": run.name, "best": Path(last).stem}
+        row.update(sh.as_dict())
+        row["protrusion_sizes"] = " ".join(str(p.size) for p in sh.protrusions)
+        rows.append(row)
+    with open(out / "replication_bests.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(r4(rows))
+    return rows
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--config", default="configs/paper_dn0.5.toml")
@@ -184,7 +233,22 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--population", type=int, default=50)
     ap.add_argument("--generations", type=int, default=100)
     ap.add_argument("--out", default=str(ROOT / "studies/shapes/results"))
+    ap.add_argument("--report", action="store_true", help="print the tables of every summary under --out and stop")
+    ap.add_argument("--replication", action="store_true",
+                    help="describe the bests of data/replication into results/replication_bests.csv and stop")
     args = ap.parse_args(argv)
+    if args.replication:
+        rows = replication_bests(Path(args.out))
+        for env in sorted({r["environment"] for r in rows}):
+            sel = [r for r in rows if r["environment"] == env]
+            print(f"{env}: {len(sel)} bests, elongation max {max(r['elongation'] for r in sel):.2f}, "
+                  f"with >= 1 protrusion {sum(r['protrusions'] >= 1 for r in sel)}, "
+                  f"with a symmetric pair {sum(r['symmetric_pairs'] >= 1 for r in sel)}, "
+                  f"largest protrusion {max(r['largest_protrusion'] for r in sel)}")
+        return 0
+    if args.report:
+        print(report(Path(args.out)))
+        return 0
 
     config = load(args.config, args.set)
     out = Path(args.out)
