@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Calibration screen (docs/regime.md): evolves short runs at every point of a factorial over the
+# constants the paper leaves open, at d_N = 0.5 and d_N = 10, and keeps each run's compact results
+# (config, history, final best) in studies/regime/screen/. Idempotent: a run already kept is skipped,
+# one left unfinished in runs/screen/ is resumed.
+#
+#   studies/regime/screen.sh            # every point, one run at a time
+#   SCREEN_JOBS=2 studies/regime/screen.sh
+#
+# Grid (environment variables, space-separated): SCREEN_ENVS, SCREEN_DAMPING, SCREEN_STIFFNESS,
+# SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+EXE=${ANIMAT_EVOLVE_EXE:-build/animat_evolve}
+ENVS=${SCREEN_ENVS:-"dn0.5 dn10"}
+DAMPING=${SCREEN_DAMPING:-"4 1 0.25"}
+STIFFNESS=${SCREEN_STIFFNESS:-"100 30"}
+SEEDS=${SCREEN_SEEDS:-"1 2"}
+POP=${SCREEN_POPULATION:-60}
+GENS=${SCREEN_GENERATIONS:-100}
+JOBS=${SCREEN_JOBS:-1}
+KEEP=studies/regime/screen
+WORK=runs/screen
+mkdir -p "$KEEP" "$WORK"
+
+one() {  # env damping stiffness seed
+  set -euo pipefail
+  local env=$1 c=$2 k=$3 seed=$4
+  local name="${env}_c${c}_k${k}_seed${seed}"
+  local keep="$KEEP/$name" work="$WORK/$name"
+  [[ -f "$keep/best_genome.json" ]] && return 0
+  local args=(--config "configs/paper_${env}.toml" --set "evolution.population=$POP"
+              --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" --generations "$GENS"
+              --threads 1 --seed "$seed" --quiet)
+  if [[ -f "$work/checkpoint.json" ]]; then
+    "$EXE" --resume "$work" --generations "$GENS" --threads 1 --quiet >/dev/null
+  else
+    rm -rf "$work"
+    "$EXE" "${args[@]}" --out "$work" >/dev/null
+  fi
+  local last
+  last=$(tail -1 "$work/history.csv" | cut -d, -f1)
+  if [[ "$last" != "$GENS" && ! -f "$work/stopped.txt" ]]; then
+    echo "screen: $name stopped at generation $last, not kept" >&2
+    return 1
+  fi
+  mkdir -p "$keep.tmp"
+  cp "$work/config.toml" "$work/history.csv" "$keep.tmp/"
+  cp "$(ls "$work"/best/gen_*.json | sort | tail -1)" "$keep.tmp/best_genome.json"
+  rm -rf "$keep" && mv "$keep.tmp" "$keep"
+  echo "screen: $name done"
+}
+export -f one
+export EXE POP GENS KEEP WORK
+points=()
+for env in $ENVS; do for c in $DAMPING; do for k in $STIFFNESS; do for s in $SEEDS; do
+  points+=("$env $c $k $s")
+done; done; done; done
+printf '%s\n' "${points[@]}" | xargs -P "$JOBS" -L 1 bash -c 'one "$@"' _

@@ -1,0 +1,92 @@
+"""Summarises the calibration screen kept in studies/regime/screen/ (one folder per run: config.toml,
+history.csv, best_genome.json, written by studies/regime/screen.sh): for every run's final best its
+fitness and the exploit guard's reference at dt/16, the energy split (docs/regime.md), the
+oscillators against their bounds, the body's shape (animat.shape) and its locomotion mode; then the
+medians per grid point. Writes studies/regime/results/screen.csv and studies/regime/screen.md:
+
+    PYTHONPATH=build/python .venv/bin/python studies/regime/summarize_screen.py
+"""
+from __future__ import annotations
+
+import csv
+import json
+import statistics
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import animat
+from animat import shape
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from measure_regime import measure  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+SCREEN = ROOT / "studies" / "regime" / "screen"
+OUT_CSV = ROOT / "studies" / "regime" / "results" / "screen.csv"
+OUT_MD = ROOT / "studies" / "regime" / "screen.md"
+
+
+def point_of(name: str):
+    env, c, k, seed = name.split("_")
+    return env, float(c[1:]), float(k[1:]), int(seed[4:])
+
+
+def summarise_run(folder: Path) -> dict:
+    config = animat.load_config(str(folder / "config.toml"))
+    entry = json.loads((folder / "best_genome.json").read_text())
+    genome = animat.Genome.from_json(json.dumps(entry["genome"]))
+    with open(folder / "history.csv") as fh:
+        last = list(csv.DictReader(fh))[-1]
+    env, c, k, seed = point_of(folder.name)
+    row = {"environment": env, "spring_damping": c, "spring_stiffness": k, "seed": seed,
+           "generations": int(last["generation"]), "best_reference": float(last["best_reference"])}
+    row.update(measure(genome, config))
+    row["reference_error"] = (row["fitness"] - row["best_reference"]) / row["best_reference"]
+    s = shape.genome_shape(genome, config)
+    row.update({"elongation": s.elongation, "concavity": s.concavity, "protrusions": s.protrusion_count,
+                "symmetric_pair": int(s.symmetric_pair)})
+    row["mode"] = animat.classify_locomotion(genome, config).label
+    return row
+
+
+def main() -> int:
+    rows = [summarise_run(f) for f in sorted(SCREEN.iterdir()) if (f / "best_genome.json").is_file()]
+    if not rows:
+        print(f"no kept runs in {SCREEN}", file=sys.stderr)
+        return 1
+    OUT_CSV.parent.mkdir(parents=True, exist_ok=True)
+    keys = list(rows[0].keys())
+    with open(OUT_CSV, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys, lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    lines = ["# Calibration screen: results", "",
+             "Rebuilt by `PYTHONPATH=build/python .venv/bin/python studies/regime/summarize_screen.py` from the",
+             "runs kept in `studies/regime/screen/` (grown by `studies/regime/screen.sh`); per run:",
+             "`studies/regime/results/screen.csv`. Medians over the seeds of each point; the criteria are those",
+             "of `docs/regime.md`.", "",
+             "| environment | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
+             "at frequency bound | median frequency | elongation | protrusions | symmetric pair | modes |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    points = sorted({(r["environment"], r["spring_damping"], r["spring_stiffness"]) for r in rows},
+                    key=lambda p: (p[0], -p[1], -p[2]))
+    for env, c, k in points:
+        sel = [r for r in rows if (r["environment"], r["spring_damping"], r["spring_stiffness"]) == (env, c, k)]
+        med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731
+        modes = ", ".join(f"{m} {sum(r['mode'] == m for r in sel)}" for m in sorted({r["mode"] for r in sel}))
+        lines.append(
+            f"| {env} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
+            f"{max(abs(r['reference_error']) for r in sel):.2%} | {med('fluid_share'):.2f} | "
+            f"{sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | {med('frequency_median'):.2f} | "
+            f"{med('elongation'):.2f} | {med('protrusions'):.0f} | {sum(r['symmetric_pair'] for r in sel)} of {len(sel)} | "
+            f"{modes} |")
+    OUT_MD.write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
