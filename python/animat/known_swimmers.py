@@ -18,12 +18,19 @@ amplitude, frequency and phase of eq. 2 of the paper, ``L = (1 + a_i sin(f_i t +
   only the appendages and the core cells they are anchored to oscillate strongly.
 - :func:`tail_swimmer`: a round core with one two-cell-wide tail at the back that beats with a
   bending wave; the core is passive.
+- :func:`appendage_swimmer`: the paper's kind of protrusion swimmer: an elliptic body with a
+  symmetric pair of flank appendages (one cell beyond the outline, a chain, or a block), **every cell
+  actuated** at 0.18–0.2, the core mostly synchronous; the appendages are extended on the backward
+  stroke and contracted on the return where their phase and the core cells just behind them (shifted
+  by ``anchor_shift``) make them row (:mod:`animat.protrusion` measures whether they do).
+- :func:`standing_swimmer`: an ellipse whose halves are in antiphase, or with random phases ("other").
 - mixtures: ``protrusion_swimmer(core_wave=...)`` (appendages on a core carrying a wave) and
   ``synchronous_contractor(lag=...)`` (in phase but for a short lag along the body).
 
 :func:`calibration_set` and :func:`held_out_set` give the two sets of the calibration table (the held-
 out one uses other shapes, sizes, appendage lengths and frequencies; it was not used to choose any
-threshold), :func:`classify_known` swims and classifies them.
+threshold), :func:`classify_known` swims and classifies them. :func:`paper_calibration_set` and
+:func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind.
 """
 from __future__ import annotations
 

@@ -42,6 +42,13 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
    - ``deformation < NONE_DEFORMATION`` (0.01): **none**: the body does not deform periodically
      (a rigid or resting body). Swimming bodies deform by 0.1–0.4 (amplitude up to 0.2 per cell,
      two cells per spring); a rigid body gives < 1e-9.
+   - the paper's stroke (only when the body's outline is known, as :func:`classify_locomotion` passes
+     it): a symmetric pair of protrusions (:mod:`animat.shape`, at rest or during the last cycle) that
+     rows, extended while moving backwards and contracted on the return
+     (:func:`animat.protrusion.stroke_motion`: pair score ``>= STROKE_SCORE`` 0.4 and loop area
+     ``>= STROKE_AREA`` 0.1 spacings²): **protrusions** (mixed with undulation when the wave
+     criterion also holds). Calibrated on :func:`animat.known_swimmers.paper_calibration_set`, whose
+     protrusion swimmers actuate every cell (docs/locomotion.md).
    - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65), or a strain contrast (RMS contraction
      amplitude of the most strained 20 % of the cells over the median cell's) ``>= LOCAL_CONTRAST``
      (3.5, issue 19): **protrusions** when those cells (the most strained fifth if the contrast
