@@ -18,12 +18,19 @@ amplitude, frequency and phase of eq. 2 of the paper, ``L = (1 + a_i sin(f_i t +
   only the appendages and the core cells they are anchored to oscillate strongly.
 - :func:`tail_swimmer`: a round core with one two-cell-wide tail at the back that beats with a
   bending wave; the core is passive.
+- :func:`appendage_swimmer`: the paper's kind of protrusion swimmer: an elliptic body with a
+  symmetric pair of flank appendages (one cell beyond the outline, a chain, or a block), **every cell
+  actuated** at 0.18–0.2, the core mostly synchronous; the appendages are extended on the backward
+  stroke and contracted on the return where their phase and the core cells just behind them (shifted
+  by ``anchor_shift``) make them row (:mod:`animat.protrusion` measures whether they do).
+- :func:`standing_swimmer`: an ellipse whose halves are in antiphase, or with random phases ("other").
 - mixtures: ``protrusion_swimmer(core_wave=...)`` (appendages on a core carrying a wave) and
   ``synchronous_contractor(lag=...)`` (in phase but for a short lag along the body).
 
 :func:`calibration_set` and :func:`held_out_set` give the two sets of the calibration table (the held-
 out one uses other shapes, sizes, appendage lengths and frequencies; it was not used to choose any
-threshold), :func:`classify_known` swims and classifies them.
+threshold), :func:`classify_known` swims and classifies them. :func:`paper_calibration_set` and
+:func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind.
 """
 from __future__ import annotations
 
@@ -37,7 +44,8 @@ from . import _core
 
 __all__ = ["KnownSwimmer", "hex_region", "undulator", "synchronous_contractor", "protrusion_swimmer",
            "tail_swimmer", "calibration_set", "held_out_set", "KnownResult", "classify_known",
-           "confusion_matrix", "Stroke", "appendage_stroke", "AMPLITUDE"]
+           "confusion_matrix", "Stroke", "appendage_stroke", "AMPLITUDE", "APPENDAGE_KINDS", "appendage_swimmer",
+           "standing_swimmer", "paper_calibration_set", "paper_held_out_set"]
 
 #: The paper's largest amplitude (development.amplitude_max): a cell changes its springs by ±20 %.
 AMPLITUDE = 0.2
@@ -366,3 +374,151 @@ def confusion_matrix(results: Sequence[KnownResult], expected: Sequence[str], fo
     for r in results:
         m[expected.index(r.swimmer.expected), found.index(r.found)] += 1
     return m
+
+
+# --- swimmers of the paper's protrusion kind (every cell actuated) -------------------------------------
+
+#: Appendage kinds of :func:`appendage_swimmer`: (rows out of the body, cells per row).
+APPENDAGE_KINDS = {"single": (1, 1), "chain2": (2, 1), "chain3": (3, 1), "block2x2": (2, 2), "block3x2": (3, 2)}
+
+
+def _lattice(i: int, j: int, spacing: float) -> Tuple[float, float]:
+    return ((i + 0.5 * (j % 2)) * spacing, j * spacing * math.sqrt(3) / 2)
+
+
+def appendage_swimmer(kind: str = "single", core_length: float = 9.0, core_width: float = 4.6,
+                      at: Sequence[float] = (1.5,), frequency: float = 8.0, appendage_phase: float = math.pi,
+                      core_jitter: float = 0.3, back_shift: float = 0.0, anchor_shift: float = 0.0,
+                      appendage_bend: float = 0.0, spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+    """An elliptic body (long axis x) with symmetric pairs of appendages on its flanks (±y), every cell
+    actuated as the paper describes its protrusion swimmers (§6, Fig. 6, 7b).
+
+    Every cell oscillates at near-maximal amplitude (``AMPLITUDE`` × uniform 0.9–1.0). The core cells are
+    mostly synchronous (phase 0 ± ``core_jitter``/2, uniform; ``back_shift`` adds a phase shift to the
+    hindmost line of cells, −x, as in the paper's Fig. 7b); the appendage cells have ``appendage_phase``
+    (± the same jitter), chosen so that they are extended on the backward stroke and contracted on the
+    return (measured by :func:`animat.protrusion.protrusion_stroke`).
+
+    Args:
+        kind: a key of :data:`APPENDAGE_KINDS`: "single" (one cell beyond the outline, the paper's 32-cell
+            bests), "chain2"/"chain3" (a chain of cells), "block2x2"/"block3x2" (rows out × cells per row).
+        core_length, core_width: the ellipse's axes (spacings).
+        at: x positions (along the body) of the appendage pairs; one pair per entry.
+    """
+    if kind not in APPENDAGE_KINDS:
+        raise ValueError(f"appendage_swimmer: kind must be one of {sorted(APPENDAGE_KINDS)}, got {kind!r}")
+    rows, width = APPENDAGE_KINDS[kind]
+    a, b = core_length / 2, core_width / 2
+    ext = int(core_length / spacing) + 4
+    core_sites = {(i, j) for j in range(-ext, ext + 1) for i in range(-ext, ext + 1)
+                  if (_lattice(i, j, spacing)[0] / a) ** 2 + (_lattice(i, j, spacing)[1] / b) ** 2 <= 1.0}
+    app_sites: List[Tuple[int, int]] = []
+    for xa in at:
+        for s in (+1, -1):
+            near = [(i, j) for (i, j) in core_sites if abs(_lattice(i, j, spacing)[0] - xa) <= 1.0 * spacing]
+            j_top = max(s * j for (_, j) in near) * s
+            for k in range(1, rows + 1):
+                j = j_top + s * k
+                cand = sorted(range(-ext, ext + 1), key=lambda i: (abs(_lattice(i, j, spacing)[0] - xa), i))
+                app_sites += [(i, j) for i in cand[:width]]
+    sites = sorted(core_sites) + [st for st in dict.fromkeys(app_sites) if st not in core_sites]
+    pos = np.array([_lattice(i, j, spacing) for i, j in sites], dtype=np.float64)
+    rng = np.random.default_rng(seed)
+    pos += rng.uniform(-0.02, 0.02, pos.shape) * spacing
+    n_core = len(core_sites)
+    # amplitude and phase jitter drawn per mirror pair of sites ((i, j) and (i, -j)): the actuation is
+    # symmetric about the long axis, as the body is
+    mirror = {st: k for k, st in enumerate(sorted({(i, abs(j)) for i, j in sites}))}
+    draw_amp = AMPLITUDE * rng.uniform(0.9, 1.0, len(mirror))
+    draw_phase = rng.uniform(-core_jitter / 2, core_jitter / 2, len(mirror))
+    key = np.array([mirror[(i, abs(j))] for i, j in sites])
+    amp, phase = draw_amp[key], draw_phase[key].copy()
+    if back_shift:
+        x = pos[:n_core, 0]
+        phase[:n_core][x <= x.min() + 0.6 * spacing] += back_shift
+    phase[n_core:] += appendage_phase
+    if appendage_bend:  # the hind cells of each appendage row (-x of the row's middle): they bend it back
+        rows_of = {}
+        for k, (i, j) in enumerate(sites[n_core:]):
+            rows_of.setdefault(j, []).append(n_core + k)
+        for members in rows_of.values():
+            mid = np.mean(pos[members, 0])
+            for k in members:
+                if pos[k, 0] < mid - 0.2 * spacing:
+                    phase[k] += appendage_bend
+    if anchor_shift:  # core cells touching an appendage's first row from behind (-x): they pull it back
+        app = pos[n_core:]
+        for k in range(n_core):
+            d = np.linalg.norm(app - pos[k], axis=1)
+            near = np.argmin(d)
+            if d[near] <= 1.2 * spacing and pos[k, 0] < app[near, 0] - 0.2 * spacing:
+                phase[k] += anchor_shift
+    label = name or f"appendages_{kind}_x{len(at)}"
+    return _swimmer(label, "protrusions", pos, amp, frequency, phase,
+                    f"{len(pos)} cells: elliptic core {core_length:g} x {core_width:g} ({n_core} cells, phase 0 "
+                    f"± {core_jitter / 2:g}" + (f", back line +{back_shift:.2f}" if back_shift else "")
+                    + f"), {len(at)} pair(s) of {kind} appendages at x = {', '.join(f'{v:g}' for v in at)} "
+                    f"(phase {appendage_phase:.2f}), every cell at amplitude 0.18-0.2, f = {frequency:g}")
+
+
+def standing_swimmer(kind: str = "halves", length: float = 8.0, width: float = 4.0, frequency: float = 8.0,
+                     spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+    """An elliptic body, every cell at full amplitude, with a phase pattern that is neither a travelling
+    wave nor synchronous: ``kind="halves"`` (front and back halves in antiphase, a standing pattern) or
+    ``kind="random"`` (independent uniform phases). Expected "other"."""
+    pos = hex_region(lambda x, y: (x / (length / 2)) ** 2 + (y / (width / 2)) ** 2 <= 1.0, spacing, seed=seed)
+    if kind == "halves":
+        phase = np.where(pos[:, 0] >= 0, 0.0, math.pi)
+    elif kind == "random":
+        phase = np.random.default_rng(seed + 100).uniform(0, 2 * math.pi, len(pos))
+    else:
+        raise ValueError(f"standing_swimmer: kind must be halves or random, got {kind!r}")
+    return _swimmer(name or f"standing_{kind}", "other", pos, np.full(len(pos), AMPLITUDE), frequency, phase,
+                    f"{len(pos)} cells, ellipse {length:g} x {width:g}, phases: {kind}, f = {frequency:g}")
+
+
+def paper_calibration_set() -> List[KnownSwimmer]:
+    """Swimmers of every class, the protrusion ones of the paper's kind (:func:`appendage_swimmer`, every
+    cell actuated); the stroke thresholds of :mod:`animat.protrusion` were set on this set only."""
+    pi = math.pi
+    return [
+        appendage_swimmer("single", at=(-1.5,), appendage_phase=pi / 4, anchor_shift=pi, name="paper_single"),
+        appendage_swimmer("single", at=(-1.5,), appendage_phase=0.0, anchor_shift=pi, name="paper_single_ph0"),
+        appendage_swimmer("chain2", at=(-1.5,), appendage_phase=pi / 4, anchor_shift=pi, name="paper_chain2"),
+        appendage_swimmer("chain2", at=(-1.5,), appendage_phase=pi / 2, anchor_shift=pi, name="paper_chain2_ph2"),
+        undulator("contraction"),
+        undulator("bending"),
+        undulator("across", length=6.0, width=5.0, name="undulator_across"),
+        synchronous_contractor(),
+        synchronous_contractor(lag=1.0),
+        tail_swimmer(),
+        standing_swimmer("halves"),
+        standing_swimmer("random"),
+    ]
+
+
+def paper_held_out_set() -> List[KnownSwimmer]:
+    """Other core sizes, appendage lengths, positions, phases and frequencies; not used to set anything."""
+    pi = math.pi
+    return [
+        appendage_swimmer("single", core_length=8.0, core_width=4.0, at=(-1.0,), frequency=6.0,
+                          appendage_phase=pi / 2, anchor_shift=pi, seed=21, name="ho_paper_single_small"),
+        appendage_swimmer("single", core_length=10.0, core_width=5.0, at=(-2.0,), frequency=10.0,
+                          appendage_phase=pi / 4, anchor_shift=pi, seed=22, name="ho_paper_single_fast"),
+        appendage_swimmer("chain2", core_length=10.0, core_width=5.0, at=(-1.5,), frequency=6.0,
+                          appendage_phase=3 * pi / 8, anchor_shift=pi, seed=23, name="ho_paper_chain2_big"),
+        appendage_swimmer("chain3", at=(-1.5,), frequency=8.0, appendage_phase=pi / 4, anchor_shift=pi, seed=24,
+                          name="ho_paper_chain3"),
+        appendage_swimmer("single", at=(-1.5,), frequency=8.0, appendage_phase=pi / 4, anchor_shift=pi,
+                          back_shift=pi / 2, seed=25, name="ho_paper_single_backline"),
+        undulator("contraction", length=12.0, width=1.8, frequency=5.0, wavelengths=1.5, seed=3, name="ho_undulator_long"),
+        undulator("bending", length=7.0, width=2.6, frequency=11.0, wavelengths=0.75, seed=4, name="ho_undulator_bend_fast"),
+        undulator("contraction", length=8.0, width=3.5, frequency=3.0, wavelengths=0.5, seed=5, name="ho_undulator_slow"),
+        synchronous_contractor(length=10.0, width=4.0, frequency=5.0, seed=6, name="ho_sync_slender"),
+        synchronous_contractor(length=6.0, width=5.5, frequency=11.0, seed=7, name="ho_sync_stubby_fast"),
+        synchronous_contractor(length=7.0, width=4.5, frequency=3.0, lag=0.6, seed=8, name="ho_sync_lag_slow"),
+        tail_swimmer(length=6, core_radius=2.0, frequency=6.0, wavelengths=0.75, seed=13, name="ho_tail6"),
+        tail_swimmer(length=3, core_radius=2.8, frequency=10.0, wavelengths=0.25, seed=14, name="ho_tail3_fast"),
+        standing_swimmer("halves", length=10.0, width=3.5, frequency=5.0, seed=26, name="ho_standing_halves"),
+        standing_swimmer("random", length=7.0, width=5.0, frequency=11.0, seed=27, name="ho_standing_random"),
+    ]

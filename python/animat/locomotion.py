@@ -42,6 +42,13 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
    - ``deformation < NONE_DEFORMATION`` (0.01): **none**: the body does not deform periodically
      (a rigid or resting body). Swimming bodies deform by 0.1–0.4 (amplitude up to 0.2 per cell,
      two cells per spring); a rigid body gives < 1e-9.
+   - the paper's stroke (only when the body's outline is known, as :func:`classify_locomotion` passes
+     it): a symmetric pair of protrusions (:mod:`animat.shape`, at rest or during the last cycle) that
+     rows, extended while moving backwards and contracted on the return
+     (:func:`animat.protrusion.stroke_motion`: pair score ``>= STROKE_SCORE`` 0.4 and loop area
+     ``>= STROKE_AREA`` 0.1 spacings²): **protrusions** (mixed with undulation when the wave
+     criterion also holds). Calibrated on :func:`animat.known_swimmers.paper_calibration_set`, whose
+     protrusion swimmers actuate every cell (docs/locomotion.md).
    - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65), or a strain contrast (RMS contraction
      amplitude of the most strained 20 % of the cells over the median cell's) ``>= LOCAL_CONTRAST``
      (3.5, issue 19): **protrusions** when those cells (the most strained fifth if the contrast
@@ -373,6 +380,7 @@ class LocomotionMode:
     amplitudes: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
     contrast: float = float("nan")
     groups: int = 0
+    stroke: Any = None  #: :class:`animat.protrusion.ProtrusionStroke` (None without an outline)
 
     @property
     def label(self) -> str:
@@ -471,7 +479,8 @@ def _no_wave(w: WaveFit) -> str:
 
 
 def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional[ArrayLike] = None,
-                    omega: Optional[float] = None, cycles: float = 4) -> LocomotionMode:
+                    omega: Optional[float] = None, cycles: float = 4, outline: Optional[Sequence[int]] = None,
+                    rest_positions: Optional[ArrayLike] = None) -> LocomotionMode:
     """Classify the locomotion of recorded node positions (the array core of :func:`classify_locomotion`).
 
     Args:
@@ -482,6 +491,9 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
         omega: angular frequency to analyse (default: the peak of the body-frame deformation spectrum).
         cycles: analyse the last ``cycles`` whole periods, at most the second half of the record
             (at least one period when the record is long enough, else all of it).
+        outline: the outer skin loop (``Body.skin_loops[0]``); with it the paper's protrusion stroke
+            (:func:`animat.protrusion.stroke_motion`) is measured and decides "protrusions" first.
+        rest_positions: (n, 2) the body at rest, where protrusions are also looked for (with ``outline``).
     Returns:
         A :class:`LocomotionMode`.
     """
@@ -566,10 +578,24 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
                 else (float("inf") if ca.max(initial=0.0) > 0 else 0.0))
     local = contrast >= LOCAL_CONTRAST
     prot = concentration >= PROTRUSION_CONCENTRATION or local
+    stroke = None
+    if outline is not None and len(outline) >= 3:
+        from .protrusion import STROKE_AREA, STROKE_SCORE, stroke_motion  # noqa: PLC0415
+
+        stroke = stroke_motion(Q, tw, omega, motion, outline, sp, rest_positions)
 
     mixed: List[str] = []
     groups = 0
-    if prot:
+    if stroke is not None and stroke.strokes:
+        mode = "protrusions"
+        groups = len(stroke.protrusions)
+        a, b = stroke.pair
+        reason = (f"a symmetric pair of protrusions ({len(stroke.protrusions[a])} and {len(stroke.protrusions[b])} "
+                  f"cells) rows: extended while moving backwards, pair score {stroke.score:.2f} >= {STROKE_SCORE}, "
+                  f"stroke area {stroke.area:.3f} >= {STROKE_AREA}")
+        if is_wave:
+            mixed.append("undulation")
+    elif prot:
         cells = c_top if local else top
         groups = _groups(cells, sp)
         mode = "protrusions" if groups >= 2 else "tail"
@@ -600,7 +626,7 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
         reason = f"{_no_wave(wave)} and contraction phases incoherent (R = {coherence:.2f} < {SYNC_COHERENCE})"
     return LocomotionMode(mode, tuple(mixed), deformation, coherence, concentration, ti, wave, omega, k,
                           int(sel.sum()), motion, speed, top, reason, np.angle(contraction), np.abs(contraction),
-                          contrast=contrast, groups=groups)
+                          contrast=contrast, groups=groups, stroke=stroke)
 
 
 def classify_locomotion(thing: Any, config: Optional[Any] = None, *, times: Optional[ArrayLike] = None,
@@ -637,7 +663,9 @@ def classify_locomotion(thing: Any, config: Optional[Any] = None, *, times: Opti
         omega = 2 * math.pi / period if math.isfinite(period) else 0.0
     if tr.frame_count < 8:
         raise ValueError(f"classify_locomotion: trajectory too short ({tr.frame_count} frames)")
-    return classify_motion(tr.positions, tr.times, springs=tr.body.springs, omega=omega, cycles=cycles)
+    loops = tr.body.skin_loops
+    return classify_motion(tr.positions, tr.times, springs=tr.body.springs, omega=omega, cycles=cycles,
+                           outline=loops[0] if len(loops) else None, rest_positions=tr.body.positions)
 
 
 # --- the paper's stroke -------------------------------------------------------------------------------------

@@ -1,0 +1,34 @@
+"""Confusion matrices of animat.classify_locomotion on the hand-built swimmers of
+animat.known_swimmers.paper_calibration_set / paper_held_out_set (2000 steps at d_N = 0.5 and 2).
+
+    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/protrusion/confusion.py calibration,held-out
+
+prints one line per swim (distance, expected and found mode, the stroke's pair score and area) and the
+matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
+then none, unstable).
+"""
+import sys
+import warnings
+
+from animat import known_swimmers as K
+
+CLASSES = ["undulation", "synchronous contraction", "protrusions", "tail", "other"]
+SETS = {"calibration": K.paper_calibration_set, "held-out": K.paper_held_out_set}
+
+
+def main(names):
+    warnings.simplefilter("ignore")
+    for name in names:
+        res = K.classify_known(SETS[name](), drags=(0.5, 2.0), steps=2000)
+        for r in res:
+            st = r.mode.stroke if r.mode is not None else None
+            sc = (f"pair score {st.score:+.2f}, area {st.area:.3f}, {len(st.protrusions)} protrusions, "
+                  f"{len(st.pairs)} pairs" if st is not None else "-")
+            print(f"{name} {r.swimmer.name:28s} dN={r.drag_normal:g} distance={r.distance:6.2f} "
+                  f"built={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}")
+        print(name)
+        print(K.confusion_matrix(res, CLASSES, CLASSES + ["none", "unstable"]))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1].split(",") if len(sys.argv) > 1 else list(SETS))
