@@ -96,7 +96,7 @@ def _classify(swimmer, drag):
     c["evaluation.steps"] = 2000
     tr = animat.replay(swimmer.body(c), c)
     assert tr.stable
-    return tr, L.classify_locomotion(tr)
+    return tr, L.classify_locomotion(tr, stroke=True)
 
 
 # The calibration set at d_N = 0.5 (docs/locomotion.md): the paper's protrusion swimmers swim and are
