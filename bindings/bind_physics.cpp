@@ -161,7 +161,7 @@ nb::ndarray<nb::numpy, double> owned_vector(const Eigen::VectorXd& v) {
 }
 
 const char* kSceneDoc =
-    "The effects a swim simulates, with their coefficients (paper §4; MODEL.md §5).\n\n"
+    "The effects a swim simulates, with their coefficients (paper §4; docs/model.md §4).\n\n"
     "``Scene()`` is the default swim scene (all five effects, d_N = 2). Keywords set fields by their\n"
     "config names, e.g. ``Scene(effects=['springs', 'actuation', 'pressure', 'drag'], drag_normal=10)``;\n"
     "an unknown keyword or an out-of-range value raises ValueError naming it. Effect names (same in\n"

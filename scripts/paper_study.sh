@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The paper's whole study (issue 20): 4 environments x 10 runs, resumable, then the replication report.
+# The paper's whole study: 4 environments x 10 runs, resumable, then the replication report.
 #
 #   scripts/paper_study.sh --np 2    [--runs 10] [--out runs/paper] [-- EXTRA...]   # one machine, one MPI job
 #   scripts/paper_study.sh --slurm   [--runs 10] [--out runs/paper] [-- EXTRA...]   # a Slurm array + a report job

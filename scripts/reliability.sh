@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reliability checks of issue 9 (docs/reliability.md), run from the repository root after
+# Reliability checks (docs/reliability.md), run from the repository root after
 # scripts/setup.sh; scripts/test.sh calls it when CI=true or ANIMAT_RELIABILITY=1.
 #
 #   asan   the whole C++ test suite built with AddressSanitizer + UndefinedBehaviorSanitizer (GCC,

@@ -81,7 +81,7 @@ if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then
   echo "replication: the experiment failed (exit $status); see $WORK/experiment.log; packing what ran" >&2
 fi
 "${PY[@]}" -m animat.replication_store pack "$WORK" "$DATA"
-CAUSES=${ANIMAT_REPLICATION_CAUSES:-data/replication_causes}  # issue 19 item 5, packed; its section if present
+CAUSES=${ANIMAT_REPLICATION_CAUSES:-data/replication_causes}  # the controlled runs, packed; their section if present
 CAUSE_ARGS=()
 [[ -d "$CAUSES" ]] && CAUSE_ARGS=(--causes "$CAUSES")
 "${PY[@]}" scripts/replication_report.py --data "$DATA" --doc "$DOC" "${CAUSE_ARGS[@]}"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The runs of docs/worlds.md (issue 17), re-checked from the packed runs in data/worlds alone.
+"""The runs of docs/worlds.md, re-checked from the packed runs in data/worlds alone.
 
     PYTHONPATH=build/python .venv/bin/python scripts/worlds_report.py energy [--data data/worlds/energy]
     PYTHONPATH=build/python .venv/bin/python scripts/worlds_report.py crawl  [--data data/worlds/crawl] \

@@ -228,7 +228,8 @@ struct StopRequest {
   [[nodiscard]] bool empty() const { return flag == nullptr && !poll; }
 };
 
-/// Calls once, before any parallel region: Box2D's lazily-initialised globals (MODEL.md Traps).
+/// Calls once, before any parallel region: Box2D's lazily-initialised globals (docs/model.md §4,
+/// "Evaluation, determinism, threads").
 void prepare_parallel_evaluation();
 
 /// Evaluates genomes in parallel (OpenMP, dynamic schedule); results in input order, independent of

@@ -1,5 +1,5 @@
 // Body: Gabriel graph against its O(n^3) definition, planar-graph invariants of regions and skin,
-// and every documented degenerate case (issue 4, MODEL.md §4).
+// and every documented degenerate case (paper §3, docs/model.md §3).
 #include <gtest/gtest.h>
 
 #include <algorithm>

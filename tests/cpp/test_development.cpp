@@ -1,4 +1,4 @@
-// Development (issue 3, MODEL.md §3): division, physics while growing, morphogens, viability.
+// Development (paper §2.2, docs/model.md §2): division, physics while growing, morphogens, viability.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Genome (include/animat/genome.hpp, MODEL.md §1): affinity, parsing into regulatory units,
+// Genome (include/animat/genome.hpp, docs/model.md §1): affinity, parsing into regulatory units,
 // validation, the random genome, genetic operators, JSON round trips and rejection of bad JSON.
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// GRN (include/animat/grn.hpp, MODEL.md §2, paper eq. 1): edges from affinities, the relaxation
+// GRN (include/animat/grn.hpp, docs/model.md §1, paper eq. 1): edges from affinities, the relaxation
 // ΔL = (tanh(max(A,0)/2) − L)·Δt against its closed form, levels in [0, 1), inputs (bias, maternal,
 // sensed morphogens), reachability (viability criterion 1) and the DOT export.
 #include <gtest/gtest.h>

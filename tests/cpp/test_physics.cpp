@@ -1,4 +1,4 @@
-// Swimming physics (issue 5, MODEL.md §5): analytic checks of every effect, conservation laws,
+// Swimming physics (paper §4, docs/model.md §4): analytic checks of every effect, conservation laws,
 // "off means off", the stable drag scheme, error detection, and the named stability cases.
 // No timing assertions anywhere.
 #include <Eigen/LU>
