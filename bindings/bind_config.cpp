@@ -91,7 +91,10 @@ void bind_config(nb::module_& m) {
       .def("to_dict", &to_dict, "Nested dict {section: {key: value}}.")
       .def("update", &update, "values"_a, "Set several values from a nested or flat dict.")
       .def("apply_override", [](Config& c, const std::string& a) { apply_override(c, a); }, "assignment"_a,
-           "Apply 'section.key=value' exactly as `animat_evolve --set` does (the value is parsed by the key's type).")
+           "Apply 'section.key=value' (the value is parsed by the key's type), then validate the config.")
+      .def("apply_overrides", [](Config& c, const std::vector<std::string>& a) { apply_overrides(c, a); }, "assignments"_a,
+           "Apply several 'section.key=value' exactly as `animat_evolve --set ... --set ...` does: all of them, then\n"
+           "the cross-key checks once, so their order does not matter. All or nothing.")
       .def("keys", [](const Config&) { return config_keys(); }, "Every 'section.key', in TOML order.")
       .def("__getitem__", &get_value, "key"_a, nb::sig("def __getitem__(self, key: str) -> typing.Any"),
            "The value of 'section.key' (bool, int, float, str or a list).")

@@ -176,11 +176,13 @@ void bind_evolution(nb::module_& m) {
       });
 
   m.def("evolve", [](std::optional<Config> config, std::optional<std::filesystem::path> out, bool resume,
-                     std::optional<nb::callable> callback, bool quiet, nb::object stop, nb::handle objective) {
+                     std::optional<nb::callable> callback, bool quiet, nb::object stop, nb::handle objective,
+                     bool overwrite) {
           const Config c = config.value_or(Config{});
           RunOptions opt;
           if (out) opt.out = *out;
           opt.resume = resume;
+          opt.overwrite = overwrite;
           opt.quiet = quiet;
           // A Python exception raised while the run is in progress (Ctrl-C's KeyboardInterrupt, an error
           // in or about the callback) stops the run like a signal does: the last complete generation is
@@ -248,7 +250,7 @@ void bind_evolution(nb::module_& m) {
           }
           return summary;
         }, "config"_a = nb::none(), "out"_a = nb::none(), "resume"_a = false, "callback"_a = nb::none(), "quiet"_a = true,
-        "stop"_a = nb::none(), "objective"_a = nb::none(),
+        "stop"_a = nb::none(), "objective"_a = nb::none(), "overwrite"_a = false,
         "Run the paper's genetic algorithm (the engine behind animat_evolve); animat.evolve wraps it.\n\n"
         "config: animat.Config (default: the embedded paper setting; set evolution.generations!).\n"
         "out: run directory for config.toml, history.csv, best/ and checkpoint.json (None = write nothing).\n"
@@ -258,6 +260,9 @@ void bind_evolution(nb::module_& m) {
         "(True or None: go on).\n"
         "stop: an object with is_set() (e.g. threading.Event), polled between evaluations; set = stop.\n"
         "objective: None (the config's evaluation.objective), a built-in name, or a Python objective.\n"
+        "overwrite: start afresh in `out` even if it holds a run (its run files are removed, under the lock).\n"
+        "The run directory is locked (out/.lock) while it runs: a second writer gets BlockingIOError naming\n"
+        "the holder's pid; a directory holding a run (with or without a checkpoint) gives FileExistsError.\n"
         "The GIL is released while it runs. Returns an EvolutionSummary (history, best, population);\n"
         "stop_reason is 'interrupted' when `stop` ended it. Ctrl-C (or an exception from the callback)\n"
         "stops it within one evaluation, leaves a checkpoint of the last complete generation in `out`\n"

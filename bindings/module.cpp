@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "animat/errors.hpp"
+#include "animat/evolution.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;
@@ -28,6 +29,10 @@ NB_MODULE(_core, m) {
   nb::register_exception_translator([](const std::exception_ptr& p, void*) {
     try {
       std::rethrow_exception(p);
+    } catch (const animat::RunDirectoryBusy& e) {
+      set_error(PyExc_BlockingIOError, e.what());
+    } catch (const animat::RunExists& e) {
+      set_error(PyExc_FileExistsError, e.what());
     } catch (const animat::IoError& e) {
       set_error(PyExc_OSError, e.what());
     } catch (const animat::SimulationError& e) {

@@ -296,7 +296,9 @@ std::string to_toml(const Config& config) {
   return out;
 }
 
-void apply_override(Config& target, std::string_view assignment) {
+namespace {
+// One "section.key=value": the value checked on its own (type, range), the cross-key rules not yet.
+void apply_override_unvalidated(Config& target, std::string_view assignment) {
   if (assignment.find_first_of("\r\n") != std::string_view::npos)
     throw ConfigError(fmt::format("--set {}: one assignment per --set; newlines are not allowed", assignment));
   Config config = target;  // applied to a copy: a rejected override leaves the config unchanged
@@ -338,7 +340,21 @@ void apply_override(Config& target, std::string_view assignment) {
     if (msg.rfind("--set", 0) == 0) msg = msg.substr(msg.find(' ') + 1);
     throw ConfigError(fmt::format("--set {}: {}", assignment, msg));
   }
+  target = std::move(config);
+}
+}  // namespace
+
+void apply_override(Config& target, std::string_view assignment) {
+  Config config = target;  // a rejected override leaves the config unchanged
+  apply_override_unvalidated(config, assignment);
   validate(config, "--set");
+  target = std::move(config);
+}
+
+void apply_overrides(Config& target, const std::vector<std::string>& assignments) {
+  Config config = target;  // all or nothing
+  for (const auto& a : assignments) apply_override_unvalidated(config, a);
+  if (!assignments.empty()) validate(config, "--set");
   target = std::move(config);
 }
 

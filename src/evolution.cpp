@@ -1,6 +1,8 @@
 #include "animat/evolution.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <fmt/format.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
@@ -799,9 +801,15 @@ void Evolution::restore(std::string_view text, std::string_view source) {
 // Run directory
 namespace {
 
+// The temporary file of an atomic write: named after the writing process, so that no two processes
+// ever write the same temporary file (the run directory's lock keeps them apart anyway).
+std::filesystem::path temporary_name(const std::filesystem::path& path) {
+  return path.string() + "." + std::to_string(::getpid()) + ".tmp";
+}
+
 // Writes via a temporary file, fsync and rename: the target is either the old or the new file.
 void write_atomically(const std::filesystem::path& path, std::string_view content) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
+  const std::filesystem::path tmp = temporary_name(path);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw IoError(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
   std::size_t done = 0;
@@ -870,7 +878,7 @@ std::string duration(double s) {
 namespace {
 
 // A run directory the file system can hold: every component within NAME_MAX, the whole within PATH_MAX
-// (with room for "/best/gen_000000.json.tmp"). Checked before anything is created.
+// (with room for "/best/gen_000000.json.PID.tmp"). Checked before anything is created.
 void check_run_path(const std::filesystem::path& dir) {
   auto shown = [](const std::string& s) { return s.size() > 60 ? s.substr(0, 57) + "..." : s; };
   for (const auto& part : dir) {
@@ -881,10 +889,10 @@ void check_run_path(const std::filesystem::path& dir) {
   }
   std::error_code ec;
   const std::filesystem::path absolute = std::filesystem::absolute(dir, ec);
-  const std::size_t length = (ec ? dir : absolute).string().size() + 32;
+  const std::size_t length = (ec ? dir : absolute).string().size() + 48;
   if (length > static_cast<std::size_t>(PATH_MAX))
     throw IoError(fmt::format("{}: the run directory's path has {} characters; with its file names it must stay within "
-                              "{} (PATH_MAX)", shown(dir.string()), length - 32, PATH_MAX));
+                              "{} (PATH_MAX)", shown(dir.string()), length - 48, PATH_MAX));
 }
 
 // Refuses a resume whose settings differ from the run's own config.toml in a key that defines the run,
@@ -913,6 +921,211 @@ std::vector<std::string> check_resume_settings(const Config& config, const std::
   return accepted;
 }
 
+// ---------------------------------------------------------------------------------------------------
+// One writer per run directory: an advisory lock (flock) on RUN/.lock, held for the run's life. The
+// kernel drops it when its process ends, however it ends, so the lock of a killed run is taken over
+// at once. The file names its holder (pid, host) for the message of a refused second writer.
+constexpr const char* kLockName = ".lock";
+
+// "pid 123 on host h" from a lock file's text; the holder may not have written it yet.
+std::string lock_holder(int fd) {
+  char buf[512];
+  const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+  const std::string text(buf, n > 0 ? static_cast<std::size_t>(n) : 0);
+  long long pid = 0;
+  char host[256] = {};
+  if (std::sscanf(text.c_str(), "pid %lld host %255s", &pid, host) == 2 && pid > 0)
+    return fmt::format("pid {} on host {}", pid, host);
+  return "a process that is just starting (no pid recorded yet)";
+}
+
+[[noreturn]] void throw_busy(const std::filesystem::path& dir, const std::string& holder) {
+  throw RunDirectoryBusy(fmt::format(
+      "{}: the run directory is in use by another animat process ({}, holding {}); one process writes a run "
+      "directory at a time. Wait for it to end or stop it (Ctrl-C or kill -TERM checkpoints), then resume; or use "
+      "another directory. Nothing was written.",
+      dir.string(), holder, (dir / kLockName).string()));
+}
+
+// Refuses a directory another process holds, without creating or changing any file.
+void probe_lock(const std::filesystem::path& dir) {
+  const std::filesystem::path path = dir / kLockName;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) return;  // no lock file (or none we can read: RunLock decides)
+  if (::flock(fd, LOCK_SH | LOCK_NB) != 0) {
+    const int err = errno;
+    const std::string holder = lock_holder(fd);
+    ::close(fd);
+    if (err == EWOULDBLOCK) throw_busy(dir, holder);
+    return;
+  }
+  ::close(fd);  // releases the shared lock
+}
+
+class RunLock {
+ public:
+  explicit RunLock(const std::filesystem::path& dir) : path_(dir / kLockName) {
+    for (int attempt = 0;; ++attempt) {
+      created_ = false;
+      fd_ = ::open(path_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
+      if (fd_ < 0 && errno == ENOENT) {
+        fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+        if (fd_ < 0 && errno == EEXIST && attempt < 100) continue;  // another process made it just now
+        created_ = fd_ >= 0;
+      }
+      if (fd_ < 0)
+        throw IoError(fmt::format("{}: cannot open the run directory's lock file: {}", path_.string(), std::strerror(errno)));
+      if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+        const int err = errno;
+        const std::string holder = lock_holder(fd_);
+        ::close(fd_);
+        fd_ = -1;
+        if (err == EWOULDBLOCK) throw_busy(dir, holder);
+        throw IoError(fmt::format("{}: cannot lock the run directory: {}", path_.string(), std::strerror(err)));
+      }
+      // Its last holder removes the file on release: make sure the file locked is the one on disk.
+      struct stat held {}, on_disk {};
+      if (::fstat(fd_, &held) == 0 && ::stat(path_.c_str(), &on_disk) == 0 && held.st_dev == on_disk.st_dev &&
+          held.st_ino == on_disk.st_ino)
+        break;
+      ::close(fd_);
+      fd_ = -1;
+      if (attempt >= 100) throw IoError(fmt::format("{}: cannot lock the run directory: the lock file keeps being replaced", path_.string()));
+    }
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') std::strcpy(host, "unknown");
+    const std::string text = fmt::format("pid {}\nhost {}\n", ::getpid(), host);
+    // Best effort: the lock holds without it; only the message of a refused writer would lack the pid.
+    if (::ftruncate(fd_, 0) == 0) {
+      const ssize_t written = ::pwrite(fd_, text.data(), text.size(), 0);
+      (void)written;
+    }
+  }
+  RunLock(const RunLock&) = delete;
+  RunLock& operator=(const RunLock&) = delete;
+  /// Every check passed: the run owns the directory, and removes the lock file when it ends.
+  void started() { started_ = true; }
+  ~RunLock() {
+    if (fd_ < 0) return;
+    // A refused command leaves a lock file it found (a killed run's) as it was.
+    if (created_ || started_) ::unlink(path_.c_str());
+    ::close(fd_);
+  }
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+  bool created_ = false, started_ = false;
+};
+
+// What a run writes into its directory (RunOptions::overwrite removes these and nothing else).
+const std::vector<std::string> kRunFiles = {"config.toml", "history.csv", "checkpoint.json", "islands.csv",
+                                            "resume.log",  "stopped.txt", "best",            "figures"};
+
+// NAME.PID.tmp or NAME.tmp next to a run file: left by a process killed while writing NAME.
+bool is_leftover_temporary(const std::string& name) {
+  if (name.size() < 5 || name.compare(name.size() - 4, 4, ".tmp") != 0) return false;
+  std::string stem = name.substr(0, name.size() - 4);
+  if (const auto dot = stem.rfind('.'); dot != std::string::npos && dot + 1 < stem.size() &&
+                                        stem.find_first_not_of("0123456789", dot + 1) == std::string::npos)
+    stem.resize(dot);
+  if (stem.rfind("gen_", 0) == 0) return true;
+  return std::find(kRunFiles.begin(), kRunFiles.end(), stem) != kRunFiles.end();
+}
+
+// Removes the temporary files of killed writers (the lock is held: no live writer has any).
+void remove_leftover_temporaries(const std::filesystem::path& dir) {
+  for (const auto& folder : {dir, dir / "best"}) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec)) continue;
+    std::vector<std::filesystem::path> doomed;
+    for (const auto& entry : std::filesystem::directory_iterator(folder))
+      if (is_leftover_temporary(entry.path().filename().string()) && !entry.is_directory(ec)) doomed.push_back(entry.path());
+    for (const auto& p : doomed) std::filesystem::remove(p);
+  }
+}
+
+std::size_t history_rows(const std::filesystem::path& path, bool* only_generation_zero) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::size_t rows = 0;
+  *only_generation_zero = true;
+  for (bool header = true; std::getline(in, line); header = false) {
+    if (header || line.empty()) continue;
+    ++rows;
+    if (line.rfind("0,", 0) != 0) *only_generation_zero = false;
+  }
+  return rows;
+}
+
+// A fresh run may start in `dir` when it holds no run: nothing of one, or exactly what this same
+// command leaves when stopped before its first checkpoint (its config.toml, generation 0 at most),
+// which it would write again identically. Otherwise refuses, naming what is there.
+void refuse_existing_run(const Config& config, const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  if (std::filesystem::exists(dir / "checkpoint.json", ec))
+    throw RunExists(fmt::format("{}: already holds a run (checkpoint.json); resume it (--resume {} / resume=True), replace "
+                                "it (--overwrite / overwrite=True) or choose another directory. Nothing was written.",
+                                dir.string(), dir.string()));
+  std::vector<std::string> found;
+  bool restartable = true;
+  const std::filesystem::path stored = dir / "config.toml";
+  if (std::filesystem::exists(stored, ec)) {
+    std::string why;
+    try {
+      const auto keys = config_differences(load_config(stored), config);
+      if (!keys.empty())
+        why = fmt::format("a different config: {}{}", fmt::join(keys.begin(), keys.begin() + std::min<std::size_t>(keys.size(), 4), ", "),
+                          keys.size() > 4 ? fmt::format(" and {} more", keys.size() - 4) : "");
+    } catch (const Error&) {
+      why = "not a valid config";
+    }
+    found.push_back(why.empty() ? "config.toml" : fmt::format("config.toml ({})", why));
+    restartable = why.empty();
+  } else {
+    restartable = false;  // results without their config
+  }
+  bool zero_only = true;
+  if (std::filesystem::exists(dir / "history.csv", ec)) {
+    const std::size_t rows = history_rows(dir / "history.csv", &zero_only);
+    found.push_back(fmt::format("history.csv ({} generation{})", rows, rows == 1 ? "" : "s"));
+    if (rows > 1 || !zero_only) restartable = false;
+  }
+  if (std::filesystem::is_directory(dir / "best", ec)) {
+    std::size_t files = 0;
+    bool beyond_zero = false;
+    for (const auto& entry : std::filesystem::directory_iterator(dir / "best")) {
+      const std::string name = entry.path().filename().string();
+      if (is_leftover_temporary(name)) continue;
+      ++files;
+      if (name != "gen_000000.json") beyond_zero = true;
+    }
+    if (files > 0) found.push_back(fmt::format("best/ ({} file{})", files, files == 1 ? "" : "s"));
+    if (beyond_zero) restartable = false;
+  }
+  if (std::filesystem::exists(dir / "islands.csv", ec)) {
+    (void)history_rows(dir / "islands.csv", &zero_only);
+    found.push_back("islands.csv");
+    if (!zero_only) restartable = false;
+  }
+  if (std::filesystem::exists(dir / "resume.log", ec)) {
+    found.push_back("resume.log");
+    restartable = false;
+  }
+  if (found.empty() || restartable) return;
+  throw RunExists(fmt::format(
+      "{}: holds the files of a run but no checkpoint.json to resume from: {}; starting a new run here would mix two "
+      "runs. Replace it (--overwrite / overwrite=True) or choose another directory. Nothing was written.",
+      dir.string(), fmt::join(found, ", ")));
+}
+
+// RunOptions::overwrite: removes what a run wrote, nothing else.
+void clear_run_directory(const std::filesystem::path& dir) {
+  for (const auto& name : kRunFiles) std::filesystem::remove_all(dir / name);
+  remove_leftover_temporaries(dir);
+}
+
 std::string local_time_stamp() {
   const std::time_t t = std::time(nullptr);
   char stamp[32];
@@ -939,23 +1152,41 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
   IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);  // [islands] islands.csv
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
-  // 1. Everything that can refuse the command, before any file is written.
+  // 1. Everything that can refuse the command, before any file is written: checked once without the
+  // run directory's lock (so that a refusal creates nothing, not even the lock file), then again
+  // holding it (another process may have written in between).
   std::vector<std::string> changed_on_resume;
   if (opt.resume && !writing) throw Error("run_evolution: resume needs a run directory");
+  if (opt.resume && opt.overwrite) throw Error("run_evolution: resume and overwrite contradict each other");
+  std::optional<RunLock> lock;
   if (writing) {
     check_run_path(opt.out);
     std::error_code ec;
-    if (opt.resume) {
-      if (!std::filesystem::is_directory(opt.out, ec))
-        throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
-      if (!std::filesystem::exists(ckpt, ec))
-        throw CheckpointError(fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
-      changed_on_resume = check_resume_settings(config, opt.out);
-      evo.restore(read_file(ckpt), ckpt.string());
-    } else if (std::filesystem::exists(ckpt, ec)) {
-      throw IoError(fmt::format("{}: already holds a run (checkpoint.json); use --resume {} or another --out",
-                                opt.out.string(), opt.out.string()));
+    auto check = [&]() -> std::string {  // the checkpoint's text when resuming
+      if (opt.resume) {
+        if (!std::filesystem::is_directory(opt.out, ec))
+          throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
+        if (!std::filesystem::exists(ckpt, ec))
+          throw CheckpointError(fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
+        changed_on_resume = check_resume_settings(config, opt.out);
+        return read_file(ckpt);
+      }
+      if (!opt.overwrite) refuse_existing_run(config, opt.out);
+      return {};
+    };
+    probe_lock(opt.out);
+    std::string checkpoint_text = check();
+    if (opt.resume) evo.restore(checkpoint_text, ckpt.string());
+    if (!opt.resume) {
+      std::filesystem::create_directories(opt.out, ec);
+      if (ec) throw IoError(fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
     }
+    lock.emplace(opt.out);
+    if (const std::string again = check(); again != checkpoint_text) evo.restore(again, ckpt.string());
+    lock->started();
+    if (opt.on_start) opt.on_start();
+    if (opt.overwrite) clear_run_directory(opt.out);
+    remove_leftover_temporaries(opt.out);
   }
 
   // 2. Write.
@@ -1098,6 +1329,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
 }
 
 }  // namespace
+
+const std::vector<std::string>& run_file_names() { return kRunFiles; }
 
 RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness,
                          FitnessFunction reference) {

@@ -1,3 +1,4 @@
+#include <unistd.h>
 #include "animat/islands.hpp"
 
 #include <fmt/format.h>
@@ -28,7 +29,7 @@ std::string row(const IslandStats& s) {
 }
 
 void write_replacing(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
+  const std::filesystem::path tmp = path.string() + "." + std::to_string(::getpid()) + ".tmp";  // one per process
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out || !(out << text) || !out.flush()) throw IoError(fmt::format("{}: cannot write", tmp.string()));

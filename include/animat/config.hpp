@@ -55,8 +55,12 @@ using ConfigValue = std::variant<bool, std::int64_t, double, std::string, std::v
 [[nodiscard]] Config load_config(const std::filesystem::path& path);
 /// The complete config as commented TOML; config_from_toml(to_toml(c)) == c.
 [[nodiscard]] std::string to_toml(const Config& config);
-/// Applies "section.key=value"; the value is parsed by the field's type.
+/// Applies "section.key=value"; the value is parsed by the field's type, then the whole config is
+/// validated (the cross-key rules included). A rejected override leaves the config unchanged.
 void apply_override(Config& config, std::string_view assignment);
+/// Applies several assignments in order, then validates once: the cross-key rules (elites <
+/// population, ...) see all of them, whatever their order. All or nothing.
+void apply_overrides(Config& config, const std::vector<std::string>& assignments);
 void set_value(Config& config, std::string_view dotted_key, const ConfigValue& value);
 [[nodiscard]] ConfigValue get_value(const Config& config, std::string_view dotted_key);
 /// Every "section.key", in order.

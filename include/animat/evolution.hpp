@@ -365,6 +365,9 @@ class Evolution {
 struct RunOptions {
   std::filesystem::path out;           ///< run directory ("" = write nothing)
   bool resume = false;                 ///< continue the run in `out`
+  /// Start afresh in `out` even when it holds a run: the run's files (run_file_names()) are removed
+  /// once the directory is locked. Contradicts `resume`.
+  bool overwrite = false;
   bool quiet = false;
   double progress_interval = 1.0;      ///< seconds between progress lines
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
@@ -374,7 +377,23 @@ struct RunOptions {
   /// Called after every generation, generation 0 of a new run included; return false to stop
   /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;
+  /// Called once every check has passed and the run directory is locked, before the first write to it
+  /// (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in place).
+  std::function<void()> on_start;
 };
+
+/// Another process holds the run directory's lock (RUN/.lock): the message names its pid and host.
+struct RunDirectoryBusy : IoError {
+  using IoError::IoError;
+};
+/// The run directory holds a run (a checkpoint, or the files of a run without one) and neither resume
+/// nor overwrite was asked for.
+struct RunExists : IoError {
+  using IoError::IoError;
+};
+
+/// The files and folders of a run directory that a run writes (and RunOptions::overwrite removes).
+[[nodiscard]] const std::vector<std::string>& run_file_names();
 
 struct RunSummary {
   std::vector<GenerationStats> history;

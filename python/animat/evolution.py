@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -315,7 +314,7 @@ class GA:
     def save(self, path: PathLike) -> Path:
         """Write :meth:`checkpoint` to ``path`` atomically (a temporary file, then a rename)."""
         path = Path(path)
-        tmp = path.with_name(path.name + ".tmp")
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # one per process
         tmp.write_text(self.checkpoint(), encoding="utf-8")
         os.replace(tmp, path)
         return path
@@ -355,22 +354,6 @@ class GA:
 
 # --- evolve ---------------------------------------------------------------------------------------------
 
-_RUN_FILES = ("config.toml", "history.csv", "checkpoint.json", "checkpoint.json.tmp")
-_RUN_DIRS = ("best", "figures")
-
-
-def _clear_run_directory(out: Path) -> None:
-    """Removes what a run wrote (config, history, checkpoint, lineage, figures); nothing else."""
-    for name in _RUN_FILES:
-        p = out / name
-        if p.is_file():
-            p.unlink()
-    for name in _RUN_DIRS:
-        p = out / name
-        if p.is_dir():
-            shutil.rmtree(p)
-
-
 def _progress_bar(total: Optional[int], enabled: bool) -> Any:
     if not enabled:
         return None
@@ -399,8 +382,9 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
             callable of an :class:`animat.EvaluationRecord`, or an :class:`Objective`; None = the
             config's ``evaluation.objective``.
         resume: continue the run in ``out`` (its checkpoint).
-        overwrite: start afresh in ``out``, removing the run there (config, history, checkpoint,
-            lineage, figures; nothing else).
+        overwrite: start afresh in ``out``, removing the run there (config.toml, history.csv,
+            checkpoint.json, islands.csv, resume.log, stopped.txt, best/, figures/; nothing else), once
+            the directory's lock is held.
         callback: called with the :class:`animat.GenerationStats` of every generation (generation 0
             of a new run included); return False to stop (checkpointed).
         quiet: no progress bar and no log lines.
@@ -413,7 +397,10 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
         :class:`EvolutionResult` (history, best, population, stop_reason).
 
     Raises:
-        FileExistsError: ``out`` holds a run and neither ``resume`` nor ``overwrite`` is set.
+        FileExistsError: ``out`` holds a run (a checkpoint, or the files of a run without one) and
+            neither ``resume`` nor ``overwrite`` is set; nothing is written.
+        BlockingIOError: another process (or another ``evolve`` call) is writing ``out``: one writer
+            per run directory, held by the lock file ``out/.lock``; the message names its pid.
         ValueError: an invalid config, or a resume with a different one.
         KeyboardInterrupt: Ctrl-C; the last complete generation is checkpointed in ``out``
             (``resume=True`` continues) and the partial :class:`EvolutionResult` is its ``.result``.
@@ -446,11 +433,8 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
         warnings.warn("evolve: no generation cap (generations=) and no wall-clock budget (wall_seconds=): the run stops "
                       f"only after {int(cfg['evolution.stall_generations'])} generations without improvement (hours)",
                       UserWarning, stacklevel=2)
-    if out_path is not None and not resume and (out_path / "checkpoint.json").exists():
-        if not overwrite:
-            raise FileExistsError(f"{out_path}: already holds a run (checkpoint.json); pass resume=True to continue it "
-                                  "or overwrite=True to start afresh")
-        _clear_run_directory(out_path)
+    # The engine refuses a directory that holds a run (FileExistsError) or that another process is
+    # writing (BlockingIOError), and clears it for overwrite=True only once it holds the directory's lock.
 
     show = (not quiet) if progress is None else bool(progress)
     cap = int(cfg["evolution.generations"])
@@ -481,7 +465,7 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
 
     try:
         summary = _core.evolve(cfg, None if out_path is None else str(out_path), resume, on_generation,
-                               quiet or bar is not None, stop=stop, objective=core_objective)
+                               quiet or bar is not None, stop=stop, objective=core_objective, overwrite=overwrite)
     except KeyboardInterrupt as e:
         partial = getattr(e, "result", None)
         if partial is not None:

@@ -180,8 +180,7 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
     bases = {}
     for name, path in envs:
         base = _core.load_config(path)
-        for o in overrides:
-            base.apply_override(o)
+        base.apply_overrides(list(overrides))  # checked together: their order does not matter
         if generations is not None:
             base["evolution.generations"] = int(generations)
         if wall_seconds is not None:

@@ -74,7 +74,7 @@ int animat_evolve_main(int argc, char** argv) {
   std::string config_path, out_dir, resume_dir, log_level = "info", seed_text;
   std::vector<std::string> overrides;
   int generations = -1, threads = -1;
-  bool print_config = false, quiet = false, use_mpi = false;
+  bool print_config = false, quiet = false, use_mpi = false, overwrite = false;
   app.add_option("--config", config_path, "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
       ->check(CLI::ExistingFile);
   app.add_option("--set", overrides, "override one value: section.key=value (repeatable)");
@@ -85,6 +85,9 @@ int animat_evolve_main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out_dir, "run directory to write (default: runs/<time>-seed<seed>)");
   app.add_option("--resume", resume_dir, "run directory to resume; its config.toml is the base config");
+  app.add_flag("--overwrite", overwrite,
+               "start afresh in --out even if it holds a run: removes its config.toml, history.csv, checkpoint.json, "
+               "islands.csv, resume.log, stopped.txt, best/ and figures/ (nothing else)");
   app.add_flag("--print-config", print_config, "print the resolved config as TOML and exit");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
   app.add_flag("--quiet", quiet, "only warnings and errors");
@@ -118,6 +121,8 @@ int animat_evolve_main(int argc, char** argv) {
     animat::set_log_level(quiet ? "warn" : log_level);
     if (!resume_dir.empty() && !out_dir.empty() && std::filesystem::path(resume_dir) != std::filesystem::path(out_dir))
       throw animat::ConfigError("--resume and --out name different directories; --resume continues in place");
+    if (!resume_dir.empty() && overwrite)
+      throw animat::ConfigError("--resume continues the run and --overwrite replaces it; pass one of them");
     if (!resume_dir.empty() && !config_path.empty())
       throw animat::ConfigError("--resume takes its config from the run directory; do not also pass --config");
     animat::Config config;
@@ -131,7 +136,7 @@ int animat_evolve_main(int argc, char** argv) {
     } else if (!config_path.empty()) {
       config = animat::load_config(config_path);
     }
-    for (const auto& o : overrides) animat::apply_override(config, o);
+    animat::apply_overrides(config, overrides);  // validated together: the order of the --set flags does not matter
     if (!seed_text.empty()) config.evolution.seed = parse_seed(seed_text);
     if (generations >= 0) config.evolution.generations = generations;
     if (threads >= 0) config.evolution.threads = threads;
@@ -144,6 +149,7 @@ int animat_evolve_main(int argc, char** argv) {
     animat::RunOptions options;
     options.resume = !resume_dir.empty();
     options.out = options.resume ? resume_dir : (out_dir.empty() ? default_run_dir(config.evolution.seed) : out_dir);
+    options.overwrite = overwrite;
     options.quiet = quiet;
     options.stop_flag = &g_stop;
     std::signal(SIGINT, on_signal);
@@ -160,12 +166,15 @@ int animat_evolve_main(int argc, char** argv) {
       options.evaluator = mpi_job->start(config, &g_stop);
       if (!quiet) spdlog::info("evaluation: {}", options.evaluator->describe());
     }
-    if (const auto stopped = options.out / "stopped.txt"; options.resume && std::filesystem::exists(stopped)) {
-      std::ifstream in(stopped, std::ios::binary);
-      spdlog::warn("the last job in {} ended so:\n{}", options.out.string(),
-                   std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
-      std::filesystem::remove(stopped);
-    }
+    // Once every check has passed and the directory is locked: a refused command leaves stopped.txt.
+    options.on_start = [&options] {
+      if (const auto stopped = options.out / "stopped.txt"; options.resume && std::filesystem::exists(stopped)) {
+        std::ifstream in(stopped, std::ios::binary);
+        spdlog::warn("the last job in {} ended so:\n{}", options.out.string(),
+                     std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+        std::filesystem::remove(stopped);
+      }
+    };
     animat::RunSummary summary;
     try {
       summary = animat::run_evolution(config, options);

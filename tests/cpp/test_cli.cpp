@@ -100,6 +100,34 @@ TEST(Cli, SetOverridesAreReflected) {
   EXPECT_TRUE(c == expected);
 }
 
+TEST(Cli, SetCrossKeyChecksDoNotDependOnTheOrderOfTheFlags) {
+  // elites < population is checked once every --set is applied: raising both works in either order.
+  const std::string up_a = "--set evolution.elites=150 --set evolution.population=200";
+  const std::string up_b = "--set evolution.population=200 --set evolution.elites=150";
+  const Result a = run("--print-config " + up_a), b = run("--print-config " + up_b);
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(a.out, b.out);
+  const Config c = config_from_toml(a.out, "stdout");
+  EXPECT_EQ(c.evolution.elites, 150);
+  EXPECT_EQ(c.evolution.population, 200);
+  // A pair that violates it fails in either order with the same message, naming both values.
+  const Result d = run("--print-config --set evolution.elites=30 --set evolution.population=20");
+  const Result e = run("--print-config --set evolution.population=20 --set evolution.elites=30");
+  EXPECT_EQ(d.exit_code, 2);
+  EXPECT_EQ(e.exit_code, 2);
+  EXPECT_TRUE(d.out.empty() && e.out.empty());
+  EXPECT_EQ(d.err, e.err);
+  EXPECT_CONTAINS(d.err, "evolution.elites = 30 must be smaller than evolution.population = 20");
+  // The library call the CLI makes: all or nothing.
+  Config lib;
+  apply_overrides(lib, {"evolution.elites=150", "evolution.population=200"});
+  EXPECT_TRUE(lib == c);
+  Config untouched;
+  EXPECT_THROW(apply_overrides(untouched, {"evolution.population=20", "evolution.elites=30"}), ConfigError);
+  EXPECT_TRUE(untouched == Config{}) << "a rejected set of overrides leaves the config unchanged";
+}
+
 TEST(Cli, SeedGenerationsThreadsOptions) {
   const Result r = run("--print-config --seed 1234 --generations 7 --threads 1");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -940,28 +940,31 @@ void expect_resume_matches_uninterrupted(const fs::path& dir, const Config& c) {
   fs::remove_all(ref);
 }
 
+/// The temporary file this process writes a checkpoint through.
+std::string checkpoint_temporary() { return "checkpoint.json." + std::to_string(::getpid()) + ".tmp"; }
+
 TEST(DiskFaults, FullDiskDuringACheckpointKeepsThePreviousOne) {
-  // checkpoint.json.tmp is a symlink to /dev/full: the next checkpoint write fails with ENOSPC.
+  // checkpoint.json.PID.tmp (this process writes it) is a symlink to /dev/full: the next checkpoint write fails with ENOSPC.
   const fs::path dir = fresh_dir("full");
   Config c = stub_config();
   c.evolution.generations = 8;
-  const std::string err = run_with_fault(dir, c, 3, [](const fs::path& d) { fs::create_symlink("/dev/full", d / "checkpoint.json.tmp"); });
+  const std::string err = run_with_fault(dir, c, 3, [](const fs::path& d) { fs::create_symlink("/dev/full", d / checkpoint_temporary()); });
   EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
   expect_checkpoint_at(dir, c, 3);
-  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / "checkpoint.json.tmp"))) << "the failed temporary file is removed";
+  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / checkpoint_temporary()))) << "the failed temporary file is removed";
   expect_resume_matches_uninterrupted(dir, c);
   fs::remove_all(dir);
 }
 
 TEST(DiskFaults, UnwritableCheckpointKeepsThePreviousOne) {
-  // checkpoint.json.tmp is a directory: the write cannot even start.
+  // checkpoint.json.PID.tmp is a directory: the write cannot even start.
   const fs::path dir = fresh_dir("blocked");
   Config c = stub_config();
   c.evolution.generations = 6;
-  const std::string err = run_with_fault(dir, c, 2, [](const fs::path& d) { fs::create_directory(d / "checkpoint.json.tmp"); });
+  const std::string err = run_with_fault(dir, c, 2, [](const fs::path& d) { fs::create_directory(d / checkpoint_temporary()); });
   EXPECT_NE(err.find("cannot write"), std::string::npos) << err;
   expect_checkpoint_at(dir, c, 2);
-  fs::remove(dir / "checkpoint.json.tmp");
+  fs::remove(dir / checkpoint_temporary());
   expect_resume_matches_uninterrupted(dir, c);
   fs::remove_all(dir);
 }
@@ -1014,6 +1017,235 @@ TEST(DiskFaults, CliTinyAndReadOnlyTmpfs) {
   rc = shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " + (mnt / "run2").string(), &err);
   EXPECT_EQ(rc, 2) << err;
   EXPECT_NE(err.find("Read-only file system"), std::string::npos) << err;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The run directory: one writer, no run silently replaced, refusals that change nothing
+
+/// Every file and folder under `dir` with its content: equal snapshots = a byte-identical directory.
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  if (!fs::exists(dir)) return out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    const std::string rel = fs::relative(e.path(), dir).string();
+    out[rel] = e.is_directory() ? std::string("<dir>") : slurp(e.path());
+  }
+  return out;
+}
+
+std::string listing(const std::map<std::string, std::string>& snap) {
+  std::string s;
+  for (const auto& [name, content] : snap) s += name + " (" + std::to_string(content.size()) + " bytes) ";
+  return s;
+}
+
+#define EXPECT_SAME_DIRECTORY(before, dir, what)                                                              \
+  do {                                                                                                        \
+    const auto after_ = snapshot(dir);                                                                        \
+    EXPECT_TRUE(after_ == (before)) << (what) << " changed the run directory:\n before: " << listing(before) \
+                                    << "\n after:  " << listing(after_);                                     \
+  } while (0)
+
+/// A stub-fitness config whose real swims are short too (a CLI run on the same directory swims).
+Config small_run_config(int generations) {
+  Config c = stub_config(8, 3);
+  c.evaluation.steps = 50;
+  c.evolution.generations = generations;
+  return c;
+}
+
+std::vector<int> history_generations(const fs::path& dir) {
+  std::istringstream in(slurp(dir / "history.csv"));
+  std::string line;
+  std::vector<int> out;
+  for (bool header = true; std::getline(in, line); header = false)
+    if (!header && !line.empty()) out.push_back(std::stoi(line.substr(0, line.find(','))));
+  return out;
+}
+
+TEST(RunDirectory, SecondWriterIsRefusedNamingTheHolderAndChangesNothing) {
+  // While a run is paused in its callback (it holds the directory), every other writer is refused:
+  // the CLI on --out and on --resume, and another run_evolution in this process. No sleeps: the
+  // callback runs them and waits for them to end.
+  const fs::path dir = fresh_dir("two_writers");
+  const Config c = small_run_config(5);
+  const std::string me = "pid " + std::to_string(::getpid()) + " on host ";
+  bool checked = false;
+  RunOptions o = run_options(dir);
+  o.callback = [&](const GenerationStats& s, const Evolution&) {
+    if (s.generation != 2) return true;
+    checked = true;
+    EXPECT_TRUE(fs::exists(dir / ".lock")) << "the run holds RUN/.lock";
+    const auto before = snapshot(dir);
+    for (const std::string& args : {std::string(" --quiet --resume ") + dir.string() + " --generations 9",
+                                    kSmallRun + "--generations 9 --out " + dir.string()}) {
+      std::string err;
+      const int rc = shell(std::string(ANIMAT_EVOLVE_EXE) + args, &err);
+      EXPECT_EQ(rc, 2) << args << ": " << err;
+      EXPECT_NE(err.find("in use by another animat process (" + me), std::string::npos) << args << ": " << err;
+      EXPECT_NE(err.find("Nothing was written"), std::string::npos) << err;
+      EXPECT_SAME_DIRECTORY(before, dir, args);
+    }
+    try {
+      RunOptions again = run_options(dir, true);
+      (void)run_evolution(c, again, stub_fitness);
+      ADD_FAILURE() << "a second run_evolution on the same directory was not refused";
+    } catch (const RunDirectoryBusy& e) {
+      EXPECT_NE(std::string(e.what()).find(me), std::string::npos) << e.what();
+    }
+    EXPECT_SAME_DIRECTORY(before, dir, "run_evolution(resume)");
+    return true;
+  };
+  const RunSummary r = run_evolution(c, o, stub_fitness);
+  ASSERT_TRUE(checked);
+  EXPECT_EQ(r.history.back().generation, 5);
+  EXPECT_EQ(history_generations(dir), (std::vector<int>{0, 1, 2, 3, 4, 5})) << "one writer, generations in order";
+  EXPECT_FALSE(fs::exists(dir / ".lock")) << "a run that ends removes its lock file";
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
+  fs::remove_all(dir);
+}
+
+TEST(RunDirectory, LockFileOfAKilledRunIsTakenOver) {
+  // A killed run leaves RUN/.lock naming a process that no longer holds it (the kernel drops an
+  // flock with its process): the next run takes it over and removes it when it ends. A lock file
+  // found by a refused command is left as it was.
+  const fs::path dir = fresh_dir("stale_lock");
+  Config c = small_run_config(2);
+  (void)run_evolution(c, run_options(dir), stub_fitness);
+  spit(dir / ".lock", "pid 999999999\nhost elsewhere\n");
+  spit(dir / "checkpoint.json.4242.tmp", "half a checkpoint");  // a killed writer's temporary file
+  Config changed = c;
+  changed.evolution.population = 9;
+  const auto before = snapshot(dir);
+  EXPECT_THROW((void)run_evolution(changed, run_options(dir, true), stub_fitness), ConfigError);
+  EXPECT_SAME_DIRECTORY(before, dir, "a refused resume");
+  c.evolution.generations = 4;
+  const RunSummary r = run_evolution(c, run_options(dir, true), stub_fitness);
+  EXPECT_EQ(r.history.back().generation, 4);
+  EXPECT_FALSE(fs::exists(dir / ".lock"));
+  EXPECT_FALSE(fs::exists(dir / "checkpoint.json.4242.tmp")) << "temporary files of dead writers are removed";
+  fs::remove_all(dir);
+}
+
+TEST(RunDirectory, TemporaryFilesAreNamedAfterTheirProcess) {
+  // Two processes never share a temporary name: checkpoint.json.PID.tmp, not checkpoint.json.tmp.
+  const fs::path dir = fresh_dir("tmp_names");
+  Config c = small_run_config(3);
+  const fs::path mine = dir / ("checkpoint.json." + std::to_string(::getpid()) + ".tmp");
+  bool seen = false;
+  RunOptions o = run_options(dir);
+  o.callback = [&](const GenerationStats& s, const Evolution&) {
+    if (s.generation == 1) {
+      fs::create_directory(mine);  // blocks exactly this process's next checkpoint write
+      fs::create_directory(dir / "checkpoint.json.tmp");
+    }
+    return true;
+  };
+  try {
+    (void)run_evolution(c, o, stub_fitness);
+  } catch (const IoError& e) {
+    seen = std::string(e.what()).find(mine.string() + ": cannot write") != std::string::npos;
+    EXPECT_TRUE(seen) << e.what();
+  }
+  EXPECT_TRUE(seen) << "the checkpoint write did not use " << mine;
+  fs::remove_all(dir);
+}
+
+TEST(RunDirectory, RunFilesWithoutACheckpointAreNeverOverwritten) {
+  // config.toml, history.csv and best/ of a run whose checkpoint.json is gone: a new run there would
+  // shrink the history and mix two lineages. Refused, naming what is there; overwrite replaces it.
+  const fs::path dir = fresh_dir("no_ckpt_files");
+  Config c = small_run_config(4);
+  (void)run_evolution(c, run_options(dir), stub_fitness);
+  fs::remove(dir / "checkpoint.json");
+  const auto before = snapshot(dir);
+  for (const std::int64_t seed : {std::int64_t{3}, std::int64_t{4}}) {  // the same config, and another
+    Config again = small_run_config(2);
+    again.evolution.seed = seed;
+    try {
+      (void)run_evolution(again, run_options(dir), stub_fitness);
+      ADD_FAILURE() << "seed " << seed << ": overwrote a run without a checkpoint";
+    } catch (const RunExists& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("no checkpoint.json"), std::string::npos) << m;
+      EXPECT_NE(m.find("history.csv (5 generations)"), std::string::npos) << m;
+      EXPECT_NE(m.find("best/ ("), std::string::npos) << m;
+      EXPECT_NE(m.find("overwrite"), std::string::npos) << m;
+      EXPECT_NE(m.find("config.toml (a different config: "), std::string::npos) << m;  // generations differs
+      EXPECT_EQ(m.find("evolution.seed") != std::string::npos, seed == 4) << m;
+    }
+    EXPECT_SAME_DIRECTORY(before, dir, "a refused new run");
+  }
+  // The CLI says the same and exits 2.
+  std::string err;
+  EXPECT_EQ(shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " + dir.string(), &err), 2) << err;
+  EXPECT_NE(err.find("holds the files of a run but no checkpoint.json"), std::string::npos) << err;
+  EXPECT_SAME_DIRECTORY(before, dir, "the CLI's refused new run");
+  // Asked for explicitly, the old run is replaced entirely.
+  Config fresh = small_run_config(1);
+  RunOptions o = run_options(dir);
+  o.overwrite = true;
+  (void)run_evolution(fresh, o, stub_fitness);
+  EXPECT_EQ(history_generations(dir), (std::vector<int>{0, 1}));
+  EXPECT_EQ(slurp(dir / "config.toml"), to_toml(fresh));
+  fs::remove_all(dir);
+}
+
+TEST(RunDirectory, TheSameCommandStoppedBeforeItsFirstCheckpointStartsOver) {
+  // Killed between generation 0's history row and its first checkpoint, a run leaves config.toml,
+  // one history row and best/gen_000000.json: the same command writes exactly these again.
+  const fs::path dir = fresh_dir("restart"), ref = fresh_dir("restart_ref");
+  const Config c = small_run_config(3);
+  (void)run_evolution(c, run_options(ref), stub_fitness);
+  RunOptions o = run_options(dir);
+  o.callback = [](const GenerationStats&, const Evolution&) { return false; };  // stop after generation 0
+  (void)run_evolution(c, o, stub_fitness);
+  fs::remove(dir / "checkpoint.json");
+  (void)run_evolution(c, run_options(dir), stub_fitness);
+  EXPECT_EQ(history_without_wall(dir), history_without_wall(ref));
+  fs::remove_all(dir);
+  fs::remove_all(ref);
+}
+
+TEST(RunDirectory, EveryRefusalOfTheCliLeavesTheDirectoryByteIdentical) {
+  // A run directory with stopped.txt (a job that ended badly): each refused command changes no byte
+  // of it, stopped.txt included. An accepted resume shows and removes stopped.txt.
+  const fs::path dir = fresh_dir("refusals");
+  const std::string exe = ANIMAT_EVOLVE_EXE;
+  std::string err;
+  ASSERT_EQ(shell(exe + kSmallRun + "--generations 2 --out " + dir.string(), &err), 0) << err;
+  spit(dir / "stopped.txt", "animat_evolve: error: MPI job stopped: rank 1 lost\n");
+  spit(dir / "resume.log", "earlier resume\n");
+  const fs::path no_ckpt = fresh_dir("refusals_no_ckpt"), corrupt = fresh_dir("refusals_corrupt");
+  fs::copy(dir, no_ckpt, fs::copy_options::recursive);
+  fs::remove(no_ckpt / "checkpoint.json");
+  fs::copy(dir, corrupt, fs::copy_options::recursive);
+  std::string ckpt = slurp(corrupt / "checkpoint.json");
+  ckpt[ckpt.size() / 2] = ckpt[ckpt.size() / 2] == 'x' ? 'y' : 'x';
+  spit(corrupt / "checkpoint.json", ckpt);
+  const std::vector<std::pair<fs::path, std::string>> refused = {
+      {dir, "--resume " + dir.string() + " --set evolution.population=9"},  // a change that defines the run
+      {dir, "--resume " + dir.string() + " --set evolution.seed=5"},
+      {dir, "--resume " + dir.string() + " --generations -1"},                // a bad flag value
+      {dir, "--resume " + dir.string() + " --set evolution.elites=nine"},
+      {dir, "--resume " + dir.string() + " --config " + (dir / "config.toml").string()},
+      {dir, "--resume " + dir.string() + " --overwrite"},
+      {dir, "--resume " + dir.string() + " --out " + no_ckpt.string()},
+      {dir, kSmallRun + "--generations 2 --out " + dir.string()},            // an existing run
+      {no_ckpt, "--resume " + no_ckpt.string()},                              // no checkpoint
+      {corrupt, "--resume " + corrupt.string()},                              // a corrupt checkpoint
+  };
+  for (const auto& [target, args] : refused) {
+    const auto before = snapshot(target);
+    const int rc = shell(exe + " --quiet " + args, &err);
+    EXPECT_NE(rc, 0) << args << ": accepted";
+    EXPECT_SAME_DIRECTORY(before, target, args);
+  }
+  EXPECT_EQ(shell(exe + " --resume " + dir.string() + " --generations 3 1>&2", &err), 0) << err;  // the log too
+  EXPECT_NE(err.find("rank 1 lost"), std::string::npos) << "the accepted resume shows stopped.txt: " << err;
+  EXPECT_FALSE(fs::exists(dir / "stopped.txt"));
+  for (const auto& d : {dir, no_ckpt, corrupt}) fs::remove_all(d);
 }
 
 // ---------------------------------------------------------------------------------------------------

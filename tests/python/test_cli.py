@@ -73,3 +73,25 @@ def test_bad_options_exit_nonzero_with_message(tmp_path, args, fragments):
     for f in fragments:
         assert f in r.stderr, r.stderr
     assert "[grn]" not in r.stdout
+
+
+@pytest.mark.parametrize("pair", [("evolution.elites=150", "evolution.population=200"),
+                                  ("evolution.elites=30", "evolution.population=20")], ids=["valid", "invalid"])
+def test_set_cross_key_checks_do_not_depend_on_the_flag_order(pair, tmp_path):
+    a = run("--print-config", "--set", pair[0], "--set", pair[1], cwd=tmp_path)
+    b = run("--print-config", "--set", pair[1], "--set", pair[0], cwd=tmp_path)
+    assert (a.returncode, a.stdout, a.stderr) == (b.returncode, b.stdout, b.stderr)
+    if pair[1].endswith("200"):
+        assert a.returncode == 0, a.stderr
+        c = animat.Config.from_toml(a.stdout)
+        assert (c["evolution.elites"], c["evolution.population"]) == (150, 200)
+        same = animat.Config()
+        same.apply_overrides(list(reversed(pair)))
+        assert same == c
+    else:
+        assert a.returncode == 2
+        assert "evolution.elites = 30 must be smaller than evolution.population = 20" in a.stderr
+        untouched = animat.Config()
+        with pytest.raises(ValueError, match="must be smaller"):
+            untouched.apply_overrides(list(pair))
+        assert untouched == animat.Config()

@@ -346,3 +346,87 @@ def test_evolve_into_an_unwritable_directory_is_an_os_error(tmp_path):
     c["evolution.generations"] = 1
     with pytest.raises(OSError, match="cannot create run directory: Not a directory"):
         animat.evolve(c, out=str(tmp_path / "file" / "run"))
+
+
+# --------------------------------------------------------------------------------------------------
+# The run directory: one writer (RUN/.lock), no run silently replaced, refusals that change nothing
+
+def small_run_config(generations: int):
+    c = animat.Config()
+    c["evolution.population"] = 8
+    c["evolution.elites"] = 1
+    c["evolution.threads"] = 1
+    c["evolution.seed"] = 3
+    c["evaluation.steps"] = 50
+    c["evolution.generations"] = generations
+    return c
+
+
+def snapshot(folder: Path) -> dict:
+    """Every file and folder under `folder` with its bytes: equal snapshots = an unchanged directory."""
+    return {str(p.relative_to(folder)): (None if p.is_dir() else p.read_bytes()) for p in sorted(folder.rglob("*"))}
+
+
+def test_evolve_refuses_a_second_writer_naming_the_holder(tmp_path):
+    # While evolve(out=run) is paused in its callback it holds run/.lock: another evolve() in this
+    # process and animat_evolve in another are refused, naming this pid, and change no byte.
+    out = tmp_path / "run"
+    c = small_run_config(4)
+    seen = {}
+
+    def second_writers(stats):
+        if stats.generation != 1:
+            return None
+        before = snapshot(out)
+        with pytest.raises(BlockingIOError, match=f"in use by another animat process \\(pid {os.getpid()} on host "):
+            animat.evolve(small_run_config(6), out=str(out), resume=True, quiet=True)
+        with pytest.raises(BlockingIOError, match=f"pid {os.getpid()}"):
+            animat.evolve(small_run_config(6), out=str(out), overwrite=True, quiet=True)
+        if EXE and Path(EXE).exists():
+            r = subprocess.run([EXE, "--quiet", "--resume", str(out), "--generations", "6"], capture_output=True,
+                               text=True, timeout=300)
+            seen["cli"] = (r.returncode, r.stderr)
+        seen["same"] = snapshot(out) == before
+        return None
+
+    r = animat.evolve(c, out=str(out), quiet=True, callback=second_writers)
+    assert seen["same"], "a refused writer changed the run directory"
+    if "cli" in seen:
+        rc, err = seen["cli"]
+        assert rc == 2 and f"pid {os.getpid()} on host " in err, err
+    assert [int(row[0]) for row in history(out)[1:]] == [0, 1, 2, 3, 4]
+    assert r.history[-1].generation == 4
+    assert not (out / ".lock").exists(), "the lock file goes with the run"
+    assert not list(out.rglob("*.tmp"))
+
+
+def test_evolve_never_replaces_run_files_without_a_checkpoint(tmp_path):
+    out = tmp_path / "run"
+    animat.evolve(small_run_config(3), out=str(out), quiet=True)
+    (out / "checkpoint.json").unlink()
+    before = snapshot(out)
+    with pytest.raises(FileExistsError, match=r"no checkpoint.json.*history.csv \(4 generations\).*overwrite=True"):
+        animat.evolve(small_run_config(1), out=str(out), quiet=True)
+    assert snapshot(out) == before
+    r = animat.evolve(small_run_config(1), out=str(out), quiet=True, overwrite=True)
+    assert [int(row[0]) for row in history(out)[1:]] == [0, 1] == [int(g) for g in r.history["generation"]]
+    assert sorted(p.name for p in (out / "best").iterdir()) == sorted(
+        f"gen_{e.generation:06d}.json" for e in animat.Run(out).best_genomes)
+
+
+@needs_exe
+def test_cli_refused_resume_keeps_stopped_txt(tmp_path):
+    run = tmp_path / "run"
+    r = subprocess.run([EXE, *SMALL, "--generations", "2", "--out", str(run)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    (run / "stopped.txt").write_text("animat_evolve: error: MPI job stopped: rank 1 lost\n")
+    empty = tmp_path / "empty"
+    shutil.copytree(run, empty)
+    (empty / "checkpoint.json").unlink()
+    for folder, args in [(run, ["--resume", str(run), "--set", "evolution.population=9"]),
+                         (run, ["--resume", str(run), "--threads", "-2"]),
+                         (empty, ["--resume", str(empty)])]:
+        before = snapshot(folder)
+        r = subprocess.run([EXE, "--quiet", *args], capture_output=True, text=True, timeout=300)
+        assert r.returncode != 0, args
+        assert snapshot(folder) == before, f"{args} changed {folder}"
