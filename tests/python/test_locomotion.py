@@ -1,5 +1,5 @@
 """Locomotion modes (undulation, synchronous contraction, protrusions) and the paper's statistics of
-the best individuals (issue 10): synthetic swims with known answers, real swims with imposed phase
+the best individuals: synthetic swims with known answers, real swims with imposed phase
 patterns, rigid-motion invariance, and the statistics helpers on hand-made inputs."""
 import math
 from pathlib import Path
