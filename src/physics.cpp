@@ -516,7 +516,7 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   st.h = s.h;
   st.mass = static_cast<double>(static_cast<float>(scene.cell_mass));  // what Box2D integrates with
   st.inv_mass = 1.0 / st.mass;
-  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &st.cx, &st.cy, &s.fx_pos, &s.fy_pos})
+  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &st.cx, &st.cy, &st.ground_fx, &st.ground_fy, &s.fx_pos, &s.fy_pos})
     v->assign(static_cast<std::size_t>(n), 0.0);
   s.midpoint = physics.velocity_forces == "midpoint";
   st.rest.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());

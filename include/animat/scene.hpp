@@ -16,7 +16,9 @@
 //      the effects before it in s.fx, s.fy, so an implicit scheme (drag) can solve for the
 //      velocity at the end of the step, v + h·F/m;
 //   3. apply() of the constraint effects (collisions, then ground), which see every force and change
-//      the end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h).
+//      the end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h). With both in the
+//      scene, the floor contacts are events of the collisions' event loop (so no floor impulse can
+//      undo a collision guarantee), and ground only adds the floor impulses collisions computed.
 // Effects loop over their own elements inside apply(): one virtual call per effect per pass, never
 // one per element. New effects (like gravity and ground, docs/worlds.md) are new Effect
 // subclasses (one file each in src/effects/) plus a name in make_effect(); the stepper does not
@@ -152,6 +154,11 @@ struct SwimState {
   /// τ, not at the start of the step, so its end position differs from x + h·v by this much.
   std::vector<double> cx, cy;
   bool position_corrected = false;
+  /// The floor's impulses (as forces J/h, n each) when effect collisions resolves the floor contacts
+  /// inside its event loop (a scene with both collisions and ground): collisions writes them here,
+  /// and effect ground, which runs after it, adds them to s.fx, s.fy (so the energy books keep the
+  /// floor's work apart from the collisions').
+  std::vector<double> ground_fx, ground_fy;
   /// Energy accounting only (null otherwise): drag adds the normal part of its forces here too, so
   /// that the books can split the fluid's dissipation into its normal and tangential parts (n each).
   double* normal_drag_fx = nullptr;

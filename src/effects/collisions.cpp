@@ -12,6 +12,10 @@
 // turns inside out (a triangle inverts only when a vertex crosses the opposite edge) and the skin
 // stays simple (two edges can only come to cross after an end of one has touched the other).
 // collision_edges = "skin" tests only the skin pairs (measured: internal regions then invert).
+//
+// With effect "ground" in the scene, the floor contacts are events of the same loop (class comment,
+// step 4b): a floor impulse changes velocities only at its event time, and every edge event after it
+// is still found, so the floor cannot undo the guarantee above.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -75,6 +79,18 @@ int roots_in_unit_interval(double A, double B, double C, std::array<double, 2>& 
 ///     step. After kMaxEvents events in one step the rest are resolved with e = 0 (counted as
 ///     inelastic); a step that still has events after 2·kMaxEvents is counted as unresolved (the
 ///     swim is then invalid);
+///  4b. with effect ground (the floor y = y0, docs/worlds.md), a cell reaching the floor is an event
+///     too (the floor wins ties): at its time the cell is put exactly on the floor and the floor's
+///     inelastic normal impulse sets its vertical velocity to 0 (or, for a cell that float rounding
+///     left below the floor at the start of the step, to the velocity that brings it back onto the
+///     floor by the end of the step: the old projection), together with the Coulomb friction impulse
+///     of that normal impulse (floor_friction(): sticking if the impulse that stops the cell is
+///     within μ_s·J_n, else sliding with μ_k·J_n). The floor events at the start of the step (cells
+///     resting on it) are resolved before the first search. A cell-edge impulse that would push a
+///     cell lying on the floor (and not moving up) into it is solved together with the floor: that
+///     cell's vertical inverse mass is 0 in the impulse, the floor takes the vertical part (a normal
+///     impulse, with its friction as above), so an edge pressing a cell onto the floor bounces off it
+///     like off a wall instead of an endless sequence of ever smaller events;
 ///  5. the velocity changes go to Box2D as forces m·Δw/h, and since a bounce happens at its event
 ///     time and not at the start of the step, the end positions of the cells involved differ from
 ///     x + h·w; the stepper applies that difference after Box2D's step (SwimState::cx, cy). Events
@@ -84,7 +100,13 @@ class Collisions final : public Effect {
  public:
   static constexpr int kMaxEvents = 64;
 
-  Collisions(const Body& body, const SceneParams& p) : restitution_(p.collision_restitution), tol_(p.collision_tolerance) {
+  Collisions(const Body& body, const SceneParams& p)
+      : restitution_(p.collision_restitution),
+        tol_(p.collision_tolerance),
+        floor_(has_effect(p.effects, "ground")),
+        y0_(p.ground_height),
+        mu_s_(p.ground_friction_static),
+        mu_k_(p.ground_friction_kinetic) {
     n_ = body.node_count();
     rx_.resize(at(n_));
     ry_.resize(at(n_));
@@ -164,6 +186,10 @@ class Collisions final : public Effect {
 
     for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &motion_, &ex_, &ey_}) v->assign(at(n_), 0.0);
     kicked_.assign(at(n_), 0);
+    if (floor_) {
+      for (auto* v : {&fvx_, &fvy_, &floor_wy_, &floor_u_}) v->assign(at(n_), 0.0);
+      floor_state_.assign(at(n_), 0);
+    }
     const std::size_t skin_vertices = items_.size() - skin_edges.size();
     candidates_.reserve(3 * tris_.size() + fixed_.size() + skin_vertices * skin_edges.size());
   }
@@ -172,7 +198,7 @@ class Collisions final : public Effect {
 
   void apply(SwimState& s) override {
     ++calls_;
-    if (a_.empty() || n_ < 3) return;
+    if (!floor_ && (a_.empty() || n_ < 3)) return;
     const double kv = s.h * s.inv_mass;
     for (int i = 0; i < n_; ++i) {
       const auto u = at(i);
@@ -184,9 +210,20 @@ class Collisions final : public Effect {
       qy_[u] = s.y[u];
     }
     tau_ = 0.0;
-    int events = 0;
+    h_ = s.h;
+    int events = 0, floor_passes = 0;  // cell-edge events; floor events after the start of the step
     long collisions = 0, inelastic = 0;
     bool resolved = true;
+    bool floor_kicked = false;
+    if (floor_) {
+      for (int i = 0; i < n_; ++i) {
+        const auto u = at(i);
+        kicked_[u] = 0;
+        fvx_[u] = fvy_[u] = floor_wy_[u] = 0.0;
+        floor_state_[u] = 0;
+      }
+      floor_kicked = floor_events(s.h, 0.0, true);  // cells on the floor at the start of the step
+    }
     while (tau_ < 1.0) {
       const double span = (1.0 - tau_) * s.h;  // time left in the step
       gather(span);
@@ -199,38 +236,64 @@ class Collisions final : public Effect {
           first = k;
         }
       }
-      if (first_u > 1.0) break;
-      if (events >= 2 * kMaxEvents) {
+      const double floor_u = floor_ ? first_floor_event(span) : 2.0;
+      if (first_u > 1.0 && floor_u > 1.0) break;
+      const bool floor_first = floor_u <= first_u;  // the floor wins ties
+      if (floor_first ? floor_passes >= 2 * kMaxEvents + n_ : events >= 2 * kMaxEvents) {
         resolved = false;
         break;
       }
-      if (events == 0)
+      if (events == 0 && !floor_)
         for (int i = 0; i < n_; ++i) kicked_[at(i)] = 0;
-      const bool fallback = events >= kMaxEvents;
-      ++events;
-      const double dt = first_u * span;
+      const double event_u = floor_first ? floor_u : first_u;
+      const double dt = event_u * span;
       for (int i = 0; i < n_; ++i) {
         qx_[at(i)] += dt * wx_[at(i)];
         qy_[at(i)] += dt * wy_[at(i)];
       }
-      tau_ += first_u * (1.0 - tau_);
+      tau_ += event_u * (1.0 - tau_);
+      if (floor_first) {
+        ++floor_passes;
+        floor_events(span, floor_u, false);
+        floor_kicked = true;
+        continue;
+      }
+      const bool fallback = events >= kMaxEvents;
+      ++events;
       bounce(candidates_[first], fallback ? 0.0 : restitution_);
       ++collisions;
       if (fallback && restitution_ > 0.0) ++inelastic;
     }
     s.counters.collisions += collisions;
     s.counters.collisions_inelastic += inelastic;
-    s.counters.collision_max_passes = std::max(s.counters.collision_max_passes, static_cast<long>(events));
+    s.counters.collision_max_passes = std::max(s.counters.collision_max_passes, static_cast<long>(events + floor_passes));
     if (!resolved) ++s.counters.collisions_unresolved;
-    if (events == 0) return;
     const double mh = s.mass / s.h;
+    if (floor_) {
+      long contacts = 0, slips = 0;
+      for (int i = 0; i < n_; ++i) {
+        const auto u = at(i);
+        s.ground_fx[u] = fvx_[u] * mh;
+        s.ground_fy[u] = fvy_[u] * mh;
+        contacts += floor_state_[u] & 1;
+        slips += (floor_state_[u] >> 1) & 1;
+      }
+      s.counters.ground_contacts += contacts;
+      s.counters.ground_slips += slips;
+    }
+    if (events == 0 && !floor_kicked) return;
     for (int i = 0; i < n_; ++i) {
       const auto u = at(i);
       s.cx[u] = 0.0;
       s.cy[u] = 0.0;
       if (!kicked_[u]) continue;
-      s.fx[u] += (wx_[u] - w0x_[u]) * mh;
-      s.fy[u] += (wy_[u] - w0y_[u]) * mh;
+      if (floor_) {  // the floor's share goes to effect ground (s.ground_fx, s.ground_fy)
+        s.fx[u] += ((wx_[u] - w0x_[u]) - fvx_[u]) * mh;
+        s.fy[u] += ((wy_[u] - w0y_[u]) - fvy_[u]) * mh;
+      } else {
+        s.fx[u] += (wx_[u] - w0x_[u]) * mh;
+        s.fy[u] += (wy_[u] - w0y_[u]) * mh;
+      }
       // End position q + (1 − τ)·h·w against Box2D's x + h·w.
       s.cx[u] = (qx_[u] - s.x[u]) - tau_ * s.h * wx_[u];
       s.cy[u] = (qy_[u] - s.y[u]) - tau_ * s.h * wy_[u];
@@ -439,11 +502,97 @@ class Collisions final : public Effect {
     const double vy = wy_[i] - ((1.0 - sc) * wy_[a] + sc * wy_[b]);
     const double vn = nx * vx + ny * vy;
     if (!(vn < 0.0)) return;
+    if (floor_ && bounce_on_floor(i, a, b, sc, nx, ny, vn, e)) return;
     // Equal masses: 1/m_eff = (1 + (1 − s)² + s²)/m; the velocity changes are J/m per unit weight.
     const double dv = -(1.0 + e) * vn / (1.0 + (1.0 - sc) * (1.0 - sc) + sc * sc);
     kick(i, dv * nx, dv * ny);
     kick(a, -(1.0 - sc) * dv * nx, -(1.0 - sc) * dv * ny);
     kick(b, -sc * dv * nx, -sc * dv * ny);
+  }
+
+  /// Whether cell k lies on the floor and is not moving up (beyond the velocity the floor gave it).
+  bool pinned(std::size_t k) const { return qy_[k] <= y0_ && wy_[k] <= floor_wy_[k]; }
+
+  /// The floor's earliest event in the next `span` of time, as a fraction of it (> 1: none): a cell
+  /// on (or, by float rounding, below) the floor moving down, or below it and not moving up fast
+  /// enough to be back on it by the end of the span, has its event now (0); a cell above it that
+  /// would end the span below it, when it reaches it. Each cell's time is kept in floor_u_.
+  double first_floor_event(double span) {
+    double first = 2.0;
+    for (int i = 0; i < n_; ++i) {
+      const auto k = at(i);
+      const double y = qy_[k], wy = wy_[k];
+      double u = 2.0;
+      if (y <= y0_) {
+        if (wy < 0.0 || (y < y0_ && wy < (y0_ - y) / span)) u = 0.0;
+      } else if (wy < 0.0 && y + span * wy < y0_) {
+        u = std::min(1.0, (y - y0_) / (-span * wy));
+      }
+      floor_u_[k] = u;
+      first = std::min(first, u);
+    }
+    return first;
+  }
+
+  /// Resolves the floor events at fraction `u` of `span` (the cells have been advanced to it):
+  /// every cell whose floor event is at u (all cells with an event at the start of the step when
+  /// `start`) is put on the floor with the floor's normal impulse and its friction. Returns whether
+  /// any cell was kicked.
+  bool floor_events(double span, double u, bool start) {
+    if (start) (void)first_floor_event(span);
+    bool any = false;
+    const double left = (1.0 - tau_) * h_;  // time left in the step after the event
+    for (int i = 0; i < n_; ++i) {
+      const auto k = at(i);
+      if (floor_u_[k] != u || floor_u_[k] > 1.0) continue;
+      if (u > 0.0) qy_[k] = y0_;  // reached the floor now (removes the rounding of the advance)
+      const double wy_new = qy_[k] < y0_ ? (y0_ - qy_[k]) / left : 0.0;
+      const double jn = wy_new - wy_[k];
+      if (!(jn > 0.0)) continue;
+      wy_[k] = wy_new;
+      fvy_[k] += jn;
+      floor_wy_[k] = wy_new;
+      floor_friction_kick(k, jn);
+      any = true;
+    }
+    return any;
+  }
+
+  /// The friction of a floor normal impulse jn (per unit mass) on cell k, and the contact's books.
+  void floor_friction_kick(std::size_t k, double jn) {
+    const FloorFriction f = floor_friction(wx_[k], jn, mu_s_, mu_k_);
+    wx_[k] += f.dvx;
+    fvx_[k] += f.dvx;
+    kicked_[k] = 1;
+    floor_state_[k] |= f.slid ? 3 : 1;
+  }
+
+  /// bounce() when a cell the impulse pushes down lies on the floor (pinned()): the impulse along n
+  /// with that cell's vertical inverse mass 0 (the floor takes the vertical part: a normal impulse,
+  /// with its friction). Returns false when no cell is in that case (bounce() then goes on as usual).
+  bool bounce_on_floor(std::size_t i, std::size_t a, std::size_t b, double sc, double nx, double ny, double vn, double e) {
+    // The impulse acts on i along +n and on a, b along −n: downwards on i if ny < 0, on a, b if ny > 0.
+    const bool pi = ny < 0.0 && pinned(i);
+    const bool pa = ny > 0.0 && sc < 1.0 && pinned(a);
+    const bool pb = ny > 0.0 && sc > 0.0 && pinned(b);
+    if (!(pi || pa || pb)) return false;
+    const double nx2 = nx * nx, ra = 1.0 - sc;
+    const double inv = (pi ? nx2 : 1.0) + ra * ra * (pa ? nx2 : 1.0) + sc * sc * (pb ? nx2 : 1.0);
+    const double dv = -(1.0 + e) * vn / inv;  // at least 1/2: i and {a, b} are never pinned together
+    auto push = [&](std::size_t k, bool pin, double w) {
+      const double dvx = w * dv * nx, dvy = w * dv * ny;
+      if (!pin) {
+        kick(k, dvx, dvy);
+        return;
+      }
+      wx_[k] += dvx;  // the vertical part goes into the floor: its normal impulse is −dvy > 0
+      fvy_[k] += -dvy;
+      floor_friction_kick(k, -dvy);
+    };
+    push(i, pi, 1.0);
+    push(a, pa, -ra);
+    push(b, pb, -sc);
+    return true;
   }
 
   void kick(std::size_t i, double dvx, double dvy) {
@@ -453,6 +602,8 @@ class Collisions final : public Effect {
   }
 
   double restitution_, tol_;
+  bool floor_;                      // effect ground is in the scene: floor contacts are events here
+  double y0_, mu_s_, mu_k_;         // the floor (effect ground)
   int n_ = 0;
   std::vector<int> a_, b_;          // edges a cell may not cross
   std::vector<int> opposite_;       // per edge: the opposite vertex of its triangular region (-1: none)
@@ -469,7 +620,12 @@ class Collisions final : public Effect {
   std::vector<double> motion_;      // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
   std::vector<double> ex_, ey_;     // per cell, q + span·w: its position at the end of the span (gather)
   std::vector<char> kicked_;        // cells whose velocity a bounce changed this step
+  std::vector<double> fvx_, fvy_;   // per cell, the floor's velocity changes this step (floor_ only)
+  std::vector<double> floor_wy_;    // per cell, the vertical velocity the floor last gave it this step
+  std::vector<double> floor_u_;     // per cell, its floor event in the current span (> 1: none)
+  std::vector<char> floor_state_;   // per cell, this step: 1 the floor pushed it, 2 it slid
   double tau_ = 0.0;                // fraction of the step done
+  double h_ = 0.0;                  // the step
 };
 
 }  // namespace

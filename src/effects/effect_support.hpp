@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -52,6 +53,19 @@ inline SegmentHit closest_on_segment(double px, double py, double ax, double ay,
   const double qx = ax + t * ex, qy = ay + t * ey;
   const double dx = px - qx, dy = py - qy;
   return {t, qx, qy, dx * dx + dy * dy};
+}
+
+/// The floor's Coulomb friction (effect ground, docs/worlds.md) for a normal impulse jn >= 0 per
+/// unit mass on a cell whose tangential velocity is wx: the velocity change that stops the cell,
+/// −wx, if |wx| <= μ_s·jn (sticking), otherwise −sign(wx)·μ_k·jn (sliding; μ_k <= μ_s, so it never
+/// reverses the cell). `slid` says which.
+struct FloorFriction {
+  double dvx;
+  bool slid;
+};
+inline FloorFriction floor_friction(double wx, double jn, double mu_s, double mu_k) {
+  if (std::abs(wx) <= mu_s * jn) return {-wx, false};
+  return {-std::copysign(mu_k * jn, wx), true};
 }
 
 }  // namespace animat::effects

@@ -6,15 +6,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
+#include "animat/embedding.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/genome.hpp"
 #include "animat/objective.hpp"
 #include "animat/physics.hpp"
 #include "animat/scene.hpp"
@@ -249,6 +257,172 @@ TEST(Ground, ConfigErrorsNameKeyAndValue) {
   c.evaluation.objective = "distance_per_energy";
   c.evaluation.energy_offset = 0.0;
   EXPECT_THROW((void)make_objective(c.evaluation), ConfigError);
+}
+
+// --- the floor and the collisions together: the embedding survives every contact ------------------
+
+/// One triangle (a region, its three springs, all skin) with the base cells a, b at y = 0.05 and the
+/// apex c at y = 0.3 above the middle of the base.
+Body falling_triangle() {
+  return make_body(points({{0.0, 0.05}, {2.0, 0.05}, {1.0, 0.3}}), {{0, 1}, {1, 2}, {0, 2}}, {{0, 1, 2}},
+                   {{0, 1}, {1, 2}, {2, 0}});
+}
+
+TEST(FloorAndCollisions, TriangleFallingFlatOntoTheFloorBouncesOffItsBase) {
+  // The traced defect, analytically: the whole triangle falls at v = 30 with no force (effects
+  // collisions and ground only), h·v = 0.5 per step. The base reaches the floor after 0.05/v and
+  // stops (inelastic); the apex would reach it after 0.3/v, on the base. With the floor applied
+  // after the collisions (as before), no cell crossed an edge under the motion the collisions saw,
+  // and the floor then put all three cells on y = 0: a region of zero area. With the floor contacts
+  // as events of the collision loop, the apex meets the stopped base at the band (tolerance 1e-3)
+  // and bounces elastically off it, and since the base lies on the floor the edge cannot give: the
+  // apex leaves at +v like off a wall, the base stays at rest on the floor, and the apex ends the
+  // step mirrored about y = band: y = 2·band − (0.3 − h·v).
+  const double v = 30.0;
+  SceneParams scene = scene_with({"collisions", "ground"});
+  const Body b = falling_triangle();
+  Simulation sim(b, scene);
+  sim.monitor_embedding(b);
+  sim.set_velocities(points({{0.0, -v}, {0.0, -v}, {0.0, -v}}));
+  const double h = sim.physics().dt, band = scene.collision_tolerance;
+  sim.step();
+  const Points p = sim.positions(), w = sim.velocities();
+  for (int i : {0, 1}) {
+    EXPECT_NEAR(p(i, 1), 0.0, 1e-6) << i;
+    EXPECT_NEAR(w(i, 1), 0.0, 1e-6 * v) << i;  // Box2D's float velocity: −v + h·(v/h) rounds
+    EXPECT_NEAR(p(i, 0), b.positions(i, 0), 1e-6) << i;
+  }
+  EXPECT_NEAR(w(2, 1), v, 1e-4 * v);
+  EXPECT_NEAR(p(2, 1), 2.0 * band - (0.3 - h * v), 1e-6);
+  EXPECT_EQ(sim.counters().collisions, 1);
+  EXPECT_EQ(sim.counters().ground_contacts, 2);
+  EXPECT_EQ(sim.counters().collisions_unresolved, 0);
+  ASSERT_NE(sim.embedding_monitor(), nullptr);
+  EXPECT_TRUE(sim.embedding_monitor()->intact());
+  EXPECT_GT(sim.embedding_monitor()->min_area_ratio(), 0.0);
+}
+
+/// What a monitored floor swim saw.
+struct FloorRun {
+  long inverted = 0, crossings = 0, unresolved = 0, contacts = 0, slips = 0;
+  double lowest = 1e9, min_area_ratio = 1.0;
+};
+
+enum class FloorCase { pressed, dropped, rolled, dragged };
+
+/// A 5 × 3 lattice body (springs, pressure, collisions, gravity, ground) in one of four hard floor
+/// contacts, simulated for 6 time units at dt/refine with the embedding monitored every Box2D step:
+///  - pressed: resting on the floor, its top row pushed down with 40 per cell (g = 1): the bottom
+///    triangles are squeezed between the load and the floor;
+///  - dropped: from 5 units above the floor under g = 20 (lands at about 14 units per time unit);
+///  - rolled: from 2 units above, spinning at 4 rad per time unit and moving sideways at 3, g = 5;
+///  - dragged: resting on the floor (g = 2), its top row pulled sideways with 8 per cell (above the
+///    static limit of the whole body): it tilts, slides and sticks again.
+FloorRun run_floor_case(FloorCase c, int refine) {
+  const Body b = swimmer(lattice_points(5, 3, 0.05, 11), Drive::none);
+  Body body = b;
+  body.positions.col(1).array() -= body.positions.col(1).minCoeff();
+  SceneParams scene = floor_scene({"springs", "pressure", "collisions", "gravity", "ground"}, 1.0);
+  const double top = body.positions.col(1).maxCoeff() - 0.1;
+  std::vector<double> top_row;
+  for (int i = 0; i < body.node_count(); ++i) top_row.push_back(body.positions(i, 1) > top ? 1.0 : 0.0);
+  Points v0 = Points::Zero(body.node_count(), 2);
+  switch (c) {
+    case FloorCase::pressed: break;
+    case FloorCase::dropped:
+      scene.gravity = 20.0;
+      body.positions.col(1).array() += 5.0;
+      break;
+    case FloorCase::rolled: {
+      scene.gravity = 5.0;
+      body.positions.col(1).array() += 2.0;
+      const Eigen::RowVector2d centre = body.positions.colwise().mean();
+      for (int i = 0; i < body.node_count(); ++i) {
+        const Eigen::RowVector2d r = body.positions.row(i) - centre;
+        v0(i, 0) = 3.0 - 4.0 * r(1);
+        v0(i, 1) = 4.0 * r(0);
+      }
+      break;
+    }
+    case FloorCase::dragged: scene.gravity = 2.0; break;
+  }
+  PhysicsParams physics;
+  physics.dt /= refine;
+  Simulation sim(body, scene, physics);
+  sim.monitor_embedding(body);
+  sim.set_velocities(v0);
+  if (c == FloorCase::pressed) sim.add_effect(std::make_unique<ConstantForce>(0.0, -40.0, top_row));
+  if (c == FloorCase::dragged) sim.add_effect(std::make_unique<ConstantForce>(8.0, 0.0, top_row));
+  FloorRun r;
+  const long steps = 360L * refine;
+  for (long k = 0; k < steps; ++k) {
+    sim.step();
+    r.lowest = std::min(r.lowest, min_y(sim));
+  }
+  const EmbeddingMonitor& m = *sim.embedding_monitor();
+  r.inverted = m.inverted_region_frames();
+  r.crossings = m.skin_crossing_frames();
+  r.min_area_ratio = m.min_area_ratio();
+  r.unresolved = sim.counters().collisions_unresolved;
+  r.contacts = sim.counters().ground_contacts;
+  r.slips = sim.counters().ground_slips;
+  return r;
+}
+
+TEST(FloorAndCollisions, PressedDroppedRolledAndDraggedBodiesKeepTheirEmbeddingAtEveryStep) {
+  const char* names[] = {"pressed", "dropped", "rolled", "dragged"};
+  for (FloorCase c : {FloorCase::pressed, FloorCase::dropped, FloorCase::rolled, FloorCase::dragged})
+    for (int refine : {1, 4, 16}) {
+      const FloorRun r = run_floor_case(c, refine);
+      const std::string what = std::string(names[static_cast<int>(c)]) + " at dt/" + std::to_string(refine);
+      EXPECT_EQ(r.inverted, 0) << what;
+      EXPECT_EQ(r.crossings, 0) << what;
+      EXPECT_GT(r.min_area_ratio, 0.0) << what;
+      EXPECT_EQ(r.unresolved, 0) << what;
+      EXPECT_GE(r.lowest, -1e-6) << what;
+      EXPECT_GT(r.contacts, 0) << what;
+      if (c == FloorCase::dragged || c == FloorCase::rolled) {
+        EXPECT_GT(r.slips, 0) << what;
+      }
+    }
+}
+
+/// The crawl genomes of tests/data/crawl (each with its config, crawl.toml there): offspring of
+/// short crawl runs whose swims broke the embedding while the floor was resolved after the
+/// collisions (the skin crossed itself; the step is recorded in the file).
+std::vector<std::pair<std::string, Genome>> crawl_genomes(Config& config) {
+  const std::filesystem::path dir = std::filesystem::path(ANIMAT_SOURCE_DIR) / "tests" / "data" / "crawl";
+  config = load_config((dir / "crawl.toml").string());
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  std::vector<std::pair<std::string, Genome>> out;
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const auto j = nlohmann::json::parse(ss.str());
+    EXPECT_EQ(j.at("config").get<std::string>(), "crawl.toml") << f;
+    out.emplace_back(f.filename().string(), genome_from_json(j.at("genome").dump(), config.genome, f.string()));
+  }
+  return out;
+}
+
+TEST(FloorAndCollisions, EvolvedCrawlersThatCrossedTheirSkinAreValid) {
+  Config config;
+  const auto genomes = crawl_genomes(config);
+  ASSERT_EQ(genomes.size(), 3u);
+  for (const auto& [name, genome] : genomes) {
+    const EvaluationResult r = evaluate(genome, config);
+    ASSERT_TRUE(r.viable) << name;
+    EXPECT_TRUE(r.valid) << name << ": " << (r.reasons.empty() ? "" : r.reasons.front());
+    EXPECT_EQ(r.skin_crossing_steps, 0) << name;
+    EXPECT_EQ(r.inverted_region_steps, 0) << name;
+    EXPECT_EQ(r.collisions_unresolved, 0) << name;
+    EXPECT_GT(r.ground_contacts, 0) << name;
+    EXPECT_EQ(r.swim_steps, config.evaluation.steps) << name;
+  }
 }
 
 // --- settling and the crawl swim ------------------------------------------------------------------
