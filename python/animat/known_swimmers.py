@@ -346,10 +346,10 @@ class KnownResult:
 
 
 def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0.5, 2.0), steps: int = 2000,
-                   config: Optional[Any] = None, stroke: bool = False) -> List[KnownResult]:
+                   config: Optional[Any] = None, stroke_rule: bool = False) -> List[KnownResult]:
     """Swim every swimmer ``steps`` steps at every normal drag (d_T = d_N / 200, the paper's ratio, via the
-    config default) and classify the recorded swim with :func:`animat.classify_locomotion` (``stroke``:
-    with the paper's stroke rule, see there)."""
+    config default) and classify the recorded swim with :func:`animat.classify_locomotion`
+    (``stroke_rule``: with the paper's stroke rule, its ``stroke`` argument)."""
     from .locomotion import classify_locomotion, paddling  # noqa: PLC0415 - avoids an import cycle
     from .trajectory import replay  # noqa: PLC0415
 
@@ -360,7 +360,7 @@ def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0
         cfg["evaluation.steps"] = int(steps)
         for s in swimmers:
             tr = replay(s.body(cfg), cfg)
-            mode = classify_locomotion(tr, stroke=stroke) if tr.stable else None
+            mode = classify_locomotion(tr, stroke=stroke_rule) if tr.stable else None
             stroke = appendage_stroke(s, tr, mode) if mode is not None else None
             paddle = paddling(tr, mode) if mode is not None else None
             out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke,

@@ -578,10 +578,10 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
                 else (float("inf") if ca.max(initial=0.0) > 0 else 0.0))
     local = contrast >= LOCAL_CONTRAST
     prot = concentration >= PROTRUSION_CONCENTRATION or local
+    from .protrusion import STROKE_AREA, STROKE_SCORE, stroke_motion  # noqa: PLC0415 - avoids an import cycle
+
     stroke = None
     if outline is not None and len(outline) >= 3:
-        from .protrusion import STROKE_AREA, STROKE_SCORE, stroke_motion  # noqa: PLC0415
-
         stroke = stroke_motion(Q, tw, omega, motion, outline, sp, rest_positions)
 
     mixed: List[str] = []

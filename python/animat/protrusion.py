@@ -173,7 +173,8 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
     cells = sorted(set(rest) | moving)
     if not cells:
         return _empty()
-    links = [(loop[k], loop[(k + 1) % len(loop)]) for k in range(len(loop))] + [tuple(map(int, e)) for e in sp]
+    links = [(int(loop[k]), int(loop[(k + 1) % len(loop)])) for k in range(len(loop))] + [
+        (int(e[0]), int(e[1])) for e in sp]
     groups = _shape._groups(cells, links)
     rest_set = set(rest)
     groups.sort(key=lambda g: (not (set(g) & rest_set), -len(g), g))

@@ -19,7 +19,7 @@ SETS = {"calibration": K.paper_calibration_set, "held-out": K.paper_held_out_set
 def main(names):
     warnings.simplefilter("ignore")
     for name in names:
-        res = K.classify_known(SETS[name](), drags=(0.5, 2.0), steps=2000, stroke=True)
+        res = K.classify_known(SETS[name](), drags=(0.5, 2.0), steps=2000, stroke_rule=True)
         for r in res:
             st = r.mode.stroke if r.mode is not None else None
             sc = (f"pair score {st.score:+.2f}, area {st.area:.3f}, {len(st.protrusions)} protrusions, "
