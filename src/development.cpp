@@ -44,6 +44,8 @@ void validate(const DevelopmentParams& p) {
   for (const auto& e : p.effects)
     if (std::find(std::begin(kDevelopmentEffectNames), std::end(kDevelopmentEffectNames), e) == std::end(kDevelopmentEffectNames))
       fail("effects", fmt::format("unknown effect '{}' (known: repulsion, adhesion, morphogens)", e));
+  if (std::find(std::begin(kDivisionAxisNames), std::end(kDivisionAxisNames), p.division_axis) == std::end(kDivisionAxisNames))
+    fail("division_axis", fmt::format("unknown value '{}' (expected one of orientation, morphogen_gradient)", p.division_axis));
   if (p.steps < 1) fail("steps", fmt::format("must be >= 1, got {}", p.steps));
   if (p.max_cells < 1) fail("max_cells", fmt::format("must be >= 1, got {}", p.max_cells));
   if (!(p.time_step > 0.0 && p.time_step <= 1.0)) fail("time_step", fmt::format("must be in (0, 1], got {}", p.time_step));
@@ -77,6 +79,7 @@ struct DevelopmentWorld::Impl {
   GrnParams grn_params;
   DevelopmentParams params;
   bool repulsion = false, adhesion = false, morphogens = false;
+  bool gradient_axis = false;  ///< division_axis == "morphogen_gradient"
   std::array<Vec2, 3> sources{};
 
   CellIntegrator motion;  ///< the cells' Box2D state (position, velocity), index = cell
@@ -102,6 +105,7 @@ struct DevelopmentWorld::Impl {
     repulsion = has_effect(params.effects, "repulsion");
     adhesion = has_effect(params.effects, "adhesion");
     morphogens = has_effect(params.effects, "morphogens");
+    gradient_axis = params.division_axis == "morphogen_gradient";
     for (std::size_t k = 0; k < 3; ++k) sources[k] = Vec2(params.maternal_sources[2 * k], params.maternal_sources[2 * k + 1]);
     morph_count = static_cast<int>(grn.morphogen_units().size());
     hist_len = (morphogens && morph_count > 0) ? params.morphogen_max_delay + 1 : 0;
@@ -330,9 +334,22 @@ int DevelopmentWorld::divide(int cell) {
   Vec2 orientation(c * mother.orientation.x() - s * mother.orientation.y(),
                    s * mother.orientation.x() + c * mother.orientation.y());
   orientation.normalize();
+  // The placement axis: the paper's is the mother's orientation. With "morphogen_gradient" it is the
+  // gradient of maternal morphogen 0 at the mother, e^(−|p − s0|/λm), which points from the mother to
+  // source 0 whatever λm, turned by the same 2π·rotate: an absolute, position-dependent axis that the
+  // GRN can turn, instead of one carried down the lineage. At the source itself (no gradient) the
+  // orientation is used.
+  Vec2 direction = mother.orientation;
+  if (w.gradient_axis) {
+    const Vec2 up = w.sources[0] - mother.position;
+    const double norm = up.norm();
+    if (norm > 0.0) {
+      const Vec2 g = up / norm;
+      direction = Vec2(c * g.x() - s * g.y(), s * g.x() + c * g.y());
+    }
+  }
   // A tiny deterministic deviation of the placement direction: without it, a genome that never
   // expresses `rotate` grows an exactly straight line that no force can ever bend.
-  Vec2 direction = mother.orientation;
   if (w.params.placement_jitter > 0.0) {
     Rng rng = Rng::derive(w.symmetry_seed, static_cast<std::uint64_t>(step_), static_cast<std::uint64_t>(cell));
     const double delta = w.params.placement_jitter * rng.uniform(-1.0, 1.0);

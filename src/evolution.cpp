@@ -171,6 +171,8 @@ const std::vector<std::string>& late_keys() {
       "evaluation.push_impulse",  "evaluation.push_cells",
       // The morphogen cut-off (issue 21): at 0 the field is the paper's, every pair.
       "development.morphogen_cutoff",
+      // The division axis: at "orientation" a daughter is placed as in the paper.
+      "development.division_axis",
       // Energy accounting changes no result (and is resumable).
       "evaluation.energy_accounting"};
   return keys;

@@ -25,6 +25,10 @@
 namespace animat {
 
 inline constexpr std::string_view kDevelopmentEffectNames[] = {"repulsion", "adhesion", "morphogens"};
+/// Where a daughter is placed (DevelopmentParams::division_axis): "orientation" (the paper's: along the
+/// mother's orientation vector) or "morphogen_gradient" (along the gradient of maternal morphogen 0 at
+/// the mother's position, turned by 2π × the mother's rotate output).
+inline constexpr std::string_view kDivisionAxisNames[] = {"orientation", "morphogen_gradient"};
 
 struct DevelopmentParams {
   int steps = 400;                ///< development steps [paper: 400]
@@ -37,6 +41,10 @@ struct DevelopmentParams {
   double max_growth = 0.5;        ///< a daughter's radius is r0·(1 + max_growth·grow) [paper: up to +50%]
   double placement_jitter = 0.05; ///< daughter placement direction deviates by up to ± this angle (rad), seeded from the genome [choose]
   double division_offset = 0.2;   ///< daughter centre = mother centre + division_offset·r_mother·orientation [choose]
+  /// Placement direction of a daughter: "orientation" (the mother's orientation vector) [paper] or
+  /// "morphogen_gradient" (the unit gradient of maternal morphogen 0 at the mother's position, i.e.
+  /// toward source 0, rotated by 2π·rotate of the mother) [choose]; the jitter applies to either.
+  std::string division_axis = "orientation";
   double frequency_min = 0.5;     ///< oscillator frequency at output 0, rad per unit time [choose]
   double frequency_max = 6.0;     ///< oscillator frequency at output 1 [choose: docs/model.md]
   double amplitude_max = 0.2;     ///< amplitude scale [paper: 0.2]
@@ -77,6 +85,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"max_growth", "daughter radius is r0*(1 + max_growth*grow) [paper: 0.5]", Bounds::closed(0, 10)}, p.max_growth);
   v(FieldInfo{"placement_jitter", "daughter placement direction deviates by up to +-this angle (rad), seeded from the genome hash; breaks exact symmetry [choose]", Bounds::closed(0, 3.2)}, p.placement_jitter);
   v(FieldInfo{"division_offset", "daughter placed at division_offset*r_mother from the mother along its orientation [choose]", Bounds::closed(0, 10)}, p.division_offset);
+  v(FieldInfo{"division_axis", "direction in which a daughter is placed: orientation (the mother's orientation vector) [paper] or morphogen_gradient (gradient of maternal morphogen 0 at the mother, i.e. toward source 0, rotated by 2*pi*rotate of the mother) [choose]", Bounds::any(), kDivisionAxisNames}, p.division_axis);
   v(FieldInfo{"frequency_min", "oscillator frequency (rad per time unit) at frequency output 0 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_min);
   v(FieldInfo{"frequency_max", "oscillator frequency (rad per time unit) at frequency output 1 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_max);
   v(FieldInfo{"amplitude_max", "oscillator amplitude at amplitude output 1 [paper: 0.2]", Bounds::closed(0, 0.45)}, p.amplitude_max);

@@ -209,6 +209,87 @@ TEST(Development, PlacementJitterIsBoundedSeededAndBreaksStraightLines) {
   EXPECT_EQ(line.positions.col(1).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(Development, GradientDivisionAxisFollowsMaternalMorphogenZeroTurnedByRotate) {
+  const Genome g = bias_divide_genome();
+  const Grn grn(g, GenomeParams{});
+  EXPECT_EQ(DevelopmentParams{}.division_axis, "orientation");  // the paper's placement by default
+  DevelopmentParams p = with_effects({});
+  p.placement_jitter = 0.0;
+  p.division_axis = "morphogen_gradient";
+  const Vec2 s0(p.maternal_sources[0], p.maternal_sources[1]);
+  ASSERT_EQ(s0, Vec2(0.0, 5.0));
+  // A mother at (3, 1), 5 from source 0, oriented along +x (not along the gradient).
+  const Vec2 at(3.0, 1.0);
+  // The gradient of maternal morphogen 0 there, by central differences of maternal_at: it points
+  // to the source, (−3, 4)/5.
+  DevelopmentWorld probe(grn, GrnParams{}, p);
+  const double h = 1e-6;
+  const Vec2 fd((probe.maternal_at(at + Vec2(h, 0))[0] - probe.maternal_at(at - Vec2(h, 0))[0]) / (2 * h),
+                (probe.maternal_at(at + Vec2(0, h))[0] - probe.maternal_at(at - Vec2(0, h))[0]) / (2 * h));
+  EXPECT_NEAR(fd.normalized().x(), -0.6, 1e-6);
+  EXPECT_NEAR(fd.normalized().y(), 0.8, 1e-6);
+  for (const double rotate : {0.0, 0.25, 0.6}) {
+    DevelopmentWorld w(grn, GrnParams{}, p);
+    const int m = w.add_cell(at, 0.5, Vec2(1.0, 0.0));
+    w.state(m).levels[static_cast<std::size_t>(grn.output_node(OutputChannel::rotate))] = rotate;
+    const int d = w.divide(m);
+    // Placed division_offset·r_mother away along the gradient turned by 2π·rotate (counter-clockwise).
+    const double a = std::atan2(0.8, -0.6) + 2.0 * std::numbers::pi * rotate;
+    const Vec2 expected = at + p.division_offset * 0.5 * Vec2(std::cos(a), std::sin(a));
+    EXPECT_NEAR(w.position(d).x(), expected.x(), 1e-6) << rotate;  // float positions in Box2D
+    EXPECT_NEAR(w.position(d).y(), expected.y(), 1e-6) << rotate;
+    // The orientation is inherited and turned as in the paper (it no longer steers placement).
+    const double o = 2.0 * std::numbers::pi * rotate;
+    EXPECT_NEAR(w.orientation(d).x(), std::cos(o), 1e-12);
+    EXPECT_NEAR(w.orientation(d).y(), std::sin(o), 1e-12);
+    EXPECT_EQ(w.orientation(m), Vec2(1.0, 0.0));
+  }
+  // The jitter still applies, within ± placement_jitter of the gradient.
+  p.placement_jitter = 0.05;
+  for (std::uint64_t seed : {1ULL, 2ULL, 3ULL}) {
+    DevelopmentWorld w(grn, GrnParams{}, p);
+    w.set_symmetry_seed(seed);
+    const int m = w.add_cell(at, 0.5, Vec2(1.0, 0.0));
+    const Vec2 along = (w.position(w.divide(m)) - at).normalized();
+    EXPECT_GE(along.dot(Vec2(-0.6, 0.8)), std::cos(p.placement_jitter) - 1e-6);
+  }
+  // At the source there is no gradient: the mother's orientation is used.
+  p.placement_jitter = 0.0;
+  {
+    DevelopmentWorld w(grn, GrnParams{}, p);
+    const int m = w.add_cell(s0, 0.5, Vec2(0.0, -1.0));
+    const Vec2 along = w.position(w.divide(m)) - s0;
+    EXPECT_NEAR(along.x(), 0.0, 1e-6);
+    EXPECT_NEAR(along.y(), -p.division_offset * 0.5, 1e-6);
+  }
+  // Through develop(): a rotate-less genome starting at the origin, below source 0, divides every
+  // cell toward it, a line on the y axis; the paper's placement gives a line on the x axis.
+  DevelopmentParams straight;
+  straight.placement_jitter = 0.0;
+  const Embryo along_x = develop(g, GenomeParams{}, GrnParams{}, straight);
+  straight.division_axis = "morphogen_gradient";
+  const Embryo along_y = develop(g, GenomeParams{}, GrnParams{}, straight);
+  ASSERT_EQ(along_y.cell_count(), straight.max_cells);
+  EXPECT_EQ(along_x.positions.col(1).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(along_y.positions.col(0).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(along_y.positions.col(1).maxCoeff() - along_y.positions.col(1).minCoeff(), 5.0);
+}
+
+TEST(Development, UnknownDivisionAxisIsRejectedNamingKeyAndValue) {
+  DevelopmentParams p;
+  p.division_axis = "gradient";
+  try {
+    validate(p);
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("development.division_axis"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'gradient'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)develop(bias_divide_genome(), GenomeParams{}, GrnParams{}, p), ConfigError);
+  p.division_axis = "morphogen_gradient";
+  EXPECT_NO_THROW(validate(p));
+}
+
 TEST(Development, DivisionRespectsThresholdAndRefractoryPeriod) {
   const Genome g = bias_divide_genome();
   const Grn grn(g, GenomeParams{});

@@ -269,7 +269,8 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nchemical = ", "\nchemical_source = ", "\nchemical_decay_length = ", "\nmode = ", "\nactuation = ",
                           "\nupdate_interval = ", "\ngrn_rate = ", "\nsignal_rate = ", "\nsignal_decay = ",
                           "\nstart_ramp = ", "\nsource_directions = ", "\nsource_seed = ", "\npush_step = ",
-                          "\npush_impulse = ", "\npush_cells = ", "\nmorphogen_cutoff = ", "\nenergy_accounting = "}) {
+                          "\npush_impulse = ", "\npush_cells = ", "\nmorphogen_cutoff = ", "\nenergy_accounting = ",
+                          "\ndivision_axis = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;

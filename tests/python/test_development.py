@@ -98,6 +98,22 @@ def test_rotation_gives_a_two_dimensional_embryo():
     assert np.ptp(blob.positions[:, 1]) > 2.0
 
 
+def test_gradient_division_axis_is_a_config_value():
+    # The paper's placement by default; with division_axis = "morphogen_gradient" a rotate-less genome
+    # divides every cell toward maternal source 0 at (0, 5): a line on the y axis instead of the x axis.
+    assert animat.Config().development.division_axis == "orientation"
+    along_x = animat.develop(bias_genome(), config(placement_jitter=0.0))
+    along_y = animat.develop(bias_genome(), config(placement_jitter=0.0, division_axis="morphogen_gradient"))
+    assert along_y.cell_count == 32
+    assert np.ptp(along_x.positions[:, 1]) == 0.0
+    assert np.ptp(along_y.positions[:, 0]) == 0.0
+    assert np.ptp(along_y.positions[:, 1]) > 5.0
+    np.testing.assert_array_equal(animat.develop(bias_genome(), config(division_axis="orientation")).positions,
+                                  animat.develop(bias_genome()).positions)
+    with pytest.raises(ValueError, match="division_axis.*sideways"):
+        animat.develop(bias_genome(), config(division_axis="sideways"))
+
+
 def test_deterministic():
     g = bias_genome(rotate_at=(1.0, 0.0))
     a, b = animat.develop(g), animat.develop(g)
