@@ -337,8 +337,18 @@ def test_ga_with_a_python_objective_needs_it_for_the_exploit_guard():
     c["evaluation.objective"] = "python:rightward"
     with pytest.raises(ValueError, match=r"python:rightward.*exploit guard.*objective=.*reference_check = 'off'"):
         animat.GA(c)
-    ga = animat.GA(c, objective=animat.Objective(rightward, every=0, name="rightward"))
+    c["evaluation.steps"] = 100
+    c["evaluation.reference_substeps"] = 2
+    c["evolution.generations"] = 2
+    objective = animat.Objective(rightward, every=10, name="rightward")
+    ga = animat.GA(c, objective=objective)
     assert ga.config["evaluation.objective"] == "python:rightward"
+    while not ga.done:
+        ga.step()  # evaluate_population with the objective; the guard scores with it at the reference step
+    ref = animat.evolve(c, objective=objective, quiet=True)
+    assert np.isfinite(ga.history["best_reference"]).all()
+    for name in ("best", "mean", "best_reference", "evaluations"):
+        assert list(ga.history[name]) == list(ref.history[name]), name
     off = c.copy()
     off["evaluation.reference_check"] = "off"
     animat.GA(off)  # no guard: nothing to evaluate here
