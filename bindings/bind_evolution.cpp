@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 
 #include <atomic>
+#include <mutex>
+#include <unordered_set>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
@@ -59,6 +61,38 @@ GenerationStats stats_from_dict(const nb::dict& d) {
   if (d.contains("drag_limited")) s.drag_limited = nb::cast<int>(d["drag_limited"]);
   return s;
 }
+
+// An Evolution's ask() and tell() run without the GIL (the exploit guard's reference swims, a Python
+// objective scoring them on the evaluation threads): every method holds a lease on its engine, and a
+// second thread gets a RuntimeError instead of a data race.
+class EngineLease {
+ public:
+  EngineLease(const Evolution& e, const char* method) : engine_(&e) {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (!busy().insert(engine_).second)
+      throw std::runtime_error(fmt::format(
+          "animat.GA.{}: this GA is in use by another thread (an ask() or tell() is running); drive a GA from one "
+          "thread at a time",
+          method));
+  }
+  ~EngineLease() {
+    std::lock_guard<std::mutex> lock(mutex());
+    busy().erase(engine_);
+  }
+  EngineLease(const EngineLease&) = delete;
+  EngineLease& operator=(const EngineLease&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static std::unordered_set<const Evolution*>& busy() {
+    static std::unordered_set<const Evolution*> set;
+    return set;
+  }
+  const Evolution* engine_;
+};
 
 std::string fitness_repr(const Fitness& f) {
   return fmt::format("animat.Fitness(fitness={}, viable={}, stable={}, cell_count={})", f.fitness,
@@ -145,23 +179,56 @@ void bind_evolution(nb::module_& m) {
 
   nb::class_<Evolution>(m, "Evolution",
                         "The GA engine behind animat.evolve, driven by ask()/tell() (animat.GA wraps it).")
-      .def(nb::init<const Config&>(), "config"_a)
-      .def("ask", &Evolution::ask, "lookahead"_a = 1,
-           "The genomes that need a fitness next (see animat.GA.ask).")
-      .def("tell", &Evolution::tell, "fitness"_a,
-           "The Fitness of every genome of the last ask(), in order; True when a generation completed.")
-      .def_prop_ro("asked", &Evolution::asked, "Whether an ask() awaits its tell().")
-      .def_prop_ro("generation", &Evolution::generation, "Last completed generation (-1 while drawing the initial population).")
-      .def_prop_ro("population", [](const Evolution& e) { return e.population(); }, "The population (list of Individual).")
-      .def_prop_ro("best", [](const Evolution& e) { return e.best(); }, "The best Individual (first of the fittest).")
-      .def_prop_ro("history", [](const Evolution& e) { return e.history(); }, "GenerationStats of every generation.")
-      .def_prop_ro("evaluations", &Evolution::evaluations, "Fitness evaluations counted so far.")
-      .def_prop_ro("generations_without_improvement", &Evolution::generations_without_improvement)
-      .def("stop_reason", &Evolution::stop_reason, "Why the run should stop now ('' = keep going).")
-      .def("initial_tries", &Evolution::initial_tries, "Random genomes drawn per initial individual.")
-      .def("checkpoint", &Evolution::checkpoint, "The whole state as checkpoint JSON text (the run directory's format).")
-      .def("restore", [](Evolution& e, const std::string& text, const std::string& source) { e.restore(text, source); },
-           "text"_a, "source"_a = "checkpoint", "Restore a checkpoint (refused if corrupt or of another config).");
+      .def("__init__", [](Evolution* e, const Config& c, nb::handle objective) {
+            // The exploit guard, as animat.evolve has it: each new best re-evaluated at the reference
+            // step with the run's objective (evaluation.reference_check "record" or "select").
+            FitnessFunction reference;
+            if (c.evaluation.reference_check != "off")
+              reference = objective_fitness(reference_config(c), objective_from_python(objective, c));
+            new (e) Evolution(c, {}, std::move(reference));
+          }, "config"_a, "objective"_a = nb::none(),
+          "An engine for ask()/tell(). objective: None (the config's evaluation.objective), a built-in name or\n"
+          "a Python objective: what the exploit guard re-evaluates each new best with (unless\n"
+          "evaluation.reference_check = \"off\"), at physics.substeps x evaluation.reference_substeps.")
+      .def("ask", [](Evolution& e, int lookahead) {
+            EngineLease lease(e, "ask");
+            nb::gil_scoped_release release;  // "select" evaluates the elite candidates' references
+            return e.ask(lookahead);
+          }, "lookahead"_a = 1, "The genomes that need a fitness next (see animat.GA.ask).")
+      .def("tell", [](Evolution& e, const std::vector<Fitness>& fitness) {
+            EngineLease lease(e, "tell");
+            nb::gil_scoped_release release;  // the exploit guard evaluates a new best's reference
+            return e.tell(fitness);
+          }, "fitness"_a,
+           "The Fitness of every genome of the last ask(), in order; True when a generation completed. Refuses\n"
+           "(ValueError naming the value's index) what the engine's own evaluations refuse: a fitness that is\n"
+           "not finite, a negative one under a distance objective, a negative cell_count.")
+      .def_prop_ro("asked", [](const Evolution& e) { EngineLease l(e, "asked"); return e.asked(); },
+                   "Whether an ask() awaits its tell().")
+      .def_prop_ro("generation", [](const Evolution& e) { EngineLease l(e, "generation"); return e.generation(); },
+                   "Last completed generation (-1 while drawing the initial population).")
+      .def_prop_ro("population", [](const Evolution& e) { EngineLease l(e, "population"); return e.population(); },
+                   "The population (list of Individual).")
+      .def_prop_ro("best", [](const Evolution& e) { EngineLease l(e, "best"); return e.best(); },
+                   "The best Individual (first of the fittest).")
+      .def_prop_ro("history", [](const Evolution& e) { EngineLease l(e, "history"); return e.history(); },
+                   "GenerationStats of every generation.")
+      .def_prop_ro("evaluations", [](const Evolution& e) { EngineLease l(e, "evaluations"); return e.evaluations(); },
+                   "Fitness evaluations counted so far.")
+      .def_prop_ro("generations_without_improvement", [](const Evolution& e) {
+            EngineLease l(e, "generations_without_improvement");
+            return e.generations_without_improvement();
+          })
+      .def("stop_reason", [](const Evolution& e) { EngineLease l(e, "stop_reason"); return e.stop_reason(); },
+           "Why the run should stop now ('' = keep going).")
+      .def("initial_tries", [](const Evolution& e) { EngineLease l(e, "initial_tries"); return e.initial_tries(); },
+           "Random genomes drawn per initial individual.")
+      .def("checkpoint", [](const Evolution& e) { EngineLease l(e, "checkpoint"); return e.checkpoint(); },
+           "The whole state as checkpoint JSON text (the run directory's format).")
+      .def("restore", [](Evolution& e, const std::string& text, const std::string& source) {
+            EngineLease l(e, "restore");
+            e.restore(text, source);
+          }, "text"_a, "source"_a = "checkpoint", "Restore a checkpoint (refused if corrupt or of another config).");
 
   nb::class_<RunSummary>(m, "EvolutionSummary", "What animat._core.evolve returns (animat.evolve wraps it).")
       .def_ro("history", &RunSummary::history, "List of GenerationStats, generation 0 first.")
@@ -242,6 +309,10 @@ void bind_evolution(nb::module_& m) {
             nb::gil_scoped_release release;
             summary = run_evolution(c, opt, std::move(fitness), std::move(reference));
           }
+          // Ctrl-C while the Python objective ran: its KeyboardInterrupt (the run stopped as for a signal).
+          if (auto interrupt = take_interrupt(scored_by); interrupt && !pending) pending.emplace(std::move(*interrupt));
+          // A Ctrl-C is an interruption wherever it landed (in the callback too), not the callback's answer.
+          if (pending && pending->matches(PyExc_KeyboardInterrupt)) summary.stop_reason = "interrupted";
           if (pending) {
             nb::object result = nb::cast(std::move(summary));
             PyObject_SetAttrString(pending->value().ptr(), "result", result.ptr());

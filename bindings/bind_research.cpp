@@ -14,6 +14,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "animat/development.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
+#include "animat/evolution.hpp"
 #include "animat/external_actuation.hpp"
 #include "animat/objective.hpp"
 #include "animat/physics.hpp"
@@ -209,6 +211,7 @@ class PythonObjective final : public Objective {
   }
   ~PythonObjective() override {
     nb::gil_scoped_acquire gil;
+    interrupt_.reset();
     obj_.reset();
   }
   std::string name() const override { return name_; }
@@ -223,15 +226,29 @@ class PythonObjective final : public Objective {
                                 nb::cast<std::string>(nb::str(out.type().attr("__name__")))));
       return nb::cast<double>(out.attr("__float__")());
     } catch (nb::python_error& e) {
+      // Ctrl-C while the objective ran: kept (under the GIL) for the caller to raise again, and the
+      // evaluation stops like a signal stops it (Interrupted; animat.evolve raises the KeyboardInterrupt
+      // with the partial result, stop reason "interrupted").
+      if (e.matches(PyExc_KeyboardInterrupt)) {
+        if (!interrupt_) interrupt_.emplace(std::move(e));
+        throw Interrupted(fmt::format("objective {} interrupted (KeyboardInterrupt)", name_));
+      }
       // Re-raised as a C++ error: a Python exception must not cross the evaluation threads.
       throw Error(fmt::format("objective {} raised {}", name_, e.what()));
     }
+  }
+  /// The KeyboardInterrupt it raised, if any (with the GIL held).
+  std::optional<nb::python_error> take_interrupt() const {
+    std::optional<nb::python_error> out = std::move(interrupt_);
+    interrupt_.reset();
+    return out;
   }
 
  private:
   nb::object obj_;
   std::string name_;
   long every_ = 0;
+  mutable std::optional<nb::python_error> interrupt_;  ///< touched with the GIL held only
 };
 
 ExternalActuation::Mode actuation_mode(const std::string& mode) {
@@ -257,6 +274,11 @@ std::shared_ptr<const Objective> objective_from_python(nb::handle objective, con
     return make_objective(p);
   }
   return std::make_shared<PythonObjective>(nb::borrow(objective));
+}
+
+std::optional<nb::python_error> take_interrupt(const std::shared_ptr<const Objective>& objective) {
+  if (const auto* python = dynamic_cast<const PythonObjective*>(objective.get())) return python->take_interrupt();
+  return std::nullopt;
 }
 
 void bind_research(nb::module_& m) {

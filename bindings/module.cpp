@@ -35,6 +35,8 @@ NB_MODULE(_core, m) {
       set_error(PyExc_FileExistsError, e.what());
     } catch (const animat::IoError& e) {
       set_error(PyExc_OSError, e.what());
+    } catch (const animat::Interrupted& e) {  // Ctrl-C in a Python objective (animat.evaluate, GA.step, ...)
+      set_error(PyExc_KeyboardInterrupt, e.what());
     } catch (const animat::SimulationError& e) {
       set_error(PyExc_RuntimeError, e.what());
     } catch (const animat::Error& e) {

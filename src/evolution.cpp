@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 #include "animat/config.hpp"
@@ -61,8 +62,8 @@ class StopWatch {
  public:
   explicit StopWatch(const StopRequest& request) : request_(request) {}
   bool stopped() {
-    if (request_.empty()) return false;
     if (stopped_.load(std::memory_order_relaxed)) return true;
+    if (request_.empty()) return false;
     if (request_.flag && request_.flag->load()) return stop();
     if (request_.poll && omp_get_thread_num() == 0) {
       const double t = now_seconds();
@@ -75,6 +76,8 @@ class StopWatch {
   }
   /// Whether a stop was seen (no new poll).
   [[nodiscard]] bool fired() const { return stopped_.load(); }
+  /// Stops the work from within (an evaluation that was itself interrupted): stopped() is true from now on.
+  void request_stop() { stop(); }
 
  private:
   bool stop() {
@@ -92,12 +95,45 @@ bool nonnegative_objective(const Config& c) {
   return c.evaluation.objective == "distance" || c.evaluation.objective == "distance_per_size";
 }
 
-// A fitness the GA can rank and a checkpoint can hold: finite, and >= 0 for a distance objective.
-void check_fitness(const Fitness& f, std::string_view where, bool nonnegative) {
+// A fitness the GA can rank and a checkpoint can hold (restore() refuses anything else): finite, and
+// >= 0 for a distance objective; cell_count and drag_limited >= 0. "" = acceptable, else what is wrong.
+// The one rule for every way a fitness reaches the engine: its own evaluations, tell() (animat.GA) and
+// the exploit guard's reference evaluations.
+std::string fitness_problem(const Fitness& f, bool nonnegative) {
   if (!std::isfinite(f.fitness) || (nonnegative && f.fitness < 0.0))
-    throw Error(fmt::format("{}: the fitness function returned {}; a fitness must be finite{}", where, f.fitness,
-                            nonnegative ? " and >= 0" : ""));
-  if (f.cell_count < 0) throw Error(fmt::format("{}: the fitness function returned cell_count {} (must be >= 0)", where, f.cell_count));
+    return fmt::format("fitness {} (a fitness must be finite{})", f.fitness,
+                       nonnegative ? " and >= 0 under evaluation.objective = distance or distance_per_size" : "");
+  if (f.cell_count < 0) return fmt::format("cell_count {} (must be >= 0)", f.cell_count);
+  if (f.drag_limited < 0) return fmt::format("drag_limited {} (must be >= 0)", f.drag_limited);
+  return {};
+}
+
+void check_fitness(const Fitness& f, std::string_view where, bool nonnegative) {
+  if (const std::string problem = fitness_problem(f, nonnegative); !problem.empty())
+    throw Error(fmt::format("{}: the fitness function returned {}", where, problem));
+}
+
+// The mean of finite values, never overflowing: their plain sum / n (bit for bit the value every run
+// so far recorded) when that sum is finite; otherwise the sum of the values scaled by 2^-(k+1), with
+// 2^k > n, which cannot overflow (|sum| <= n max|x| 2^-(k+1) < max|x| / 2), clamped to [min, max],
+// where the true mean lies. So a generation of finite fitnesses has a finite mean (docs/reliability.md).
+double finite_mean(const std::vector<double>& v) {
+  const double n = static_cast<double>(v.size());
+  const double sum = std::accumulate(v.begin(), v.end(), 0.0);
+  if (std::isfinite(sum)) return sum / n;
+  int k = 0;
+  std::frexp(n, &k);  // n < 2^k
+  double scaled = 0.0;
+  for (double x : v) scaled += std::ldexp(x, -(k + 1));
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  return std::clamp(std::ldexp(scaled / n, k + 1), *lo, *hi);
+}
+
+// The midpoint of two finite values, never overflowing: 0.5 (a + b) (bit for bit today's) when a + b
+// is finite, else 0.5 a + 0.5 b.
+double finite_midpoint(double a, double b) {
+  const double sum = a + b;
+  return std::isfinite(sum) ? 0.5 * sum : 0.5 * a + 0.5 * b;
 }
 
 bool fitter(const Individual& a, const Individual& b) {
@@ -259,7 +295,12 @@ void Evolution::check_reference() {
   const Individual& b = best();
   if (!b.result.viable) return;
   Individual& mutable_best = population_[static_cast<std::size_t>(&b - population_.data())];
-  if (std::isnan(mutable_best.reference)) mutable_best.reference = reference_(mutable_best.genome).fitness;
+  if (std::isnan(mutable_best.reference)) {
+    const Fitness r = reference_(mutable_best.genome);
+    check_fitness(r, fmt::format("exploit guard, generation {}: the reference evaluation of the best", generation_),
+                  nonnegative_objective(*config_));
+    mutable_best.reference = r.fitness;
+  }
   history_.back().best_reference = mutable_best.reference;
 }
 
@@ -271,8 +312,14 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
   std::vector<std::size_t> todo;
   for (std::size_t c : cand)
     if (std::isnan(population_[c].reference)) todo.push_back(c);
-  parallel_for(todo.size(), config_->evolution.threads,
-               [&](std::size_t k) { population_[todo[k]].reference = reference_(population_[todo[k]].genome).fitness; });
+  std::vector<Fitness> refs(todo.size());
+  parallel_for(todo.size(), config_->evolution.threads, [&](std::size_t k) {
+    refs[k] = reference_(population_[todo[k]].genome);
+    check_fitness(refs[k], fmt::format("exploit guard (select): the reference evaluation of individual {}", todo[k]),
+                  nonnegative_objective(*config_));
+  });
+  // Stored only once every one is known and acceptable: an exception leaves the population as it was.
+  for (std::size_t k = 0; k < todo.size(); ++k) population_[todo[k]].reference = refs[k].fitness;
   std::stable_sort(cand.begin(), cand.end(),
                    [&](std::size_t a, std::size_t b) { return population_[a].reference > population_[b].reference; });
   if (cand.size() > elites) cand.resize(elites);
@@ -330,7 +377,12 @@ std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& geno
   StopWatch watch(stop_);
   parallel_for(genomes.size(), config_->evolution.threads, [&](std::size_t k) {
     if (watch.stopped()) return;
-    out[k] = fitness_(genomes[k]);
+    try {
+      out[k] = fitness_(genomes[k]);
+    } catch (const Interrupted&) {  // the fitness function itself was interrupted (Ctrl-C in a Python objective)
+      watch.request_stop();
+      return;
+    }
     check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
   });
   if (watch.fired())
@@ -352,10 +404,38 @@ bool Evolution::tell(const std::vector<Fitness>& fitness) {
   if (fitness.size() != asked_.size())
     throw Error(fmt::format("Evolution::tell: {} fitness values for the {} genomes of the last ask()", fitness.size(),
                             asked_.size()));
+  // The engine's own rule for its evaluations (check_fitness): what tell() accepts, a checkpoint holds
+  // and restore() reads back.
   for (std::size_t k = 0; k < fitness.size(); ++k)
-    if (!std::isfinite(fitness[k].fitness))
-      throw Error(fmt::format("Evolution::tell: fitness {} of genome {} is not finite", fitness[k].fitness, k));
-  const bool done = generation_ < 0 ? tell_initial(fitness) : tell_generation(fitness);
+    if (const std::string problem = fitness_problem(fitness[k], nonnegative_objective(*config_)); !problem.empty())
+      throw Error(fmt::format("Evolution::tell: value {} (genome {} of the last ask()) is refused: {}", k, k, problem));
+  bool done = false;
+  if (!reference_) {
+    done = generation_ < 0 ? tell_initial(fitness) : tell_generation(fitness);
+  } else {
+    // The exploit guard evaluates the new best at the end of the tell; if that throws (an interrupted
+    // Python objective, a refused reference fitness), the engine is put back as it was before this
+    // tell, the ask still pending: the same tell can be repeated.
+    auto saved_population = population_;
+    auto saved_slots = slots_;
+    auto saved_next = next_;
+    auto saved_history = history_;
+    auto saved_migrations = migrations_;
+    auto saved_asked = asked_;  // tell_initial moves the viable genomes out of it
+    const auto saved = std::make_tuple(generation_, stall_, best_ever_, evaluations_);
+    try {
+      done = generation_ < 0 ? tell_initial(fitness) : tell_generation(fitness);
+    } catch (...) {
+      population_ = std::move(saved_population);
+      slots_ = std::move(saved_slots);
+      next_ = std::move(saved_next);
+      history_ = std::move(saved_history);
+      migrations_ = std::move(saved_migrations);
+      asked_ = std::move(saved_asked);
+      std::tie(generation_, stall_, best_ever_, evaluations_) = saved;
+      throw;
+    }
+  }
   pending_ = false;
   asked_.clear();
   asked_index_.clear();
@@ -534,10 +614,10 @@ GenerationStats population_statistics(const std::vector<Individual>& population)
   s.best_cells = b.result.cell_count;
   s.viable_fraction = static_cast<double>(viable.size()) / static_cast<double>(population.size());
   if (!viable.empty()) {
-    s.mean = std::accumulate(viable.begin(), viable.end(), 0.0) / static_cast<double>(viable.size());
+    s.mean = finite_mean(viable);
     std::sort(viable.begin(), viable.end());
     const std::size_t m = viable.size() / 2;
-    s.median = viable.size() % 2 ? viable[m] : 0.5 * (viable[m - 1] + viable[m]);
+    s.median = viable.size() % 2 ? viable[m] : finite_midpoint(viable[m - 1], viable[m]);
   }
   return s;
 }

@@ -187,8 +187,10 @@ struct Individual {
 struct GenerationStats {
   int generation = 0;
   double best = 0.0;     ///< best fitness in the population (all-time best, thanks to elitism)
-  double mean = 0.0;     ///< over viable individuals
-  double median = 0.0;   ///< over viable individuals
+  /// Over viable individuals; finite whenever their fitnesses are (no overflow: see finite_mean in
+  /// evolution.cpp), so that a checkpoint always holds it.
+  double mean = 0.0;
+  double median = 0.0;   ///< over viable individuals (finite likewise)
   double viable_fraction = 0.0;
   int best_cells = 0;
   std::int64_t evaluations = 0;  ///< cumulative fitness evaluations (swims and non-viable developments)
@@ -274,8 +276,12 @@ class Evolution {
   /// ask() again before tell() returns the same genomes.
   std::vector<Genome> ask(int lookahead = 1);
   /// The fitness of every genome of the last ask(), in order. Returns true when this completed a
-  /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a
-  /// non-finite fitness, or an initial slot that used up evolution.max_init_tries.
+  /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a value
+  /// that the engine's own evaluations refuse (naming its index: a fitness that is not finite, a
+  /// negative one under a distance objective, a negative cell_count or drag_limited), or an initial
+  /// slot that used up evolution.max_init_tries. With a reference fitness function (the exploit
+  /// guard), a tell that completes a generation with a new best evaluates its reference here, as
+  /// step() does; if that throws, the engine is left as before the tell (the ask still pending).
   bool tell(const std::vector<Fitness>& fitness);
   /// Whether an ask() awaits its tell().
   [[nodiscard]] bool asked() const { return pending_; }

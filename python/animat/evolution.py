@@ -214,6 +214,14 @@ class GA:
     each ``ask()`` returns the offspring of the next generation that need a fitness (elites and
     unchanged copies keep theirs; the list may be empty: tell ``[]``).
 
+    The exploit guard (``evaluation.reference_check``, "record" by default, or "select") is the
+    engine's, as in :func:`evolve`: when a generation brings a new best, ``tell()`` re-evaluates it
+    itself, in this process, with animat's swim at the reference step (``physics.substeps`` x
+    ``evaluation.reference_substeps``) and the GA's objective, and "select" ranks the elite candidates
+    by their reference fitness in ``ask()``. So the loop below gives ``evolve``'s run, ``best_reference``
+    included. When your fitness is not animat's swim (your own simulator), set
+    ``evaluation.reference_check = "off"``: a reference of animat's swim would mean nothing there.
+
     Example::
 
         ga = animat.GA(config)
@@ -221,11 +229,26 @@ class GA:
             genomes = ga.ask()
             ga.tell([animat.evaluate(g, config) for g in genomes])
         print(ga.best.fitness, ga.history["best"])
+
+    Args:
+        config: the run's :class:`animat.Config` (default: the embedded paper setting).
+        objective: as for :func:`evolve`: a built-in name, a callable or an :class:`Objective` (sets
+            ``evaluation.objective``); what :meth:`step` and the exploit guard score with. A config
+            whose ``evaluation.objective`` is ``"python:NAME"`` needs it unless ``reference_check`` is
+            ``"off"`` (ValueError otherwise).
     """
 
-    def __init__(self, config: Any = None) -> None:
-        self._config = _core.Config() if config is None else config.copy()
-        self._engine = _core.Evolution(self._config)
+    def __init__(self, config: Any = None, objective: ObjectiveLike = None) -> None:
+        obj = _objective(objective)
+        self._config = _config_for(config, obj)
+        self._objective = obj if isinstance(obj, Objective) else None
+        name = str(self._config["evaluation.objective"])
+        guard = str(self._config["evaluation.reference_check"])
+        if name.startswith("python:") and self._objective is None and guard != "off":
+            raise ValueError(f"GA: evaluation.objective = {name!r} is a Python objective and the exploit guard "
+                             f"(evaluation.reference_check = {guard!r}) re-evaluates each new best with it: pass "
+                             "objective=animat.Objective(...) with that name, or set evaluation.reference_check = 'off'")
+        self._engine = _core.Evolution(self._config, self._objective)
 
     # --- the loop ---------------------------------------------------------------------------------
     def ask(self, lookahead: int = 1) -> List[Any]:
@@ -239,8 +262,22 @@ class GA:
         """The fitness of every genome of the last ``ask()``, in order: numbers, None (not viable),
         :class:`animat.Fitness` or :class:`animat.EvaluationResult` (see :func:`to_fitness`).
         Returns the :class:`animat.GenerationStats` of the generation this completed, or None while
-        the initial population is still being drawn."""
-        values = [to_fitness(v) for v in fitnesses]
+        the initial population is still being drawn.
+
+        Raises:
+            ValueError: naming the value's index, for what the engine's own evaluations refuse: a
+                fitness that is not finite, a negative one under ``evaluation.objective`` = distance
+                or distance_per_size, a negative ``cell_count``. Nothing is taken: tell again.
+            KeyboardInterrupt: Ctrl-C in the objective during the exploit guard's reference evaluation
+                (the GA is as before the call)."""
+        values = []
+        for i, v in enumerate(fitnesses):
+            try:
+                values.append(to_fitness(v))
+            except (TypeError, ValueError) as e:
+                raise type(e)(f"GA.tell: value {i} ({v!r:.60}): {e}") from None
+        # The engine checks every value as it checks its own evaluations (finite; >= 0 under a distance
+        # objective; cell_count >= 0): what tell() accepts, a checkpoint holds and GA.load reads back.
         if self._engine.tell(values):
             return self._engine.history[-1]
         return None
@@ -254,7 +291,7 @@ class GA:
         n = int(cfg["evolution.threads"]) if threads is None else threads
 
         def in_parallel(genomes: List[Any]) -> Sequence[Any]:
-            return evaluate_population(genomes, cfg, n)
+            return evaluate_population(genomes, cfg, n, objective=self._objective)
 
         fitness_of = in_parallel if evaluate is None else evaluate
         target = self.generation + 1
@@ -320,15 +357,15 @@ class GA:
         return path
 
     @classmethod
-    def from_checkpoint(cls, text: str, config: Any, source: str = "checkpoint") -> "GA":
+    def from_checkpoint(cls, text: str, config: Any, source: str = "checkpoint", objective: ObjectiveLike = None) -> "GA":
         """A GA restored from checkpoint text; ``config`` must be the run's (only its stopping and
-        resource knobs may differ), else ValueError."""
-        ga = cls(config)
+        resource knobs may differ), else ValueError. ``objective``: as for :class:`GA`."""
+        ga = cls(config, objective)
         ga._engine.restore(text, source)
         return ga
 
     @classmethod
-    def load(cls, path: PathLike, config: Any = None) -> "GA":
+    def load(cls, path: PathLike, config: Any = None, objective: ObjectiveLike = None) -> "GA":
         """A GA restored from a checkpoint file: one written by :meth:`save`, or a run directory's
         ``checkpoint.json`` (or the run directory itself: its config.toml is then the default config)."""
         path = Path(path)
@@ -338,14 +375,18 @@ class GA:
             path = path / "checkpoint.json"
         if config is None:
             raise ValueError(f"GA.load({str(path)!r}): pass the run's config (a checkpoint holds only its identity)")
-        return cls.from_checkpoint(path.read_text(encoding="utf-8"), config, str(path))
+        return cls.from_checkpoint(path.read_text(encoding="utf-8"), config, str(path), objective)
 
     def __getstate__(self) -> dict:
-        return {"config": self._config, "checkpoint": self.checkpoint()}
+        state = {"config": self._config, "checkpoint": self.checkpoint()}
+        if self._objective is not None:
+            state["objective"] = self._objective  # pickled with it (a module-level function pickles)
+        return state
 
     def __setstate__(self, state: dict) -> None:
         self._config = state["config"]
-        self._engine = _core.Evolution(self._config)
+        self._objective = state.get("objective")
+        self._engine = _core.Evolution(self._config, self._objective)
         self._engine.restore(state["checkpoint"], "pickle")
 
     def __repr__(self) -> str:

@@ -1,7 +1,9 @@
 // The GA engine, checked in milliseconds with a cheap deterministic stub fitness.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -323,4 +325,200 @@ TEST(EndToEnd, RealRunIsIdenticalOnOneAndTwoThreads) {
   const RunSummary two = run_evolution(c, opt);
   expect_same_history(one.history, two.history);
   EXPECT_TRUE(one.best.genome == two.best.genome);
+}
+
+// --- The Python paths held to the engine's rules (tell, statistics, the exploit guard) ----------------
+
+namespace {
+
+constexpr double kHuge = std::numeric_limits<double>::max();
+
+// Completes generation 0 and `generations` more by ask()/tell(), every viable genome told `value`.
+Evolution told_everything(const Config& c, double value, int generations) {
+  Evolution evo(c);
+  while (evo.generation() < generations) {
+    const std::vector<Genome> genomes = evo.ask();
+    std::vector<Fitness> f;
+    f.assign(genomes.size(), Fitness{value, true, true, 5});
+    evo.tell(f);
+  }
+  return evo;
+}
+
+}  // namespace
+
+TEST(Evolution, TellRefusesWhatTheEnginesOwnEvaluationsRefuseNamingTheValue) {
+  Config c = small_config(6);  // evaluation.objective = distance: a fitness is >= 0
+  Evolution evo(c);
+  const std::size_t n = evo.ask().size();
+  auto told = [&](std::size_t at, Fitness bad) {
+    std::vector<Fitness> f(n, Fitness{1.0, true, true, 3});
+    f[at] = bad;
+    try {
+      evo.tell(f);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string negative = told(2, Fitness{-1.5, true, true, 3});
+  EXPECT_NE(negative.find("value 2"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("fitness -1.5"), std::string::npos) << negative;
+  EXPECT_NE(negative.find(">= 0"), std::string::npos) << negative;
+  const std::string cells = told(4, Fitness{1.0, true, true, -7});
+  EXPECT_NE(cells.find("value 4"), std::string::npos) << cells;
+  EXPECT_NE(cells.find("cell_count -7"), std::string::npos) << cells;
+  const std::string infinite = told(0, Fitness{std::numeric_limits<double>::infinity(), true, true, 3});
+  EXPECT_NE(infinite.find("value 0"), std::string::npos) << infinite;
+  EXPECT_NE(infinite.find("fitness inf"), std::string::npos) << infinite;
+  // Nothing was taken: the ask is still pending, and a good tell completes generation 0.
+  EXPECT_TRUE(evo.asked());
+  EXPECT_EQ(evo.generation(), -1);
+  EXPECT_TRUE(evo.tell(std::vector<Fitness>(n, Fitness{1.0, true, true, 3})));
+  EXPECT_EQ(evo.generation(), 0);
+
+  // A signed objective accepts a negative fitness, and its checkpoint restores.
+  c.evaluation.objective = "speed_toward";
+  const Evolution signed_run = told_everything(c, -2.0, 1);
+  Evolution back(c);
+  back.restore(signed_run.checkpoint());
+  EXPECT_EQ(back.history().back().mean, -2.0);
+}
+
+TEST(Evolution, StatisticsOfHugeFiniteFitnessesStayFiniteAndTheCheckpointRestores) {
+  // The plain mean of 6 fitnesses of DBL_MAX was inf: the checkpoint held null and never restored.
+  Config c = small_config(6);
+  const Evolution top = told_everything(c, kHuge, 2);
+  for (const auto& s : top.history()) {
+    EXPECT_EQ(s.mean, kHuge) << "generation " << s.generation;
+    EXPECT_EQ(s.median, kHuge) << "generation " << s.generation;
+  }
+  Evolution back(c);
+  back.restore(top.checkpoint());
+  EXPECT_EQ(back.generation(), 2);
+  c.evaluation.objective = "speed_toward";  // signed: the same at the other end
+  const Evolution bottom = told_everything(c, -kHuge, 1);
+  EXPECT_EQ(bottom.history().back().mean, -kHuge);
+  EXPECT_EQ(bottom.history().back().median, -kHuge);
+  Evolution back2(c);
+  back2.restore(bottom.checkpoint());
+  EXPECT_EQ(back2.generation(), 1);
+}
+
+TEST(RunDirectory, HugeFiniteFitnessesGiveAFiniteHistoryAndAResumableCheckpoint) {
+  // animat_evolve's path (run_evolution): every history row finite, the checkpoint resumes, and the
+  // resumed run is the uninterrupted one.
+  const FitnessFunction huge = [](const Genome& g) {
+    Fitness f = stub_fitness(g);
+    if (f.viable) f.fitness = kHuge * (0.5 + 0.25 * std::clamp(f.fitness, -1.0, 1.0));  // in [DBL_MAX/4, 3 DBL_MAX/4]
+    return f;
+  };
+  const auto dir = fresh_dir("huge");
+  Config c = small_config(8);
+  c.evolution.generations = 3;
+  RunOptions opt;
+  opt.out = dir;
+  opt.quiet = true;
+  const RunSummary first = run_evolution(c, opt, huge);
+  for (const auto& s : first.history) {
+    EXPECT_TRUE(std::isfinite(s.mean) && std::isfinite(s.median)) << "generation " << s.generation;
+    EXPECT_LE(s.mean, s.best);
+    EXPECT_GE(s.mean, kHuge / 4);
+  }
+  const std::string hist = slurp(dir / "history.csv");
+  EXPECT_EQ(hist.find("inf"), std::string::npos) << hist;
+  EXPECT_EQ(slurp(dir / "checkpoint.json").find("null"), std::string::npos);
+  c.evolution.generations = 5;
+  opt.resume = true;
+  const RunSummary resumed = run_evolution(c, opt, huge);
+  EXPECT_EQ(resumed.history.back().generation, 5);
+  RunOptions straight;
+  straight.out = fresh_dir("huge_straight");
+  straight.quiet = true;
+  expect_same_history(run_evolution(c, straight, huge).history, resumed.history);
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(straight.out);
+}
+
+TEST(Evolution, ARefusedReferenceLeavesTheEngineAsBeforeTheTell) {
+  // The exploit guard's reference evaluation runs inside tell(); a reference that is not finite was
+  // stored (the checkpoint then held null). Now it is refused and the tell undone, the ask pending.
+  Config c = small_config(6);
+  c.evaluation.reference_check = "record";
+  int calls = 0;
+  const FitnessFunction flaky = [&calls](const Genome& g) {
+    Fitness f = stub_fitness(g);
+    if (++calls == 1) f.fitness = std::numeric_limits<double>::quiet_NaN();  // first reference: refused
+    return f;
+  };
+  Evolution evo(c, {}, flaky);
+  Evolution twin(c, {}, stub_fitness);
+  auto answer = [](const std::vector<Genome>& genomes) {
+    std::vector<Fitness> f;
+    for (const Genome& g : genomes) f.push_back(stub_fitness(g));
+    return f;
+  };
+  while (evo.generation() < 0) {
+    const auto genomes = evo.ask();
+    ASSERT_EQ(genomes, twin.ask());
+    const auto f = answer(genomes);
+    twin.tell(f);
+    if (twin.generation() == 0) {  // this tell completes generation 0: its reference is evaluated
+      EXPECT_THROW(evo.tell(f), Error);
+      EXPECT_EQ(evo.generation(), -1);
+      EXPECT_TRUE(evo.asked());
+      EXPECT_EQ(evo.ask(), genomes);
+    }
+    evo.tell(f);
+  }
+  for (int g = 0; g < 3; ++g) {
+    const auto genomes = evo.ask();
+    ASSERT_EQ(genomes, twin.ask());
+    evo.tell(answer(genomes));
+    twin.tell(answer(genomes));
+  }
+  expect_same_history(evo.history(), twin.history());
+  for (std::size_t k = 0; k < evo.history().size(); ++k)
+    EXPECT_EQ(evo.history()[k].best_reference, twin.history()[k].best_reference) << k;
+  Evolution back(c, {}, stub_fitness);
+  back.restore(evo.checkpoint());
+  EXPECT_EQ(back.generation(), 3);
+}
+
+TEST(Evolution, AFitnessFunctionThatIsInterruptedStopsTheGenerationAtOnce) {
+  // A Python objective hit by Ctrl-C throws Interrupted: no evaluation starts after it (they all did,
+  // one after the other, before), and the run stops "interrupted" with a resumable checkpoint.
+  Config c = small_config(8);
+  c.evolution.generations = 4;
+  c.evaluation.reference_check = "off";
+  int calls = 0, interrupt_at = 0;
+  const FitnessFunction counting = [&](const Genome& g) {
+    if (++calls == interrupt_at) throw Interrupted("interrupted by the test");
+    return stub_fitness(g);
+  };
+  // Where generation 2 starts, counted in calls.
+  RunOptions probe;
+  probe.quiet = true;
+  int calls_before_gen2 = -1;
+  probe.callback = [&](const GenerationStats& s, const Evolution&) {
+    if (s.generation == 1) calls_before_gen2 = calls;
+    return true;
+  };
+  (void)run_evolution(c, probe, counting);
+  ASSERT_GT(calls_before_gen2, 0);
+  const auto dir = fresh_dir("interrupted_fitness");
+  RunOptions opt;
+  opt.out = dir;
+  opt.quiet = true;
+  calls = 0;
+  interrupt_at = calls_before_gen2 + 1;  // the first evaluation of generation 2
+  const RunSummary s = run_evolution(c, opt, counting);
+  EXPECT_EQ(s.stop_reason, "interrupted");
+  EXPECT_EQ(calls, interrupt_at) << "evaluations started after the interruption";
+  EXPECT_EQ(s.history.back().generation, 1);
+  opt.resume = true;
+  interrupt_at = 0;
+  const RunSummary resumed = run_evolution(c, opt, counting);
+  EXPECT_EQ(resumed.history.back().generation, 4);
+  std::filesystem::remove_all(dir);
 }

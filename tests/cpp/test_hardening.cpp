@@ -7,7 +7,7 @@
 //                      signal, in a child process
 //   ResumeSettings.*   --resume with changed settings: refused before any write, naming the keys;
 //                      resumable keys accepted and recorded
-//   StopRequests.*     stops honoured within a second: seeding, evaluation, the CLI
+//   StopRequests.*     stops honoured within one evaluation (counted, not timed): seeding, evaluation, the CLI
 //   CheckpointMeaning.* checkpoints with a valid checksum but a content the engine cannot have written
 //   Rows.*             the other rows of the issue's table
 #include <fmt/format.h>
@@ -666,17 +666,13 @@ TEST(ResumeSettings, InProcessResumeWithAnotherConfigWritesNothing) {
 // ---------------------------------------------------------------------------------------------------
 // Stop requests
 
-namespace {
-// A fitness that takes a while (sleeping, so the machine's load hardly matters).
-Fitness slow_fitness(const Genome& g) {
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  return stub_fitness(g);
-}
-}  // namespace
+// Deterministic: the stop is raised by the fitness function itself on its k-th call, and the tests count
+// the evaluations started after it (was: a stop from a timer thread and bounds in seconds, which failed on
+// a loaded machine).
 
 TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNothing) {
   Config c;
-  c.evolution.population = 16;  // 15 evaluations of 50 ms: 0.75 s for the whole generation
+  c.evolution.population = 16;
   c.evolution.elites = 1;
   c.evolution.threads = 1;
   c.genome.initial_units = 30;  // no duplicates among offspring: every child is evaluated
@@ -685,24 +681,23 @@ TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNo
   (void)reference.step();
   (void)reference.step();
 
-  Evolution evo(c, slow_fitness);
   std::atomic<bool> stop{false};
+  std::atomic<int> calls{0};
+  int stop_at = -1;  // the call that raises the stop (-1: never)
+  Evolution evo(c, [&](const Genome& g) {
+    if (++calls == stop_at) stop = true;
+    return stub_fitness(g);
+  });
   evo.set_stop(StopRequest{&stop, {}});
   evo.initialize();
   (void)evo.step();
-  std::thread t([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(120));
-    stop = true;
-  });
-  const auto t0 = Clock::now();
+  calls = 0;
+  stop_at = 3;  // the third evaluation of generation 2 (of 15)
   EXPECT_THROW((void)evo.step(), Interrupted);
-  const double took = seconds_since(t0);
-  t.join();
-  std::printf("[ stop     ] in-process stop during a generation (50 ms evaluations): step() returned %.3f s after it "
-              "started, %.3f s after the stop\n", took, took - 0.12);
-  EXPECT_LT(took, 0.3) << "the generation ran on after the stop";
+  EXPECT_EQ(calls.load(), 3) << "evaluations started after the stop (one thread: none)";
   EXPECT_EQ(evo.generation(), 1) << "an interrupted generation must leave the state at the previous one";
   stop = false;
+  stop_at = -1;
   (void)evo.step();  // the same generation again, from (seed, g, i): identical to the uninterrupted run
   EXPECT_EQ(evo.history().back().best, reference.history().back().best);
   EXPECT_EQ(evo.population()[3].genome, reference.population()[3].genome);
@@ -713,25 +708,34 @@ TEST(StopRequests, AStopWhileSeedingIsHonouredWithinOneEvaluation) {
   c.evolution.population = 4;
   c.evolution.threads = 2;
   c.evolution.max_init_tries = 1000000000;
-  Evolution evo(c, [](const Genome&) {  // never viable: seeding would take years
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    return Fitness{};
-  });
-  int polls = 0;
-  const auto t0 = Clock::now();
-  evo.set_stop(StopRequest{nullptr, [&] { return ++polls > 0 && seconds_since(t0) > 0.3; }});
-  EXPECT_THROW(evo.initialize(), Interrupted);
-  EXPECT_LT(seconds_since(t0), 0.6);
-  EXPECT_GT(polls, 3) << "the poll runs about every 20 ms";
-  EXPECT_EQ(evo.generation(), -1);
-  EXPECT_TRUE(evo.population().empty());
+  // Never viable: seeding would take years. The stop comes from the flag (set by the 50th evaluation)
+  // and from the poll (true from its 3rd call on): at most one evaluation per other thread starts after it.
+  for (const bool by_poll : {false, true}) {
+    std::atomic<bool> stop{false};
+    std::atomic<int> calls{0}, after{0};
+    Evolution evo(c, [&](const Genome&) {
+      if (stop.load()) ++after;
+      if (++calls == 50 && !by_poll) stop = true;
+      return Fitness{};
+    });
+    int polls = 0;
+    evo.set_stop(by_poll ? StopRequest{nullptr, [&] { return ++polls >= 3 && (stop = true); }}
+                         : StopRequest{&stop, {}});
+    EXPECT_THROW(evo.initialize(), Interrupted) << (by_poll ? "poll" : "flag");
+    EXPECT_LE(after.load(), c.evolution.threads - 1) << (by_poll ? "poll" : "flag");
+    if (by_poll) {
+      EXPECT_EQ(polls, 3);
+    }
+    EXPECT_EQ(evo.generation(), -1);
+    EXPECT_TRUE(evo.population().empty());
+  }
 }
 
 namespace {
-// Starts the CLI, waits until `ready` (at most 120 s) and then `after` seconds, sends `sig`; returns the exit
-// status and the seconds from the signal to the exit.
-std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig, double after,
-                                  const std::function<bool()>& ready = [] { return true; }) {
+// Starts the CLI, waits until `ready` (a condition on its files), sends `sig`; returns the exit status and
+// the seconds from the signal to the exit (printed, never asserted: the in-process tests above count the
+// evaluations after a stop instead).
+std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig, const std::function<bool()>& ready) {
   std::fflush(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
@@ -743,51 +747,53 @@ std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig,
     _exit(126);
   }
   const auto started = Clock::now();
-  while (!ready() && seconds_since(started) < 120) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  std::this_thread::sleep_for(std::chrono::duration<double>(after));
-  kill(pid, sig);
-  const auto t0 = Clock::now();
   int status = 0;
-  waitpid(pid, &status, 0);
+  bool exited = false;  // on its own, before the signal: reaped, so never signalled (its pid may be reused)
+  // Polls the condition; the 900 s only keep a broken build from hanging the suite.
+  while (!ready() && seconds_since(started) < 900 && !(exited = waitpid(pid, &status, WNOHANG) == pid))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const auto t0 = Clock::now();
+  if (!exited) {
+    kill(pid, sig);
+    waitpid(pid, &status, 0);
+  }
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), seconds_since(t0)};
 }
 }  // namespace
 
-TEST(StopRequests, CliSignalWhileSeedingEndsWithinASecond) {
+TEST(StopRequests, CliSignalWhileSeedingEndsTheRunWithNothingToResume) {
   // quiet_steps = steps forbids every division: no random genome is ever viable, seeding runs forever.
+  // Before, the signal was ignored until the population was complete: here, never.
   for (int sig : {SIGTERM, SIGINT}) {
     const fs::path out = fresh_dir("seed_signal");
+    // config.toml is written after the signal handlers are installed, before seeding starts.
     const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--set", "development.quiet_steps=400",
                                            "--set", "evolution.population=100", "--out", out.string()},
-                                          sig, 1.0);
+                                          sig, [&] { return fs::exists(out / "config.toml"); });
     std::printf("[ stop     ] %s while seeding: exit %d, %.3f s after the signal\n", strsignal(sig), rc, seconds);
     EXPECT_EQ(rc, 130) << strsignal(sig);
-    // Measured 0.001 to 0.03 s (docs/reliability.md); the machine is shared, so the test allows 3 s.
-    // Before, the signal was ignored until the population was complete: here, never.
-    EXPECT_LT(seconds, 3.0) << strsignal(sig);
     EXPECT_FALSE(fs::exists(out / "checkpoint.json"));
-    // Nothing to resume, so the same command may start over in the same directory.
+    // Nothing to resume: another run may replace it when asked (--overwrite; without it, a different
+    // config is refused since the run directory guard: RunDirectory.RunFilesWithoutACheckpoint...).
     const Shell again = run_exe({kExe, "--quiet", "--threads", "1", "--set", "evolution.population=4", "--set",
-                                 "evaluation.steps=50", "--generations", "1", "--out", out.string()});
+                                 "evaluation.steps=50", "--generations", "1", "--overwrite", "--out", out.string()});
     EXPECT_EQ(again.rc, 0) << again.err;
     fs::remove_all(out);
   }
 }
 
-TEST(StopRequests, CliSignalDuringAGenerationEndsWithinASecondWithAResumableCheckpoint) {
-  if (ANIMAT_TEST_SANITIZED) GTEST_SKIP() << "a latency test: one sanitized evaluation of 40,000 steps takes seconds";
-  // 30 individuals swimming 20,000 steps: 0.3–0.8 s per evaluation with the collision and embedding
-  // checks of issue 14 (the load of a shared machine included), 5–12 s per generation on 2 cores.
-  // Before, the generation was finished first (5 s or more); now one evaluation per thread at most.
+TEST(StopRequests, CliSignalDuringAGenerationEndsWithAResumableCheckpoint) {
+  // The signal is sent as soon as generation 0's checkpoint exists, so it lands in generation 1 (or in a
+  // later one: nothing here depends on when). The latency is printed only: the in-process tests above
+  // count the evaluations after a stop.
   const fs::path out = fresh_dir("gen_signal");
   const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--seed", "4", "--set",
-                                         "evolution.population=30", "--set", "evaluation.steps=20000", "--set",
+                                         "evolution.population=30", "--set", "evaluation.steps=2000", "--set",
                                          "evolution.checkpoint_every=5", "--out", out.string()},
-                                        SIGTERM, 0.5, [&] { return fs::exists(out / "checkpoint.json"); });
-  std::printf("[ stop     ] SIGTERM during a generation (population 30, 20000 swim steps): exit %d, %.3f s after the "
+                                        SIGTERM, [&] { return fs::exists(out / "checkpoint.json"); });
+  std::printf("[ stop     ] SIGTERM during a generation (population 30, 2000 swim steps): exit %d, %.3f s after the "
               "signal\n", rc, seconds);
   EXPECT_EQ(rc, 130);
-  EXPECT_LT(seconds, 2.0) << "the generation ran on after the signal (the test allows 2 s on a shared machine)";
   ASSERT_TRUE(fs::exists(out / "checkpoint.json"));
   Config c = load_config(out / "config.toml");
   Evolution evo(c, stub_fitness);

@@ -199,6 +199,161 @@ def test_tell_refuses_what_it_cannot_use():
     assert len(ga.ask()) == 2 and len(genomes) == 6
 
 
+# --- 2b. tell is held to the engine's rules; what save() writes, load() reads ---------------------------
+
+def _answer_everything(ga, value):
+    """Tells `value` for every asked genome until generation 0 exists (every draw viable)."""
+    while ga.generation < 0:
+        ga.tell([value] * len(ga.ask()))
+
+
+def test_tell_refuses_what_the_engines_evaluation_refuses_naming_index_and_value():
+    ga = animat.GA(small_config(population=6))  # evaluation.objective = distance: a fitness is >= 0
+    n = len(ga.ask())
+    with pytest.raises(ValueError, match=r"value 2 .*fitness -0\.5.*>= 0"):  # was accepted, then GA.load refused it
+        ga.tell([1.0, 1.0, -0.5] + [1.0] * (n - 3))
+    with pytest.raises(ValueError, match=r"value 1 .*cell_count -3"):
+        ga.tell([1.0, animat.Fitness(1.0, True, True, -3)] + [1.0] * (n - 2))
+    with pytest.raises(ValueError, match=r"value 0 .*fitness inf"):
+        ga.tell([animat.Fitness(math.inf)] + [1.0] * (n - 1))
+    with pytest.raises(ValueError, match=r"GA.tell: value 3 \(nan\).*must be finite"):
+        ga.tell([1.0] * 3 + [math.nan] + [1.0] * (n - 4))
+    assert ga.generation == -1 and ga._engine.asked  # nothing was taken
+    ga.tell([1.0] * n)
+    assert ga.generation == 0
+    signed = small_config(population=6)
+    signed["evaluation.objective"] = "speed_toward"  # a signed objective: negative values are fine
+    sga = animat.GA(signed)
+    _answer_everything(sga, -1.25)
+    assert sga.history[-1]["mean"] == -1.25
+
+
+def test_every_checkpoint_saved_after_an_accepted_tell_loads(tmp_path):
+    # A seeded random sweep of adversarial values: tell() accepts exactly what the engine's rule allows
+    # (finite; >= 0 under a distance objective; cell_count >= 0), and whatever it accepted, save() writes
+    # and load() reads back as the same state. Was: negative fitness, negative cell counts and a mean
+    # overflowing to inf were accepted and written, and GA.load refused the file.
+    rng = np.random.default_rng(20240601)
+    tiny = float(np.nextafter(0.0, 1.0))
+    top = 1.7976931348623157e308
+    special = [0.0, -0.0, tiny, -tiny, 1e-300, -1e-300, 1.0, -1.0, 1e300, -1e300, top, -top, top / 2, -top / 2,
+               math.nan, math.inf, -math.inf]
+    cells = [0, 1, 7, 2**31 - 1, -1, -2**31]
+
+    def adversarial():
+        pick = rng.integers(0, 5)
+        if pick == 0:
+            return None  # not viable
+        if pick == 1:
+            return float(special[rng.integers(0, len(special))])
+        if pick == 2:
+            return float(rng.normal() * 10.0 ** int(rng.integers(-320, 309)))  # may overflow to inf: refused
+        fit = float(special[rng.integers(0, len(special))]) if pick == 3 else float(rng.normal())
+        return animat.Fitness(fit, bool(rng.integers(0, 2)), bool(rng.integers(0, 2)),
+                              int(cells[rng.integers(0, len(cells))]), bool(rng.integers(0, 2)))
+
+    def acceptable(v, objective):
+        if v is None:
+            return True
+        fit, count = (v.fitness, v.cell_count) if isinstance(v, animat.Fitness) else (v, 0)
+        return math.isfinite(fit) and (objective != "distance" or fit >= 0) and count >= 0
+
+    def value(objective):
+        v = adversarial()
+        if rng.random() < 0.9:  # mostly acceptable values, so that the run goes on and is saved often
+            while not acceptable(v, objective):
+                v = adversarial()
+        return v
+
+    accepted = refused = saved = 0
+    for objective in ("distance", "speed_toward"):
+        c = small_config(population=4, steps=10)
+        c["evolution.elites"] = 1
+        c["evaluation.objective"] = objective
+        c["evaluation.reference_check"] = "off"  # the values are not animat's swims
+        for trial in range(5):
+            c["evolution.seed"] = trial
+            ga = animat.GA(c)
+            for _ in range(40):
+                genomes = ga.ask(3 if ga.generation < 0 else 1)
+                told = [value(objective) for _ in genomes]
+                bad = [k for k, v in enumerate(told) if not acceptable(v, objective)]
+                if bad:
+                    with pytest.raises(ValueError, match=rf"value {bad[0]} "):
+                        ga.tell(told)
+                    refused += 1
+                    continue
+                ga.tell(told)
+                accepted += 1
+                if ga.generation >= 0:
+                    for row in ga.history:
+                        assert math.isfinite(row["best"]) and math.isfinite(row["mean"]) and math.isfinite(row["median"])
+                    back = animat.GA.load(ga.save(tmp_path / f"{objective}_{trial}.json"), c)
+                    saved += 1
+                    assert back.history.tobytes() == ga.history.tobytes()
+                    assert back.ask() == ga.ask()
+    assert accepted > 100 and refused > 20 and saved > 100, (accepted, refused, saved)
+
+
+def test_the_generation_mean_of_huge_finite_fitnesses_is_finite_and_the_checkpoint_loads(tmp_path):
+    # Was: the mean of 4 x 1.7e308 overflowed to inf, the checkpoint held null, and no resume read it.
+    huge = 1.7976931348623157e308
+    c = small_config(population=4, steps=10)
+    c["evaluation.reference_check"] = "off"
+    ga = animat.GA(c)
+    _answer_everything(ga, huge)
+    ga.tell([huge * 0.5] * len(ga.ask()))
+    assert ga.history["mean"][0] == huge and ga.history["median"][0] == huge
+    assert huge * 0.5 <= ga.history["mean"][1] <= huge
+    back = animat.GA.load(ga.save(tmp_path / "huge.json"), c)
+    assert list(back.history["mean"]) == list(ga.history["mean"])
+
+
+@pytest.mark.parametrize("guard", ["record", "select"])
+def test_ga_loop_and_evolve_give_identical_histories_with_the_exploit_guard(guard, tmp_path):
+    # Was: ask/tell dropped the exploit guard (best_reference NaN; "select" ranked elites differently).
+    c = small_config(population=8, steps=150, seed=4)
+    c["evolution.generations"] = 3
+    c["evolution.elites"] = 2
+    c["evaluation.reference_check"] = guard
+    c["evaluation.reference_substeps"] = 2
+    ref = animat.evolve(c, quiet=True)
+    ga = animat.GA(c)
+    while not ga.done:
+        genomes = ga.ask()
+        ga.tell([animat.evaluate(g, c) for g in genomes])
+    columns = [n for n in ref.history.dtype.names if n != "wall_seconds"]
+    for name in columns:
+        np.testing.assert_array_equal(ga.history[name], ref.history[name], err_msg=name)
+    assert np.isfinite(ga.history["best_reference"]).all()
+    assert [i.genome for i in ga.population] == [i.genome for i in ref.population]
+    assert [i.fitness for i in ga.population] == [i.fitness for i in ref.population]
+    again = animat.GA.load(ga.save(tmp_path / "ga.json"), c)  # the references survive a checkpoint
+    assert list(again.history["best_reference"]) == list(ga.history["best_reference"])
+
+
+def test_ga_with_a_python_objective_needs_it_for_the_exploit_guard():
+    c = small_config(population=6)
+    c["evaluation.objective"] = "python:rightward"
+    with pytest.raises(ValueError, match=r"python:rightward.*exploit guard.*objective=.*reference_check = 'off'"):
+        animat.GA(c)
+    c["evaluation.steps"] = 100
+    c["evaluation.reference_substeps"] = 2
+    c["evolution.generations"] = 2
+    objective = animat.Objective(rightward, every=10, name="rightward")
+    ga = animat.GA(c, objective=objective)
+    assert ga.config["evaluation.objective"] == "python:rightward"
+    while not ga.done:
+        ga.step()  # evaluate_population with the objective; the guard scores with it at the reference step
+    ref = animat.evolve(c, objective=objective, quiet=True)
+    assert np.isfinite(ga.history["best_reference"]).all()
+    for name in ("best", "mean", "best_reference", "evaluations"):
+        assert list(ga.history[name]) == list(ref.history[name]), name
+    off = c.copy()
+    off["evaluation.reference_check"] = "off"
+    animat.GA(off)  # no guard: nothing to evaluate here
+
+
 # --- 3. pickle and copy ----------------------------------------------------------------------------------
 
 def _same(a, b):
