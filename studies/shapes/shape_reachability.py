@@ -110,6 +110,8 @@ def select(config: Any, objective: str, seed: int, population: int, generations:
     cfg["evolution.population"] = population
     cfg["evolution.generations"] = generations
     cfg["evolution.seed"] = seed
+    # Shape scores are not swims: no exploit guard (it would re-swim each new best at dt/16).
+    cfg["evaluation.reference_check"] = "off"
     ga = animat.GA(cfg)
     score_of = OBJECTIVES[objective]
     max_cells = int(cfg["development.max_cells"])
