@@ -31,6 +31,7 @@
 #include "animat/config.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "animat/wire.hpp"
 
 using namespace animat;

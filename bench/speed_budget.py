@@ -34,11 +34,20 @@ from pathlib import Path
 LIBS = ["-lbox2d", "-lspdlog", "-lfmt", "-ltomlplusplus", "-fopenmp", "-lgmp", "-lmpfr"]
 
 
+def archives(build: Path) -> list[str]:
+    """The library's static archives in link order: the five layers (top first), or libanimat.a of a
+    tree from before the layers."""
+    single = build / "libanimat.a"
+    if single.exists():
+        return [str(single)]
+    return [str(build / f"libanimat_{layer}.a") for layer in ("run", "evolution", "evaluation", "simulation", "model")]
+
+
 def build_genomes_tool(tree: Path, build: Path, out: Path) -> Path:
     src = Path(__file__).resolve().parent / "bench_genomes.cpp"
     exe = out / f"bench_genomes_{tree.name}"
     cmd = ["g++", "-O3", "-DNDEBUG", "-std=c++20", f"-I{tree / 'include'}", "-I/usr/include/eigen3",
-           '-DANIMAT_VERSION="bench"', str(src), "-o", str(exe), str(build / "libanimat.a"), *LIBS]
+           '-DANIMAT_VERSION="bench"', str(src), "-o", str(exe), *archives(build), *LIBS]
     subprocess.run(cmd, check=True)
     return exe
 

@@ -15,6 +15,7 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "animat/objective.hpp"
 #include "bindings.hpp"
 

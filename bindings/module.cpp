@@ -4,6 +4,7 @@
 
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;

@@ -21,6 +21,7 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "fuzz_util.hpp"
 
 namespace {

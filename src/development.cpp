@@ -25,7 +25,6 @@
 #include "cell_integrator.hpp"
 #include "neighbour_grid.hpp"
 #include "animat/random.hpp"
-#include "animat/scene.hpp"  // has_effect
 
 namespace animat {
 

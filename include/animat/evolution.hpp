@@ -12,82 +12,12 @@
 #include <vector>
 
 #include "animat/errors.hpp"
+#include "animat/evaluation_params.hpp"
+#include "animat/evolution_params.hpp"
 #include "animat/genome.hpp"
 #include "animat/params.hpp"
 
 namespace animat {
-
-inline constexpr std::string_view kReferenceCheckNames[] = {"record", "select", "off"};
-/// Allowed values of evaluation.objective: the built-in objectives (kObjectiveNames in objective.hpp;
-/// a new one is added to both lists) and "python:NAME" (the trailing * is a wildcard).
-inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "distance_x",
-                                                         "distance_minus_energy", "distance_per_energy", "chemotaxis",
-                                                         "python:*"};
-inline constexpr std::string_view kPushCellNames[] = {"all", "front"};
-
-/// How an evaluation is run and scored: the swim horizon, the objective (objective.hpp), the
-/// invariants checked, and the exploit guard.
-struct EvaluationParams {
-  int steps = 4000;  ///< swim steps at physics.dt [paper: 4000 or 8000]
-  /// distance (the paper's), distance_per_size, speed_toward, or "python:NAME" (a Python callable).
-  std::string objective = "distance";
-  std::vector<double> direction = {1.0, 0.0};  ///< speed_toward's direction (normalised when used)
-  /// Check the body's planar embedding after every step (no region inverted, the skin simple); a
-  /// swim that breaks it is invalid and gets fitness 0, like an unstable one.
-  bool check_embedding = true;
-  /// "record": each time the GA's best changes, re-evaluate it with physics.substeps multiplied by
-  /// reference_substeps (the same horizon at a finer step) and record both fitnesses; "select": the
-  /// same, and elites are ranked by the reference fitness; "off".
-  std::string reference_check = "record";
-  int reference_substeps = 16;             ///< refinement factor of the reference evaluation
-  double reference_tolerance = 0.01;       ///< relative fitness difference that is warned about...
-  double reference_abs_tolerance = 0.05;   ///< ...when it also exceeds this many length units
-  /// Control steps simulated before the fitness clock starts, with actuation off (the crawl world:
-  /// the body settles onto the ground); 0 = none, today's swims bit for bit (docs/worlds.md).
-  int settle_steps = 0;
-  /// λ of distance_minus_energy: distance − λ·(positive actuation work) [choose: docs/worlds.md; a
-  /// 20-generation d_N = 2 best swims 12.8 for W⁺ = 6.5e4, so λ = 1e-4 weighs both alike]
-  double energy_weight = 1e-4;
-  /// W₀ of distance_per_energy: distance / (positive actuation work + W₀) [choose: docs/worlds.md; of
-  /// the order of a swimmer's W⁺, so that barely moving bodies do not win on the ratio]
-  double energy_offset = 1e4;
-  // Directional tasks and disruption (issue 18, docs/control.md).
-  int source_directions = 4;   ///< objective chemotaxis: swims per evaluation, one per source direction [choose]
-  int source_seed = 1;         ///< objective chemotaxis: seed of the source directions (the same for every genome) [choose]
-  int push_step = -1;          ///< control step (from the fitness clock's start) of a push; -1 = none
-  std::vector<double> push_impulse = {0.0, 0.0};  ///< impulse [Jx, Jy] given to every pushed cell
-  std::string push_cells = "all";  ///< pushed cells: all, or front (x >= the centre of mass's x)
-  /// Keep the energy books of every swim (EvaluationResult::energy): slower, results unchanged.
-  bool energy_accounting = false;
-};
-
-template <class V>
-void visit_fields(EvaluationParams& p, V&& v) {
-  v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
-  v(FieldInfo{"objective", "what the GA maximises: distance (straight-line distance of the centre of mass, the paper's); "
-                           "distance_per_size (distance / body length); speed_toward (centre-of-mass speed along "
-                           "evaluation.direction); distance_x (|horizontal displacement| of the centre of mass, the "
-                           "crawl world's); distance_minus_energy (distance - energy_weight * positive actuation work); "
-                           "distance_per_energy (distance / (positive actuation work + energy_offset)); python:NAME (a "
-                           "Python callable, set by animat.evolve)",
-              Bounds::any(), kObjectiveChoices},
-    p.objective);
-  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)", Bounds::closed(-kMaxLength, kMaxLength)}, p.direction);
-  v(FieldInfo{"check_embedding", "check after every step that no region is inverted and the skin is a simple polygon; a swim that breaks it gets fitness 0", Bounds::any()}, p.check_embedding);
-  v(FieldInfo{"reference_check", "exploit guard: re-evaluate each new best at a finer step and record both fitnesses (record), also rank elites by it (select), or off", Bounds::any(), kReferenceCheckNames}, p.reference_check);
-  v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
-  v(FieldInfo{"reference_tolerance", "warn when the best's fitness and its reference differ by more than this fraction...", Bounds::upto(1e6)}, p.reference_tolerance);
-  v(FieldInfo{"reference_abs_tolerance", "...and by more than this many length units", Bounds::upto(kMaxLength)}, p.reference_abs_tolerance);
-  v(FieldInfo{"settle_steps", "control steps simulated with actuation off before the fitness clock starts (crawl world: the body settles onto the ground; docs/worlds.md); 0 = none", Bounds::closed(0, 10000000)}, p.settle_steps);
-  v(FieldInfo{"energy_weight", "lambda of objective distance_minus_energy: distance - lambda * positive actuation work, length per energy unit [choose]", Bounds::upto(1e6)}, p.energy_weight);
-  v(FieldInfo{"energy_offset", "W0 of objective distance_per_energy: distance / (positive actuation work + W0), energy units, > 0 [choose]", Bounds::positive_upto(1e12)}, p.energy_offset);
-  v(FieldInfo{"source_directions", "objective chemotaxis: swims per evaluation, each with scene.chemical_source rotated to a random direction; fitness = mean progress toward the source (docs/control.md) [choose]", Bounds::closed(1, 64)}, p.source_directions);
-  v(FieldInfo{"source_seed", "objective chemotaxis: seed of the source directions, the same for every genome [choose]", Bounds::closed(0, 2147483647)}, p.source_seed);
-  v(FieldInfo{"push_step", "disruption: control step (from the fitness clock's start) at which the pushed cells get push_impulse; -1 = never (docs/control.md)", Bounds::closed(-1, 10000000)}, p.push_step);
-  v(FieldInfo{"push_impulse", "disruption: impulse [Jx, Jy] given to every pushed cell (velocity change impulse / cell_mass), mass * length / time", Bounds::closed(-kMaxCoefficient, kMaxCoefficient)}, p.push_impulse);
-  v(FieldInfo{"push_cells", "disruption: which cells are pushed: all, or front (x >= the centre of mass's x, a push that also turns the body)", Bounds::any(), kPushCellNames}, p.push_cells);
-  v(FieldInfo{"energy_accounting", "keep the energy books of every swim: actuation work in; fluid drag (normal, tangential), spring damping, collisions and ground out; kinetic and potential energies stored (include/animat/energy.hpp). Slower; fitness unchanged", Bounds::any()}, p.energy_accounting);
-}
 
 struct Config;
 /// Whether a fitness and its reference differ by more than both evaluation.reference_tolerance
@@ -97,48 +27,6 @@ struct Config;
 /// evaluation.reference_substeps, everything else equal.
 [[nodiscard]] Config reference_config(const Config& config);
 
-struct EvolutionParams {
-  std::int64_t seed = 1;                  ///< run seed; every random number derives from it
-  int population = 100;                   ///< [paper: 100]
-  int elites = 2;                         ///< best individuals copied unchanged [choose]
-  double crossover_fraction = 0.2;        ///< share of offspring made by crossover [paper: 0.2]
-  double tournament_p_start = 0.8;        ///< p(fitter wins) at generation 0 [paper: 0.8]
-  double tournament_p_end = 1.0;          ///< p(fitter wins) after the ramp [paper: 1]
-  int tournament_ramp_generations = 1000; ///< [paper: 1000]
-  int generations = 0;                    ///< generation cap; 0 = none
-  int stall_generations = 500;            ///< stop after this many generations without improvement [paper: 500]
-  double wall_seconds = 0.0;              ///< wall-clock budget; 0 = none
-  int threads = 0;                        ///< OpenMP threads; 0 = all cores
-  int checkpoint_every = 1;               ///< write a checkpoint every k generations
-  int max_init_tries = 1000000;           ///< give up seeding one viable individual after this many tries
-  // [islands] islands.hpp; 1 = the paper's single population
-  int islands = 1;                        ///< sub-populations evolving apart [not in the paper; 1 = off]
-  int migration_interval = 10;            ///< generations between ring migrations
-  int migrants = 1;                       ///< best individuals each island sends to the next one
-};
-
-template <class V>
-void visit_fields(EvolutionParams& p, V&& v) {
-  v(FieldInfo{"seed", "run seed", Bounds::non_negative()}, p.seed);
-  v(FieldInfo{"population", "population size [paper: 100]", Bounds::closed(2, 100000)}, p.population);
-  v(FieldInfo{"elites", "best individuals copied unchanged into the next generation [choose]", Bounds::closed(0, 100000)}, p.elites);
-  v(FieldInfo{"crossover_fraction", "share of each generation made by crossover [paper: 0.2]", Bounds::unit()}, p.crossover_fraction);
-  v(FieldInfo{"tournament_p_start", "probability that the fitter of 2 wins, at generation 0 [paper: 0.8]", Bounds::unit()}, p.tournament_p_start);
-  v(FieldInfo{"tournament_p_end", "probability that the fitter wins after the ramp [paper: 1.0]", Bounds::unit()}, p.tournament_p_end);
-  v(FieldInfo{"tournament_ramp_generations", "generations of the linear ramp [paper: 1000]", Bounds::closed(0, 100000000)}, p.tournament_ramp_generations);
-  v(FieldInfo{"generations", "generation cap; 0 = no cap", Bounds::closed(0, 100000000)}, p.generations);
-  v(FieldInfo{"stall_generations", "stop after this many generations without improvement [paper: 500]; 0 = never", Bounds::closed(0, 100000000)}, p.stall_generations);
-  v(FieldInfo{"wall_seconds", "wall-clock budget in seconds; 0 = none", Bounds::upto(1e10)}, p.wall_seconds);
-  v(FieldInfo{"threads", "OpenMP threads; 0 = all cores", Bounds::closed(0, 1024)}, p.threads);
-  v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000)}, p.checkpoint_every);
-  v(FieldInfo{"max_init_tries", "tries to find one viable random individual before giving up", Bounds::closed(1, 1000000000)}, p.max_init_tries);
-  // [islands] last in the section: run_identity() of a run without islands ignores these lines
-  v(FieldInfo{"islands", "sub-populations evolving apart with ring migration [not in the paper: 1 = off]", Bounds::closed(1, 10000)}, p.islands);
-  v(FieldInfo{"migration_interval", "generations between migrations (islands > 1)", Bounds::closed(1, 100000000)}, p.migration_interval);
-  v(FieldInfo{"migrants", "best individuals each island copies to the next island of the ring (islands > 1)", Bounds::closed(0, 100000)}, p.migrants);
-}
-
-struct Config;
 class Evaluator;  // evaluator.hpp
 
 /// [islands] One migrant (islands.hpp): a copy of population[from] (island from_island) replaced population[to].
@@ -366,59 +254,5 @@ class Evolution {
 /// nothing, and run_identity() then hashes the config without them, so older runs still resume.
 /// A new key whose default keeps today's results belongs here.
 [[nodiscard]] const std::vector<std::string>& late_keys();
-
-/// Options of a run on disk (animat_evolve and animat.evolve).
-struct RunOptions {
-  std::filesystem::path out;           ///< run directory ("" = write nothing)
-  bool resume = false;                 ///< continue the run in `out`
-  /// Start afresh in `out` even when it holds a run: the run's files (run_file_names()) are removed
-  /// once the directory is locked. Contradicts `resume`.
-  bool overwrite = false;
-  bool quiet = false;
-  double progress_interval = 1.0;      ///< seconds between progress lines
-  const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
-  /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint and stop.
-  std::function<bool()> stop_poll;
-  std::shared_ptr<Evaluator> evaluator;           ///< how to evaluate (evaluator.hpp); null = OpenMP threads
-  /// Called after every generation, generation 0 of a new run included; return false to stop
-  /// (checkpointed).
-  std::function<bool(const GenerationStats&, const Evolution&)> callback;
-  /// Called once every check has passed and the run directory is locked, before the first write to it
-  /// (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in place).
-  std::function<void()> on_start;
-};
-
-/// Another process holds the run directory's lock (RUN/.lock): the message names its pid and host.
-struct RunDirectoryBusy : IoError {
-  using IoError::IoError;
-};
-/// The run directory holds a run (a checkpoint, or the files of a run without one) and neither resume
-/// nor overwrite was asked for.
-struct RunExists : IoError {
-  using IoError::IoError;
-};
-
-/// The files and folders of a run directory that a run writes (and RunOptions::overwrite removes).
-[[nodiscard]] const std::vector<std::string>& run_file_names();
-
-struct RunSummary {
-  std::vector<GenerationStats> history;
-  Individual best;
-  std::string stop_reason;
-  std::vector<Individual> population;  ///< the final population
-};
-
-/// Runs (or resumes) an evolution, writing config.toml, history.csv, best/ lineage and checkpoints.
-/// Everything that can refuse the command is checked before any file is written: the run directory
-/// (path length, an existing run, a missing checkpoint), and on resume the checkpoint itself and the
-/// settings, which may differ from the run's config.toml only in resumable_keys() (the others are
-/// named in the ConfigError). Accepted changes are written to config.toml and noted in resume.log.
-/// A stop (stop_flag, stop_poll, or the callback returning false) leaves a checkpoint of the last
-/// complete generation; stop_reason is then "interrupted" (history empty if it came before
-/// generation 0 was complete, and nothing to resume).
-/// `fitness` defaults to swim_fitness(config), and then `reference` to the exploit guard's
-/// swim_fitness(reference_config(config)) unless evaluation.reference_check is "off".
-RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {},
-                         FitnessFunction reference = {});
 
 }  // namespace animat

@@ -72,4 +72,11 @@ concept ParamValue = std::same_as<T, bool> || std::same_as<T, int> || std::same_
                      std::same_as<T, double> || std::same_as<T, std::string> ||
                      std::same_as<T, std::vector<std::string>> || std::same_as<T, std::vector<double>>;
 
+/// Whether `name` is listed in an effects list (scene.effects, development.effects).
+[[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {
+  for (const auto& e : effects)
+    if (e == name) return true;
+  return false;
+}
+
 }  // namespace animat

@@ -99,11 +99,7 @@ void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"chemical_decay_length", "decay length l of the chemical field, length units, > 0 [choose]", Bounds::positive_upto(kMaxLength)}, p.chemical_decay_length);
 }
 
-[[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {
-  for (const auto& e : effects)
-    if (e == name) return true;
-  return false;
-}
+// has_effect(effects, name): params.hpp (development.effects uses it too).
 
 /// d_T actually used: drag_tangential, or drag_normal/200 when drag_tangential is negative.
 [[nodiscard]] inline double tangential_drag(const SceneParams& p) {

@@ -1,4 +1,6 @@
 // animat_evolve: run an evolution experiment (paper §5) from the embedded default or a TOML config.
+// animat_evolve_main() is the whole command line; src/cli/main.cpp calls it, and so does the Python
+// module (animat._core.evolve_cli, `animat evolve`), which links the same library (animat_cli).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <atomic>
@@ -17,6 +19,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "animat/log.hpp"
 #include "animat/mpi.hpp"
 
@@ -210,6 +213,3 @@ int animat_evolve_main(int argc, char** argv) {
   }
 }
 
-#ifndef ANIMAT_CLI_NO_MAIN
-int main(int argc, char** argv) { return animat_evolve_main(argc, argv); }
-#endif

@@ -11,6 +11,7 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "test_support.hpp"
 
 using namespace animat;

@@ -36,6 +36,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "animat/genome.hpp"
 #include "animat/random.hpp"
 #include "test_support.hpp"

@@ -9,6 +9,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "animat/external_actuation.hpp"
 #include "animat/objective.hpp"
 #include "animat/physics.hpp"

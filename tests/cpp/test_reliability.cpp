@@ -41,6 +41,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run.hpp"
 #include "animat/genome.hpp"
 
 namespace fs = std::filesystem;

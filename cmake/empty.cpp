@@ -1,0 +1,1 @@
+// Empty: the layer checks of CMakeLists.txt link whole archives into a shared library.
