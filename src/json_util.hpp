@@ -11,25 +11,54 @@
 
 namespace animat::detail {
 
-/// Thrown from the parser callback; callers turn it into their own error type.
+/// Thrown by the counting pass of parse_bounded; callers turn it into their own error type.
 struct JsonLimit : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 /// Parses with at most `max_depth` levels of nesting and, if `max_items` >= 0, at most `max_items`
-/// objects closed at depth `item_depth` (the elements of an array at depth item_depth - 1). Nothing
-/// deeper or longer is ever built, so memory and recursion stay bounded.
+/// objects closed at depth `item_depth` (the elements of an array at depth item_depth - 1). A first
+/// pass only counts (SAX, builds nothing), so a document beyond the limits is refused before any of
+/// it is built and memory and recursion stay bounded; the second pass builds the document. Both are
+/// linear in the text (nlohmann's parse with a callback is quadratic in an array's length).
 inline nlohmann::json parse_bounded(std::string_view text, int max_depth, int item_depth = -1, long long max_items = -1) {
-  long long items = 0;
-  auto callback = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json&) {
-    using E = nlohmann::json::parse_event_t;
-    if ((event == E::object_start || event == E::array_start) && depth >= max_depth)
-      throw JsonLimit("nesting deeper than " + std::to_string(max_depth) + " levels");
-    if (max_items >= 0 && event == E::object_end && depth == item_depth && ++items > max_items)
-      throw JsonLimit("more than " + std::to_string(max_items) + " items");
-    return true;
+  struct Counter {
+    int max_depth, item_depth;
+    long long max_items;
+    int depth = 0;
+    long long items = 0;
+    bool open() {
+      if (depth >= max_depth) throw JsonLimit("nesting deeper than " + std::to_string(max_depth) + " levels");
+      ++depth;
+      return true;
+    }
+    bool close_object() {
+      --depth;
+      if (max_items >= 0 && depth == item_depth && ++items > max_items)
+        throw JsonLimit("more than " + std::to_string(max_items) + " items");
+      return true;
+    }
+    bool null() { return true; }
+    bool boolean(bool) { return true; }
+    bool number_integer(nlohmann::json::number_integer_t) { return true; }
+    bool number_unsigned(nlohmann::json::number_unsigned_t) { return true; }
+    bool number_float(nlohmann::json::number_float_t, const std::string&) { return true; }
+    bool string(std::string&) { return true; }
+    bool binary(nlohmann::json::binary_t&) { return true; }
+    bool start_object(std::size_t) { return open(); }
+    bool key(std::string&) { return true; }
+    bool end_object() { return close_object(); }
+    bool start_array(std::size_t) { return open(); }
+    bool end_array() {
+      --depth;
+      return true;
+    }
+    // A syntax error stops the count; the building pass below then reports it exactly as parse() does.
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) { return false; }
   };
-  return nlohmann::json::parse(text.begin(), text.end(), callback);
+  Counter counter{max_depth, item_depth, max_items};
+  nlohmann::json::sax_parse(text.begin(), text.end(), &counter);
+  return nlohmann::json::parse(text.begin(), text.end());
 }
 
 /// An integer JSON value in [lo, hi], whatever integer type holds it; nullopt for anything else.
