@@ -235,22 +235,7 @@ struct Simulation::Impl {
     std::fill(nx, nx + n, 0.0);
     std::fill(ny, ny + n, 0.0);
     if (!velocity_effects.empty()) {
-      std::copy(state.vx.begin(), state.vx.end(), state.ux.begin());
-      std::copy(state.vy.begin(), state.vy.end(), state.uy.begin());
-      if (midpoint) {  // the predictor pass, as in velocity_forces(): nothing booked
-        std::copy(state.fx.begin(), state.fx.end(), fx_pos.begin());
-        std::copy(state.fy.begin(), state.fy.end(), fy_pos.begin());
-        state.predictor = true;
-        for (Effect* e : velocity_effects) e->apply_velocity(state);
-        state.predictor = false;
-        const double kh = 0.5 * h * state.inv_mass;
-        for (std::size_t i = 0; i < n; ++i) {
-          state.ux[i] = state.vx[i] + kh * state.fx[i];
-          state.uy[i] = state.vy[i] + kh * state.fy[i];
-        }
-        std::copy(fx_pos.begin(), fx_pos.end(), state.fx.begin());
-        std::copy(fy_pos.begin(), fy_pos.end(), state.fy.begin());
-      }
+      evaluation_velocity();  // the predictor pass books nothing
       for (std::size_t k = 0; k < velocity_effects.size(); ++k) {
         const int bucket = b.velocity_bucket[k];
         if (bucket >= 0 && b.sink[static_cast<std::size_t>(bucket)] == Sink::drag) {
@@ -355,26 +340,30 @@ struct Simulation::Impl {
     for (Effect* e : constraint_effects) e->apply(state);
   }
 
-  void velocity_forces() {
-    if (velocity_effects.empty()) return;
-    // Velocity-dependent forces at u = v (start) or u = v + (h/2)·F(v)/m (midpoint: predictor at v,
-    // then the forces are recomputed at u on top of the position-dependent ones).
+  /// The velocity s.ux, s.uy the velocity-dependent forces are evaluated at: u = v (start) or
+  /// u = v + (h/2)·F(v)/m (midpoint: a predictor pass at v, whose forces are then discarded, so
+  /// that the forces are recomputed at u on top of the position-dependent ones).
+  void evaluation_velocity() {
     std::copy(state.vx.begin(), state.vx.end(), state.ux.begin());
     std::copy(state.vy.begin(), state.vy.end(), state.uy.begin());
-    if (midpoint) {
-      std::copy(state.fx.begin(), state.fx.end(), fx_pos.begin());
-      std::copy(state.fy.begin(), state.fy.end(), fy_pos.begin());
-      state.predictor = true;
-      for (Effect* e : velocity_effects) e->apply_velocity(state);
-      state.predictor = false;
-      const double k = 0.5 * h * state.inv_mass;
-      for (std::size_t i = 0; i < state.ux.size(); ++i) {
-        state.ux[i] = state.vx[i] + k * state.fx[i];
-        state.uy[i] = state.vy[i] + k * state.fy[i];
-      }
-      std::copy(fx_pos.begin(), fx_pos.end(), state.fx.begin());
-      std::copy(fy_pos.begin(), fy_pos.end(), state.fy.begin());
+    if (!midpoint) return;
+    std::copy(state.fx.begin(), state.fx.end(), fx_pos.begin());
+    std::copy(state.fy.begin(), state.fy.end(), fy_pos.begin());
+    state.predictor = true;
+    for (Effect* e : velocity_effects) e->apply_velocity(state);
+    state.predictor = false;
+    const double k = 0.5 * h * state.inv_mass;
+    for (std::size_t i = 0; i < state.ux.size(); ++i) {
+      state.ux[i] = state.vx[i] + k * state.fx[i];
+      state.uy[i] = state.vy[i] + k * state.fy[i];
     }
+    std::copy(fx_pos.begin(), fx_pos.end(), state.fx.begin());
+    std::copy(fy_pos.begin(), fy_pos.end(), state.fy.begin());
+  }
+
+  void velocity_forces() {
+    if (velocity_effects.empty()) return;
+    evaluation_velocity();
     for (Effect* e : velocity_effects) e->apply_velocity(state);
   }
 
