@@ -66,33 +66,12 @@ GenerationStats stats_from_dict(const nb::dict& d) {
 // An Evolution's ask() and tell() run without the GIL (the exploit guard's reference swims, a Python
 // objective scoring them on the evaluation threads): every method holds a lease on its engine, and a
 // second thread gets a RuntimeError instead of a data race.
-class EngineLease {
+class EngineLease : public ThreadLease<Evolution> {
  public:
-  EngineLease(const Evolution& e, const char* method) : engine_(&e) {
-    std::lock_guard<std::mutex> lock(mutex());
-    if (!busy().insert(engine_).second)
-      throw std::runtime_error(fmt::format(
-          "animat.GA.{}: this GA is in use by another thread (an ask() or tell() is running); drive a GA from one "
-          "thread at a time",
-          method));
-  }
-  ~EngineLease() {
-    std::lock_guard<std::mutex> lock(mutex());
-    busy().erase(engine_);
-  }
-  EngineLease(const EngineLease&) = delete;
-  EngineLease& operator=(const EngineLease&) = delete;
-
- private:
-  static std::mutex& mutex() {
-    static std::mutex m;
-    return m;
-  }
-  static std::unordered_set<const Evolution*>& busy() {
-    static std::unordered_set<const Evolution*> set;
-    return set;
-  }
-  const Evolution* engine_;
+  EngineLease(const Evolution& e, const char* method)
+      : ThreadLease(e, "GA", method,
+                    "this GA is in use by another thread (an ask() or tell() is running); drive a GA from one thread "
+                    "at a time") {}
 };
 
 std::string fitness_repr(const Fitness& f) {

@@ -42,33 +42,12 @@ namespace {
 // A Simulation owns one Box2D world and is not thread-safe. step() and record() run without the GIL,
 // so two Python threads could drive one world at once (Box2D aborts on its stack allocator). Every
 // method holds a lease on its Simulation; a second thread gets a RuntimeError instead.
-class Lease {
+class Lease : public ThreadLease<Simulation> {
  public:
-  Lease(const Simulation& s, const char* method) : sim_(&s) {
-    std::lock_guard<std::mutex> lock(mutex());
-    if (!busy().insert(sim_).second)
-      throw std::runtime_error(fmt::format(
-          "animat.Simulation.{}: this Simulation is in use by another thread; a Simulation (one Box2D world) is not "
-          "thread-safe: give each thread its own Simulation",
-          method));
-  }
-  ~Lease() {
-    std::lock_guard<std::mutex> lock(mutex());
-    busy().erase(sim_);
-  }
-  Lease(const Lease&) = delete;
-  Lease& operator=(const Lease&) = delete;
-
- private:
-  static std::mutex& mutex() {
-    static std::mutex m;
-    return m;
-  }
-  static std::unordered_set<const Simulation*>& busy() {
-    static std::unordered_set<const Simulation*> set;
-    return set;
-  }
-  const Simulation* sim_;
+  Lease(const Simulation& s, const char* method)
+      : ThreadLease(s, "Simulation", method,
+                    "this Simulation is in use by another thread; a Simulation (one Box2D world) is not thread-safe: "
+                    "give each thread its own Simulation") {}
 };
 
 std::vector<std::string> scene_keys() {

@@ -2,8 +2,13 @@
 // Each stage binds itself in its own file; module.cpp calls them in pipeline order.
 #include <nanobind/nanobind.h>
 
+#include <fmt/format.h>
+
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <stdexcept>
+#include <unordered_set>
 
 namespace animat {
 struct Config;
@@ -27,4 +32,32 @@ std::shared_ptr<const Objective> objective_from_python(nanobind::handle objectiv
 /// taken from it (later calls return nothing); nothing for a built-in objective. Called with the GIL held.
 /// Such an objective throws animat::Interrupted, which stops a run like a signal does.
 std::optional<nanobind::python_error> take_interrupt(const std::shared_ptr<const Objective>& objective);
+/// Holds an object that is not thread-safe for the duration of one bound method (which may run without
+/// the GIL); a second thread gets a RuntimeError "animat.KIND.METHOD: MESSAGE" instead of a data race.
+template <class T>
+class ThreadLease {
+ public:
+  ThreadLease(const T& object, const char* kind, const char* method, const char* message) : object_(&object) {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (!busy().insert(object_).second) throw std::runtime_error(fmt::format("animat.{}.{}: {}", kind, method, message));
+  }
+  ~ThreadLease() {
+    std::lock_guard<std::mutex> lock(mutex());
+    busy().erase(object_);
+  }
+  ThreadLease(const ThreadLease&) = delete;
+  ThreadLease& operator=(const ThreadLease&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static std::unordered_set<const T*>& busy() {
+    static std::unordered_set<const T*> set;
+    return set;
+  }
+  const T* object_;
+};
+
 }  // namespace animat::py
