@@ -266,8 +266,8 @@ def calibration_set() -> List[KnownSwimmer]:
     ]
 
 
-def held_out_set() -> List[KnownSwimmer]:
-    """Other shapes, sizes, appendage lengths and frequencies; not used to set any threshold."""
+def _held_out_whole_body() -> List[KnownSwimmer]:
+    """The held-out undulators and synchronous contractors (both held-out sets use them)."""
     return [
         undulator("contraction", length=12.0, width=1.8, frequency=5.0, wavelengths=1.5, seed=3, name="ho_undulator_long"),
         undulator("bending", length=7.0, width=2.6, frequency=11.0, wavelengths=0.75, seed=4, name="ho_undulator_bend_fast"),
@@ -275,6 +275,12 @@ def held_out_set() -> List[KnownSwimmer]:
         synchronous_contractor(length=10.0, width=4.0, frequency=5.0, seed=6, name="ho_sync_slender"),
         synchronous_contractor(length=6.0, width=5.5, frequency=11.0, seed=7, name="ho_sync_stubby_fast"),
         synchronous_contractor(length=7.0, width=4.5, frequency=3.0, lag=0.6, seed=8, name="ho_sync_lag_slow"),
+    ]
+
+
+def held_out_set() -> List[KnownSwimmer]:
+    """Other shapes, sizes, appendage lengths and frequencies; not used to set any threshold."""
+    return _held_out_whole_body() + [
         protrusion_swimmer(length=2, core_radius=2.0, frequency=5.0, seed=9, name="ho_protrusions_single2"),
         protrusion_swimmer(length=4, wide=True, core_radius=3.2, frequency=6.0, seed=10, name="ho_protrusions_wide4"),
         protrusion_swimmer(length=2, wide=True, core_radius=2.6, frequency=11.0, anchor_amplitude=0.15, seed=11,
@@ -512,12 +518,7 @@ def paper_held_out_set() -> List[KnownSwimmer]:
                           name="ho_paper_chain3"),
         appendage_swimmer("single", at=(-1.5,), frequency=8.0, appendage_phase=pi / 4, anchor_shift=pi,
                           back_shift=pi / 2, seed=25, name="ho_paper_single_backline"),
-        undulator("contraction", length=12.0, width=1.8, frequency=5.0, wavelengths=1.5, seed=3, name="ho_undulator_long"),
-        undulator("bending", length=7.0, width=2.6, frequency=11.0, wavelengths=0.75, seed=4, name="ho_undulator_bend_fast"),
-        undulator("contraction", length=8.0, width=3.5, frequency=3.0, wavelengths=0.5, seed=5, name="ho_undulator_slow"),
-        synchronous_contractor(length=10.0, width=4.0, frequency=5.0, seed=6, name="ho_sync_slender"),
-        synchronous_contractor(length=6.0, width=5.5, frequency=11.0, seed=7, name="ho_sync_stubby_fast"),
-        synchronous_contractor(length=7.0, width=4.5, frequency=3.0, lag=0.6, seed=8, name="ho_sync_lag_slow"),
+        *_held_out_whole_body(),
         tail_swimmer(length=6, core_radius=2.0, frequency=6.0, wavelengths=0.75, seed=13, name="ho_tail6"),
         tail_swimmer(length=3, core_radius=2.8, frequency=10.0, wavelengths=0.25, seed=14, name="ho_tail3_fast"),
         standing_swimmer("halves", length=10.0, width=3.5, frequency=5.0, seed=26, name="ho_standing_halves"),

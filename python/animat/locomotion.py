@@ -453,18 +453,9 @@ def _wave_fit(z: np.ndarray, coords: np.ndarray, motion: np.ndarray) -> WaveFit:
 
 def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
     """Connected components of the spring graph restricted to ``cells``."""
-    parent = {int(c): int(c) for c in cells}
+    from .shape import _groups as components  # noqa: PLC0415
 
-    def find(a: int) -> int:
-        while parent[a] != a:
-            parent[a] = parent[parent[a]]
-            a = parent[a]
-        return a
-
-    for i, j in springs:
-        if int(i) in parent and int(j) in parent:
-            parent[find(int(i))] = find(int(j))
-    return len({find(c) for c in parent})
+    return len(components([int(c) for c in cells], [(int(i), int(j)) for i, j in springs]))
 
 
 def _no_wave(w: WaveFit) -> str:
