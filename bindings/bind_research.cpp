@@ -6,6 +6,7 @@
 #include <nanobind/stl/array.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/string_view.h>
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
@@ -28,6 +29,7 @@
 #include "animat/evolution.hpp"
 #include "animat/external_actuation.hpp"
 #include "animat/objective.hpp"
+#include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "bindings.hpp"
 
@@ -408,11 +410,50 @@ void bind_research(nb::module_& m) {
   m.def("body_length", &body_length, "body"_a,
         "Length of a body along its longest axis: the largest distance between two cell centres at rest plus\n"
         "one cell diameter (1 length unit). The `distance_per_size` objective divides by it.");
+  nb::class_<ObjectiveSpec>(m, "ObjectiveSpec",
+                             "A built-in objective (a row of the C++ table kObjectives): its name, what it measures, its\n"
+                             "sign rule and what it reads. animat.objectives() lists them.")
+      .def_prop_ro("name", [](const ObjectiveSpec& s) { return std::string(s.name); }, "Its value of evaluation.objective.")
+      .def_prop_ro("meaning", [](const ObjectiveSpec& s) { return std::string(s.meaning); }, "What it measures.")
+      .def_ro("nonnegative", &ObjectiveSpec::nonnegative,
+              "Every value is >= 0 by construction (a negative fitness is refused under it).")
+      .def_ro("needs_body", &ObjectiveSpec::needs_body, "It reads the body's length.")
+      .def_ro("one_swim", &ObjectiveSpec::one_swim,
+              "One swim decides it (SwimEnv can reward it); otherwise one swim per source direction.")
+      .def("__repr__", [](const ObjectiveSpec& s) { return fmt::format("ObjectiveSpec('{}': {})", s.name, s.meaning); });
+  m.def("objectives", [] { return std::vector<ObjectiveSpec>(std::begin(kObjectives), std::end(kObjectives)); },
+        "The built-in objectives, in the order of the C++ table.");
   m.attr("OBJECTIVES") = [] {
     std::vector<std::string> out;
-    for (auto n : kObjectiveNames) out.emplace_back(n);
+    for (const auto& spec : kObjectives) out.emplace_back(spec.name);
     return out;
   }();
+  m.def("objective_value",
+        [](std::string_view name, double distance, double dx, double dy, double duration, double body_length,
+           double actuation_work_positive, double source_progress, std::optional<Config> config) {
+          const ObjectiveSpec* spec = find_objective(name);
+          if (!spec) {
+            std::vector<std::string_view> names;
+            for (const auto& row : kObjectives) names.push_back(row.name);
+            throw ConfigError(fmt::format("objective_value: \"{}\" is not a built-in objective (one of {})", name,
+                                          fmt::join(names, ", ")));
+          }
+          const Config c = config.value_or(Config{});
+          validate(c.evaluation);
+          SwimOutcome o;
+          o.distance = distance;
+          o.dx = dx;
+          o.dy = dy;
+          o.duration = duration;
+          o.body_length = body_length;
+          o.actuation_work_positive = actuation_work_positive;
+          o.source_progress = source_progress;
+          return spec->value(o, c.evaluation);
+        },
+        "name"_a, "distance"_a, "dx"_a, "dy"_a, "duration"_a, "body_length"_a = 0.0, "actuation_work_positive"_a = 0.0,
+        "source_progress"_a = 0.0, "config"_a = nb::none(),
+        "A built-in objective's value of a swim's outcome, exactly as the engine scores it (the C++ table's\n"
+        "function; SwimEnv rewards with it). config supplies evaluation.direction, energy_weight and energy_offset.");
 
   // --- externally driven actuation ------------------------------------------------------------------
   nb::class_<ExternalActuation>(m, "ExternalActuation",

@@ -15,6 +15,7 @@
 #include "animat/development.hpp"
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
+#include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
 
@@ -299,9 +300,10 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
     options.control = &config.control;
   }
   if (observer) observer->on_body(body);
-  // Objective chemotaxis: one swim per source direction (the first is observed and gives the
-  // diagnostics), the fitness their mean progress toward the source.
-  const bool chemotaxis = config.evaluation.objective == "chemotaxis";
+  // An objective that one swim does not decide (chemotaxis): one swim per source direction (the first
+  // is observed and gives the diagnostics), the fitness their mean progress toward the source.
+  const ObjectiveSpec* spec = find_objective(config.evaluation.objective);
+  const bool chemotaxis = spec != nullptr && !spec->one_swim;
   const int trials = chemotaxis ? config.evaluation.source_directions : 1;
   SwimResult s;
   double progress = 0.0;

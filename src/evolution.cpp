@@ -19,6 +19,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/islands.hpp"
+#include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "json_util.hpp"
 
@@ -78,20 +79,29 @@ class StopWatch {
   double last_poll_ = 0.0;  // touched by thread 0 only
 };
 
-// Objectives whose every value is >= 0 by construction (a distance); others (speed_toward, a Python
-// objective) may be negative.
+// The built-in objectives that are never negative, for messages: "distance, distance_per_size, ...".
+std::string nonnegative_names() {
+  std::string out;
+  for (const auto& spec : kObjectives)
+    if (spec.nonnegative) out += (out.empty() ? "" : ", ") + std::string(spec.name);
+  return out;
+}
+
+// Built-in objectives whose every value is >= 0 by construction (kObjectives' sign rule); others
+// (speed_toward, a Python objective) may be negative.
 bool nonnegative_objective(const Config& c) {
-  return c.evaluation.objective == "distance" || c.evaluation.objective == "distance_per_size";
+  const ObjectiveSpec* spec = find_objective(c.evaluation.objective);
+  return spec != nullptr && spec->nonnegative;
 }
 
 // A fitness the GA can rank and a checkpoint can hold (restore() refuses anything else): finite, and
-// >= 0 for a distance objective; cell_count and drag_limited >= 0. "" = acceptable, else what is wrong.
+// >= 0 under an objective that is never negative; cell_count and drag_limited >= 0. "" = acceptable, else what is wrong.
 // The one rule for every way a fitness reaches the engine: its own evaluations, tell() (animat.GA) and
 // the exploit guard's reference evaluations.
 std::string fitness_problem(const Fitness& f, bool nonnegative) {
   if (!std::isfinite(f.fitness) || (nonnegative && f.fitness < 0.0))
     return fmt::format("fitness {} (a fitness must be finite{})", f.fitness,
-                       nonnegative ? " and >= 0 under evaluation.objective = distance or distance_per_size" : "");
+                       nonnegative ? " and >= 0 under an objective that is never negative: " + nonnegative_names() : "");
   if (f.cell_count < 0) return fmt::format("cell_count {} (must be >= 0)", f.cell_count);
   if (f.drag_limited < 0) return fmt::format("drag_limited {} (must be >= 0)", f.drag_limited);
   return {};

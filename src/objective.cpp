@@ -12,87 +12,68 @@
 #include "animat/physics.hpp"
 
 namespace animat {
+
+namespace objective_values {
+// The paper's objective; evaluate() has computed it (0 for an unstable or invalid swim).
+double distance(const SwimOutcome& o, const EvaluationParams&) { return o.distance; }
+
+// Distance in body lengths: favours fast small bodies over merely big ones.
+double distance_per_size(const SwimOutcome& o, const EvaluationParams&) {
+  return o.body_length > 0.0 ? o.distance / o.body_length : 0.0;
+}
+
+// Displacement · d / time: a body swimming backwards scores below one that stays put.
+double speed_toward(const SwimOutcome& o, const EvaluationParams& p) {
+  if (!(o.duration > 0.0)) return 0.0;
+  const double norm = std::hypot(p.direction[0], p.direction[1]);
+  return (o.dx * (p.direction[0] / norm) + o.dy * (p.direction[1] / norm)) / o.duration;
+}
+
+// Either direction, like the paper's distance; vertical motion (falling) does not count.
+double distance_x(const SwimOutcome& o, const EvaluationParams&) { return std::abs(o.dx); }
+
+double distance_minus_energy(const SwimOutcome& o, const EvaluationParams& p) {
+  return o.distance - p.energy_weight * o.actuation_work_positive;
+}
+
+// The offset W0 > 0 keeps a body that barely works from scoring a ratio of round-off.
+double distance_per_energy(const SwimOutcome& o, const EvaluationParams& p) {
+  return o.distance / (o.actuation_work_positive + p.energy_offset);
+}
+
+// evaluate() swims once per source direction and leaves the mean progress in source_progress.
+double chemotaxis(const SwimOutcome& o, const EvaluationParams&) { return o.source_progress; }
+}  // namespace objective_values
+
 namespace {
 
-/// The paper's objective: straight-line distance of the centre of mass, start to end (0 if unstable).
-class Distance final : public Objective {
- public:
-  std::string name() const override { return "distance"; }
-  double value(const EvaluationRecord& r) const override { return r.result.fitness; }
-};
+std::vector<std::string_view> objective_names() {
+  std::vector<std::string_view> out;
+  for (const auto& spec : kObjectives) out.push_back(spec.name);
+  return out;
+}
 
-/// Distance in body lengths (body_length()): favours fast small bodies over merely big ones.
-class DistancePerSize final : public Objective {
+/// A built-in objective: a row of kObjectives with the evaluation parameters it reads.
+class Builtin final : public Objective {
  public:
-  std::string name() const override { return "distance_per_size"; }
-  bool needs_body() const override { return true; }
+  Builtin(const ObjectiveSpec& spec, const EvaluationParams& params) : spec_(spec), params_(params) {}
+  std::string name() const override { return std::string(spec_.name); }
+  bool needs_body() const override { return spec_.needs_body; }
   double value(const EvaluationRecord& r) const override {
-    const double length = body_length(r.body);
-    return length > 0.0 ? r.result.fitness / length : 0.0;
-  }
-};
-
-/// Mean speed of the centre of mass along a direction: displacement · d / simulated time. Signed: a
-/// body swimming backwards scores below one that stays put; an unstable or invalid swim scores 0
-/// (evaluate() does not ask the objective then).
-class SpeedToward final : public Objective {
- public:
-  explicit SpeedToward(const std::vector<double>& direction) {
-    const double norm = std::hypot(direction[0], direction[1]);
-    dx_ = direction[0] / norm;
-    dy_ = direction[1] / norm;
-  }
-  std::string name() const override { return "speed_toward"; }
-  double value(const EvaluationRecord& r) const override {
-    if (!r.result.stable || !(r.result.simulated_time > 0.0)) return 0.0;
-    return (r.result.displacement.x() * dx_ + r.result.displacement.y() * dy_) / r.result.simulated_time;
+    SwimOutcome o;
+    o.distance = r.result.fitness;  // evaluate() leaves the paper's distance there
+    o.dx = r.result.displacement.x();
+    o.dy = r.result.displacement.y();
+    o.duration = r.result.simulated_time;
+    o.body_length = spec_.needs_body ? body_length(r.body) : 0.0;
+    o.actuation_work_positive = r.result.actuation_work_positive;
+    o.source_progress = r.result.source_progress;
+    return spec_.value(o, params_);
   }
 
  private:
-  double dx_ = 1.0, dy_ = 0.0;
-};
-
-/// Issue 18: the mean progress toward the chemical source over evaluation.source_directions swims
-/// (EvaluationResult::source_progress, computed by evaluate()).
-class Chemotaxis final : public Objective {
- public:
-  std::string name() const override { return "chemotaxis"; }
-  double value(const EvaluationRecord& r) const override { return r.result.source_progress; }
-};
-
-/// The crawl world's objective: |horizontal displacement| of the centre of mass, start to end
-/// (either direction, like the paper's distance; vertical motion, e.g. falling, does not count).
-class DistanceX final : public Objective {
- public:
-  std::string name() const override { return "distance_x"; }
-  double value(const EvaluationRecord& r) const override { return std::abs(r.result.displacement.x()); }
-};
-
-/// The paper's distance minus λ times the positive mechanical work of actuation (evaluation.energy_weight).
-class DistanceMinusEnergy final : public Objective {
- public:
-  explicit DistanceMinusEnergy(double weight) : weight_(weight) {}
-  std::string name() const override { return "distance_minus_energy"; }
-  double value(const EvaluationRecord& r) const override {
-    return r.result.fitness - weight_ * r.result.actuation_work_positive;
-  }
-
- private:
-  double weight_;
-};
-
-/// The paper's distance per unit of positive actuation work, distance / (W+ + W0) (W0 =
-/// evaluation.energy_offset > 0 keeps a body that barely works from scoring a ratio of round-off).
-class DistancePerEnergy final : public Objective {
- public:
-  explicit DistancePerEnergy(double offset) : offset_(offset) {}
-  std::string name() const override { return "distance_per_energy"; }
-  double value(const EvaluationRecord& r) const override {
-    return r.result.fitness / (r.result.actuation_work_positive + offset_);
-  }
-
- private:
-  double offset_;
+  const ObjectiveSpec& spec_;
+  EvaluationParams params_;
 };
 
 /// Copies the body and the sampled frames an objective asked for.
@@ -124,40 +105,27 @@ class Recorder final : public EvaluationObserver {
 }  // namespace
 
 std::shared_ptr<const Objective> make_objective(const EvaluationParams& p) {
-  if (p.objective == "distance") return std::make_shared<Distance>();
-  if (p.objective == "distance_per_size") return std::make_shared<DistancePerSize>();
-  if (p.objective == "speed_toward") {
+  if (const ObjectiveSpec* spec = find_objective(p.objective)) {
     validate(p);
-    return std::make_shared<SpeedToward>(p.direction);
+    return std::make_shared<Builtin>(*spec, p);
   }
-  if (p.objective == "distance_x") return std::make_shared<DistanceX>();
-  if (p.objective == "chemotaxis") return std::make_shared<Chemotaxis>();
-  if (p.objective == "distance_minus_energy") {
-    validate(p);
-    return std::make_shared<DistanceMinusEnergy>(p.energy_weight);
-  }
-  if (p.objective == "distance_per_energy") {
-    validate(p);
-    return std::make_shared<DistancePerEnergy>(p.energy_offset);
-  }
-  // Register new built-ins here.
   if (std::string_view(p.objective).starts_with(kPythonObjectivePrefix))
     throw ConfigError(fmt::format("evaluation.objective = \"{}\" is a Python objective: run it from Python with "
                                   "animat.evolve(config, objective=...) (the C++ engine cannot call it)",
                                   p.objective));
   throw ConfigError(fmt::format("evaluation.objective: unknown objective \"{}\" (expected one of {}, or python:NAME)",
-                                p.objective, fmt::join(kObjectiveNames, ", ")));
+                                p.objective, fmt::join(objective_names(), ", ")));
 }
 
 void validate(const EvaluationParams& p) {
   const std::string_view name = p.objective;
-  const bool builtin = std::find(std::begin(kObjectiveNames), std::end(kObjectiveNames), name) != std::end(kObjectiveNames);
+  const bool builtin = find_objective(name) != nullptr;
   if (name.starts_with(kPythonObjectivePrefix)) {
     if (name.size() == kPythonObjectivePrefix.size())
       throw ConfigError("evaluation.objective = \"python:\": a Python objective needs a name (python:NAME)");
   } else if (!builtin) {
     throw ConfigError(fmt::format("evaluation.objective: unknown objective \"{}\" (expected one of {}, or python:NAME)",
-                                  p.objective, fmt::join(kObjectiveNames, ", ")));
+                                  p.objective, fmt::join(objective_names(), ", ")));
   }
   if (p.direction.size() != 2)
     throw ConfigError(fmt::format("evaluation.direction: expected 2 numbers [x, y], got {}", p.direction.size()));

@@ -5,16 +5,12 @@
 #include <string_view>
 #include <vector>
 
+#include "animat/objective_table.hpp"
 #include "animat/params.hpp"
 
 namespace animat {
 
 inline constexpr std::string_view kReferenceCheckNames[] = {"record", "select", "off"};
-/// Allowed values of evaluation.objective: the built-in objectives (kObjectiveNames in objective.hpp;
-/// a new one is added to both lists) and "python:NAME" (the trailing * is a wildcard).
-inline constexpr std::string_view kObjectiveChoices[] = {"distance", "distance_per_size", "speed_toward", "distance_x",
-                                                         "distance_minus_energy", "distance_per_energy", "chemotaxis",
-                                                         "python:*"};
 inline constexpr std::string_view kPushCellNames[] = {"all", "front"};
 
 /// How an evaluation is run and scored: the swim horizon, the objective (objective.hpp), the

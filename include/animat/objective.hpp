@@ -3,9 +3,9 @@
 // of the evaluation record to a float). The paper's objective is `distance`; the config selects one
 // by name (evaluation.objective) and Python can bring its own callable (named "python:NAME").
 //
-// Adding a built-in objective: a name in kObjectiveNames, a class below Objective in
-// src/objective.cpp and one line in make_objective(). The energy objectives (distance_minus_energy,
-// distance_per_energy) read the positive actuation work of the swim (docs/worlds.md).
+// The built-ins are the rows of kObjectives (objective_table.hpp); make_objective() wraps one. The
+// energy objectives (distance_minus_energy, distance_per_energy) read the positive actuation work of
+// the swim (docs/worlds.md).
 #include <memory>
 #include <string>
 #include <string_view>
@@ -14,18 +14,12 @@
 #include "animat/body.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/genome.hpp"
+#include "animat/objective_table.hpp"
 
 namespace animat {
 
 struct Config;
 struct EvaluationParams;
-
-/// The built-in objectives, selectable as evaluation.objective.
-inline constexpr std::string_view kObjectiveNames[] = {"distance",   "distance_per_size",     "speed_toward",
-                                                       "distance_x", "distance_minus_energy", "distance_per_energy",
-                                                       "chemotaxis"};
-/// evaluation.objective of a run whose objective is a Python callable: "python:" + its name.
-inline constexpr std::string_view kPythonObjectivePrefix = "python:";
 
 /// Everything an objective may look at: the evaluation result (fitness = the paper's distance, and
 /// every diagnostic), the body that swam, and its trajectory sampled every `every` control steps

@@ -21,6 +21,7 @@ from . import _core
 
 from ._core import (
     OBJECTIVES,
+    ObjectiveSpec,
     Body,
     Config,
     ConfigSection,
@@ -92,6 +93,8 @@ affinity = documented(_core.affinity)
 body_length = documented(_core.body_length)
 delaunay_edges = documented(_core.delaunay_edges)
 gabriel_graph = documented(_core.gabriel_graph)
+objectives = documented(_core.objectives)
+objective_value = documented(_core.objective_value)
 grn_swim = documented(_core.grn_swim)
 polygon_area = documented(_core.polygon_area)
 set_log_level = documented(_core.set_log_level)
@@ -111,7 +114,7 @@ __all__ = [
     "EvaluationRecord", "record_evaluation", "actuation_start_time", "actuation_term", "warm_up_box2d",
     "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
     # evolution
-    "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "Fitness", "Individual", "GenerationStats",
+    "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "ObjectiveSpec", "objectives", "objective_value", "Fitness", "Individual", "GenerationStats",
     "History", "evaluate_population", "to_fitness", "tournament_probability", "reference_disagrees", "run_experiment",
     "run_study",
     # control

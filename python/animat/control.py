@@ -16,9 +16,9 @@ Actions set every cell's actuation (eq. 2: the rest length of spring (i, j) is
 An action holds for ``frame_skip`` control steps. Observations, shape (4n + m,), float64: the cell
 positions relative to the centre of mass (n × 2, flattened), the cell velocities relative to the
 centre-of-mass velocity (n × 2) and the spring strains ``length / L0 - 1`` (m). The reward is the
-increment of the objective over the step (any objective of the config that a swim alone decides:
-``distance``, ``distance_per_size``, ``speed_toward``, ``distance_x``, ``distance_minus_energy``,
-``distance_per_energy``; or ``objective=``), so an episode's return is the objective of its whole
+increment of the objective over the step (any built-in objective of the config that one swim decides,
+:data:`SWIM_ENV_OBJECTIVES`; or ``objective=``), scored by the engine's own objective functions
+(``animat._core.objective_value``), so an episode's return is the objective of its whole
 swim (speed_toward over the episode's full duration; the energy objectives with the actuation work
 the springs metered since ``reset``, docs/worlds.md). In the crawl world (effect ``ground`` in the
 scene) every episode starts where an evaluation does: the body placed on the floor and settled for
@@ -37,9 +37,8 @@ from .trajectory import body_of
 
 __all__ = ["SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available"]
 
-#: The objectives SwimEnv can reward: those a swim alone decides (src/objective.cpp's built-ins).
-SWIM_ENV_OBJECTIVES = ("distance", "distance_per_size", "speed_toward", "distance_x", "distance_minus_energy",
-                       "distance_per_energy")
+#: The objectives SwimEnv can reward: the built-ins one swim decides (``animat.objectives()``).
+SWIM_ENV_OBJECTIVES = tuple(spec.name for spec in _core.objectives() if spec.one_swim)
 
 try:  # optional dependency
     import gymnasium as _gym
@@ -102,10 +101,6 @@ class SwimEnv(_EnvBase):
         self.objective = str(self.config["evaluation.objective"]) if objective is None else objective
         if self.objective not in SWIM_ENV_OBJECTIVES:
             raise ValueError(f"SwimEnv: objective must be one of {', '.join(SWIM_ENV_OBJECTIVES)}, got {self.objective!r}")
-        self._energy_weight = float(self.config["evaluation.energy_weight"])
-        self._energy_offset = float(self.config["evaluation.energy_offset"])
-        direction = np.asarray(self.config["evaluation.direction"], dtype=np.float64)
-        self._direction = direction / np.linalg.norm(direction)
         self._length = float(_core.body_length(self.body))
         self._frequency = frequency
         self.velocity_noise = float(velocity_noise)
@@ -147,19 +142,10 @@ class SwimEnv(_EnvBase):
     def objective_value(self) -> float:
         """The objective of the swim so far (the rewards of an episode add up to it)."""
         disp = np.asarray(self._sim.center_of_mass()) - self._com0
-        if self.objective == "distance":
-            return float(np.linalg.norm(disp))
-        if self.objective == "distance_per_size":
-            return float(np.linalg.norm(disp)) / self._length
-        if self.objective == "distance_x":
-            return float(abs(disp[0]))
-        if self.objective in ("distance_minus_energy", "distance_per_energy"):
-            work = float(self._sim.counters["actuation_work_positive"])
-            if self.objective == "distance_minus_energy":
-                return float(np.linalg.norm(disp)) - self._energy_weight * work
-            return float(np.linalg.norm(disp)) / (work + self._energy_offset)
-        horizon = self.max_episode_steps * self.dt
-        return float(disp @ self._direction) / horizon
+        return _core.objective_value(
+            self.objective, distance=float(np.linalg.norm(disp)), dx=float(disp[0]), dy=float(disp[1]),
+            duration=self.max_episode_steps * self.dt, body_length=self._length,
+            actuation_work_positive=float(self._sim.counters["actuation_work_positive"]), config=self.config)
 
     def _info(self) -> Dict[str, Any]:
         return {"time": float(self._sim.time), "steps": int(self._sim.steps_done),

@@ -22,6 +22,7 @@
 #include "animat/run.hpp"
 #include "animat/log.hpp"
 #include "animat/mpi.hpp"
+#include "animat/objective_table.hpp"
 
 namespace {
 
@@ -193,8 +194,8 @@ int animat_evolve_main(int argc, char** argv) {
     }
     const auto& best = summary.best;
     const std::string& objective = config.evaluation.objective;
-    const std::string meaning = objective == "distance" ? "distance travelled by the centre of mass"
-                                                        : "evaluation.objective = " + objective;
+    const animat::ObjectiveSpec* spec = animat::find_objective(objective);
+    const std::string meaning = spec ? std::string(spec->meaning) : "evaluation.objective = " + objective;
     std::printf("\nBest swimmer: fitness %.4f (%s), %d cells, generation %d\n", best.result.fitness,
                 meaning.c_str(), best.result.cell_count, summary.history.back().generation);
     std::printf("Stopped: %s\n", summary.stop_reason.c_str());

@@ -12,6 +12,7 @@
 #include "animat/run.hpp"
 #include "animat/external_actuation.hpp"
 #include "animat/objective.hpp"
+#include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "test_support.hpp"
 
@@ -272,6 +273,63 @@ TEST(Objective, DistancePerSizeAndSpeedTowardFollowTheirFormulas) {
   EXPECT_DOUBLE_EQ(evaluate(g, c, *make_objective(c.evaluation)).fitness, toward);
   c.evaluation.direction = {-3.0, -4.0};
   EXPECT_DOUBLE_EQ(evaluate(g, c, *make_objective(c.evaluation)).fitness, -toward);
+}
+
+TEST(ObjectiveTable, EveryRowIsSelectableAndItsSignRuleHoldsOnExtremeOutcomes) {
+  // The config's choices are the table's names (and python:*), in its order; every row is what
+  // make_objective() builds for its name.
+  ASSERT_EQ(std::size(kObjectiveChoices), std::size(kObjectives) + 1);
+  EXPECT_EQ(kObjectiveChoices.back(), "python:*");
+  EvaluationParams p;
+  p.direction = {3.0, -4.0};
+  p.energy_weight = 2.0;
+  p.energy_offset = 0.5;
+  for (std::size_t i = 0; i < std::size(kObjectives); ++i) {
+    const ObjectiveSpec& spec = kObjectives[i];
+    EXPECT_EQ(kObjectiveChoices[i], spec.name);
+    EXPECT_EQ(find_objective(spec.name), &spec);
+    for (std::size_t j = 0; j < i; ++j) EXPECT_NE(kObjectives[j].name, spec.name);
+    p.objective = std::string(spec.name);
+    const auto built = make_objective(p);
+    EXPECT_EQ(built->name(), spec.name);
+    EXPECT_EQ(built->needs_body(), spec.needs_body);
+    EXPECT_FALSE(spec.meaning.empty());
+    // A nonnegative objective is >= 0 for any outcome a swim can have (distance, length, work >= 0;
+    // displacements and progress of either sign).
+    if (!spec.nonnegative) continue;
+    for (double d : {-7.0, -1e-300, 0.0, 3.0})
+      for (double work : {0.0, 1e-9, 4.0}) {
+        SwimOutcome o;
+        o.distance = std::hypot(d, 2.0 * d);
+        o.dx = d;
+        o.dy = 2.0 * d;
+        o.duration = 10.0;
+        o.body_length = 3.0;
+        o.actuation_work_positive = work;
+        o.source_progress = d;
+        EXPECT_GE(spec.value(o, p), 0.0) << spec.name << " d " << d << " work " << work;
+      }
+  }
+  EXPECT_EQ(find_objective("python:mine"), nullptr);
+  EXPECT_EQ(find_objective("fastest"), nullptr);
+  // Each formula, on one outcome.
+  SwimOutcome o;
+  o.distance = 5.0;
+  o.dx = -3.0;
+  o.dy = 4.0;
+  o.duration = 2.0;
+  o.body_length = 2.5;
+  o.actuation_work_positive = 1.5;
+  o.source_progress = -0.25;
+  auto value = [&](std::string_view name) { return find_objective(name)->value(o, p); };
+  EXPECT_EQ(value("distance"), 5.0);
+  EXPECT_EQ(value("distance_per_size"), 2.0);
+  EXPECT_DOUBLE_EQ(value("speed_toward"), (-3.0 * 0.6 + 4.0 * -0.8) / 2.0);
+  EXPECT_EQ(value("distance_x"), 3.0);
+  EXPECT_EQ(value("distance_minus_energy"), 5.0 - 2.0 * 1.5);
+  EXPECT_EQ(value("distance_per_energy"), 5.0 / (1.5 + 0.5));
+  EXPECT_EQ(value("chemotaxis"), -0.25);
+  EXPECT_FALSE(find_objective("chemotaxis")->one_swim);
 }
 
 TEST(Objective, CustomObjectiveDrivesTheGAAndStaysThreadCountIndependent) {

@@ -63,6 +63,33 @@ def test_builtin_objectives_by_name_and_config_key(viable):
         c2["evaluation.objective"] = "fastest"
 
 
+def test_the_objective_table_scores_an_evaluation_exactly_as_the_engine(viable):
+    c, g = viable
+    table = animat.objectives()
+    assert [o.name for o in table] == list(animat.OBJECTIVES)
+    assert animat.SWIM_ENV_OBJECTIVES == tuple(o.name for o in table if o.one_swim)
+    assert "chemotaxis" not in animat.SWIM_ENV_OBJECTIVES
+    rec = animat.record_evaluation(g, c, every=0)
+    r = rec.result
+    assert r.viable and r.stable and r.valid
+    length = animat.body_length(rec.body)
+    for spec in table:
+        if not spec.one_swim:
+            continue
+        c2 = c.copy()
+        c2["evaluation.objective"] = spec.name
+        c2["evaluation.direction"] = [1.0, -2.0]
+        c2["evaluation.energy_weight"] = 0.5
+        engine = animat.evaluate(g, c2).fitness
+        table_value = animat.objective_value(spec.name, distance=r.fitness, dx=r.displacement[0], dy=r.displacement[1],
+                                             duration=r.simulated_time, body_length=length,
+                                             actuation_work_positive=r.actuation_work_positive, config=c2)
+        assert table_value == engine, spec.name
+        assert spec.meaning and (not spec.nonnegative or engine >= 0.0), spec.name
+    with pytest.raises(ValueError, match='"fastest" is not a built-in objective'):
+        animat.objective_value("fastest", distance=1.0, dx=1.0, dy=0.0, duration=1.0)
+
+
 def test_record_exposes_every_evaluation_result_field_and_the_trajectory(viable):
     c, g = viable
     rec = animat.record_evaluation(g, c, every=25)
