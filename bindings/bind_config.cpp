@@ -87,7 +87,7 @@ void bind_config(nb::module_& m) {
                   "Build from a nested {section: {key: value}} or flat {'section.key': value} dict.")
       .def_static("from_toml", &config_from_toml, "text"_a, "source"_a = "<string>",
                   "Parse TOML text; errors name `source`, the line, the key and the expected type or range.")
-      .def("to_toml", &to_toml, "The complete config as commented TOML (what ``animat_evolve --print-config`` prints).")
+      .def("to_toml", [](const Config& c) { return to_toml(c); }, "The complete config as commented TOML (what ``animat_evolve --print-config`` prints).")
       .def("to_dict", &to_dict, "Nested dict {section: {key: value}}.")
       .def("update", &update, "values"_a, "Set several values from a nested or flat dict.")
       .def("apply_override", [](Config& c, const std::string& a) { apply_override(c, a); }, "assignment"_a,

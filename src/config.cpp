@@ -270,22 +270,28 @@ Config load_config(const std::filesystem::path& path) {
   return config_from_toml(text, path.string());
 }
 
-std::string to_toml(const Config& config) {
+std::string to_toml(const Config& config, std::string_view version,
+                    const std::function<std::string(std::string_view, std::string_view)>& comment) {
   Config copy = config;
   std::string out = fmt::format(
       "# animat {} configuration. Every key is listed with its default or resolved value.\n"
       "# [paper] marks values fixed by Joachimczak & Wrobel (GECCO 2012); [choose] marks project choices\n"
       "# documented in docs/model.md.\n",
-      ANIMAT_VERSION);
+      version);
   std::string_view current;
   for_each_field(copy, [&](std::string_view section, const FieldInfo& info, auto& value) {
     if (section != current) {
       out += fmt::format("\n[{}]\n", section);
       current = section;
     }
-    out += fmt::format("# {}\n{} = {}\n", info.doc, info.name, format_value(value));
+    out += fmt::format("# {}\n{} = {}\n", comment(fmt::format("{}.{}", section, info.name), info.doc), info.name,
+                       format_value(value));
   });
   return out;
+}
+
+std::string to_toml(const Config& config) {
+  return to_toml(config, ANIMAT_VERSION, [](std::string_view, std::string_view doc) { return std::string(doc); });
 }
 
 namespace {
@@ -422,6 +428,15 @@ std::string config_doc(std::string_view dotted) {
   return doc;
 }
 
+Identity config_identity(std::string_view dotted) {
+  const auto [section, key] = split_key(dotted);
+  Config c;
+  Identity identity = Identity::defines_run;
+  if (!with_field(c, section, key, [&](const FieldInfo& info, auto&) { identity = info.identity; }))
+    throw ConfigError(fmt::format("unknown config key '{}'", dotted));
+  return identity;
+}
+
 void validate(const Config& config, std::string_view source) {
   Config copy = config;
   for_each_field(copy, [&](std::string_view section, const FieldInfo& info, auto& value) {
@@ -480,14 +495,16 @@ std::string format_config_value(const ConfigValue& value) {
   return std::visit([](const auto& v) { return format_value(v); }, value);
 }
 
-std::uint64_t config_hash(const Config& config) {
+std::uint64_t fnv1a(std::string_view text) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char ch : to_toml(config)) {
+  for (unsigned char ch : text) {
     h ^= ch;
     h *= 0x100000001b3ULL;
   }
   return h;
 }
+
+std::uint64_t config_hash(const Config& config) { return fnv1a(to_toml(config)); }
 
 bool operator==(const Config& a, const Config& b) { return to_toml(a) == to_toml(b); }
 

@@ -21,6 +21,7 @@
 #include "animat/islands.hpp"
 #include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
+#include "animat/run_identity.hpp"
 #include "json_util.hpp"
 
 namespace animat {
@@ -33,15 +34,6 @@ constexpr int kCheckpointVersion = 1;
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-std::uint64_t fnv1a(std::string_view s) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
 }
 
 std::string hex(std::uint64_t x) { return fmt::format("{:016x}", x); }
@@ -172,109 +164,6 @@ std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const Fitn
 bool reference_disagrees(double fitness, double reference, const EvaluationParams& params) {
   const double diff = std::abs(fitness - reference);
   return diff > params.reference_abs_tolerance && diff > params.reference_tolerance * std::abs(reference);
-}
-
-const std::vector<std::string>& resumable_keys() {
-  static const std::vector<std::string> keys = {"evolution.generations", "evolution.stall_generations",
-                                                "evolution.wall_seconds", "evolution.threads",
-                                                "evolution.checkpoint_every", "physics.integrator",
-                                                "evaluation.energy_accounting"};
-  return keys;
-}
-
-const std::vector<std::string>& late_keys() {
-  // evaluation.objective and .direction came with the research API (issue 16), after the runs of
-  // data/study_issue14; physics.integrator with the native integrator (issue 21); the crawl world's
-  // keys with issue 17 (their defaults leave a swim as it was), as did the body graph keys of issue 17
-  // part 4 (the default graph is the paper's Gabriel graph).
-  static const std::vector<std::string> keys = {
-      "evaluation.objective",     "evaluation.direction",  "physics.integrator",
-      "scene.gravity",            "scene.ground_height",   "scene.ground_friction_static",
-      "scene.ground_friction_kinetic", "evaluation.settle_steps", "evaluation.energy_weight",
-      "evaluation.energy_offset",
-      // The genome's extension channels (issue 18; docs/model.md): at "" a genome is the paper's.
-      "genome.extra_inputs",      "genome.extra_outputs",
-      // The body graphs (issue 17 part 4): at "gabriel" the body is the paper's.
-      "body.graph", "body.distance_threshold", "body.alpha",
-      // Evolvable stiffness (issue 17 part 3): used only when genome.extra_outputs has stiffness.
-      "development.stiffness_min", "development.stiffness_max",
-      // Active control, the chemical field (issue 18; docs/control.md): the defaults are the paper's swim.
-      "scene.chemical",           "scene.chemical_source", "scene.chemical_decay_length",
-      "control.mode",             "control.actuation",     "control.update_interval", "control.grn_rate",
-      "control.signal_rate",      "control.signal_decay",  "control.start_ramp",
-      "evaluation.source_directions", "evaluation.source_seed", "evaluation.push_step",
-      "evaluation.push_impulse",  "evaluation.push_cells",
-      // The morphogen cut-off (issue 21): at 0 the field is the paper's, every pair.
-      "development.morphogen_cutoff",
-      // The division axis: at "orientation" a daughter is placed as in the paper.
-      "development.division_axis",
-      // Energy accounting changes no result (and is resumable).
-      "evaluation.energy_accounting"};
-  return keys;
-}
-
-namespace {
-
-/// Removes the line of `section.key` and the comment lines just above it from to_toml() text.
-void erase_key_lines(std::string& text, std::string_view dotted) {
-  const auto dot = dotted.find('.');
-  const std::string header = fmt::format("[{}]\n", dotted.substr(0, dot));
-  const std::string line = fmt::format("\n{} = ", dotted.substr(dot + 1));
-  const auto section = text.find(header);
-  if (section == std::string::npos) return;
-  const auto next_section = text.find("\n[", section + header.size());
-  const auto key = text.find(line, section);
-  if (key == std::string::npos || (next_section != std::string::npos && key > next_section)) return;
-  auto begin = key + 1;  // start of the key's line
-  while (begin > 0) {    // and of the comment lines above it
-    const auto prev = text.rfind('\n', begin - 2);
-    const auto start = prev == std::string::npos ? 0 : prev + 1;
-    if (text.compare(start, 1, "#") != 0) break;
-    begin = start;
-  }
-  const auto end = text.find('\n', key + 1);
-  text.erase(begin, end == std::string::npos ? std::string::npos : end + 1 - begin);
-}
-
-}  // namespace
-
-std::uint64_t run_identity(const Config& config) {
-  Config c = config;
-  const Config defaults;
-  for (const auto& key : resumable_keys()) set_value(c, key, get_value(defaults, key));
-  std::string text = to_toml(c);
-  bool erased = false;
-  // Keys added after runs were first checkpointed change nothing at their default value: hash the
-  // config without their lines, so those runs still resume.
-  for (const auto& key : late_keys()) {
-    if (get_value(c, key) != get_value(defaults, key)) continue;
-    erase_key_lines(text, key);
-    erased = true;
-  }
-  // A section left without keys ([control] at its defaults) goes with its header.
-  for (auto at = text.find("\n["); at != std::string::npos;) {
-    const auto close = text.find("]\n", at);
-    const auto after = close == std::string::npos ? std::string::npos : close + 2;
-    if (after != std::string::npos && (after == text.size() || text.compare(after, 2, "\n[") == 0)) {
-      text.erase(at, after - at);
-      at = text.find("\n[", at);
-    } else {
-      at = text.find("\n[", at + 1);
-    }
-  }
-  // [islands] Without islands the island keys change nothing: hash the config without their lines
-  // (each key with its comment line), so runs checkpointed before islands existed resume.
-  if (c.evolution.islands <= 1) {
-    const auto key = text.find("\nislands = ");
-    const auto last = text.find("\nmigrants = ", key == std::string::npos ? 0 : key);
-    if (key != std::string::npos && last != std::string::npos) {
-      const auto begin = text.rfind('\n', key - 1) + 1;  // the comment line of `islands`
-      const auto end = text.find('\n', last + 1);       // the end of the `migrants` line
-      text.erase(begin, end == std::string::npos ? std::string::npos : end + 1 - begin);
-      return fnv1a(text);
-    }
-  }
-  return erased ? fnv1a(text) : config_hash(c);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -758,6 +647,7 @@ std::string Evolution::checkpoint() const {
   payload["format"] = "animat.checkpoint";
   payload["version"] = kCheckpointVersion;
   payload["identity"] = hex(identity_);
+  payload["identity_scheme"] = kRunIdentityScheme;
   payload["generation"] = generation_;
   payload["stall"] = stall_;
   payload["best_ever"] = best_ever_;
@@ -815,11 +705,17 @@ void Evolution::restore(std::string_view text, std::string_view source) {
       throw CheckpointError(fmt::format("{}: checkpoint version {} is not supported (this build reads version {})", source,
                                         detail::describe(p.at("version")), kCheckpointVersion));
     if (!p.at("identity").is_string()) throw CheckpointError(fmt::format("{}: field \"identity\" must be a string", source));
-    if (p.at("identity").get<std::string>() != hex(identity_))
+    // Checkpoints without "identity_scheme" were identified by scheme 1 (run_identity.hpp).
+    const bool scheme_1 = !p.contains("identity_scheme");
+    if (!scheme_1 && !detail::int_in(p.at("identity_scheme"), kRunIdentityScheme, kRunIdentityScheme))
+      throw CheckpointError(fmt::format("{}: identity scheme {} is not supported (this build reads 1 and {})", source,
+                                        detail::describe(p.at("identity_scheme")), kRunIdentityScheme));
+    const std::string expected = hex(scheme_1 ? run_identity_v1(*config_) : identity_);
+    if (p.at("identity").get<std::string>() != expected)
       throw CheckpointError(fmt::format(
           "{}: checkpoint belongs to a different run configuration (identity {} vs {} for the current config); "
-          "only evolution.generations, stall_generations, wall_seconds, threads and checkpoint_every may change on resume",
-          source, p.at("identity").get<std::string>(), hex(identity_)));
+          "only {} may change on resume",
+          source, p.at("identity").get<std::string>(), expected, fmt::join(resumable_keys(), ", ")));
     std::vector<Individual> pop;
     for (const json& ji : p.at("population")) {
       Individual ind;

@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "animat/config.hpp"
+#include "animat/run_identity.hpp"
 #include "animat/errors.hpp"
 #include "animat/islands.hpp"
 

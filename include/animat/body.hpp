@@ -27,9 +27,9 @@ template <class V>
 void visit_fields(BodyParams& p, V&& v) {
   v(FieldInfo{"merge_distance", "centres closer than this are duplicates and are rejected [choose]", Bounds::upto(kMaxLength)}, p.merge_distance);
   v(FieldInfo{"max_coordinate", "coordinates beyond this magnitude are rejected [choose]", Bounds::positive_upto(kMaxLength)}, p.max_coordinate);
-  v(FieldInfo{"graph", "body graph: gabriel (paper: Gabriel graph, closed disc); distance (Delaunay-tessellation edges not longer than distance_threshold, plus the relative-neighbourhood edges that keep the body in one piece); alpha_shape (regularized alpha complex of radius alpha, same connecting edges; bounded faces outside the complex are holes: no pressure, skin) [issue 17]", Bounds::any(), kBodyGraphNames}, p.graph);
-  v(FieldInfo{"distance_threshold", "graph = distance: longest spring, in units of the mean nearest-neighbour distance of the cell centres (1 = a packed cell diameter), (0, 1e6] [issue 17]", Bounds::positive_upto(kMaxLength)}, p.distance_threshold);
-  v(FieldInfo{"alpha", "graph = alpha_shape: largest circumradius of a filled triangle, in units of the mean nearest-neighbour distance of the cell centres (CGAL's alpha is its square), (0, 1e6] [issue 17]", Bounds::positive_upto(kMaxLength)}, p.alpha);
+  v(FieldInfo{"graph", "body graph: gabriel (paper: Gabriel graph, closed disc); distance (Delaunay-tessellation edges not longer than distance_threshold, plus the relative-neighbourhood edges that keep the body in one piece); alpha_shape (regularized alpha complex of radius alpha, same connecting edges; bounded faces outside the complex are holes: no pressure, skin) [issue 17]", Bounds::any(), kBodyGraphNames, Identity::late}, p.graph);
+  v(FieldInfo{"distance_threshold", "graph = distance: longest spring, in units of the mean nearest-neighbour distance of the cell centres (1 = a packed cell diameter), (0, 1e6] [issue 17]", Bounds::positive_upto(kMaxLength), {}, Identity::late}, p.distance_threshold);
+  v(FieldInfo{"alpha", "graph = alpha_shape: largest circumradius of a filled triangle, in units of the mean nearest-neighbour distance of the cell centres (CGAL's alpha is its square), (0, 1e6] [issue 17]", Bounds::positive_upto(kMaxLength), {}, Identity::late}, p.alpha);
 }
 
 /// The spring-mass structure an embryo becomes.

@@ -2,6 +2,7 @@
 // The whole configuration: one params struct per stage, mapped one to one onto TOML sections.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -56,6 +57,10 @@ using ConfigValue = std::variant<bool, std::int64_t, double, std::string, std::v
 [[nodiscard]] Config load_config(const std::filesystem::path& path);
 /// The complete config as commented TOML; config_from_toml(to_toml(c)) == c.
 [[nodiscard]] std::string to_toml(const Config& config);
+/// to_toml() with the version in its first line and each key's comment chosen by the caller:
+/// comment(dotted_key, doc) gives the text of the key's comment line.
+[[nodiscard]] std::string to_toml(const Config& config, std::string_view version,
+                                  const std::function<std::string(std::string_view dotted_key, std::string_view doc)>& comment);
 /// Applies "section.key=value"; the value is parsed by the field's type, then the whole config is
 /// validated (the cross-key rules included). A rejected override leaves the config unchanged.
 void apply_override(Config& config, std::string_view assignment);
@@ -67,14 +72,19 @@ void set_value(Config& config, std::string_view dotted_key, const ConfigValue& v
 /// Every "section.key", in order.
 [[nodiscard]] std::vector<std::string> config_keys();
 [[nodiscard]] std::string config_doc(std::string_view dotted_key);
+/// The key's part in a run's identity (its descriptor's FieldInfo::identity); throws ConfigError for
+/// an unknown key.
+[[nodiscard]] Identity config_identity(std::string_view dotted_key);
 /// Checks every field's range and the cross-field rules; throws ConfigError naming the key.
 void validate(const Config& config, std::string_view source = "config");
 /// The keys whose values differ between a and b, in config order (as "section.key").
 [[nodiscard]] std::vector<std::string> config_differences(const Config& a, const Config& b);
 /// A value as the TOML form writes it (for messages).
 [[nodiscard]] std::string format_config_value(const ConfigValue& value);
-/// Stable 64-bit hash of the resolved config (FNV-1a of to_toml), for checkpoints.
+/// Stable 64-bit hash of the resolved config (FNV-1a of to_toml).
 [[nodiscard]] std::uint64_t config_hash(const Config& config);
+/// 64-bit FNV-1a hash of text (config and run identities, checkpoint checksums).
+[[nodiscard]] std::uint64_t fnv1a(std::string_view text);
 
 bool operator==(const Config& a, const Config& b);
 

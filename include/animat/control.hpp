@@ -51,13 +51,13 @@ struct ControlParams {
 
 template <class V>
 void visit_fields(ControlParams& p, V&& v) {
-  v(FieldInfo{"mode", "what drives actuation while swimming: open_loop (the paper's sinusoids) or grn (the GRN keeps running, its actuation output sets u_i; docs/control.md) [beyond the paper]", Bounds::any(), kControlModeNames}, p.mode);
-  v(FieldInfo{"actuation", "what the GRN's actuation output L sets in mode grn: direct (u_i = amplitude_max*(2L-1)) or amplitude (u_i = amplitude_max*L*sin(f_i t + phi_i), the developed oscillator with a GRN-controlled amplitude) [choose]", Bounds::any(), kControlActuationNames}, p.actuation);
-  v(FieldInfo{"update_interval", "k, Box2D steps between GRN updates in mode grn (sensors, signalling and eq. 1 advance together), 1 to 1000 [choose]", Bounds::closed(1, 1000)}, p.update_interval);
-  v(FieldInfo{"grn_rate", "rate of eq. 1 while swimming, per time unit: an update advances eq. 1 by grn_rate*k*h (h = physics.dt/substeps, must be <= 1) [choose]", Bounds::positive_upto(1e6)}, p.grn_rate);
-  v(FieldInfo{"signal_rate", "D, diffusion rate of cell products along the springs while swimming (graph Laplacian), per time unit, >= 0 [choose]", Bounds::upto(1e6)}, p.signal_rate);
-  v(FieldInfo{"signal_decay", "lambda, rate at which a cell's sensed product relaxes to its own product level (secretion = decay), per time unit, >= 0 [choose]", Bounds::upto(1e6)}, p.signal_decay);
-  v(FieldInfo{"start_ramp", "time units over which the GRN's actuation terms ramp in from 0 at the start of a swim (rest lengths do not jump), 0 = none [choose]", Bounds::upto(1e6)}, p.start_ramp);
+  v(FieldInfo{"mode", "what drives actuation while swimming: open_loop (the paper's sinusoids) or grn (the GRN keeps running, its actuation output sets u_i; docs/control.md) [beyond the paper]", Bounds::any(), kControlModeNames, Identity::late}, p.mode);
+  v(FieldInfo{"actuation", "what the GRN's actuation output L sets in mode grn: direct (u_i = amplitude_max*(2L-1)) or amplitude (u_i = amplitude_max*L*sin(f_i t + phi_i), the developed oscillator with a GRN-controlled amplitude) [choose]", Bounds::any(), kControlActuationNames, Identity::late}, p.actuation);
+  v(FieldInfo{"update_interval", "k, Box2D steps between GRN updates in mode grn (sensors, signalling and eq. 1 advance together), 1 to 1000 [choose]", Bounds::closed(1, 1000), {}, Identity::late}, p.update_interval);
+  v(FieldInfo{"grn_rate", "rate of eq. 1 while swimming, per time unit: an update advances eq. 1 by grn_rate*k*h (h = physics.dt/substeps, must be <= 1) [choose]", Bounds::positive_upto(1e6), {}, Identity::late}, p.grn_rate);
+  v(FieldInfo{"signal_rate", "D, diffusion rate of cell products along the springs while swimming (graph Laplacian), per time unit, >= 0 [choose]", Bounds::upto(1e6), {}, Identity::late}, p.signal_rate);
+  v(FieldInfo{"signal_decay", "lambda, rate at which a cell's sensed product relaxes to its own product level (secretion = decay), per time unit, >= 0 [choose]", Bounds::upto(1e6), {}, Identity::late}, p.signal_decay);
+  v(FieldInfo{"start_ramp", "time units over which the GRN's actuation terms ramp in from 0 at the start of a swim (rest lengths do not jump), 0 = none [choose]", Bounds::upto(1e6), {}, Identity::late}, p.start_ramp);
 }
 
 /// Checks what bounds cannot: the eq. 1 step grn_rate·k·h <= 1 (signalling stays stable by taking

@@ -85,12 +85,12 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"max_growth", "daughter radius is r0*(1 + max_growth*grow) [paper: 0.5]", Bounds::closed(0, 10)}, p.max_growth);
   v(FieldInfo{"placement_jitter", "daughter placement direction deviates by up to +-this angle (rad), seeded from the genome hash; breaks exact symmetry [choose]", Bounds::closed(0, 3.2)}, p.placement_jitter);
   v(FieldInfo{"division_offset", "daughter placed at division_offset*r_mother from the mother along its orientation [choose]", Bounds::closed(0, 10)}, p.division_offset);
-  v(FieldInfo{"division_axis", "direction in which a daughter is placed: orientation (the mother's orientation vector) [paper] or morphogen_gradient (gradient of maternal morphogen 0 at the mother, i.e. toward source 0, rotated by 2*pi*rotate of the mother) [choose]", Bounds::any(), kDivisionAxisNames}, p.division_axis);
+  v(FieldInfo{"division_axis", "direction in which a daughter is placed: orientation (the mother's orientation vector) [paper] or morphogen_gradient (gradient of maternal morphogen 0 at the mother, i.e. toward source 0, rotated by 2*pi*rotate of the mother) [choose]", Bounds::any(), kDivisionAxisNames, Identity::late}, p.division_axis);
   v(FieldInfo{"frequency_min", "oscillator frequency (rad per time unit) at frequency output 0 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_min);
   v(FieldInfo{"frequency_max", "oscillator frequency (rad per time unit) at frequency output 1 [choose]", Bounds::upto(kMaxCoefficient)}, p.frequency_max);
   v(FieldInfo{"amplitude_max", "oscillator amplitude at amplitude output 1 [paper: 0.2]", Bounds::closed(0, 0.45)}, p.amplitude_max);
-  v(FieldInfo{"stiffness_min", "spring stiffness factor of a cell at stiffness output 0 (used only when genome.extra_outputs has stiffness), dimensionless multiple of scene.spring_stiffness, [1e-6, 1e6] [issue 17]", Bounds::closed(1e-6, 1e6)}, p.stiffness_min);
-  v(FieldInfo{"stiffness_max", "stiffness factor at stiffness output 1; the factor is stiffness_min*(stiffness_max/stiffness_min)^output (geometric), [1e-6, 1e6], >= stiffness_min [issue 17]", Bounds::closed(1e-6, 1e6)}, p.stiffness_max);
+  v(FieldInfo{"stiffness_min", "spring stiffness factor of a cell at stiffness output 0 (used only when genome.extra_outputs has stiffness), dimensionless multiple of scene.spring_stiffness, [1e-6, 1e6] [issue 17]", Bounds::closed(1e-6, 1e6), {}, Identity::late}, p.stiffness_min);
+  v(FieldInfo{"stiffness_max", "stiffness factor at stiffness output 1; the factor is stiffness_min*(stiffness_max/stiffness_min)^output (geometric), [1e-6, 1e6], >= stiffness_min [issue 17]", Bounds::closed(1e-6, 1e6), {}, Identity::late}, p.stiffness_max);
   v(FieldInfo{"time_step", "Box2D time step of one development step [choose]", Bounds::closed(kMinTimeStep, 1.0)}, p.time_step);
   v(FieldInfo{"cell_mass", "mass of every cell body during development [choose]", Bounds::closed(kMinMass, kMaxMass)}, p.cell_mass);
   v(FieldInfo{"damping", "Box2D linear damping of cells, fluid-like [choose]", Bounds::upto(kMaxCoefficient)}, p.damping);
@@ -102,7 +102,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"maternal_decay_length", "maternal level at distance d from its source is exp(-d/length) [choose]", Bounds::positive_upto(kMaxLength)}, p.maternal_decay_length);
   v(FieldInfo{"morphogen_speed", "speed v of cell-made morphogens, length units per step: delay = d/v [choose]", Bounds::positive_upto(kMaxLength)}, p.morphogen_speed);
   v(FieldInfo{"morphogen_decay_length", "cell-made morphogen level falls as exp(-d/length) [choose]", Bounds::positive_upto(kMaxLength)}, p.morphogen_decay_length);
-  v(FieldInfo{"morphogen_cutoff", "distance beyond which cells do not sense each other's morphogens; 0 = no cut-off, every pair (the paper's field); a cut-off makes development linear in cells [choose, issue 21]", Bounds::upto(kMaxLength)}, p.morphogen_cutoff);
+  v(FieldInfo{"morphogen_cutoff", "distance beyond which cells do not sense each other's morphogens; 0 = no cut-off, every pair (the paper's field); a cut-off makes development linear in cells [choose, issue 21]", Bounds::upto(kMaxLength), {}, Identity::late}, p.morphogen_cutoff);
   v(FieldInfo{"morphogen_max_delay", "longest morphogen delay kept in the per-cell history, in steps [choose]", Bounds::closed(0, 100000)}, p.morphogen_max_delay);
   v(FieldInfo{"effects", "effects of the development world", Bounds::any(), kDevelopmentEffectNames}, p.effects);
   v(FieldInfo{"trace_every", "record positions every k steps for plotting; 0 = off", Bounds::closed(0, 100000)}, p.trace_every);

@@ -17,7 +17,7 @@ inline constexpr std::string_view kPushCellNames[] = {"all", "front"};
 /// invariants checked, and the exploit guard.
 struct EvaluationParams {
   int steps = 4000;  ///< swim steps at physics.dt [paper: 4000 or 8000]
-  /// distance (the paper's), distance_per_size, speed_toward, or "python:NAME" (a Python callable).
+  /// A built-in objective (kObjectives) or "python:NAME" (a Python callable).
   std::string objective = "distance";
   std::vector<double> direction = {1.0, 0.0};  ///< speed_toward's direction (normalised when used)
   /// Check the body's planar embedding after every step (no region inverted, the skin simple); a
@@ -52,29 +52,23 @@ struct EvaluationParams {
 template <class V>
 void visit_fields(EvaluationParams& p, V&& v) {
   v(FieldInfo{"steps", "swim steps per evaluation [paper: 4000, or 8000]", Bounds::closed(0, 10000000)}, p.steps);
-  v(FieldInfo{"objective", "what the GA maximises: distance (straight-line distance of the centre of mass, the paper's); "
-                           "distance_per_size (distance / body length); speed_toward (centre-of-mass speed along "
-                           "evaluation.direction); distance_x (|horizontal displacement| of the centre of mass, the "
-                           "crawl world's); distance_minus_energy (distance - energy_weight * positive actuation work); "
-                           "distance_per_energy (distance / (positive actuation work + energy_offset)); python:NAME (a "
-                           "Python callable, set by animat.evolve)",
-              Bounds::any(), kObjectiveChoices},
+  v(FieldInfo{"objective", objective_field_doc(), Bounds::any(), kObjectiveChoices, Identity::late},
     p.objective);
-  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)", Bounds::closed(-kMaxLength, kMaxLength)}, p.direction);
+  v(FieldInfo{"direction", "direction [x, y] of speed_toward (normalised; not both 0)", Bounds::closed(-kMaxLength, kMaxLength), {}, Identity::late}, p.direction);
   v(FieldInfo{"check_embedding", "check after every step that no region is inverted and the skin is a simple polygon; a swim that breaks it gets fitness 0", Bounds::any()}, p.check_embedding);
   v(FieldInfo{"reference_check", "exploit guard: re-evaluate each new best at a finer step and record both fitnesses (record), also rank elites by it (select), or off", Bounds::any(), kReferenceCheckNames}, p.reference_check);
   v(FieldInfo{"reference_substeps", "the reference evaluation uses physics.substeps times this (dt/16 by default)", Bounds::closed(1, 1024)}, p.reference_substeps);
   v(FieldInfo{"reference_tolerance", "warn when the best's fitness and its reference differ by more than this fraction...", Bounds::upto(1e6)}, p.reference_tolerance);
   v(FieldInfo{"reference_abs_tolerance", "...and by more than this many length units", Bounds::upto(kMaxLength)}, p.reference_abs_tolerance);
-  v(FieldInfo{"settle_steps", "control steps simulated with actuation off before the fitness clock starts (crawl world: the body settles onto the ground; docs/worlds.md); 0 = none", Bounds::closed(0, 10000000)}, p.settle_steps);
-  v(FieldInfo{"energy_weight", "lambda of objective distance_minus_energy: distance - lambda * positive actuation work, length per energy unit [choose]", Bounds::upto(1e6)}, p.energy_weight);
-  v(FieldInfo{"energy_offset", "W0 of objective distance_per_energy: distance / (positive actuation work + W0), energy units, > 0 [choose]", Bounds::positive_upto(1e12)}, p.energy_offset);
-  v(FieldInfo{"source_directions", "objective chemotaxis: swims per evaluation, each with scene.chemical_source rotated to a random direction; fitness = mean progress toward the source (docs/control.md) [choose]", Bounds::closed(1, 64)}, p.source_directions);
-  v(FieldInfo{"source_seed", "objective chemotaxis: seed of the source directions, the same for every genome [choose]", Bounds::closed(0, 2147483647)}, p.source_seed);
-  v(FieldInfo{"push_step", "disruption: control step (from the fitness clock's start) at which the pushed cells get push_impulse; -1 = never (docs/control.md)", Bounds::closed(-1, 10000000)}, p.push_step);
-  v(FieldInfo{"push_impulse", "disruption: impulse [Jx, Jy] given to every pushed cell (velocity change impulse / cell_mass), mass * length / time", Bounds::closed(-kMaxCoefficient, kMaxCoefficient)}, p.push_impulse);
-  v(FieldInfo{"push_cells", "disruption: which cells are pushed: all, or front (x >= the centre of mass's x, a push that also turns the body)", Bounds::any(), kPushCellNames}, p.push_cells);
-  v(FieldInfo{"energy_accounting", "keep the energy books of every swim: actuation work in; fluid drag (normal, tangential), spring damping, collisions and ground out; kinetic and potential energies stored (include/animat/energy.hpp). Slower; fitness unchanged", Bounds::any()}, p.energy_accounting);
+  v(FieldInfo{"settle_steps", "control steps simulated with actuation off before the fitness clock starts (crawl world: the body settles onto the ground; docs/worlds.md); 0 = none", Bounds::closed(0, 10000000), {}, Identity::late}, p.settle_steps);
+  v(FieldInfo{"energy_weight", "lambda of objective distance_minus_energy: distance - lambda * positive actuation work, length per energy unit [choose]", Bounds::upto(1e6), {}, Identity::late}, p.energy_weight);
+  v(FieldInfo{"energy_offset", "W0 of objective distance_per_energy: distance / (positive actuation work + W0), energy units, > 0 [choose]", Bounds::positive_upto(1e12), {}, Identity::late}, p.energy_offset);
+  v(FieldInfo{"source_directions", "objective chemotaxis: swims per evaluation, each with scene.chemical_source rotated to a random direction; fitness = mean progress toward the source (docs/control.md) [choose]", Bounds::closed(1, 64), {}, Identity::late}, p.source_directions);
+  v(FieldInfo{"source_seed", "objective chemotaxis: seed of the source directions, the same for every genome [choose]", Bounds::closed(0, 2147483647), {}, Identity::late}, p.source_seed);
+  v(FieldInfo{"push_step", "disruption: control step (from the fitness clock's start) at which the pushed cells get push_impulse; -1 = never (docs/control.md)", Bounds::closed(-1, 10000000), {}, Identity::late}, p.push_step);
+  v(FieldInfo{"push_impulse", "disruption: impulse [Jx, Jy] given to every pushed cell (velocity change impulse / cell_mass), mass * length / time", Bounds::closed(-kMaxCoefficient, kMaxCoefficient), {}, Identity::late}, p.push_impulse);
+  v(FieldInfo{"push_cells", "disruption: which cells are pushed: all, or front (x >= the centre of mass's x, a push that also turns the body)", Bounds::any(), kPushCellNames, Identity::late}, p.push_cells);
+  v(FieldInfo{"energy_accounting", "keep the energy books of every swim: actuation work in; fluid drag (normal, tangential), spring damping, collisions and ground out; kinetic and potential energies stored (include/animat/energy.hpp). Slower; fitness unchanged", Bounds::any(), {}, Identity::resumable}, p.energy_accounting);
 }
 
 }  // namespace animat

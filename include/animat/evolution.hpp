@@ -244,15 +244,4 @@ class Evolution {
   StopRequest stop_;
 };
 
-/// Hash of what defines a run: the config minus its stopping and resource knobs (resumable_keys()),
-/// so a resumed run may extend its cap.
-[[nodiscard]] std::uint64_t run_identity(const Config& config);
-/// The config keys that may change when a run is resumed (caps, budgets, threads, checkpoint interval);
-/// every other key is part of run_identity().
-[[nodiscard]] const std::vector<std::string>& resumable_keys();
-/// Keys added to the config after runs were first checkpointed: at their default value they change
-/// nothing, and run_identity() then hashes the config without them, so older runs still resume.
-/// A new key whose default keeps today's results belongs here.
-[[nodiscard]] const std::vector<std::string>& late_keys();
-
 }  // namespace animat

@@ -36,11 +36,11 @@ void visit_fields(EvolutionParams& p, V&& v) {
   v(FieldInfo{"tournament_p_start", "probability that the fitter of 2 wins, at generation 0 [paper: 0.8]", Bounds::unit()}, p.tournament_p_start);
   v(FieldInfo{"tournament_p_end", "probability that the fitter wins after the ramp [paper: 1.0]", Bounds::unit()}, p.tournament_p_end);
   v(FieldInfo{"tournament_ramp_generations", "generations of the linear ramp [paper: 1000]", Bounds::closed(0, 100000000)}, p.tournament_ramp_generations);
-  v(FieldInfo{"generations", "generation cap; 0 = no cap", Bounds::closed(0, 100000000)}, p.generations);
-  v(FieldInfo{"stall_generations", "stop after this many generations without improvement [paper: 500]; 0 = never", Bounds::closed(0, 100000000)}, p.stall_generations);
-  v(FieldInfo{"wall_seconds", "wall-clock budget in seconds; 0 = none", Bounds::upto(1e10)}, p.wall_seconds);
-  v(FieldInfo{"threads", "OpenMP threads; 0 = all cores", Bounds::closed(0, 1024)}, p.threads);
-  v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000)}, p.checkpoint_every);
+  v(FieldInfo{"generations", "generation cap; 0 = no cap", Bounds::closed(0, 100000000), {}, Identity::resumable}, p.generations);
+  v(FieldInfo{"stall_generations", "stop after this many generations without improvement [paper: 500]; 0 = never", Bounds::closed(0, 100000000), {}, Identity::resumable}, p.stall_generations);
+  v(FieldInfo{"wall_seconds", "wall-clock budget in seconds; 0 = none", Bounds::upto(1e10), {}, Identity::resumable}, p.wall_seconds);
+  v(FieldInfo{"threads", "OpenMP threads; 0 = all cores", Bounds::closed(0, 1024), {}, Identity::resumable}, p.threads);
+  v(FieldInfo{"checkpoint_every", "write a checkpoint every k generations", Bounds::closed(1, 1000000), {}, Identity::resumable}, p.checkpoint_every);
   v(FieldInfo{"max_init_tries", "tries to find one viable random individual before giving up", Bounds::closed(1, 1000000000)}, p.max_init_tries);
   // [islands] last in the section: run_identity() of a run without islands ignores these lines
   v(FieldInfo{"islands", "sub-populations evolving apart with ring migration [not in the paper: 1 = off]", Bounds::closed(1, 10000)}, p.islands);

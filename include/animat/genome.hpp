@@ -114,8 +114,8 @@ void visit_fields(GenomeParams& p, V&& v) {
   v(FieldInfo{"initial_units", "regulatory units (promoter + gene) in a random genome [paper: 10]", Bounds::closed(0, 1000)}, p.initial_units);
   v(FieldInfo{"morphogen_gene_probability", "chance that a random gene codes for a morphogen [choose]", Bounds::unit()}, p.morphogen_gene_probability);
   v(FieldInfo{"max_elements", "safety cap on genome length; longer genomes are rejected [choose]", Bounds::closed(1, 1000000)}, p.max_elements);
-  v(FieldInfo{"extra_inputs", "extension input channels random genomes and mutations may create, comma-separated: strain, pressure, chemical; \"\" = the paper's 4 inputs only (docs/model.md) [beyond the paper]"}, p.extra_inputs);
-  v(FieldInfo{"extra_outputs", "extension output channels random genomes and mutations may create, comma-separated: stiffness, actuation; \"\" = the paper's 6 outputs only (docs/model.md) [beyond the paper]"}, p.extra_outputs);
+  v(FieldInfo{"extra_inputs", "extension input channels random genomes and mutations may create, comma-separated: strain, pressure, chemical; \"\" = the paper's 4 inputs only (docs/model.md) [beyond the paper]", Bounds::any(), {}, Identity::late}, p.extra_inputs);
+  v(FieldInfo{"extra_outputs", "extension output channels random genomes and mutations may create, comma-separated: stiffness, actuation; \"\" = the paper's 6 outputs only (docs/model.md) [beyond the paper]", Bounds::any(), {}, Identity::late}, p.extra_outputs);
 }
 
 /// The input channels random genomes and mutations draw from: the paper's 0-3, then the enabled

@@ -7,6 +7,7 @@
 // Adding a built-in objective: one row in kObjectives and its value function in src/objective.cpp.
 #include <array>
 #include <cstddef>
+#include <string>
 #include <string_view>
 
 namespace animat {
@@ -46,12 +47,12 @@ double chemotaxis(const SwimOutcome&, const EvaluationParams&);
 }  // namespace objective_values
 
 inline constexpr ObjectiveSpec kObjectives[] = {
-    {"distance", "straight-line distance of the centre of mass, start to end (the paper's)", true, false, true,
+    {"distance", "the paper's: straight-line distance of the centre of mass, start to end", true, false, true,
      objective_values::distance},
     {"distance_per_size", "distance / body length", true, true, true, objective_values::distance_per_size},
-    {"speed_toward", "centre-of-mass speed along evaluation.direction (signed)", false, false, true,
+    {"speed_toward", "signed centre-of-mass speed along evaluation.direction", false, false, true,
      objective_values::speed_toward},
-    {"distance_x", "|horizontal displacement| of the centre of mass (the crawl world's)", true, false, true,
+    {"distance_x", "the crawl world's: |horizontal displacement| of the centre of mass", true, false, true,
      objective_values::distance_x},
     {"distance_minus_energy", "distance - energy_weight * positive actuation work", false, false, true,
      objective_values::distance_minus_energy},
@@ -71,6 +72,16 @@ inline constexpr auto kObjectiveChoices = [] {
   out.back() = "python:*";
   return out;
 }();
+
+/// evaluation.objective's documentation, written from the table.
+inline std::string_view objective_field_doc() {
+  static const std::string doc = [] {
+    std::string out = "what the GA maximises: ";
+    for (const auto& spec : kObjectives) out.append(spec.name).append(" (").append(spec.meaning).append("); ");
+    return out + "python:NAME (a Python callable, set by animat.evolve)";
+  }();
+  return doc;
+}
 
 /// The row of a built-in objective, or nullptr (a "python:" name or an unknown one).
 [[nodiscard]] constexpr const ObjectiveSpec* find_objective(std::string_view name) {

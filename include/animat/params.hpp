@@ -57,13 +57,23 @@ inline constexpr double kMaxMass = 1e12;
 /// Shortest Box2D time step: 1/dt stays finite in float, and a step is not rounded to 0.
 inline constexpr double kMinTimeStep = 1e-9;
 
-/// Static description of one field: name, meaning, allowed values.
+/// A config field's part in a run's identity (run_identity(): what a resume may not change).
+enum class Identity : std::uint8_t {
+  defines_run,  ///< part of the identity: a resume may not change it
+  resumable,    ///< a stopping or resource knob (generations, threads, ...): a resume may change it
+  late,         ///< added after runs were first checkpointed, with a default that reproduces them: part
+                ///< of the identity only away from its default, so those runs still resume
+};
+
+/// Static description of one field: name, meaning, allowed values, part in a run's identity.
 struct FieldInfo {
   std::string_view name;
   std::string_view doc;
   Bounds bounds = Bounds::any();
   /// Allowed words for string and string-list fields; empty means any.
   std::span<const std::string_view> choices = {};
+  /// A new key whose default keeps results as they were is Identity::late.
+  Identity identity = Identity::defines_run;
 };
 
 /// Field value types a params struct may use.

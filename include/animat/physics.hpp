@@ -60,7 +60,7 @@ void visit_fields(PhysicsParams& p, V&& v) {
   v(FieldInfo{"drag_scheme", "drag integration: semi_implicit (F = -d L |u_start| u_end, second order, never reverses an edge velocity); explicit; stable (explicit, scaled down where it would overshoot, counted); implicit (backward Euler)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
   v(FieldInfo{"velocity_forces", "velocity that damping and drag use: midpoint (predicted, second order) or start (first order) [choose]", Bounds::any(), kVelocityForceNames}, p.velocity_forces);
   v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
-  v(FieldInfo{"integrator", "who moves the cells: native (Box2D's float step for fixture-less bodies, bit for bit, without its overhead) or box2d (a real b2World); same results", Bounds::any(), kIntegratorNames}, p.integrator);
+  v(FieldInfo{"integrator", "who moves the cells: native (Box2D's float step for fixture-less bodies, bit for bit, without its overhead) or box2d (a real b2World); same results", Bounds::any(), kIntegratorNames, Identity::resumable}, p.integrator);
 }
 
 /// Checks what visit_fields bounds cannot say (finite dt, known drag scheme); throws ConfigError.

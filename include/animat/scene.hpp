@@ -90,13 +90,13 @@ void visit_fields(SceneParams& p, V&& v) {
   v(FieldInfo{"collision_tolerance", "a cell closer than this to an edge it is not an end of collides (length units) [choose]", Bounds{0.0, 0.1, true, false}}, p.collision_tolerance);
   v(FieldInfo{"collision_stiffness", "penalty stiffness of the optional skin_collision effect (a soft force, lets cells through) [choose]", Bounds::upto(kMaxCoefficient)}, p.collision_stiffness);
   v(FieldInfo{"collision_radius", "distance from a skin edge where the skin_collision penalty starts [choose]", Bounds::upto(kMaxLength)}, p.collision_radius);
-  v(FieldInfo{"gravity", "g of effect gravity: force -m*g along y on every cell, length/time^2 (crawl world, docs/worlds.md) [choose]", Bounds::upto(kMaxCoefficient)}, p.gravity);
-  v(FieldInfo{"ground_height", "y of the floor of effect ground, length units; the body is placed with its lowest cell on it [choose]", Bounds::closed(-kMaxLength, kMaxLength)}, p.ground_height);
-  v(FieldInfo{"ground_friction_static", "Coulomb static friction coefficient mu_s of the floor: a contact sticks while the tangential impulse needed is <= mu_s * normal impulse [choose]", Bounds::upto(100.0)}, p.ground_friction_static);
-  v(FieldInfo{"ground_friction_kinetic", "Coulomb kinetic friction coefficient mu_k of the floor (sliding contacts), at most ground_friction_static [choose]", Bounds::upto(100.0)}, p.ground_friction_kinetic);
-  v(FieldInfo{"chemical", "chemical field sensed by the GRN's chemical input under control.mode = grn: none, point (exp(-|x - x_s|/l)) or plane (exp(-max(0, (x_s - x).n)/l), n from the start centre to x_s) (docs/control.md) [beyond the paper]", Bounds::any(), kChemicalNames}, p.chemical);
-  v(FieldInfo{"chemical_source", "source x_s [x, y] of the chemical field, relative to the body's centre at the start of the swim, length units [choose]", Bounds::closed(-kMaxLength, kMaxLength)}, p.chemical_source);
-  v(FieldInfo{"chemical_decay_length", "decay length l of the chemical field, length units, > 0 [choose]", Bounds::positive_upto(kMaxLength)}, p.chemical_decay_length);
+  v(FieldInfo{"gravity", "g of effect gravity: force -m*g along y on every cell, length/time^2 (crawl world, docs/worlds.md) [choose]", Bounds::upto(kMaxCoefficient), {}, Identity::late}, p.gravity);
+  v(FieldInfo{"ground_height", "y of the floor of effect ground, length units; the body is placed with its lowest cell on it [choose]", Bounds::closed(-kMaxLength, kMaxLength), {}, Identity::late}, p.ground_height);
+  v(FieldInfo{"ground_friction_static", "Coulomb static friction coefficient mu_s of the floor: a contact sticks while the tangential impulse needed is <= mu_s * normal impulse [choose]", Bounds::upto(100.0), {}, Identity::late}, p.ground_friction_static);
+  v(FieldInfo{"ground_friction_kinetic", "Coulomb kinetic friction coefficient mu_k of the floor (sliding contacts), at most ground_friction_static [choose]", Bounds::upto(100.0), {}, Identity::late}, p.ground_friction_kinetic);
+  v(FieldInfo{"chemical", "chemical field sensed by the GRN's chemical input under control.mode = grn: none, point (exp(-|x - x_s|/l)) or plane (exp(-max(0, (x_s - x).n)/l), n from the start centre to x_s) (docs/control.md) [beyond the paper]", Bounds::any(), kChemicalNames, Identity::late}, p.chemical);
+  v(FieldInfo{"chemical_source", "source x_s [x, y] of the chemical field, relative to the body's centre at the start of the swim, length units [choose]", Bounds::closed(-kMaxLength, kMaxLength), {}, Identity::late}, p.chemical_source);
+  v(FieldInfo{"chemical_decay_length", "decay length l of the chemical field, length units, > 0 [choose]", Bounds::positive_upto(kMaxLength), {}, Identity::late}, p.chemical_decay_length);
 }
 
 // has_effect(effects, name): params.hpp (development.effects uses it too).

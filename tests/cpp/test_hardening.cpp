@@ -36,6 +36,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run_identity.hpp"
 #include "animat/run.hpp"
 #include "animat/genome.hpp"
 #include "animat/random.hpp"
@@ -465,6 +466,7 @@ TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
       Config c = base;
       set_value(c, dotted, p.value);
       EXPECT_EQ(run_identity(c) == run_identity(base), may_change) << dotted << " = " << p.text;
+      EXPECT_EQ(run_identity_v1(c) == run_identity_v1(base), may_change) << dotted << " = " << p.text << " (scheme 1)";
       break;
     }
   }

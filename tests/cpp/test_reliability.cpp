@@ -41,6 +41,7 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run_identity.hpp"
 #include "animat/run.hpp"
 #include "animat/genome.hpp"
 
@@ -1306,6 +1307,7 @@ TEST(FuzzRegressions, CheckpointInputsRaiseOnlyAnimatErrors) {
         json p = json::parse(rest, nullptr, false);
         if (p.is_discarded() || !p.is_object()) continue;
         p["identity"] = fmt::format("{:016x}", run_identity(c));
+        p["identity_scheme"] = kRunIdentityScheme;
         p["format"] = "animat.checkpoint";
         p["version"] = 1;
         text = rewrap(p);

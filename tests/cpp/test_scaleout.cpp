@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
+#include "animat/run_identity.hpp"
 #include "animat/islands.hpp"
 #include "animat/wire.hpp"
 #include "test_support.hpp"
@@ -248,11 +251,13 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   b.evolution.migration_interval = 77;
   b.evolution.migrants = 5;
   EXPECT_EQ(run_identity(a), run_identity(b));
+  EXPECT_EQ(run_identity_v1(a), run_identity_v1(b));
   Config k = a;
   k.evolution.islands = 2;
   EXPECT_NE(run_identity(a), run_identity(k));
-  // The identity is the hash of the TOML without the three island keys and their comments (as before
-  // islands existed), with the resource knobs at their defaults; lines after them still count.
+  EXPECT_NE(run_identity_v1(a), run_identity_v1(k));
+  // Scheme 1 hashed the TOML without the three island keys and their comments (as before islands
+  // existed), with the resource knobs at their defaults; lines after them still count.
   Config plain = a;
   plain.evolution.threads = EvolutionParams{}.threads;
   std::string text = to_toml(plain);
@@ -260,7 +265,7 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   const auto end = text.find('\n', text.find("\nmigrants = ") + 1) + 1;
   ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin), text.begin() + static_cast<std::ptrdiff_t>(end), '\n'), 6);
   text.erase(begin, end - begin);
-  // So are the late keys at their defaults (evolution.cpp late_keys()), each with its comment line.
+  // So are the late keys at their defaults, each with its comment line.
   for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = ", "\ngravity = ", "\nground_height = ",
                           "\nground_friction_static = ", "\nground_friction_kinetic = ", "\nsettle_steps = ",
                           "\nenergy_weight = ", "\nenergy_offset = ", "\nextra_inputs = ", "\nextra_outputs = ",
@@ -285,19 +290,68 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
     h ^= ch;
     h *= 0x100000001b3ULL;
   }
-  EXPECT_EQ(run_identity(a), h);
+  EXPECT_EQ(run_identity_v1(a), h);
 }
 
 TEST(RunIdentity, RunsCheckpointedBeforeTheLateKeysStillResume) {
-  // data/study_issue14 was checkpointed before evaluation.objective, evaluation.direction and
-  // physics.integrator existed; its checkpoints carry these identities (the checkpoint field
+  // data/study_issue14 was checkpointed (scheme 1) before evaluation.objective, evaluation.direction
+  // and physics.integrator existed; its checkpoints carry these identities (the checkpoint field
   // "identity"), which the config it was run with must still give.
-  const std::filesystem::path study = std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "study_issue14";
-  EXPECT_EQ(run_identity(load_config(study / "dn2" / "run_1" / "config.toml")), 0xc3f866cda3ad7231ULL);
+  const std::filesystem::path run = std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "study_issue14" / "dn2" / "run_1";
+  const Config config = load_config(run / "config.toml");
+  EXPECT_EQ(run_identity_v1(config), 0xc3f866cda3ad7231ULL);
   // And a late key away from its default is part of the identity.
-  Config c = load_config(study / "dn2" / "run_1" / "config.toml");
+  Config c = config;
   c.evaluation.objective = "distance_per_size";
-  EXPECT_NE(run_identity(c), 0xc3f866cda3ad7231ULL);
+  EXPECT_NE(run_identity_v1(c), 0xc3f866cda3ad7231ULL);
+  EXPECT_NE(run_identity(c), run_identity(config));
+  // (tests/python/test_evolution.py resumes the run's own checkpoint.)
+}
+
+constexpr std::uint64_t kPinnedDefaultIdentity = 0x18200722bab35f84ULL;
+constexpr std::uint64_t kPinnedStudyIdentity = 0xc1511dfee1a098d1ULL;
+
+TEST(RunIdentity, SchemeTwoIsPinnedAndReadsValuesNotDocumentation) {
+  // The identity of the paper's default config and of a study config, pinned: a change of scheme 2
+  // would strand every run checkpointed since.
+  const std::filesystem::path run = std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "study_issue14" / "dn2" / "run_1";
+  EXPECT_EQ(run_identity(Config{}), kPinnedDefaultIdentity);
+  EXPECT_EQ(run_identity(load_config(run / "config.toml")), kPinnedStudyIdentity);
+  // It is the hash of "section.key = value" lines: the documentation and the version are not in it.
+  Config c;
+  c.evolution.islands = 3;
+  c.evaluation.objective = "distance_x";
+  std::string text;
+  for (const auto& key : config_keys()) {
+    if (config_identity(key) == Identity::resumable) continue;
+    if (config_identity(key) == Identity::late && get_value(c, key) == get_value(Config{}, key)) continue;
+    text += key + " = " + format_config_value(get_value(c, key)) + "\n";
+  }
+  EXPECT_EQ(text.find('#'), std::string::npos);
+  EXPECT_NE(text.find("evaluation.objective = \"distance_x\"\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("evolution.migrants = 1\n"), std::string::npos);
+  EXPECT_EQ(run_identity(c), fnv1a(text));
+  // A checkpoint records its scheme; one of an unknown scheme is refused by name.
+  c.evolution.population = 12;
+  c.evolution.elites = 1;
+  Evolution evo(c, stub_fitness);
+  evo.initialize();
+  const std::string saved = evo.checkpoint();
+  EXPECT_NE(saved.find("identity_scheme"), std::string::npos);
+  Evolution resumed(c, stub_fitness);
+  EXPECT_NO_THROW(resumed.restore(saved, "scheme 2"));
+  // One of an unknown scheme (an intact checkpoint: its checksum recomputed) is refused by name.
+  nlohmann::json payload = nlohmann::json::parse(nlohmann::json::parse(saved).at("payload").get<std::string>());
+  EXPECT_EQ(payload.at("identity_scheme"), kRunIdentityScheme);
+  payload["identity_scheme"] = 7;
+  const std::string body = payload.dump();
+  const std::string unknown = nlohmann::json{{"checksum", fmt::format("{:016x}", fnv1a(body))}, {"payload", body}}.dump();
+  try {
+    Evolution(c, stub_fitness).restore(unknown, "unknown.json");
+    FAIL();
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown.json: identity scheme 7 is not supported"), std::string::npos) << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------

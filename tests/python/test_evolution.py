@@ -103,3 +103,24 @@ def test_evaluate_population_is_thread_count_independent():
     assert viable, "1500 random genomes should contain a viable one (about 0.7% are)"
     assert all(f.fitness >= 0 and f.stable for f in one)
     assert all(f.fitness == 0 for f in one if not f.viable)
+
+
+def test_a_run_checkpointed_under_identity_scheme_1_resumes_and_is_saved_under_scheme_2(tmp_path):
+    """A committed study run (checkpointed before identity scheme 2) restores against its config,
+    refuses a changed one, and a re-save records the current scheme."""
+    import gzip
+    from pathlib import Path
+
+    run = Path(__file__).resolve().parents[2] / "data" / "study_issue14" / "dn2" / "run_1"
+    text = gzip.decompress((run / "checkpoint.json.gz").read_bytes()).decode()
+    assert "identity_scheme" not in text
+    config = animat.load_config(run / "config.toml")
+    ga = animat.GA.from_checkpoint(text, config, "study run_1")
+    assert ga.generation == 100
+    changed = config.copy()
+    changed["development.steps"] = 399
+    with pytest.raises(ValueError, match="belongs to a different run configuration"):
+        animat.GA.from_checkpoint(text, changed, "study run_1")
+    resaved = json.loads(json.loads(ga.checkpoint())["payload"])
+    assert resaved["identity_scheme"] == 2
+    assert animat.GA.from_checkpoint(ga.checkpoint(), config).generation == 100
