@@ -50,8 +50,8 @@ double cpu_now() {
 
 class ProfilingEvaluator final : public Evaluator {
  public:
-  ProfilingEvaluator(const Config& c) : config_(c), fitness_(swim_fitness(c)) {}
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes) override {
+  explicit ProfilingEvaluator(const Config& c) : fitness_(swim_fitness(c)) {}
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest&) override {
     std::vector<Fitness> out;
     for (const Genome* g : genomes) {
       const double t0 = cpu_now();
@@ -62,16 +62,6 @@ class ProfilingEvaluator final : public Evaluator {
     }
     return out;
   }
-  std::vector<Individual> seed(std::size_t first, std::size_t count) override {
-    std::vector<Individual> out;
-    for (std::size_t i = first; i < first + count; ++i) {
-      const double t0 = cpu_now();
-      out.push_back(seed_individual(config_, fitness_, i));
-      tasks.push_back(cpu_now() - t0);
-      viable.push_back(true);
-    }
-    return out;
-  }
   std::string describe() const override { return "profiling, 1 thread"; }
 
   std::vector<double> tasks;  // seconds of each task of the current call
@@ -79,7 +69,6 @@ class ProfilingEvaluator final : public Evaluator {
   std::size_t bytes = 0;
 
  private:
-  Config config_;
   FitnessFunction fitness_;
 };
 

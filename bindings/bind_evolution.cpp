@@ -14,6 +14,7 @@
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
 #include "animat/run.hpp"
 #include "animat/objective.hpp"
@@ -25,41 +26,22 @@ using namespace nb::literals;
 namespace animat::py {
 namespace {
 
+// GenerationStats' fields, pickling and dicts from its one descriptor (visit_fields in evolution.hpp).
 nb::dict stats_dict(const GenerationStats& s) {
   nb::dict d;
-  d["generation"] = s.generation;
-  d["best"] = s.best;
-  d["mean"] = s.mean;
-  d["median"] = s.median;
-  d["viable_fraction"] = s.viable_fraction;
-  d["best_cells"] = s.best_cells;
-  d["evaluations"] = s.evaluations;
-  d["wall_seconds"] = s.wall_seconds;
-  d["evaluations_per_second"] = s.evaluations_per_second;
-  d["best_changed"] = s.best_changed;
-  d["crossovers"] = s.crossovers;
-  d["best_reference"] = s.best_reference;
-  d["invalid"] = s.invalid;
-  d["drag_limited"] = s.drag_limited;
+  visit_fields(s, [&](const StatsField& f, const auto& value) { d[f.name] = value; });
   return d;
 }
 
+// Every field is required but those a checkpoint may lack (they keep their defaults), as in a checkpoint.
 GenerationStats stats_from_dict(const nb::dict& d) {
   GenerationStats s;
-  s.generation = nb::cast<int>(d["generation"]);
-  s.best = nb::cast<double>(d["best"]);
-  s.mean = nb::cast<double>(d["mean"]);
-  s.median = nb::cast<double>(d["median"]);
-  s.viable_fraction = nb::cast<double>(d["viable_fraction"]);
-  s.best_cells = nb::cast<int>(d["best_cells"]);
-  s.evaluations = nb::cast<std::int64_t>(d["evaluations"]);
-  s.wall_seconds = nb::cast<double>(d["wall_seconds"]);
-  s.evaluations_per_second = nb::cast<double>(d["evaluations_per_second"]);
-  s.best_changed = nb::cast<bool>(d["best_changed"]);
-  s.crossovers = nb::cast<int>(d["crossovers"]);
-  if (d.contains("best_reference")) s.best_reference = nb::cast<double>(d["best_reference"]);
-  if (d.contains("invalid")) s.invalid = nb::cast<int>(d["invalid"]);
-  if (d.contains("drag_limited")) s.drag_limited = nb::cast<int>(d["drag_limited"]);
+  visit_fields(s, [&](const StatsField& f, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    const bool optional = f.checkpoint == StatsField::Checkpoint::later || f.checkpoint == StatsField::Checkpoint::when_set;
+    if (optional && !d.contains(f.name)) return;
+    value = nb::cast<T>(d[f.name]);
+  });
   return s;
 }
 
@@ -111,26 +93,23 @@ void bind_evolution(nb::module_& m) {
       .def("__deepcopy__", [](const Fitness& f, nb::handle) { return f; }, "memo"_a)
       .def("__repr__", &fitness_repr);
 
-  nb::class_<GenerationStats>(m, "GenerationStats", "Statistics of one generation (a row of history.csv).")
+  nb::class_<GenerationStats> stats(m, "GenerationStats", "Statistics of one generation (a row of history.csv).");
+  {
+    GenerationStats probe;
+    nb::list columns;
+    visit_fields(probe, [&](const StatsField& f, auto& field) {
+      using T = std::decay_t<decltype(field)>;
+      const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
+      stats.def_prop_ro(f.name, [offset](const GenerationStats& g) {
+        return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&g) + offset);
+      }, f.doc);
+      if (f.csv) columns.append(nb::make_tuple(f.name, std::is_floating_point_v<T> ? "float64" : "int64"));
+    });
+    stats.attr("HISTORY_COLUMNS") = nb::tuple(columns);
+  }
+  stats
       .def("__init__", [](GenerationStats* s, const nb::dict& d) { new (s) GenerationStats(stats_from_dict(d)); }, "values"_a,
            "Statistics from a dict of every field (as to_dict() gives).")
-      .def_ro("generation", &GenerationStats::generation, "Generation number (0 = the initial population).")
-      .def_ro("best", &GenerationStats::best, "Best fitness in the population.")
-      .def_ro("mean", &GenerationStats::mean, "Mean fitness of the viable individuals.")
-      .def_ro("median", &GenerationStats::median, "Median fitness of the viable individuals.")
-      .def_ro("viable_fraction", &GenerationStats::viable_fraction, "Share of viable individuals.")
-      .def_ro("best_cells", &GenerationStats::best_cells, "Cells of the best individual.")
-      .def_ro("evaluations", &GenerationStats::evaluations, "Cumulative fitness evaluations.")
-      .def_ro("wall_seconds", &GenerationStats::wall_seconds, "Cumulative wall time of the run.")
-      .def_ro("evaluations_per_second", &GenerationStats::evaluations_per_second, "Evaluations per second of this generation alone.")
-      .def_ro("best_changed", &GenerationStats::best_changed, "Whether the best genome changed in this generation.")
-      .def_ro("crossovers", &GenerationStats::crossovers, "Offspring made by crossover in this generation.")
-      .def_ro("best_reference", &GenerationStats::best_reference,
-              "The best's fitness at the reference step (evaluation.reference_check); NaN when off.")
-      .def_ro("invalid", &GenerationStats::invalid,
-              "Viable individuals whose swim was unstable or broke an invariant (fitness 0).")
-      .def_ro("drag_limited", &GenerationStats::drag_limited,
-              "Individuals whose swim the drag limiter altered (physics.drag_scheme = \"stable\" only; 0 otherwise).")
       .def("to_dict", &stats_dict, "Every field as a dict.")
       .def("__getstate__", &stats_dict)
       .def("__setstate__", [](GenerationStats& s, const nb::dict& d) { new (&s) GenerationStats(stats_from_dict(d)); })

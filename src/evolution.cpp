@@ -38,39 +38,6 @@ double now_seconds() {
 
 std::string hex(std::uint64_t x) { return fmt::format("{:016x}", x); }
 
-// Watches a StopRequest during one parallel piece of work. Any thread may ask stopped(); only the
-// thread that created it (OpenMP's thread 0 of the regions it runs) calls the poll, at most every 20 ms.
-class StopWatch {
- public:
-  explicit StopWatch(const StopRequest& request) : request_(request) {}
-  bool stopped() {
-    if (stopped_.load(std::memory_order_relaxed)) return true;
-    if (request_.empty()) return false;
-    if (request_.flag && request_.flag->load()) return stop();
-    if (request_.poll && omp_get_thread_num() == 0) {
-      const double t = now_seconds();
-      if (t - last_poll_ >= 0.02) {
-        last_poll_ = t;
-        if (request_.poll()) return stop();
-      }
-    }
-    return false;
-  }
-  /// Whether a stop was seen (no new poll).
-  [[nodiscard]] bool fired() const { return stopped_.load(); }
-  /// Stops the work from within (an evaluation that was itself interrupted): stopped() is true from now on.
-  void request_stop() { stop(); }
-
- private:
-  bool stop() {
-    stopped_.store(true);
-    return true;
-  }
-  const StopRequest& request_;
-  std::atomic<bool> stopped_{false};
-  double last_poll_ = 0.0;  // touched by thread 0 only
-};
-
 // The built-in objectives that are never negative, for messages: "distance, distance_per_size, ...".
 std::string nonnegative_names() {
   std::string out;
@@ -154,13 +121,6 @@ std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std
 
 void prepare_parallel_evaluation() { warm_up_box2d(); }
 
-std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness, int threads) {
-  prepare_parallel_evaluation();
-  std::vector<Fitness> out(genomes.size());
-  parallel_for(genomes.size(), threads, [&](std::size_t i) { out[i] = fitness(genomes[i]); });
-  return out;
-}
-
 bool reference_disagrees(double fitness, double reference, const EvaluationParams& params) {
   const double diff = std::abs(fitness - reference);
   return diff > params.reference_abs_tolerance && diff > params.reference_tolerance * std::abs(reference);
@@ -176,6 +136,9 @@ Evolution::Evolution(const Config& config, FitnessFunction fitness, FitnessFunct
       started_(now_seconds()) {
   validate(*config_);
   if (config_->evaluation.reference_check != "off") reference_ = std::move(reference);
+  // One evaluation path: every evaluation of the GA goes through an Evaluator.
+  if (!evaluator_ && fitness_) evaluator_ = make_local_evaluator(*config_, fitness_);
+  if (reference_) reference_evaluator_ = make_local_evaluator(*config_, reference_);
 }
 
 void Evolution::check_reference() {
@@ -200,12 +163,12 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
   std::vector<std::size_t> todo;
   for (std::size_t c : cand)
     if (std::isnan(population_[c].reference)) todo.push_back(c);
-  std::vector<Fitness> refs(todo.size());
-  parallel_for(todo.size(), config_->evolution.threads, [&](std::size_t k) {
-    refs[k] = reference_(population_[todo[k]].genome);
+  std::vector<const Genome*> genomes;
+  for (std::size_t c : todo) genomes.push_back(&population_[c].genome);
+  const std::vector<Fitness> refs = reference_evaluator_->evaluate(genomes, StopRequest{});  // inside tell(): not stoppable
+  for (std::size_t k = 0; k < todo.size(); ++k)
     check_fitness(refs[k], fmt::format("exploit guard (select): the reference evaluation of individual {}", todo[k]),
                   nonnegative_objective(*config_));
-  });
   // Stored only once every one is known and acceptable: an exception leaves the population as it was.
   for (std::size_t k = 0; k < todo.size(); ++k) population_[todo[k]].reference = refs[k].fitness;
   std::stable_sort(cand.begin(), cand.end(),
@@ -215,7 +178,7 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
 }
 
 void Evolution::initialize() {
-  if (!fitness_ && !evaluator_)
+  if (!evaluator_)
     throw Error("Evolution::initialize: no fitness function (drive this engine with ask() and tell())");
   if (generation_ >= 0) throw Error("Evolution::initialize: the initial population exists already");
   const EvolutionParams& ep = config_->evolution;
@@ -247,7 +210,7 @@ std::vector<int> Evolution::initial_tries() const {
 }
 
 GenerationStats Evolution::step() {
-  if (!fitness_ && !evaluator_) throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
+  if (!evaluator_) throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
   if (generation_ < 0) throw Error("Evolution::step: call initialize() first");
   const std::vector<Genome> genomes = ask();
   tell(evaluate_genomes(genomes, fmt::format("generation {}", generation_ + 1)));
@@ -255,27 +218,15 @@ GenerationStats Evolution::step() {
 }
 
 std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what) {
-  if (evaluator_) {  // another evaluator (MPI ranks): it honours the stop flag itself
-    std::vector<Fitness> out = evaluator_->evaluate(genomes);
-    for (std::size_t k = 0; k < out.size(); ++k) check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
-    return out;
-  }
-  prepare_parallel_evaluation();
-  std::vector<Fitness> out(genomes.size());
-  StopWatch watch(stop_);
-  parallel_for(genomes.size(), config_->evolution.threads, [&](std::size_t k) {
-    if (watch.stopped()) return;
-    try {
-      out[k] = fitness_(genomes[k]);
-    } catch (const Interrupted&) {  // the fitness function itself was interrupted (Ctrl-C in a Python objective)
-      watch.request_stop();
-      return;
-    }
-    check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
-  });
-  if (watch.fired())
+  std::vector<Fitness> out;
+  try {
+    out = evaluator_->evaluate(genomes, stop_);
+  } catch (const Interrupted&) {
     throw Interrupted(generation_ < 0 ? std::string("interrupted while drawing the initial population")
                                       : fmt::format("interrupted during {}", what));
+  }
+  for (std::size_t k = 0; k < out.size(); ++k)
+    check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
   return out;
 }
 
@@ -542,11 +493,19 @@ std::string Evolution::stop_reason() const {
 namespace {
 
 json stats_to_json(const GenerationStats& s) {
-  json j{{"generation", s.generation}, {"best", s.best}, {"mean", s.mean}, {"median", s.median},
-         {"viable_fraction", s.viable_fraction}, {"best_cells", s.best_cells}, {"evaluations", s.evaluations},
-         {"wall_seconds", s.wall_seconds}, {"best_changed", s.best_changed}, {"invalid", s.invalid}};
-  if (!std::isnan(s.best_reference)) j["best_reference"] = s.best_reference;
-  if (s.drag_limited > 0) j["drag_limited"] = s.drag_limited;  // only the "stable" drag scheme has it
+  json j = json::object();
+  visit_fields(s, [&](const StatsField& f, const auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if (f.checkpoint == StatsField::Checkpoint::none) return;
+    if (f.checkpoint == StatsField::Checkpoint::when_set) {
+      if constexpr (std::is_floating_point_v<T>) {
+        if (std::isnan(value)) return;
+      } else {
+        if (value == T{}) return;
+      }
+    }
+    j[f.name] = value;
+  });
   return j;
 }
 
@@ -573,19 +532,15 @@ constexpr long long kInt64Max = std::numeric_limits<std::int64_t>::max();
 
 GenerationStats stats_from_json(const json& j) {
   GenerationStats s;
-  s.generation = static_cast<int>(int_field(j, "generation", 0, kIntMax));
-  s.best = number_field(j, "best");
-  s.mean = number_field(j, "mean");
-  s.median = number_field(j, "median");
-  s.viable_fraction = number_field(j, "viable_fraction");
-  s.best_cells = static_cast<int>(int_field(j, "best_cells", 0, kIntMax));
-  s.evaluations = int_field(j, "evaluations", 0, kInt64Max);
-  s.wall_seconds = number_field(j, "wall_seconds");
-  s.best_changed = bool_field(j, "best_changed");
-  // Fields added with the exploit guard; absent in older checkpoints.
-  if (j.contains("invalid")) s.invalid = static_cast<int>(int_field(j, "invalid", 0, kIntMax));
-  if (j.contains("best_reference")) s.best_reference = number_field(j, "best_reference");
-  if (j.contains("drag_limited")) s.drag_limited = static_cast<int>(int_field(j, "drag_limited", 0, kIntMax));
+  visit_fields(s, [&](const StatsField& f, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if (f.checkpoint == StatsField::Checkpoint::none) return;
+    if (f.checkpoint != StatsField::Checkpoint::required && !j.contains(f.name)) return;  // its default
+    if constexpr (std::is_same_v<T, bool>) value = bool_field(j, f.name);
+    else if constexpr (std::is_same_v<T, int>) value = static_cast<int>(int_field(j, f.name, 0, kIntMax));
+    else if constexpr (std::is_same_v<T, std::int64_t>) value = int_field(j, f.name, 0, kInt64Max);
+    else value = number_field(j, f.name);
+  });
   return s;
 }
 

@@ -84,13 +84,33 @@ std::string read_file(const std::filesystem::path& path) {
   return ss.str();
 }
 
-constexpr std::string_view kHistoryHeader =
-    "generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,drag_limited,wall_seconds\n";
+// history.csv's columns and rows, from GenerationStats' descriptor.
+const std::string& history_header() {
+  static const std::string header = [] {
+    std::string out;
+    GenerationStats probe;
+    visit_fields(probe, [&](const StatsField& f, const auto&) {
+      if (f.csv) out += (out.empty() ? "" : ",") + std::string(f.name);
+    });
+    return out + "\n";
+  }();
+  return header;
+}
 
-// wall_seconds stays the last column: the only machine-dependent one.
 std::string history_row(const GenerationStats& s) {
-  return fmt::format("{},{},{},{},{},{},{},{},{},{},{:.3f}\n", s.generation, s.best, s.mean, s.median, s.viable_fraction,
-                     s.best_cells, s.evaluations, s.best_reference, s.invalid, s.drag_limited, s.wall_seconds);
+  std::string out;
+  visit_fields(s, [&](const StatsField& f, const auto& value) {
+    if (!f.csv) return;
+    if (!out.empty()) out += ',';
+    if constexpr (std::is_floating_point_v<std::decay_t<decltype(value)>>) {
+      if (f.decimals >= 0) {
+        out += fmt::format("{:.{}f}", value, f.decimals);
+        return;
+      }
+    }
+    out += fmt::format("{}", value);
+  });
+  return out + "\n";
 }
 
 void append(const std::filesystem::path& path, std::string_view text) {
@@ -451,7 +471,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
   }
 
   if (opt.resume) {
-    std::string rows(kHistoryHeader);
+    std::string rows(history_header());
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
     island_log.resume(evo.generation());
@@ -478,7 +498,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
       spdlog::info("initial population: {:.0f} random genomes per viable individual on average (paper: \"a few hundred\")",
                    mean_tries);
     if (writing) {
-      write_atomically(hist, std::string(kHistoryHeader) + history_row(evo.history().back()));
+      write_atomically(hist, history_header() + history_row(evo.history().back()));
       write_lineage(opt.out, evo);
       island_log.start(evo);
       write_atomically(ckpt, evo.checkpoint());

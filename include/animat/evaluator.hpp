@@ -3,8 +3,8 @@
 // (LocalEvaluator) and the ranks of an MPI job (mpi.hpp). The GA (evolution.hpp) sees only this.
 //
 // Every evaluator returns the same results for the same input, whatever its layout: a genome's
-// fitness depends only on the genome and the config, and the initial individual i only on
-// (evolution.seed, i). Results are stored by index, never in arrival order.
+// fitness depends only on the genome and the config. Results are stored by index, never in arrival
+// order. The GA evaluates only through an Evaluator (its initial population too: ask/tell seeding).
 #include <cstddef>
 #include <exception>
 #include <memory>
@@ -22,28 +22,33 @@ class Evaluator {
  public:
   virtual ~Evaluator() = default;
 
-  /// Fitness of every genome, in input order.
-  [[nodiscard]] virtual std::vector<Fitness> evaluate(std::span<const Genome* const> genomes) = 0;
-  /// Initial individuals `first`, ..., `first + count - 1` (see seed_individual).
-  [[nodiscard]] virtual std::vector<Individual> seed(std::size_t first, std::size_t count) = 0;
+  /// Fitness of every genome, in input order. Throws Interrupted if `stop` fires before every genome
+  /// is evaluated (no evaluation starts after it; what was done is dropped); a fitness function that
+  /// throws Interrupted itself (Ctrl-C in a Python objective) stops it the same way. The MPI
+  /// evaluator honours its job's own stop flag instead (mpi.hpp).
+  [[nodiscard]] virtual std::vector<Fitness> evaluate(std::span<const Genome* const> genomes,
+                                                      const StopRequest& stop) = 0;
   /// One line for the log: "OpenMP, 2 threads", "MPI, 3 ranks, 6 threads".
   [[nodiscard]] virtual std::string describe() const = 0;
 
   /// Convenience overload for a contiguous list of genomes.
-  [[nodiscard]] std::vector<Fitness> evaluate(const std::vector<Genome>& genomes);
+  [[nodiscard]] std::vector<Fitness> evaluate(const std::vector<Genome>& genomes, const StopRequest& stop = {});
 };
 
 /// Rng stream key of the initial population: individual i draws from Rng::derive(evolution.seed,
-/// kInitialStreamKey, i), in Evolution's ask/tell seeding and in seed_individual alike.
+/// kInitialStreamKey, i) (Evolution's ask/tell seeding).
 inline constexpr std::uint64_t kInitialStreamKey = 0xffffffffffffffffULL;
 
-/// Initial individual `index`: random genomes drawn from Rng::derive(evolution.seed, initial key,
-/// index) until one is viable (the same individual Evolution::initialize() keeps for slot `index`). Throws Error after evolution.max_init_tries tries.
-[[nodiscard]] Individual seed_individual(const Config& config, const FitnessFunction& fitness, std::size_t index);
-
-/// The OpenMP threads of this process (evolution.threads; 0 = all cores), dynamic schedule with
-/// one genome per chunk; an exception is rethrown after the loop, the first by index.
+/// The OpenMP threads of this process (`threads`, resolve_threads), dynamic schedule with one genome
+/// per chunk; an exception is rethrown after the loop, the first by index.
+[[nodiscard]] std::shared_ptr<Evaluator> make_local_evaluator(FitnessFunction fitness, int threads);
+/// The same on evolution.threads of `config`.
 [[nodiscard]] std::shared_ptr<Evaluator> make_local_evaluator(const Config& config, FitnessFunction fitness);
+
+/// Evaluates genomes on `threads` OpenMP threads (a local evaluator); results in input order,
+/// independent of the thread count. threads = 0 means all cores.
+[[nodiscard]] std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness,
+                                               int threads);
 
 /// Threads that evolution.threads = `requested` means on this machine (0 = all available cores).
 [[nodiscard]] int resolve_threads(int requested);

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "animat/errors.hpp"
@@ -93,6 +94,54 @@ struct GenerationStats {
   int drag_limited = 0;
 };
 
+/// How a GenerationStats field is stored (its descriptor, visit_fields below).
+struct StatsField {
+  enum class Checkpoint : std::uint8_t {
+    none,      ///< not in a checkpoint (a per-session figure)
+    required,  ///< always written; a checkpoint without it is refused
+    later,     ///< always written; absent from older checkpoints, where it reads as its default
+    when_set,  ///< written only when it holds information (not NaN, not 0); absent reads as its default
+  };
+  const char* name;
+  const char* doc;
+  bool csv;                 ///< a column of history.csv (columns in visiting order)
+  Checkpoint checkpoint;
+  int decimals = -1;        ///< history.csv: fixed decimals (-1: the shortest form that reads back exactly)
+};
+
+/// GenerationStats' fields with their documentation, in history.csv's column order: the one list from
+/// which history.csv, a checkpoint's history, the Python class (fields, to_dict, pickling) and
+/// animat.HISTORY_DTYPE follow. A new field is one line here.
+template <class S, class V>
+void visit_fields(S& s, V&& v)
+  requires std::is_same_v<std::remove_const_t<S>, GenerationStats>
+{
+  using C = StatsField::Checkpoint;
+  v(StatsField{"generation", "Generation number (0 = the initial population).", true, C::required}, s.generation);
+  v(StatsField{"best", "Best fitness in the population.", true, C::required}, s.best);
+  v(StatsField{"mean", "Mean fitness of the viable individuals.", true, C::required}, s.mean);
+  v(StatsField{"median", "Median fitness of the viable individuals.", true, C::required}, s.median);
+  v(StatsField{"viable_fraction", "Share of viable individuals.", true, C::required}, s.viable_fraction);
+  v(StatsField{"best_cells", "Cells of the best individual.", true, C::required}, s.best_cells);
+  v(StatsField{"evaluations", "Cumulative fitness evaluations (swims and non-viable developments).", true, C::required},
+    s.evaluations);
+  v(StatsField{"best_reference", "The best's fitness at the reference step (evaluation.reference_check); NaN when off.",
+               true, C::when_set},
+    s.best_reference);
+  v(StatsField{"invalid", "Viable individuals whose swim was unstable or broke an invariant (fitness 0).", true, C::later},
+    s.invalid);
+  v(StatsField{"drag_limited",
+               "Individuals whose swim the drag limiter altered (physics.drag_scheme = \"stable\" only; 0 otherwise).",
+               true, C::when_set},
+    s.drag_limited);
+  // Last column: the only machine-dependent one.
+  v(StatsField{"wall_seconds", "Cumulative wall time of the run, seconds.", true, C::required, 3}, s.wall_seconds);
+  v(StatsField{"best_changed", "Whether the best genome changed in this generation.", false, C::required}, s.best_changed);
+  v(StatsField{"evaluations_per_second", "Evaluations per second of this generation alone.", false, C::none},
+    s.evaluations_per_second);
+  v(StatsField{"crossovers", "Offspring made by crossover in this generation.", false, C::none}, s.crossovers);
+}
+
 /// Probability that the fitter of two wins a tournament at generation g (linear ramp, paper §5).
 [[nodiscard]] double tournament_probability(const EvolutionParams& p, int generation);
 
@@ -122,10 +171,6 @@ struct StopRequest {
 /// "Evaluation, determinism, threads").
 void prepare_parallel_evaluation();
 
-/// Evaluates genomes in parallel (OpenMP, dynamic schedule); results in input order, independent of
-/// the thread count. threads = 0 means all cores.
-[[nodiscard]] std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness,
-                                               int threads);
 
 /// The genetic algorithm (paper §5). Every random number of generation g, offspring i derives from
 /// Rng::derive(seed, g, i), so a run is bit-identical for any thread count and across resumes.
@@ -149,8 +194,8 @@ class Evolution {
   /// Makes and evaluates the next generation; returns its statistics. Throws Interrupted if the stop
   /// request fires before the generation is complete: the state stays at the previous generation
   /// (resuming recomputes the same generation, every random number derives from (seed, g, i)).
-  /// Throws Error if the fitness function returns a non-finite fitness, or a negative one under a
-  /// distance objective (evaluation.objective = distance or distance_per_size).
+  /// Throws Error if the fitness function returns a non-finite fitness, or a negative one under an
+  /// objective that is never negative (ObjectiveSpec::nonnegative).
   GenerationStats step();
   /// Checked by initialize() and step() (see StopRequest); empty = never stop.
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
@@ -203,7 +248,8 @@ class Evolution {
   /// Exploit guard, after a generation is complete: the best's reference fitness (evaluated once
   /// per genome), recorded in the last history row.
   void check_reference();
-  /// fitness_ of every genome in parallel, honouring the stop request (throws Interrupted).
+  /// The evaluator's fitness of every genome, honouring the stop request (throws Interrupted), each
+  /// checked by fitness_problem.
   std::vector<Fitness> evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what);
   /// "select": reference fitness of the elite candidates, which are then ranked by it.
   std::vector<std::size_t> reference_ranked(const std::vector<std::size_t>& order, std::size_t elites);
@@ -225,7 +271,8 @@ class Evolution {
   std::uint64_t identity_;
   FitnessFunction fitness_;
   FitnessFunction reference_;
-  std::shared_ptr<Evaluator> evaluator_;
+  std::shared_ptr<Evaluator> evaluator_;            ///< runs fitness_ (or the given evaluator); null: ask/tell only
+  std::shared_ptr<Evaluator> reference_evaluator_;  ///< runs reference_ on this process's threads
   std::vector<Migration> migrations_;  // [islands]
   std::vector<Individual> population_;
   std::vector<InitialSlot> slots_;          ///< before generation 0 only

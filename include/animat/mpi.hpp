@@ -36,9 +36,11 @@ struct Launch {
 /// How to get a build with MPI (install Open MPI, rebuild).
 [[nodiscard]] std::string how_to_get_mpi();
 
-/// The evaluation stopped because the process was told to stop (under mpirun: a rank died, or the
-/// job was cancelled). The generation being evaluated is lost; the last checkpoint stands.
-class Interrupted : public Error {
+/// The MPI job stopped mid-evaluation because the process was told to stop (under mpirun: a rank
+/// died, or the job was cancelled). Unlike animat::Interrupted (a stop request the run honours and
+/// continues from), the job cannot go on: rank 0 leaves at once. The generation being evaluated is
+/// lost; the last checkpoint stands.
+class JobStopped : public Error {
  public:
   using Error::Error;
 };
@@ -72,10 +74,10 @@ class Job {
   int serve();
 
   /// Rank 0: sends the config to every rank and returns the evaluator that uses them all. `stop`
-  /// (a signal flag) interrupts an evaluation with Interrupted.
+  /// (a signal flag) interrupts an evaluation with JobStopped.
   [[nodiscard]] std::shared_ptr<Evaluator> start(const Config& config, const std::atomic<bool>* stop);
 
-  /// Rank 0, after an Interrupted or a RankFailure: end this process now without waiting for ranks
+  /// Rank 0, after a JobStopped or a RankFailure: end this process now without waiting for ranks
   /// that may be gone (no MPI_Finalize; the launcher ends the others).
   [[noreturn]] static void abandon(int status);
 

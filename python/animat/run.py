@@ -25,20 +25,9 @@ from . import _core
 
 __all__ = ["Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE"]
 
-#: Columns of ``history.csv`` and their numpy types (the dtype of :attr:`Run.history`).
-HISTORY_DTYPE = np.dtype([
-    ("generation", np.int64),
-    ("best", np.float64),
-    ("mean", np.float64),
-    ("median", np.float64),
-    ("viable_fraction", np.float64),
-    ("best_cells", np.int64),
-    ("evaluations", np.int64),
-    ("best_reference", np.float64),
-    ("invalid", np.int64),
-    ("drag_limited", np.int64),
-    ("wall_seconds", np.float64),
-])
+#: Columns of ``history.csv`` and their numpy types (the dtype of :attr:`Run.history`), from the
+#: engine's descriptor of a generation's statistics (``GenerationStats.HISTORY_COLUMNS``).
+HISTORY_DTYPE = np.dtype([(name, np.dtype(kind)) for name, kind in _core.GenerationStats.HISTORY_COLUMNS])
 
 #: Columns that older runs do not have, and the value they read as.
 _LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0, "drag_limited": 0}

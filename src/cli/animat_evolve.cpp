@@ -182,7 +182,7 @@ int animat_evolve_main(int argc, char** argv) {
     animat::RunSummary summary;
     try {
       summary = animat::run_evolution(config, options);
-    } catch (const animat::mpi::Interrupted& e) {  // [mpi] a rank died or the job was cancelled
+    } catch (const animat::mpi::JobStopped& e) {  // [mpi] a rank died or the job was cancelled
       mpi_stopped(e, options.out, config);
     } catch (const animat::mpi::RankFailure& e) {
       mpi_stopped(e, options.out, config);

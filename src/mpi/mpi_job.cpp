@@ -7,7 +7,7 @@
 //   0 -> r  kConfig  u8 run (0 = no run: exit), string config TOML
 //   r -> 0  kHello   u8 ok, i32 threads, string host (or the error)
 //   0 -> r  kWork    u8 kind, u32 n, n x (u32 task, genome if kind = evaluate)
-//   r -> 0  kResult  u8 kind, u32 n, n x (u32 task, u8 ok, fitness [+ i32 tries, genome if seed] | string error)
+//   r -> 0  kResult  u8 kind, u32 n, n x (u32 task, u8 ok, fitness | string error)
 //   0 -> r  kStop    (empty): finish, answer kBye
 //   r -> 0  kBye     (empty): nothing more comes from this rank
 //   0 -> r  kPing    (empty): answer kPong at once (the comm thread answers even while all threads evaluate)
@@ -55,7 +55,7 @@ constexpr auto kSilence = std::chrono::seconds(20);
 
 std::atomic<unsigned> g_sigcont{0};
 extern "C" void on_sigcont(int) { g_sigcont.fetch_add(1); }
-enum class Kind : std::uint8_t { evaluate = 1, seed = 2 };
+enum class Kind : std::uint8_t { evaluate = 1 };  // the only task kind (the byte keeps the protocol extensible)
 
 std::string error_string(int code) {
   char text[MPI_MAX_ERROR_STRING];
@@ -148,7 +148,7 @@ struct Job::State {
     Backoff backoff;
     while (!sends.empty()) {
       progress_sends();
-      if (stopping()) throw Interrupted("stopped by a signal while sending to the other ranks");
+      if (stopping()) throw JobStopped("stopped by a signal while sending to the other ranks");
       if (!sends.empty()) backoff.wait();
     }
   }
@@ -160,7 +160,7 @@ struct Job::State {
     Message m;
     Backoff backoff;
     while (byes < size - 1) {
-      if (stopping()) throw Interrupted("stopped by a signal while the other ranks were finishing");
+      if (stopping()) throw JobStopped("stopped by a signal while the other ranks were finishing");
       progress_sends();
       if (poll(MPI_ANY_SOURCE, m)) {
         if (m.tag == kBye) ++byes;  // results of an abandoned evaluation are dropped
@@ -327,7 +327,7 @@ void Job::State::run(const Tasks& t) {
   }
   if (interrupted) {
     broken = true;
-    throw Interrupted(fmt::format("stopped by a signal during an evaluation on {} ranks ({} of {} tasks done); under "
+    throw JobStopped(fmt::format("stopped by a signal during an evaluation on {} ranks ({} of {} tasks done); under "
                                   "mpirun this means that a rank died (see mpirun's message above) or that the job "
                                   "was cancelled",
                                   size, completed.load(), n));
@@ -348,26 +348,13 @@ class MpiEvaluator final : public Evaluator {
  public:
   explicit MpiEvaluator(std::shared_ptr<Job::State> state) : state_(std::move(state)) {}
 
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes) override {
+  // The job honours its own stop flag (Job::start), which the CLI sets from the same signal.
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest&) override {
     std::vector<Fitness> out(genomes.size());
     Job::State::Tasks t{Kind::evaluate, genomes.size(),
                         [&](wire::Writer& w, std::size_t i) { w.genome(*genomes[i]); },
                         [&](std::size_t i) { out[i] = state_->fitness(*genomes[i]); },
                         [&](wire::Reader& r, std::size_t i) { out[i] = r.fitness(); }};
-    state_->run(t);
-    return out;
-  }
-
-  std::vector<Individual> seed(std::size_t first, std::size_t count) override {
-    std::vector<Individual> out(count);
-    // A seed task travels as its index in [0, count) plus `first`: the other rank draws the same genomes.
-    Job::State::Tasks t{Kind::seed, count, [first](wire::Writer& w, std::size_t) { w.put(static_cast<std::uint64_t>(first)); },
-                        [&](std::size_t i) { out[i] = seed_individual(*state_->config, state_->fitness, first + i); },
-                        [&](wire::Reader& r, std::size_t i) {
-                          out[i].result = r.fitness();
-                          out[i].tries = r.get<std::int32_t>();
-                          out[i].genome = r.genome();
-                        }};
     state_->run(t);
     return out;
   }
@@ -391,7 +378,6 @@ class MpiEvaluator final : public Evaluator {
 struct Task {
   Kind kind;
   std::uint32_t index;
-  std::uint64_t offset = 0;  // seed: individual = offset + index
   Genome genome;
 };
 
@@ -400,10 +386,10 @@ struct Done {
   std::uint32_t index;
   bool ok;
   std::string error;
-  Individual result;  // evaluate: only .result
+  Fitness result;
 };
 
-void serve_tasks(const Config& config, const FitnessFunction& fitness, int threads) {
+void serve_tasks(const FitnessFunction& fitness, int threads) {
   std::mutex mutex;
   std::condition_variable ready;
   std::deque<Task> queue;
@@ -414,8 +400,7 @@ void serve_tasks(const Config& config, const FitnessFunction& fitness, int threa
   auto compute = [&](Task& task) {
     Done d{task.kind, task.index, true, {}, {}};
     try {
-      if (task.kind == Kind::evaluate) d.result.result = fitness(task.genome);
-      else d.result = seed_individual(config, fitness, static_cast<std::size_t>(task.offset + task.index));
+      d.result = fitness(task.genome);
     } catch (const std::exception& e) {
       d.ok = false;
       d.error = e.what();
@@ -447,13 +432,14 @@ void serve_tasks(const Config& config, const FitnessFunction& fitness, int threa
             }
             if (m.tag != kWork) throw RankFailure(fmt::format("unexpected message tag {} from rank 0", m.tag));
             wire::Reader rd(m.bytes);
-            const auto kind = static_cast<Kind>(rd.get<std::uint8_t>());
+            const auto kind = rd.get<std::uint8_t>();
+            if (kind != static_cast<std::uint8_t>(Kind::evaluate))
+              throw RankFailure(fmt::format("unexpected task kind {} from rank 0", kind));
             const auto k = rd.get<std::uint32_t>();
             std::vector<Task> tasks;
             for (std::uint32_t j = 0; j < k; ++j) {
-              Task task{kind, rd.get<std::uint32_t>(), 0, {}};
-              if (kind == Kind::evaluate) task.genome = rd.genome();
-              else task.offset = rd.get<std::uint64_t>();
+              Task task{Kind::evaluate, rd.get<std::uint32_t>(), {}};
+              task.genome = rd.genome();
               tasks.push_back(std::move(task));
             }
             {
@@ -478,11 +464,7 @@ void serve_tasks(const Config& config, const FitnessFunction& fitness, int threa
               if (!d.ok) {
                 w.string(d.error);
               } else {
-                w.fitness(d.result.result);
-                if (kind == Kind::seed) {
-                  w.put(static_cast<std::int32_t>(d.result.tries));
-                  w.genome(d.result.genome);
-                }
+                w.fitness(d.result);
               }
             }
             send(0, kResult, w.take());
@@ -601,7 +583,7 @@ std::shared_ptr<Evaluator> Job::start(const Config& config, const std::atomic<bo
   while (hellos < s.size - 1) {
     if (s.stopping()) {
       s.broken = true;
-      throw Interrupted("stopped by a signal while the ranks were starting");
+      throw JobStopped("stopped by a signal while the ranks were starting");
     }
     if (!poll(MPI_ANY_SOURCE, m)) {
       backoff.wait();
@@ -651,7 +633,7 @@ int Job::serve() {
   w.string(error.empty() ? s.host : error);
   send(0, kHello, w.take());
   if (!error.empty()) throw Error(error);
-  serve_tasks(config, fitness, threads);
+  serve_tasks(fitness, threads);
   send(0, kBye, {});
   s.broken = false;
   return 0;

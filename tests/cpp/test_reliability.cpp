@@ -40,6 +40,7 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
+#include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
 #include "animat/run_identity.hpp"
 #include "animat/run.hpp"

@@ -47,25 +47,16 @@ void expect_same_population(const std::vector<Individual>& a, const std::vector<
 // Counts calls and answers like the stub: an evaluator that is not the OpenMP one.
 class CountingEvaluator final : public Evaluator {
  public:
-  explicit CountingEvaluator(const Config& c) : config_(c) {}
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes) override {
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest&) override {
     ++calls;
     evaluated += genomes.size();
     std::vector<Fitness> out;
     for (const Genome* g : genomes) out.push_back(stub_fitness(*g));
     return out;
   }
-  std::vector<Individual> seed(std::size_t first, std::size_t count) override {
-    std::vector<Individual> out;
-    for (std::size_t i = first; i < first + count; ++i) out.push_back(seed_individual(config_, stub_fitness, i));
-    return out;
-  }
   std::string describe() const override { return "counting"; }
   int calls = 0;
   std::size_t evaluated = 0;
-
- private:
-  Config config_;
 };
 
 }  // namespace
@@ -74,7 +65,7 @@ class CountingEvaluator final : public Evaluator {
 TEST(Evaluator, AnyEvaluatorGivesTheSameRunAsTheOpenMpThreads) {
   Config c = island_config(1, 16);
   Evolution local(c, stub_fitness);
-  auto counting = std::make_shared<CountingEvaluator>(c);
+  auto counting = std::make_shared<CountingEvaluator>();
   Evolution other(c, {}, {}, counting);
   local.initialize();
   other.initialize();
@@ -91,17 +82,6 @@ TEST(Evaluator, AnyEvaluatorGivesTheSameRunAsTheOpenMpThreads) {
   EXPECT_EQ(local.evaluations(), other.evaluations());
   EXPECT_EQ(counting->calls - seeding_calls, 5);  // one call per generation: the whole generation is handed out at once
   EXPECT_EQ(seeding + static_cast<std::int64_t>(counting->evaluated - seeding_evaluated), other.evaluations());
-}
-
-TEST(Evaluator, SeedIndividualDependsOnlyOnSeedAndIndex) {
-  Config c = island_config(1, 8);
-  const auto all = make_local_evaluator(c, stub_fitness)->seed(0, 8);
-  const auto tail = make_local_evaluator(c, stub_fitness)->seed(5, 3);
-  for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_TRUE(all[5 + i].genome == tail[i].genome);
-    EXPECT_EQ(all[5 + i].tries, tail[i].tries);
-    EXPECT_TRUE(all[5 + i].result.viable);
-  }
 }
 
 TEST(Evaluator, LocalEvaluatorRethrowsTheFirstErrorByIndex) {

@@ -124,3 +124,32 @@ def test_a_run_checkpointed_under_identity_scheme_1_resumes_and_is_saved_under_s
     resaved = json.loads(json.loads(ga.checkpoint())["payload"])
     assert resaved["identity_scheme"] == 2
     assert animat.GA.from_checkpoint(ga.checkpoint(), config).generation == 100
+
+
+def test_generation_stats_fields_pickling_and_history_columns_follow_one_descriptor(tmp_path):
+    import pickle
+
+    c = animat.Config()
+    c["evolution.population"] = 6
+    c["evolution.elites"] = 1
+    c["evaluation.steps"] = 100
+    animat.evolve(c, generations=1, out=tmp_path / "run", quiet=True)
+    run = animat.Run(tmp_path / "run")
+    header = (tmp_path / "run" / "history.csv").read_text().splitlines()[0].split(",")
+    assert list(animat.HISTORY_DTYPE.names) == header == [n for n, _ in animat.GenerationStats.HISTORY_COLUMNS]
+    assert run.history.dtype == animat.HISTORY_DTYPE
+    d = {"generation": 3, "best": 1.5, "mean": 0.5, "median": 0.25, "viable_fraction": 0.75, "best_cells": 9,
+         "evaluations": 120, "best_reference": float("nan"), "invalid": 2, "drag_limited": 0, "wall_seconds": 1.25,
+         "best_changed": True, "evaluations_per_second": 40.0, "crossovers": 1}
+    s = animat.GenerationStats(d)
+    back = s.to_dict()
+    assert set(back) == set(d)
+    for k, v in d.items():
+        assert back[k] == v or (v != v and back[k] != back[k]), k
+        assert type(s).__dict__[k].__doc__, k
+    assert pickle.loads(pickle.dumps(s)).to_dict().keys() == back.keys()
+    # Fields an older checkpoint may lack keep their defaults; the others are required.
+    older = {k: v for k, v in d.items() if k not in ("best_reference", "invalid", "drag_limited")}
+    assert animat.GenerationStats(older).invalid == 0
+    with pytest.raises(Exception):
+        animat.GenerationStats({k: v for k, v in d.items() if k != "best"})
