@@ -123,14 +123,19 @@ const fs::path& small_run() {
 // Child processes: a crash (signal) in the code under test must fail the test, not kill it.
 
 struct ChildResult {
-  enum Kind { ok, error, foreign, crashed, timed_out } kind = ok;
-  std::string message;  // what the child wrote (an animat::Error message) or the signal
+  enum Kind { ok, error, foreign, crashed, hung } kind = ok;
+  std::string message;  // what the child wrote (its note, an animat::Error message) or the signal
 };
 
-/// Runs f in a forked child with a time limit. The parent must not have used OpenMP before (each test
-/// runs in its own process under ctest), so the child's runtime starts clean.
+/// Only keeps a broken build from hanging the suite: every child's work is bounded (see the sweep
+/// below), so a child still running after this long is a hang, and a failure. Never a verdict on speed.
+constexpr double kHangGuardSeconds = 900.0;
+
+/// Runs f in a forked child; f returns a note (e.g. which work budget it reached). The parent must
+/// not have used OpenMP before (each test runs in its own process under ctest), so the child's runtime
+/// starts clean.
 template <class F>
-ChildResult in_child(F&& f, double limit_seconds) {
+ChildResult in_child(F&& f) {
   int fds[2];
   if (pipe(fds) != 0) return {ChildResult::foreign, "pipe failed"};
   std::fflush(nullptr);
@@ -140,7 +145,7 @@ ChildResult in_child(F&& f, double limit_seconds) {
     int code = 0;
     std::string msg;
     try {
-      f();
+      msg = f();
     } catch (const Error& e) {
       code = 3;
       msg = e.what();
@@ -154,12 +159,12 @@ ChildResult in_child(F&& f, double limit_seconds) {
   close(fds[1]);
   const auto t0 = Clock::now();
   int status = 0;
-  bool timed_out = false;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (seconds_since(t0) > limit_seconds) {
+  bool hung = false;
+  while (waitpid(pid, &status, WNOHANG) == 0) {  // polls for the exit; the time decides nothing but a hang
+    if (seconds_since(t0) > kHangGuardSeconds) {
       kill(pid, SIGKILL);
       waitpid(pid, &status, 0);
-      timed_out = true;
+      hung = true;
       break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -168,10 +173,10 @@ ChildResult in_child(F&& f, double limit_seconds) {
   char buf[4096];
   for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) msg.append(buf, static_cast<std::size_t>(n));
   close(fds[0]);
-  if (timed_out) return {ChildResult::timed_out, "time limit"};
+  if (hung) return {ChildResult::hung, fmt::format("still running after {} s (hang guard)", kHangGuardSeconds)};
   if (WIFSIGNALED(status)) return {ChildResult::crashed, fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)))};
   switch (WEXITSTATUS(status)) {
-    case 0: return {ChildResult::ok, ""};
+    case 0: return {ChildResult::ok, msg};
     case 3: return {ChildResult::error, msg};
     default: return {ChildResult::foreign, fmt::format("exit {}: {}", WEXITSTATUS(status), msg)};
   }
@@ -327,6 +332,37 @@ const Genome& viable_genome() {
   return g;
 }
 
+/// A viable genome with a small body (at most 12 cells; the first one, viable_genome(), has 32): what
+/// the probes of evaluation.settle_steps swim (see the sweep).
+const Genome& small_viable_genome() {
+  static const Genome g = [] {
+    const Config c = sweep_base();
+    for (int i = 0; i < 20000; ++i) {
+      Rng rng = Rng::derive(2024, i);
+      Genome candidate = random_genome(c.genome, rng);
+      const EvaluationResult r = evaluate(candidate, c);
+      if (r.viable && r.cell_count <= 12) return candidate;
+    }
+    ADD_FAILURE() << "no viable genome of at most 12 cells";
+    return Genome{};
+  }();
+  return g;
+}
+
+/// The sweep's work budgets (see EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal).
+constexpr long kSwimStepBudget = 4000;           // control steps of evaluate()'s swim: the paper's horizon
+constexpr long kEvaluationBudget = 5000;         // fitness evaluations of the GA: 400 generations of the base
+struct SwimBudgetReached {};                     // thrown by SwimBudget; no library code catches it
+
+/// Stops evaluate()'s swim once it has run kSwimStepBudget control steps (sampled every 1000 steps:
+/// splitting a swim's steps changes nothing in its motion).
+struct SwimBudget final : EvaluationObserver {
+  [[nodiscard]] long sample_every() const override { return 1000; }
+  void on_sample(const Simulation& sim) override {
+    if (sim.steps_done() >= kSwimStepBudget) throw SwimBudgetReached{};
+  }
+};
+
 /// The shared stub (mean first coordinate) can go negative when a sweep moves coordinates far; a
 /// fitness is a distance, so the sweep uses its magnitude.
 Fitness sweep_fitness(const Genome& g) {
@@ -399,10 +435,23 @@ TEST(ConfigSweep, RefusedValuesOnTheCommandLineChangeNoFileOfARun) {
 TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
   // In a child per value: evaluate() of a viable genome and two generations of the GA (stub fitness),
   // a checkpoint and its restore. A signal is a failure; an animat::Error must name something clear
-  // (the genome not fitting the config); a run longer than the limit (e.g. 10^7 swim steps) is counted.
+  // (the genome not fitting the config).
+  //
+  // The work of each child is bounded, not its time (a 3 s limit used to decide which values were
+  // checked, so a loaded machine checked fewer, and a crash after the limit passed): the swim stops
+  // after kSwimStepBudget control steps (an observer; only evaluation.steps = 10^7 gets there), the
+  // GA after kEvaluationBudget evaluations (a stop request; only evolution.population = 100,000).
+  // Development and settling run before the first step an observer sees and always run to their
+  // end: development.steps = 100,000 (1.5 to 4 s) and development.max_cells = 4096 (a 4096-cell
+  // embryo, 6 to 14 s) as they are; evaluation.settle_steps = 10^7 on the small body of
+  // small_viable_genome() (11 cells: 8 s; 20 to 38 s on the 32-cell one). Which values reach a budget
+  // is fixed by the values, never by the machine; the children's time limit is only a hang guard.
   const Genome& genome = viable_genome();
+  const Genome& small = small_viable_genome();
   ASSERT_FALSE(genome.elements.empty());
-  int accepted = 0, cross_refused = 0, errors = 0, timeouts = 0;
+  ASSERT_FALSE(small.elements.empty());
+  int accepted = 0, cross_refused = 0, errors = 0;
+  std::map<std::string, std::vector<std::string>> budgets;  // budget -> the values that reached it
   for (const auto& kp : all_probes()) {
     const std::string dotted = kp.section + "." + kp.key;
     for (const auto& p : kp.probes) {
@@ -418,37 +467,62 @@ TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
         continue;
       }
       ++accepted;
-      const ChildResult r = in_child([&] {
+      const Genome& swimmer = dotted == "evaluation.settle_steps" ? small : genome;
+      const ChildResult r = in_child([&]() -> std::string {
+        std::string note;
         try {
-          const EvaluationResult e = evaluate(genome, c);
+          SwimBudget budget;
+          const EvaluationResult e = evaluate(swimmer, c, &budget);
           if (!std::isfinite(e.fitness) || e.fitness < 0.0) _exit(6);
           if (e.cell_count > c.development.max_cells) _exit(7);
         } catch (const GenomeError&) {
           // the sweep's genome does not fit this config (genome.dimensions): refused cleanly
+        } catch (const SwimBudgetReached&) {
+          note += "swim";
         }
         const Config& g = c;
-        Evolution evo(g, sweep_fitness);
-        evo.initialize();
-        (void)evo.step();
-        (void)evo.step();
+        std::atomic<long> evaluations{0};
+        std::atomic<bool> spent{false};
+        Evolution evo(g, [&](const Genome& x) {
+          if (evaluations.fetch_add(1) + 1 >= kEvaluationBudget) spent = true;
+          return sweep_fitness(x);
+        });
+        evo.set_stop(StopRequest{&spent, {}});
+        try {
+          evo.initialize();
+          (void)evo.step();
+          (void)evo.step();
+        } catch (const Interrupted&) {
+          if (!spent) throw;
+          return note + (note.empty() ? "" : ",") + "evaluations";
+        }
         for (const auto& ind : evo.population()) validate(ind.genome, g.genome, "offspring");
         Evolution again(g, sweep_fitness);
         again.restore(evo.checkpoint());
-      }, 3.0);
+        return note;
+      });
       switch (r.kind) {
-        case ChildResult::ok: break;
+        case ChildResult::ok:
+          if (!r.message.empty()) budgets[r.message].push_back(dotted + " = " + p.text);
+          break;
         case ChildResult::error:  // clean, but it must say which setting caused it
           ++errors;
           std::printf("[ sweep    ] %s = %s: %s\n", dotted.c_str(), p.text.c_str(), r.message.c_str());
           EXPECT_TRUE(names_key(r.message, dotted)) << r.message;
           break;
-        case ChildResult::timed_out: ++timeouts; std::printf("[ sweep    ] %s = %s: still running after 3 s (no signal)\n", dotted.c_str(), p.text.c_str()); break;
         default: ADD_FAILURE() << r.message;
       }
     }
   }
-  std::printf("[ sweep    ] %d in-bounds values run in a child (%d animat errors naming the key, %d over 3 s, no signal); "
-              "%d refused by a cross-field rule naming the key\n", accepted, errors, timeouts, cross_refused);
+  // The values that reach a budget are known: a new one is either a slow new key (give it a budget or
+  // a small body above) or a regression that makes an old one slow.
+  const std::map<std::string, std::vector<std::string>> expected = {
+      {"swim", {"evaluation.steps = 10000000"}}, {"evaluations", {"evolution.population = 100000"}}};
+  EXPECT_EQ(budgets, expected);
+  for (const auto& [budget, values] : budgets)
+    std::printf("[ sweep    ] stopped at the %s budget: %s\n", budget.c_str(), fmt::format("{}", fmt::join(values, "; ")).c_str());
+  std::printf("[ sweep    ] %d in-bounds values run in a child (%d animat errors naming the key, no signal); "
+              "%d refused by a cross-field rule naming the key\n", accepted, errors, cross_refused);
 }
 
 TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {

@@ -180,9 +180,14 @@ def test_deeply_nested_genome_is_a_value_error_not_a_crash():
 # --------------------------------------------------------------------------------------------------
 # Kill-and-resume of the real binary
 
-RUN_ARGS = ["--quiet", "--threads", "2", "--seed", "5", "--set", "evolution.population=12",
-            "--set", "evaluation.steps=300", "--generations", "20"]
 FINAL_GENERATION = 20
+RUN_ARGS = ["--quiet", "--threads", "2", "--seed", "5", "--set", "evolution.population=12",
+            "--set", "evaluation.steps=300", "--generations", str(FINAL_GENERATION)]
+# The runs that are killed or signalled: the same run with no generation cap and no stall limit (both
+# may change on resume and are not part of the run), so that it can never end before the kill or the
+# signal, however fast or slow the machine; a resume with --generations FINAL_GENERATION finishes it.
+UNCAPPED = [*RUN_ARGS[:-2], "--generations", "0", "--set", "evolution.stall_generations=0"]
+HANG_GUARD_SECONDS = 900  # only keeps a broken build from hanging the suite; never a verdict on speed
 
 
 def fnv1a(data: bytes) -> str:
@@ -209,6 +214,7 @@ def assert_restores(run: Path, tmp: Path):
     copy = tmp / f"restore_{time.monotonic_ns()}"
     shutil.copytree(run, copy)
     config = animat.load_config(str(copy / "config.toml"))
+    config["evolution.generations"] = read_checkpoint(run)["generation"] + 1  # the killed runs have no cap
     r = animat.evolve(config, out=str(copy), resume=True, quiet=True, callback=lambda s: False)
     assert r.history[-1].generation == read_checkpoint(run)["generation"] + 1
     shutil.rmtree(copy)
@@ -228,82 +234,105 @@ def start(args, **kw) -> subprocess.Popen:
     return subprocess.Popen([EXE, *args], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, **kw)
 
 
+def checkpoint_generation(run: Path) -> int:
+    """The generation checkpoint.json holds (-1 before the first); it is written atomically."""
+    return read_checkpoint(run)["generation"] if (run / "checkpoint.json").exists() else -1
+
+
+def wait_until(proc: subprocess.Popen, condition, what: str):
+    """Polls `condition` (on the run's files) while `proc` runs. An uncapped run cannot end on its own,
+    so an exit is a failure; the time limit is a hang guard only."""
+    hang_guard = time.monotonic() + HANG_GUARD_SECONDS
+    while not condition():
+        assert proc.poll() is None, f"the run ended before {what}: exit {proc.returncode}: {proc.stderr.read()}"
+        assert time.monotonic() < hang_guard, f"hang guard: no {what} after {HANG_GUARD_SECONDS} s"
+        time.sleep(0.02)  # polling the condition
+
+
+def finish_and_compare(run: Path, reference: dict):
+    """Resumes an uncapped run to FINAL_GENERATION and compares it with the uninterrupted run. If the
+    last kill or signal landed after FINAL_GENERATION (possible only when this process was held up for
+    several generations), the run holds more generations: then its first FINAL_GENERATION + 1 must be
+    the uninterrupted run's."""
+    r = subprocess.run([EXE, "--resume", str(run), "--generations", str(FINAL_GENERATION), "--quiet"],
+                       capture_output=True, text=True, timeout=HANG_GUARD_SECONDS)
+    assert r.returncode == 0, r.stderr
+    generation = read_checkpoint(run)["generation"]
+    assert generation >= FINAL_GENERATION
+    rows = history(run)
+    assert len(rows) == len(reference["history"]) + generation - FINAL_GENERATION
+    assert rows[:len(reference["history"])] == reference["history"]
+    assert {name: genome for name, genome in lineage(run).items()
+            if int(name[len("gen_"):-len(".json")]) <= FINAL_GENERATION} == reference["lineage"]
+
+
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
-    """An uninterrupted run: its history, lineage and wall time."""
+    """An uninterrupted run: its history and lineage."""
     if not EXE or not Path(EXE).exists():
         pytest.skip("ANIMAT_EVOLVE_EXE is not set")
     run = tmp_path_factory.mktemp("reference") / "run"
-    t0 = time.monotonic()
-    r = subprocess.run([EXE, *RUN_ARGS, "--out", str(run)], capture_output=True, text=True, timeout=600)
+    r = subprocess.run([EXE, *RUN_ARGS, "--out", str(run)], capture_output=True, text=True, timeout=HANG_GUARD_SECONDS)
     assert r.returncode == 0, r.stderr
-    return {"run": run, "seconds": time.monotonic() - t0, "history": history(run), "lineage": lineage(run)}
+    return {"run": run, "history": history(run), "lineage": lineage(run)}
 
 
 @needs_exe
 def test_sigkill_at_random_moments_then_resume_equals_an_uninterrupted_run(reference, tmp_path):
+    # Six SIGKILLs, each followed by a resume (or a fresh start while there is no checkpoint). Where a
+    # kill lands is random: a seeded delay after its condition spreads the kills over initialization,
+    # evaluations, checkpoint writes and history appends. That they land, and where they count, is
+    # not: the run has no generation cap, so it is running at every kill, and kills 3 to 6 wait until
+    # the checkpoint has moved 1 to 3 generations past the one they resumed from (a condition on the
+    # files, polled), so they come after a checkpoint on any machine under any load.
     run = tmp_path / "run"
     rng = random.Random(20240901)
-    kills, checked, mid_run = 0, 0, []
-    for attempt in range(40):
-        resuming = (run / "checkpoint.json").exists()
-        proc = start(["--resume", str(run), "--threads", "2", "--quiet"] if resuming else [*RUN_ARGS, "--out", str(run)])
-        # Six kills, and more (up to 16) until two have landed after the first checkpoint: the
-        # initial population takes a good share of this short run, so six may all land before it.
-        if kills < 6 or (len(mid_run) < 2 and kills < 16):
-            # A random moment within the next third of the run: initialization, an evaluation, a
-            # checkpoint write or a history append.
-            delay = rng.uniform(0.05, 0.33) * reference["seconds"]
-            try:
-                proc.wait(timeout=delay)
-            except subprocess.TimeoutExpired:
-                proc.send_signal(signal.SIGKILL)
-                proc.wait()
-                kills += 1
-                if (run / "checkpoint.json").exists():
-                    mid_run.append(read_checkpoint(run)["generation"])
-                    if checked < 2:  # a full restore costs one generation: do it for the first two
-                        assert_restores(run, tmp_path)
-                        checked += 1
-                continue
+    mid_run, checked = [], 0
+    for kill in range(6):
+        resumed_from = checkpoint_generation(run)
+        proc = start(["--resume", str(run), "--threads", "2", "--quiet"] if resumed_from >= 0
+                     else [*UNCAPPED, "--out", str(run)])
+        if kill < 2:
+            delay = rng.uniform(0.0, 0.5)  # from the start: often during initialization
         else:
-            proc.wait(timeout=600)
-        err = proc.stderr.read()
-        assert proc.returncode == 0, f"exit {proc.returncode}: {err}"
-        break
-    else:
-        pytest.fail("the run never finished")
-    assert kills >= 3, f"only {kills} kills landed"
-    assert len(mid_run) >= 2, f"kills after the first checkpoint: generations {mid_run}"
-    print(f"{kills} SIGKILLs; checkpoints found at generations {mid_run}")
-    assert read_checkpoint(run)["generation"] == FINAL_GENERATION
-    assert history(run) == reference["history"]
-    assert lineage(run) == reference["lineage"]
+            target = resumed_from + rng.randint(1, 3)
+            wait_until(proc, lambda: checkpoint_generation(run) >= target, f"checkpoint of generation {target}")
+            delay = rng.uniform(0.0, 0.05)  # within the next generation or so
+        try:
+            proc.wait(timeout=delay)  # only where the kill lands; the run cannot end meanwhile
+            pytest.fail(f"the uncapped run ended on its own: exit {proc.returncode}: {proc.stderr.read()}")
+        except subprocess.TimeoutExpired:
+            pass
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        assert proc.returncode == -signal.SIGKILL, proc.stderr.read()
+        if (run / "checkpoint.json").exists():
+            mid_run.append(read_checkpoint(run)["generation"])
+            if checked < 2:  # a full restore costs one generation: do it for the first two
+                assert_restores(run, tmp_path)
+                checked += 1
+    assert len(mid_run) >= 4, f"kills after the first checkpoint: generations {mid_run}"
+    print(f"6 SIGKILLs; checkpoints found at generations {mid_run}")
+    finish_and_compare(run, reference)
 
 
 @needs_exe
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_sigint_and_sigterm_end_cleanly_with_a_fresh_checkpoint(sig, reference, tmp_path):
+    # The signal is sent once generations 0 and 1 are in history.csv (a condition, polled); the run has
+    # no generation cap, so it is still running then, on any machine under any load.
     run = tmp_path / "run"
-    proc = start([*RUN_ARGS, "--out", str(run)])
-    deadline = time.monotonic() + 300
-    while time.monotonic() < deadline and proc.poll() is None:
-        if (run / "history.csv").exists() and len(history(run)) >= 3:  # header + generations 0 and 1
-            break
-        time.sleep(0.02)
-    assert proc.poll() is None, "the run ended before the signal"
+    proc = start([*UNCAPPED, "--out", str(run)])
+    wait_until(proc, lambda: (run / "history.csv").exists() and len(history(run)) >= 3, "generation 1")
     proc.send_signal(sig)
-    proc.wait(timeout=300)
+    proc.wait(timeout=HANG_GUARD_SECONDS)
     assert proc.returncode == 130, proc.stderr.read()
     rows = history(run)
     payload = read_checkpoint(run)
     assert payload["generation"] == int(rows[-1][0]), "the checkpoint is the last generation written"
-    assert payload["generation"] < FINAL_GENERATION
+    assert payload["generation"] >= 1
     # Resumed to the end, the run equals the uninterrupted one.
-    r = subprocess.run([EXE, "--resume", str(run), "--quiet"], capture_output=True, text=True, timeout=600)
-    assert r.returncode == 0, r.stderr
-    assert history(run) == reference["history"]
-    assert lineage(run) == reference["lineage"]
+    finish_and_compare(run, reference)
 
 
 # --------------------------------------------------------------------------------------------------
