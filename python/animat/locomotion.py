@@ -453,9 +453,9 @@ def _wave_fit(z: np.ndarray, coords: np.ndarray, motion: np.ndarray) -> WaveFit:
 
 def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
     """Connected components of the spring graph restricted to ``cells``."""
-    from .shape import _groups as components  # noqa: PLC0415
+    from .shape import connected_groups  # noqa: PLC0415
 
-    return len(components([int(c) for c in cells], [(int(i), int(j)) for i, j in springs]))
+    return len(connected_groups([int(c) for c in cells], [(int(i), int(j)) for i, j in springs]))
 
 
 def _no_wave(w: WaveFit) -> str:
