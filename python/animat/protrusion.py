@@ -31,8 +31,8 @@ in shape during motion". :func:`stroke_motion` asks exactly that of a window of 
    swim **strokes** when that score reaches :data:`STROKE_SCORE` and the pair's smaller area reaches
    :data:`STROKE_AREA`.
 
-The thresholds were set on the calibration set of :func:`animat.known_swimmers.paper_calibration_set`
-(swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; :func:`animat.locomotion.classify_motion`
+The thresholds were set on the hand-built swimmers of ``paper_calibration_set`` in
+studies/locomotion/known_swimmers.py (swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; :func:`animat.locomotion.classify_motion`
 uses the rule as its first test for "protrusions" (docs/locomotion.md).
 """
 from __future__ import annotations
