@@ -13,13 +13,17 @@ from __future__ import annotations
 
 import argparse
 import glob
+import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
 import animat
-from animat.replication_store import unpack_run
+
+# The packed-run store is study code (studies/replication), not part of the package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "studies" / "replication"))
+from replication_store import unpack_run  # noqa: E402
 
 
 def compare(label: str, cases: list, cutoffs: list[float]) -> None:

@@ -26,7 +26,10 @@ import tempfile
 import numpy as np
 
 import animat
-from animat.replication_store import unpack_run
+
+# The packed-run store is study code (studies/replication), not part of the package.
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "studies" / "replication"))
+from replication_store import unpack_run  # noqa: E402
 
 PUSH_STEP = 2000
 

@@ -26,7 +26,7 @@ while (($#)); do
 done
 [[ -n "$MODE" ]] || { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 
-# The paper's four environments (§6), named as scripts/replication_report.py expects.
+# The paper's four environments (§6), named as studies/replication/replication_report.py expects.
 ENVS=(dn0.5=configs/paper_dn0.5.toml dn2=configs/paper_dn2.toml dn10=configs/paper_dn10.toml
       dn0.2_64cells=configs/paper_dn0.2_64cells.toml)
 PY=${ANIMAT_PYTHON:-.venv/bin/python}
@@ -34,7 +34,7 @@ export PYTHONPATH=${ANIMAT_PYTHONPATH:-$PWD/build/python}
 experiment() { "$PY" -m animat experiment "${ENVS[@]}" --runs "$RUNS" --out "$OUT" "$@" "${EXTRA[@]}"; }
 report() {
   experiment --quiet  # every run is finished: each stops at once; writes OUT/<env>/summary.{json,md}
-  "$PY" scripts/replication_report.py --runs "$OUT" --doc "$OUT/replication.md" --discussion "$OUT/discussion.md"
+  "$PY" studies/replication/replication_report.py --runs "$OUT" --doc "$OUT/replication.md" --discussion "$OUT/discussion.md"
 }
 
 case "$MODE" in

@@ -25,7 +25,10 @@ from pathlib import Path
 import numpy as np
 
 import animat
-from animat.replication_store import packed_runs, unpack_run
+
+# The packed-run store is study code (studies/replication), not part of the package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "studies" / "replication"))
+from replication_store import packed_runs, unpack_run  # noqa: E402
 
 NEAR_ZERO_AMPLITUDE = 0.05  # of development.amplitude_max
 IDLE_WORK = 0.10            # of the body's mean positive work per cell

@@ -1,4 +1,4 @@
-"""Locomotion modes and the paper's statistics of evolved swimmers (issue 10, paper §6–§7).
+"""Locomotion modes and the paper's statistics of evolved swimmers (paper §6–§7).
 
 Classification (:func:`classify_locomotion`)
 -------------------------------------------
@@ -47,14 +47,15 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
      rows, extended while moving backwards and contracted on the return
      (:func:`animat.protrusion.stroke_motion`: pair score ``>= STROKE_SCORE`` 0.4 and loop area
      ``>= STROKE_AREA`` 0.1 spacings²): **protrusions** (mixed with undulation when the wave
-     criterion also holds). Calibrated on :func:`animat.known_swimmers.paper_calibration_set`, whose
-     protrusion swimmers actuate every cell (docs/locomotion.md).
+     criterion also holds). Calibrated on ``paper_calibration_set`` of the hand-built swimmers
+     (studies/locomotion/known_swimmers.py), whose protrusion swimmers actuate every cell
+     (docs/locomotion.md).
    - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65), or a strain contrast (RMS contraction
      amplitude of the most strained 20 % of the cells over the median cell's) ``>= LOCAL_CONTRAST``
-     (3.5, issue 19): **protrusions** when those cells (the most strained fifth if the contrast
+     (3.5): **protrusions** when those cells (the most strained fifth if the contrast
      decided, else the most mobile fifth) form two or more groups joined by springs, **tail** when they
      form one. The contrast rule was added because hand-built protrusion swimmers
-     (:mod:`animat.known_swimmers`) put only 0.44–0.62 of the motion in their top fifth: the passive
+     (studies/locomotion/known_swimmers.py) put only 0.44–0.62 of the motion in their top fifth: the passive
      core of a soft body is pushed around by its appendages. For the old rule: the rest of the body
      moves with less than 37 % of the RMS amplitude of its most mobile fifth. Smooth whole-body
      deformations stay below: a breathing disc puts 0.36 of its energy in the top 20 % (amplitude
@@ -81,13 +82,13 @@ or 2π along the long axis or π across it gave fit ≥ 0.94, lag 2.2–6.3 and 
 (37 "synchronous contraction", 17 mixed): a quarter-period command is at the threshold. The
 concentration threshold could not be calibrated on real protrusion swimmers (none was at hand); it rests
 on the smooth-deformation bounds above and on a synthetic swimmer (two 3-cell appendages on a 19-cell
-blob that sweep and extend as the paper's Fig. 6 describes: 0.86). Issue 19 swam hand-built swimmers
-of known mode (:mod:`animat.known_swimmers`; the confusion matrices are in docs/replication.md): the
+blob that sweep and extend as the paper's Fig. 6 describes: 0.86). Hand-built swimmers of known mode
+(studies/locomotion/known_swimmers.py; the confusion matrices are in docs/replication.md) were swum: the
 contrast rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase)
 is still missed (wave fit 0.78–0.80, just under WAVE_FIT).
 
-The paper's stroke, tested directly (issue 19)
-----------------------------------------------
+The paper's stroke, tested directly
+-----------------------------------
 :func:`paddling` asks of a swim what the paper (§6) says of its protrusion swimmers, without a mode:
 "protrusions are fully extended when moving backwards (generating thrust) but are contracted during
 their return", "a clear tendency to place the protrusions symmetrically", and "in 32-cell structures
@@ -101,8 +102,8 @@ moves backwards fastest: a loop traversed out, back, in, forward; 0 for a purely
 sweeping motion, which are a quarter period apart; −1 for the loop the other way round). The *pair
 score* is the best min(rowing) over two protruding cells on opposite sides of the axis of motion; a
 swim *paddles* when it reaches ``PADDLE_ROWING`` (0.6). On the hand-built swimmers of
-:mod:`animat.known_swimmers` the whole-body ones (undulators, synchronous contractors) score at most
-0.49 (docs/replication.md); the hand-built protrusion swimmers do not paddle either (their appendages
+studies/locomotion/known_swimmers.py the whole-body ones (undulators, synchronous contractors) score
+at most 0.49 (docs/replication.md); the hand-built protrusion swimmers do not paddle either (their appendages
 are driven to row but follow it only loosely), so the test has negative controls only.
 
 Statistics (paper §6–§7)
@@ -147,8 +148,8 @@ PROTRUSION_CONCENTRATION = 0.65
 #: The most mobile fraction of the cells used by the concentration measure.
 TOP_FRACTION = 0.2
 #: RMS contraction amplitude of the most strained 20 % of the cells over the median cell's, from which
-#: the deformation is localised in appendages (protrusions or a tail; issue 19, set between the two
-#: groups of the calibration set of :mod:`animat.known_swimmers`, swum 2000 steps at d_N = 0.5 and 2:
+#: the deformation is localised in appendages (protrusions or a tail; set between the two groups of
+#: the calibration set of studies/locomotion/known_swimmers.py, swum 2000 steps at d_N = 0.5 and 2:
 #: undulators and synchronous contractors 1.98–3.01, protrusion and tail swimmers 4.14–7.33).
 LOCAL_CONTRAST = 3.5
 #: Height above the chord of its two skin neighbours, in median rest spring lengths, from which a skin
@@ -453,9 +454,9 @@ def _wave_fit(z: np.ndarray, coords: np.ndarray, motion: np.ndarray) -> WaveFit:
 
 def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
     """Connected components of the spring graph restricted to ``cells``."""
-    from .shape import _groups as components  # noqa: PLC0415
+    from .shape import connected_groups  # noqa: PLC0415
 
-    return len(components([int(c) for c in cells], [(int(i), int(j)) for i, j in springs]))
+    return len(connected_groups([int(c) for c in cells], [(int(i), int(j)) for i, j in springs]))
 
 
 def _no_wave(w: WaveFit) -> str:

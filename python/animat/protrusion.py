@@ -31,8 +31,8 @@ in shape during motion". :func:`stroke_motion` asks exactly that of a window of 
    swim **strokes** when that score reaches :data:`STROKE_SCORE` and the pair's smaller area reaches
    :data:`STROKE_AREA`.
 
-The thresholds were set on the calibration set of :func:`animat.known_swimmers.paper_calibration_set`
-(swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; :func:`animat.locomotion.classify_motion`
+The thresholds were set on the hand-built swimmers of ``paper_calibration_set`` in
+studies/locomotion/known_swimmers.py (swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; :func:`animat.locomotion.classify_motion`
 uses the rule as its first test for "protrusions" (docs/locomotion.md).
 """
 from __future__ import annotations
@@ -43,7 +43,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import shape as _shape
+from .shape import Protrusion, ShapeParams, cell_heights, cell_spacing, connected_groups, symmetric_pairs
 
 __all__ = ["ProtrusionStroke", "stroke_motion", "protrusion_stroke", "cell_strokes", "rowing",
            "STROKE_SCORE", "STROKE_AREA", "STROKE_SAMPLES"]
@@ -131,9 +131,9 @@ def _empty() -> ProtrusionStroke:
     return ProtrusionStroke((), (), np.zeros(0), np.zeros(0), (), np.zeros(0), (), float("nan"), float("nan"))
 
 
-def _protruding(positions: np.ndarray, outline: Sequence[int], springs: np.ndarray, params: _shape.ShapeParams,
+def _protruding(positions: np.ndarray, outline: Sequence[int], springs: np.ndarray, params: ShapeParams,
                 spacing: float) -> List[int]:
-    h = _shape.cell_heights(positions, outline, params, spacing)
+    h = cell_heights(positions, outline, params, spacing)
     if h is None:
         return []
     return [int(i) for i in np.flatnonzero(h >= params.min_height)]
@@ -141,7 +141,7 @@ def _protruding(positions: np.ndarray, outline: Sequence[int], springs: np.ndarr
 
 def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any, outline: Sequence[int],
                   springs: Any, rest_positions: Optional[Any] = None, samples: int = STROKE_SAMPLES,
-                  params: _shape.ShapeParams = _shape.ShapeParams()) -> ProtrusionStroke:
+                  params: ShapeParams = ShapeParams()) -> ProtrusionStroke:
     """:class:`ProtrusionStroke` of a window of body-frame frames.
 
     Args:
@@ -160,7 +160,7 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
     if len(loop) < 3 or n < 3 or not omega > 0 or F < 4:
         return _empty()
     mean = Q.mean(axis=0)
-    s = _shape.cell_spacing(mean if rest_positions is None else np.asarray(rest_positions, dtype=np.float64))
+    s = cell_spacing(mean if rest_positions is None else np.asarray(rest_positions, dtype=np.float64))
     rest: List[int] = []
     if rest_positions is not None:
         rest = _protruding(np.asarray(rest_positions, dtype=np.float64), loop, sp, params, s)
@@ -175,7 +175,7 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
         return _empty()
     links = [(int(loop[k]), int(loop[(k + 1) % len(loop)])) for k in range(len(loop))] + [
         (int(e[0]), int(e[1])) for e in sp]
-    groups = _shape._groups(cells, links)
+    groups = connected_groups(cells, links)
     rest_set = set(rest)
     groups.sort(key=lambda g: (not (set(g) & rest_set), -len(g), g))
     member = {c: k for k, g in enumerate(groups) for c in g}
@@ -195,15 +195,14 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
         if not np.linalg.norm(outward) > 0:
             scores.append(float("nan"))
             areas.append(float("nan"))
-            found.append(_shape.Protrusion(tuple(g), 0.0, tuple(mean[list(g)].mean(axis=0))))
+            found.append(Protrusion(tuple(g), 0.0, tuple(mean[list(g)].mean(axis=0))))
             continue
         X, E = cell_strokes(Q, t, omega, d, g, base, outward)
         scores.append(rowing(X, E))
         areas.append(float(np.mean(-math.pi * np.imag(E * np.conj(X)))) / s ** 2)
         cx, cy = mean[list(g)].mean(axis=0)
-        found.append(_shape.Protrusion(tuple(g), 0.0, (float(cx), float(cy))))
-    _, axes = _shape._moments(mean, (params.cell_diameter * s) ** 2 / 16.0)
-    pairs = tuple(_shape._symmetric_pairs(mean, found, params, s, axes))
+        found.append(Protrusion(tuple(g), 0.0, (float(cx), float(cy))))
+    pairs = tuple(symmetric_pairs(mean, found, params, s))
     sc = np.array(scores, dtype=np.float64)
     ar = np.array(areas, dtype=np.float64)
     pair_scores = np.array([np.fmin(sc[a], sc[b]) if np.isfinite(sc[a]) and np.isfinite(sc[b]) else np.nan

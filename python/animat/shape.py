@@ -78,7 +78,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 __all__ = ["ShapeParams", "Protrusion", "Shape", "describe", "body_shape", "genome_shape", "cell_spacing",
-           "elongation", "concavity", "cell_heights"]
+           "principal_axes", "elongation", "concavity", "cell_heights", "connected_groups", "symmetric_pairs"]
 
 
 @dataclass(frozen=True)
@@ -178,10 +178,19 @@ def cell_spacing(positions: np.ndarray) -> float:
     return s if s > 0 else 1.0
 
 
-def _moments(p: np.ndarray, disc_term: float) -> Tuple[np.ndarray, np.ndarray]:
-    """Eigenvalues (ascending) and eigenvectors of the cells' second-moment matrix."""
+def principal_axes(positions: np.ndarray, params: ShapeParams = ShapeParams(),
+                   spacing: Optional[float] = None) -> Tuple[np.ndarray, np.ndarray]:
+    """The cells' principal second moments about their centroid and the principal axes (module
+    docstring, "Elongation"): the eigenvalues λ2 ≤ λ1 (ascending, squared length units) and the unit
+    eigenvectors (the columns of a 2 × 2 array, in the same order) of the covariance matrix of the
+    cell centres plus ``(cell_diameter·s)² / 16`` on the diagonal, each cell counted as a uniform disc.
+    ``spacing`` is s (default :func:`cell_spacing` of ``positions``). Needs at least one cell."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 2)
+    if len(p) == 0:
+        raise ValueError("principal_axes: no cells")
+    s = cell_spacing(p) if spacing is None else spacing
     c = p - p.mean(axis=0)
-    m = c.T @ c / len(p) + disc_term * np.eye(2)
+    m = c.T @ c / len(p) + (params.cell_diameter * s) ** 2 / 16.0 * np.eye(2)
     return np.linalg.eigh(m)
 
 
@@ -190,8 +199,7 @@ def elongation(positions: np.ndarray, params: ShapeParams = ShapeParams(), spaci
     p = np.asarray(positions, dtype=float)
     if len(p) == 0:
         return 1.0
-    s = cell_spacing(p) if spacing is None else spacing
-    lam, _ = _moments(p, (params.cell_diameter * s) ** 2 / 16.0)
+    lam, _ = principal_axes(p, params, spacing)
     if lam[1] <= 0:
         return 1.0
     if lam[0] <= 1e-12 * lam[1]:
@@ -361,7 +369,12 @@ def cell_heights(positions: np.ndarray, outline: Sequence[int], params: ShapePar
     return np.maximum(0.0, heights - rho)
 
 
-def _groups(members: Sequence[int], links: Sequence[Tuple[int, int]]) -> List[List[int]]:
+def connected_groups(members: Sequence[int], links: Sequence[Tuple[int, int]]) -> List[List[int]]:
+    """The connected components of the graph on ``members`` (distinct cell indices) whose edges are
+    the ``links`` (index pairs; a link with an end outside ``members`` is ignored), by union-find: one
+    sorted list per component, the components in the order in which their first member appears in
+    ``members`` (by smallest index when ``members`` is sorted). Protruding cells joined this way form
+    one protrusion (:func:`describe`, :mod:`animat.protrusion`)."""
     parent = {m: m for m in members}
 
     def find(x: int) -> int:
@@ -381,8 +394,16 @@ def _groups(members: Sequence[int], links: Sequence[Tuple[int, int]]) -> List[Li
     return [sorted(g) for g in out.values()]
 
 
-def _symmetric_pairs(p: np.ndarray, protrusions: Sequence[Protrusion], params: ShapeParams, s: float,
-                     axes: np.ndarray) -> List[Tuple[int, int]]:
+def symmetric_pairs(positions: np.ndarray, protrusions: Sequence[Protrusion], params: ShapeParams = ShapeParams(),
+                    spacing: Optional[float] = None) -> List[Tuple[int, int]]:
+    """The symmetric pairs among ``protrusions`` (module docstring, "Symmetric pair"): index pairs
+    ``(i, j)``, i < j, of protrusions whose centroids, taken relative to the centroid of the cells at
+    ``positions``, are mirror images of each other about one of the principal axes of those cells
+    (:func:`principal_axes`) within ``params.pair_tolerance`` spacings, on opposite sides of that axis.
+    ``spacing`` is s (default :func:`cell_spacing` of ``positions``)."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 2)
+    s = cell_spacing(p) if spacing is None else spacing
+    _, axes = principal_axes(p, params, s)
     centre = p.mean(axis=0)
     pairs: List[Tuple[int, int]] = []
     for i in range(len(protrusions)):
@@ -424,12 +445,11 @@ def describe(positions: Any, outline: Optional[Sequence[int]], springs: Any = No
         d = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=2)
         links += [(i, j) for i in protruding for j in protruding if i < j and d[i, j] < 1.5 * s]
     found = []
-    for g in _groups(protruding, links):
+    for g in connected_groups(protruding, links):
         cx, cy = p[g].mean(axis=0)
         found.append(Protrusion(tuple(g), float(max(heights[g])), (float(cx), float(cy))))
     found.sort(key=lambda pr: (-pr.size, -pr.height, pr.cells))
-    _, axes = _moments(p, (params.cell_diameter * s) ** 2 / 16.0)
-    pairs = _symmetric_pairs(p, found, params, s, axes)
+    pairs = symmetric_pairs(p, found, params, s)
     return Shape(n, s, el, conc, a_out / s**2, a_hull / s**2, n - len(protruding),
                  tuple(map(float, heights)), tuple(found), tuple(pairs))
 

@@ -21,7 +21,9 @@ from pathlib import Path
 import numpy as np
 
 import animat
-from animat.replication_store import packed_runs, unpack_run
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "replication"))
+from replication_store import packed_runs, unpack_run  # noqa: E402
 
 COLUMNS = ["environment", "run", "fitness", "cells", "actuation", "fluid_share", "drag_normal_share",
            "drag_tangential_share", "damping_share", "collision_share", "residual_share", "frequency_median",

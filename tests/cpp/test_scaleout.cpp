@@ -274,10 +274,11 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
 }
 
 TEST(RunIdentity, RunsCheckpointedBeforeTheLateKeysStillResume) {
-  // data/study_issue14 was checkpointed (scheme 1) before evaluation.objective, evaluation.direction
-  // and physics.integrator existed; its checkpoints carry these identities (the checkpoint field
-  // "identity"), which the config it was run with must still give.
-  const std::filesystem::path run = std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "study_issue14" / "dn2" / "run_1";
+  // data/paper_100_generations was checkpointed (scheme 1) before evaluation.objective,
+  // evaluation.direction and physics.integrator existed; its checkpoints carry these identities (the
+  // checkpoint field "identity"), which the config it was run with must still give.
+  const std::filesystem::path run =
+      std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "paper_100_generations" / "dn2" / "run_1";
   const Config config = load_config(run / "config.toml");
   EXPECT_EQ(run_identity_v1(config), 0xc3f866cda3ad7231ULL);
   // And a late key away from its default is part of the identity.
@@ -294,7 +295,8 @@ constexpr std::uint64_t kPinnedStudyIdentity = 0xc1511dfee1a098d1ULL;
 TEST(RunIdentity, SchemeTwoIsPinnedAndReadsValuesNotDocumentation) {
   // The identity of the paper's default config and of a study config, pinned: a change of scheme 2
   // would strand every run checkpointed since.
-  const std::filesystem::path run = std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "study_issue14" / "dn2" / "run_1";
+  const std::filesystem::path run =
+      std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "paper_100_generations" / "dn2" / "run_1";
   EXPECT_EQ(run_identity(Config{}), kPinnedDefaultIdentity);
   EXPECT_EQ(run_identity(load_config(run / "config.toml")), kPinnedStudyIdentity);
   // It is the hash of "section.key = value" lines: the documentation and the version are not in it.

@@ -137,7 +137,7 @@ def test_malformed_run_directories_give_clear_errors(run_dir, tmp_path):
     h = run.history
     assert np.isnan(h["best_reference"]).all() and (h["invalid"] == 0).all() and (h["drag_limited"] == 0).all()
     assert h["wall_seconds"][-1] == float(lines[-1].rstrip("\n").split(",")[-1])
-    # One written with the exploit guard but before the drag limiter's column (data/study_issue14).
+    # One written with the exploit guard but before the drag limiter's column (data/paper_100_generations).
     guard = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k != 9) + "\n" for line in lines]
     (bad / "history.csv").write_text("".join(guard))
     h = run.history

@@ -111,7 +111,7 @@ def test_a_run_checkpointed_under_identity_scheme_1_resumes_and_is_saved_under_s
     import gzip
     from pathlib import Path
 
-    run = Path(__file__).resolve().parents[2] / "data" / "study_issue14" / "dn2" / "run_1"
+    run = Path(__file__).resolve().parents[2] / "data" / "paper_100_generations" / "dn2" / "run_1"
     text = gzip.decompress((run / "checkpoint.json.gz").read_bytes()).decode()
     assert "identity_scheme" not in text
     config = animat.load_config(run / "config.toml")

@@ -1,11 +1,12 @@
-"""Hand-built swimmers of known locomotion mode (animat.known_swimmers, issue 19) are classified as built."""
+"""Hand-built swimmers of known locomotion mode (studies/locomotion/known_swimmers.py) are classified as built."""
 import math
 
 import numpy as np
 import pytest
 
+import known_swimmers as K  # studies/locomotion (conftest.py)
+
 import animat
-from animat import known_swimmers as K
 from animat import locomotion as L
 
 

@@ -439,8 +439,9 @@ def test_replication_report_on_finished_and_partial_runs(tmp_path):
     c["evolution.generations"] = 1
     animat.evolve(c, out=str(runs / "dn10" / "run_0"))  # a run without summary.json ("in progress")
     doc = tmp_path / "docs" / "replication.md"
-    out = subprocess.run([sys.executable, str(root / "scripts" / "replication_report.py"), "--runs", str(runs),
-                          "--doc", str(doc), "--no-gif"], capture_output=True, text=True)
+    report = str(root / "studies" / "replication" / "replication_report.py")
+    out = subprocess.run([sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"],
+                         capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     text = doc.read_text()
     assert text.count("<!-- DISCUSSION -->") == 1
@@ -455,6 +456,6 @@ def test_replication_report_on_finished_and_partial_runs(tmp_path):
     assert "images/replication/dn2_run0_motion.png" in text
     # deterministic: a second run writes the same document
     first = text
-    subprocess.run([sys.executable, str(root / "scripts" / "replication_report.py"), "--runs", str(runs),
-                    "--doc", str(doc), "--no-gif"], capture_output=True, text=True, check=True)
+    subprocess.run([sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"], capture_output=True,
+                   text=True, check=True)
     assert doc.read_text() == first

@@ -4,8 +4,9 @@ import math
 import numpy as np
 import pytest
 
+import known_swimmers as K  # studies/locomotion (conftest.py)
+
 import animat
-from animat import known_swimmers as K
 from animat import locomotion as L
 from animat import protrusion as P
 

@@ -1,10 +1,10 @@
-"""animat.replication_stats (issue 19): Fisher's exact test against hand-computed tables, the bootstrap."""
+"""replication_stats (studies/replication): Fisher's exact test against hand-computed tables, the bootstrap."""
 import math
 
 import numpy as np
 import pytest
 
-from animat import replication_stats as S
+import replication_stats as S  # studies/replication (conftest.py)
 
 
 def test_fisher_2x2_by_hand():

@@ -1,5 +1,5 @@
-"""animat.replication_store: packed runs unpack into run directories and pack back to the same bytes; pack
-refuses runs that would not restore or are behind, unpack verifies every checksum and size."""
+"""replication_store (studies/replication): packed runs unpack into run directories and pack back to the
+same bytes; pack refuses runs that would not restore or are behind, unpack verifies every checksum and size."""
 import gzip
 import hashlib
 import json
@@ -14,9 +14,10 @@ from pathlib import Path
 import pytest
 
 import animat
-from animat import replication_store as R
+import replication_store as R  # studies/replication (conftest.py)
 
 ROOT = Path(__file__).resolve().parents[2]
+STUDY = ROOT / "studies" / "replication"
 # Frozen copies of two packed runs at generation 100 (data/replication itself grows across sessions).
 FIXTURES = ROOT / "tests" / "data" / "replication"
 PACKED = FIXTURES / "dn2_run_0"
@@ -90,7 +91,7 @@ def _two_packed_runs_and_report_command(tmp_path):
     shutil.copytree(PACKED, data / "dn2" / "run_0")
     shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
     doc = tmp_path / "docs" / "replication.md"
-    cmd = [sys.executable, str(ROOT / "scripts" / "replication_report.py"), "--data", str(data), "--doc", str(doc),
+    cmd = [sys.executable, str(STUDY / "replication_report.py"), "--data", str(data), "--doc", str(doc),
            "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
     return data, doc, cmd
 
@@ -248,7 +249,7 @@ def test_unpack_on_a_full_disk_writes_nothing_and_a_retry_completes_it(tmp_path)
     data = tmp_path / "data"
     shutil.copytree(PACKED, data / "dn2" / "run_0")
     work = tmp_path / "work"
-    cmd = [sys.executable, "-m", "animat.replication_store", "unpack", str(data), str(work)]
+    cmd = [sys.executable, str(STUDY / "replication_store.py"), "unpack", str(data), str(work)]
 
     def file_size_limit():  # every other file fits; the checkpoint (440 KB) does not
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)

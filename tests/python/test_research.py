@@ -631,7 +631,8 @@ def test_pyright_reports_no_error_on_the_examples_and_the_package():
     config = stage.parent / "pyrightconfig.json"  # pyright reads "include" relative to its config file
     config.write_text(json.dumps({
         "include": [os.path.relpath(ROOT / "examples", config.parent), os.path.relpath(stage / "animat", config.parent)],
-        "extraPaths": [str(stage), str(ROOT / "examples")],
+        # examples/push_recovery.py imports the packed-run store from its study folder, as it runs
+        "extraPaths": [str(stage), str(ROOT / "examples"), str(ROOT / "studies" / "replication")],
         "pythonVersion": f"{sys.version_info.major}.{sys.version_info.minor}",
         "typeCheckingMode": "standard",
         "exclude": [os.path.relpath(stage / "animat" / "_core.pyi", config.parent)],  # nanobind's generated stub

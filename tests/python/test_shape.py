@@ -205,3 +205,24 @@ def test_params_are_checked():
         S.ShapeParams(core_radius=0.0)
     with pytest.raises(ValueError):
         S.ShapeParams(min_height=-1.0)
+
+
+def test_public_building_blocks_agree_with_describe():
+    # principal_axes: the moments behind elongation; axes orthonormal, the long one along x for a strip
+    body = strip()
+    lam, axes = S.principal_axes(body)
+    assert lam[0] <= lam[1]
+    assert math.sqrt(lam[1] / lam[0]) == pytest.approx(S.elongation(body), rel=1e-12)
+    assert axes.T @ axes == pytest.approx(np.eye(2), abs=1e-12)
+    assert abs(axes[0, 1]) == pytest.approx(1.0, abs=1e-9)
+    with pytest.raises(ValueError, match="no cells"):
+        S.principal_axes(np.zeros((0, 2)))
+    # connected_groups: components over the members only, each sorted, in order of first member
+    assert S.connected_groups([5, 1, 2, 9], [(1, 2), (2, 7), (9, 5)]) == [[5, 9], [1, 2]]
+    assert S.connected_groups([], [(0, 1)]) == []
+    # symmetric_pairs: the pairs describe reports
+    bump = np.array([2.5, SQ3 / 2])
+    points = np.vstack([hexagon(), bump, -bump])
+    sh = shape_of(points)
+    assert tuple(S.symmetric_pairs(points, sh.protrusions)) == sh.symmetric_pairs == ((0, 1),)
+    assert S.symmetric_pairs(points, sh.protrusions[:1]) == []

@@ -1,4 +1,4 @@
-"""Small-sample statistics for the replication report (issue 19): pure functions on plain numbers.
+"""Small-sample statistics for the replication report (replication_report.py): pure functions on plain numbers.
 
 - :func:`fisher_exact`: Fisher's exact test of independence for an r x c contingency table (the
   Freeman–Halton extension beyond 2 x 2): does the locomotion mode depend on the environment? Exact

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Issues 10 and 19: grow the replication study of the paper's four environments (§6) and rewrite
-# docs/replication.md from it.
-#   scripts/replication.sh [SESSION_SECONDS]      (default 5400)
+# Grow the replication study of the paper's four environments (§6) and rewrite docs/replication.md
+# from it. Run from anywhere; it works in the repository root.
+#   studies/replication/replication.sh [SESSION_SECONDS]      (default 5400)
 #
 # The study lives in the repository, in data/replication/<env>/run_<i>/ (config.toml, history.csv.gz,
-# best.tar.gz, checkpoint.json.gz, status.json: python/animat/replication_store.py). A session
+# best.tar.gz, checkpoint.json.gz, status.json, manifest.json: replication_store.py here). A session
 #  1. unpacks every packed run into a work directory (runs/replication/<env>/run_<i>, kept when it is
 #     already there and newer),
 #  2. resumes them, and starts the runs not started yet, with `python -m animat experiment` (run i of an
@@ -13,19 +13,20 @@
 #     generations without improvement, in the configs); the session stops every run still going after
 #     SESSION_SECONDS (SIGINT: each writes the checkpoint of its last complete generation),
 #  3. packs every run back into data/replication (commit it: the study grows across sessions),
-#  4. rewrites docs/replication.md from data/replication alone (scripts/replication_report.py).
+#  4. rewrites docs/replication.md from data/replication alone (replication_report.py here).
 # Runs 0-4 of every environment were made before the [evaluation] objective keys existed; they resume
 # since run_identity() leaves keys added later out of the hash while they hold their default
 # (late_keys() in src/evolution.cpp).
 # ANIMAT_REPLICATION_INDEX="1 2 3" restricts step 2 to those runs of the study (env-major: run i of the
 # e-th environment of dn0.5, dn2, dn10, dn0.2_64cells is e * RUNS + i).
 # ANIMAT_REPLICATION_ROUND=150 grows the study breadth first: step 2 runs in rounds, each taking every
-# open run to ROUND generations past the least advanced one (python -m animat.replication_store
+# open run to ROUND generations past the least advanced one (replication_store.py
 # next-cap), so that a short session leaves the runs at comparable lengths instead of finishing the
 # first few. Default 0: every run straight to the cap. (With an INDEX, the rounds stop as soon as the
 # least advanced run is one outside it.)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
+HERE=studies/replication
 SESSION=${1:-5400}
 RUNS=${ANIMAT_REPLICATION_RUNS:-10}
 GENERATIONS=${ANIMAT_REPLICATION_GENERATIONS:-1000}
@@ -43,7 +44,7 @@ INDEX_ARGS=()
 for i in ${ANIMAT_REPLICATION_INDEX:-}; do INDEX_ARGS+=(--index "$i"); done
 
 mkdir -p "$WORK"
-"${PY[@]}" -m animat.replication_store unpack "$DATA" "$WORK"
+"${PY[@]}" "$HERE/replication_store.py" unpack "$DATA" "$WORK"
 git rev-parse HEAD > "$WORK/commit.txt" 2>/dev/null || true
 rm -f "$WORK"/*/summary.json  # stop reasons of this session only (an --index session writes none)
 : > "$WORK/experiment.log"
@@ -66,7 +67,7 @@ status=0
 if (( ROUND > 0 )); then
   previous=""
   while :; do
-    cap=$("${PY[@]}" -m animat.replication_store next-cap "$WORK" --envs "${ENVS[@]}" --runs "$RUNS" \
+    cap=$("${PY[@]}" "$HERE/replication_store.py" next-cap "$WORK" --envs "${ENVS[@]}" --runs "$RUNS" \
           --generations "$GENERATIONS" --round "$ROUND")
     # Every run finished, or the last round did not move the least advanced run (a failed run).
     [[ "$cap" == "-1" || "$cap" == "$previous" ]] && break
@@ -80,9 +81,9 @@ fi
 if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then
   echo "replication: the experiment failed (exit $status); see $WORK/experiment.log; packing what ran" >&2
 fi
-"${PY[@]}" -m animat.replication_store pack "$WORK" "$DATA"
+"${PY[@]}" "$HERE/replication_store.py" pack "$WORK" "$DATA"
 CAUSES=${ANIMAT_REPLICATION_CAUSES:-data/replication_causes}  # the controlled runs, packed; their section if present
 CAUSE_ARGS=()
 [[ -d "$CAUSES" ]] && CAUSE_ARGS=(--causes "$CAUSES")
-"${PY[@]}" scripts/replication_report.py --data "$DATA" --doc "$DOC" "${CAUSE_ARGS[@]}"
+"${PY[@]}" "$HERE/replication_report.py" --data "$DATA" --doc "$DOC" "${CAUSE_ARGS[@]}"
 if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then exit 1; fi

@@ -1,5 +1,7 @@
-"""The replication study's runs, kept in the repository: pack a run directory into
-``data/replication/<env>/run_<i>/`` and unpack it again to resume it.
+"""Evolution runs kept in the repository: pack a run directory into ``data/<study>/<env>/run_<i>/``
+(the replication study's runs in ``data/replication``; ``data/README.md`` lists the other folders in
+this format) and unpack it again to resume or re-analyse it. Study code, not part of the installed
+package: scripts import it from this folder (``sys.path``), the tests through ``tests/python/conftest.py``.
 
 A packed run holds what is needed to check and to continue it, compressed:
 
@@ -27,8 +29,8 @@ without ``manifest.json`` (packed before manifests existed) is checked only by t
 length of each stream, read to its end: a change to its plain files (config.toml, resume.log,
 status.json) or a consistent re-compression of other content is not detected. Command line::
 
-    python -m animat.replication_store unpack data/replication runs/replication   # into work dirs
-    python -m animat.replication_store pack runs/replication data/replication     # back into the repository
+    python studies/replication/replication_store.py unpack data/replication runs/replication   # into work dirs
+    python studies/replication/replication_store.py pack runs/replication data/replication     # back into the repository
 
 Both exit 1 with one line per refused run (naming the run and the file) when something is wrong.
 """
@@ -56,6 +58,7 @@ __all__ = ["PACKED_FILES", "MANIFEST", "MAX_UNPACKED_BYTES", "StoreError", "pack
 PACKED_FILES = ("config.toml", "history.csv.gz", "best.tar.gz", "checkpoint.json.gz", "status.json")
 OPTIONAL_FILES = ("resume.log",)
 MANIFEST = "manifest.json"
+# The format name written into every manifest.json (data kept in the repository carries it: do not change).
 MANIFEST_FORMAT = "animat.replication_store.manifest"
 # Per decompressed stream of a packed run without a manifest (a run's checkpoint is a few MB).
 MAX_UNPACKED_BYTES = 4 << 30
@@ -693,7 +696,7 @@ def pack_tree(work: Path, root: Path) -> List[Path]:
 
 
 def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int, round_size: int) -> int:
-    """Breadth-first growth (``ANIMAT_REPLICATION_ROUND`` of scripts/replication.sh): the generation cap of
+    """Breadth-first growth (``ANIMAT_REPLICATION_ROUND`` of replication.sh): the generation cap of
     the next round, ``round_size`` generations past the least advanced run that is still open, at most
     ``generations``; -1 when every run is finished. A run is open when it has not reached ``generations``
     and has not stopped by the stall rule of its config; a run not started yet counts as generation 0."""
@@ -717,8 +720,8 @@ def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int,
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m animat.replication_store",
-                                description="Pack replication runs into data/replication, or unpack them.")
+    p = argparse.ArgumentParser(prog="replication_store.py",
+                                description="Pack evolution runs into the repository (data/replication, ...), or unpack them.")
     sub = p.add_subparsers(dest="command", required=True)
     u = sub.add_parser("unpack", help="unpack DATA/<env>/run_<i> into WORK/<env>/run_<i>")
     u.add_argument("data", type=Path)

@@ -1,5 +1,6 @@
 """Swimmers built by hand with a known locomotion mode, to check :func:`animat.classify_locomotion`
-(issue 19).
+and the stroke rule of :mod:`animat.protrusion`. Study code, not part of the installed package: the
+replication report, confusion.py beside it and the tests import it from this folder.
 
 Nothing here is evolved: each builder places cell centres on a jittered triangular lattice (spacing
 ``spacing``; the body is their Gabriel graph, as ``animat.build_body`` makes it) and sets every cell's
@@ -40,7 +41,9 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import _core
+import animat
+from animat.locomotion import classify_locomotion, paddling, procrustes_frames
+from animat.trajectory import replay
 
 __all__ = ["KnownSwimmer", "hex_region", "undulator", "synchronous_contractor", "protrusion_swimmer",
            "tail_swimmer", "calibration_set", "held_out_set", "KnownResult", "classify_known",
@@ -78,7 +81,7 @@ class KnownSwimmer:
 
     def body(self, config: Optional[Any] = None) -> Any:
         """The :class:`animat.Body` (springs: the Gabriel graph of the cell centres)."""
-        return _core.build_body(self.positions, self.amplitude, self.frequency, self.phase, config=config)
+        return animat.build_body(self.positions, self.amplitude, self.frequency, self.phase, config=config)
 
 
 def hex_region(inside: Callable[[float, float], bool], spacing: float = 1.0, extent: int = 12,
@@ -313,8 +316,6 @@ def appendage_stroke(swimmer: KnownSwimmer, trajectory: Any, mode: Any) -> Optio
     """:class:`Stroke` of ``swimmer``'s full-amplitude cells in a recorded ``trajectory``, using the window
     (last ``mode.cycles`` periods), body frame and direction of motion of the classifier's ``mode``.
     None when the swimmer has no appendage cells or the mode has no frequency."""
-    from .locomotion import procrustes_frames  # noqa: PLC0415
-
     app = np.flatnonzero(swimmer.amplitude >= AMPLITUDE)
     if swimmer.expected not in ("protrusions", "tail") or len(app) == 0 or not mode.omega > 0:
         return None
@@ -356,12 +357,9 @@ def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0
     """Swim every swimmer ``steps`` steps at every normal drag (d_T = d_N / 200, the paper's ratio, via the
     config default) and classify the recorded swim with :func:`animat.classify_locomotion`
     (``stroke_rule``: with the paper's stroke rule, its ``stroke`` argument)."""
-    from .locomotion import classify_locomotion, paddling  # noqa: PLC0415 - avoids an import cycle
-    from .trajectory import replay  # noqa: PLC0415
-
     out = []
     for dn in drags:
-        cfg = (config.copy() if config is not None else _core.Config())
+        cfg = (config.copy() if config is not None else animat.Config())
         cfg["scene.drag_normal"] = float(dn)
         cfg["evaluation.steps"] = int(steps)
         for s in swimmers:

@@ -1,16 +1,17 @@
-"""Confusion matrices of animat.classify_locomotion on the hand-built swimmers of
-animat.known_swimmers.paper_calibration_set / paper_held_out_set (2000 steps at d_N = 0.5 and 2).
+"""Confusion matrices of animat.classify_locomotion with the paper's stroke rule on the hand-built
+swimmers of known_swimmers.py (paper_calibration_set / paper_held_out_set; 2000 steps at d_N = 0.5
+and 2).
 
-    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/protrusion/confusion.py calibration,held-out
+    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out
 
 prints one line per swim (distance, expected and found mode, the stroke's pair score and area) and the
 matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
 then none, unstable).
 """
-import sys
+import argparse
 import warnings
 
-from animat import known_swimmers as K
+import known_swimmers as K  # this folder (sys.path[0] when run as a script)
 
 CLASSES = ["undulation", "synchronous contraction", "protrusions", "tail", "other"]
 SETS = {"calibration": K.paper_calibration_set, "held-out": K.paper_held_out_set}
@@ -31,4 +32,11 @@ def main(names):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1].split(",") if len(sys.argv) > 1 else list(SETS))
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("sets", nargs="?", default=",".join(SETS),
+                    help="comma-separated sets to swim: " + ", ".join(SETS) + " (default: both)")
+    names = ap.parse_args().sets.split(",")
+    unknown = [n for n in names if n not in SETS]
+    if unknown:
+        ap.error(f"unknown set(s) {', '.join(unknown)}; choose from {', '.join(SETS)}")
+    main(names)
