@@ -257,86 +257,78 @@ void bind_physics(nb::module_& m) {
   nb::class_<SwimResult> swim_result(m, "SwimResult", "What one swim did (see ``animat.swim``).");
   nb::class_<EvaluationResult> evaluation_result(m, "EvaluationResult",
                                                  "Fitness and diagnostics of one genome (see ``animat.evaluate``).");
-  // The invariants and counted deviations, the same fields in both results.
-  auto invariant_fields = [](auto& cls, auto tag) {
-    using R = typename decltype(tag)::type;
-    cls.def_ro("valid", &R::valid,
-               "False if the swim broke an invariant: unstable, a region inverted, the skin crossed itself, or a\n"
-               "collision could not be resolved. An invalid swim has fitness/distance 0.")
-        .def_ro("max_kinetic_energy_per_cell", &R::max_kinetic_energy_per_cell, "Largest kinetic energy / cells.")
-        .def_ro("min_area_ratio", &R::min_area_ratio, "Smallest S/S0 of any region over the swim (must stay > 0).")
-        .def_ro("inverted_region_steps", &R::inverted_region_steps, "(region, step) pairs with S/S0 <= 0 (must be 0).")
-        .def_ro("skin_crossing_steps", &R::skin_crossing_steps, "Steps in which two skin edges intersected (must be 0).")
-        .def_ro("first_invalid_step", &R::first_invalid_step, "Step at whose end an invariant first broke (-1: never).")
-        .def_ro("collisions", &R::collisions, "Cell-edge collisions resolved by an impulse.")
-        .def_ro("collisions_inelastic", &R::collisions_inelastic, "Collisions resolved by the inelastic fallback.")
-        .def_ro("collisions_unresolved", &R::collisions_unresolved, "Steps with a crossing no impulse prevented (must be 0).")
-        .def_ro("drag_limited", &R::drag_limited, "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.")
-        .def_ro("settle_steps", &R::settle_steps, "Control steps settled (actuation off) before the fitness clock started.")
-        .def_ro("ground_contacts", &R::ground_contacts, "(cell, Box2D step) contacts with the floor (effect ground).")
-        .def_ro("ground_slips", &R::ground_slips, "Of the floor contacts, those that slid (kinetic friction).")
-        .def_ro("actuation_work", &R::actuation_work, "Net mechanical work of actuation on the springs (docs/worlds.md).")
-        .def_ro("actuation_work_positive", &R::actuation_work_positive,
-                "Positive actuation work, summed per spring and Box2D step (what the actuators spend).")
-        .def_ro("actuation_work_absolute", &R::actuation_work_absolute,
-                "Absolute actuation work, summed per spring and Box2D step.")
-        .def_prop_ro("cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
-                     nb::rv_policy::move, "Per cell (n,): half the positive actuation work of each spring it ends.")
-        .def_prop_ro("cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
-                     nb::rv_policy::move, "Per cell (n,): half the absolute actuation work of each spring it ends.")
-        .def_ro("grn_updates", &R::grn_updates, "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).")
-        .def_prop_ro("displacement_at_push", [](const R& r) -> Eigen::Vector2d { return r.displacement_at_push; },
-                     "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).")
-        .def_ro("energy", &R::energy,
-                "Where the energy went (an EnergyAccount; measured only with evaluation.energy_accounting).");
+  // EvaluationResult: every field from its one descriptor (visit_fields in animat/evaluate.hpp).
+  {
+    EvaluationResult probe;
+    visit_fields(probe, [&](const char* name, const char* doc, auto& field) {
+      using T = std::decay_t<decltype(field)>;
+      const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
+      auto at = [offset](const EvaluationResult& r) -> const T& {
+        return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&r) + offset);
+      };
+      if constexpr (std::is_same_v<T, Eigen::VectorXd>)
+        evaluation_result.def_prop_ro(name, [at](const EvaluationResult& r) { return owned_vector(at(r)); },
+                                      nb::rv_policy::move, doc);
+      else
+        evaluation_result.def_prop_ro(name, [at](const EvaluationResult& r) -> T { return at(r); }, doc);
+    });
+  }
+  // SwimResult shares the invariants and counted deviations, documented once (EvaluationResult's).
+  auto doc_of = [](std::string_view name) {
+    EvaluationResult probe;
+    const char* out = nullptr;
+    visit_fields(probe, [&](const char* n, const char* doc, auto&) {
+      if (name == n) out = doc;
+    });
+    if (!out) throw std::logic_error("no EvaluationResult field " + std::string(name));
+    return out;
   };
-  invariant_fields(swim_result, std::type_identity<SwimResult>{});
-  invariant_fields(evaluation_result, std::type_identity<EvaluationResult>{});
+  {
+    using R = SwimResult;
+    swim_result.def_ro("valid", &R::valid, doc_of("valid"))
+        .def_ro("max_kinetic_energy_per_cell", &R::max_kinetic_energy_per_cell, doc_of("max_kinetic_energy_per_cell"))
+        .def_ro("min_area_ratio", &R::min_area_ratio, doc_of("min_area_ratio"))
+        .def_ro("inverted_region_steps", &R::inverted_region_steps, doc_of("inverted_region_steps"))
+        .def_ro("skin_crossing_steps", &R::skin_crossing_steps, doc_of("skin_crossing_steps"))
+        .def_ro("first_invalid_step", &R::first_invalid_step, doc_of("first_invalid_step"))
+        .def_ro("collisions", &R::collisions, doc_of("collisions"))
+        .def_ro("collisions_inelastic", &R::collisions_inelastic, doc_of("collisions_inelastic"))
+        .def_ro("collisions_unresolved", &R::collisions_unresolved, doc_of("collisions_unresolved"))
+        .def_ro("drag_limited", &R::drag_limited, doc_of("drag_limited"))
+        .def_ro("settle_steps", &R::settle_steps, doc_of("settle_steps"))
+        .def_ro("ground_contacts", &R::ground_contacts, doc_of("ground_contacts"))
+        .def_ro("ground_slips", &R::ground_slips, doc_of("ground_slips"))
+        .def_ro("actuation_work", &R::actuation_work, doc_of("actuation_work"))
+        .def_ro("actuation_work_positive", &R::actuation_work_positive, doc_of("actuation_work_positive"))
+        .def_ro("actuation_work_absolute", &R::actuation_work_absolute, doc_of("actuation_work_absolute"))
+        .def_prop_ro("cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
+                     nb::rv_policy::move, doc_of("cell_work_positive"))
+        .def_prop_ro("cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
+                     nb::rv_policy::move, doc_of("cell_work_absolute"))
+        .def_ro("grn_updates", &R::grn_updates, doc_of("grn_updates"))
+        .def_prop_ro("displacement_at_push", [](const R& r) -> Eigen::Vector2d { return r.displacement_at_push; },
+                      doc_of("displacement_at_push"))
+        .def_ro("energy", &R::energy, doc_of("energy"));
+  }
   swim_result
       .def_ro("distance", &SwimResult::distance, "|COM(end) - COM(start)|; 0 when unstable.")
-      .def_prop_ro("displacement", [](const SwimResult& r) -> Eigen::Vector2d { return r.displacement; },
-                   "COM(end) - COM(start) as a (2,) array.")
+      .def_prop_ro("displacement", [](const SwimResult& r) -> Eigen::Vector2d { return r.displacement; }, doc_of("displacement"))
       .def_ro("stable", &SwimResult::stable, "False if a step left the valid domain.")
       .def_ro("failure", &SwimResult::failure, "The instability message ('' when stable).")
       .def_ro("steps", &SwimResult::steps, "Control steps completed.")
-      .def_ro("simulated_time", &SwimResult::simulated_time, "Simulated time swum.")
-      .def_ro("max_speed", &SwimResult::max_speed, "Largest cell speed seen.")
-      .def_ro("max_step_displacement", &SwimResult::max_step_displacement, "Largest |v|*h of one Box2D step seen.")
-      .def_ro("max_stretch", &SwimResult::max_stretch, "Largest spring length / L0 (sampled every 16 steps).")
-      .def_ro("min_stretch", &SwimResult::min_stretch, "Smallest spring length / L0 (same samples).")
-      .def_ro("final_kinetic_energy", &SwimResult::final_kinetic_energy, "Kinetic energy at the end.")
-      .def_ro("max_kinetic_energy", &SwimResult::max_kinetic_energy, "Largest kinetic energy (same samples).")
+      .def_ro("simulated_time", &SwimResult::simulated_time, doc_of("simulated_time"))
+      .def_ro("max_speed", &SwimResult::max_speed, doc_of("max_speed"))
+      .def_ro("max_step_displacement", &SwimResult::max_step_displacement, doc_of("max_step_displacement"))
+      .def_ro("max_stretch", &SwimResult::max_stretch, doc_of("max_stretch"))
+      .def_ro("min_stretch", &SwimResult::min_stretch, doc_of("min_stretch"))
+      .def_ro("final_kinetic_energy", &SwimResult::final_kinetic_energy, doc_of("final_kinetic_energy"))
+      .def_ro("max_kinetic_energy", &SwimResult::max_kinetic_energy, doc_of("max_kinetic_energy"))
       .def("__repr__", [](const SwimResult& r) {
         return fmt::format("<animat.SwimResult distance={:.6g} stable={} valid={} steps={}>", r.distance,
                            r.stable ? "True" : "False", r.valid ? "True" : "False", r.steps);
       });
 
   evaluation_result
-      .def_ro("fitness", &EvaluationResult::fitness, "Straight-line distance of the centre of mass, start to end (0 if not viable or unstable).")
-      .def_ro("source_progress", &EvaluationResult::source_progress,
-              "Objective chemotaxis: mean progress toward the chemical source over evaluation.source_directions swims "
-              "(|x_s| - |x_s - displacement|; 0 otherwise).")
-      .def_ro("viable", &EvaluationResult::viable, "Development verdict; non-viable genomes are never swum.")
-      .def_ro("stable", &EvaluationResult::stable, "False if the development or the swim left the valid domain.")
-      .def_ro("cell_count", &EvaluationResult::cell_count, "Cells of the embryo.")
-      .def_ro("reasons", &EvaluationResult::reasons, "Non-viability reasons, or the instability description.")
-      .def_prop_ro("displacement", [](const EvaluationResult& r) -> Eigen::Vector2d { return r.displacement; },
-                   "COM(end) - COM(start) as a (2,) array.")
-      .def_ro("spring_count", &EvaluationResult::spring_count, "Springs of the body.")
-      .def_ro("region_count", &EvaluationResult::region_count, "Regions of the body.")
-      .def_ro("skin_edge_count", &EvaluationResult::skin_edge_count, "Skin edges of the body.")
-      .def_ro("development_steps", &EvaluationResult::development_steps, "Development steps actually run.")
-      .def_ro("swim_steps", &EvaluationResult::swim_steps, "Control steps swum.")
-      .def_ro("simulated_time", &EvaluationResult::simulated_time, "Simulated swim time.")
-      .def_ro("max_speed", &EvaluationResult::max_speed, "Largest cell speed seen.")
-      .def_ro("max_step_displacement", &EvaluationResult::max_step_displacement, "Largest |v|*h of one Box2D step seen.")
-      .def_ro("max_stretch", &EvaluationResult::max_stretch, "Largest spring length / L0 (sampled every 16 steps).")
-      .def_ro("min_stretch", &EvaluationResult::min_stretch, "Smallest spring length / L0 (same samples).")
-      .def_ro("max_kinetic_energy", &EvaluationResult::max_kinetic_energy, "Largest kinetic energy (same samples).")
-      .def_ro("final_kinetic_energy", &EvaluationResult::final_kinetic_energy, "Kinetic energy at the end.")
-      .def_ro("seconds_development", &EvaluationResult::seconds_development, "Wall time of development (diagnostic).")
-      .def_ro("seconds_body", &EvaluationResult::seconds_body, "Wall time of body construction (diagnostic).")
-      .def_ro("seconds_swim", &EvaluationResult::seconds_swim, "Wall time of the swim (diagnostic).")
       .def("__repr__", [](const EvaluationResult& r) {
         return fmt::format("<animat.EvaluationResult fitness={:.6g} viable={} stable={} valid={} cells={}>", r.fitness,
                            r.viable ? "True" : "False", r.stable ? "True" : "False", r.valid ? "True" : "False",

@@ -78,65 +78,18 @@ void add_pickle(nb::handle type, const char* format, Save save, Load load) {
   }
 }
 
-// --- EvaluationResult fields, one list for pickling (a new field: one line here) ---------------
-template <class V>
-void visit_result(EvaluationResult& r, V&& v) {
-  v("fitness", r.fitness);
-  v("viable", r.viable);
-  v("stable", r.stable);
-  v("valid", r.valid);
-  v("cell_count", r.cell_count);
-  v("reasons", r.reasons);
-  v("displacement", r.displacement);
-  v("spring_count", r.spring_count);
-  v("region_count", r.region_count);
-  v("skin_edge_count", r.skin_edge_count);
-  v("development_steps", r.development_steps);
-  v("swim_steps", r.swim_steps);
-  v("simulated_time", r.simulated_time);
-  v("max_speed", r.max_speed);
-  v("max_step_displacement", r.max_step_displacement);
-  v("max_stretch", r.max_stretch);
-  v("min_stretch", r.min_stretch);
-  v("max_kinetic_energy", r.max_kinetic_energy);
-  v("final_kinetic_energy", r.final_kinetic_energy);
-  v("max_kinetic_energy_per_cell", r.max_kinetic_energy_per_cell);
-  v("min_area_ratio", r.min_area_ratio);
-  v("inverted_region_steps", r.inverted_region_steps);
-  v("skin_crossing_steps", r.skin_crossing_steps);
-  v("first_invalid_step", r.first_invalid_step);
-  v("collisions", r.collisions);
-  v("collisions_inelastic", r.collisions_inelastic);
-  v("collisions_unresolved", r.collisions_unresolved);
-  v("drag_limited", r.drag_limited);
-  v("settle_steps", r.settle_steps);
-  v("ground_contacts", r.ground_contacts);
-  v("ground_slips", r.ground_slips);
-  v("actuation_work", r.actuation_work);
-  v("actuation_work_positive", r.actuation_work_positive);
-  v("actuation_work_absolute", r.actuation_work_absolute);
-  v("cell_work_positive", r.cell_work_positive);
-  v("cell_work_absolute", r.cell_work_absolute);
-  v("source_progress", r.source_progress);
-  v("grn_updates", r.grn_updates);
-  v("displacement_at_push", r.displacement_at_push);
-  v("energy", r.energy);
-  v("seconds_development", r.seconds_development);
-  v("seconds_body", r.seconds_body);
-  v("seconds_swim", r.seconds_swim);
-}
-
+// --- EvaluationResult pickling, from its descriptor (visit_fields in animat/evaluate.hpp) -------
 nb::dict result_state(const EvaluationResult& r) {
   nb::dict d;
   EvaluationResult copy = r;
-  visit_result(copy, [&](const char* name, auto& value) { d[name] = nb::cast(value, nb::rv_policy::copy); });
+  visit_fields(copy, [&](const char* name, const char*, auto& value) { d[name] = nb::cast(value, nb::rv_policy::copy); });
   return d;
 }
 
 EvaluationResult result_from_state(nb::handle state) {
   const nb::dict d = nb::cast<nb::dict>(state);
   EvaluationResult r;
-  visit_result(r, [&](const char* name, auto& value) {
+  visit_fields(r, [&](const char* name, const char*, auto& value) {
     using T = std::decay_t<decltype(value)>;
     if (d.contains(name)) value = nb::cast<T>(d[name]);
   });
