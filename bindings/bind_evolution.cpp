@@ -64,7 +64,8 @@ std::string fitness_repr(const Fitness& f) {
 }  // namespace
 
 void bind_evolution(nb::module_& m) {
-  nb::class_<Fitness>(m, "Fitness", "What the GA knows about one evaluated genome.")
+  nb::class_<Fitness> fitness_class(m, "Fitness", "What the GA knows about one evaluated genome.");
+  fitness_class
       .def("__init__", [](Fitness* f, double fitness, bool viable, bool stable, int cell_count, bool valid, long drag_limited) {
             if (drag_limited < 0) throw nb::value_error("Fitness: drag_limited must be >= 0");
             new (f) Fitness{fitness, viable, stable, cell_count, valid, drag_limited};
@@ -73,36 +74,43 @@ void bind_evolution(nb::module_& m) {
           "A fitness to tell() the GA: the objective's value, whether the genome was viable (non-viable ones\n"
           "are never selected before viable ones), whether its swim was stable, its cell count, whether the\n"
           "swim kept every invariant, and how often the drag limiter altered it (drag_scheme \"stable\" only).")
-      .def_ro("fitness", &Fitness::fitness, "The objective's value (the paper's: distance travelled by the centre of mass; 0 if not viable).")
-      .def_ro("viable", &Fitness::viable, "Development verdict; non-viable genomes are never swum.")
-      .def_ro("stable", &Fitness::stable, "False if the swim was flagged unstable.")
-      .def_ro("cell_count", &Fitness::cell_count, "Cells of the embryo.")
-      .def_ro("valid", &Fitness::valid, "False if the swim broke an invariant (embedding, collisions); its fitness is 0.")
       .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
-      .def_ro("drag_limited", &Fitness::drag_limited,
-              "Edge-component steps where physics.drag_scheme = \"stable\" scaled eq. 5 down (0 with every other scheme).")
+      // The pickled state is the tuple of the descriptor's fields; 5 entries: pickled before drag_limited.
       .def("__getstate__", [](const Fitness& f) {
-            return std::make_tuple(f.fitness, f.viable, f.stable, f.cell_count, f.valid, f.drag_limited);
+            nb::list state;
+            visit_fields(f, [&](const char*, const char*, const auto& value) { state.append(value); });
+            return nb::tuple(state);
           })
-      .def("__setstate__", [](Fitness& f, const nb::tuple& t) {  // 5 entries: pickled before drag_limited existed
-            if (t.size() != 5 && t.size() != 6) throw nb::value_error("Fitness state: expected 5 or 6 entries");
-            new (&f) Fitness{nb::cast<double>(t[0]), nb::cast<bool>(t[1]), nb::cast<bool>(t[2]), nb::cast<int>(t[3]),
-                             nb::cast<bool>(t[4]), t.size() == 6 ? nb::cast<long>(t[5]) : 0L};
+      .def("__setstate__", [](Fitness& f, const nb::tuple& t) {
+            std::size_t fields = 0;
+            const Fitness empty;
+            visit_fields(empty, [&](const char*, const char*, const auto&) { ++fields; });
+            if (t.size() != 5 && t.size() != fields)
+              throw nb::value_error(fmt::format("Fitness state: expected 5 or {} entries", fields).c_str());
+            new (&f) Fitness{};
+            std::size_t k = 0;
+            visit_fields(f, [&](const char*, const char*, auto& value) {
+              if (k < t.size()) value = nb::cast<std::decay_t<decltype(value)>>(t[k]);
+              ++k;
+            });
           })
       .def("__copy__", [](const Fitness& f) { return f; })
       .def("__deepcopy__", [](const Fitness& f, nb::handle) { return f; }, "memo"_a)
       .def("__repr__", &fitness_repr);
+  {
+    const Fitness probe;
+    visit_fields(probe, [&](const char* name, const char* doc, const auto& field) {
+      def_field_property(fitness_class, probe, field, name, doc);
+    });
+  }
 
   nb::class_<GenerationStats> stats(m, "GenerationStats", "Statistics of one generation (a row of history.csv).");
   {
-    GenerationStats probe;
+    const GenerationStats probe;
     nb::list columns;
-    visit_fields(probe, [&](const StatsField& f, auto& field) {
+    visit_fields(probe, [&](const StatsField& f, const auto& field) {
       using T = std::decay_t<decltype(field)>;
-      const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
-      stats.def_prop_ro(f.name, [offset](const GenerationStats& g) {
-        return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&g) + offset);
-      }, f.doc);
+      def_field_property(stats, probe, field, f.name, f.doc);
       if (f.csv) columns.append(nb::make_tuple(f.name, std::is_floating_point_v<T> ? "float64" : "int64"));
     });
     stats.attr("HISTORY_COLUMNS") = nb::tuple(columns);

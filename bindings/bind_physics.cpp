@@ -208,13 +208,9 @@ void bind_physics(nb::module_& m) {
                                    "leave unexplained (integration error), small against the energy that flowed.");
   energy.def(nb::init<>());
   {
-    EnergyAccount probe;
-    visit_fields(probe, [&](const char* name, const char* doc, auto& field) {
-      using T = std::decay_t<decltype(field)>;
-      const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
-      energy.def_prop_ro(name, [offset](const EnergyAccount& a) {
-        return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&a) + offset);
-      }, doc);
+    const EnergyAccount probe;
+    visit_fields(probe, [&](const char* name, const char* doc, const auto& field) {
+      def_field_property(energy, probe, field, name, doc);
     });
   }
   energy.def_prop_ro("fluid", &EnergyAccount::fluid, "Dissipated by the fluid: drag_normal + drag_tangential.")
@@ -259,23 +255,22 @@ void bind_physics(nb::module_& m) {
                                                  "Fitness and diagnostics of one genome (see ``animat.evaluate``).");
   // EvaluationResult: every field from its one descriptor (visit_fields in animat/evaluate.hpp).
   {
-    EvaluationResult probe;
-    visit_fields(probe, [&](const char* name, const char* doc, auto& field) {
+    const EvaluationResult probe;
+    visit_fields(probe, [&](const char* name, const char* doc, const auto& field) {
       using T = std::decay_t<decltype(field)>;
-      const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
-      auto at = [offset](const EvaluationResult& r) -> const T& {
-        return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&r) + offset);
-      };
-      if constexpr (std::is_same_v<T, Eigen::VectorXd>)
-        evaluation_result.def_prop_ro(name, [at](const EvaluationResult& r) { return owned_vector(at(r)); },
-                                      nb::rv_policy::move, doc);
-      else
-        evaluation_result.def_prop_ro(name, [at](const EvaluationResult& r) -> T { return at(r); }, doc);
+      if constexpr (std::is_same_v<T, Eigen::VectorXd>) {  // a numpy array that owns its copy
+        const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
+        evaluation_result.def_prop_ro(name, [offset](const EvaluationResult& r) {
+          return owned_vector(*reinterpret_cast<const T*>(reinterpret_cast<const char*>(&r) + offset));
+        }, nb::rv_policy::move, doc);
+      } else {
+        def_field_property(evaluation_result, probe, field, name, doc);
+      }
     });
   }
   // SwimResult shares the invariants and counted deviations, documented once (EvaluationResult's).
   auto doc_of = [](std::string_view name) {
-    EvaluationResult probe;
+    const EvaluationResult probe;
     const char* out = nullptr;
     visit_fields(probe, [&](const char* n, const char* doc, auto&) {
       if (name == n) out = doc;

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <cstddef>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -32,6 +33,16 @@ std::shared_ptr<const Objective> objective_from_python(nanobind::handle objectiv
 /// taken from it (later calls return nothing); nothing for a built-in objective. Called with the GIL held.
 /// Such an objective throws animat::Interrupted, which stops a run like a signal does.
 std::optional<nanobind::python_error> take_interrupt(const std::shared_ptr<const Objective>& objective);
+/// A read-only property `name` of `cls` returning a copy of `field`, a member of the record `probe`
+/// (found by its offset): the way a record's visit_fields descriptor becomes its Python properties.
+template <class Record, class Class, class T>
+void def_field_property(Class& cls, const Record& probe, const T& field, const char* name, const char* doc) {
+  const std::ptrdiff_t offset = reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
+  cls.def_prop_ro(name, [offset](const Record& r) -> T {
+    return *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&r) + offset);
+  }, doc);
+}
+
 /// Holds an object that is not thread-safe for the duration of one bound method (which may run without
 /// the GIL); a second thread gets a RuntimeError "animat.KIND.METHOD: MESSAGE" instead of a data race.
 template <class T>

@@ -29,14 +29,16 @@ void Writer::genome(const Genome& g) {
   }
 }
 
+// A Fitness field by field, in its descriptor's order (evolution.hpp): f64, bools as u8, int as i32,
+// long as i64.
 void Writer::fitness(const Fitness& f) {
-  const auto& [value, viable, stable, cell_count, valid, drag_limited] = f;  // a new Fitness field must be added here (and in Reader)
-  put(value);
-  put(static_cast<std::uint8_t>(viable));
-  put(static_cast<std::uint8_t>(stable));
-  put(static_cast<std::int32_t>(cell_count));
-  put(static_cast<std::uint8_t>(valid));
-  put(static_cast<std::int64_t>(drag_limited));
+  visit_fields(f, [this](const char*, const char*, const auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if constexpr (std::is_same_v<T, bool>) put(static_cast<std::uint8_t>(value));
+    else if constexpr (std::is_same_v<T, int>) put(static_cast<std::int32_t>(value));
+    else if constexpr (std::is_same_v<T, long>) put(static_cast<std::int64_t>(value));
+    else put(value);
+  });
 }
 
 void Reader::need(std::size_t n) const {
@@ -75,12 +77,13 @@ Genome Reader::genome() {
 
 Fitness Reader::fitness() {
   Fitness f;
-  f.fitness = get<double>();
-  f.viable = get<std::uint8_t>() != 0;
-  f.stable = get<std::uint8_t>() != 0;
-  f.cell_count = get<std::int32_t>();
-  f.valid = get<std::uint8_t>() != 0;
-  f.drag_limited = static_cast<long>(get<std::int64_t>());
+  visit_fields(f, [this](const char*, const char*, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if constexpr (std::is_same_v<T, bool>) value = get<std::uint8_t>() != 0;
+    else if constexpr (std::is_same_v<T, int>) value = get<std::int32_t>();
+    else if constexpr (std::is_same_v<T, long>) value = static_cast<long>(get<std::int64_t>());
+    else value = get<T>();
+  });
   return f;
 }
 

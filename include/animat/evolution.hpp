@@ -51,6 +51,23 @@ struct Fitness {
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
+/// Fitness's fields with their documentation, in one list: its order is that of the MPI wire
+/// (wire.hpp) and of the Python pickle; the Python properties follow it too. A new field: one line.
+template <class F, class V>
+void visit_fields(F& f, V&& v)
+  requires std::is_same_v<std::remove_const_t<F>, Fitness>
+{
+  v("fitness", "The objective's value (the paper's: distance travelled by the centre of mass); 0 if not viable.",
+    f.fitness);
+  v("viable", "Development verdict; non-viable genomes are never swum.", f.viable);
+  v("stable", "False if the swim was flagged unstable.", f.stable);
+  v("cell_count", "Cells of the embryo.", f.cell_count);
+  v("valid", "False if the swim broke an invariant (embedding, collisions); its fitness is 0.", f.valid);
+  v("drag_limited",
+    "Edge-component steps where physics.drag_scheme = \"stable\" scaled eq. 5 down (0 with every other scheme).",
+    f.drag_limited);
+}
+
 /// Deterministic, thread-safe fitness of a genome. The real one develops and swims (swim_fitness);
 /// tests plug in cheap stubs.
 using FitnessFunction = std::function<Fitness(const Genome&)>;
