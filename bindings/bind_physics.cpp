@@ -424,18 +424,8 @@ void bind_physics(nb::module_& m) {
                    [](const Simulation& s) { Lease l(s, "max_step_displacement_seen"); return s.max_step_displacement_seen(); },
                    "Largest |v|*h a cell was about to move in one Box2D step so far.")
       .def_prop_ro("counters", [](const Simulation& s) {
-        const SwimCounters& c = s.counters();
         nb::dict d;
-        d["collisions"] = c.collisions;
-        d["collisions_inelastic"] = c.collisions_inelastic;
-        d["collisions_unresolved"] = c.collisions_unresolved;
-        d["collision_max_passes"] = c.collision_max_passes;
-        d["drag_limited"] = c.drag_limited;
-        d["ground_contacts"] = c.ground_contacts;
-        d["ground_slips"] = c.ground_slips;
-        d["actuation_work"] = c.actuation_work;
-        d["actuation_work_positive"] = c.actuation_work_positive;
-        d["actuation_work_absolute"] = c.actuation_work_absolute;
+        visit_fields(s.counters(), [&](const char* name, const char*, const auto& value) { d[name] = value; });
         return d;
       }, "What the effects counted so far: collisions (resolved, inelastic, unresolved, most passes in a\n"
          "step), drag limiter engagements, floor contacts and slips, and the actuation work (net,\n"

@@ -25,6 +25,7 @@
 // change.
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <string_view>
 #include <vector>
 
@@ -127,6 +128,23 @@ struct SwimCounters {
   double actuation_work_positive = 0.0;  ///< Σ max(ΔW, 0) per spring and step
   double actuation_work_absolute = 0.0;  ///< Σ |ΔW| per spring and step
 };
+
+/// SwimCounters' fields with their documentation, in one list (Simulation.counters in Python).
+template <class C, class V>
+void visit_fields(C& c, V&& v)
+  requires std::is_same_v<std::remove_const_t<C>, SwimCounters>
+{
+  v("collisions", "cell-edge collisions resolved by an impulse (effect collisions)", c.collisions);
+  v("collisions_inelastic", "of those, resolved by the inelastic fallback (restitution 0)", c.collisions_inelastic);
+  v("collisions_unresolved", "Box2D steps after which a crossing could not be prevented", c.collisions_unresolved);
+  v("collision_max_passes", "most resolution passes one step needed", c.collision_max_passes);
+  v("drag_limited", "edge-component steps where drag_scheme \"stable\" scaled eq. 5 down", c.drag_limited);
+  v("ground_contacts", "(cell, Box2D step) pairs in which the floor pushed a cell (effect ground)", c.ground_contacts);
+  v("ground_slips", "of those, contacts that slid (kinetic friction)", c.ground_slips);
+  v("actuation_work", "net mechanical work of actuation", c.actuation_work);
+  v("actuation_work_positive", "positive work, per spring and Box2D step", c.actuation_work_positive);
+  v("actuation_work_absolute", "absolute work, per spring and Box2D step", c.actuation_work_absolute);
+}
 
 /// The state every effect reads and writes during one Box2D step, structure-of-arrays, sized once
 /// by the simulation (never resized in the step loop). Positions and velocities are Box2D's (float)
