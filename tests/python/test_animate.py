@@ -1,4 +1,5 @@
 """animat.animate: GIF with the expected frames and size; MP4 only where ffmpeg exists."""
+
 import numpy as np
 import pytest
 from PIL import Image, ImageSequence
@@ -74,7 +75,8 @@ def test_mp4_where_ffmpeg_is_available(trajectory, tmp_path):
 
 def test_animate_replays_a_body_first(tmp_path):
     body = wave_body()
-    out = animat.animate(body, tmp_path / "b.gif", max_frames=5, size=(100, 80),
-                         config=animat.Config({"evaluation.steps": 40}))
+    out = animat.animate(
+        body, tmp_path / "b.gif", max_frames=5, size=(100, 80), config=animat.Config({"evaluation.steps": 40})
+    )
     with Image.open(out) as im:
         assert im.n_frames == 5
