@@ -2,6 +2,7 @@
 
     animat evolve [animat_evolve's flags]   # the engine, flags and output of animat_evolve
     python -m animat show RUN_DIR       # figures/ development, construction, motion_cycle, phase_map, fitness_history
+                                        #   (+ stiffness_map for a body with evolved stiffness)
     python -m animat animate RUN_DIR    # figures/best.gif
     python -m animat info RUN_DIR       # a short summary of the run
     python -m animat experiment CONFIG --runs N --out DIR   # N independent seeds, resumable, with a summary
@@ -18,7 +19,7 @@ import time
 from pathlib import Path
 from typing import List, Optional
 
-FIGURES = ("development", "construction", "motion_cycle", "phase_map", "fitness_history")
+FIGURES = ("development", "construction", "motion_cycle", "phase_map", "stiffness_map", "fitness_history")
 
 
 def _size(text: str):
@@ -44,7 +45,12 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
     s.add_argument("run", metavar="RUN_DIR")
     s.add_argument("--out", type=Path, help="output directory (default RUN_DIR/figures)")
-    s.add_argument("--only", nargs="+", choices=FIGURES, help="draw only these figures")
+    s.add_argument(
+        "--only",
+        nargs="+",
+        choices=FIGURES,
+        help="draw only these figures (default: all; stiffness_map only for a body with evolved stiffness)",
+    )
     s.add_argument("--frames", type=int, default=6, help="snapshots in the motion cycle (default 6)")
     s.add_argument("--steps", type=int, help="swim steps to replay (default: the run's evaluation.steps)")
     s.add_argument("--dpi", type=int, default=110, help="PNG resolution (default 110)")
@@ -96,26 +102,41 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def cmd_show(args) -> int:
-    import matplotlib
+def has_evolved_stiffness(run, entry=None) -> bool:
+    """True when the run's best body has evolved stiffness: the GRN output ``stiffness`` is enabled
+    (``genome.extra_outputs``) or the body carries per-cell factors (``Body.stiffness``)."""
+    from .trajectory import body_of
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    config = run.config
+    if "stiffness" in [c.strip() for c in str(config["genome.extra_outputs"]).split(",")]:
+        return True
+    try:
+        return len(body_of(entry if entry is not None else run.best(), config).stiffness) > 0
+    except ValueError:
+        return False
 
+
+def show_figures(run, only=None, *, frames: int = 6, steps: Optional[int] = None):
+    """The figures of ``animat show`` for a run (an :class:`animat.Run`), in order: a dict of figure
+    name -> a function that draws it (a matplotlib Figure). ``only`` picks names of :data:`FIGURES`
+    (default: all of them, ``stiffness_map`` only when the best body has evolved stiffness,
+    :func:`has_evolved_stiffness`). Every figure names the run's objective and world where it has
+    a title to do so."""
     import animat
     from animat import plot
 
-    run = animat.Run(args.run)
     entry = run.best()
     config = run.config
-    out = args.out or run.path / "figures"
-    out.mkdir(parents=True, exist_ok=True)
-    wanted = args.only or FIGURES
-    t0 = time.perf_counter()
-    trajectory = None
-    if "motion_cycle" in wanted:
-        trajectory = animat.replay(entry, config, steps=args.steps)
-    label = f"best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}"
+    wanted = list(only) if only else [n for n in FIGURES if n != "stiffness_map" or has_evolved_stiffness(run, entry)]
+    objective, _, _ = plot.objective_info(config)
+    label = f"best of {run.path.name}: generation {entry.generation}, fitness ({objective}) {entry.fitness:.3f}"
+    cache = {}
+
+    def trajectory():
+        if "tr" not in cache:
+            cache["tr"] = animat.replay(entry, config, steps=steps)
+        return cache["tr"]
+
     makers = {
         "development": lambda: plot.development(
             entry, config=config, title=f"Development (paper Fig. 2) of the {label}"
@@ -123,21 +144,38 @@ def cmd_show(args) -> int:
         "construction": lambda: plot.construction(
             entry, config=config, title=f"From embryo to body (paper Fig. 3): {label}"
         ),
-        "motion_cycle": lambda: plot.motion_cycle(
-            animat.replay(entry, config, steps=args.steps) if trajectory is None else trajectory, count=args.frames
-        ),
+        "motion_cycle": lambda: plot.motion_cycle(trajectory(), count=frames),
         "phase_map": lambda: plot.phase_map(entry, config=config),
+        "stiffness_map": lambda: plot.stiffness_map(entry, config=config),
         "fitness_history": lambda: plot.fitness_history(run),
     }
-    for name in FIGURES:
-        if name not in wanted:
-            continue
-        fig = makers[name]()
+    return {name: makers[name] for name in FIGURES if name in wanted}
+
+
+def cmd_show(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    import animat
+
+    run = animat.Run(args.run)
+    entry = run.best()
+    out = args.out or run.path / "figures"
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    for name, make in show_figures(run, args.only, frames=args.frames, steps=args.steps).items():
+        fig = make()
         path = out / f"{name}.png"
         fig.savefig(path, dpi=args.dpi)
         plt.close(fig)
         print(path)
-    print(f"({label}; {time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    print(
+        f"(best of {run.path.name}: generation {entry.generation}, fitness ({run.config['evaluation.objective']}) "
+        f"{entry.fitness:.3f}; {time.perf_counter() - t0:.1f} s)",
+        file=sys.stderr,
+    )
     return 0
 
 
@@ -164,8 +202,8 @@ def cmd_animate(args) -> int:
     )
     print(path)
     print(
-        f"(best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}; "
-        f"{time.perf_counter() - t0:.1f} s)",
+        f"(best of {run.path.name}: generation {entry.generation}, fitness ({config['evaluation.objective']}) "
+        f"{entry.fitness:.3f}; {time.perf_counter() - t0:.1f} s)",
         file=sys.stderr,
     )
     return 0

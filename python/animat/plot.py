@@ -8,7 +8,7 @@ headless Agg backend. Save with ``fig.savefig("x.png")`` and free with ``plt.clo
 function               paper        shows
 =====================  ===========  ==========================================================
 :func:`development`    Fig. 2       cells (circles + orientation ticks) at chosen steps
-:func:`construction`   Fig. 3       centres → Delaunay → Gabriel graph (regions, skin)
+:func:`construction`   Fig. 3       centres → Delaunay → body graph (regions, skin)
 :func:`motion_cycle`   Figs. 4–6    snapshots of one motion cycle, nodes red / blue / green
 :func:`phase_map`      Fig. 7       nodes coloured by phase shift, maximum indicated
 :func:`stiffness_map`  (Fig. 7)     nodes and springs coloured by evolved stiffness (issue 17)
@@ -17,7 +17,10 @@ function               paper        shows
 =====================  ===========  ==========================================================
 
 :func:`draw_body` draws one body into an existing Axes (used by all of the above and by
-:func:`animat.animate`).
+:func:`animat.animate`); :func:`draw_world` the floor and the chemical source of the world a body
+swims in. Every figure names the world as it is (:func:`world_text`: the fluid only with effect
+``drag``, gravity and the floor only with theirs), the run's objective (:func:`objective_info`) and
+the body graph used (:func:`graph_name`).
 """
 
 from __future__ import annotations
@@ -56,6 +59,14 @@ __all__ = [
     "development_steps",
     "energy_split",
     "ENERGY_SINKS",
+    "world_text",
+    "objective_info",
+    "graph_name",
+    "draw_world",
+    "chemical_source_of",
+    "FLOOR_COLOR",
+    "GROUND_COLOR",
+    "SOURCE_COLOR",
 ]
 
 #: The sinks of :class:`animat.EnergyAccount` that :func:`energy_split` draws, with their labels and colours.
@@ -80,6 +91,163 @@ STIFFNESS_CMAP = "viridis_r"
 SPRING_COLOR = "#8c8c8c"
 SKIN_COLOR = "#111111"
 FILL_COLOR = "#e9eef3"
+#: The floor line (effect ``ground``), the ground below it, and the chemical source (star, arrow).
+FLOOR_COLOR = "#8c564b"
+GROUND_COLOR = "#eee4da"
+SOURCE_COLOR = "#ff7f0e"
+
+
+# --- the world, the objective and the body graph, as the figures name them --------------------------------
+
+
+def _scene_of(config: Any = None, scene: Any = None) -> Any:
+    if scene is not None:
+        return scene
+    return _core.Scene.from_config(config if config is not None else _core.Config())
+
+
+def world_text(config: Any = None, scene: Any = None) -> str:
+    """One line naming the world a swim happens in, as it is: the fluid (``d_N``, ``d_T``) only when
+    effect ``drag`` is in the scene ("no fluid drag" otherwise), gravity and the floor only when
+    effects ``gravity`` / ``ground`` are, the GRN controller under ``control.mode = "grn"`` and the
+    chemical source when there is one (see :func:`chemical_source_of`).
+
+    ``scene`` (an :class:`animat.Scene`) overrides ``config``'s scene (default: animat defaults)."""
+    cfg = config if config is not None else _core.Config()
+    sc = _scene_of(cfg, scene)
+    effects = list(sc.effects)
+    parts = []
+    if "drag" in effects:
+        d_t = sc.drag_tangential if sc.drag_tangential >= 0 else sc.drag_normal / 200.0
+        parts.append(f"fluid d_N = {sc.drag_normal:g}, d_T = {d_t:g}")
+    else:
+        parts.append("no fluid drag")
+    if "gravity" in effects:
+        parts.append(f"gravity g = {sc.gravity:g}")
+    if "ground" in effects:
+        parts.append(
+            f"floor at y = {sc.ground_height:g} (μ_s = {sc.ground_friction_static:g}, "
+            f"μ_k = {sc.ground_friction_kinetic:g})"
+        )
+    if str(cfg["control.mode"]) == "grn":
+        parts.append(f"GRN control ({cfg['control.actuation']})")
+    source = chemical_source_of(cfg, sc)
+    if source is not None:
+        kind = sc.chemical if sc.chemical != "none" else "chemotaxis"
+        parts.append(f"{kind} source at ({source[0]:g}, {source[1]:g}) from the start")
+    return "; ".join(parts)
+
+
+def chemical_source_of(config: Any = None, scene: Any = None) -> Optional[np.ndarray]:
+    """The chemical source ``scene.chemical_source`` (relative to the body's centre at the start of
+    the swim) when the world has one: a GRN-controlled swim (``control.mode = "grn"``) sensing a
+    ``point`` or ``plane`` field, or the objective ``chemotaxis`` (which scores progress toward it).
+    None otherwise."""
+    cfg = config if config is not None else _core.Config()
+    sc = _scene_of(cfg, scene)
+    sensed = str(cfg["control.mode"]) == "grn" and sc.chemical != "none"
+    if not sensed and str(cfg["evaluation.objective"]) != "chemotaxis":
+        return None
+    return np.asarray(sc.chemical_source, dtype=float)
+
+
+def objective_info(config: Any = None) -> Tuple[str, str, Optional[bool]]:
+    """(name, meaning, nonnegative) of ``config``'s ``evaluation.objective``, from its row of
+    :func:`animat.objectives`; a Python objective ``"python:NAME"`` gives ``NAME``, its meaning
+    "Python objective NAME" and ``None`` for the sign (unknown)."""
+    cfg = config if config is not None else _core.Config()
+    name = str(cfg["evaluation.objective"])
+    if name.startswith("python:"):
+        short = name[len("python:") :]
+        return short, f"Python objective {short}", None
+    for spec in _core.objectives():
+        if spec.name == name:
+            return spec.name, spec.meaning, bool(spec.nonnegative)
+    return name, name, None
+
+
+def graph_name(config: Any = None, body: Any = None) -> str:
+    """The body graph, as titles name it, from ``config``'s ``body.graph`` (default: animat
+    defaults): "Gabriel graph", "distance graph (≤ t × neighbour distance)" (t =
+    ``body.distance_threshold``) or "alpha-shape graph (α = a)" (a = ``body.alpha``). Without a
+    config, a ``body`` whose springs are the Gabriel graph of its cells is "Gabriel graph" and any
+    other "body graph"."""
+    if config is None and body is not None:
+        pos = np.asarray(body.positions)
+        try:
+            gabriel = np.asarray(_core.gabriel_graph(pos)).reshape(-1, 2)
+        except ValueError:  # cells the Gabriel graph rejects (duplicates): not a Gabriel body
+            return "body graph"
+        same = np.array_equal(gabriel, np.asarray(body.springs).reshape(-1, 2))  # both sorted, i < j
+        return "Gabriel graph" if same else "body graph"
+    cfg = config if config is not None else _core.Config()
+    graph = str(cfg["body.graph"])
+    if graph == "gabriel":
+        return "Gabriel graph"
+    if graph == "distance":
+        return f"distance graph (≤ {cfg['body.distance_threshold']:g} × neighbour distance)"
+    if graph == "alpha_shape":
+        return f"alpha-shape graph (α = {cfg['body.alpha']:g})"
+    return f"{graph} graph"
+
+
+def draw_world(
+    ax: Axes,
+    config: Any = None,
+    *,
+    scene: Any = None,
+    start: ArrayLike = (0.0, 0.0),
+    transform: Optional[Any] = None,
+    extent: float = 1e4,
+) -> Dict[str, Any]:
+    """Draw the world around a body into ``ax``: the floor (effect ``ground``: a line at
+    ``scene.ground_height``, label ``"floor"``, the ground below it shaded, label ``"ground"``) and
+    the chemical source (a star at ``start + scene.chemical_source``, label ``"chemical source"``;
+    see :func:`chemical_source_of`).
+
+    Args:
+        start: the body's centre of mass at the start of the swim (the source is relative to it).
+        transform: a function mapping (k, 2) world points to the drawing's coordinates (default: none;
+            :func:`animat.animate` and :func:`motion_cycle` rotate and shift the world with it).
+        extent: half-length of the floor line along x.
+    Returns:
+        dict ``"floor"``, ``"ground"``, ``"source"``: the artists drawn (None where the world has none)
+        and ``"source_xy"``, the source in drawing coordinates (or None).
+    """
+    cfg = config if config is not None else _core.Config()
+    sc = _scene_of(cfg, scene)
+    tf = transform if transform is not None else (lambda p: p)
+    out: Dict[str, Any] = {"floor": None, "ground": None, "source": None, "source_xy": None}
+    if "ground" in list(sc.effects):
+        h = float(sc.ground_height)
+        x0 = float(np.asarray(start, dtype=float)[0])
+        line = tf(np.array([[x0 - extent, h], [x0 + extent, h]]))
+        below = tf(np.array([[x0 - extent, h], [x0 + extent, h], [x0 + extent, h - extent], [x0 - extent, h - extent]]))
+        out["ground"] = ax.add_patch(
+            Polygon(below, closed=True, facecolor=GROUND_COLOR, edgecolor="none", zorder=0.5, label="ground")
+        )
+        (out["floor"],) = ax.plot(
+            line[:, 0], line[:, 1], color=FLOOR_COLOR, lw=2.0, zorder=0.6, label="floor", scalex=False, scaley=False
+        )
+    source = chemical_source_of(cfg, sc)
+    if source is not None:
+        xy = tf((np.asarray(start, dtype=float) + source)[None, :])[0]
+        out["source_xy"] = xy
+        (out["source"],) = ax.plot(
+            [xy[0]],
+            [xy[1]],
+            marker="*",
+            ms=16,
+            ls="",
+            color=SOURCE_COLOR,
+            mec="#7f3f00",
+            mew=0.8,
+            zorder=6,
+            label="chemical source",
+            scalex=False,
+            scaley=False,
+        )
+    return out
 
 
 # --- helpers ------------------------------------------------------------------------------------------
@@ -322,8 +490,9 @@ def construction(
     title: Optional[str] = None,
 ) -> Figure:
     """Paper Fig. 3: (a) cell centres at the end of development, (b) their Delaunay
-    triangulation, (c) the Gabriel graph, the final structure, with its regions shaded (one colour
-    each) and the skin (the only edges that feel drag) drawn thick.
+    triangulation, (c) the body graph (the paper's Gabriel graph, or ``config``'s ``body.graph``,
+    named in the title by :func:`graph_name`), the final structure, with its regions shaded (one
+    colour each) and the skin (the only edges that feel drag) drawn thick.
 
     Args:
         embryo_or_points: an :class:`animat.Embryo`, a Genome / LineageEntry (developed with
@@ -351,6 +520,7 @@ def construction(
     if radii is None:
         radii = np.full(len(pos), 0.5)
     delaunay = np.asarray(_core.delaunay_edges(pos, config))
+    graph = graph_name(config, body if config is None and isinstance(thing, _core.Body) else None)
 
     pad = float(np.max(radii)) + 0.3
     lo, hi = pos.min(axis=0), pos.max(axis=0)
@@ -391,7 +561,7 @@ def construction(
     ax.add_collection(LineCollection(_segments(pos, skin), colors="#b2182b", linewidths=2.8, capstyle="round"))
     ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5, zorder=3)
     ax.set_title(
-        f"(c) Gabriel graph: {body.spring_count} springs,\n{body.region_count} regions (shaded), "
+        f"(c) {graph}: {body.spring_count} springs,\n{body.region_count} regions (shaded), "
         f"{len(skin)} skin edges (thick)",
         fontsize=10,
     )
@@ -403,12 +573,18 @@ def construction(
 # --- Figs. 4-6: motion cycle ----------------------------------------------------------------------------
 
 
+def _has_down(trajectory: Trajectory) -> bool:
+    """True when the trajectory's world has a fixed "down" (effect ``gravity`` or ``ground``)."""
+    effects = list(_scene_of(trajectory.config, trajectory.meta.get("scene")).effects)
+    return "gravity" in effects or "ground" in effects
+
+
 def motion_cycle(
     trajectory: Trajectory,
     frames: Optional[Sequence[int]] = None,
     *,
     count: int = 6,
-    align: bool = True,
+    align: Optional[bool] = None,
     cols: Optional[int] = None,
     color_springs: bool = False,
     title: Optional[str] = None,
@@ -425,7 +601,8 @@ def motion_cycle(
             ``trajectory.cycle_frames(count)``, ``count`` frames spread over the last dominant
             oscillation period.
         align: rotate every snapshot so that the overall direction of motion points right, as in
-            the paper (the same rotation for all panels).
+            the paper (the same rotation for all panels). Default: True, but False in a world with
+            gravity or a floor (down stays down; the floor, effect ``ground``, is drawn at its height).
         cols: panels per row (default: all in one row up to 6).
         color_springs: colour the springs by ``trajectory.spring_state`` instead of grey.
     Returns:
@@ -439,9 +616,11 @@ def motion_cycle(
     for f in frames:
         if not -tr.frame_count <= f < tr.frame_count:
             raise ValueError(f"motion_cycle: frame {f} out of range (trajectory has {tr.frame_count} frames)")
+    if align is None:
+        align = not _has_down(tr)
     rot = rotation_to(tr.direction) if align else np.eye(2)
     direction = rot @ tr.direction
-    origin = tr.com[frames[0]]
+    origin = tr.com[frames[0]] if align else np.zeros(2)  # unrotated: world coordinates (the floor's height)
     snaps = [(tr.positions[f] - origin) @ rot.T for f in frames]
     allpts = np.concatenate(snaps)
     r = _node_radius(tr.body)
@@ -456,10 +635,14 @@ def motion_cycle(
     for ax in axes.flat[len(frames) :]:
         ax.set_visible(False)
     steps0 = int(tr.steps[frames[0]])
+    world: Dict[str, Any] = {"floor": None}
     for ax, f, pos in zip(axes.flat, frames, snaps):
         colors = [STATE_COLORS[int(s)] for s in tr.node_state[f]]
         scol = [STATE_COLORS[int(s)] for s in tr.spring_state[f]] if color_springs else SPRING_COLOR
         draw_body(ax, tr.body, pos, colors, node_radius=r, spring_colors=scol)
+        world = draw_world(
+            ax, tr.config, scene=tr.meta.get("scene"), start=tr.com[0], transform=lambda p: (p - origin) @ rot.T
+        )
         _frame_axes(ax, lo, hi, r + 0.4)
         ax.set_title(f"step {int(tr.steps[f])}", fontsize=9)
         ax.text(0.02, 0.03, f"+{int(tr.steps[f]) - steps0}", transform=ax.transAxes, fontsize=7, color="#666666")
@@ -495,6 +678,8 @@ def motion_cycle(
             label="direction of motion" + (" (rotated to point right)" if align else ""),
         )
     )
+    if world["floor"] is not None:
+        handles.append(Line2D([], [], color=FLOOR_COLOR, lw=2.0, label="floor"))
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
     period = tr.period()
     cycle = f"dominant period {period / tr.dt:.0f} steps" if math.isfinite(period) else "no oscillation"
@@ -502,7 +687,7 @@ def motion_cycle(
         title
         or f"Motion cycle (paper Figs. 4-6): steps {int(tr.steps[frames[0]])}-"
         f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g} in "
-        f"{int(tr.steps[-1] - tr.steps[0])} steps",
+        f"{int(tr.steps[-1] - tr.steps[0])} steps\n{world_text(tr.config, tr.meta.get('scene'))}",
         fontsize=9.5,
     )
     fig.tight_layout(rect=(0, 0.07, 1, 1))
@@ -701,7 +886,10 @@ def fitness_history(
     """Paper Figs. 8–9: the best fitness over generations, with the generations at which the best
     individual's morphology changed marked, and thumbnails of those bodies (at rest, nodes
     coloured by phase shift, each thumbnail normalised like :func:`phase_map`; plain nodes when
-    all cells have the same phase) joined to their point on the curve.
+    all cells have the same phase) joined to their point on the curve. The y axis is labelled with
+    the run's objective (``evaluation.objective``, :func:`objective_info`) and starts at 0 only when
+    no value drawn is negative: a signed objective (speed_toward, distance_minus_energy,
+    chemotaxis, a Python one) is drawn whole, with 0 marked.
 
     Args:
         run: an :class:`animat.Run` or a run directory path.
@@ -760,14 +948,21 @@ def fitness_history(
     if changes:
         main.plot(cg, cf, "D", ms=6, mfc="#d62728", mec="k", mew=0.6, label="morphology changed", zorder=4)
     main.set_xlabel("generation")
-    main.set_ylabel("best fitness (distance travelled)")
+    objective, meaning, nonnegative = objective_info(cfg)
+    main.set_ylabel(f"fitness: {objective}")
+    main.set_title(f"objective {objective}: {meaning}", fontsize=8, loc="left", color="#444444")
     main.grid(alpha=0.25)
     main.legend(fontsize=8, loc="upper left")
     main.xaxis.set_major_locator(MaxNLocator(integer=True))
     if len(gens):
         span = max(float(gens[-1] - gens[0]), 1.0)
         main.set_xlim(float(gens[0]) - 0.02 * span, float(gens[-1]) + 0.02 * span)
-    main.set_ylim(bottom=0)
+    shown_values = [np.asarray(ln.get_ydata(), dtype=float) for ln in main.get_lines()]
+    lowest = min((float(np.nanmin(v)) for v in shown_values if v.size and np.isfinite(v).any()), default=0.0)
+    if lowest >= 0.0 and nonnegative is not False:
+        main.set_ylim(bottom=0)  # a non-negative objective (or values): the axis starts at 0
+    else:  # a signed objective can go below 0: nothing clipped, 0 marked
+        main.axhline(0.0, color="#777777", lw=0.7, zorder=0)
 
     for col, entry in enumerate(shown):
         ax = fig.add_subplot(gs[0, col])

@@ -143,7 +143,9 @@ class Trajectory:
 
     The body (``body``: springs, skin, regions, oscillator parameters) is the :class:`animat.Body`
     that swam. ``stable`` is False if the simulation left its valid domain; the frames then stop
-    at the last valid state and ``failure`` holds the message.
+    at the last valid state and ``failure`` holds the message. ``config`` is the config it swam
+    with; ``meta`` holds ``neutral``, ``control`` ("open_loop" or "grn") and ``scene`` (the
+    :class:`animat.Scene` that overrode ``config.scene``, or None).
     """
 
     body: Any
@@ -301,6 +303,13 @@ def replay(
         neutral: the neutral band as a fraction of the body's largest cell rate ``max_i a_i f_i``
             (see the module docstring); 0 makes every moving cell red or blue.
 
+    Under ``control.mode = "grn"`` (docs/control.md) the genome's GRN drives the actuation while it
+    swims, as in ``animat.evaluate`` (the chemical source at ``scene.chemical_source`` from the start
+    centre: the objective ``chemotaxis`` scores this swim's progress toward it, averaged over turned
+    sources); the cell terms are the controller's, their rates the terms' time derivative between
+    frames, and the neutral band ``neutral`` times the largest rate seen. That needs the genome: a
+    Body or an Embryo under such a config is a ValueError.
+
     Returns:
         A :class:`Trajectory`. A swim that leaves the simulator's valid domain stops early:
         ``stable`` is False, ``failure`` holds the message and a RuntimeWarning is issued.
@@ -316,10 +325,25 @@ def replay(
     n_steps = int(cfg["evaluation.steps"] if steps is None else steps)
     if n_steps < 0:
         raise ValueError(f"replay: steps must be >= 0, got {n_steps}")
+    grn = str(cfg["control.mode"]) == "grn"
+    genome = genome_or_body
+    if hasattr(genome, "genome") and not isinstance(genome, _core.Genome):  # LineageEntry
+        genome = genome.genome
+    if grn and not isinstance(genome, _core.Genome):
+        raise ValueError(
+            "replay: control.mode = 'grn' runs the genome's GRN while swimming; pass the Genome "
+            f"(or a LineageEntry), not a {type(genome_or_body).__name__}"
+        )
     body = body_of(genome_or_body, cfg)
     # The crawl world (docs/worlds.md): placed on the floor and settled, exactly as evaluate() does.
     body, start_velocities, settled = _core.start_state(body, scene, cfg)
-    sim = _core.Simulation(body, scene, cfg)
+    control = None
+    if grn:  # the GRN writes the rest lengths: no open-loop actuation beside it (as in evaluate())
+        base: Any = scene if scene is not None else _core.Scene.from_config(cfg)
+        sim = _core.Simulation(body, base.replace(effects=[e for e in base.effects if e != "actuation"]), cfg)
+        control = sim.add_grn_control(body, genome, cfg)
+    else:
+        sim = _core.Simulation(body, scene, cfg)
     if settled:
         sim.velocities = start_velocities
     frames = n_steps // every + 1
@@ -328,6 +352,7 @@ def replay(
     vel = np.empty((frames, n, 2))
     times = np.empty(frames)
     steps_done = np.empty(frames, dtype=np.int64)
+    grn_terms = np.zeros((frames, n)) if control is not None else None
     failure = ""
     recorded = 0
     for k in range(frames):
@@ -341,6 +366,8 @@ def replay(
         vel[k] = sim.velocities
         times[k] = sim.time
         steps_done[k] = sim.steps_done
+        if grn_terms is not None and control is not None:
+            grn_terms[k] = control.terms
         recorded += 1
     if failure:
         import warnings
@@ -353,9 +380,14 @@ def replay(
     pos, vel, times, steps_done = pos[:recorded], vel[:recorded], times[:recorded], steps_done[:recorded]
 
     a, f, p = body.amplitude, body.frequency, body.phase
-    terms = actuation_terms(a, f, p, times)
-    rates = actuation_rates(a, f, p, times)
-    peak = float(np.max(a * f)) if n else 0.0
+    if grn_terms is not None:
+        terms = grn_terms[:recorded]
+        rates = np.gradient(terms, times, axis=0) if recorded > 1 else np.zeros_like(terms)
+        peak = float(np.abs(rates).max()) if rates.size else 0.0
+    else:
+        terms = actuation_terms(a, f, p, times)
+        rates = actuation_rates(a, f, p, times)
+        peak = float(np.max(a * f)) if n else 0.0
     threshold = neutral * peak
     springs = body.springs
     i, j = springs[:, 0], springs[:, 1]
@@ -380,5 +412,5 @@ def replay(
         config=cfg,
         stable=not failure,
         failure=failure,
-        meta={"neutral": float(neutral)},
+        meta={"neutral": float(neutral), "control": "grn" if grn else "open_loop", "scene": scene},
     )
