@@ -1,4 +1,5 @@
 """Rendering a swim to a GIF (Pillow) or an MP4 (ffmpeg, where available): :func:`animate`."""
+
 from __future__ import annotations
 
 import math
@@ -10,7 +11,7 @@ from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-__all__ = ["animate", "default_frames", "mp4_available"]
+__all__ = ["animate", "frame_figure", "default_frames", "mp4_available"]
 
 
 def mp4_available() -> bool:
@@ -49,17 +50,36 @@ def default_frames(trajectory, max_frames: int = 240, per_cycle: int = 8, start:
     return list(range(int(start) % F, F, stride))[:max_frames]
 
 
-def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0,
-            frames: Optional[Sequence[int]] = None, max_frames: int = 240, start: Optional[int] = None,
-            size: Tuple[int, int] = (560, 360), follow: Optional[bool] = None, align: bool = True,
-            trail: bool = True, color_springs: bool = False, title: Optional[str] = None,
-            progress: Optional[bool] = None, config: Optional[Any] = None, colors: int = 64) -> Path:
+def animate(
+    trajectory: Any,
+    path: Union[str, os.PathLike],
+    *,
+    fps: float = 25.0,
+    frames: Optional[Sequence[int]] = None,
+    max_frames: int = 240,
+    start: Optional[int] = None,
+    size: Tuple[int, int] = (560, 360),
+    follow: Optional[bool] = None,
+    align: Optional[bool] = None,
+    trail: bool = True,
+    color_springs: bool = False,
+    title: Optional[str] = None,
+    progress: Optional[bool] = None,
+    config: Optional[Any] = None,
+    colors: int = 64,
+) -> Path:
     """Render a trajectory to an animated GIF, or to MP4 where ffmpeg is available.
 
     Each frame shows the body (region fill, springs, thick skin, nodes red expanding / blue
     contracting / green neutral as in :func:`animat.plot.motion_cycle`), a background grid fixed in
     the world (so the motion shows even when the camera follows the body), the centre-of-mass
-    trail, and the time, control step and distance travelled so far.
+    trail, the world (:func:`animat.plot.draw_world`: the floor at ``scene.ground_height`` with
+    effect ``ground``; the chemical source as a star, and an arrow toward it, when the swim has one),
+    the time, the control step and the swim's progress by the run's objective so far (progress
+    toward the source for ``chemotaxis``, the horizontal distance for ``distance_x``, the signed
+    distance along ``evaluation.direction`` for ``speed_toward``, else the distance travelled), and
+    a banner naming the world as it is (:func:`animat.plot.world_text`). :func:`frame_figure` draws
+    one such frame as a matplotlib Figure.
 
     Args:
         trajectory: an :class:`animat.Trajectory`; anything else accepted by
@@ -75,23 +95,19 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
         follow: keep the body centred (the camera follows the centre of mass). Default: follow
             only when the rendered path would not fit in a view about twice the body's size; a
             fixed view makes much smaller GIFs.
-        align: rotate the world so the overall direction of motion points right.
+        align: rotate the world so the overall direction of motion points right. Default: True,
+            but False in a world with gravity or a floor (down stays down, the floor level).
         trail: draw the centre-of-mass track.
         color_springs: colour springs by their actuation state too.
         title: caption at the bottom right (default: the colour legend).
         progress: show a tqdm progress bar (default: when stderr is a terminal and there are at
             least 60 frames).
-        config: config for replaying a non-Trajectory.
+        config: config for replaying a non-Trajectory (and for naming the world of a Trajectory
+            recorded without one).
         colors: GIF palette size (one palette for all frames; <= 256, fewer = smaller file).
     Returns:
         The path written: ``len(frames)`` frames of ``size`` pixels.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.collections import LineCollection
-    from matplotlib.figure import Figure
-    from matplotlib.patches import FancyArrowPatch
-
-    from . import plot as aplot
     from .trajectory import Trajectory, replay
 
     tr = trajectory if isinstance(trajectory, Trajectory) else replay(trajectory, config)
@@ -103,71 +119,26 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
     if suffix == ".mp4":
         ffmpeg = _ffmpeg_exe()
         if ffmpeg is None:
-            raise RuntimeError(f"animate: cannot write {path}: MP4 needs ffmpeg (pip install imageio-ffmpeg, or "
-                               "install ffmpeg); write a .gif instead")
-    idx = list(default_frames(tr, max_frames=max_frames, start=start) if frames is None else frames)
-    if not idx:
-        raise ValueError("animate: no frames to render")
-    bad = [f for f in idx if not -tr.frame_count <= f < tr.frame_count]
-    if bad:
-        raise ValueError(f"animate: frames {bad[:5]} out of range (trajectory has {tr.frame_count} frames)")
-    idx = [f % tr.frame_count for f in idx]
+            raise RuntimeError(
+                f"animate: cannot write {path}: MP4 needs ffmpeg (pip install imageio-ffmpeg, or "
+                "install ffmpeg); write a .gif instead"
+            )
+    idx = _frame_indices(tr, frames, max_frames, start)
     width, height = int(size[0]), int(size[1])
     if ffmpeg:
         width += width % 2
         height += height % 2
-    if width < 32 or height < 32:
-        raise ValueError(f"animate: size {size} too small (at least 32 x 32 pixels)")
-
-    rot = aplot.rotation_to(tr.direction) if align else np.eye(2)
-    origin = tr.com[idx[0]]
-    world = (tr.positions - origin) @ rot.T  # (F, n, 2)
-    com = (tr.com - origin) @ rot.T  # (F, 2)
-    r = aplot._node_radius(tr.body)
-    aspect = width / height
-
-    # View: the body's largest extent (relative to its centre of mass) plus a margin.
-    sel = world[idx]
-    rel = sel - com[idx][:, None, :]
-    half = np.abs(rel).max(axis=(0, 1)) + r + 0.5
-    view_w = max(2 * half[0], 2 * half[1] * aspect) * 1.3
-    lo, hi = sel.reshape(-1, 2).min(axis=0) - r - 0.5, sel.reshape(-1, 2).max(axis=0) + r + 0.5
-    span = hi - lo
-    fixed_w = max(span[0], span[1] * aspect) * 1.1
-    if follow is None:
-        follow = fixed_w > 2.0 * view_w
-    fixed_centre = (lo + hi) / 2
-    if not follow:
-        view_w = fixed_w
-    view_h = view_w / aspect
-
-    dpi = 100
-    fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
-    fig.patch.set_facecolor("white")
-    canvas = FigureCanvasAgg(fig)
-    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
-    ax.set_aspect("auto")
-    ax.set_axis_off()
-    # world-fixed grid, about 7 lines across the view
-    spacing = _nice_spacing(view_w, 7)
-    allc = sel.reshape(-1, 2)
-    g_lo = np.floor((allc.min(axis=0) - max(view_w, view_h)) / spacing) * spacing
-    g_hi = np.ceil((allc.max(axis=0) + max(view_w, view_h)) / spacing) * spacing
-    xs = np.arange(g_lo[0], g_hi[0] + spacing / 2, spacing)
-    ys = np.arange(g_lo[1], g_hi[1] + spacing / 2, spacing)
-    if len(xs) + len(ys) < 4000:
-        lines = [((x, g_lo[1]), (x, g_hi[1])) for x in xs] + [((g_lo[0], y), (g_hi[0], y)) for y in ys]
-        ax.add_collection(LineCollection(lines, colors="#e3e7ec", linewidths=0.8, zorder=0))
-
-    f0 = idx[0]
-    artists = aplot.draw_body(ax, tr.body, world[f0], [aplot.STATE_COLORS[int(s)] for s in tr.node_state[f0]],
-                              node_radius=r, spring_colors=aplot.SPRING_COLOR)
-    (trail_line,) = ax.plot([], [], color="#7f7f7f", lw=1.0, ls="--", zorder=1)
-    (com_dot,) = ax.plot([], [], "+", color="#444444", ms=7, zorder=5)
-    if align:
-        ax.add_patch(FancyArrowPatch((0.9, 0.915), (0.975, 0.915), transform=ax.transAxes, arrowstyle="-|>",
-                                     mutation_scale=10, color="#777777", lw=1.2, zorder=6))
-    caption = title if title is not None else "red: expanding   blue: contracting   green: neutral"
+    stage = _Stage(
+        tr,
+        idx,
+        (width, height),
+        follow=follow,
+        align=align,
+        trail=trail,
+        color_springs=color_springs,
+        title=title,
+        config=config,
+    )
     overlay = _TextOverlay(width, height)
 
     show_bar = progress if progress is not None else (len(idx) >= 60 and _stderr_is_tty())
@@ -181,37 +152,40 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
     proc = None
     if ffmpeg:
         path.parent.mkdir(parents=True, exist_ok=True)
-        proc = subprocess.Popen([ffmpeg, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
-                                 f"{width}x{height}", "-r", f"{fps}", "-i", "-", "-an", "-vcodec", "libx264",
-                                 "-pix_fmt", "yuv420p", "-crf", "23", str(path)], stdin=subprocess.PIPE)
-    springs = np.asarray(tr.body.springs)
-    regions = tr.body.regions
-    loops = tr.body.skin_loops
+        proc = subprocess.Popen(
+            [
+                ffmpeg,
+                "-y",
+                "-loglevel",
+                "error",
+                "-f",
+                "rawvideo",
+                "-pix_fmt",
+                "rgb24",
+                "-s",
+                f"{width}x{height}",
+                "-r",
+                f"{fps}",
+                "-i",
+                "-",
+                "-an",
+                "-vcodec",
+                "libx264",
+                "-pix_fmt",
+                "yuv420p",
+                "-crf",
+                "23",
+                str(path),
+            ],
+            stdin=subprocess.PIPE,
+        )
     try:
         for f in iterator:
-            pos = world[f]
-            if artists["fill"] is not None:
-                artists["fill"].set_verts([pos[reg] for reg in regions])
-            if len(springs):
-                artists["springs"].set_segments(pos[springs])
-            if color_springs:
-                artists["springs"].set_color([aplot.STATE_COLORS[int(s)] for s in tr.spring_state[f]])
-            artists["skin"].set_segments(aplot._loops_closed(pos, loops))
-            artists["nodes"].set_offsets(pos)
-            artists["nodes"].set_facecolor([aplot.STATE_COLORS[int(s)] for s in tr.node_state[f]])
-            c = com[f]
-            if trail:
-                upto = [k for k in idx if k <= f]
-                trail_line.set_data(com[upto, 0], com[upto, 1])
-            com_dot.set_data([c[0]], [c[1]])
-            centre = c if follow else fixed_centre
-            ax.set_xlim(centre[0] - view_w / 2, centre[0] + view_w / 2)
-            ax.set_ylim(centre[1] - view_h / 2, centre[1] + view_h / 2)
-            canvas.draw()
-            rgb = np.asarray(canvas.buffer_rgba())[:height, :width, :3]
-            travelled = float(np.linalg.norm(tr.com[f] - tr.com[0]))
-            image = overlay.apply(rgb, f"t = {tr.times[f]:6.2f}   step {int(tr.steps[f]):5d}\n"
-                                       f"distance {travelled:8.3f}", caption, "motion" if align else "")
+            stage.update(f)
+            stage.canvas.draw()
+            rgb = np.asarray(stage.canvas.buffer_rgba())[:height, :width, :3]
+            text = stage.texts(f)
+            image = overlay.apply(rgb, text["clock"], text["caption"], text["motion"], text["world"])
             if proc is not None and proc.stdin is not None:
                 proc.stdin.write(np.asarray(image).tobytes())
             else:
@@ -226,6 +200,250 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
         return path
     _write_gif(path, images, fps, colors)
     return path
+
+
+def frame_figure(
+    trajectory: Any,
+    frame: int = -1,
+    *,
+    frames: Optional[Sequence[int]] = None,
+    max_frames: int = 240,
+    start: Optional[int] = None,
+    size: Tuple[int, int] = (560, 360),
+    follow: Optional[bool] = None,
+    align: Optional[bool] = None,
+    trail: bool = True,
+    color_springs: bool = False,
+    title: Optional[str] = None,
+    config: Optional[Any] = None,
+):
+    """One frame of :func:`animate` as a matplotlib Figure (a still, or a look at what the GIF draws).
+
+    Same arguments as :func:`animate`; ``frame`` is the trajectory frame shown (default the last),
+    ``frames`` the frames the view is fitted to (default those :func:`animate` renders, plus
+    ``frame``). The texts the GIF writes with Pillow are matplotlib texts here, labelled ``"clock"``
+    (time, step, progress), ``"world"`` (:func:`animat.plot.world_text`), ``"caption"`` and
+    ``"motion"``. Artists are labelled as :func:`animat.plot.draw_body` and
+    :func:`animat.plot.draw_world` label them (``"nodes"``, ``"floor"``, ``"ground"``, ``"chemical
+    source"``), plus ``"toward source"`` (the arrow) and ``"trail"``.
+    """
+    from .trajectory import Trajectory, replay
+
+    tr = trajectory if isinstance(trajectory, Trajectory) else replay(trajectory, config)
+    if not -tr.frame_count <= frame < tr.frame_count:
+        raise ValueError(f"frame_figure: frame {frame} out of range (trajectory has {tr.frame_count} frames)")
+    frame %= tr.frame_count
+    idx = _frame_indices(tr, frames, max_frames, start)
+    if frame not in idx:
+        idx = sorted(set(idx) | {frame})
+    stage = _Stage(
+        tr,
+        idx,
+        (int(size[0]), int(size[1])),
+        follow=follow,
+        align=align,
+        trail=trail,
+        color_springs=color_springs,
+        title=title,
+        config=config,
+    )
+    stage.update(frame)
+    text = stage.texts(frame)
+    fig = stage.fig
+    # figure coordinates, where the GIF's overlay writes them
+    fig.text(0.01, 0.99, text["clock"], va="top", ha="left", family="monospace", label="clock", fontsize=8)
+    fig.text(
+        0.01, 0.99 - 30.0 / size[1], text["world"], va="top", ha="left", label="world", color="#555555", fontsize=8
+    )
+    fig.text(0.99, 0.01, text["caption"], va="bottom", ha="right", label="caption", color="#555555", fontsize=8)
+    if text["motion"]:
+        fig.text(0.9375, 0.94, text["motion"], va="bottom", ha="center", label="motion", color="#777777", fontsize=8)
+    return fig
+
+
+def _frame_indices(tr, frames, max_frames, start) -> list:
+    idx = list(default_frames(tr, max_frames=max_frames, start=start) if frames is None else frames)
+    if not idx:
+        raise ValueError("animate: no frames to render")
+    bad = [f for f in idx if not -tr.frame_count <= f < tr.frame_count]
+    if bad:
+        raise ValueError(f"animate: frames {bad[:5]} out of range (trajectory has {tr.frame_count} frames)")
+    return [f % tr.frame_count for f in idx]
+
+
+class _Stage:
+    """The matplotlib scene of :func:`animate`: built once, updated per frame (``update``), with the
+    texts of each frame (``texts``)."""
+
+    def __init__(self, tr, idx, size, *, follow, align, trail, color_springs, title, config=None):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.collections import LineCollection
+        from matplotlib.figure import Figure
+        from matplotlib.patches import FancyArrowPatch
+
+        from . import _core
+        from . import plot as aplot
+
+        width, height = size
+        if width < 32 or height < 32:
+            raise ValueError(f"animate: size {size} too small (at least 32 x 32 pixels)")
+        self.tr, self.idx, self.trail, self.color_springs = tr, list(idx), trail, color_springs
+        self.config = tr.config if tr.config is not None else (config if config is not None else _core.Config())
+        self.scene = tr.meta.get("scene")
+        if align is None:
+            effects = list(aplot._scene_of(self.config, self.scene).effects)
+            align = "gravity" not in effects and "ground" not in effects
+        self.align = align
+        rot = aplot.rotation_to(tr.direction) if align else np.eye(2)
+        origin = tr.com[idx[0]] if align else np.zeros(2)  # unrotated: world coordinates (the floor's height)
+        self.to_view = lambda p: (np.asarray(p, dtype=float) - origin) @ rot.T
+        self.world = self.to_view(tr.positions)  # (F, n, 2)
+        self.com = self.to_view(tr.com)  # (F, 2)
+        r = aplot._node_radius(tr.body)
+        aspect = width / height
+
+        # View: the body's largest extent (relative to its centre of mass) plus a margin.
+        sel = self.world[idx]
+        rel = sel - self.com[idx][:, None, :]
+        half = np.abs(rel).max(axis=(0, 1)) + r + 0.5
+        view_w = max(2 * half[0], 2 * half[1] * aspect) * 1.3
+        lo, hi = sel.reshape(-1, 2).min(axis=0) - r - 0.5, sel.reshape(-1, 2).max(axis=0) + r + 0.5
+        span = hi - lo
+        fixed_w = max(span[0], span[1] * aspect) * 1.1
+        if follow is None:
+            follow = fixed_w > 2.0 * view_w
+        source = aplot.chemical_source_of(self.config, self.scene)
+        self.source_rel = source
+        if source is not None and not follow:  # a source near enough is kept in the fixed view
+            s_xy = self.to_view((tr.com[0] + source)[None, :])[0]
+            lo2, hi2 = np.minimum(lo, s_xy - 1.0), np.maximum(hi, s_xy + 1.0)
+            wide = max((hi2 - lo2)[0], (hi2 - lo2)[1] * aspect) * 1.1
+            if wide <= 2.5 * fixed_w:
+                lo, hi, fixed_w = lo2, hi2, wide
+        self.follow = follow
+        self.fixed_centre = (lo + hi) / 2
+        if not follow:
+            view_w = fixed_w
+        self.view_w, self.view_h = view_w, view_w / aspect
+
+        dpi = 100
+        self.fig = fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
+        fig.patch.set_facecolor("white")
+        self.canvas = FigureCanvasAgg(fig)
+        self.ax = ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+        ax.set_aspect("auto")
+        ax.set_axis_off()
+        # world-fixed grid, about 7 lines across the view
+        spacing = _nice_spacing(view_w, 7)
+        allc = sel.reshape(-1, 2)
+        reach = max(view_w, self.view_h)
+        g_lo = np.floor((allc.min(axis=0) - reach) / spacing) * spacing
+        g_hi = np.ceil((allc.max(axis=0) + reach) / spacing) * spacing
+        xs = np.arange(g_lo[0], g_hi[0] + spacing / 2, spacing)
+        ys = np.arange(g_lo[1], g_hi[1] + spacing / 2, spacing)
+        if len(xs) + len(ys) < 4000:
+            lines = [((x, g_lo[1]), (x, g_hi[1])) for x in xs] + [((g_lo[0], y), (g_hi[0], y)) for y in ys]
+            ax.add_collection(LineCollection(lines, colors="#e3e7ec", linewidths=0.8, zorder=0))
+        # the world: floor and chemical source (in view coordinates)
+        self.world_artists = aplot.draw_world(
+            ax,
+            self.config,
+            scene=self.scene,
+            start=tr.com[0],
+            transform=self.to_view,
+            extent=float(np.max(np.abs(g_hi - g_lo))) + reach,
+        )
+        self.arrow = None
+        if self.world_artists["source_xy"] is not None:
+            self.arrow = FancyArrowPatch(
+                (0, 0),
+                (0, 0),
+                arrowstyle="-|>",
+                mutation_scale=12,
+                color=aplot.SOURCE_COLOR,
+                lw=1.6,
+                zorder=5,
+                label="toward source",
+            )
+            ax.add_patch(self.arrow)
+
+        f0 = idx[0]
+        self.artists = aplot.draw_body(
+            ax,
+            tr.body,
+            self.world[f0],
+            [aplot.STATE_COLORS[int(s)] for s in tr.node_state[f0]],
+            node_radius=r,
+            spring_colors=aplot.SPRING_COLOR,
+        )
+        (self.trail_line,) = ax.plot([], [], color="#7f7f7f", lw=1.0, ls="--", zorder=1, label="trail")
+        (self.com_dot,) = ax.plot([], [], "+", color="#444444", ms=7, zorder=5)
+        if align:
+            ax.add_patch(
+                FancyArrowPatch(
+                    (0.9, 0.915),
+                    (0.975, 0.915),
+                    transform=ax.transAxes,
+                    arrowstyle="-|>",
+                    mutation_scale=10,
+                    color="#777777",
+                    lw=1.2,
+                    zorder=6,
+                )
+            )
+        self.caption = title if title is not None else "red: expanding   blue: contracting   green: neutral"
+        self.banner = aplot.world_text(self.config, self.scene)
+        self.objective = str(self.config["evaluation.objective"])
+        self.springs = np.asarray(tr.body.springs)
+        self.aplot = aplot
+
+    def update(self, f: int) -> None:
+        """Move every artist to frame ``f`` and set the view."""
+        tr, aplot, artists = self.tr, self.aplot, self.artists
+        pos = self.world[f]
+        if artists["fill"] is not None:
+            artists["fill"].set_verts([pos[reg] for reg in tr.body.regions])
+        if len(self.springs):
+            artists["springs"].set_segments(pos[self.springs])
+        if self.color_springs:
+            artists["springs"].set_color([aplot.STATE_COLORS[int(s)] for s in tr.spring_state[f]])
+        artists["skin"].set_segments(aplot._loops_closed(pos, tr.body.skin_loops))
+        artists["nodes"].set_offsets(pos)
+        artists["nodes"].set_facecolor([aplot.STATE_COLORS[int(s)] for s in tr.node_state[f]])
+        c = self.com[f]
+        if self.trail:
+            upto = [k for k in self.idx if k <= f]
+            self.trail_line.set_data(self.com[upto, 0], self.com[upto, 1])
+        self.com_dot.set_data([c[0]], [c[1]])
+        if self.arrow is not None:  # from the centre of mass toward the source, at most a third of the view long
+            to = self.world_artists["source_xy"] - c
+            dist = float(np.linalg.norm(to))
+            length = min(dist, 0.3 * min(self.view_w, self.view_h))
+            tip = c + (to / dist * length if dist > 0 else 0.0)
+            self.arrow.set_positions(tuple(c), tuple(tip))
+        centre = c if self.follow else self.fixed_centre
+        self.ax.set_xlim(centre[0] - self.view_w / 2, centre[0] + self.view_w / 2)
+        self.ax.set_ylim(centre[1] - self.view_h / 2, centre[1] + self.view_h / 2)
+
+    def progress(self, f: int) -> Tuple[str, float]:
+        """(label, value) of the swim so far by the objective (see :func:`animate`)."""
+        d = self.tr.com[f] - self.tr.com[0]
+        if self.source_rel is not None and self.objective == "chemotaxis":
+            s = self.source_rel
+            return "to source", float(np.linalg.norm(s) - np.linalg.norm(s - d))
+        if self.objective == "distance_x":
+            return "x distance", float(abs(d[0]))
+        if self.objective == "speed_toward":
+            u = np.asarray(self.config["evaluation.direction"], dtype=float)
+            u = u / (np.linalg.norm(u) or 1.0)
+            return "along dir.", float(d @ u)
+        return "distance", float(np.linalg.norm(d))
+
+    def texts(self, f: int) -> dict:
+        """The texts of frame ``f``: ``clock`` (time, step, progress), ``world``, ``caption``, ``motion``."""
+        label, value = self.progress(f)
+        clock = f"t = {self.tr.times[f]:6.2f}   step {int(self.tr.steps[f]):5d}\n{label:<10s}{value:8.3f}"
+        return {"clock": clock, "world": self.banner, "caption": self.caption, "motion": "motion" if self.align else ""}
 
 
 class _TextOverlay:
@@ -244,18 +462,26 @@ class _TextOverlay:
         self.width, self.height = width, height
         self.margin = int(round(6 * scale))
 
-    def apply(self, rgb: np.ndarray, top_left: str, bottom_right: str, top_right: str):
+    def apply(self, rgb: np.ndarray, top_left: str, bottom_right: str, top_right: str, below: str = ""):
         from PIL import Image, ImageDraw
 
         image = Image.fromarray(np.ascontiguousarray(rgb))
         draw = ImageDraw.Draw(image)
         m = self.margin
         draw.multiline_text((m, m), top_left, font=self.mono, fill=(34, 34, 34), spacing=2)
+        if below:  # a line under the top-left block: the world
+            bottom = draw.multiline_textbbox((m, m), top_left, font=self.mono, spacing=2)[3]
+            draw.text((m, bottom + m // 2), below, font=self.sans, fill=(85, 85, 85))
         if bottom_right:
             draw.text((self.width - m, self.height - m), bottom_right, font=self.sans, fill=(85, 85, 85), anchor="rd")
         if top_right:
-            draw.text((int(0.9375 * self.width), int(0.085 * self.height) - 2), top_right, font=self.sans,
-                      fill=(119, 119, 119), anchor="md")
+            draw.text(
+                (int(0.9375 * self.width), int(0.085 * self.height) - 2),
+                top_right,
+                font=self.sans,
+                fill=(119, 119, 119),
+                anchor="md",
+            )
         return image
 
 
@@ -278,9 +504,26 @@ def _stderr_is_tty() -> bool:
         return False
 
 
-#: Colours every GIF palette keeps exactly (background, skin, springs, fill, grid, text, node states).
-_KEY_COLORS = ["#ffffff", "#111111", "#222222", "#8c8c8c", "#e9eef3", "#e3e7ec", "#555555", "#777777",
-               "#7f7f7f", "#444444", "#d62728", "#1f77b4", "#2ca02c"]
+#: Colours every GIF palette keeps exactly (background, skin, springs, fill, grid, text, node states, floor,
+#: ground, chemical source).
+_KEY_COLORS = [
+    "#ffffff",
+    "#111111",
+    "#222222",
+    "#8c8c8c",
+    "#e9eef3",
+    "#e3e7ec",
+    "#555555",
+    "#777777",
+    "#7f7f7f",
+    "#444444",
+    "#d62728",
+    "#1f77b4",
+    "#2ca02c",
+    "#8c564b",
+    "#eee4da",
+    "#ff7f0e",
+]
 
 
 def _write_gif(path: Path, images, fps: float, colors: int) -> None:
@@ -295,8 +538,7 @@ def _write_gif(path: Path, images, fps: float, colors: int) -> None:
     mosaic = Image.new("RGB", (w, h * len(sample)))
     for k, im in enumerate(sample):
         mosaic.paste(im, (0, k * h))
-    rest = mosaic.quantize(colors=colors - len(_KEY_COLORS), method=Image.Quantize.MEDIANCUT,
-                           dither=Image.Dither.NONE)
+    rest = mosaic.quantize(colors=colors - len(_KEY_COLORS), method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
     extra = (rest.getpalette() or [])[: 3 * (colors - len(_KEY_COLORS))]
     keys = [int(round(255 * v)) for c in _KEY_COLORS for v in to_rgb(c)]
     palette = Image.new("P", (1, 1))
@@ -304,5 +546,4 @@ def _write_gif(path: Path, images, fps: float, colors: int) -> None:
     frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
     path.parent.mkdir(parents=True, exist_ok=True)
     duration = max(20, int(round(100.0 / fps)) * 10)  # GIF delays are whole 1/100 s
-    frames[0].save(path, save_all=True, append_images=frames[1:], duration=duration, loop=0, optimize=False,
-                   disposal=1)
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=duration, loop=0, optimize=False, disposal=1)

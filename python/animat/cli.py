@@ -2,6 +2,7 @@
 
     animat evolve [animat_evolve's flags]   # the engine, flags and output of animat_evolve
     python -m animat show RUN_DIR       # figures/ development, construction, motion_cycle, phase_map, fitness_history
+                                        #   (+ stiffness_map for a body with evolved stiffness)
     python -m animat animate RUN_DIR    # figures/best.gif
     python -m animat info RUN_DIR       # a short summary of the run
     python -m animat experiment CONFIG --runs N --out DIR   # N independent seeds, resumable, with a summary
@@ -9,6 +10,7 @@
 
 Every command exits with status 1 and a one-line message for a missing or malformed run directory.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -17,7 +19,7 @@ import time
 from pathlib import Path
 from typing import List, Optional
 
-FIGURES = ("development", "construction", "motion_cycle", "phase_map", "fitness_history")
+FIGURES = ("development", "construction", "motion_cycle", "phase_map", "stiffness_map", "fitness_history")
 
 
 def _size(text: str):
@@ -29,17 +31,26 @@ def _size(text: str):
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="animat", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="animat", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     sub = p.add_subparsers(dest="command", required=True, metavar="{evolve,show,animate,info,experiment}")
 
-    sub.add_parser("evolve", add_help=False,
-                   help="run an evolution: animat_evolve's engine and flags (animat evolve --help lists them)")
+    sub.add_parser(
+        "evolve",
+        add_help=False,
+        help="run an evolution: animat_evolve's engine and flags (animat evolve --help lists them)",
+    )
 
     s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
     s.add_argument("run", metavar="RUN_DIR")
     s.add_argument("--out", type=Path, help="output directory (default RUN_DIR/figures)")
-    s.add_argument("--only", nargs="+", choices=FIGURES, help="draw only these figures")
+    s.add_argument(
+        "--only",
+        nargs="+",
+        choices=FIGURES,
+        help="draw only these figures (default: all; stiffness_map only for a body with evolved stiffness)",
+    )
     s.add_argument("--frames", type=int, default=6, help="snapshots in the motion cycle (default 6)")
     s.add_argument("--steps", type=int, help="swim steps to replay (default: the run's evaluation.steps)")
     s.add_argument("--dpi", type=int, default=110, help="PNG resolution (default 110)")
@@ -60,8 +71,12 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("run", metavar="RUN_DIR")
 
     e = sub.add_parser("experiment", help="run (or resume) N independent seeds of a config and summarise them")
-    e.add_argument("config", metavar="CONFIG", nargs="+",
-                   help="TOML config file; several as NAME=CONFIG make a study in OUT/NAME/ (docs/cluster.md)")
+    e.add_argument(
+        "config",
+        metavar="CONFIG",
+        nargs="+",
+        help="TOML config file; several as NAME=CONFIG make a study in OUT/NAME/ (docs/cluster.md)",
+    )
     e.add_argument("--runs", type=int, default=3, help="independent runs, seeds evolution.seed + 0..N-1 (default 3)")
     e.add_argument("--out", required=True, help="experiment directory (run_<i>/ per run, summary.json, summary.md)")
     e.add_argument("--parallel", type=int, default=1, help="runs at once; the cores are split between them")
@@ -70,13 +85,71 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--wall-seconds", type=float, help="per-run wall-clock budget in seconds (overrides the config)")
     e.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a config value")
     e.add_argument("--quiet", action="store_true", help="no per-run lines")
-    e.add_argument("--mpi", action="store_true",
-                   help="place the runs on the ranks of an MPI job: mpirun -np R python -m animat experiment ... --mpi "
-                        "(needs mpi4py)")
-    e.add_argument("--index", type=int, action="append", metavar="I",
-                   help="run only run I of the study, numbered environment-major (one Slurm array task: "
-                        "--index $SLURM_ARRAY_TASK_ID); repeatable; writes no summary")
+    e.add_argument(
+        "--mpi",
+        action="store_true",
+        help="place the runs on the ranks of an MPI job: mpirun -np R python -m animat experiment ... --mpi "
+        "(needs mpi4py)",
+    )
+    e.add_argument(
+        "--index",
+        type=int,
+        action="append",
+        metavar="I",
+        help="run only run I of the study, numbered environment-major (one Slurm array task: "
+        "--index $SLURM_ARRAY_TASK_ID); repeatable; writes no summary",
+    )
     return p
+
+
+def has_evolved_stiffness(run, entry=None) -> bool:
+    """True when the run's best body has evolved stiffness: the GRN output ``stiffness`` is enabled
+    (``genome.extra_outputs``) or the body carries per-cell factors (``Body.stiffness``)."""
+    from .trajectory import body_of
+
+    config = run.config
+    if "stiffness" in [c.strip() for c in str(config["genome.extra_outputs"]).split(",")]:
+        return True
+    try:
+        return len(body_of(entry if entry is not None else run.best(), config).stiffness) > 0
+    except ValueError:
+        return False
+
+
+def show_figures(run, only=None, *, frames: int = 6, steps: Optional[int] = None):
+    """The figures of ``animat show`` for a run (an :class:`animat.Run`), in order: a dict of figure
+    name -> a function that draws it (a matplotlib Figure). ``only`` picks names of :data:`FIGURES`
+    (default: all of them, ``stiffness_map`` only when the best body has evolved stiffness,
+    :func:`has_evolved_stiffness`). Every figure names the run's objective and world where it has
+    a title to do so."""
+    import animat
+    from animat import plot
+
+    entry = run.best()
+    config = run.config
+    wanted = list(only) if only else [n for n in FIGURES if n != "stiffness_map" or has_evolved_stiffness(run, entry)]
+    objective, _, _ = plot.objective_info(config)
+    label = f"best of {run.path.name}: generation {entry.generation}, fitness ({objective}) {entry.fitness:.3f}"
+    cache = {}
+
+    def trajectory():
+        if "tr" not in cache:
+            cache["tr"] = animat.replay(entry, config, steps=steps)
+        return cache["tr"]
+
+    makers = {
+        "development": lambda: plot.development(
+            entry, config=config, title=f"Development (paper Fig. 2) of the {label}"
+        ),
+        "construction": lambda: plot.construction(
+            entry, config=config, title=f"From embryo to body (paper Fig. 3): {label}"
+        ),
+        "motion_cycle": lambda: plot.motion_cycle(trajectory(), count=frames),
+        "phase_map": lambda: plot.phase_map(entry, config=config),
+        "stiffness_map": lambda: plot.stiffness_map(entry, config=config),
+        "fitness_history": lambda: plot.fitness_history(run),
+    }
+    return {name: makers[name] for name in FIGURES if name in wanted}
 
 
 def cmd_show(args) -> int:
@@ -86,38 +159,23 @@ def cmd_show(args) -> int:
     import matplotlib.pyplot as plt
 
     import animat
-    from animat import plot
 
     run = animat.Run(args.run)
     entry = run.best()
-    config = run.config
     out = args.out or run.path / "figures"
     out.mkdir(parents=True, exist_ok=True)
-    wanted = args.only or FIGURES
     t0 = time.perf_counter()
-    trajectory = None
-    if "motion_cycle" in wanted:
-        trajectory = animat.replay(entry, config, steps=args.steps)
-    label = f"best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}"
-    makers = {
-        "development": lambda: plot.development(entry, config=config,
-                                                title=f"Development (paper Fig. 2) of the {label}"),
-        "construction": lambda: plot.construction(entry, config=config,
-                                                  title=f"From embryo to body (paper Fig. 3): {label}"),
-        "motion_cycle": lambda: plot.motion_cycle(animat.replay(entry, config, steps=args.steps) if trajectory is None
-                                                  else trajectory, count=args.frames),
-        "phase_map": lambda: plot.phase_map(entry, config=config),
-        "fitness_history": lambda: plot.fitness_history(run),
-    }
-    for name in FIGURES:
-        if name not in wanted:
-            continue
-        fig = makers[name]()
+    for name, make in show_figures(run, args.only, frames=args.frames, steps=args.steps).items():
+        fig = make()
         path = out / f"{name}.png"
         fig.savefig(path, dpi=args.dpi)
         plt.close(fig)
         print(path)
-    print(f"({label}; {time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    print(
+        f"(best of {run.path.name}: generation {entry.generation}, fitness ({run.config['evaluation.objective']}) "
+        f"{entry.fitness:.3f}; {time.perf_counter() - t0:.1f} s)",
+        file=sys.stderr,
+    )
     return 0
 
 
@@ -131,11 +189,23 @@ def cmd_animate(args) -> int:
     t0 = time.perf_counter()
     trajectory = animat.replay(entry, config, steps=args.steps)
     start = None if args.start is None else trajectory.frame_index(args.start)
-    path = animat.animate(trajectory, out, fps=args.fps, max_frames=args.max_frames, start=start, size=args.size,
-                          colors=args.colors, follow=args.follow, progress=False if args.no_progress else None)
+    path = animat.animate(
+        trajectory,
+        out,
+        fps=args.fps,
+        max_frames=args.max_frames,
+        start=start,
+        size=args.size,
+        colors=args.colors,
+        follow=args.follow,
+        progress=False if args.no_progress else None,
+    )
     print(path)
-    print(f"(best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}; "
-          f"{time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    print(
+        f"(best of {run.path.name}: generation {entry.generation}, fitness ({config['evaluation.objective']}) "
+        f"{entry.fitness:.3f}; {time.perf_counter() - t0:.1f} s)",
+        file=sys.stderr,
+    )
     return 0
 
 
@@ -153,9 +223,20 @@ def cmd_info(args) -> int:
 def cmd_experiment(args) -> int:
     from .experiment import run_study, summarize
 
-    by_env = run_study(args.config, args.runs, args.out, mpi=args.mpi, index=args.index, parallel=args.parallel,
-                       threads=args.threads, generations=args.generations, wall_seconds=args.wall_seconds,
-                       overrides=args.set, quiet=args.quiet, log=lambda m: print(m, flush=True))
+    by_env = run_study(
+        args.config,
+        args.runs,
+        args.out,
+        mpi=args.mpi,
+        index=args.index,
+        parallel=args.parallel,
+        threads=args.threads,
+        generations=args.generations,
+        wall_seconds=args.wall_seconds,
+        overrides=args.set,
+        quiet=args.quiet,
+        log=lambda m: print(m, flush=True),
+    )
     nested = len(by_env) > 1 or "=" in args.config[0]
     for name, records in by_env.items():
         where = f"{args.out}/{name}" if nested else args.out
@@ -165,8 +246,10 @@ def cmd_experiment(args) -> int:
             continue
         stats = summarize(records)
         if stats:
-            print(f"{where}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
-                  f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {where}/summary.md")
+            print(
+                f"{where}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
+                f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {where}/summary.md"
+            )
     return 0
 
 
@@ -179,8 +262,7 @@ def main(argv: Optional[List[str]] = None) -> int:
 
         return _core.evolve_cli(argv[1:])
     args = _parser().parse_args(argv)
-    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info,
-               "experiment": cmd_experiment}[args.command]
+    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info, "experiment": cmd_experiment}[args.command]
     try:
         return command(args)
     except KeyboardInterrupt as e:

@@ -16,6 +16,7 @@ near the turning points of its oscillation (``|cos| <= 0.1`` for the fastest cel
 not started yet, and always when its own ``a_i f_i`` is below the threshold (a practically
 non-oscillating cell). A body without any oscillation is neutral everywhere.
 """
+
 from __future__ import annotations
 
 import math
@@ -27,8 +28,18 @@ import numpy as np
 from . import _core
 
 __all__ = [
-    "Trajectory", "replay", "actuation_terms", "actuation_rates", "actuation_start_times", "classify_rates",
-    "EXPANDING", "CONTRACTING", "NEUTRAL", "STATE_NAMES", "DEFAULT_NEUTRAL", "body_of",
+    "Trajectory",
+    "replay",
+    "actuation_terms",
+    "actuation_rates",
+    "actuation_start_times",
+    "classify_rates",
+    "EXPANDING",
+    "CONTRACTING",
+    "NEUTRAL",
+    "STATE_NAMES",
+    "DEFAULT_NEUTRAL",
+    "body_of",
 ]
 
 #: Actuation state codes used in :attr:`Trajectory.node_state` and :attr:`Trajectory.spring_state`.
@@ -48,7 +59,9 @@ def actuation_start_times(frequency: np.ndarray, phase: np.ndarray) -> np.ndarra
     Returns:
         (n,) float64 array; +inf for a cell that never starts.
     """
-    return np.array([_core.actuation_start_time(float(f), float(p)) for f, p in zip(frequency, phase)], dtype=np.float64)
+    return np.array(
+        [_core.actuation_start_time(float(f), float(p)) for f, p in zip(frequency, phase)], dtype=np.float64
+    )
 
 
 def _broadcast(amplitude, frequency, phase, t):
@@ -130,7 +143,9 @@ class Trajectory:
 
     The body (``body``: springs, skin, regions, oscillator parameters) is the :class:`animat.Body`
     that swam. ``stable`` is False if the simulation left its valid domain; the frames then stop
-    at the last valid state and ``failure`` holds the message.
+    at the last valid state and ``failure`` holds the message. ``config`` is the config it swam
+    with; ``meta`` holds ``neutral``, ``control`` ("open_loop" or "grn") and ``scene`` (the
+    :class:`animat.Scene` that overrode ``config.scene``, or None).
     """
 
     body: Any
@@ -246,19 +261,29 @@ class Trajectory:
         """Index of the frame recorded at control step ``step`` (ValueError if none was)."""
         hits = np.nonzero(self.steps == step)[0]
         if not len(hits):
-            raise ValueError(f"no frame at step {step} (frames are every {self.every} steps, "
-                             f"{int(self.steps[0])}..{int(self.steps[-1])})")
+            raise ValueError(
+                f"no frame at step {step} (frames are every {self.every} steps, "
+                f"{int(self.steps[0])}..{int(self.steps[-1])})"
+            )
         return int(hits[0])
 
     def __repr__(self) -> str:
-        return (f"<animat.Trajectory {self.frame_count} frames (every {self.every} steps, t = "
-                f"{self.times[0]:.3g}..{self.times[-1]:.3g}), {self.node_count} nodes, "
-                f"{len(self.body.springs)} springs, distance {self.distance:.4g}"
-                f"{'' if self.stable else ', UNSTABLE'}>")
+        return (
+            f"<animat.Trajectory {self.frame_count} frames (every {self.every} steps, t = "
+            f"{self.times[0]:.3g}..{self.times[-1]:.3g}), {self.node_count} nodes, "
+            f"{len(self.body.springs)} springs, distance {self.distance:.4g}"
+            f"{'' if self.stable else ', UNSTABLE'}>"
+        )
 
 
-def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[int] = None, every: int = 1,
-           scene: Optional[Any] = None, neutral: float = DEFAULT_NEUTRAL) -> Trajectory:
+def replay(
+    genome_or_body: Any,
+    config: Optional[Any] = None,
+    steps: Optional[int] = None,
+    every: int = 1,
+    scene: Optional[Any] = None,
+    neutral: float = DEFAULT_NEUTRAL,
+) -> Trajectory:
     """Swim a genome (or a developed embryo, or a body) again and record it.
 
     The swim is the one ``animat.evaluate`` does: ``develop`` → ``build_body`` → ``Simulation``
@@ -278,6 +303,13 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
         neutral: the neutral band as a fraction of the body's largest cell rate ``max_i a_i f_i``
             (see the module docstring); 0 makes every moving cell red or blue.
 
+    Under ``control.mode = "grn"`` (docs/control.md) the genome's GRN drives the actuation while it
+    swims, as in ``animat.evaluate`` (the chemical source at ``scene.chemical_source`` from the start
+    centre: the objective ``chemotaxis`` scores this swim's progress toward it, averaged over turned
+    sources); the cell terms are the controller's, their rates the terms' time derivative between
+    frames, and the neutral band ``neutral`` times the largest rate seen. That needs the genome: a
+    Body or an Embryo under such a config is a ValueError.
+
     Returns:
         A :class:`Trajectory`. A swim that leaves the simulator's valid domain stops early:
         ``stable`` is False, ``failure`` holds the message and a RuntimeWarning is issued.
@@ -293,10 +325,25 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
     n_steps = int(cfg["evaluation.steps"] if steps is None else steps)
     if n_steps < 0:
         raise ValueError(f"replay: steps must be >= 0, got {n_steps}")
+    grn = str(cfg["control.mode"]) == "grn"
+    genome = genome_or_body
+    if hasattr(genome, "genome") and not isinstance(genome, _core.Genome):  # LineageEntry
+        genome = genome.genome
+    if grn and not isinstance(genome, _core.Genome):
+        raise ValueError(
+            "replay: control.mode = 'grn' runs the genome's GRN while swimming; pass the Genome "
+            f"(or a LineageEntry), not a {type(genome_or_body).__name__}"
+        )
     body = body_of(genome_or_body, cfg)
     # The crawl world (docs/worlds.md): placed on the floor and settled, exactly as evaluate() does.
     body, start_velocities, settled = _core.start_state(body, scene, cfg)
-    sim = _core.Simulation(body, scene, cfg)
+    control = None
+    if grn:  # the GRN writes the rest lengths: no open-loop actuation beside it (as in evaluate())
+        base: Any = scene if scene is not None else _core.Scene.from_config(cfg)
+        sim = _core.Simulation(body, base.replace(effects=[e for e in base.effects if e != "actuation"]), cfg)
+        control = sim.add_grn_control(body, genome, cfg)
+    else:
+        sim = _core.Simulation(body, scene, cfg)
     if settled:
         sim.velocities = start_velocities
     frames = n_steps // every + 1
@@ -305,6 +352,7 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
     vel = np.empty((frames, n, 2))
     times = np.empty(frames)
     steps_done = np.empty(frames, dtype=np.int64)
+    grn_terms = np.zeros((frames, n)) if control is not None else None
     failure = ""
     recorded = 0
     for k in range(frames):
@@ -318,25 +366,51 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
         vel[k] = sim.velocities
         times[k] = sim.time
         steps_done[k] = sim.steps_done
+        if grn_terms is not None and control is not None:
+            grn_terms[k] = control.terms
         recorded += 1
     if failure:
         import warnings
-        warnings.warn(f"replay: swim became unstable after {int(steps_done[recorded - 1])} steps: {failure}",
-                      RuntimeWarning, stacklevel=2)
+
+        warnings.warn(
+            f"replay: swim became unstable after {int(steps_done[recorded - 1])} steps: {failure}",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     pos, vel, times, steps_done = pos[:recorded], vel[:recorded], times[:recorded], steps_done[:recorded]
 
     a, f, p = body.amplitude, body.frequency, body.phase
-    terms = actuation_terms(a, f, p, times)
-    rates = actuation_rates(a, f, p, times)
-    peak = float(np.max(a * f)) if n else 0.0
+    if grn_terms is not None:
+        terms = grn_terms[:recorded]
+        rates = np.gradient(terms, times, axis=0) if recorded > 1 else np.zeros_like(terms)
+        peak = float(np.abs(rates).max()) if rates.size else 0.0
+    else:
+        terms = actuation_terms(a, f, p, times)
+        rates = actuation_rates(a, f, p, times)
+        peak = float(np.max(a * f)) if n else 0.0
     threshold = neutral * peak
     springs = body.springs
     i, j = springs[:, 0], springs[:, 1]
     spring_rates = rates[:, i] + rates[:, j]
     rest = (1.0 + terms[:, i] + terms[:, j]) * body.rest_lengths[None, :]
     return Trajectory(
-        body=body, positions=pos, velocities=vel, times=times, steps=steps_done, com=pos.mean(axis=1),
-        node_terms=terms, node_rates=rates, node_state=classify_rates(rates, threshold),
-        spring_rates=spring_rates, spring_state=classify_rates(spring_rates, threshold), rest_lengths=rest,
-        neutral_threshold=threshold, dt=float(cfg["physics.dt"]), every=int(every), config=cfg,
-        stable=not failure, failure=failure, meta={"neutral": float(neutral)})
+        body=body,
+        positions=pos,
+        velocities=vel,
+        times=times,
+        steps=steps_done,
+        com=pos.mean(axis=1),
+        node_terms=terms,
+        node_rates=rates,
+        node_state=classify_rates(rates, threshold),
+        spring_rates=spring_rates,
+        spring_state=classify_rates(spring_rates, threshold),
+        rest_lengths=rest,
+        neutral_threshold=threshold,
+        dt=float(cfg["physics.dt"]),
+        every=int(every),
+        config=cfg,
+        stable=not failure,
+        failure=failure,
+        meta={"neutral": float(neutral), "control": "grn" if grn else "open_loop", "scene": scene},
+    )

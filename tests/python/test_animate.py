@@ -1,10 +1,18 @@
-"""animat.animate: GIF with the expected frames and size; MP4 only where ffmpeg exists."""
-import numpy as np
-import pytest
-from PIL import Image, ImageSequence
+"""animat.animate: GIF with the expected frames and size; MP4 only where ffmpeg exists; the world
+(floor, chemical source) and the objective's progress drawn in it."""
 
-import animat
-from animat.animation import default_frames
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from PIL import Image, ImageSequence  # noqa: E402
+
+import animat  # noqa: E402
+from animat.animation import default_frames, frame_figure  # noqa: E402
 
 
 def wave_body():
@@ -74,7 +82,98 @@ def test_mp4_where_ffmpeg_is_available(trajectory, tmp_path):
 
 def test_animate_replays_a_body_first(tmp_path):
     body = wave_body()
-    out = animat.animate(body, tmp_path / "b.gif", max_frames=5, size=(100, 80),
-                         config=animat.Config({"evaluation.steps": 40}))
+    out = animat.animate(
+        body, tmp_path / "b.gif", max_frames=5, size=(100, 80), config=animat.Config({"evaluation.steps": 40})
+    )
     with Image.open(out) as im:
         assert im.n_frames == 5
+
+
+# --- the world in the GIF (issue "See a run", item 3) ---------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def crawl_trajectory():
+    data = ROOT / "tests" / "data" / "crawl"
+    config = animat.load_config(str(data / "crawl.toml"))
+    genome = animat.Genome.from_json(json.dumps(json.loads((data / "s1_g7.json").read_text())["genome"]))
+    return animat.replay(genome, config, steps=300, every=10)
+
+
+@pytest.fixture(scope="module")
+def chemotaxis():
+    run = ROOT / "data" / "control" / "chemotaxis_amplitude_seed2"
+    config = animat.load_config(f"{run}_config.toml")
+    return animat.Genome.load(f"{run}_best_genome.json"), config
+
+
+def texts_of(fig):
+    return {t.get_label(): t.get_text() for t in fig.texts}
+
+
+def count_colour(path, colour):
+    rgb = np.array([int(colour[k : k + 2], 16) for k in (1, 3, 5)])
+    with Image.open(path) as im:
+        return [
+            int(np.all(np.asarray(frame.convert("RGB")) == rgb, axis=2).sum()) for frame in ImageSequence.Iterator(im)
+        ]
+
+
+def test_crawl_gif_draws_the_floor_and_names_the_world(tmp_path):
+    from animat import plot
+
+    tr = crawl_trajectory()
+    h = tr.config["scene.ground_height"]
+    fig = frame_figure(tr, size=(280, 180))
+    ax = fig.axes[0]
+    floors = [ln for ln in ax.get_lines() if ln.get_label() == "floor"]
+    assert len(floors) == 1 and np.allclose(floors[0].get_ydata(), h)
+    assert [p.get_label() for p in ax.patches].count("ground") == 1
+    # not rotated (down stays down): the body rests on the floor, in view
+    nodes = next(c for c in ax.collections if c.get_label() == "nodes").get_offsets()
+    assert nodes[:, 1].min() == pytest.approx(h, abs=1e-3)
+    assert ax.get_ylim()[0] < h < ax.get_ylim()[1]
+    text = texts_of(fig)
+    assert text["world"] == plot.world_text(tr.config)
+    assert "d_N" not in text["world"] and "gravity g = 1" in text["world"] and "floor at y = 0" in text["world"]
+    # distance_x: the clock shows the horizontal distance, the objective of the crawl world
+    dx = abs(tr.com[-1, 0] - tr.com[0, 0])
+    assert "x distance" in text["clock"] and f"{dx:8.3f}" in text["clock"]
+    # and the GIF itself has the floor in every frame
+    out = animat.animate(tr, tmp_path / "crawl.gif", max_frames=6, size=(280, 180), progress=False)
+    assert min(count_colour(out, plot.FLOOR_COLOR)) > 280 // 2  # a floor line across the frame
+
+
+def test_chemotaxis_gif_draws_the_source_and_the_progress_toward_it(chemotaxis, tmp_path):
+    from animat import plot
+
+    genome, config = chemotaxis
+    tr = animat.replay(genome, config, steps=600, every=10)
+    # the swim is the GRN-controlled one evaluate() scores, not the open-loop oscillators
+    assert tr.meta["control"] == "grn"
+    ref = animat.grn_swim(genome, config, steps=600, every=10)
+    assert np.allclose(tr.com, ref["com"]) and np.allclose(tr.node_terms, ref["terms"])
+    source = np.asarray(config["scene.chemical_source"])
+    fig = frame_figure(tr, align=False, size=(400, 240))
+    ax = fig.axes[0]
+    stars = [ln for ln in ax.get_lines() if ln.get_label() == "chemical source"]
+    assert len(stars) == 1 and stars[0].get_marker() == "*"
+    assert np.allclose(np.column_stack(stars[0].get_data())[0], tr.com[0] + source)
+    arrow = next(p for p in ax.patches if p.get_label() == "toward source")
+    assert arrow is not None
+    text = texts_of(fig)
+    d = tr.com[-1] - tr.com[0]
+    progress = np.linalg.norm(source) - np.linalg.norm(source - d)
+    assert "to source" in text["clock"] and f"{progress:8.3f}" in text["clock"]
+    assert "distance" not in text["clock"]
+    assert "point source at (20, 0)" in text["world"] and "GRN control" in text["world"]
+    # aligned (the default in a fluid), the star is rotated with the world but stays as far from the start
+    fig = frame_figure(tr, size=(400, 240))
+    star = next(ln for ln in fig.axes[0].get_lines() if ln.get_label() == "chemical source")
+    first = default_frames(tr)[0]  # the aligned view is centred on the first rendered frame's centre
+    assert np.linalg.norm(np.column_stack(star.get_data())[0]) == pytest.approx(
+        np.linalg.norm(tr.com[0] + source - tr.com[first])
+    )
+    out = animat.animate(tr, tmp_path / "chem.gif", max_frames=6, size=(400, 240), align=False, progress=False)
+    assert min(count_colour(out, plot.SOURCE_COLOR)) > 20

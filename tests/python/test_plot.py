@@ -1,7 +1,10 @@
 """animat.plot on a small real run, headless (Agg): every function returns a Figure and draws what
 the paper's figure shows; motion_cycle colours follow eq. 2, phase_map's colour range the phases."""
+
+import json
 import math
 import re
+from pathlib import Path
 
 import matplotlib
 
@@ -104,8 +107,11 @@ def test_motion_cycle_node_colours_follow_eq2(trajectory):
     assert len(panels) == 5
     # the skin is drawn thick in every panel and the direction of motion is marked
     for ax in panels:
-        widths = [lc.get_linewidth()[0] for lc in ax.collections if lc.get_label() != "nodes"
-                  and hasattr(lc, "get_segments") and len(lc.get_segments())]
+        widths = [
+            lc.get_linewidth()[0]
+            for lc in ax.collections
+            if lc.get_label() != "nodes" and hasattr(lc, "get_segments") and len(lc.get_segments())
+        ]
         assert max(widths) >= 2.0
     assert any("direction of motion" in t.get_text() for t in fig.legends[0].get_texts())
 
@@ -209,3 +215,144 @@ def test_construction_shows_delaunay_then_gabriel(run):
     assert "Delaunay" in b.get_title() and "Gabriel" in c.get_title()
     # points work too
     assert isinstance(plot.construction(embryo.positions), Figure)
+
+
+# --- figures that fit every world (issue "See a run", item 3) ------------------------------------------
+
+
+def small_config(config=None, **keys):
+    c = (config if config is not None else animat.Config()).copy()
+    c["evolution.population"] = 10
+    c["evolution.generations"] = 2
+    c["evaluation.steps"] = 300
+    c["evolution.seed"] = 5
+    for k, v in keys.items():
+        c[k.replace("__", ".")] = v
+    return c
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def crawl_trajectory(steps=300):
+    data = ROOT / "tests" / "data" / "crawl"
+    config = animat.load_config(str(data / "crawl.toml"))
+    genome = animat.Genome.from_json(json.dumps(json.loads((data / "s1_g7.json").read_text())["genome"]))
+    return animat.replay(genome, config, steps=steps, every=10)
+
+
+def test_world_text_names_the_world_as_it_is():
+    assert plot.world_text(animat.Config()) == "fluid d_N = 2, d_T = 0.01"
+    crawl = animat.load_config(str(ROOT / "configs" / "crawl.toml"))
+    assert crawl["scene.drag_normal"] == 2.0  # the key is set, but effect drag is not in the scene
+    text = plot.world_text(crawl)
+    assert "d_N" not in text and "drag" in text and "gravity g = 1" in text and "floor at y = 0" in text
+    chem = animat.load_config(str(ROOT / "configs" / "chemotaxis.toml"))
+    text = plot.world_text(chem)
+    assert "fluid d_N = 2" in text and "GRN control" in text and "point source at (20, 0)" in text
+    assert plot.chemical_source_of(animat.Config()) is None
+    assert list(plot.chemical_source_of(chem)) == [20.0, 0.0]
+
+
+def test_construction_names_the_body_graph_used(run):
+    genome = run.best().genome
+    for graph, words in (
+        ("alpha_shape", "alpha-shape graph (α = 1)"),
+        ("distance", "distance graph"),
+        ("gabriel", "Gabriel graph"),
+    ):
+        c = run.config.copy()
+        c["body.graph"] = graph
+        title = plot.construction(genome, config=c).axes[2].get_title()
+        assert title.startswith(f"(c) {words}"), title
+        if graph != "gabriel":
+            assert "Gabriel" not in title
+    # a bare Body: Gabriel if its springs are the Gabriel graph of its cells, else not claimed
+    c = run.config.copy()
+    c["body.graph"] = "alpha_shape"
+    embryo = animat.develop(genome, c)
+    alpha_body = animat.build_body(embryo, config=c)
+    assert "Gabriel" not in plot.construction(alpha_body).axes[2].get_title()
+    gabriel_body = animat.build_body(embryo)
+    assert "(c) Gabriel graph" in plot.construction(gabriel_body).axes[2].get_title()
+
+
+def fitness_axes(fig):
+    return next(ax for ax in fig.axes if ax.get_label() == "fitness")
+
+
+def test_fitness_history_labels_the_objective(run):
+    ax = fitness_axes(plot.fitness_history(run, max_thumbnails=0))
+    assert ax.get_ylabel() == "fitness: distance" and "distance travelled" not in ax.get_ylabel()
+    spec = next(o for o in animat.objectives() if o.name == "distance")
+    assert ax.get_title(loc="left") == f"objective distance: {spec.meaning}"
+    assert ax.get_ylim()[0] == 0.0  # non-negative objective: the axis starts at 0
+
+
+def test_fitness_history_of_a_signed_objective_is_not_clipped(tmp_path):
+    def standstill(record):  # a signed Python objective: minus the distance travelled
+        return -float(np.linalg.norm(record.com[-1] - record.com[0]))
+
+    animat.evolve(
+        small_config(),
+        out=str(tmp_path / "run"),
+        quiet=True,
+        objective=animat.Objective(standstill, every=50, name="standstill"),
+    )
+    run = animat.Run(tmp_path / "run")
+    assert run.config["evaluation.objective"] == "python:standstill"
+    lowest = float(run.history["mean"].min())
+    assert lowest < 0.0
+    ax = fitness_axes(plot.fitness_history(run, max_thumbnails=0))
+    assert ax.get_ylabel() == "fitness: standstill"
+    bottom, top = ax.get_ylim()
+    assert bottom <= lowest < 0.0 <= top
+    mean = next(ln for ln in ax.get_lines() if ln.get_label() == "mean fitness (viable)")
+    assert np.allclose(mean.get_ydata(), run.history["mean"])
+    assert any(list(ln.get_ydata()) == [0.0, 0.0] for ln in ax.get_lines())  # 0 is marked
+
+
+def test_motion_cycle_in_the_crawl_world_draws_the_floor():
+    tr = crawl_trajectory()
+    h = tr.config["scene.ground_height"]
+    fig = plot.motion_cycle(tr, count=3)
+    panels = [ax for ax in fig.axes if any(c.get_label() == "nodes" for c in ax.collections)]
+    assert len(panels) == 3
+    for ax in panels:
+        floors = [ln for ln in ax.get_lines() if ln.get_label() == "floor"]
+        assert len(floors) == 1 and np.allclose(floors[0].get_ydata(), h)
+        # not rotated: the nodes rest on the floor, none below it
+        nodes = nodes_of(ax).get_offsets()
+        assert nodes[:, 1].min() == pytest.approx(h, abs=1e-3)
+    title = fig._suptitle.get_text()
+    assert "d_N" not in title and "floor at y = 0" in title and "gravity g = 1" in title
+
+
+def test_show_draws_the_stiffness_map_of_evolved_stiffness(run, tmp_path):
+    from animat.cli import show_figures
+
+    assert "stiffness_map" not in show_figures(run)  # the paper's uniform springs: no map
+    config = small_config(**{"genome__extra_outputs": "stiffness", "body__graph": "alpha_shape"})
+    config["evolution.seed"] = 7  # a best whose cells differ in stiffness
+    animat.evolve(config, out=str(tmp_path / "stiff"), quiet=True)
+    stiff = animat.Run(tmp_path / "stiff")
+    makers = show_figures(stiff)
+    assert list(makers) == [
+        "development",
+        "construction",
+        "motion_cycle",
+        "phase_map",
+        "stiffness_map",
+        "fitness_history",
+    ]
+    body = animat.build_body(animat.develop(stiff.best().genome, stiff.config), config=stiff.config)
+    f = np.asarray(body.stiffness)
+    assert len(f) == body.node_count and f.max() > f.min()
+    fig = makers["stiffness_map"]()
+    ax, bar = fig.axes
+    assert np.allclose(nodes_of(ax).get_array(), f)
+    assert "stiffness" in bar.get_ylabel() and bar.get_ylim() == pytest.approx((f.min(), f.max()))
+    assert ax.get_title().startswith("Evolved stiffness")
+    # the same run's construction names its alpha-shape graph, and the history its objective
+    assert "alpha-shape graph" in makers["construction"]().axes[2].get_title()
+    assert fitness_axes(makers["fitness_history"]()).get_ylabel() == "fitness: distance"
