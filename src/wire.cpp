@@ -20,7 +20,8 @@ void Writer::genome(const Genome& g) {
   put(static_cast<std::int32_t>(g.dimensions));
   put(static_cast<std::uint32_t>(g.elements.size()));
   for (const Element& e : g.elements) {
-    const auto& [type, sign, channel, coords] = e;  // a new Element field must be added here (and in Reader)
+    // a new Element field must be added here (and in Reader)
+    const auto& [type, sign, channel, coords] = e;
     put(static_cast<std::uint8_t>(type));
     put(static_cast<std::int8_t>(sign));
     put(static_cast<std::int32_t>(channel));
@@ -30,7 +31,8 @@ void Writer::genome(const Genome& g) {
 }
 
 void Writer::fitness(const Fitness& f) {
-  const auto& [value, viable, stable, cell_count, valid, drag_limited] = f;  // a new Fitness field must be added here (and in Reader)
+  // a new Fitness field must be added here (and in Reader)
+  const auto& [value, viable, stable, cell_count, valid, drag_limited] = f;
   put(value);
   put(static_cast<std::uint8_t>(viable));
   put(static_cast<std::uint8_t>(stable));
@@ -41,7 +43,8 @@ void Writer::fitness(const Fitness& f) {
 
 void Reader::need(std::size_t n) const {
   if (n > size_ - pos_)
-    throw Error(fmt::format("MPI message truncated: {} more bytes needed at byte {} of {}", n, pos_, size_));
+    throw Error(fmt::format("MPI message truncated: {} more bytes needed at byte {} of {}", n, pos_,
+                            size_));
 }
 
 std::string Reader::string() {
