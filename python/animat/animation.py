@@ -1,4 +1,5 @@
 """Rendering a swim to a GIF (Pillow) or an MP4 (ffmpeg, where available): :func:`animate`."""
+
 from __future__ import annotations
 
 import math
@@ -49,11 +50,24 @@ def default_frames(trajectory, max_frames: int = 240, per_cycle: int = 8, start:
     return list(range(int(start) % F, F, stride))[:max_frames]
 
 
-def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0,
-            frames: Optional[Sequence[int]] = None, max_frames: int = 240, start: Optional[int] = None,
-            size: Tuple[int, int] = (560, 360), follow: Optional[bool] = None, align: bool = True,
-            trail: bool = True, color_springs: bool = False, title: Optional[str] = None,
-            progress: Optional[bool] = None, config: Optional[Any] = None, colors: int = 64) -> Path:
+def animate(
+    trajectory: Any,
+    path: Union[str, os.PathLike],
+    *,
+    fps: float = 25.0,
+    frames: Optional[Sequence[int]] = None,
+    max_frames: int = 240,
+    start: Optional[int] = None,
+    size: Tuple[int, int] = (560, 360),
+    follow: Optional[bool] = None,
+    align: bool = True,
+    trail: bool = True,
+    color_springs: bool = False,
+    title: Optional[str] = None,
+    progress: Optional[bool] = None,
+    config: Optional[Any] = None,
+    colors: int = 64,
+) -> Path:
     """Render a trajectory to an animated GIF, or to MP4 where ffmpeg is available.
 
     Each frame shows the body (region fill, springs, thick skin, nodes red expanding / blue
@@ -103,8 +117,10 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
     if suffix == ".mp4":
         ffmpeg = _ffmpeg_exe()
         if ffmpeg is None:
-            raise RuntimeError(f"animate: cannot write {path}: MP4 needs ffmpeg (pip install imageio-ffmpeg, or "
-                               "install ffmpeg); write a .gif instead")
+            raise RuntimeError(
+                f"animate: cannot write {path}: MP4 needs ffmpeg (pip install imageio-ffmpeg, or "
+                "install ffmpeg); write a .gif instead"
+            )
     idx = list(default_frames(tr, max_frames=max_frames, start=start) if frames is None else frames)
     if not idx:
         raise ValueError("animate: no frames to render")
@@ -160,13 +176,29 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
         ax.add_collection(LineCollection(lines, colors="#e3e7ec", linewidths=0.8, zorder=0))
 
     f0 = idx[0]
-    artists = aplot.draw_body(ax, tr.body, world[f0], [aplot.STATE_COLORS[int(s)] for s in tr.node_state[f0]],
-                              node_radius=r, spring_colors=aplot.SPRING_COLOR)
+    artists = aplot.draw_body(
+        ax,
+        tr.body,
+        world[f0],
+        [aplot.STATE_COLORS[int(s)] for s in tr.node_state[f0]],
+        node_radius=r,
+        spring_colors=aplot.SPRING_COLOR,
+    )
     (trail_line,) = ax.plot([], [], color="#7f7f7f", lw=1.0, ls="--", zorder=1)
     (com_dot,) = ax.plot([], [], "+", color="#444444", ms=7, zorder=5)
     if align:
-        ax.add_patch(FancyArrowPatch((0.9, 0.915), (0.975, 0.915), transform=ax.transAxes, arrowstyle="-|>",
-                                     mutation_scale=10, color="#777777", lw=1.2, zorder=6))
+        ax.add_patch(
+            FancyArrowPatch(
+                (0.9, 0.915),
+                (0.975, 0.915),
+                transform=ax.transAxes,
+                arrowstyle="-|>",
+                mutation_scale=10,
+                color="#777777",
+                lw=1.2,
+                zorder=6,
+            )
+        )
     caption = title if title is not None else "red: expanding   blue: contracting   green: neutral"
     overlay = _TextOverlay(width, height)
 
@@ -181,9 +213,33 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
     proc = None
     if ffmpeg:
         path.parent.mkdir(parents=True, exist_ok=True)
-        proc = subprocess.Popen([ffmpeg, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s",
-                                 f"{width}x{height}", "-r", f"{fps}", "-i", "-", "-an", "-vcodec", "libx264",
-                                 "-pix_fmt", "yuv420p", "-crf", "23", str(path)], stdin=subprocess.PIPE)
+        proc = subprocess.Popen(
+            [
+                ffmpeg,
+                "-y",
+                "-loglevel",
+                "error",
+                "-f",
+                "rawvideo",
+                "-pix_fmt",
+                "rgb24",
+                "-s",
+                f"{width}x{height}",
+                "-r",
+                f"{fps}",
+                "-i",
+                "-",
+                "-an",
+                "-vcodec",
+                "libx264",
+                "-pix_fmt",
+                "yuv420p",
+                "-crf",
+                "23",
+                str(path),
+            ],
+            stdin=subprocess.PIPE,
+        )
     springs = np.asarray(tr.body.springs)
     regions = tr.body.regions
     loops = tr.body.skin_loops
@@ -210,8 +266,12 @@ def animate(trajectory: Any, path: Union[str, os.PathLike], *, fps: float = 25.0
             canvas.draw()
             rgb = np.asarray(canvas.buffer_rgba())[:height, :width, :3]
             travelled = float(np.linalg.norm(tr.com[f] - tr.com[0]))
-            image = overlay.apply(rgb, f"t = {tr.times[f]:6.2f}   step {int(tr.steps[f]):5d}\n"
-                                       f"distance {travelled:8.3f}", caption, "motion" if align else "")
+            image = overlay.apply(
+                rgb,
+                f"t = {tr.times[f]:6.2f}   step {int(tr.steps[f]):5d}\ndistance {travelled:8.3f}",
+                caption,
+                "motion" if align else "",
+            )
             if proc is not None and proc.stdin is not None:
                 proc.stdin.write(np.asarray(image).tobytes())
             else:
@@ -254,8 +314,13 @@ class _TextOverlay:
         if bottom_right:
             draw.text((self.width - m, self.height - m), bottom_right, font=self.sans, fill=(85, 85, 85), anchor="rd")
         if top_right:
-            draw.text((int(0.9375 * self.width), int(0.085 * self.height) - 2), top_right, font=self.sans,
-                      fill=(119, 119, 119), anchor="md")
+            draw.text(
+                (int(0.9375 * self.width), int(0.085 * self.height) - 2),
+                top_right,
+                font=self.sans,
+                fill=(119, 119, 119),
+                anchor="md",
+            )
         return image
 
 
@@ -279,8 +344,21 @@ def _stderr_is_tty() -> bool:
 
 
 #: Colours every GIF palette keeps exactly (background, skin, springs, fill, grid, text, node states).
-_KEY_COLORS = ["#ffffff", "#111111", "#222222", "#8c8c8c", "#e9eef3", "#e3e7ec", "#555555", "#777777",
-               "#7f7f7f", "#444444", "#d62728", "#1f77b4", "#2ca02c"]
+_KEY_COLORS = [
+    "#ffffff",
+    "#111111",
+    "#222222",
+    "#8c8c8c",
+    "#e9eef3",
+    "#e3e7ec",
+    "#555555",
+    "#777777",
+    "#7f7f7f",
+    "#444444",
+    "#d62728",
+    "#1f77b4",
+    "#2ca02c",
+]
 
 
 def _write_gif(path: Path, images, fps: float, colors: int) -> None:
@@ -295,8 +373,7 @@ def _write_gif(path: Path, images, fps: float, colors: int) -> None:
     mosaic = Image.new("RGB", (w, h * len(sample)))
     for k, im in enumerate(sample):
         mosaic.paste(im, (0, k * h))
-    rest = mosaic.quantize(colors=colors - len(_KEY_COLORS), method=Image.Quantize.MEDIANCUT,
-                           dither=Image.Dither.NONE)
+    rest = mosaic.quantize(colors=colors - len(_KEY_COLORS), method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
     extra = (rest.getpalette() or [])[: 3 * (colors - len(_KEY_COLORS))]
     keys = [int(round(255 * v)) for c in _KEY_COLORS for v in to_rgb(c)]
     palette = Image.new("P", (1, 1))
@@ -304,5 +381,4 @@ def _write_gif(path: Path, images, fps: float, colors: int) -> None:
     frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
     path.parent.mkdir(parents=True, exist_ok=True)
     duration = max(20, int(round(100.0 / fps)) * 10)  # GIF delays are whole 1/100 s
-    frames[0].save(path, save_all=True, append_images=frames[1:], duration=duration, loop=0, optimize=False,
-                   disposal=1)
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=duration, loop=0, optimize=False, disposal=1)

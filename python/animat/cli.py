@@ -9,6 +9,7 @@
 
 Every command exits with status 1 and a one-line message for a missing or malformed run directory.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -29,12 +30,16 @@ def _size(text: str):
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="animat", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="animat", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     sub = p.add_subparsers(dest="command", required=True, metavar="{evolve,show,animate,info,experiment}")
 
-    sub.add_parser("evolve", add_help=False,
-                   help="run an evolution: animat_evolve's engine and flags (animat evolve --help lists them)")
+    sub.add_parser(
+        "evolve",
+        add_help=False,
+        help="run an evolution: animat_evolve's engine and flags (animat evolve --help lists them)",
+    )
 
     s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
     s.add_argument("run", metavar="RUN_DIR")
@@ -60,8 +65,12 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("run", metavar="RUN_DIR")
 
     e = sub.add_parser("experiment", help="run (or resume) N independent seeds of a config and summarise them")
-    e.add_argument("config", metavar="CONFIG", nargs="+",
-                   help="TOML config file; several as NAME=CONFIG make a study in OUT/NAME/ (docs/cluster.md)")
+    e.add_argument(
+        "config",
+        metavar="CONFIG",
+        nargs="+",
+        help="TOML config file; several as NAME=CONFIG make a study in OUT/NAME/ (docs/cluster.md)",
+    )
     e.add_argument("--runs", type=int, default=3, help="independent runs, seeds evolution.seed + 0..N-1 (default 3)")
     e.add_argument("--out", required=True, help="experiment directory (run_<i>/ per run, summary.json, summary.md)")
     e.add_argument("--parallel", type=int, default=1, help="runs at once; the cores are split between them")
@@ -70,12 +79,20 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--wall-seconds", type=float, help="per-run wall-clock budget in seconds (overrides the config)")
     e.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a config value")
     e.add_argument("--quiet", action="store_true", help="no per-run lines")
-    e.add_argument("--mpi", action="store_true",
-                   help="place the runs on the ranks of an MPI job: mpirun -np R python -m animat experiment ... --mpi "
-                        "(needs mpi4py)")
-    e.add_argument("--index", type=int, action="append", metavar="I",
-                   help="run only run I of the study, numbered environment-major (one Slurm array task: "
-                        "--index $SLURM_ARRAY_TASK_ID); repeatable; writes no summary")
+    e.add_argument(
+        "--mpi",
+        action="store_true",
+        help="place the runs on the ranks of an MPI job: mpirun -np R python -m animat experiment ... --mpi "
+        "(needs mpi4py)",
+    )
+    e.add_argument(
+        "--index",
+        type=int,
+        action="append",
+        metavar="I",
+        help="run only run I of the study, numbered environment-major (one Slurm array task: "
+        "--index $SLURM_ARRAY_TASK_ID); repeatable; writes no summary",
+    )
     return p
 
 
@@ -100,12 +117,15 @@ def cmd_show(args) -> int:
         trajectory = animat.replay(entry, config, steps=args.steps)
     label = f"best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}"
     makers = {
-        "development": lambda: plot.development(entry, config=config,
-                                                title=f"Development (paper Fig. 2) of the {label}"),
-        "construction": lambda: plot.construction(entry, config=config,
-                                                  title=f"From embryo to body (paper Fig. 3): {label}"),
-        "motion_cycle": lambda: plot.motion_cycle(animat.replay(entry, config, steps=args.steps) if trajectory is None
-                                                  else trajectory, count=args.frames),
+        "development": lambda: plot.development(
+            entry, config=config, title=f"Development (paper Fig. 2) of the {label}"
+        ),
+        "construction": lambda: plot.construction(
+            entry, config=config, title=f"From embryo to body (paper Fig. 3): {label}"
+        ),
+        "motion_cycle": lambda: plot.motion_cycle(
+            animat.replay(entry, config, steps=args.steps) if trajectory is None else trajectory, count=args.frames
+        ),
         "phase_map": lambda: plot.phase_map(entry, config=config),
         "fitness_history": lambda: plot.fitness_history(run),
     }
@@ -131,11 +151,23 @@ def cmd_animate(args) -> int:
     t0 = time.perf_counter()
     trajectory = animat.replay(entry, config, steps=args.steps)
     start = None if args.start is None else trajectory.frame_index(args.start)
-    path = animat.animate(trajectory, out, fps=args.fps, max_frames=args.max_frames, start=start, size=args.size,
-                          colors=args.colors, follow=args.follow, progress=False if args.no_progress else None)
+    path = animat.animate(
+        trajectory,
+        out,
+        fps=args.fps,
+        max_frames=args.max_frames,
+        start=start,
+        size=args.size,
+        colors=args.colors,
+        follow=args.follow,
+        progress=False if args.no_progress else None,
+    )
     print(path)
-    print(f"(best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}; "
-          f"{time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    print(
+        f"(best of {run.path.name}: generation {entry.generation}, fitness {entry.fitness:.3f}; "
+        f"{time.perf_counter() - t0:.1f} s)",
+        file=sys.stderr,
+    )
     return 0
 
 
@@ -153,9 +185,20 @@ def cmd_info(args) -> int:
 def cmd_experiment(args) -> int:
     from .experiment import run_study, summarize
 
-    by_env = run_study(args.config, args.runs, args.out, mpi=args.mpi, index=args.index, parallel=args.parallel,
-                       threads=args.threads, generations=args.generations, wall_seconds=args.wall_seconds,
-                       overrides=args.set, quiet=args.quiet, log=lambda m: print(m, flush=True))
+    by_env = run_study(
+        args.config,
+        args.runs,
+        args.out,
+        mpi=args.mpi,
+        index=args.index,
+        parallel=args.parallel,
+        threads=args.threads,
+        generations=args.generations,
+        wall_seconds=args.wall_seconds,
+        overrides=args.set,
+        quiet=args.quiet,
+        log=lambda m: print(m, flush=True),
+    )
     nested = len(by_env) > 1 or "=" in args.config[0]
     for name, records in by_env.items():
         where = f"{args.out}/{name}" if nested else args.out
@@ -165,8 +208,10 @@ def cmd_experiment(args) -> int:
             continue
         stats = summarize(records)
         if stats:
-            print(f"{where}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
-                  f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {where}/summary.md")
+            print(
+                f"{where}: median best fitness {stats['median']:.4f} over {stats['runs']} runs "
+                f"(min {stats['min']:.4f}, max {stats['max']:.4f}); see {where}/summary.md"
+            )
     return 0
 
 
@@ -179,8 +224,7 @@ def main(argv: Optional[List[str]] = None) -> int:
 
         return _core.evolve_cli(argv[1:])
     args = _parser().parse_args(argv)
-    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info,
-               "experiment": cmd_experiment}[args.command]
+    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info, "experiment": cmd_experiment}[args.command]
     try:
         return command(args)
     except KeyboardInterrupt as e:

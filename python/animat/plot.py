@@ -19,6 +19,7 @@ function               paper        shows
 :func:`draw_body` draws one body into an existing Axes (used by all of the above and by
 :func:`animat.animate`).
 """
+
 from __future__ import annotations
 
 import math
@@ -27,22 +28,33 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
-from numpy.typing import ArrayLike
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from matplotlib.collections import EllipseCollection, LineCollection, PatchCollection, PolyCollection
 from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, ConnectionPatch, Polygon
 from matplotlib.ticker import MaxNLocator
+from numpy.typing import ArrayLike
 
 from . import _core
 from .run import MORPHOLOGY_TOLERANCE, Run
 from .trajectory import CONTRACTING, EXPANDING, NEUTRAL, STATE_NAMES, Trajectory, body_of
 
 __all__ = [
-    "development", "construction", "motion_cycle", "phase_map", "stiffness_map", "fitness_history", "draw_body",
-    "STATE_COLORS", "PHASE_CMAP", "STIFFNESS_CMAP", "rotation_to", "development_steps", "energy_split",
+    "development",
+    "construction",
+    "motion_cycle",
+    "phase_map",
+    "stiffness_map",
+    "fitness_history",
+    "draw_body",
+    "STATE_COLORS",
+    "PHASE_CMAP",
+    "STIFFNESS_CMAP",
+    "rotation_to",
+    "development_steps",
+    "energy_split",
     "ENERGY_SINKS",
 ]
 
@@ -72,6 +84,7 @@ FILL_COLOR = "#e9eef3"
 
 # --- helpers ------------------------------------------------------------------------------------------
 
+
 def rotation_to(direction: ArrayLike, target: ArrayLike = (1.0, 0.0)) -> np.ndarray:
     """The 2×2 rotation matrix R with ``R @ direction`` parallel to ``target`` (default +x).
 
@@ -97,10 +110,22 @@ def _loops_closed(positions, loops):
     return [positions[np.append(loop, loop[0])] for loop in loops if len(loop)]
 
 
-def draw_body(ax: Axes, body: Any, positions: Optional[np.ndarray] = None, node_colors: Any = "#444444", *,
-              node_radius: Optional[float] = None, fill: bool = True, springs: bool = True,
-              spring_colors: Any = SPRING_COLOR, skin_width: float = 2.2, spring_width: float = 0.8,
-              node_edge: str = "#222222", zorder: float = 2.0, label: str = "nodes") -> Dict[str, Any]:
+def draw_body(
+    ax: Axes,
+    body: Any,
+    positions: Optional[np.ndarray] = None,
+    node_colors: Any = "#444444",
+    *,
+    node_radius: Optional[float] = None,
+    fill: bool = True,
+    springs: bool = True,
+    spring_colors: Any = SPRING_COLOR,
+    skin_width: float = 2.2,
+    spring_width: float = 0.8,
+    node_edge: str = "#222222",
+    zorder: float = 2.0,
+    label: str = "nodes",
+) -> Dict[str, Any]:
     """Draw one body into ``ax``: light region fill, springs (thin), skin (thick) and nodes.
 
     Args:
@@ -121,20 +146,38 @@ def draw_body(ax: Axes, body: Any, positions: Optional[np.ndarray] = None, node_
     r = _node_radius(body) if node_radius is None else node_radius
     out: Dict[str, Any] = {"fill": None}
     if fill and len(body.regions):
-        out["fill"] = PolyCollection([pos[reg] for reg in body.regions], facecolors=FILL_COLOR, edgecolors="none",
-                                     zorder=zorder - 0.3)
+        out["fill"] = PolyCollection(
+            [pos[reg] for reg in body.regions], facecolors=FILL_COLOR, edgecolors="none", zorder=zorder - 0.3
+        )
         ax.add_collection(out["fill"])
     sp = np.asarray(body.springs)
-    out["springs"] = LineCollection(_segments(pos, sp if springs else sp[:0]), colors=spring_colors,
-                                    linewidths=spring_width, zorder=zorder - 0.2)
+    out["springs"] = LineCollection(
+        _segments(pos, sp if springs else sp[:0]), colors=spring_colors, linewidths=spring_width, zorder=zorder - 0.2
+    )
     ax.add_collection(out["springs"])
-    out["skin"] = LineCollection(_loops_closed(pos, body.skin_loops), colors=SKIN_COLOR, linewidths=skin_width,
-                                 capstyle="round", joinstyle="round", zorder=zorder - 0.1)
+    out["skin"] = LineCollection(
+        _loops_closed(pos, body.skin_loops),
+        colors=SKIN_COLOR,
+        linewidths=skin_width,
+        capstyle="round",
+        joinstyle="round",
+        zorder=zorder - 0.1,
+    )
     ax.add_collection(out["skin"])
     n = len(pos)
-    out["nodes"] = EllipseCollection(np.full(n, 2 * r), np.full(n, 2 * r), np.zeros(n), units="xy", offsets=pos,
-                                     offset_transform=ax.transData, facecolors=node_colors, edgecolors=node_edge,
-                                     linewidths=0.5, zorder=zorder, label=label)
+    out["nodes"] = EllipseCollection(
+        np.full(n, 2 * r),
+        np.full(n, 2 * r),
+        np.zeros(n),
+        units="xy",
+        offsets=pos,
+        offset_transform=ax.transData,
+        facecolors=node_colors,
+        edgecolors=node_edge,
+        linewidths=0.5,
+        zorder=zorder,
+        label=label,
+    )
     ax.add_collection(out["nodes"])
     return out
 
@@ -150,6 +193,7 @@ def _frame_axes(ax, lo, hi, pad):
 
 
 # --- Fig. 2: development --------------------------------------------------------------------------------
+
 
 def development_steps(embryo_or_trace) -> list:
     """Default steps for :func:`development`: the first cell, every division round (daughters still
@@ -173,13 +217,20 @@ def development_steps(embryo_or_trace) -> list:
             chosen.append(s)
     if len(chosen) > 12:  # many division rounds: keep the first, the last three and an even spread
         keep = np.unique(np.linspace(0, len(chosen) - 4, 8).round().astype(int)).tolist() + list(
-            range(len(chosen) - 3, len(chosen)))
+            range(len(chosen) - 3, len(chosen))
+        )
         chosen = [chosen[k] for k in sorted(set(keep))]
     return chosen
 
 
-def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, config: Optional[Any] = None,
-                cols: int = 4, title: Optional[str] = None) -> Figure:
+def development(
+    embryo_or_trace: Any,
+    steps: Optional[Sequence[int]] = None,
+    *,
+    config: Optional[Any] = None,
+    cols: int = 4,
+    title: Optional[str] = None,
+) -> Figure:
     """Paper Fig. 2: the embryo at chosen development steps, cells as circles with a short line
     along each cell's orientation vector, all panels at the same scale.
 
@@ -206,8 +257,10 @@ def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, 
     if isinstance(embryo_or_trace, _core.Embryo):
         embryo = embryo_or_trace
         if embryo.trace is None:
-            raise ValueError("development: this Embryo has no trace; develop it with "
-                             "config['development.trace_every'] = 1 (or pass the genome)")
+            raise ValueError(
+                "development: this Embryo has no trace; develop it with "
+                "config['development.trace_every'] = 1 (or pass the genome)"
+            )
         trace = embryo.trace
     else:
         trace = embryo_or_trace
@@ -215,14 +268,21 @@ def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, 
     index = {s: k for k, s in enumerate(trace.steps)}
     missing = [s for s in steps if s not in index]
     if missing:
-        raise ValueError(f"development: steps {missing} are not in the trace (recorded: {trace.steps[0]}.."
-                         f"{trace.steps[-1]} every {trace.steps[1] - trace.steps[0] if len(trace.steps) > 1 else 1})")
+        raise ValueError(
+            f"development: steps {missing} are not in the trace (recorded: {trace.steps[0]}.."
+            f"{trace.steps[-1]} every {trace.steps[1] - trace.steps[0] if len(trace.steps) > 1 else 1})"
+        )
     if not steps:
         raise ValueError("development: no steps to draw")
     last = index[max(steps)]
     centre = trace.positions[last].mean(axis=0)
-    half = np.max([np.abs(trace.positions[index[s]] - centre).max(axis=0) + np.max(trace.radii[index[s]])
-                   for s in steps], axis=0) * 1.08  # (2,) half-extent of the common frame
+    half = (
+        np.max(
+            [np.abs(trace.positions[index[s]] - centre).max(axis=0) + np.max(trace.radii[index[s]]) for s in steps],
+            axis=0,
+        )
+        * 1.08
+    )  # (2,) half-extent of the common frame
     half = np.maximum(half, 0.35 * half.max())
     cols = max(1, min(cols, len(steps)))
     rows = (len(steps) + cols - 1) // cols
@@ -230,15 +290,19 @@ def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, 
     panel_h = float(np.clip(panel_w * half[1] / half[0], 0.9, 2.6))
     fig = plt.figure(figsize=(panel_w * cols, (panel_h + 0.35) * rows + 0.45))
     axes = fig.subplots(rows, cols, squeeze=False)
-    for ax in axes.flat[len(steps):]:
+    for ax in axes.flat[len(steps) :]:
         ax.set_visible(False)
     for ax, s, letter in zip(axes.flat, steps, "abcdefghijklmnopqrstuvwxyz"):
         k = index[s]
         pos, radii, orient = trace.positions[k], trace.radii[k], trace.orientations[k]
-        ax.add_collection(PatchCollection([Circle(p, r) for p, r in zip(pos, radii)], facecolor="#cfe3f7",
-                                          edgecolor="#1f4e79", linewidth=0.8))
-        ax.add_collection(LineCollection([(p, p + r * o) for p, r, o in zip(pos, radii, orient)],
-                                         colors="#b22222", linewidths=1.2))
+        ax.add_collection(
+            PatchCollection(
+                [Circle(p, r) for p, r in zip(pos, radii)], facecolor="#cfe3f7", edgecolor="#1f4e79", linewidth=0.8
+            )
+        )
+        ax.add_collection(
+            LineCollection([(p, p + r * o) for p, r, o in zip(pos, radii, orient)], colors="#b22222", linewidths=1.2)
+        )
         _frame_axes(ax, centre - half, centre + half, 0.0)
         ax.set_title(f"step {s} ({len(radii)} cell{'s' if len(radii) != 1 else ''})", fontsize=9)
         ax.text(0.03, 0.97, f"({letter})", transform=ax.transAxes, va="top", fontsize=8)
@@ -249,8 +313,14 @@ def development(embryo_or_trace: Any, steps: Optional[Sequence[int]] = None, *, 
 
 # --- Fig. 3: construction -------------------------------------------------------------------------------
 
-def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, config: Optional[Any] = None,
-                 title: Optional[str] = None) -> Figure:
+
+def construction(
+    embryo_or_points: Any,
+    radii: Optional[np.ndarray] = None,
+    *,
+    config: Optional[Any] = None,
+    title: Optional[str] = None,
+) -> Figure:
     """Paper Fig. 3: (a) cell centres at the end of development, (b) their Delaunay
     triangulation, (c) the Gabriel graph, the final structure, with its regions shaded (one colour
     each) and the skin (the only edges that feel drag) drawn thick.
@@ -292,31 +362,39 @@ def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, c
         _frame_axes(ax, lo, hi, pad)
 
     ax = axes[0]
-    ax.add_collection(PatchCollection([Circle(p, r) for p, r in zip(pos, radii)], facecolor="#dde8f3",
-                                      edgecolor="#8aa6c1", linewidth=0.6))
+    ax.add_collection(
+        PatchCollection(
+            [Circle(p, r) for p, r in zip(pos, radii)], facecolor="#dde8f3", edgecolor="#8aa6c1", linewidth=0.6
+        )
+    )
     ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5)
     ax.set_title(f"(a) cell centres ({len(pos)} cells)", fontsize=10)
 
     ax = axes[1]
-    ax.add_collection(LineCollection(_segments(pos, delaunay), colors="#555555",
-                                     linewidths=0.9))
+    ax.add_collection(LineCollection(_segments(pos, delaunay), colors="#555555", linewidths=0.9))
     ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5)
     ax.set_title(f"(b) Delaunay triangulation ({len(delaunay)} edges)", fontsize=10)
 
     ax = axes[2]
     cmap = plt.get_cmap("Pastel1")
     if body.region_count:
-        ax.add_collection(PatchCollection([Polygon(pos[r]) for r in body.regions],
-                                          facecolor=[cmap(k % 9) for k in range(body.region_count)], edgecolor="none"))
+        ax.add_collection(
+            PatchCollection(
+                [Polygon(pos[r]) for r in body.regions],
+                facecolor=[cmap(k % 9) for k in range(body.region_count)],
+                edgecolor="none",
+            )
+        )
     springs = np.asarray(body.springs)
-    ax.add_collection(LineCollection(_segments(pos, springs), colors="#555555",
-                                     linewidths=0.9))
+    ax.add_collection(LineCollection(_segments(pos, springs), colors="#555555", linewidths=0.9))
     skin = np.asarray(body.skin)
-    ax.add_collection(LineCollection(_segments(pos, skin), colors="#b2182b",
-                                     linewidths=2.8, capstyle="round"))
+    ax.add_collection(LineCollection(_segments(pos, skin), colors="#b2182b", linewidths=2.8, capstyle="round"))
     ax.plot(pos[:, 0], pos[:, 1], "o", color="k", ms=3.5, zorder=3)
-    ax.set_title(f"(c) Gabriel graph: {body.spring_count} springs,\n{body.region_count} regions (shaded), "
-                 f"{len(skin)} skin edges (thick)", fontsize=10)
+    ax.set_title(
+        f"(c) Gabriel graph: {body.spring_count} springs,\n{body.region_count} regions (shaded), "
+        f"{len(skin)} skin edges (thick)",
+        fontsize=10,
+    )
     fig.suptitle(title or "From embryo to body (paper Fig. 3)", fontsize=11)
     fig.tight_layout()
     return fig
@@ -324,9 +402,17 @@ def construction(embryo_or_points: Any, radii: Optional[np.ndarray] = None, *, c
 
 # --- Figs. 4-6: motion cycle ----------------------------------------------------------------------------
 
-def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None, *, count: int = 6,
-                 align: bool = True, cols: Optional[int] = None, color_springs: bool = False,
-                 title: Optional[str] = None) -> Figure:
+
+def motion_cycle(
+    trajectory: Trajectory,
+    frames: Optional[Sequence[int]] = None,
+    *,
+    count: int = 6,
+    align: bool = True,
+    cols: Optional[int] = None,
+    color_springs: bool = False,
+    title: Optional[str] = None,
+) -> Figure:
     """Paper Figs. 4–6: snapshots of one motion cycle. Node colour is the cell's actuation state
     from eq. 2 (``trajectory.node_state``): red expanding, blue contracting, green neutral
     (:data:`STATE_COLORS`). The skin is drawn thick, springs thin, and an arrow in each panel
@@ -367,7 +453,7 @@ def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None,
     panel_h = float(np.clip(panel_w * ext[1] / ext[0], 1.2, 4.0))
     fig = plt.figure(figsize=(panel_w * cols, panel_h * rows + 1.0))
     axes = fig.subplots(rows, cols, squeeze=False)
-    for ax in axes.flat[len(frames):]:
+    for ax in axes.flat[len(frames) :]:
         ax.set_visible(False)
     steps0 = int(tr.steps[frames[0]])
     for ax, f, pos in zip(axes.flat, frames, snaps):
@@ -377,25 +463,54 @@ def motion_cycle(trajectory: Trajectory, frames: Optional[Sequence[int]] = None,
         _frame_axes(ax, lo, hi, r + 0.4)
         ax.set_title(f"step {int(tr.steps[f])}", fontsize=9)
         ax.text(0.02, 0.03, f"+{int(tr.steps[f]) - steps0}", transform=ax.transAxes, fontsize=7, color="#666666")
-        ax.annotate("", xy=(0.93 + 0.05 * direction[0], 0.12 + 0.05 * direction[1] * panel_w / panel_h),
-                    xytext=(0.93 - 0.05 * direction[0], 0.12 - 0.05 * direction[1] * panel_w / panel_h),
-                    xycoords="axes fraction", arrowprops=dict(arrowstyle="-|>", color="#555555", lw=1.2))
-    handles = [Line2D([], [], marker="o", ls="", markerfacecolor=STATE_COLORS[s], markeredgecolor="#222222",
-                      markersize=8, label=STATE_NAMES[s]) for s in (EXPANDING, CONTRACTING, NEUTRAL)]
+        ax.annotate(
+            "",
+            xy=(0.93 + 0.05 * direction[0], 0.12 + 0.05 * direction[1] * panel_w / panel_h),
+            xytext=(0.93 - 0.05 * direction[0], 0.12 - 0.05 * direction[1] * panel_w / panel_h),
+            xycoords="axes fraction",
+            arrowprops=dict(arrowstyle="-|>", color="#555555", lw=1.2),
+        )
+    handles = [
+        Line2D(
+            [],
+            [],
+            marker="o",
+            ls="",
+            markerfacecolor=STATE_COLORS[s],
+            markeredgecolor="#222222",
+            markersize=8,
+            label=STATE_NAMES[s],
+        )
+        for s in (EXPANDING, CONTRACTING, NEUTRAL)
+    ]
     handles.append(Line2D([], [], color=SKIN_COLOR, lw=2.2, label="skin"))
-    handles.append(Line2D([], [], marker=r"$\rightarrow$", ls="", color="#555555", markersize=12,
-                          label="direction of motion" + (" (rotated to point right)" if align else "")))
+    handles.append(
+        Line2D(
+            [],
+            [],
+            marker=r"$\rightarrow$",
+            ls="",
+            color="#555555",
+            markersize=12,
+            label="direction of motion" + (" (rotated to point right)" if align else ""),
+        )
+    )
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
     period = tr.period()
-    cycle = (f"dominant period {period / tr.dt:.0f} steps" if math.isfinite(period) else "no oscillation")
-    fig.suptitle(title or f"Motion cycle (paper Figs. 4-6): steps {int(tr.steps[frames[0]])}-"
-                          f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g} in "
-                          f"{int(tr.steps[-1] - tr.steps[0])} steps", fontsize=9.5)
+    cycle = f"dominant period {period / tr.dt:.0f} steps" if math.isfinite(period) else "no oscillation"
+    fig.suptitle(
+        title
+        or f"Motion cycle (paper Figs. 4-6): steps {int(tr.steps[frames[0]])}-"
+        f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g} in "
+        f"{int(tr.steps[-1] - tr.steps[0])} steps",
+        fontsize=9.5,
+    )
     fig.tight_layout(rect=(0, 0.07, 1, 1))
     return fig
 
 
 # --- Fig. 7: phase map ----------------------------------------------------------------------------------
+
 
 def _map_axes(ax: Optional[Axes], extent: np.ndarray, colorbar: bool) -> Tuple[Figure, Axes]:
     """The figure and axes of a body map (phase_map, stiffness_map): ``ax`` and its figure, or a new
@@ -414,15 +529,29 @@ def _label_max(ax: Axes, pos: np.ndarray, k: int, lo: np.ndarray, hi: np.ndarray
     """Label node k of a body map "max <value>", the label pushed outward from the body's centre."""
     toward = (lo + hi) / 2 - pos[k]
     toward = toward / (np.linalg.norm(toward) or 1.0)
-    ax.annotate(f"max {value:.2f}", xy=pos[k], xytext=tuple(22 * toward), textcoords="offset points", fontsize=8,
-                ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
-                va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
-                arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
-                bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9), zorder=5)
+    ax.annotate(
+        f"max {value:.2f}",
+        xy=pos[k],
+        xytext=tuple(22 * toward),
+        textcoords="offset points",
+        fontsize=8,
+        ha="left" if toward[0] > 0.3 else ("right" if toward[0] < -0.3 else "center"),
+        va="bottom" if toward[1] > 0.3 else ("top" if toward[1] < -0.3 else "center"),
+        arrowprops=dict(arrowstyle="-", color="#444444", lw=0.8),
+        bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="#999999", lw=0.5, alpha=0.9),
+        zorder=5,
+    )
 
 
-def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = PHASE_CMAP,
-              colorbar: bool = True, title: Optional[str] = None) -> Figure:
+def phase_map(
+    body: Any,
+    *,
+    config: Optional[Any] = None,
+    ax: Optional[Axes] = None,
+    cmap: str = PHASE_CMAP,
+    colorbar: bool = True,
+    title: Optional[str] = None,
+) -> Figure:
     """Paper Fig. 7: the body at rest (its initial, equilibrium state) with every node coloured by
     its oscillation phase shift. The colour range is normalised to the body's phases
     (``vmin = phase.min()``, ``vmax = phase.max()``) and the maximum (the red node) is written
@@ -464,8 +593,15 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = N
         cb = fig.colorbar(nodes, ax=ax, fraction=0.045, pad=0.03)
         cb.set_label("phase shift φ (rad)", fontsize=8)
         cb.ax.tick_params(labelsize=7)
-    ax.set_title(title if title is not None else (f"Phase shifts (paper Fig. 7)\nmax φ = {vmax:.2f} rad" + (
-        " (all equal)" if vmax == vmin else f", min {vmin:.2f} rad")), fontsize=9)
+    ax.set_title(
+        title
+        if title is not None
+        else (
+            f"Phase shifts (paper Fig. 7)\nmax φ = {vmax:.2f} rad"
+            + (" (all equal)" if vmax == vmin else f", min {vmin:.2f} rad")
+        ),
+        fontsize=9,
+    )
     if standalone:
         fig.tight_layout()
     return fig
@@ -473,8 +609,16 @@ def phase_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = N
 
 # --- stiffness map (issue 17 part 3), the phase map's sibling ---------------------------------------------
 
-def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes] = None, cmap: str = STIFFNESS_CMAP,
-                  colorbar: bool = True, title: Optional[str] = None) -> Figure:
+
+def stiffness_map(
+    body: Any,
+    *,
+    config: Optional[Any] = None,
+    ax: Optional[Axes] = None,
+    cmap: str = STIFFNESS_CMAP,
+    colorbar: bool = True,
+    title: Optional[str] = None,
+) -> Figure:
     """The sibling of :func:`phase_map` (paper Fig. 7 style) for evolved stiffness: the body at rest
     with every node coloured by its stiffness factor f (GRN output ``stiffness``) and every spring by
     its own factor, the harmonic mean 2 f_i f_j / (f_i + f_j) of its two cells (its stiffness is
@@ -532,8 +676,11 @@ def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes]
         cb.set_label("stiffness factor f (× k)", fontsize=8)
         cb.ax.tick_params(labelsize=7)
     if title is None:
-        title = ("Stiffness (uniform: no evolved stiffness)" if uniform else
-                 f"Evolved stiffness\nfactor {vmin:.2f} to {vmax:.2f} (× spring_stiffness)")
+        title = (
+            "Stiffness (uniform: no evolved stiffness)"
+            if uniform
+            else f"Evolved stiffness\nfactor {vmin:.2f} to {vmax:.2f} (× spring_stiffness)"
+        )
     ax.set_title(title, fontsize=9)
     if standalone:
         fig.tight_layout()
@@ -542,8 +689,15 @@ def stiffness_map(body: Any, *, config: Optional[Any] = None, ax: Optional[Axes]
 
 # --- Figs. 8-9: fitness history ------------------------------------------------------------------------
 
-def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MORPHOLOGY_TOLERANCE,
-                    show_mean: bool = True, title: Optional[str] = None) -> Figure:
+
+def fitness_history(
+    run: Any,
+    *,
+    max_thumbnails: int = 6,
+    tolerance: float = MORPHOLOGY_TOLERANCE,
+    show_mean: bool = True,
+    title: Optional[str] = None,
+) -> Figure:
     """Paper Figs. 8–9: the best fitness over generations, with the generations at which the best
     individual's morphology changed marked, and thumbnails of those bodies (at rest, nodes
     coloured by phase shift, each thumbnail normalised like :func:`phase_map`; plain nodes when
@@ -574,8 +728,17 @@ def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MOR
     fig = plt.figure(figsize=(10, 6.2 if shown else 4.2))
     gs: Any = None
     if shown:
-        gs = fig.add_gridspec(2, max(len(shown), 1), height_ratios=[1.0, 1.5], hspace=0.25, left=0.07, right=0.98,
-                              top=0.88, bottom=0.09, wspace=0.12)
+        gs = fig.add_gridspec(
+            2,
+            max(len(shown), 1),
+            height_ratios=[1.0, 1.5],
+            hspace=0.25,
+            left=0.07,
+            right=0.98,
+            top=0.88,
+            bottom=0.09,
+            wspace=0.12,
+        )
         main = fig.add_subplot(gs[1, :])
     else:
         main = fig.add_subplot()
@@ -625,20 +788,36 @@ def fitness_history(run: Any, *, max_thumbnails: int = 6, tolerance: float = MOR
             _frame_axes(ax, pos.min(axis=0), pos.max(axis=0), _node_radius(body) + 0.5)
             note = "no phase shift"
         ax.set_title(f"gen {entry.generation}: {entry.fitness:.3g}\n{note}", fontsize=8)
-        con = ConnectionPatch(xyA=(0.5, 0.0), coordsA=ax.transAxes, xyB=(entry.generation, entry.fitness),
-                              coordsB=main.transData, color="#d62728", lw=0.7, alpha=0.7)
+        con = ConnectionPatch(
+            xyA=(0.5, 0.0),
+            coordsA=ax.transAxes,
+            xyB=(entry.generation, entry.fitness),
+            coordsB=main.transData,
+            color="#d62728",
+            lw=0.7,
+            alpha=0.7,
+        )
         fig.add_artist(con)
     n_changes = len(changes)
-    fig.suptitle(title or f"Fitness history (paper Figs. 8-9): {run.path.name}, {len(hist)} generations, "
-                          f"{len(lineage)} improvements, {n_changes} morpholog{'y' if n_changes == 1 else 'ies'}"
-                          f"{f' ({len(shown)} shown, nodes coloured by phase)' if shown else ''}", fontsize=10)
+    fig.suptitle(
+        title
+        or f"Fitness history (paper Figs. 8-9): {run.path.name}, {len(hist)} generations, "
+        f"{len(lineage)} improvements, {n_changes} morpholog{'y' if n_changes == 1 else 'ies'}"
+        f"{f' ({len(shown)} shown, nodes coloured by phase)' if shown else ''}",
+        fontsize=10,
+    )
     if not shown:
         fig.tight_layout()
     return fig
 
 
-def energy_split(accounts: Any, labels: Optional[Sequence[str]] = None, *, ax: Optional[Axes] = None,
-                 title: str = "Where the actuation work goes") -> Figure:
+def energy_split(
+    accounts: Any,
+    labels: Optional[Sequence[str]] = None,
+    *,
+    ax: Optional[Axes] = None,
+    title: str = "Where the actuation work goes",
+) -> Figure:
     """One horizontal bar per swim: the share of the energy that came in (actuation plus pushes)
     taken by each sink of its :class:`animat.EnergyAccount` (``evaluation.energy_accounting``), in
     the order of :data:`ENERGY_SINKS`; the fluid's share is printed at the end of each bar.
@@ -651,9 +830,13 @@ def energy_split(accounts: Any, labels: Optional[Sequence[str]] = None, *, ax: O
     books = [getattr(a, "energy", a) for a in items]
     for k, b in enumerate(books):
         if not getattr(b, "measured", False):
-            raise ValueError(f"energy_split: swim {k + 1} has no energy books (set evaluation.energy_accounting = true)")
+            raise ValueError(
+                f"energy_split: swim {k + 1} has no energy books (set evaluation.energy_accounting = true)"
+            )
         if not b.actuation + b.external > 0.0:
-            raise ValueError(f"energy_split: swim {k + 1} took in no energy (actuation {b.actuation}, pushes {b.external})")
+            raise ValueError(
+                f"energy_split: swim {k + 1} took in no energy (actuation {b.actuation}, pushes {b.external})"
+            )
     names = list(labels) if labels is not None else [f"swim {k + 1}" for k in range(len(books))]
     if len(names) != len(books):
         raise ValueError(f"energy_split: {len(names)} labels for {len(books)} swims")
@@ -670,13 +853,20 @@ def energy_split(accounts: Any, labels: Optional[Sequence[str]] = None, *, ax: O
         ax.barh(y, share, left=left, color=color, label=label, height=0.7)
         left += share
     for yy, b in zip(y, books):
-        ax.text(1.01, yy, f"fluid {100.0 * b.fluid / (b.actuation + b.external):.0f} %", va="center", fontsize=8,
-                transform=ax.get_yaxis_transform())
+        ax.text(
+            1.01,
+            yy,
+            f"fluid {100.0 * b.fluid / (b.actuation + b.external):.0f} %",
+            va="center",
+            fontsize=8,
+            transform=ax.get_yaxis_transform(),
+        )
     ax.set_yticks(y, names)
     ax.set_xlim(min(0.0, float(left.min()) - 0.02), max(1.0, float(left.max())) + 0.02)
     ax.set_xlabel("share of the energy that came in (actuation + pushes)")
     ax.set_title(title)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.35 if len(books) < 4 else -0.12), ncol=4, fontsize=7,
-              frameon=False)
+    ax.legend(
+        loc="upper center", bbox_to_anchor=(0.5, -0.35 if len(books) < 4 else -0.12), ncol=4, fontsize=7, frameon=False
+    )
     fig.tight_layout()
     return fig

@@ -16,6 +16,7 @@ near the turning points of its oscillation (``|cos| <= 0.1`` for the fastest cel
 not started yet, and always when its own ``a_i f_i`` is below the threshold (a practically
 non-oscillating cell). A body without any oscillation is neutral everywhere.
 """
+
 from __future__ import annotations
 
 import math
@@ -27,8 +28,18 @@ import numpy as np
 from . import _core
 
 __all__ = [
-    "Trajectory", "replay", "actuation_terms", "actuation_rates", "actuation_start_times", "classify_rates",
-    "EXPANDING", "CONTRACTING", "NEUTRAL", "STATE_NAMES", "DEFAULT_NEUTRAL", "body_of",
+    "Trajectory",
+    "replay",
+    "actuation_terms",
+    "actuation_rates",
+    "actuation_start_times",
+    "classify_rates",
+    "EXPANDING",
+    "CONTRACTING",
+    "NEUTRAL",
+    "STATE_NAMES",
+    "DEFAULT_NEUTRAL",
+    "body_of",
 ]
 
 #: Actuation state codes used in :attr:`Trajectory.node_state` and :attr:`Trajectory.spring_state`.
@@ -48,7 +59,9 @@ def actuation_start_times(frequency: np.ndarray, phase: np.ndarray) -> np.ndarra
     Returns:
         (n,) float64 array; +inf for a cell that never starts.
     """
-    return np.array([_core.actuation_start_time(float(f), float(p)) for f, p in zip(frequency, phase)], dtype=np.float64)
+    return np.array(
+        [_core.actuation_start_time(float(f), float(p)) for f, p in zip(frequency, phase)], dtype=np.float64
+    )
 
 
 def _broadcast(amplitude, frequency, phase, t):
@@ -246,19 +259,29 @@ class Trajectory:
         """Index of the frame recorded at control step ``step`` (ValueError if none was)."""
         hits = np.nonzero(self.steps == step)[0]
         if not len(hits):
-            raise ValueError(f"no frame at step {step} (frames are every {self.every} steps, "
-                             f"{int(self.steps[0])}..{int(self.steps[-1])})")
+            raise ValueError(
+                f"no frame at step {step} (frames are every {self.every} steps, "
+                f"{int(self.steps[0])}..{int(self.steps[-1])})"
+            )
         return int(hits[0])
 
     def __repr__(self) -> str:
-        return (f"<animat.Trajectory {self.frame_count} frames (every {self.every} steps, t = "
-                f"{self.times[0]:.3g}..{self.times[-1]:.3g}), {self.node_count} nodes, "
-                f"{len(self.body.springs)} springs, distance {self.distance:.4g}"
-                f"{'' if self.stable else ', UNSTABLE'}>")
+        return (
+            f"<animat.Trajectory {self.frame_count} frames (every {self.every} steps, t = "
+            f"{self.times[0]:.3g}..{self.times[-1]:.3g}), {self.node_count} nodes, "
+            f"{len(self.body.springs)} springs, distance {self.distance:.4g}"
+            f"{'' if self.stable else ', UNSTABLE'}>"
+        )
 
 
-def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[int] = None, every: int = 1,
-           scene: Optional[Any] = None, neutral: float = DEFAULT_NEUTRAL) -> Trajectory:
+def replay(
+    genome_or_body: Any,
+    config: Optional[Any] = None,
+    steps: Optional[int] = None,
+    every: int = 1,
+    scene: Optional[Any] = None,
+    neutral: float = DEFAULT_NEUTRAL,
+) -> Trajectory:
     """Swim a genome (or a developed embryo, or a body) again and record it.
 
     The swim is the one ``animat.evaluate`` does: ``develop`` → ``build_body`` → ``Simulation``
@@ -321,8 +344,12 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
         recorded += 1
     if failure:
         import warnings
-        warnings.warn(f"replay: swim became unstable after {int(steps_done[recorded - 1])} steps: {failure}",
-                      RuntimeWarning, stacklevel=2)
+
+        warnings.warn(
+            f"replay: swim became unstable after {int(steps_done[recorded - 1])} steps: {failure}",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     pos, vel, times, steps_done = pos[:recorded], vel[:recorded], times[:recorded], steps_done[:recorded]
 
     a, f, p = body.amplitude, body.frequency, body.phase
@@ -335,8 +362,23 @@ def replay(genome_or_body: Any, config: Optional[Any] = None, steps: Optional[in
     spring_rates = rates[:, i] + rates[:, j]
     rest = (1.0 + terms[:, i] + terms[:, j]) * body.rest_lengths[None, :]
     return Trajectory(
-        body=body, positions=pos, velocities=vel, times=times, steps=steps_done, com=pos.mean(axis=1),
-        node_terms=terms, node_rates=rates, node_state=classify_rates(rates, threshold),
-        spring_rates=spring_rates, spring_state=classify_rates(spring_rates, threshold), rest_lengths=rest,
-        neutral_threshold=threshold, dt=float(cfg["physics.dt"]), every=int(every), config=cfg,
-        stable=not failure, failure=failure, meta={"neutral": float(neutral)})
+        body=body,
+        positions=pos,
+        velocities=vel,
+        times=times,
+        steps=steps_done,
+        com=pos.mean(axis=1),
+        node_terms=terms,
+        node_rates=rates,
+        node_state=classify_rates(rates, threshold),
+        spring_rates=spring_rates,
+        spring_state=classify_rates(spring_rates, threshold),
+        rest_lengths=rest,
+        neutral_threshold=threshold,
+        dt=float(cfg["physics.dt"]),
+        every=int(every),
+        config=cfg,
+        stable=not failure,
+        failure=failure,
+        meta={"neutral": float(neutral)},
+    )

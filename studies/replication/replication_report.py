@@ -17,6 +17,7 @@ counts, and the scale of the runs. Nothing is evolved: the bests are only develo
 (one 4000-step swim each), so it takes a minute or two. The output depends only on the run
 directories (no dates, no timings of this script).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -52,7 +53,7 @@ PAPER_GENERATIONS = "about 5,000 (rarely above 10,000)"
 # What the paper reports per environment (§6), quoted.
 PAPER_MODES: Dict[str, Dict[str, str]] = {
     "dn0.5": {
-        "undulation": "0 (\"rarely if at all\": only 1 mixed strategy with limited undulation)",
+        "undulation": '0 ("rarely if at all": only 1 mixed strategy with limited undulation)',
         "synchronous contraction": "1",
         "protrusions": "9 (1 of them mixed with some undulation)",
         "other": "—",
@@ -64,37 +65,37 @@ PAPER_MODES: Dict[str, Dict[str, str]] = {
         "other": "—",
     },
     "dn10": {
-        "undulation": "5 (\"half\", including the two best solutions overall)",
+        "undulation": '5 ("half", including the two best solutions overall)',
         "synchronous contraction": "2",
-        "protrusions": "4 (strategy \"less clear\"; 1 mixed with undulation)",
+        "protrusions": '4 (strategy "less clear"; 1 mixed with undulation)',
         "other": "—",
     },
     "dn0.2_64cells": {
         "undulation": "not reported",
         "synchronous contraction": "not reported",
-        "protrusions": "9 (1 of them mixed with a \"tail\")",
-        "tail": "1 (a \"tail\" only; 1 more mixed a tail into protrusions)",
+        "protrusions": '9 (1 of them mixed with a "tail")',
+        "tail": '1 (a "tail" only; 1 more mixed a tail into protrusions)',
         "other": "—",
     },
 }
 PAPER_QUOTES = {
-    "dn0.5": "\"animats often evolved protrusions (\"appendages\"; in nine out of 10 runs with d_N = 0.5, in one "
-             "of these nine the best strategy was mixed with some undulation)\"; synchronous contraction "
-             "\"emerged in all environmental settings (d_N = 0.5: one out of 10 ...)\"; undulation appeared "
-             "\"rarely if at all when the drag was low (d_N = 0.5; only one mixed strategy involved limited "
-             "undulation)\".",
-    "dn2": "\"when d_N = 2, four out of 10 used undulation, three mixed it with other strategies\"; synchronous "
-           "contraction \"was the most successful when drag coefficients were moderate (d_N = 2: six best "
-           "individuals in 10 independent runs, one of them with undulation)\"; \"protrusions appeared, but only "
-           "in strategies mixed with undulation (d_N = 2: in two out of 10)\".",
-    "dn10": "\"In 10 independent runs with a high drag coefficient (d_N = 10), half of the best individuals in 10 "
-            "independent runs, including the two best solutions overall, moved by undulation\"; synchronous "
-            "contraction \"d_N = 10: two out of 10\"; \"protrusions also appeared (in four out of 10), but the "
-            "movement strategy was less clear or (in one of these four best individuals) mixed with undulation\".",
-    "dn0.2_64cells": "\"Much more clearly defined protrusions, consisting of multiple cells (Fig. 6b), emerged when "
-                     "the cell limit was increased to 64 cells and the drag was put at an even lower value "
-                     "(d_N = 0.2; under these conditions nine out of 10 best individuals used protrusions, but one "
-                     "had a mixed strategy, using a \"tail\", the remaining one used only the \"tail\")\".",
+    "dn0.5": '"animats often evolved protrusions ("appendages"; in nine out of 10 runs with d_N = 0.5, in one '
+    'of these nine the best strategy was mixed with some undulation)"; synchronous contraction '
+    '"emerged in all environmental settings (d_N = 0.5: one out of 10 ...)"; undulation appeared '
+    '"rarely if at all when the drag was low (d_N = 0.5; only one mixed strategy involved limited '
+    'undulation)".',
+    "dn2": '"when d_N = 2, four out of 10 used undulation, three mixed it with other strategies"; synchronous '
+    'contraction "was the most successful when drag coefficients were moderate (d_N = 2: six best '
+    'individuals in 10 independent runs, one of them with undulation)"; "protrusions appeared, but only '
+    'in strategies mixed with undulation (d_N = 2: in two out of 10)".',
+    "dn10": '"In 10 independent runs with a high drag coefficient (d_N = 10), half of the best individuals in 10 '
+    'independent runs, including the two best solutions overall, moved by undulation"; synchronous '
+    'contraction "d_N = 10: two out of 10"; "protrusions also appeared (in four out of 10), but the '
+    'movement strategy was less clear or (in one of these four best individuals) mixed with undulation".',
+    "dn0.2_64cells": '"Much more clearly defined protrusions, consisting of multiple cells (Fig. 6b), emerged when '
+    "the cell limit was increased to 64 cells and the drag was put at an even lower value "
+    "(d_N = 0.2; under these conditions nine out of 10 best individuals used protrusions, but one "
+    'had a mixed strategy, using a "tail", the remaining one used only the "tail")".',
 }
 MODE_COLUMNS = ["undulation", "synchronous contraction", "protrusions", "tail", "other", "none"]
 #: The paper's main counts per environment (of 10 runs), mixed strategies under their main mode where the
@@ -109,7 +110,7 @@ CALIBRATION_DRAGS = (0.5, 2.0)
 CALIBRATION_STEPS = 2000
 
 # Verdict thresholds for the claims (the classification thresholds live in animat.locomotion).
-GROW_MAXIMAL = 0.9       # realised grow level >= 0.9 of the maximum counts as "maximal"
+GROW_MAXIMAL = 0.9  # realised grow level >= 0.9 of the maximum counts as "maximal"
 AMPLITUDE_NEAR_MAX = 0.9  # mean amplitude >= 90 % of amplitude_max counts as "near maximum"
 
 
@@ -119,7 +120,7 @@ class RunReport:
     index: int
     path: Path
     seed: int
-    generations: int           # last completed generation (0-based), -1 if none yet
+    generations: int  # last completed generation (0-based), -1 if none yet
     wall_seconds: float
     evaluations: int
     stop: str
@@ -176,6 +177,7 @@ class EnvReport:
 
 # --- reading ----------------------------------------------------------------------------------------------
 
+
 def _retry(fn, what: str, tries: int = 4):
     """Files of a running run can be caught half-written: read again a moment later."""
     for k in range(tries):
@@ -189,8 +191,9 @@ def _retry(fn, what: str, tries: int = 4):
 
 
 def read_env(path: Path) -> Optional[EnvReport]:
-    run_dirs = sorted((p for p in path.glob("run_*") if p.is_dir() and p.name[4:].isdigit()),
-                      key=lambda p: int(p.name[4:]))
+    run_dirs = sorted(
+        (p for p in path.glob("run_*") if p.is_dir() and p.name[4:].isdigit()), key=lambda p: int(p.name[4:])
+    )
     run_dirs = [p for p in run_dirs if (p / "config.toml").is_file()]
     if not run_dirs:
         return None
@@ -202,22 +205,31 @@ def read_env(path: Path) -> Optional[EnvReport]:
     for p in run_dirs:
         run = animat.Run(p)
         i = int(p.name[4:])
-        h = _retry(lambda: run.history, f"{p}/history.csv")
+        h = _retry(lambda: run.history, f"{p}/history.csv")  # noqa: B023 (called right here)
         cfg = run.config
         rec = summary.get(i)
         status = json.loads((p / "status.json").read_text()) if (p / "status.json").is_file() else {}
         stop = rec["stop_reason"] if rec else status.get("stop_reason", "in progress")
-        runs.append(RunReport(env=path.name, index=i, path=p, seed=int(cfg["evolution.seed"]),
-                              generations=int(h["generation"][-1]) if len(h) else -1,
-                              wall_seconds=float(h["wall_seconds"][-1]) if len(h) else 0.0,
-                              evaluations=int(h["evaluations"][-1]) if len(h) else 0, stop=stop, history=h))
+        runs.append(
+            RunReport(
+                env=path.name,
+                index=i,
+                path=p,
+                seed=int(cfg["evolution.seed"]),
+                generations=int(h["generation"][-1]) if len(h) else -1,
+                wall_seconds=float(h["wall_seconds"][-1]) if len(h) else 0.0,
+                evaluations=int(h["evaluations"][-1]) if len(h) else 0,
+                stop=stop,
+                history=h,
+            )
+        )
     config = animat.Run(run_dirs[0]).config
-    finished = all(r.stop not in ("in progress", "interrupted") and not r.stop.startswith("wall-clock")
-                   for r in runs)
+    finished = all(r.stop not in ("in progress", "interrupted") and not r.stop.startswith("wall-clock") for r in runs)
     return EnvReport(path.name, path, config, runs, finished=finished)
 
 
 # --- per-run analysis -------------------------------------------------------------------------------------
+
 
 def analyse_run(r: RunReport, images: Path, gif: bool) -> None:
     run = animat.Run(r.path)
@@ -237,22 +249,23 @@ def analyse_run(r: RunReport, images: Path, gif: bool) -> None:
     stem = f"{r.env}_run{r.index}"
     label = f"{r.env} run {r.index}: best of generation {r.best.generation}, fitness {r.best.fitness:.2f}"
 
-    fig = animat.plot.motion_cycle(tr, count=6, title=f"Motion cycle (paper Figs. 4-6), {label}; "
-                                                      f"mode: {r.mode.label}")
+    fig = animat.plot.motion_cycle(tr, count=6, title=f"Motion cycle (paper Figs. 4-6), {label}; mode: {r.mode.label}")
     fig.savefig(images / f"{stem}_motion.png", dpi=72)
     plt.close(fig)
     r.images["motion"] = f"{stem}_motion.png"
 
     ph = np.asarray(tr.body.phase)
-    fig = animat.plot.phase_map(tr.body, title=f"{r.env} run {r.index}: phase shifts (Fig. 7)\nmax φ = {ph.max():.2f} rad"
-                                + (" (all equal)" if np.ptp(ph) == 0 else f", min {ph.min():.2f} rad"))
+    fig = animat.plot.phase_map(
+        tr.body,
+        title=f"{r.env} run {r.index}: phase shifts (Fig. 7)\nmax φ = {ph.max():.2f} rad"
+        + (" (all equal)" if np.ptp(ph) == 0 else f", min {ph.min():.2f} rad"),
+    )
     fig.savefig(images / f"{stem}_phase.png", dpi=72)
     plt.close(fig)
     r.images["phase"] = f"{stem}_phase.png"
 
     if gif:
-        animat.animate(tr, images / f"{stem}.gif", fps=16, max_frames=60, size=(320, 200), colors=16,
-                       progress=False)
+        animat.animate(tr, images / f"{stem}.gif", fps=16, max_frames=60, size=(320, 200), colors=16, progress=False)
         r.images["gif"] = f"{stem}.gif"
 
 
@@ -264,8 +277,9 @@ def fitness_figure(env: EnvReport, images: Path) -> str:
         h = r.history
         if not len(h):
             continue
-        ax.plot(h["generation"], h["best"], drawstyle="steps-post", color=c, lw=1.6,
-                label=f"run {r.index} (seed {r.seed})")
+        ax.plot(
+            h["generation"], h["best"], drawstyle="steps-post", color=c, lw=1.6, label=f"run {r.index} (seed {r.seed})"
+        )
         ax.plot(h["generation"], h["mean"], color=c, lw=0.7, alpha=0.5)
         if r.changes:
             best_at = {int(g): float(b) for g, b in zip(h["generation"], h["best"])}
@@ -278,8 +292,9 @@ def fitness_figure(env: EnvReport, images: Path) -> str:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.25)
     ax.legend(fontsize=8, loc="upper left")
-    ax.set_title(f"Best fitness per generation (paper Figs. 8-9): {env.title}, d_T = {env.drag_tangential:g}",
-                 fontsize=10)
+    ax.set_title(
+        f"Best fitness per generation (paper Figs. 8-9): {env.title}, d_T = {env.drag_tangential:g}", fontsize=10
+    )
     fig.tight_layout()
     name = f"{env.name}_fitness.png"
     fig.savefig(images / name, dpi=80)
@@ -289,12 +304,13 @@ def fitness_figure(env: EnvReport, images: Path) -> str:
 
 # --- text helpers ----------------------------------------------------------------------------------------
 
+
 def fmt_range(values: List[float], digits: int = 2) -> str:
     vals = [v for v in values if v == v]
     if not vals:
         return "—"
     lo, hi = min(vals), max(vals)
-    return f"{lo:.{digits}f}" if abs(hi - lo) < 0.5 * 10 ** -digits else f"{lo:.{digits}f}–{hi:.{digits}f}"
+    return f"{lo:.{digits}f}" if abs(hi - lo) < 0.5 * 10**-digits else f"{lo:.{digits}f}–{hi:.{digits}f}"
 
 
 def hours(seconds: float) -> str:
@@ -315,27 +331,34 @@ def env_claims(env: EnvReport) -> Dict[str, Dict[str, str]]:
     full = [r for r in rs if r.stats.cells == r.stats.max_cells]
     out["cells"] = {
         "ours": ", ".join(str(r.stats.cells) for r in rs) + f" (max {env.max_cells})",
-        "verdict": ("agrees: every best has the maximum number of cells" if len(full) == n else
-                    f"differs: {n - len(full)} of {n} bests have fewer than {env.max_cells} cells "
-                    f"({', '.join(f'run {r.index}: {r.stats.cells}' for r in rs if r not in full)})"),
+        "verdict": (
+            "agrees: every best has the maximum number of cells"
+            if len(full) == n
+            else f"differs: {n - len(full)} of {n} bests have fewer than {env.max_cells} cells "
+            f"({', '.join(f'run {r.index}: {r.stats.cells}' for r in rs if r not in full)})"
+        ),
     }
     realized = [r.stats.grow.realized for r in rs]
     final = [r.stats.grow.final_mean for r in rs]
     maximal = [r for r in rs if r.stats.grow.realized >= GROW_MAXIMAL]
     out["grow"] = {
         "ours": f"at divisions {fmt_range(realized)}; final {fmt_range(final)}",
-        "verdict": ("agrees: every best grows its cells at ≥ 90 % of the maximum" if len(maximal) == n else
-                    f"differs: {count_word(n - len(maximal), n)} best{'s' if n - len(maximal) != 1 else ''} "
-                    f"grow{'s' if n - len(maximal) == 1 else ''} cells at less than 90 % of the maximum "
-                    f"(realised grow level {fmt_range([r.stats.grow.realized for r in rs if r not in maximal])})"),
+        "verdict": (
+            "agrees: every best grows its cells at ≥ 90 % of the maximum"
+            if len(maximal) == n
+            else f"differs: {count_word(n - len(maximal), n)} best{'s' if n - len(maximal) != 1 else ''} "
+            f"grow{'s' if n - len(maximal) == 1 else ''} cells at less than 90 % of the maximum "
+            f"(realised grow level {fmt_range([r.stats.grow.realized for r in rs if r not in maximal])})"
+        ),
     }
     rel = [r.stats.oscillators.amplitude_relative for r in rs]
     rng = [r.stats.oscillators.amplitude_range for r in rs]
     near = [r for r in rs if r.stats.oscillators.amplitude_relative >= AMPLITUDE_NEAR_MAX]
     diff = [r for r in rs if r.stats.oscillators.amplitude_differentiated]
     parts = []
-    parts.append("near maximum in all" if len(near) == n else
-                 f"below 90 % of the maximum in {count_word(n - len(near), n)}")
+    parts.append(
+        "near maximum in all" if len(near) == n else f"below 90 % of the maximum in {count_word(n - len(near), n)}"
+    )
     parts.append("differentiated in none" if not diff else f"differentiated in {count_word(len(diff), n)}")
     agrees = len(near) == n and not diff
     out["amplitude"] = {
@@ -344,22 +367,29 @@ def env_claims(env: EnvReport) -> Dict[str, Dict[str, str]]:
     }
     fdiff = [r for r in rs if r.stats.oscillators.frequency_differentiated]
     out["frequency"] = {
-        "ours": "spread " + fmt_range([r.stats.oscillators.frequency_max - r.stats.oscillators.frequency_min
-                                       for r in rs], 3) + " rad/time",
-        "verdict": ("agrees: not differentiated in any best" if not fdiff else
-                    f"{'differs' if len(fdiff) > n / 2 else 'mostly agrees'}: differentiated in "
-                    f"{count_word(len(fdiff), n)}"),
+        "ours": "spread "
+        + fmt_range([r.stats.oscillators.frequency_max - r.stats.oscillators.frequency_min for r in rs], 3)
+        + " rad/time",
+        "verdict": (
+            "agrees: not differentiated in any best"
+            if not fdiff
+            else f"{'differs' if len(fdiff) > n / 2 else 'mostly agrees'}: differentiated in "
+            f"{count_word(len(fdiff), n)}"
+        ),
     }
     pr = [r.stats.oscillators.phase.range for r in rs]
     pdiff = [r for r in rs if r.stats.oscillators.phase.differentiated]
     same = n - len(pdiff)
     out["phase"] = {
         "ours": f"range {fmt_range(pr)} rad",
-        "verdict": ("agrees: differentiated (range > " f"{L.PHASE_DIFFERENTIATED} rad) in every best" if not same else
-                    f"{'differs' if same > n / 2 else 'partly agrees'}: differentiated (range > "
-                    f"{L.PHASE_DIFFERENTIATED} rad) in {count_word(len(pdiff), n)}; "
-                    f"{'every best oscillates' if same == n else count_word(same, n) + (' bests oscillate' if same > 1 else ' best oscillates')}"
-                    " with all cells in phase"),
+        "verdict": (
+            f"agrees: differentiated (range > {L.PHASE_DIFFERENTIATED} rad) in every best"
+            if not same
+            else f"{'differs' if same > n / 2 else 'partly agrees'}: differentiated (range > "
+            f"{L.PHASE_DIFFERENTIATED} rad) in {count_word(len(pdiff), n)}; "
+            f"{'every best oscillates' if same == n else count_word(same, n) + (' bests oscillate' if same > 1 else ' best oscillates')}"
+            " with all cells in phase"
+        ),
     }
     tries = [r.tries for r in rs if r.tries == r.tries]
     if tries:
@@ -379,34 +409,61 @@ def env_claims(env: EnvReport) -> Dict[str, Dict[str, str]]:
         late = [g for g in last if g > 500]
         out["morphology"] = {
             "ours": "generation " + ", ".join(str(g) for g in last) + f" (of {fmt_range(reached, 0)} reached)",
-            "verdict": ((f"agrees within our horizon: every last change by generation {max(last)}"
-                         if not late else f"differs: {count_word(len(late), len(last))} after generation 500")
-                        + (f"; our runs stopped at generation {max(reached)}, so changes after thousands of "
-                           "generations (paper: rare) cannot be seen" if max(reached) < 2000 else "")),
+            "verdict": (
+                (
+                    f"agrees within our horizon: every last change by generation {max(last)}"
+                    if not late
+                    else f"differs: {count_word(len(late), len(last))} after generation 500"
+                )
+                + (
+                    f"; our runs stopped at generation {max(reached)}, so changes after thousands of "
+                    "generations (paper: rare) cannot be seen"
+                    if max(reached) < 2000
+                    else ""
+                )
+            ),
         }
     return out
 
 
 CLAIMS = [
-    ("cells", "Cell count of the best", "\"the best individuals we obtained always had the maximum number of cells "
-                                        "that was allowed\" (§7)"),
-    ("grow", "Grow output of the best (size increase)", "\"In almost all cases, the factor responsible for an "
-                                                        "increase of cell sizes during development was found to be "
-                                                        "expressed at the maximum level\" (§6)"),
-    ("amplitude", "Amplitude across cells", "\"The amplitude of oscillation almost universally evolved to be close "
-                                            "to maximum for all cells\"; \"the amplitude and frequency of the "
-                                            "oscillations is rarely differentiated between cells\" (§6)"),
+    (
+        "cells",
+        "Cell count of the best",
+        '"the best individuals we obtained always had the maximum number of cells that was allowed" (§7)',
+    ),
+    (
+        "grow",
+        "Grow output of the best (size increase)",
+        '"In almost all cases, the factor responsible for an '
+        "increase of cell sizes during development was found to be "
+        'expressed at the maximum level" (§6)',
+    ),
+    (
+        "amplitude",
+        "Amplitude across cells",
+        '"The amplitude of oscillation almost universally evolved to be close '
+        'to maximum for all cells"; "the amplitude and frequency of the '
+        'oscillations is rarely differentiated between cells" (§6)',
+    ),
     ("frequency", "Frequency across cells", "rarely differentiated (§6, as above)"),
-    ("phase", "Phase across cells", "\"the differentiation of phase did evolve\" (§6)"),
-    ("tries", "Random tries per viable initial individual", "\"Typically, this required a few hundred tries for "
-                                                             "each random individual\" (§5)"),
-    ("morphology", "Generation of the last morphological change of the best",
-     "\"entirely new combinations of morphology and control sweep through the population for the first hundreds "
-     "of generations\"; \"Only rarely would the best morphology change after many thousands of generations\" (§7)"),
+    ("phase", "Phase across cells", '"the differentiation of phase did evolve" (§6)'),
+    (
+        "tries",
+        "Random tries per viable initial individual",
+        '"Typically, this required a few hundred tries for each random individual" (§5)',
+    ),
+    (
+        "morphology",
+        "Generation of the last morphological change of the best",
+        '"entirely new combinations of morphology and control sweep through the population for the first hundreds '
+        'of generations"; "Only rarely would the best morphology change after many thousands of generations" (§7)',
+    ),
 ]
 
 
 # --- the document ----------------------------------------------------------------------------------------
+
 
 def _score(p: Optional[L.Paddling]) -> str:
     """A paddle pair score for a table: the score (bold when the swim paddles), or — without a pair."""
@@ -421,86 +478,115 @@ def calibration_lines(results: Dict[str, List[KS.KnownResult]]) -> List[str]:
     w = out.append
     w("## Calibration: the classifier on swimmers of known mode")
     w("")
-    w("Before any evolved swimmer is classified, `animat.classify_locomotion` is checked on swimmers built by "
-      "hand with a known mode (`studies/locomotion/known_swimmers.py`: cell positions on a jittered triangular "
-      "lattice, every cell's amplitude, frequency and phase set directly, nothing evolved): undulators (a phase "
-      "ramp of a travelling wave along the body, a bending wave with the two sides in antiphase, a ramp across "
-      "the body), synchronous contractors on an asymmetric tear-drop outline (one with a short lag along the "
-      "body), bodies with two symmetric appendages (one cell, or two-cell-wide strips of 2–4 rows) whose "
-      "actuation is set to swing them back and forth, longest on the backward swing (paper Fig. 6; how far the "
-      "swims follow is measured below), the core passive but for the cells they are anchored to, one with a weak wave on its core (a mixture), and a passive body with one beating tail. "
-      f"Each is swum {CALIBRATION_STEPS} steps at d_N = " + " and ".join(f"{d:g}" for d in CALIBRATION_DRAGS)
-      + ". The *calibration* set was used to set the one new threshold (LOCAL_CONTRAST below); the *held-out* "
-      "set (other shapes, sizes, appendage lengths, frequencies 3–11) was not used to set anything.")
+    w(
+        "Before any evolved swimmer is classified, `animat.classify_locomotion` is checked on swimmers built by "
+        "hand with a known mode (`studies/locomotion/known_swimmers.py`: cell positions on a jittered triangular "
+        "lattice, every cell's amplitude, frequency and phase set directly, nothing evolved): undulators (a phase "
+        "ramp of a travelling wave along the body, a bending wave with the two sides in antiphase, a ramp across "
+        "the body), synchronous contractors on an asymmetric tear-drop outline (one with a short lag along the "
+        "body), bodies with two symmetric appendages (one cell, or two-cell-wide strips of 2–4 rows) whose "
+        "actuation is set to swing them back and forth, longest on the backward swing (paper Fig. 6; how far the "
+        "swims follow is measured below), the core passive but for the cells they are anchored to, one with a weak wave on its core (a mixture), and a passive body with one beating tail. "
+        f"Each is swum {CALIBRATION_STEPS} steps at d_N = "
+        + " and ".join(f"{d:g}" for d in CALIBRATION_DRAGS)
+        + ". The *calibration* set was used to set the one new threshold (LOCAL_CONTRAST below); the *held-out* "
+        "set (other shapes, sizes, appendage lengths, frequencies 3–11) was not used to set anything."
+    )
     w("")
     found_cols = ["undulation", "synchronous contraction", "protrusions", "tail", "other", "none", "unstable"]
     for name, res in results.items():
-        expected = [m for m in ["undulation", "synchronous contraction", "protrusions", "tail"]
-                    if any(r.swimmer.expected == m for r in res)]
+        expected = [
+            m
+            for m in ["undulation", "synchronous contraction", "protrusions", "tail"]
+            if any(r.swimmer.expected == m for r in res)
+        ]
         cols = [c for c in found_cols if any(r.found == c for r in res) or c in expected]
         m = KS.confusion_matrix(res, expected, cols)
         correct = sum(1 for r in res if r.correct)
-        w(f"**{name}** ({len({r.swimmer.name for r in res})} swimmers × {len(CALIBRATION_DRAGS)} drags): "
-          f"{correct} of {len(res)} swims classified as built. Rows: built as; columns: classified as.")
+        w(
+            f"**{name}** ({len({r.swimmer.name for r in res})} swimmers × {len(CALIBRATION_DRAGS)} drags): "
+            f"{correct} of {len(res)} swims classified as built. Rows: built as; columns: classified as."
+        )
         w("")
         w("| built as \\ classified as | " + " | ".join(cols) + " |")
         w("| --- | " + " | ".join("---" for _ in cols) + " |")
         for i, e in enumerate(expected):
             w(f"| {e} | " + " | ".join(str(int(v)) for v in m[i]) + " |")
         w("")
-    w("Every swim (deformation, contraction coherence R, wave fit and lag, top-20 % share of the motion, "
-      "strain contrast: the RMS contraction of the most strained 20 % of the cells over the median cell's):")
+    w(
+        "Every swim (deformation, contraction coherence R, wave fit and lag, top-20 % share of the motion, "
+        "strain contrast: the RMS contraction of the most strained 20 % of the cells over the median cell's):"
+    )
     w("")
-    w("| set | swimmer | cells | d_N | built as | classified as | distance | R | wave fit | lag (rad) | "
-      "top-20 % share | strain contrast | groups | paddle pair score |")
+    w(
+        "| set | swimmer | cells | d_N | built as | classified as | distance | R | wave fit | lag (rad) | "
+        "top-20 % share | strain contrast | groups | paddle pair score |"
+    )
     w("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name, res in results.items():
         for r in res:
             md = r.mode
             if md is None:
-                w(f"| {name} | `{r.swimmer.name}` | {r.swimmer.cells} | {r.drag_normal:g} | {r.swimmer.expected} | "
-                  "unstable | — | — | — | — | — | — | — | — |")
+                w(
+                    f"| {name} | `{r.swimmer.name}` | {r.swimmer.cells} | {r.drag_normal:g} | {r.swimmer.expected} | "
+                    "unstable | — | — | — | — | — | — | — | — |"
+                )
                 continue
             wv = md.wave
             mark = "" if r.correct else " ✗"
-            w(f"| {name} | `{r.swimmer.name}` | {r.swimmer.cells} | {r.drag_normal:g} | {r.swimmer.expected}"
-              + (f" (+ {r.swimmer.mixed})" if r.swimmer.mixed else "") + f" | {md.label}{mark} | {r.distance:.2f} | "
-              f"{md.coherence:.2f} | {wv.fit if wv else float('nan'):.2f} | {wv.lag if wv else float('nan'):.2f} | "
-              f"{md.concentration:.2f} | {md.contrast:.2f} | {md.groups or '—'} | {_score(r.paddling)} |")
+            w(
+                f"| {name} | `{r.swimmer.name}` | {r.swimmer.cells} | {r.drag_normal:g} | {r.swimmer.expected}"
+                + (f" (+ {r.swimmer.mixed})" if r.swimmer.mixed else "")
+                + f" | {md.label}{mark} | {r.distance:.2f} | "
+                f"{md.coherence:.2f} | {wv.fit if wv else float('nan'):.2f} | {wv.lag if wv else float('nan'):.2f} | "
+                f"{md.concentration:.2f} | {md.contrast:.2f} | {md.groups or '—'} | {_score(r.paddling)} |"
+            )
     w("")
     allres = [r for res in results.values() for r in res if r.mode is not None]
     strokes = [r for r in allres if r.stroke is not None and r.swimmer.expected == "protrusions"]
     if strokes:
-        w("Do the hand-built appendages row as the paper's Fig. 6 describes (extended while they move "
-          "backwards, contracted on the return)? Their actuation was set for it; the swims show how far it "
-          "happened. Per protrusion swim, over the classifier's window in the body frame: the appendage cells' "
-          "sweep along the direction of motion, their extension (peak-to-peak distance from the centre) and "
-          "the correlation of extension with backward velocity (+1: farthest out exactly while moving back):")
+        w(
+            "Do the hand-built appendages row as the paper's Fig. 6 describes (extended while they move "
+            "backwards, contracted on the return)? Their actuation was set for it; the swims show how far it "
+            "happened. Per protrusion swim, over the classifier's window in the body frame: the appendage cells' "
+            "sweep along the direction of motion, their extension (peak-to-peak distance from the centre) and "
+            "the correlation of extension with backward velocity (+1: farthest out exactly while moving back):"
+        )
         w("")
         w("| set | swimmer | d_N | sweep | extension | extension vs backward velocity |")
         w("| --- | --- | --- | --- | --- | --- |")
         for name, res in results.items():
             for r in res:
                 if r.stroke is not None and r.swimmer.expected == "protrusions":
-                    w(f"| {name} | `{r.swimmer.name}` | {r.drag_normal:g} | {r.stroke.sweep:.2f} | "
-                      f"{r.stroke.extension:.2f} | {r.stroke.rowing:+.2f} |")
+                    w(
+                        f"| {name} | `{r.swimmer.name}` | {r.drag_normal:g} | {r.stroke.sweep:.2f} | "
+                        f"{r.stroke.extension:.2f} | {r.stroke.rowing:+.2f} |"
+                    )
         w("")
         rows = [r.stroke.rowing for r in strokes]
-        w(f"The appendages sweep and extend, but the rowing correlation is only {min(rows):+.2f} to "
-          f"{max(rows):+.2f}: these bodies are appendage swimmers by construction (localised actuation, passive "
-          "core), not tuned rowers; the classifier is calibrated on *where* a body deforms, not on the stroke.")
+        w(
+            f"The appendages sweep and extend, but the rowing correlation is only {min(rows):+.2f} to "
+            f"{max(rows):+.2f}: these bodies are appendage swimmers by construction (localised actuation, passive "
+            "core), not tuned rowers; the classifier is calibrated on *where* a body deforms, not on the stroke."
+        )
         w("")
 
     def rng(vals: List[float]) -> str:
         return fmt_range(vals, 2).replace("–", "–") if vals else "—"
 
     def scores(kinds: Tuple[str, ...]) -> List[float]:
-        return [r.paddling.score for r in allres if r.swimmer.expected in kinds and r.paddling is not None
-                and r.paddling.score == r.paddling.score]
+        return [
+            r.paddling.score
+            for r in allres
+            if r.swimmer.expected in kinds and r.paddling is not None and r.paddling.score == r.paddling.score
+        ]
 
     def unscored(kinds: Tuple[str, ...]) -> int:
-        return sum(1 for r in allres if r.swimmer.expected in kinds and r.paddling is not None
-                   and r.paddling.score != r.paddling.score)
+        return sum(
+            1
+            for r in allres
+            if r.swimmer.expected in kinds and r.paddling is not None and r.paddling.score != r.paddling.score
+        )
 
     def score_range(kinds: Tuple[str, ...]) -> str:
         v, none = scores(kinds), unscored(kinds)
@@ -509,41 +595,44 @@ def calibration_lines(results: Dict[str, List[KS.KnownResult]]) -> List[str]:
         return f"{min(v):+.2f} to {max(v):+.2f}" + (f" ({none} swims without a pair)" if none else "")
 
     whole = ("undulation", "synchronous contraction")
-    w("**The paper's stroke, tested without a classifier** (`animat.locomotion.paddling`, the column *paddle pair "
-      "score* above and in the table of evolved bests): the paper says its protrusions are \"fully extended when "
-      "moving backwards (generating thrust) but are contracted during their return\", placed symmetrically, and in "
-      "32-cell bodies \"often built from one cell extending beyond the main outline\". Per skin cell, over the "
-      "classifier's window in the body frame: it *protrudes* when it stands at least "
-      f"{L.PADDLE_SPIKE:g} median rest spring lengths above the chord of its two skin neighbours at some time (a "
-      "cell standing out of a straight edge: 0.87 at rest), and it *rows* with the correlation of its distance "
-      "from the centre with its backward velocity (+1: a loop traversed out, back, in, forward). The pair score is "
-      "the best min(rowing) of two protruding cells on opposite sides of the axis of motion (— where there is no "
-      f"such pair); a swim *paddles* from {L.PADDLE_ROWING:g}. On the hand-built swims: undulators and "
-      f"synchronous contractors {score_range(whole)}, protrusion swimmers {score_range(('protrusions',))}, tails "
-      f"{score_range(('tail',))}. So no whole-body swim paddles (the "
-      "threshold lies above all of them), but neither does any hand-built protrusion swimmer: their appendages "
-      "follow the commanded stroke only loosely (table above). The test has negative controls only: a best that "
-      "paddles moves as the paper's words describe, no more is calibrated.")
+    w(
+        "**The paper's stroke, tested without a classifier** (`animat.locomotion.paddling`, the column *paddle pair "
+        'score* above and in the table of evolved bests): the paper says its protrusions are "fully extended when '
+        'moving backwards (generating thrust) but are contracted during their return", placed symmetrically, and in '
+        '32-cell bodies "often built from one cell extending beyond the main outline". Per skin cell, over the '
+        "classifier's window in the body frame: it *protrudes* when it stands at least "
+        f"{L.PADDLE_SPIKE:g} median rest spring lengths above the chord of its two skin neighbours at some time (a "
+        "cell standing out of a straight edge: 0.87 at rest), and it *rows* with the correlation of its distance "
+        "from the centre with its backward velocity (+1: a loop traversed out, back, in, forward). The pair score is "
+        "the best min(rowing) of two protruding cells on opposite sides of the axis of motion (— where there is no "
+        f"such pair); a swim *paddles* from {L.PADDLE_ROWING:g}. On the hand-built swims: undulators and "
+        f"synchronous contractors {score_range(whole)}, protrusion swimmers {score_range(('protrusions',))}, tails "
+        f"{score_range(('tail',))}. So no whole-body swim paddles (the "
+        "threshold lies above all of them), but neither does any hand-built protrusion swimmer: their appendages "
+        "follow the commanded stroke only loosely (table above). The test has negative controls only: a best that "
+        "paddles moves as the paper's words describe, no more is calibrated."
+    )
     w("")
 
     prot_conc = [r.mode.concentration for r in allres if r.swimmer.expected == "protrusions" and not r.swimmer.mixed]
-    app_con = [r.mode.contrast for r in allres if r.swimmer.expected in ("protrusions", "tail")
-               and not r.swimmer.mixed]
+    app_con = [r.mode.contrast for r in allres if r.swimmer.expected in ("protrusions", "tail") and not r.swimmer.mixed]
     whole_con = [r.mode.contrast for r in allres if r.swimmer.expected in ("undulation", "synchronous contraction")]
-    w("Why the classifier has a strain-contrast rule: the displacement-energy rule alone (the most mobile 20 % of the "
-      f"cells carry ≥ {L.PROTRUSION_CONCENTRATION:g} of the displacement energy) misses hand-built protrusion "
-      "swimmers: a soft body's passive core is pushed around by its appendages, so the top fifth carries only "
-      f"{rng(prot_conc)} of the motion in these swims, as in whole-body modes. What singles them out is where "
-      f"the springs change length: in the swims above, the appendage swimmers without a core wave have a strain "
-      f"contrast of {rng(app_con)}, the undulators and synchronous contractors {rng(whole_con)}. So "
-      f"*protrusions* also holds when the strain contrast is ≥ {L.LOCAL_CONTRAST:g} (set between the two "
-      "groups of the calibration set), and the most strained (or, under the displacement-energy rule, the most mobile) fifth of "
-      "the cells is split into groups connected by springs: two or more groups are **protrusions**, one group "
-      "is a **tail** (the paper counts a \"tail\" apart from protrusions at d_N = 0.2). "
-      "The failures are marked ✗: a bending wave (the two sides in antiphase) is not a linear "
-      f"phase pattern and its fit stays just below {L.WAVE_FIT:g}; the mixture with a wave on its core strains "
-      "the core too and falls below the contrast threshold; a long tail beating with a bending wave splits into "
-      "more than one strained group and is counted as protrusions.")
+    w(
+        "Why the classifier has a strain-contrast rule: the displacement-energy rule alone (the most mobile 20 % of the "
+        f"cells carry ≥ {L.PROTRUSION_CONCENTRATION:g} of the displacement energy) misses hand-built protrusion "
+        "swimmers: a soft body's passive core is pushed around by its appendages, so the top fifth carries only "
+        f"{rng(prot_conc)} of the motion in these swims, as in whole-body modes. What singles them out is where "
+        f"the springs change length: in the swims above, the appendage swimmers without a core wave have a strain "
+        f"contrast of {rng(app_con)}, the undulators and synchronous contractors {rng(whole_con)}. So "
+        f"*protrusions* also holds when the strain contrast is ≥ {L.LOCAL_CONTRAST:g} (set between the two "
+        "groups of the calibration set), and the most strained (or, under the displacement-energy rule, the most mobile) fifth of "
+        "the cells is split into groups connected by springs: two or more groups are **protrusions**, one group "
+        'is a **tail** (the paper counts a "tail" apart from protrusions at d_N = 0.2). '
+        "The failures are marked ✗: a bending wave (the two sides in antiphase) is not a linear "
+        f"phase pattern and its fit stays just below {L.WAVE_FIT:g}; the mixture with a wave on its core strains "
+        "the core too and falls below the contrast threshold; a long tail beating with a bending wave splits into "
+        "more than one strained group and is counted as protrusions."
+    )
     w("")
     return out
 
@@ -557,17 +646,25 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
     w("")
     w("### Locomotion modes against the paper's counts")
     w("")
-    w("Main mode of every best (a mixed best counts under its main mode), ours next to the paper's (of 10 runs; "
-      "\"?\" where the paper's words give no main-mode count: at d_N = 2 its 2 protrusion swimmers are mixed "
-      "into undulation, at d_N = 0.2 it reports only protrusions and tails; its d_N = 10 counts overlap, 5 + 2 + 4 "
-      "of 10, one best being mixed).")
+    w(
+        "Main mode of every best (a mixed best counts under its main mode), ours next to the paper's (of 10 runs; "
+        '"?" where the paper\'s words give no main-mode count: at d_N = 2 its 2 protrusion swimmers are mixed '
+        "into undulation, at d_N = 0.2 it reports only protrusions and tails; its d_N = 10 counts overlap, 5 + 2 + 4 "
+        "of 10, one best being mixed)."
+    )
     w("")
     modes = [m for m in MODE_COLUMNS if m != "none"] + ["none"]
     labels = {e.name: [r.mode.mode for r in e.runs if r.mode is not None] for e in envs}
-    used = [m for m in modes if any(m in v for v in labels.values()) or m in ("undulation", "synchronous contraction",
-                                                                               "protrusions", "tail")]
-    w("| mode | " + " | ".join(f"`{e.name}` ours (of {len(labels[e.name])}) | `{e.name}` paper (of 10)" for e in envs)
-      + " |")
+    used = [
+        m
+        for m in modes
+        if any(m in v for v in labels.values()) or m in ("undulation", "synchronous contraction", "protrusions", "tail")
+    ]
+    w(
+        "| mode | "
+        + " | ".join(f"`{e.name}` ours (of {len(labels[e.name])}) | `{e.name}` paper (of 10)" for e in envs)
+        + " |"
+    )
     w("| --- | " + " | ".join("--- | ---" for _ in envs) + " |")
     for m in used:
         cells = []
@@ -576,31 +673,43 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             cells.append(f"{labels[e.name].count(m)} | {'?' if paper is None else paper}")
         w(f"| {m} | " + " | ".join(cells) + " |")
     paddlers = {e.name: sum(1 for r in e.runs if r.paddling is not None and r.paddling.paddles) for e in envs}
-    w("| *paddles (the paper's stroke; any mode)* | " + " | ".join(
-        f"{paddlers[e.name]} | {PAPER_COUNTS.get(e.name, {}).get('protrusions') or '?'} (protrusions)" for e in envs)
-      + " |")
+    w(
+        "| *paddles (the paper's stroke; any mode)* | "
+        + " | ".join(
+            f"{paddlers[e.name]} | {PAPER_COUNTS.get(e.name, {}).get('protrusions') or '?'} (protrusions)" for e in envs
+        )
+        + " |"
+    )
     w("")
     drag_envs = [e for e in envs if e.max_cells == 32]
-    for title, group in (("the three 32-cell environments (d_N = 0.5, 2, 10: does the mode depend on the drag?)",
-                          drag_envs), ("all environments", envs)):
+    for title, group in (
+        ("the three 32-cell environments (d_N = 0.5, 2, 10: does the mode depend on the drag?)", drag_envs),
+        ("all environments", envs),
+    ):
         if len(group) < 2:
             continue
         rows, cols, table = RS.mode_table({e.name: labels[e.name] for e in group}, modes)
         res = RS.fisher_exact(table)
-        w(f"Fisher's exact test (Freeman–Halton, r × c) over {title}: p = {res.p_value:.3g} "
-          f"({res.method}, {res.tables} tables with the observed margins; {res.shape[0]} modes × {res.shape[1]} "
-          f"environments, {int(table.sum())} bests).")
+        w(
+            f"Fisher's exact test (Freeman–Halton, r × c) over {title}: p = {res.p_value:.3g} "
+            f"({res.method}, {res.tables} tables with the observed margins; {res.shape[0]} modes × {res.shape[1]} "
+            f"environments, {int(table.sum())} bests)."
+        )
         w("")
     counts = sorted({len(labels[e.name]) for e in envs}) or [0]
     per_env = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}–{counts[-1]}"
-    w(f"With {per_env} runs per environment a p-value above 0.05 says little: the test has little power. "
-      "The paper's counts are quoted, not tested: its modes were judged by eye from videos.")
+    w(
+        f"With {per_env} runs per environment a p-value above 0.05 says little: the test has little power. "
+        "The paper's counts are quoted, not tested: its modes were judged by eye from videos."
+    )
     w("")
     w("### Best fitness")
     w("")
-    w("Distance travelled by each environment's final bests: median and mean with percentile bootstrap 95 % "
-      f"intervals (10,000 resamples, seed 0; with {per_env} runs the interval cannot reach beyond the sample's "
-      "range and is narrower than its nominal level).")
+    w(
+        "Distance travelled by each environment's final bests: median and mean with percentile bootstrap 95 % "
+        f"intervals (10,000 resamples, seed 0; with {per_env} runs the interval cannot reach beyond the sample's "
+        "range and is narrower than its nominal level)."
+    )
     w("")
     w("| environment | runs | bests | median [95 % CI] | mean [95 % CI] |")
     w("| --- | --- | --- | --- | --- |")
@@ -610,8 +719,10 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             continue
         med = RS.bootstrap_ci(fit, lambda a: np.median(a, axis=1))
         mean = RS.bootstrap_ci(fit)
-        w(f"| `{e.name}` | {len(fit)} | {', '.join(f'{v:.2f}' for v in fit)} | {med.estimate:.2f} "
-          f"[{med.low:.2f}, {med.high:.2f}] | {mean.estimate:.2f} [{mean.low:.2f}, {mean.high:.2f}] |")
+        w(
+            f"| `{e.name}` | {len(fit)} | {', '.join(f'{v:.2f}' for v in fit)} | {med.estimate:.2f} "
+            f"[{med.low:.2f}, {med.high:.2f}] | {mean.estimate:.2f} [{mean.low:.2f}, {mean.high:.2f}] |"
+        )
     w("")
     w("### Generations to the last morphology change")
     w("")
@@ -621,14 +732,18 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
         last = [r.changes[-1] for r in e.runs if r.changes]
         if not last:
             continue
-        w(f"| `{e.name}` | {', '.join(str(g) for g in last)} | {statistics.median(last):g} | "
-          f"{fmt_range([float(r.generations) for r in e.runs], 0)} |")
+        w(
+            f"| `{e.name}` | {', '.join(str(g) for g in last)} | {statistics.median(last):g} | "
+            f"{fmt_range([float(r.generations) for r in e.runs], 0)} |"
+        )
     w("")
     w("### Reference fitness of every best")
     w("")
-    w("The engine's exploit guard re-evaluates every new best at a finer reference time step "
-      "(`evaluation.reference_check`); its fitness there (lineage field `reference_fitness`, history column "
-      "`best_reference`) next to the evolved fitness:")
+    w(
+        "The engine's exploit guard re-evaluates every new best at a finer reference time step "
+        "(`evaluation.reference_check`); its fitness there (lineage field `reference_fitness`, history column "
+        "`best_reference`) next to the evolved fitness:"
+    )
     w("")
     w("| environment | run | evolved fitness | reference fitness | difference |")
     w("| --- | --- | --- | --- | --- |")
@@ -646,34 +761,53 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             if ref != ref:
                 continue
             checked += 1
-            tolerances[e.name] = (float(cfg["evaluation.reference_tolerance"]),
-                                  float(cfg["evaluation.reference_abs_tolerance"]))
+            tolerances[e.name] = (
+                float(cfg["evaluation.reference_tolerance"]),
+                float(cfg["evaluation.reference_abs_tolerance"]),
+            )
             if animat.reference_disagrees(r.best.fitness, ref, cfg):
-                side = "farther at the finer step: the default step costs it distance" if ref > r.best.fitness \
+                side = (
+                    "farther at the finer step: the default step costs it distance"
+                    if ref > r.best.fitness
                     else "**shorter at the finer step: the default step gives it distance**"
+                )
                 outside.append(f"`{e.name}` run {r.index} ({rel_diff:+.2f} %, {side})")
     w("")
     if checked:
         # One statement when every environment uses the same tolerances, else one per environment.
         if len(set(tolerances.values())) == 1:
             rel, absolute = next(iter(tolerances.values()))
-            tol = (f"`evaluation.reference_tolerance` = {100 * rel:g} % and "
-                   f"`evaluation.reference_abs_tolerance` = {absolute:g}")
+            tol = (
+                f"`evaluation.reference_tolerance` = {100 * rel:g} % and "
+                f"`evaluation.reference_abs_tolerance` = {absolute:g}"
+            )
         else:
-            tol = ("the environment's `evaluation.reference_tolerance` and `evaluation.reference_abs_tolerance`: "
-                   + ", ".join(f"`{n}` {100 * t[0]:g} % and {t[1]:g}" for n, t in tolerances.items()))
-        w(f"Within the guard's tolerance (it warns where the two differ by more than both "
-          f"{tol}): "
-          f"{checked - len(outside)} of {checked} bests"
-          + (f"; outside it: {'; '.join(outside)}." if outside else "."))
+            tol = (
+                "the environment's `evaluation.reference_tolerance` and `evaluation.reference_abs_tolerance`: "
+                + ", ".join(f"`{n}` {100 * t[0]:g} % and {t[1]:g}" for n, t in tolerances.items())
+            )
+        w(
+            f"Within the guard's tolerance (it warns where the two differ by more than both "
+            f"{tol}): "
+            f"{checked - len(outside)} of {checked} bests"
+            + (f"; outside it: {'; '.join(outside)}." if outside else ".")
+        )
         w("")
     return out
 
 
-def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, commit: str,
-              discussion: Optional[Path] = None, calibration: Optional[Dict[str, List[KS.KnownResult]]] = None,
-              data: Optional[Path] = None, target_runs: int = PAPER_RUNS,
-              causes: Optional[List[str]] = None) -> None:
+def write_doc(
+    envs: List[EnvReport],
+    runs_dir: Path,
+    doc: Path,
+    images: Path,
+    commit: str,
+    discussion: Optional[Path] = None,
+    calibration: Optional[Dict[str, List[KS.KnownResult]]] = None,
+    data: Optional[Path] = None,
+    target_runs: int = PAPER_RUNS,
+    causes: Optional[List[str]] = None,
+) -> None:
     rel_img = Path(os.path.relpath(images, doc.parent))
     img = lambda name: f"{rel_img.as_posix()}/{name}"  # noqa: E731
     all_runs = [r for e in envs for r in e.runs]
@@ -682,28 +816,38 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
     w = lines.append
     w("# Replication of the paper's experiments")
     w("")
-    w(f"<!-- Generated by studies/replication/replication_report.py from {'data/replication' if data else 'the run directories'}; do not edit by hand "
-      "(the discussion at the end comes from docs/notes/replication_discussion.md). -->")
+    w(
+        f"<!-- Generated by studies/replication/replication_report.py from {'data/replication' if data else 'the run directories'}; do not edit by hand "
+        "(the discussion at the end comes from docs/notes/replication_discussion.md). -->"
+    )
     w("")
-    w("We evolved swimmers in the four environments of Joachimczak & Wróbel (GECCO 2012, §6) with the "
-      "paper's genetic algorithm (population 100, elitism, tournament of two with p rising from 0.8 to 1 over "
-      "1000 generations, 20 % crossover, 4000 swim steps, stop after 500 generations without improvement) "
-      "and compare what emerged with what the paper reports. Every number and figure below is computed from "
-      f"the runs under `{(data or runs_dir).as_posix()}/` by `studies/replication/replication_report.py`; the best "
-      "swimmers are developed and replayed, nothing is evolved again.")
+    w(
+        "We evolved swimmers in the four environments of Joachimczak & Wróbel (GECCO 2012, §6) with the "
+        "paper's genetic algorithm (population 100, elitism, tournament of two with p rising from 0.8 to 1 over "
+        "1000 generations, 20 % crossover, 4000 swim steps, stop after 500 generations without improvement) "
+        "and compare what emerged with what the paper reports. Every number and figure below is computed from "
+        f"the runs under `{(data or runs_dir).as_posix()}/` by `studies/replication/replication_report.py`; the best "
+        "swimmers are developed and replayed, nothing is evolved again."
+    )
     w("")
     if not finished:
-        w(f"**Status: runs still in progress.** This page was generated from partial runs; "
-          f"{sum(1 for r in all_runs if r.stop == 'in progress')} of {len(all_runs)} runs had not finished.")
+        w(
+            f"**Status: runs still in progress.** This page was generated from partial runs; "
+            f"{sum(1 for r in all_runs if r.stop == 'in progress')} of {len(all_runs)} runs had not finished."
+        )
         w("")
     if data is not None:
         gens = sorted({r.generations for r in all_runs})
         caps = sorted({r.stop for r in all_runs})
-        w(f"**Scale, exactly:** {len(all_runs)} runs: " + ", ".join(f"{len(e.runs)} in `{e.name}`" for e in envs)
-          + f" of the {target_runs} per environment the study aims at (the paper's {PAPER_RUNS}); generations "
-          f"reached: {', '.join(map(str, gens))} (the paper: about 5,000); every run stopped by: "
-          f"{'; '.join(caps)}. Runs not started yet: "
-          + "; ".join(f"`{e.name}` " + (", ".join(f"run {i}" for i in e.not_started) or "none") for e in envs) + ".")
+        w(
+            f"**Scale, exactly:** {len(all_runs)} runs: "
+            + ", ".join(f"{len(e.runs)} in `{e.name}`" for e in envs)
+            + f" of the {target_runs} per environment the study aims at (the paper's {PAPER_RUNS}); generations "
+            f"reached: {', '.join(map(str, gens))} (the paper: about 5,000); every run stopped by: "
+            f"{'; '.join(caps)}. Runs not started yet: "
+            + "; ".join(f"`{e.name}` " + (", ".join(f"run {i}" for i in e.not_started) or "none") for e in envs)
+            + "."
+        )
         w("")
     if calibration:
         lines.extend(calibration_lines(calibration))
@@ -714,45 +858,61 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
     w("")
     w(f"The paper: {PAPER_RUNS} independent runs per environment of {PAPER_GENERATIONS} generations. Ours:")
     w("")
-    w("| environment | d_N | d_T | max cells | runs | generations reached per run | wall time per run | "
-      "evaluations per run | stopped by |")
+    w(
+        "| environment | d_N | d_T | max cells | runs | generations reached per run | wall time per run | "
+        "evaluations per run | stopped by |"
+    )
     w("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for e in envs:
         gens = ", ".join(str(r.generations) if r.generations >= 0 else "—" for r in e.runs)
         wall = fmt_range([r.wall_seconds / 3600 for r in e.runs]) + " h"
         ev = fmt_range([float(r.evaluations) for r in e.runs], 0)
         stops = ", ".join(sorted(set(r.stop for r in e.runs)))
-        w(f"| `{e.name}` | {e.drag_normal:g} | {e.drag_tangential:g} | {e.max_cells} | {len(e.runs)} | {gens} | "
-          f"{wall} | {ev} | {stops} |")
+        w(
+            f"| `{e.name}` | {e.drag_normal:g} | {e.drag_tangential:g} | {e.max_cells} | {len(e.runs)} | {gens} | "
+            f"{wall} | {ev} | {stops} |"
+        )
     w("")
     total_gens = [r.generations for r in all_runs if r.generations >= 0]
     if total_gens:
-        w(f"So we ran {len(all_runs)} runs ({len(envs)} environments × "
-          f"{fmt_range([float(len(e.runs)) for e in envs], 0)}) of {min(total_gens)}–{max(total_gens)} "
-          f"generations (median {statistics.median(total_gens):g}): {len(envs[0].runs) if envs else 0} of the paper's "
-          f"{PAPER_RUNS} runs per environment, each {100 * statistics.median(total_gens) / 5000:.1f} % of its "
-          f"typical run length (about 5,000 generations). Wall time per run is the history's wall_seconds "
-          f"(machine- and load-dependent, summed over sessions). Everything the paper "
-          f"observed after {max(total_gens)} generations is beyond what these runs can show.")
+        w(
+            f"So we ran {len(all_runs)} runs ({len(envs)} environments × "
+            f"{fmt_range([float(len(e.runs)) for e in envs], 0)}) of {min(total_gens)}–{max(total_gens)} "
+            f"generations (median {statistics.median(total_gens):g}): {len(envs[0].runs) if envs else 0} of the paper's "
+            f"{PAPER_RUNS} runs per environment, each {100 * statistics.median(total_gens) / 5000:.1f} % of its "
+            f"typical run length (about 5,000 generations). Wall time per run is the history's wall_seconds "
+            f"(machine- and load-dependent, summed over sessions). Everything the paper "
+            f"observed after {max(total_gens)} generations is beyond what these runs can show."
+        )
         w("")
     if data is not None:
-        w("To regenerate this page from the data alone, and to grow the study (resume every run, start the "
-          "missing ones, pack them back into the data, rewrite this page):")
+        w(
+            "To regenerate this page from the data alone, and to grow the study (resume every run, start the "
+            "missing ones, pack them back into the data, rewrite this page):"
+        )
         w("")
         w("```bash")
-        w(f"PYTHONPATH=build/python .venv/bin/python studies/replication/replication_report.py --data {data.as_posix()} "
-          f"--doc {doc.as_posix()}")
-        w("studies/replication/replication.sh 5400    # one session of 5400 s; cap 1000 generations or 500 without improvement")
-        w("ANIMAT_REPLICATION_ROUND=150 studies/replication/replication.sh 5400    # the same, breadth first: rounds of 150 "
-          "generations past the least advanced run")
+        w(
+            f"PYTHONPATH=build/python .venv/bin/python studies/replication/replication_report.py --data {data.as_posix()} "
+            f"--doc {doc.as_posix()}"
+        )
+        w(
+            "studies/replication/replication.sh 5400    # one session of 5400 s; cap 1000 generations or 500 without improvement"
+        )
+        w(
+            "ANIMAT_REPLICATION_ROUND=150 studies/replication/replication.sh 5400    # the same, breadth first: rounds of 150 "
+            "generations past the least advanced run"
+        )
         w("```")
     else:
         w(f"Commit of the runs: `{commit}` (`{runs_dir.as_posix()}/commit.txt`). To regenerate:")
         w("")
         w("```bash")
         w("studies/replication/replication.sh 5400    # resumes every run of data/replication, 5400 s per session")
-        w(f"PYTHONPATH=build/python .venv/bin/python studies/replication/replication_report.py --runs {runs_dir.as_posix()} "
-          f"--doc {doc.as_posix()}")
+        w(
+            f"PYTHONPATH=build/python .venv/bin/python studies/replication/replication_report.py --runs {runs_dir.as_posix()} "
+            f"--doc {doc.as_posix()}"
+        )
         w("```")
     w("")
     seeds = {e.name: [r.seed for r in e.runs] for e in envs}
@@ -767,9 +927,11 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
             groups.setdefault(key, []).append(e.name)
     shared = [names for names in groups.values() if len(names) > 1]
     for names in shared:
-        para += (f" The initial population depends only on the seed and the development settings, not on the drag, "
-                 f"so {', '.join(f'`{n}`' for n in names)} start from the same random genomes (with different "
-                 f"fitness) and have the same tries per viable individual.")
+        para += (
+            f" The initial population depends only on the seed and the development settings, not on the drag, "
+            f"so {', '.join(f'`{n}`' for n in names)} start from the same random genomes (with different "
+            f"fitness) and have the same tries per viable individual."
+        )
     w(para)
     w("")
 
@@ -779,9 +941,11 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
         w("")
         w(f"![best fitness, {e.name}]({img(e.images['fitness'])})")
         w("")
-        w("| run | seed | generations | best fitness (reference) | found at generation | cells | grow (at divisions / final) | "
-          "amplitude mean (spread) of max | frequency | phase range (rad) | tries per viable | "
-          "last morphology change | locomotion mode |")
+        w(
+            "| run | seed | generations | best fitness (reference) | found at generation | cells | grow (at divisions / final) | "
+            "amplitude mean (spread) of max | frequency | phase range (rad) | tries per viable | "
+            "last morphology change | locomotion mode |"
+        )
         w("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
         for r in e.runs:
             if r.best is None:
@@ -789,31 +953,44 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
                 continue
             s = r.stats
             o = s.oscillators
-            freq = (f"{o.frequency_min:.2f}" if o.frequency_max - o.frequency_min < 5e-3
-                    else f"{o.frequency_min:.2f}–{o.frequency_max:.2f}")
-            w(f"| {r.index} | {r.seed} | {r.generations} | {r.best.fitness:.3f} ({r.reference:.3f}) | {r.best.generation} | "
-              f"{s.cells}/{s.max_cells} | {s.grow.realized:.2f} / {s.grow.final_mean:.2f} | "
-              f"{o.amplitude_relative:.2f} ({o.amplitude_range:.2f}) | {freq} | {o.phase.range:.2f} | "
-              f"{r.tries:.1f} | {r.changes[-1] if r.changes else '—'} | {r.mode.label} |")
+            freq = (
+                f"{o.frequency_min:.2f}"
+                if o.frequency_max - o.frequency_min < 5e-3
+                else f"{o.frequency_min:.2f}–{o.frequency_max:.2f}"
+            )
+            w(
+                f"| {r.index} | {r.seed} | {r.generations} | {r.best.fitness:.3f} ({r.reference:.3f}) | {r.best.generation} | "
+                f"{s.cells}/{s.max_cells} | {s.grow.realized:.2f} / {s.grow.final_mean:.2f} | "
+                f"{o.amplitude_relative:.2f} ({o.amplitude_range:.2f}) | {freq} | {o.phase.range:.2f} | "
+                f"{r.tries:.1f} | {r.changes[-1] if r.changes else '—'} | {r.mode.label} |"
+            )
         w("")
         mism = [r for r in e.runs if r.best is not None and abs(r.replay_distance - r.best.fitness) > 1e-6]
         if mism:
-            w("**Replay check failed:** " + "; ".join(
-                f"run {r.index} replays to {r.replay_distance:.6f}, recorded {r.best.fitness:.6f}" for r in mism)
-              + ". The module used for this report does not reproduce the runs exactly.")
+            w(
+                "**Replay check failed:** "
+                + "; ".join(
+                    f"run {r.index} replays to {r.replay_distance:.6f}, recorded {r.best.fitness:.6f}" for r in mism
+                )
+                + ". The module used for this report does not reproduce the runs exactly."
+            )
             w("")
         for r in e.runs:
             if r.best is None:
                 continue
             m = r.mode
-            w(f"**Run {r.index}** (seed {r.seed}): best of generation {r.best.generation}, fitness "
-              f"{r.best.fitness:.3f}, {r.stats.cells} cells. Mode: **{m.label}** — {m.reason}.")
+            w(
+                f"**Run {r.index}** (seed {r.seed}): best of generation {r.best.generation}, fitness "
+                f"{r.best.fitness:.3f}, {r.stats.cells} cells. Mode: **{m.label}** — {m.reason}."
+            )
             w("")
             if "gif" in r.images:
                 w("| swimming (the end of the 4000-step swim, 8 frames per period) | phase shifts (paper Fig. 7) |")
                 w("| --- | --- |")
-                w(f"| ![{e.name} run {r.index}]({img(r.images['gif'])}) | "
-                  f"![{e.name} run {r.index} phases]({img(r.images['phase'])}) |")
+                w(
+                    f"| ![{e.name} run {r.index}]({img(r.images['gif'])}) | "
+                    f"![{e.name} run {r.index} phases]({img(r.images['phase'])}) |"
+                )
             else:
                 w(f"![{e.name} run {r.index} phases]({img(r.images['phase'])})")
             w("")
@@ -823,38 +1000,52 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
     # method
     w("## How the locomotion mode is decided")
     w("")
-    w("`animat.classify_locomotion` (module `animat.locomotion`) replays the best genome for the full 4000 "
-      "steps and looks at the last four periods of its dominant oscillation (at most the second half of the "
-      "swim). Each frame is aligned onto the mean shape by the best rotation and translation, so only the "
-      "deformation remains. For every cell it measures, at the dominant frequency, its displacement and its "
-      "*contraction* (the mean relative length change of its springs — what the paper's figures colour blue "
-      "and red, here measured from the motion). Then:")
+    w(
+        "`animat.classify_locomotion` (module `animat.locomotion`) replays the best genome for the full 4000 "
+        "steps and looks at the last four periods of its dominant oscillation (at most the second half of the "
+        "swim). Each frame is aligned onto the mean shape by the best rotation and translation, so only the "
+        "deformation remains. For every cell it measures, at the dominant frequency, its displacement and its "
+        "*contraction* (the mean relative length change of its springs — what the paper's figures colour blue "
+        "and red, here measured from the motion). Then:"
+    )
     w("")
-    w(f"1. **none** if the displacement amplitude is below {L.NONE_DEFORMATION:g} of the body's RMS radius "
-      "(a rigid body);")
-    w(f"2. **protrusions** or **tail** if the most mobile 20 % of the cells carry at least "
-      f"{L.PROTRUSION_CONCENTRATION:g} of the displacement energy (a breathing disc gives 0.36, an elongated "
-      f"body contracting along its axis 0.49) or the most strained 20 % contract at least {L.LOCAL_CONTRAST:g} "
-      "times as much as the median cell (see the calibration above): protrusions when those cells "
-      "form two or more groups joined by springs, a tail when they form one;")
-    w(f"3. **undulation** if the contraction phases follow a travelling wave: a circular-linear fit "
-      f"φ_i ≈ φ_0 + g·x_i explains them (resultant ≥ {L.WAVE_FIT:g}), the phase lag across the body |g|·extent "
-      f"is at least π/2 (a quarter period), and the contraction field is travelling rather than standing "
-      f"(travelling index ≥ {L.WAVE_TI:g}: two halves in antiphase fit a gradient but do not travel);")
-    w(f"4. **synchronous contraction** if the contraction phases are coherent, R = |Σ a_i e^(iφ_i)| / Σ a_i ≥ "
-      f"{L.SYNC_COHERENCE:g}; also listed as mixed with an undulation that keeps R ≥ {L.SYNC_COHERENCE:g};")
+    w(
+        f"1. **none** if the displacement amplitude is below {L.NONE_DEFORMATION:g} of the body's RMS radius "
+        "(a rigid body);"
+    )
+    w(
+        f"2. **protrusions** or **tail** if the most mobile 20 % of the cells carry at least "
+        f"{L.PROTRUSION_CONCENTRATION:g} of the displacement energy (a breathing disc gives 0.36, an elongated "
+        f"body contracting along its axis 0.49) or the most strained 20 % contract at least {L.LOCAL_CONTRAST:g} "
+        "times as much as the median cell (see the calibration above): protrusions when those cells "
+        "form two or more groups joined by springs, a tail when they form one;"
+    )
+    w(
+        f"3. **undulation** if the contraction phases follow a travelling wave: a circular-linear fit "
+        f"φ_i ≈ φ_0 + g·x_i explains them (resultant ≥ {L.WAVE_FIT:g}), the phase lag across the body |g|·extent "
+        f"is at least π/2 (a quarter period), and the contraction field is travelling rather than standing "
+        f"(travelling index ≥ {L.WAVE_TI:g}: two halves in antiphase fit a gradient but do not travel);"
+    )
+    w(
+        f"4. **synchronous contraction** if the contraction phases are coherent, R = |Σ a_i e^(iφ_i)| / Σ a_i ≥ "
+        f"{L.SYNC_COHERENCE:g}; also listed as mixed with an undulation that keeps R ≥ {L.SYNC_COHERENCE:g};"
+    )
     w("5. **other** otherwise (no travelling wave, phases incoherent).")
     w("")
-    w("The thresholds were set on real swims with imposed phase patterns before looking at the evolved "
-      "bests (6 bodies × 3 frequencies × 3 drags per pattern): synchronous phases gave R ≥ 0.94 and lags ≤ "
-      "0.74 rad (all 54 classified synchronous contraction); phase ramps of π or 2π gave fits ≥ 0.94 and lags "
-      "≥ 2.2 rad (all 162 undulation); halves or ends in antiphase gave a travelling index ≤ 0.11 or a fit ≤ "
-      "0.78 (all 108 other). The protrusion and tail rules are checked on the hand-built swimmers of the "
-      "calibration section above. Details in the module docstring, tests in "
-      "`tests/python/test_locomotion.py` and `tests/python/test_known_swimmers.py`. The measured numbers of every best:")
+    w(
+        "The thresholds were set on real swims with imposed phase patterns before looking at the evolved "
+        "bests (6 bodies × 3 frequencies × 3 drags per pattern): synchronous phases gave R ≥ 0.94 and lags ≤ "
+        "0.74 rad (all 54 classified synchronous contraction); phase ramps of π or 2π gave fits ≥ 0.94 and lags "
+        "≥ 2.2 rad (all 162 undulation); halves or ends in antiphase gave a travelling index ≤ 0.11 or a fit ≤ "
+        "0.78 (all 108 other). The protrusion and tail rules are checked on the hand-built swimmers of the "
+        "calibration section above. Details in the module docstring, tests in "
+        "`tests/python/test_locomotion.py` and `tests/python/test_known_swimmers.py`. The measured numbers of every best:"
+    )
     w("")
-    w("| environment | run | mode | deformation | coherence R | wave fit | phase lag (rad) | travelling index | "
-      "wave travels (against the motion: backward) | top-20 % share | strain contrast | paddle pair score |")
+    w(
+        "| environment | run | mode | deformation | coherence R | wave fit | phase lag (rad) | travelling index | "
+        "wave travels (against the motion: backward) | top-20 % share | strain contrast | paddle pair score |"
+    )
     w("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for e in envs:
         for r in e.runs:
@@ -862,25 +1053,31 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
             if m is None:
                 continue
             wv = m.wave
-            w(f"| `{e.name}` | {r.index} | {m.label} | {m.deformation:.3f} | {m.coherence:.2f} | "
-              f"{wv.fit if wv else float('nan'):.2f} | {wv.lag if wv else float('nan'):.2f} | "
-              f"{m.travelling_index:.2f} | {wv.travel if wv and wv.is_wave else '—'} | {m.concentration:.2f} | {m.contrast:.2f} | "
-              f"{_score(r.paddling)} |")
+            w(
+                f"| `{e.name}` | {r.index} | {m.label} | {m.deformation:.3f} | {m.coherence:.2f} | "
+                f"{wv.fit if wv else float('nan'):.2f} | {wv.lag if wv else float('nan'):.2f} | "
+                f"{m.travelling_index:.2f} | {wv.travel if wv and wv.is_wave else '—'} | {m.concentration:.2f} | {m.contrast:.2f} | "
+                f"{_score(r.paddling)} |"
+            )
     w("")
-    w("The paper classified its bests by eye from videos and reports mixed strategies; our rule gives one main "
-      "mode per best and lists a second one only where a second criterion also holds, so counts are "
-      "comparable only roughly. Frequencies of the figures: motion cycles show six frames over the last "
-      "dominant period (red expanding, blue contracting, green neutral: the commanded actuation, eq. 2); the "
-      "GIFs show the last part of the swim at 8 frames per period.")
+    w(
+        "The paper classified its bests by eye from videos and reports mixed strategies; our rule gives one main "
+        "mode per best and lists a second one only where a second criterion also holds, so counts are "
+        "comparable only roughly. Frequencies of the figures: motion cycles show six frames over the last "
+        "dominant period (red expanding, blue contracting, green neutral: the commanded actuation, eq. 2); the "
+        "GIFs show the last part of the swim at 8 frames per period."
+    )
     w("")
     # claims
     w("## The paper's claims, measured")
     w("")
-    w("Per environment: our numbers over its runs (a range when they differ), and whether they agree. "
-      "Grow: the grow output level a cell's mother had when the cell was made (what sets its radius, "
-      "r0·(1 + 0.5·grow)) and the final grow output of the cells; amplitude: the mean over the cells "
-      "relative to the maximum 0.2 and the spread max − min relative to it; phase range: the shortest arc "
-      "holding every cell's phase.")
+    w(
+        "Per environment: our numbers over its runs (a range when they differ), and whether they agree. "
+        "Grow: the grow output level a cell's mother had when the cell was made (what sets its radius, "
+        "r0·(1 + 0.5·grow)) and the final grow output of the cells; amplitude: the mean over the cells "
+        "relative to the maximum 0.2 and the spread max − min relative to it; phase range: the shortest arc "
+        "holding every cell's phase."
+    )
     w("")
     claims = {e.name: env_claims(e) for e in envs}
     w("| claim | the paper | " + " | ".join(f"`{e.name}`" for e in envs) + " |")
@@ -896,8 +1093,10 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
     # modes
     w("## Locomotion modes against the paper's counts")
     w("")
-    w("Counts of the best individuals' modes: ours (of our runs) next to the paper's (of 10 runs). A mixed "
-      "strategy counts under its main mode and is listed after the count; see the method below.")
+    w(
+        "Counts of the best individuals' modes: ours (of our runs) next to the paper's (of 10 runs). A mixed "
+        "strategy counts under its main mode and is listed after the count; see the method below."
+    )
     w("")
     for e in envs:
         rs = [r for r in e.runs if r.mode is not None]
@@ -910,8 +1109,13 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
             mixed = [r for r in rs if mode in r.mode.mixed]
             txt = str(len(ours))
             if ours:
-                txt += " (" + ", ".join(f"run {r.index}" + (f" + {', '.join(r.mode.mixed)}" if r.mode.mixed else "")
-                                        for r in ours) + ")"
+                txt += (
+                    " ("
+                    + ", ".join(
+                        f"run {r.index}" + (f" + {', '.join(r.mode.mixed)}" if r.mode.mixed else "") for r in ours
+                    )
+                    + ")"
+                )
             if mixed:
                 txt += f"; mixed into {len(mixed)} other" + ("s" if len(mixed) > 1 else "")
             paper = PAPER_MODES.get(e.name, {}).get(mode, "—")
@@ -933,14 +1137,20 @@ def write_doc(envs: List[EnvReport], runs_dir: Path, doc: Path, images: Path, co
         modes = {}
         for r in rs:
             modes[r.mode.mode] = modes.get(r.mode.mode, 0) + 1
-        expected = {"dn0.5": "protrusions", "dn2": "synchronous contraction", "dn10": "undulation",
-                    "dn0.2_64cells": "protrusions"}.get(e.name)
+        expected = {
+            "dn0.5": "protrusions",
+            "dn2": "synchronous contraction",
+            "dn10": "undulation",
+            "dn0.2_64cells": "protrusions",
+        }.get(e.name)
         if expected and rs:
             got = modes.get(expected, 0)
             main = max(modes.items(), key=lambda kv: (kv[1], kv[0]))[0]
             if main != expected:
-                diffs.append(f"- `{e.name}`, locomotion: the paper's most frequent mode here is {expected}; ours is "
-                             f"{main} ({modes[main]} of {len(rs)}; {expected}: {got} of {len(rs)}).")
+                diffs.append(
+                    f"- `{e.name}`, locomotion: the paper's most frequent mode here is {expected}; ours is "
+                    f"{main} ({modes[main]} of {len(rs)}; {expected}: {got} of {len(rs)})."
+                )
     if diffs:
         lines.extend(diffs)
     else:
@@ -983,19 +1193,40 @@ def _cause_row(label: str, index: int, entry: animat.LineageEntry, cfg: animat.C
     fmin, fmax = float(cfg["development.frequency_min"]), float(cfg["development.frequency_max"])
     at_bound = float(np.mean(f >= fmax - 0.02 * (fmax - fmin)))  # the output saturates: within 2 % of the range
     ph = L.phase_spread(np.asarray(body.phase))
-    return [label, str(index), str(entry.generation), f"{entry.fitness:.2f}", f"{entry.reference_fitness:.2f}", mode.label, f"{f.max():.2f}",
-            f"{at_bound:.0%}", f"{ph.range:.2f}", f"{mode.contrast:.2f}"]
+    return [
+        label,
+        str(index),
+        str(entry.generation),
+        f"{entry.fitness:.2f}",
+        f"{entry.reference_fitness:.2f}",
+        mode.label,
+        f"{f.max():.2f}",
+        f"{at_bound:.0%}",
+        f"{ph.range:.2f}",
+        f"{mode.contrast:.2f}",
+    ]
 
 
 def causes_lines(causes: Path, baseline_runs: Path, generation: int = 100) -> List[str]:
     """Small controlled runs at d_N = 0.5 (seeds 1-3, `generation` generations), one change each,
     against the study's own runs of the same seeds at the same generation."""
-    header = ["variant", "run", "best of generation", "fitness", "fitness at dt/16", "mode", "highest frequency", "cells within 2 % of the frequency bound",
-              "phase range (rad)", "strain contrast"]
+    header = [
+        "variant",
+        "run",
+        "best of generation",
+        "fitness",
+        "fitness at dt/16",
+        "mode",
+        "highest frequency",
+        "cells within 2 % of the frequency bound",
+        "phase range (rad)",
+        "strain contrast",
+    ]
     rows: List[List[str]] = []
     summary: Dict[str, List[str]] = {}
     variants = [("baseline (the study's dn0.5 runs)", baseline_runs)] + [
-        (CAUSE_TITLES.get(d.name, d.name), d) for d in sorted(causes.iterdir()) if d.is_dir()]
+        (CAUSE_TITLES.get(d.name, d.name), d) for d in sorted(causes.iterdir()) if d.is_dir()
+    ]
     for label, root in variants:
         for run_dir in sorted(root.glob("run_*"), key=lambda q: int(q.name[4:])):
             index = int(run_dir.name[4:])
@@ -1008,14 +1239,19 @@ def causes_lines(causes: Path, baseline_runs: Path, generation: int = 100) -> Li
             row = _cause_row(label, index, entry, run.config)
             rows.append(row)
             summary.setdefault(label, []).append(row[5])
-    lines = ["## Controlled runs: what changes the mode at low drag", "",
-             f"Small controlled runs test the likely causes of the differences at low drag. Each "
-             f"variant changes one thing in `configs/paper_dn0.5.toml` and evolves seeds 1–3 for {generation} "
-             "generations; the baseline is the study's own runs of the same seeds, their best at the same generation. "
-             "Packed in `data/replication_causes/<variant>/run_<i>` (run i has seed i + 1); this table is rebuilt from "
-             "there by `studies/replication/replication_report.py --causes data/replication_causes`. Three runs of 100 generations "
-             "per variant can show a large effect only: they are a screen, not a test.", "",
-             "| " + " | ".join(header) + " |", "| " + " | ".join("---" for _ in header) + " |"]
+    lines = [
+        "## Controlled runs: what changes the mode at low drag",
+        "",
+        f"Small controlled runs test the likely causes of the differences at low drag. Each "
+        f"variant changes one thing in `configs/paper_dn0.5.toml` and evolves seeds 1–3 for {generation} "
+        "generations; the baseline is the study's own runs of the same seeds, their best at the same generation. "
+        "Packed in `data/replication_causes/<variant>/run_<i>` (run i has seed i + 1); this table is rebuilt from "
+        "there by `studies/replication/replication_report.py --causes data/replication_causes`. Three runs of 100 generations "
+        "per variant can show a large effect only: they are a screen, not a test.",
+        "",
+        "| " + " | ".join(header) + " |",
+        "| " + " | ".join("---" for _ in header) + " |",
+    ]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     lines += ["", "Modes per variant: " + "; ".join(f"{k}: {', '.join(v)}" for k, v in summary.items()) + ".", ""]
     return lines
@@ -1031,10 +1267,15 @@ def main(argv: Optional[List[str]] = None) -> int:
     p.add_argument("--no-gif", action="store_true", help="skip the animations")
     p.add_argument("--no-calibration", action="store_true", help="skip the known-swimmer calibration section")
     p.add_argument("--target-runs", type=int, default=PAPER_RUNS, help="runs per environment the study aims at")
-    p.add_argument("--discussion", type=Path, default=Path("docs/notes/replication_discussion.md"),
-                   help="hand-written discussion inserted after the tables (if the file exists)")
-    p.add_argument("--causes", type=Path, default=None,
-                   help="packed controlled runs (data/replication_causes): adds their section")
+    p.add_argument(
+        "--discussion",
+        type=Path,
+        default=Path("docs/notes/replication_discussion.md"),
+        help="hand-written discussion inserted after the tables (if the file exists)",
+    )
+    p.add_argument(
+        "--causes", type=Path, default=None, help="packed controlled runs (data/replication_causes): adds their section"
+    )
     args = p.parse_args(argv)
     if args.runs is None and args.data is None:
         args.data = Path("data/replication")
@@ -1068,8 +1309,10 @@ def main(argv: Optional[List[str]] = None) -> int:
             env.images = {"fitness": fitness_figure(env, images)}
             envs.append(env)
         if not envs:
-            print(f"replication_report: {args.data or args.runs}: no runs (expected <env>/run_<i>/config.toml)",
-                  file=sys.stderr)
+            print(
+                f"replication_report: {args.data or args.runs}: no runs (expected <env>/run_<i>/config.toml)",
+                file=sys.stderr,
+            )
             return 1
         calibration = None
         if not args.no_calibration:
@@ -1085,8 +1328,18 @@ def main(argv: Optional[List[str]] = None) -> int:
             causes_dir = Path(tmp) / "_causes"
             replication_store.unpack_tree(args.causes, causes_dir)
             causes = causes_lines(causes_dir, runs_dir / CAUSE_BASELINE)
-        write_doc(envs, args.runs or runs_dir, args.doc, images, commit, args.discussion, calibration=calibration,
-                  data=args.data, target_runs=args.target_runs, causes=causes)
+        write_doc(
+            envs,
+            args.runs or runs_dir,
+            args.doc,
+            images,
+            commit,
+            args.discussion,
+            calibration=calibration,
+            data=args.data,
+            target_runs=args.target_runs,
+            causes=causes,
+        )
     print(f"{args.doc} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
     return 0
 

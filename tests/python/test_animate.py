@@ -1,4 +1,5 @@
 """animat.animate: GIF with the expected frames and size; MP4 only where ffmpeg exists."""
+
 import numpy as np
 import pytest
 from PIL import Image, ImageSequence
@@ -35,8 +36,8 @@ def test_gif_has_the_expected_frames_and_size(trajectory, tmp_path):
     assert stack.shape[:3] == (len(frames), 120, 200)
     # the nodes are drawn in the paper's colours: some red and some blue pixels somewhere
     rgb = stack[..., :3].reshape(-1, 3).astype(int)
-    red = np.sum((np.abs(rgb - [214, 39, 40]).sum(axis=1) < 40))
-    blue = np.sum((np.abs(rgb - [31, 119, 180]).sum(axis=1) < 40))
+    red = np.sum(np.abs(rgb - [214, 39, 40]).sum(axis=1) < 40)
+    blue = np.sum(np.abs(rgb - [31, 119, 180]).sum(axis=1) < 40)
     assert red > 50 and blue > 50
 
 
@@ -74,7 +75,8 @@ def test_mp4_where_ffmpeg_is_available(trajectory, tmp_path):
 
 def test_animate_replays_a_body_first(tmp_path):
     body = wave_body()
-    out = animat.animate(body, tmp_path / "b.gif", max_frames=5, size=(100, 80),
-                         config=animat.Config({"evaluation.steps": 40}))
+    out = animat.animate(
+        body, tmp_path / "b.gif", max_frames=5, size=(100, 80), config=animat.Config({"evaluation.steps": 40})
+    )
     with Image.open(out) as im:
         assert im.n_frames == 5

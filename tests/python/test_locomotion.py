@@ -1,6 +1,7 @@
 """Locomotion modes (undulation, synchronous contraction, protrusions) and the paper's statistics of
 the best individuals: synthetic swims with known answers, real swims with imposed phase
 patterns, rigid-motion invariance, and the statistics helpers on hand-made inputs."""
+
 import math
 from pathlib import Path
 from types import SimpleNamespace
@@ -18,6 +19,7 @@ PERIOD = 2 * math.pi / OMEGA
 
 
 # --- synthetic swims --------------------------------------------------------------------------------------
+
 
 def frame_times(periods=8, per_period=40):
     return np.arange(periods * per_period + 1) * (PERIOD / per_period)
@@ -116,6 +118,7 @@ def rigidly_moved(P, t, angle=0.7, spin=0.05, shift=(3.0, -2.0)):
 
 
 # --- classification of synthetic swims ------------------------------------------------------------------
+
 
 def test_travelling_contraction_wave_is_undulation_with_its_phase_gradient():
     k = 0.6
@@ -230,6 +233,7 @@ def test_classify_motion_checks_its_input():
 
 # --- helpers --------------------------------------------------------------------------------------------
 
+
 def test_harmonic_amplitudes_use_the_actuation_phase_convention():
     t = np.linspace(0, 5 * PERIOD, 400)
     s = np.stack([0.3 * np.sin(OMEGA * t + 1.2) + 2.0, 0.1 * np.sin(OMEGA * t - 2.5)], axis=1)
@@ -260,8 +264,12 @@ def test_circular_linear_fit_recovers_a_gradient_modulo_2pi():
 
 def test_procrustes_removes_rotation_and_translation():
     X = hex_blob()
-    frames = np.array([X @ np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]]).T + [a, 2 * a]
-                       for a in np.linspace(0, 3, 7)])
+    frames = np.array(
+        [
+            X @ np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]]).T + [a, 2 * a]
+            for a in np.linspace(0, 3, 7)
+        ]
+    )
     Q, R, mean = L.procrustes_frames(frames)
     assert np.allclose(Q, Q[0], atol=1e-12)
     assert np.allclose(np.einsum("fij,fkj->fik", R, R), np.eye(2), atol=1e-12)
@@ -269,6 +277,7 @@ def test_procrustes_removes_rotation_and_translation():
 
 
 # --- real swims with imposed phase patterns ---------------------------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def real_body_setup():
@@ -279,15 +288,18 @@ def real_body_setup():
     return X, c
 
 
-@pytest.mark.parametrize("pattern,expected", [
-    ("sync", "synchronous contraction"), ("ramp", "undulation"), ("halves", "other")])
+@pytest.mark.parametrize(
+    "pattern,expected", [("sync", "synchronous contraction"), ("ramp", "undulation"), ("halves", "other")]
+)
 def test_real_swims_with_imposed_phases(real_body_setup, pattern, expected):
     X, config = real_body_setup
     n = len(X)
     x = X[:, 0]
-    phase = {"sync": np.zeros(n),
-             "ramp": np.mod(-2 * math.pi * (x - x.min()) / np.ptp(x), 2 * math.pi),
-             "halves": np.where(X[:, 1] > 0, math.pi, 0.0)}[pattern]
+    phase = {
+        "sync": np.zeros(n),
+        "ramp": np.mod(-2 * math.pi * (x - x.min()) / np.ptp(x), 2 * math.pi),
+        "halves": np.where(X[:, 1] > 0, math.pi, 0.0),
+    }[pattern]
     body = animat.build_body(X, np.full(n, 0.2), np.full(n, 8.0), phase)
     tr = animat.replay(body, config)
     m = L.classify_locomotion(tr)
@@ -316,6 +328,7 @@ def test_classify_locomotion_replays_a_genome():
 
 
 # --- statistics --------------------------------------------------------------------------------------------
+
 
 def test_phase_spread_on_the_circle():
     same = L.phase_spread([1.0, 1.0, 1.0])
@@ -353,8 +366,10 @@ def test_oscillator_spread_of_a_hand_made_body():
 
 
 def test_grow_output_final_and_realised():
-    embryo = SimpleNamespace(outputs=np.array([[0, 0, 0.2, 0, 0, 0], [0, 0, 0.4, 0, 0, 0], [0, 0, 0.6, 0, 0, 0]]),
-                             radii=np.array([0.5, 0.55, 0.75]))
+    embryo = SimpleNamespace(
+        outputs=np.array([[0, 0, 0.2, 0, 0, 0], [0, 0, 0.4, 0, 0, 0], [0, 0, 0.6, 0, 0, 0]]),
+        radii=np.array([0.5, 0.55, 0.75]),
+    )
     g = L.grow_output(embryo)  # cell_radius 0.5, max_growth 0.5
     assert (g.final_mean, g.final_min, g.final_max) == pytest.approx((0.4, 0.2, 0.6))
     assert g.realized == pytest.approx((0.2 + 1.0) / 2) and g.realized_min == pytest.approx(0.2)
@@ -425,6 +440,7 @@ def test_morphology_changes_of_a_run_match_the_run_method(tmp_path):
 
 # --- the report script on a tiny experiment -----------------------------------------------------------------
 
+
 def test_replication_report_on_finished_and_partial_runs(tmp_path):
     import subprocess
     import sys
@@ -440,8 +456,9 @@ def test_replication_report_on_finished_and_partial_runs(tmp_path):
     animat.evolve(c, out=str(runs / "dn10" / "run_0"))  # a run without summary.json ("in progress")
     doc = tmp_path / "docs" / "replication.md"
     report = str(root / "studies" / "replication" / "replication_report.py")
-    out = subprocess.run([sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"],
-                         capture_output=True, text=True)
+    out = subprocess.run(
+        [sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"], capture_output=True, text=True
+    )
     assert out.returncode == 0, out.stderr
     text = doc.read_text()
     assert text.count("<!-- DISCUSSION -->") == 1
@@ -456,6 +473,10 @@ def test_replication_report_on_finished_and_partial_runs(tmp_path):
     assert "images/replication/dn2_run0_motion.png" in text
     # deterministic: a second run writes the same document
     first = text
-    subprocess.run([sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"], capture_output=True,
-                   text=True, check=True)
+    subprocess.run(
+        [sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     assert doc.read_text() == first

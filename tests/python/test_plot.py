@@ -1,5 +1,6 @@
 """animat.plot on a small real run, headless (Agg): every function returns a Figure and draws what
 the paper's figure shows; motion_cycle colours follow eq. 2, phase_map's colour range the phases."""
+
 import math
 import re
 
@@ -104,8 +105,11 @@ def test_motion_cycle_node_colours_follow_eq2(trajectory):
     assert len(panels) == 5
     # the skin is drawn thick in every panel and the direction of motion is marked
     for ax in panels:
-        widths = [lc.get_linewidth()[0] for lc in ax.collections if lc.get_label() != "nodes"
-                  and hasattr(lc, "get_segments") and len(lc.get_segments())]
+        widths = [
+            lc.get_linewidth()[0]
+            for lc in ax.collections
+            if lc.get_label() != "nodes" and hasattr(lc, "get_segments") and len(lc.get_segments())
+        ]
         assert max(widths) >= 2.0
     assert any("direction of motion" in t.get_text() for t in fig.legends[0].get_texts())
 
