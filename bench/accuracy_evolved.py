@@ -17,6 +17,7 @@ draws). A discretisation error below that spread is noise that no step size remo
 
 prints the Markdown tables that docs/accuracy.md quotes.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -52,7 +53,7 @@ def best_of(run: Path):
     return int(data["generation"]), animat.Genome.from_json(json.dumps(data["genome"]))
 
 
-def config_for(run: Path, dt: float, substeps: int) -> "animat.Config":
+def config_for(run: Path, dt: float, substeps: int) -> animat.Config:
     c = animat.load_config(str(run / "config.toml"))
     horizon = c["evaluation.steps"] * c["physics.dt"]
     c["physics.dt"] = dt
@@ -75,11 +76,24 @@ def measure(run_path: str) -> list[dict]:
         t0 = time.process_time()
         r = animat.swim(body, config=c)
         cpu = time.process_time() - t0
-        rows.append(dict(run=str(run), environment=env, drag_normal=base["scene.drag_normal"],
-                         generation=generation, cells=embryo.cell_count, step=label, h=dt / sub,
-                         fitness=r.distance, valid=r.valid, collisions=r.collisions,
-                         min_area_ratio=r.min_area_ratio, drag_limited=r.drag_limited, cpu_seconds=cpu,
-                         median_frequency=float(np.median(embryo.frequency))))
+        rows.append(
+            dict(
+                run=str(run),
+                environment=env,
+                drag_normal=base["scene.drag_normal"],
+                generation=generation,
+                cells=embryo.cell_count,
+                step=label,
+                h=dt / sub,
+                fitness=r.distance,
+                valid=r.valid,
+                collisions=r.collisions,
+                min_area_ratio=r.min_area_ratio,
+                drag_limited=r.drag_limited,
+                cpu_seconds=cpu,
+                median_frequency=float(np.median(embryo.frequency)),
+            )
+        )
     # Chaos: perturbed starts at the default step.
     c = config_for(run, DEFAULT_DT, 1)
     embryo = animat.develop(genome, c)
@@ -105,19 +119,28 @@ def summarize(rows: list[dict]) -> str:
     for r in rows:
         by_run.setdefault(r["run"], {})[r["step"]] = r
     out = []
-    out.append("| environment | run | gen. | cells | median f | collisions | min S/S0 | "
-               + " | ".join(f"h = {s[0]}" for s in SETTINGS) + " | error at 1/60 | chaos spread (1e-6) |")
+    out.append(
+        "| environment | run | gen. | cells | median f | collisions | min S/S0 | "
+        + " | ".join(f"h = {s[0]}" for s in SETTINGS)
+        + " | error at 1/60 | chaos spread (1e-6) |"
+    )
     out.append("|" + "---|" * (8 + len(SETTINGS)))
     for run, steps in sorted(by_run.items(), key=lambda kv: (kv[1][DEFAULT]["drag_normal"], kv[0])):
         d = steps[DEFAULT]
         ref = steps[REFERENCE]["fitness"]
         chaos = 100.0 * (d["chaos_max"] - d["chaos_min"]) / max(ref, 1e-12)
-        fits = " | ".join(f"{steps[s[0]]['fitness']:.3f}{'' if steps[s[0]]['valid'] else ' (invalid)'}" for s in SETTINGS)
-        out.append(f"| {d['environment']} | {Path(run).name} | {d['generation']} | {d['cells']} | "
-                   f"{d['median_frequency']:.2f} | {d['collisions']} | {d['min_area_ratio']:.3f} | {fits} | "
-                   f"{percent(d['fitness'], ref):.2f}% | {chaos:.2f}% |")
+        fits = " | ".join(
+            f"{steps[s[0]]['fitness']:.3f}{'' if steps[s[0]]['valid'] else ' (invalid)'}" for s in SETTINGS
+        )
+        out.append(
+            f"| {d['environment']} | {Path(run).name} | {d['generation']} | {d['cells']} | "
+            f"{d['median_frequency']:.2f} | {d['collisions']} | {d['min_area_ratio']:.3f} | {fits} | "
+            f"{percent(d['fitness'], ref):.2f}% | {chaos:.2f}% |"
+        )
     out.append("")
-    out.append("| h | genomes | invalid | fitness error median | p90 | max | within 1 % (or 0.05) | CPU ms per swim (median) | cost vs 1/60 |")
+    out.append(
+        "| h | genomes | invalid | fitness error median | p90 | max | within 1 % (or 0.05) | CPU ms per swim (median) | cost vs 1/60 |"
+    )
     out.append("|---|---|---|---|---|---|---|---|---|")
     default_cpu = np.median([s[DEFAULT]["cpu_seconds"] for s in by_run.values()])
     for label, _, _ in SETTINGS:
@@ -132,28 +155,34 @@ def summarize(rows: list[dict]) -> str:
             invalid += not steps[label]["valid"]
             cpu.append(steps[label]["cpu_seconds"])
         e = np.array(errs)
-        out.append(f"| {label}{' (default)' if label == DEFAULT else ''} | {len(e)} | {invalid} | {np.median(e):.2f}% | "
-                   f"{np.percentile(e, 90):.2f}% | {e.max():.2f}% | {ok}/{len(e)} | {1e3 * np.median(cpu):.1f} | "
-                   f"{np.median(cpu) / default_cpu:.2f}x |")
+        out.append(
+            f"| {label}{' (default)' if label == DEFAULT else ''} | {len(e)} | {invalid} | {np.median(e):.2f}% | "
+            f"{np.percentile(e, 90):.2f}% | {e.max():.2f}% | {ok}/{len(e)} | {1e3 * np.median(cpu):.1f} | "
+            f"{np.median(cpu) / default_cpu:.2f}x |"
+        )
     return "\n".join(out)
 
 
 def plot(rows: list[dict], path: str) -> None:
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     by_run: dict[str, dict[str, dict]] = {}
     for r in rows:
         by_run.setdefault(r["run"], {})[r["step"]] = r
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     colours = {}
-    for run, steps in by_run.items():
+    for _run, steps in by_run.items():
         ref = steps[REFERENCE]["fitness"]
         hs = [steps[s[0]]["h"] for s in SETTINGS if s[0] != REFERENCE]
         es = [max(percent(steps[s[0]]["fitness"], ref), 1e-4) for s in SETTINGS if s[0] != REFERENCE]
         env = steps[DEFAULT]["environment"]
         colour = colours.setdefault(env, f"C{len(colours)}")
-        ax.loglog(hs, es, "o-", color=colour, alpha=0.7, label=env if env not in ax.get_legend_handles_labels()[1] else None)
+        ax.loglog(
+            hs, es, "o-", color=colour, alpha=0.7, label=env if env not in ax.get_legend_handles_labels()[1] else None
+        )
     ax.axhline(1.0, color="k", lw=0.8, ls="--")
     ax.axvline(DEFAULT_DT, color="grey", lw=0.8, ls=":")
     ax.set_xlabel("step h")
@@ -175,8 +204,11 @@ def main() -> int:
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     except OSError:
         commit = "?"
-    print(f"# accuracy_evolved: {len(args.runs)} runs, {args.workers} workers, {platform.processor() or platform.machine()}, "
-          f"{os.cpu_count()} cores, Python {platform.python_version()}, commit {commit}", file=sys.stderr)
+    print(
+        f"# accuracy_evolved: {len(args.runs)} runs, {args.workers} workers, {platform.processor() or platform.machine()}, "
+        f"{os.cpu_count()} cores, Python {platform.python_version()}, commit {commit}",
+        file=sys.stderr,
+    )
     rows = []
     with cf.ProcessPoolExecutor(args.workers) as pool:
         for part in pool.map(measure, args.runs):

@@ -19,6 +19,7 @@ initial cell positions are perturbed by 1e-6. A discretisation error below that 
 
 prints the summary table (Markdown) that docs/accuracy.md quotes.
 """
+
 import argparse
 import concurrent.futures as cf
 import csv
@@ -34,9 +35,9 @@ import numpy as np
 import animat
 
 DEFAULT_DT = 1.0 / 60.0
-HORIZON = 4000 * DEFAULT_DT          # simulated time of one evaluation
-REF_DIV = 16                         # reference step = DEFAULT_DT / 16
-SAMPLES = 40                         # COM samples along the horizon
+HORIZON = 4000 * DEFAULT_DT  # simulated time of one evaluation
+REF_DIV = 16  # reference step = DEFAULT_DT / 16
+SAMPLES = 40  # COM samples along the horizon
 STEPS = [1 / 15, 1 / 30, 1 / 60, 1 / 120, 1 / 240]
 DEFAULT_SCHEME = "semi_implicit"
 SCHEMES = ["semi_implicit", "explicit", "stable", "implicit"]
@@ -63,8 +64,9 @@ def hand_made():
     out.append(("sync f=2 (36)", q, np.full(len(q), 0.2), np.full(len(q), 2.0), np.zeros(len(q))))
     r = lattice(8, 8, 0.15, 3)
     rng = np.random.default_rng(4)
-    out.append(("random (64)", r, rng.uniform(0, 0.2, len(r)), rng.uniform(0.5, 12, len(r)),
-                rng.uniform(0, 2 * np.pi, len(r))))
+    out.append(
+        ("random (64)", r, rng.uniform(0, 0.2, len(r)), rng.uniform(0.5, 12, len(r)), rng.uniform(0, 2 * np.pi, len(r)))
+    )
     return out
 
 
@@ -112,8 +114,13 @@ def errors(com, ref):
     fit, fit_ref = np.linalg.norm(d), np.linalg.norm(dr)
     traj = np.sqrt(np.mean(np.sum((com - com[0] - (ref - ref[0])) ** 2, axis=1)))
     scale = fit_ref if fit_ref > 0 else float("nan")  # relative errors; near-zero references are left out later
-    return dict(failed=0, fitness=fit, fit_err=abs(fit - fit_ref) / scale, disp_err=np.linalg.norm(d - dr) / scale,
-                traj_err=traj / scale)
+    return dict(
+        failed=0,
+        fitness=fit,
+        fit_err=abs(fit - fit_ref) / scale,
+        disp_err=np.linalg.norm(d - dr) / scale,
+        traj_err=traj / scale,
+    )
 
 
 def case(body_spec, dn):
@@ -125,13 +132,35 @@ def case(body_spec, dn):
     for vf in VELOCITY_FORCES:
         for scheme in SCHEMES:
             for h in STEPS:
-                rows.append(dict(body=body_spec[0], d_N=dn, h=h, dt=h, substeps=1, scheme=scheme, velocity_forces=vf,
-                                 fitness_ref=fit_ref, chaos_floor=floor_err["fit_err"],
-                                 **errors(run(body_spec, dn, h, scheme, velocity_forces=vf), ref)))
+                rows.append(
+                    dict(
+                        body=body_spec[0],
+                        d_N=dn,
+                        h=h,
+                        dt=h,
+                        substeps=1,
+                        scheme=scheme,
+                        velocity_forces=vf,
+                        fitness_ref=fit_ref,
+                        chaos_floor=floor_err["fit_err"],
+                        **errors(run(body_spec, dn, h, scheme, velocity_forces=vf), ref),
+                    )
+                )
     for dt, s in SUBSTEP_COMBOS:
-        rows.append(dict(body=body_spec[0], d_N=dn, h=dt / s, dt=dt, substeps=s, scheme=DEFAULT_SCHEME, velocity_forces="midpoint",
-                         fitness_ref=fit_ref, chaos_floor=floor_err["fit_err"],
-                         **errors(run(body_spec, dn, dt / s, DEFAULT_SCHEME, s), ref)))
+        rows.append(
+            dict(
+                body=body_spec[0],
+                d_N=dn,
+                h=dt / s,
+                dt=dt,
+                substeps=s,
+                scheme=DEFAULT_SCHEME,
+                velocity_forces="midpoint",
+                fitness_ref=fit_ref,
+                chaos_floor=floor_err["fit_err"],
+                **errors(run(body_spec, dn, dt / s, DEFAULT_SCHEME, s), ref),
+            )
+        )
     return rows
 
 
@@ -171,28 +200,48 @@ def machine():
                 break
     except OSError:
         pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}, Python {platform.python_version()}"
+    return (
+        f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}, Python {platform.python_version()}"
+    )
 
 
 def summarise(rows, costs, min_fitness):
     """Per (h, scheme, substeps): median/max fitness error over cases with reference fitness >=
     min_fitness, share within 1%, median trajectory error, failures, cost."""
-    keys = sorted({(r["dt"], r["substeps"], r["scheme"], r["velocity_forces"]) for r in rows},
-                  key=lambda k: (VELOCITY_FORCES.index(k[3]), SCHEMES.index(k[2]), -k[0] / k[1], k[1]))
+    keys = sorted(
+        {(r["dt"], r["substeps"], r["scheme"], r["velocity_forces"]) for r in rows},
+        key=lambda k: (VELOCITY_FORCES.index(k[3]), SCHEMES.index(k[2]), -k[0] / k[1], k[1]),
+    )
     out = []
     for dt, s, scheme, vf in keys:
-        sel = [r for r in rows if r["dt"] == dt and r["substeps"] == s and r["scheme"] == scheme and r["velocity_forces"] == vf]
+        sel = [
+            r
+            for r in rows
+            if r["dt"] == dt and r["substeps"] == s and r["scheme"] == scheme and r["velocity_forces"] == vf
+        ]
         good = [r for r in sel if r["fitness_ref"] >= min_fitness]
         fe = np.array([r["fit_err"] for r in good], dtype=float)
         te = np.array([r["traj_err"] for r in good], dtype=float)
         ae = np.array([abs(r["fitness"] - r["fitness_ref"]) if not r["failed"] else float("inf") for r in sel])
         h = dt / s
-        out.append(dict(dt=dt, substeps=s, h=h, scheme=scheme, velocity_forces=vf, cases=len(good),
-                        failed=sum(r["failed"] for r in sel),
-                        abs_max=float(ae.max()),
-                        fit_median=float(np.median(fe)), fit_p90=float(np.percentile(fe, 90)), fit_max=float(fe.max()),
-                        within_1pct=float(np.mean(fe <= 0.01)), traj_median=float(np.median(te)),
-                        cost=costs.get((h, scheme, vf), float("nan")) if s == 1 else float("nan")))
+        out.append(
+            dict(
+                dt=dt,
+                substeps=s,
+                h=h,
+                scheme=scheme,
+                velocity_forces=vf,
+                cases=len(good),
+                failed=sum(r["failed"] for r in sel),
+                abs_max=float(ae.max()),
+                fit_median=float(np.median(fe)),
+                fit_p90=float(np.percentile(fe, 90)),
+                fit_max=float(fe.max()),
+                within_1pct=float(np.mean(fe <= 0.01)),
+                traj_median=float(np.median(te)),
+                cost=costs.get((h, scheme, vf), float("nan")) if s == 1 else float("nan"),
+            )
+        )
     return out
 
 
@@ -201,37 +250,59 @@ def frac(x):
 
 
 def markdown(summary, floors, default_cost):
-    lines = ["| h = dt/substeps | dt | substeps | velocity forces | drag scheme | failed | fitness error median | p90 | max | within 1% | "
-             "trajectory error median | max abs. fitness error, all cases | CPU ms per time unit | cost vs default |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| h = dt/substeps | dt | substeps | velocity forces | drag scheme | failed | fitness error median | p90 | max | within 1% | "
+        "trajectory error median | max abs. fitness error, all cases | CPU ms per time unit | cost vs default |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+
+    def pct(x):
+        return "∞" if not math.isfinite(x) else f"{100 * x:.2f}%"
+
     for s in summary:
-        pct = lambda x: "∞" if not math.isfinite(x) else f"{100 * x:.2f}%"
         cost = s["cost"]
-        lines.append(f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['velocity_forces']} | {s['scheme']} | {s['failed']} | "
-                     f"{pct(s['fit_median'])} | {pct(s['fit_p90'])} | {pct(s['fit_max'])} | {100 * s['within_1pct']:.0f}% | "
-                     f"{pct(s['traj_median'])} | {s['abs_max']:.3g} | {1e3 * cost:.2f} | {cost / default_cost:.2f}× |"
-                     if math.isfinite(cost) else
-                     f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['velocity_forces']} | {s['scheme']} | {s['failed']} | "
-                     f"{pct(s['fit_median'])} | {pct(s['fit_p90'])} | {pct(s['fit_max'])} | {100 * s['within_1pct']:.0f}% | "
-                     f"{pct(s['traj_median'])} | {s['abs_max']:.3g} | = h row | = h row |")
+        lines.append(
+            f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['velocity_forces']} | {s['scheme']} | {s['failed']} | "
+            f"{pct(s['fit_median'])} | {pct(s['fit_p90'])} | {pct(s['fit_max'])} | {100 * s['within_1pct']:.0f}% | "
+            f"{pct(s['traj_median'])} | {s['abs_max']:.3g} | {1e3 * cost:.2f} | {cost / default_cost:.2f}× |"
+            if math.isfinite(cost)
+            else f"| {frac(s['h'])} | {frac(s['dt'])} | {s['substeps']} | {s['velocity_forces']} | {s['scheme']} | {s['failed']} | "
+            f"{pct(s['fit_median'])} | {pct(s['fit_p90'])} | {pct(s['fit_max'])} | {100 * s['within_1pct']:.0f}% | "
+            f"{pct(s['traj_median'])} | {s['abs_max']:.3g} | = h row | = h row |"
+        )
     lines.append("")
-    lines.append(f"Chaos floor (fitness change from a 1e-6 perturbation of the initial positions, at the reference "
-                 f"step): median {100 * np.median(floors):.3f}%, max {100 * np.max(floors):.2f}%.")
+    lines.append(
+        f"Chaos floor (fitness change from a 1e-6 perturbation of the initial positions, at the reference "
+        f"step): median {100 * np.median(floors):.3f}%, max {100 * np.max(floors):.2f}%."
+    )
     return "\n".join(lines)
 
 
 def plot(summary, path):
     import matplotlib
     import matplotlib.ticker
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for (scheme, vf), marker, ls in zip([(s, v) for v in VELOCITY_FORCES for s in SCHEMES], "osdosd",
-                                        ["-", "-", "-", ":", ":", ":"]):
-        pts = [s for s in summary if s["scheme"] == scheme and s["velocity_forces"] == vf and s["substeps"] == 1
-               and math.isfinite(s["cost"]) and math.isfinite(s["fit_median"])]
+    for (scheme, vf), marker, ls in zip(
+        [(s, v) for v in VELOCITY_FORCES for s in SCHEMES], "osdosd", ["-", "-", "-", ":", ":", ":"]
+    ):
+        pts = [
+            s
+            for s in summary
+            if s["scheme"] == scheme
+            and s["velocity_forces"] == vf
+            and s["substeps"] == 1
+            and math.isfinite(s["cost"])
+            and math.isfinite(s["fit_median"])
+        ]
         x = [1e3 * s["cost"] for s in pts]
-        for ax, key, label in [(axes[0], "fit_median", "median fitness error"), (axes[1], "traj_median", "median trajectory error")]:
+        for ax, key, label in [
+            (axes[0], "fit_median", "median fitness error"),
+            (axes[1], "traj_median", "median trajectory error"),
+        ]:
             y = [max(s[key], 1e-6) for s in pts]
             ax.plot(x, y, marker=marker, ls=ls, label=f"{scheme}, {vf}")
             for s, xi, yi in zip(pts, x, y):
@@ -257,8 +328,12 @@ def main():
     ap.add_argument("--genomes", type=int, default=6, help="random viable genomes")
     ap.add_argument("--seed", type=int, default=2012)
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--min-fitness", type=float, default=0.5,
-                    help="cases whose reference fitness is below this are left out of relative summaries")
+    ap.add_argument(
+        "--min-fitness",
+        type=float,
+        default=0.5,
+        help="cases whose reference fitness is below this are left out of relative summaries",
+    )
     ap.add_argument("--quick", action="store_true", help="2 hand-made bodies, 1 genome, d_N = 2 only")
     args = ap.parse_args()
 
@@ -279,7 +354,9 @@ def main():
         w.writeheader()
         w.writerows(rows)
     summary = summarise(rows, costs, args.min_fitness)
-    floors = sorted({(r["body"], r["d_N"]): r["chaos_floor"] for r in rows if r["fitness_ref"] >= args.min_fitness}.values())
+    floors = sorted(
+        {(r["body"], r["d_N"]): r["chaos_floor"] for r in rows if r["fitness_ref"] >= args.min_fitness}.values()
+    )
     default_cost = costs[(DEFAULT_DT, DEFAULT_SCHEME, "midpoint")]
     plot(summary, args.plot)
     try:
@@ -287,26 +364,41 @@ def main():
     except OSError:
         commit = "?"
     print(f"machine: {machine()}; commit {commit}; sweep {sweep_seconds:.0f} s wall on {args.threads} threads")
-    print(f"bodies: {len(bodies)} x d_N {envs}; horizon {HORIZON:.2f} time units; reference h = 1/{round(REF_DIV / DEFAULT_DT)}")
-    print(f"cases in summaries (reference fitness >= {args.min_fitness}): "
-          f"{sum(1 for r in rows if r['fitness_ref'] >= args.min_fitness) // (len(VELOCITY_FORCES) * len(SCHEMES) * len(STEPS) + len(SUBSTEP_COMBOS))}"
-          f" of {len(cases)}")
-    print(f"default (h = 1/60, semi-implicit drag, midpoint velocity forces): {1e3 * default_cost:.2f} CPU ms per time unit, "
-          f"{1e3 * default_cost * HORIZON:.0f} ms per evaluation horizon, "
-          f"{1e6 * default_cost * DEFAULT_DT:.1f} us per step")
+    print(
+        f"bodies: {len(bodies)} x d_N {envs}; horizon {HORIZON:.2f} time units; reference h = 1/{round(REF_DIV / DEFAULT_DT)}"
+    )
+    print(
+        f"cases in summaries (reference fitness >= {args.min_fitness}): "
+        f"{sum(1 for r in rows if r['fitness_ref'] >= args.min_fitness) // (len(VELOCITY_FORCES) * len(SCHEMES) * len(STEPS) + len(SUBSTEP_COMBOS))}"
+        f" of {len(cases)}"
+    )
+    print(
+        f"default (h = 1/60, semi-implicit drag, midpoint velocity forces): {1e3 * default_cost:.2f} CPU ms per time unit, "
+        f"{1e3 * default_cost * HORIZON:.0f} ms per evaluation horizon, "
+        f"{1e6 * default_cost * DEFAULT_DT:.1f} us per step"
+    )
     print()
     print(markdown(summary, floors, default_cost))
     print()
     print("per case (fitness error %, default: semi-implicit drag, midpoint velocity forces):")
     for b in bodies:
         for dn in sorted({r["d_N"] for r in rows}):
-            sel = {r["h"]: r for r in rows if r["body"] == b[0] and r["d_N"] == dn and r["scheme"] == DEFAULT_SCHEME
-                   and r["substeps"] == 1 and r["velocity_forces"] == "midpoint"}
+            sel = {
+                r["h"]: r
+                for r in rows
+                if r["body"] == b[0]
+                and r["d_N"] == dn
+                and r["scheme"] == DEFAULT_SCHEME
+                and r["substeps"] == 1
+                and r["velocity_forces"] == "midpoint"
+            }
             if not sel:
                 continue
             any_row = next(iter(sel.values()))
             cells = " ".join(f"{frac(h)}:{100 * sel[h]['fit_err']:.2f}" for h in STEPS)
-            print(f"  {b[0]:28s} d_N={dn:<4g} fit_ref={any_row['fitness_ref']:8.3f} floor={100 * any_row['chaos_floor']:.3f}%  {cells}")
+            print(
+                f"  {b[0]:28s} d_N={dn:<4g} fit_ref={any_row['fitness_ref']:8.3f} floor={100 * any_row['chaos_floor']:.3f}%  {cells}"
+            )
 
 
 if __name__ == "__main__":

@@ -90,7 +90,8 @@ void BM_Develop(benchmark::State& state) {
   const Sample& s = sample();
   std::size_t k = 0;
   for (auto _ : state) {
-    Embryo e = develop(s.genomes[k++ % kGenomes], s.config.genome, s.config.grn, s.config.development);
+    Embryo e =
+        develop(s.genomes[k++ % kGenomes], s.config.genome, s.config.grn, s.config.development);
     benchmark::DoNotOptimize(e.viable);
   }
   set_counters(state, "per_s");
@@ -114,7 +115,8 @@ void BM_Swim(benchmark::State& state) {
   const Sample& s = sample();
   std::size_t k = 0;
   for (auto _ : state) {
-    SwimResult r = swim(s.bodies[k++ % kGenomes], s.config.scene, s.config.physics, s.config.evaluation.steps);
+    SwimResult r =
+        swim(s.bodies[k++ % kGenomes], s.config.scene, s.config.physics, s.config.evaluation.steps);
     benchmark::DoNotOptimize(r.distance);
   }
   set_counters(state, "per_s");
@@ -135,7 +137,8 @@ void BM_RandomTry(benchmark::State& state) {
   }
   set_counters(state, "per_s");
   // A label, not a counter: the CSV reporter wants the same counters in every benchmark.
-  state.SetLabel("viable_fraction=" + std::to_string(static_cast<double>(viable) / static_cast<double>(state.iterations())));
+  state.SetLabel("viable_fraction=" + std::to_string(static_cast<double>(viable) /
+                                                     static_cast<double>(state.iterations())));
 }
 BENCHMARK(BM_RandomTry)->Unit(benchmark::kMicrosecond);
 
@@ -160,8 +163,8 @@ void BM_DevelopStep(benchmark::State& state) {
   const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
   for (int i = 0; i < n; ++i) {
     const int row = i / side, col = i % side;
-    world.add_cell(DevelopmentWorld::Vec2(col + 0.5 * (row % 2), row * 0.8660254037844386), params.cell_radius,
-                   DevelopmentWorld::Vec2(1.0, 0.0));
+    world.add_cell(DevelopmentWorld::Vec2(col + 0.5 * (row % 2), row * 0.8660254037844386),
+                   params.cell_radius, DevelopmentWorld::Vec2(1.0, 0.0));
   }
   for (int k = 0; k < 50; ++k) world.step();
   for (auto _ : state) benchmark::DoNotOptimize(world.step());
@@ -179,9 +182,12 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   animat::bench::add_context();
-  sample();  // draw the genomes before any benchmark (and outside callgrind's --toggle-collect window)
-  benchmark::AddCustomContext("genomes", std::to_string(kGenomes) + " viable random genomes, seeds from 0");
-  benchmark::AddCustomContext("tries_per_viable", std::to_string(static_cast<double>(sample().tries) / kGenomes));
+  // draw the genomes before any benchmark (and outside callgrind's --toggle-collect window)
+  sample();
+  benchmark::AddCustomContext("genomes",
+                              std::to_string(kGenomes) + " viable random genomes, seeds from 0");
+  benchmark::AddCustomContext("tries_per_viable",
+                              std::to_string(static_cast<double>(sample().tries) / kGenomes));
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -4,11 +4,11 @@
 //
 // Runs the GA with a profiling evaluator (evaluator.hpp) that times every task one after the other
 // (thread CPU time, so a loaded machine does not inflate them):
-// an initial individual (its random tries until viable, then its swim) or one offspring's evaluation.
-// The rest of a generation is the serial part on rank 0: breeding, bookkeeping, and the checkpoint
-// (serialised, written and fsync'ed like run_evolution does; its per-individual part, which rank 0
-// runs on its threads, is timed apart). Then it replays the measured task
-// times through the scheduler of each path, task by task in index order to the first free worker:
+// an initial individual (its random tries until viable, then its swim) or one offspring's
+// evaluation. The rest of a generation is the serial part on rank 0: breeding, bookkeeping, and the
+// checkpoint (serialised, written and fsync'ed like run_evolution does; its per-individual part,
+// which rank 0 runs on its threads, is timed apart). Then it replays the measured task times
+// through the scheduler of each path, task by task in index order to the first free worker:
 //   threads  OpenMP schedule(dynamic, 1) on W threads of one process
 //   mpi      W workers with the MPI hand-out (mpi_job.cpp), each holding up to 2 tasks, one message
 //            round trip of LATENCY per hand-out
@@ -51,7 +51,8 @@ double cpu_now() {
 class ProfilingEvaluator final : public Evaluator {
  public:
   explicit ProfilingEvaluator(const Config& c) : fitness_(swim_fitness(c)) {}
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest&) override {
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes,
+                                const StopRequest&) override {
     std::vector<Fitness> out;
     for (const Genome* g : genomes) {
       const double t0 = cpu_now();
@@ -126,7 +127,8 @@ int main(int argc, char** argv) {
     std::vector<double> tasks;
     std::vector<bool> viable;
     double serial = 0.0, checkpoint = 0.0, fsync = 0.0, eval = 0.0;
-    double checkpoint_parallel = 0.0;  // the per-individual part of checkpoint(), spread over rank 0's threads
+    // the per-individual part of checkpoint(), spread over rank 0's threads
+    double checkpoint_parallel = 0.0;
     std::size_t checkpoint_bytes = 0, work_bytes = 0;
   };
   std::vector<Generation> gens;
@@ -135,8 +137,10 @@ int main(int argc, char** argv) {
     prof->viable.clear();
     prof->bytes = 0;
     const double t0 = cpu_now();
-    if (g == 0) evo.initialize();
-    else evo.step();
+    if (g == 0)
+      evo.initialize();
+    else
+      evo.step();
     const double total = cpu_now() - t0;
     Generation G;
     G.tasks = prof->tasks;
@@ -145,7 +149,8 @@ int main(int argc, char** argv) {
     G.serial = total - G.eval;
     G.work_bytes = prof->bytes;
     const double c0 = cpu_now();
-    const std::string text = evo.checkpoint();  // serialised as run_evolution does, then written and fsync'ed
+    // serialised as run_evolution does, then written and fsync'ed
+    const std::string text = evo.checkpoint();
     FILE* f = std::fopen(ckpt_path.c_str(), "wb");
     std::fwrite(text.data(), 1, text.size(), f);
     std::fflush(f);
@@ -156,7 +161,8 @@ int main(int argc, char** argv) {
     G.fsync = seconds(Clock::now() - s0);
     const double p0 = cpu_now();  // the same work as checkpoint()'s per-individual loop
     std::size_t items = 0;
-    for (const auto& ind : evo.population()) items += nlohmann::json::parse(to_json(ind.genome)).size();
+    for (const auto& ind : evo.population())
+      items += nlohmann::json::parse(to_json(ind.genome)).size();
     if (items == 0) std::fprintf(stderr, "empty genomes?\n");
     G.checkpoint_parallel = std::min(G.checkpoint, cpu_now() - p0);
     G.checkpoint_bytes = text.size();
@@ -168,43 +174,59 @@ int main(int argc, char** argv) {
     const auto& G = gens[g];
     std::vector<double> sorted = G.tasks;
     std::sort(sorted.begin(), sorted.end());
-    auto q = [&](double p) { return sorted.empty() ? 0.0 : sorted[static_cast<std::size_t>(p * (sorted.size() - 1))]; };
+    auto q = [&](double p) {
+      return sorted.empty() ? 0.0 : sorted[static_cast<std::size_t>(p * (sorted.size() - 1))];
+    };
     std::size_t nv = 0;
     for (bool v : G.viable) nv += v;
-    std::printf("{\"kind\": \"generation\", \"population\": %d, \"generation\": %zu, \"tasks\": %zu, \"viable_tasks\": %zu, "
-                "\"eval_s\": %.6f, \"serial_s\": %.6f, \"checkpoint_s\": %.6f, \"checkpoint_parallel_s\": %.6f, \"fsync_s\": %.6f, \"checkpoint_bytes\": %zu, "
-                "\"work_bytes\": %zu, \"task_min_s\": %.6f, \"task_median_s\": %.6f, \"task_p90_s\": %.6f, "
-                "\"task_max_s\": %.6f}\n",
-                c.evolution.population, g, G.tasks.size(), nv, G.eval, G.serial, G.checkpoint, G.checkpoint_parallel, G.fsync, G.checkpoint_bytes,
-                G.work_bytes, q(0.0), q(0.5), q(0.9), q(1.0));
+    std::printf(
+        "{\"kind\": \"generation\", \"population\": %d, \"generation\": %zu, \"tasks\": %zu, "
+        "\"viable_tasks\": %zu, "
+        "\"eval_s\": %.6f, \"serial_s\": %.6f, \"checkpoint_s\": %.6f, \"checkpoint_parallel_s\": "
+        "%.6f, \"fsync_s\": %.6f, \"checkpoint_bytes\": %zu, "
+        "\"work_bytes\": %zu, \"task_min_s\": %.6f, \"task_median_s\": %.6f, \"task_p90_s\": %.6f, "
+        "\"task_max_s\": %.6f}\n",
+        c.evolution.population, g, G.tasks.size(), nv, G.eval, G.serial, G.checkpoint,
+        G.checkpoint_parallel, G.fsync, G.checkpoint_bytes, G.work_bytes, q(0.0), q(0.5), q(0.9),
+        q(1.0));
   }
-  // Projected speedup over one worker of the whole run (seeding + generations), serial part included,
-  // with a checkpoint every generation (the default) or every 10th (evolution.checkpoint_every = 10).
-  // spread = 0: the checkpoint as before issue 20 (all on one thread); 1: its per-individual part on
-  // rank 0's threads (now).
+  // Projected speedup over one worker of the whole run (seeding + generations), serial part
+  // included, with a checkpoint every generation (the default) or every 10th
+  // (evolution.checkpoint_every = 10). spread = 0: the checkpoint as before issue 20 (all on one
+  // thread); 1: its per-individual part on rank 0's threads (now).
   for (int spread : {0, 1})
-  for (int every : {1, 10})
-  for (const char* path : {"threads", "mpi"}) {
-    for (int w : {1, 2, 4, 8, 16, 32, 64}) {
-      double t1 = 0.0, tw = 0.0, t_seed1 = 0.0, t_seedw = 0.0;
-      for (std::size_t g = 0; g < gens.size(); ++g) {
-        const auto& G = gens[g];
-        // Rank 0 spreads the per-individual part of the checkpoint over its threads (at most 16: one node).
-        const double ckpt = spread ? G.checkpoint - G.checkpoint_parallel + G.checkpoint_parallel / std::min(w, 16) : G.checkpoint;
-        const double serial = G.serial + (ckpt + G.fsync) / every;
-        const double one = G.eval + serial;
-        const double many = (std::string(path) == "threads" ? dynamic_makespan(G.tasks, w) : mpi_makespan(G.tasks, w, 100e-6)) + serial;
-        t1 += one;
-        tw += many;
-        if (g == 0) {
-          t_seed1 = one;
-          t_seedw = many;
+    for (int every : {1, 10})
+      for (const char* path : {"threads", "mpi"}) {
+        for (int w : {1, 2, 4, 8, 16, 32, 64}) {
+          double t1 = 0.0, tw = 0.0, t_seed1 = 0.0, t_seedw = 0.0;
+          for (std::size_t g = 0; g < gens.size(); ++g) {
+            const auto& G = gens[g];
+            // Rank 0 spreads the per-individual part of the checkpoint over its threads (at most
+            // 16: one node).
+            const double ckpt = spread ? G.checkpoint - G.checkpoint_parallel +
+                                             G.checkpoint_parallel / std::min(w, 16)
+                                       : G.checkpoint;
+            const double serial = G.serial + (ckpt + G.fsync) / every;
+            const double one = G.eval + serial;
+            const double many =
+                (std::string(path) == "threads" ? dynamic_makespan(G.tasks, w)
+                                                : mpi_makespan(G.tasks, w, 100e-6)) +
+                serial;
+            t1 += one;
+            tw += many;
+            if (g == 0) {
+              t_seed1 = one;
+              t_seedw = many;
+            }
+          }
+          std::printf(
+              "{\"kind\": \"projection\", \"path\": \"%s\", \"checkpoint_spread\": %d, "
+              "\"checkpoint_every\": %d, \"population\": %d, "
+              "\"workers\": %d, \"speedup\": %.3f, \"speedup_seeding\": %.3f, \"speedup_later\": "
+              "%.3f}\n",
+              path, spread, every, c.evolution.population, w, t1 / tw, t_seed1 / t_seedw,
+              (t1 - t_seed1) / (tw - t_seedw));
         }
       }
-      std::printf("{\"kind\": \"projection\", \"path\": \"%s\", \"checkpoint_spread\": %d, \"checkpoint_every\": %d, \"population\": %d, "
-                  "\"workers\": %d, \"speedup\": %.3f, \"speedup_seeding\": %.3f, \"speedup_later\": %.3f}\n",
-                  path, spread, every, c.evolution.population, w, t1 / tw, t_seed1 / t_seedw, (t1 - t_seed1) / (tw - t_seedw));
-    }
-  }
   return 0;
 }

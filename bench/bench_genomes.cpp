@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
     }
   }
   if (files.empty()) {
-    std::fprintf(stderr, "usage: bench_genomes [--set section.key=value]... [--repeat N] GENOME.json...\n");
+    std::fprintf(stderr,
+                 "usage: bench_genomes [--set section.key=value]... [--repeat N] GENOME.json...\n");
     return 2;
   }
   warm_up_box2d();
@@ -56,7 +57,8 @@ int main(int argc, char** argv) {
     for (int r = 0; r < repeat; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
       const EvaluationResult e = evaluate(g, config);
-      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       fitness = e.fitness;
     }
     std::sort(ms.begin(), ms.end());
@@ -64,6 +66,7 @@ int main(int argc, char** argv) {
     std::printf("%s\t%.3f ms\tfitness %.6f\n", f.c_str(), ms[ms.size() / 2], fitness);
   }
   std::sort(medians.begin(), medians.end());
-  std::printf("median over %zu genomes: %.3f ms per evaluation\n", medians.size(), medians[medians.size() / 2]);
+  std::printf("median over %zu genomes: %.3f ms per evaluation\n", medians.size(),
+              medians[medians.size() / 2]);
   return 0;
 }

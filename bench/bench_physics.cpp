@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../src/box2d_island.hpp"
 #include "animat/body.hpp"
 #include "animat/control.hpp"
 #include "animat/errors.hpp"
@@ -25,7 +26,6 @@
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
-#include "../src/box2d_island.hpp"
 #include "bench_context.hpp"
 
 namespace {
@@ -51,7 +51,8 @@ Body lattice_swimmer(int cells) {
 }
 
 /// Runs control steps in chunks; restarts the simulation if it ever fails (it should not).
-void run_swim(benchmark::State& state, const Body& body, const SceneParams& scene, const PhysicsParams& physics) {
+void run_swim(benchmark::State& state, const Body& body, const SceneParams& scene,
+              const PhysicsParams& physics) {
   auto sim = std::make_unique<Simulation>(body, scene, physics);
   for (auto _ : state) {
     try {
@@ -62,7 +63,8 @@ void run_swim(benchmark::State& state, const Body& body, const SceneParams& scen
       state.ResumeTiming();
     }
   }
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["steps_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = body.node_count();
 }
 
@@ -90,7 +92,8 @@ void run_box2d_only(benchmark::State& state, bool linked) {
   }
   if (linked) link_into_one_island(world, bodies);
   for (auto _ : state) world.Step(1.0f / 60.0f, 1, 1);
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["steps_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = n;
 }
 
@@ -104,12 +107,13 @@ BENCHMARK(BM_Box2DLinkedStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 
 /// The default scene (all five effects, stable drag, d_N = 2).
 void BM_SwimStep(benchmark::State& state) {
-  run_swim(state, lattice_swimmer(static_cast<int>(state.range(0))), SceneParams{}, PhysicsParams{});
+  run_swim(state, lattice_swimmer(static_cast<int>(state.range(0))), SceneParams{},
+           PhysicsParams{});
 }
 BENCHMARK(BM_SwimStep)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 
-/// The same swim step with physics.integrator = "box2d": a real b2World (one island) moves the cells,
-/// bit for bit as the native integrator does (tests/cpp/test_integrator.cpp).
+/// The same swim step with physics.integrator = "box2d": a real b2World (one island) moves the
+/// cells, bit for bit as the native integrator does (tests/cpp/test_integrator.cpp).
 void BM_SwimStepBox2D(benchmark::State& state) {
   PhysicsParams physics;
   physics.integrator = "box2d";
@@ -117,20 +121,26 @@ void BM_SwimStepBox2D(benchmark::State& state) {
 }
 BENCHMARK(BM_SwimStepBox2D)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 
-/// One effect alone, 32 cells: 0-4 springs, actuation, pressure, drag, collisions; 5 = no effect at all;
-/// 6 = all (the default scene); 7 skin_collision, 8 gravity, 9 ground (the floor 10 below the body: the
-/// contact test runs for every cell, nothing touches); 10 = the crawl scene (configs/crawl.toml's
-/// effects, the body resting on the floor). 0-6 keep their numbers so that older tables compare.
+/// One effect alone, 32 cells: 0-4 springs, actuation, pressure, drag, collisions; 5 = no effect at
+/// all; 6 = all (the default scene); 7 skin_collision, 8 gravity, 9 ground (the floor 10 below the
+/// body: the contact test runs for every cell, nothing touches); 10 = the crawl scene
+/// (configs/crawl.toml's effects, the body resting on the floor). 0-6 keep their numbers so that
+/// older tables compare.
 void BM_Effect(benchmark::State& state) {
   const int k = static_cast<int>(state.range(0));
-  static constexpr const char* kLabels[] = {"springs", "actuation", "pressure", "drag", "collisions", "none", "all",
-                                            "skin_collision", "gravity", "ground", "crawl scene"};
+  static constexpr const char* kLabels[] = {
+      "springs", "actuation",      "pressure", "drag",   "collisions", "none",
+      "all",     "skin_collision", "gravity",  "ground", "crawl scene"};
   const Body body = lattice_swimmer(32);
   SceneParams scene;
-  if (k < 5) scene.effects = {std::string(kSceneEffectNames[k])};
-  else if (k == 5) scene.effects = {};
-  else if (k >= 7 && k <= 9) scene.effects = {std::string(kSceneEffectNames[k - 2])};
-  else if (k == 10) scene.effects = {"springs", "actuation", "pressure", "collisions", "gravity", "ground"};
+  if (k < 5)
+    scene.effects = {std::string(kSceneEffectNames[k])};
+  else if (k == 5)
+    scene.effects = {};
+  else if (k >= 7 && k <= 9)
+    scene.effects = {std::string(kSceneEffectNames[k - 2])};
+  else if (k == 10)
+    scene.effects = {"springs", "actuation", "pressure", "collisions", "gravity", "ground"};
   const double lowest = body.positions.col(1).minCoeff();
   if (k == 9) scene.ground_height = lowest - 10.0;
   if (k == 10) scene.ground_height = lowest;
@@ -174,7 +184,8 @@ void BM_ControlStep(benchmark::State& state) {
   gp.extra_outputs = "actuation";
   Rng rng(7);
   Genome g = random_genome(gp, rng);
-  for (int tries = 0; tries < 1000 && Grn(g, gp).morphogen_units().empty(); ++tries) g = random_genome(gp, rng);
+  for (int tries = 0; tries < 1000 && Grn(g, gp).morphogen_units().empty(); ++tries)
+    g = random_genome(gp, rng);
   GrnControlStart start;
   start.grn = Grn(g, gp);
   start.levels.assign(static_cast<std::size_t>(body.node_count() * start.grn.node_count()), 0.0);
@@ -203,7 +214,8 @@ void BM_ControlStep(benchmark::State& state) {
       state.ResumeTiming();
     }
   }
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["steps_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = body.node_count();
   state.counters["grn_units"] = start.grn.unit_count();
 }
@@ -215,7 +227,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   animat::bench::add_context();
-  benchmark::AddCustomContext("bodies", "triangular lattices, spacing 1, jitter 0.05, travelling wave a=0.2 f=4");
+  benchmark::AddCustomContext(
+      "bodies", "triangular lattices, spacing 1, jitter 0.05, travelling wave a=0.2 f=4");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

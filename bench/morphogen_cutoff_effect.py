@@ -9,6 +9,7 @@ config.
 
     PYTHONPATH=build/python .venv/bin/python bench/morphogen_cutoff_effect.py [--random 40] [--cutoffs 4 8 12]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -42,8 +43,10 @@ def compare(label: str, cases: list, cutoffs: list[float]) -> None:
             same_fitness += res.fitness == ref.fitness
             changes.append(abs(res.fitness - ref.fitness) / max(abs(ref.fitness), 1e-12))
         rel = np.array(changes)
-        print(f"  cutoff {cut:g}: same cell count {same_cells}/{len(cases)}, fitness bitwise unchanged "
-              f"{same_fitness}/{len(cases)}, largest relative change {rel.max():.3g}, over 5 %: {(rel > 0.05).sum()}")
+        print(
+            f"  cutoff {cut:g}: same cell count {same_cells}/{len(cases)}, fitness bitwise unchanged "
+            f"{same_fitness}/{len(cases)}, largest relative change {rel.max():.3g}, over 5 %: {(rel > 0.05).sum()}"
+        )
 
 
 def main() -> None:

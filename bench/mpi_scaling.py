@@ -13,6 +13,7 @@ with seed 1; the times are the wall time of generation 0 (seeding the initial po
 mean wall time of the later generations, both from history.csv. Ranks beyond the machine's cores run
 with --oversubscribe: their efficiency measures the machine, not the code.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,8 +34,20 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 
 
 def run(exe: Path, population: int, generations: int, ranks: int, threads: int, out: Path) -> dict:
-    cmd = [str(exe), "--set", f"evolution.population={population}", "--generations", str(generations), "--seed", "1",
-           "--threads", str(threads), "--out", str(out), "--quiet"]
+    cmd = [
+        str(exe),
+        "--set",
+        f"evolution.population={population}",
+        "--generations",
+        str(generations),
+        "--seed",
+        "1",
+        "--threads",
+        str(threads),
+        "--out",
+        str(out),
+        "--quiet",
+    ]
     if ranks > 0:
         cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks), *cmd]
     ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -49,9 +62,18 @@ def run(exe: Path, population: int, generations: int, ranks: int, threads: int, 
         rows = list(csv.DictReader(f))
     t = [float(row["wall_seconds"]) for row in rows]
     later = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else float("nan")
-    return {"population": population, "ranks": max(ranks, 1), "threads": threads, "mpirun": ranks > 0,
-            "seeding_s": t[0], "generation_s": later, "process_wall_s": wall, "cpu_s": cpu,
-            "best": rows[-1]["best"], "evaluations": rows[-1]["evaluations"]}
+    return {
+        "population": population,
+        "ranks": max(ranks, 1),
+        "threads": threads,
+        "mpirun": ranks > 0,
+        "seeding_s": t[0],
+        "generation_s": later,
+        "process_wall_s": wall,
+        "cpu_s": cpu,
+        "best": rows[-1]["best"],
+        "evaluations": rows[-1]["evaluations"],
+    }
 
 
 def main() -> int:
@@ -64,11 +86,14 @@ def main() -> int:
     exe = args.build / "animat_evolve"
     results = ROOT / "bench" / "results"
     results.mkdir(parents=True, exist_ok=True)
-    print(f"machine: {platform.node()} {os.cpu_count()} cores, load {os.getloadavg()}, "
-          f"{subprocess.run(['mpirun', '--version'], capture_output=True, text=True).stdout.splitlines()[0]}",
-          flush=True)
+    print(
+        f"machine: {platform.node()} {os.cpu_count()} cores, load {os.getloadavg()}, "
+        f"{subprocess.run(['mpirun', '--version'], capture_output=True, text=True).stdout.splitlines()[0]}",
+        flush=True,
+    )
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
+
         def measure(kind, population, ranks, threads):
             out = Path(tmp) / f"{kind}_{population}_{ranks}_{threads}"
             load = os.getloadavg()[0]
@@ -90,9 +115,11 @@ def main() -> int:
         w.writeheader()
         w.writerows(rows)
 
-    md = ["| run | population | ranks x threads | generation 0 s | s per later generation | speedup (later) | "
-          "efficiency | CPU s in all (every process) | CPU over 1 rank | load avg before/after |",
-          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    md = [
+        "| run | population | ranks x threads | generation 0 s | s per later generation | speedup (later) | "
+        "efficiency | CPU s in all (every process) | CPU over 1 rank | load avg before/after |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
     base = {}
     for r in rows:
         key = (r["kind"] if r["kind"] != "threads" else "strong", r["population"] if r["kind"] != "weak" else 0)
@@ -107,10 +134,12 @@ def main() -> int:
         else:
             speed = b["generation_s"] / r["generation_s"]
         label = {"strong": "strong", "weak": "weak", "threads": "OpenMP only"}[r["kind"]]
-        md.append(f"| {label} | {r['population']} | {r['ranks']} x {r['threads']}{'' if r['mpirun'] else ' (no mpirun)'} "
-                  f"| {r['seeding_s']:.2f} | {r['generation_s']:.2f} | {speed:.2f}x | {speed / workers:.0%} | "
-                  f"{r['cpu_s']:.1f} | {r['cpu_s'] / b['cpu_s'] / (1 if kind != 'weak' else workers):.3f} | "
-                  f"{r['load_before']:.1f} / {r['load_after']:.1f} |")
+        md.append(
+            f"| {label} | {r['population']} | {r['ranks']} x {r['threads']}{'' if r['mpirun'] else ' (no mpirun)'} "
+            f"| {r['seeding_s']:.2f} | {r['generation_s']:.2f} | {speed:.2f}x | {speed / workers:.0%} | "
+            f"{r['cpu_s']:.1f} | {r['cpu_s'] / b['cpu_s'] / (1 if kind != 'weak' else workers):.3f} | "
+            f"{r['load_before']:.1f} / {r['load_after']:.1f} |"
+        )
     print("\n".join(md))
 
     if not args.skip_profile:

@@ -7,6 +7,7 @@ a Python callable (with and without a trajectory), on 1 and 2 threads.
 Prints the machine and settings, and the median of `--repeat` runs. The Python objective runs under
 the GIL while the swims run in parallel without it.
 """
+
 import argparse
 import os
 import platform
@@ -29,11 +30,16 @@ def main() -> None:
     args = p.parse_args()
     config = animat.Config()
     genomes = [animat.Genome.random_viable(seed=s, config=config)[0] for s in range(args.genomes)]
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; animat "
-          f"{animat.__version__}; {args.genomes} viable genomes, {int(config['evaluation.steps'])} steps, "
-          f"median of {args.repeat}")
-    objectives = [("distance (C++)", None), ("Python, no trajectory", animat.Objective(py_distance, every=0)),
-                  ("Python, every=20", animat.Objective(py_distance, every=20))]
+    print(
+        f"machine: {platform.machine()}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; animat "
+        f"{animat.__version__}; {args.genomes} viable genomes, {int(config['evaluation.steps'])} steps, "
+        f"median of {args.repeat}"
+    )
+    objectives = [
+        ("distance (C++)", None),
+        ("Python, no trajectory", animat.Objective(py_distance, every=0)),
+        ("Python, every=20", animat.Objective(py_distance, every=20)),
+    ]
     for threads in (1, 2):
         for name, objective in objectives:
             rates = []

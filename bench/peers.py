@@ -16,6 +16,7 @@ Times are medians of --repeat runs of --steps steps each (CPU time of this proce
 interleaved); callgrind counts the instructions of Chipmunk's cpSpaceStep per step beside ours.
 Writes bench/results/peers.csv and prints a markdown table.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,7 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 PEER_VENV = ROOT / "bench" / ".venv-peers"
 PYMUNK = "pymunk==7.3.1"
 
-PEER_SCRIPT = r'''
+PEER_SCRIPT = r"""
 import json, math, sys, time
 import pymunk
 spec = json.load(open(sys.argv[1])); variant = sys.argv[2]; steps = int(sys.argv[3])
@@ -86,7 +87,7 @@ t0 = time.process_time()
 for _ in range(steps): step()
 print(json.dumps({"us_per_step": (time.process_time() - t0) / steps * 1e6,
                   "pymunk": pymunk.version, "chipmunk": pymunk.chipmunk_version}))
-'''
+"""
 
 
 def peer_python() -> Path:
@@ -95,7 +96,9 @@ def peer_python() -> Path:
         subprocess.run([sys.executable, "-m", "venv", str(PEER_VENV)], check=True)
     have = subprocess.run([str(py), "-c", "import pymunk, numpy"], capture_output=True).returncode == 0
     if not have:
-        subprocess.run([str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check", PYMUNK, "numpy"], check=True)
+        subprocess.run(
+            [str(py), "-m", "pip", "install", "-q", "--disable-pip-version-check", PYMUNK, "numpy"], check=True
+        )
     return py
 
 
@@ -103,7 +106,9 @@ def body_spec() -> dict:
     """The 32-cell lattice swimmer of bench_physics (8 x 4 triangular lattice, spacing 1, travelling
     wave a = 0.2, f = 4), built by animat itself: positions, springs, rest lengths, skin."""
     import numpy as np
+
     import animat
+
     rng = np.random.default_rng(1)
     pts = np.array([[i + (0.5 if j % 2 else 0.0), j * np.sqrt(3.0) / 2.0] for j in range(4) for i in range(8)])
     pts += rng.uniform(-0.05, 0.05, pts.shape)
@@ -111,16 +116,34 @@ def body_spec() -> dict:
     phase = np.mod(2 * np.pi * pts[:, 0] / 4.0, 2 * np.pi)
     body = animat.build_body(pts, np.full(n, 0.2), np.full(n, 4.0), phase)
     cfg = animat.Config()
-    return {"positions": np.asarray(body.positions).tolist(), "springs": np.asarray(body.springs).tolist(),
-            "rest": np.asarray(body.rest_lengths).tolist(), "skin": np.asarray(body.skin).tolist(),
-            "amplitude": [0.2] * n, "frequency": [4.0] * n, "phase": phase.tolist(),
-            "dt": cfg["physics.dt"], "k": cfg["scene.spring_stiffness"], "c": cfg["scene.spring_damping"],
-            "d_n": cfg["scene.drag_normal"], "d_t": cfg["scene.drag_normal"] / 200.0}
+    return {
+        "positions": np.asarray(body.positions).tolist(),
+        "springs": np.asarray(body.springs).tolist(),
+        "rest": np.asarray(body.rest_lengths).tolist(),
+        "skin": np.asarray(body.skin).tolist(),
+        "amplitude": [0.2] * n,
+        "frequency": [4.0] * n,
+        "phase": phase.tolist(),
+        "dt": cfg["physics.dt"],
+        "k": cfg["scene.spring_stiffness"],
+        "c": cfg["scene.spring_damping"],
+        "d_n": cfg["scene.drag_normal"],
+        "d_t": cfg["scene.drag_normal"] / 200.0,
+    }
 
 
 def ours(filt: str) -> float:
-    out = subprocess.run([str(ROOT / "build" / "bench_physics"), f"--benchmark_filter={filt}", "--benchmark_format=json",
-                          "--benchmark_min_time=0.5"], capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [
+            str(ROOT / "build" / "bench_physics"),
+            f"--benchmark_filter={filt}",
+            "--benchmark_format=json",
+            "--benchmark_min_time=0.5",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
     b = [r for r in json.loads(out)["benchmarks"] if r.get("run_type") == "iteration"][0]
     return b["cpu_time"] * {"ns": 1e-3, "us": 1.0, "ms": 1e3}[b["time_unit"]]
 
@@ -129,10 +152,18 @@ def callgrind(cmd: list[str], toggle: str, calls_of: str) -> tuple[int, int]:
     """Instructions inside `toggle` and the number of calls of `calls_of` (callgrind)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "cg.out"
-        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", f"--toggle-collect={toggle}", *cmd],
-                       check=True, capture_output=True, env={**os.environ, "LD_BIND_NOW": "1"})
-        ann = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=caller", str(out)], capture_output=True,
-                             text=True, check=True).stdout
+        subprocess.run(
+            ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", f"--toggle-collect={toggle}", *cmd],
+            check=True,
+            capture_output=True,
+            env={**os.environ, "LD_BIND_NOW": "1"},
+        )
+        ann = subprocess.run(
+            ["callgrind_annotate", "--inclusive=yes", "--tree=caller", str(out)],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
     total = int(re.search(r"([\d,]+) \([ \d.]+%\)\s+PROGRAM TOTALS", ann).group(1).replace(",", ""))
     calls = 0
     lines = ann.splitlines()
@@ -166,8 +197,14 @@ def main() -> int:
         for _ in range(args.repeat):
             for variant in ("springs", "python", "numpy"):
                 steps = args.steps if variant == "springs" else args.steps // 10
-                r = json.loads(subprocess.run([str(py), str(script), str(spec_path), variant, str(steps)],
-                                              capture_output=True, text=True, check=True).stdout)
+                r = json.loads(
+                    subprocess.run(
+                        [str(py), str(script), str(spec_path), variant, str(steps)],
+                        capture_output=True,
+                        text=True,
+                        check=True,
+                    ).stdout
+                )
                 times[variant].append(r["us_per_step"])
                 version = {"pymunk": r["pymunk"], "chipmunk": r["chipmunk"]}
             times["ours_springs"].append(ours("^BM_Effect/0$"))
@@ -175,15 +212,22 @@ def main() -> int:
         med = {k: statistics.median(v) for k, v in times.items()}
         ins = {}
         if not args.no_callgrind:
-            total, calls = callgrind([str(py), str(script), str(spec_path), "springs", "2000"], "cpSpaceStep", "cpSpaceStep")
+            total, calls = callgrind(
+                [str(py), str(script), str(spec_path), "springs", "2000"], "cpSpaceStep", "cpSpaceStep"
+            )
             ins["springs"] = total / calls if calls else float("nan")
             for key, filt in (("ours_springs", "^BM_Effect/0$"), ("ours_all", "^BM_SwimStep/32$")):
-                total, calls = callgrind([str(ROOT / "build" / "bench_physics"), f"--benchmark_filter={filt}",
-                                          "--benchmark_min_time=0.05"], "animat::Simulation::step*", "animat::Simulation::step")
+                total, calls = callgrind(
+                    [str(ROOT / "build" / "bench_physics"), f"--benchmark_filter={filt}", "--benchmark_min_time=0.05"],
+                    "animat::Simulation::step*",
+                    "animat::Simulation::step",
+                )
                 ins[key] = total / calls if calls else float("nan")
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-    print(f"machine: {cpu}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; pymunk {version.get('pymunk')} "
-          f"(Chipmunk {version.get('chipmunk')}); 32 cells, dt 1/60, one iteration; medians of {args.repeat} interleaved runs")
+    print(
+        f"machine: {cpu}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; pymunk {version.get('pymunk')} "
+        f"(Chipmunk {version.get('chipmunk')}); 32 cells, dt 1/60, one iteration; medians of {args.repeat} interleaved runs"
+    )
     rows = [
         ("pymunk, springs only (cpDampedSpring, one iteration)", med["springs"], ins.get("springs")),
         ("pymunk, springs + actuation + skin drag in Python", med["python"], None),

@@ -16,8 +16,8 @@
 #include "animat/errors.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
-#include "animat/run.hpp"
 #include "animat/objective.hpp"
+#include "animat/run.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;
@@ -26,33 +26,37 @@ using namespace nb::literals;
 namespace animat::py {
 namespace {
 
-// GenerationStats' fields, pickling and dicts from its one descriptor (visit_fields in evolution.hpp).
+// GenerationStats' fields, pickling and dicts from its one descriptor (visit_fields in
+// evolution.hpp).
 nb::dict stats_dict(const GenerationStats& s) {
   nb::dict d;
   visit_fields(s, [&](const StatsField& f, const auto& value) { d[f.name] = value; });
   return d;
 }
 
-// Every field is required but those a checkpoint may lack (they keep their defaults), as in a checkpoint.
+// Every field is required but those a checkpoint may lack (they keep their defaults), as in a
+// checkpoint.
 GenerationStats stats_from_dict(const nb::dict& d) {
   GenerationStats s;
   visit_fields(s, [&](const StatsField& f, auto& value) {
     using T = std::decay_t<decltype(value)>;
-    const bool optional = f.checkpoint == StatsField::Checkpoint::later || f.checkpoint == StatsField::Checkpoint::when_set;
+    const bool optional = f.checkpoint == StatsField::Checkpoint::later ||
+                          f.checkpoint == StatsField::Checkpoint::when_set;
     if (optional && !d.contains(f.name)) return;
     value = nb::cast<T>(d[f.name]);
   });
   return s;
 }
 
-// An Evolution's ask() and tell() run without the GIL (the exploit guard's reference swims, a Python
-// objective scoring them on the evaluation threads): every method holds a lease on its engine, and a
-// second thread gets a RuntimeError instead of a data race.
+// An Evolution's ask() and tell() run without the GIL (the exploit guard's reference swims, a
+// Python objective scoring them on the evaluation threads): every method holds a lease on its
+// engine, and a second thread gets a RuntimeError instead of a data race.
 class EngineLease : public ThreadLease<Evolution> {
  public:
   EngineLease(const Evolution& e, const char* method)
       : ThreadLease(e, "GA", method,
-                    "this GA is in use by another thread (an ask() or tell() is running); drive a GA from one thread "
+                    "this GA is in use by another thread (an ask() or tell() is running); drive a "
+                    "GA from one thread "
                     "at a time") {}
 };
 
@@ -66,36 +70,49 @@ std::string fitness_repr(const Fitness& f) {
 void bind_evolution(nb::module_& m) {
   nb::class_<Fitness> fitness_class(m, "Fitness", "What the GA knows about one evaluated genome.");
   fitness_class
-      .def("__init__", [](Fitness* f, double fitness, bool viable, bool stable, int cell_count, bool valid, long drag_limited) {
+      .def(
+          "__init__",
+          [](Fitness* f, double fitness, bool viable, bool stable, int cell_count, bool valid,
+             long drag_limited) {
             if (drag_limited < 0) throw nb::value_error("Fitness: drag_limited must be >= 0");
             new (f) Fitness{fitness, viable, stable, cell_count, valid, drag_limited};
-          }, "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0, "valid"_a = true,
-          "drag_limited"_a = 0,
-          "A fitness to tell() the GA: the objective's value, whether the genome was viable (non-viable ones\n"
-          "are never selected before viable ones), whether its swim was stable, its cell count, whether the\n"
-          "swim kept every invariant, and how often the drag limiter altered it (drag_scheme \"stable\" only).")
+          },
+          "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0,
+          "valid"_a = true, "drag_limited"_a = 0,
+          "A fitness to tell() the GA: the objective's value, whether the genome was viable "
+          "(non-viable ones\n"
+          "are never selected before viable ones), whether its swim was stable, its cell count, "
+          "whether the\n"
+          "swim kept every invariant, and how often the drag limiter altered it (drag_scheme "
+          "\"stable\" only).")
       .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
-      // The pickled state is the tuple of the descriptor's fields; 5 entries: pickled before drag_limited.
-      .def("__getstate__", [](const Fitness& f) {
-            nb::list state;
-            visit_fields(f, [&](const char*, const char*, const auto& value) { state.append(value); });
-            return nb::tuple(state);
-          })
-      .def("__setstate__", [](Fitness& f, const nb::tuple& t) {
-            std::size_t fields = 0;
-            const Fitness empty;
-            visit_fields(empty, [&](const char*, const char*, const auto&) { ++fields; });
-            if (t.size() != 5 && t.size() != fields)
-              throw nb::value_error(fmt::format("Fitness state: expected 5 or {} entries", fields).c_str());
-            new (&f) Fitness{};
-            std::size_t k = 0;
-            visit_fields(f, [&](const char*, const char*, auto& value) {
-              if (k < t.size()) value = nb::cast<std::decay_t<decltype(value)>>(t[k]);
-              ++k;
-            });
-          })
+      // The pickled state is the tuple of the descriptor's fields; 5 entries: pickled before
+      // drag_limited.
+      .def("__getstate__",
+           [](const Fitness& f) {
+             nb::list state;
+             visit_fields(
+                 f, [&](const char*, const char*, const auto& value) { state.append(value); });
+             return nb::tuple(state);
+           })
+      .def("__setstate__",
+           [](Fitness& f, const nb::tuple& t) {
+             std::size_t fields = 0;
+             const Fitness empty;
+             visit_fields(empty, [&](const char*, const char*, const auto&) { ++fields; });
+             if (t.size() != 5 && t.size() != fields)
+               throw nb::value_error(
+                   fmt::format("Fitness state: expected 5 or {} entries", fields).c_str());
+             new (&f) Fitness{};
+             std::size_t k = 0;
+             visit_fields(f, [&](const char*, const char*, auto& value) {
+               if (k < t.size()) value = nb::cast<std::decay_t<decltype(value)>>(t[k]);
+               ++k;
+             });
+           })
       .def("__copy__", [](const Fitness& f) { return f; })
-      .def("__deepcopy__", [](const Fitness& f, nb::handle) { return f; }, "memo"_a)
+      .def(
+          "__deepcopy__", [](const Fitness& f, nb::handle) { return f; }, "memo"_a)
       .def("__repr__", &fitness_repr);
   {
     const Fitness probe;
@@ -104,228 +121,361 @@ void bind_evolution(nb::module_& m) {
     });
   }
 
-  nb::class_<GenerationStats> stats(m, "GenerationStats", "Statistics of one generation (a row of history.csv).");
+  nb::class_<GenerationStats> stats(m, "GenerationStats",
+                                    "Statistics of one generation (a row of history.csv).");
   {
     const GenerationStats probe;
     nb::list columns;
     visit_fields(probe, [&](const StatsField& f, const auto& field) {
       using T = std::decay_t<decltype(field)>;
       def_field_property(stats, probe, field, f.name, f.doc);
-      if (f.csv) columns.append(nb::make_tuple(f.name, std::is_floating_point_v<T> ? "float64" : "int64"));
+      if (f.csv)
+        columns.append(nb::make_tuple(f.name, std::is_floating_point_v<T> ? "float64" : "int64"));
     });
     stats.attr("HISTORY_COLUMNS") = nb::tuple(columns);
   }
   stats
-      .def("__init__", [](GenerationStats* s, const nb::dict& d) { new (s) GenerationStats(stats_from_dict(d)); }, "values"_a,
-           "Statistics from a dict of every field (as to_dict() gives).")
+      .def(
+          "__init__",
+          [](GenerationStats* s, const nb::dict& d) {
+            new (s) GenerationStats(stats_from_dict(d));
+          },
+          "values"_a, "Statistics from a dict of every field (as to_dict() gives).")
       .def("to_dict", &stats_dict, "Every field as a dict.")
       .def("__getstate__", &stats_dict)
-      .def("__setstate__", [](GenerationStats& s, const nb::dict& d) { new (&s) GenerationStats(stats_from_dict(d)); })
+      .def("__setstate__", [](GenerationStats& s,
+                              const nb::dict& d) { new (&s) GenerationStats(stats_from_dict(d)); })
       .def("__copy__", [](const GenerationStats& s) { return s; })
-      .def("__deepcopy__", [](const GenerationStats& s, nb::handle) { return s; }, "memo"_a)
+      .def(
+          "__deepcopy__", [](const GenerationStats& s, nb::handle) { return s; }, "memo"_a)
       .def("__repr__", [](const GenerationStats& s) {
-        return "<animat.GenerationStats gen " + std::to_string(s.generation) + " best " + std::to_string(s.best) + ">";
+        return "<animat.GenerationStats gen " + std::to_string(s.generation) + " best " +
+               std::to_string(s.best) + ">";
       });
 
-  nb::class_<Individual>(m, "Individual", "A member of the population: its genome, Fitness and (initial population) tries.")
-      .def("__init__", [](Individual* i, const Genome& g, const Fitness& f, int tries) { new (i) Individual{g, f, tries}; },
-           "genome"_a, "fitness"_a, "tries"_a = 0)
+  nb::class_<Individual>(
+      m, "Individual",
+      "A member of the population: its genome, Fitness and (initial population) tries.")
+      .def(
+          "__init__",
+          [](Individual* i, const Genome& g, const Fitness& f, int tries) {
+            new (i) Individual{g, f, tries};
+          },
+          "genome"_a, "fitness"_a, "tries"_a = 0)
       .def_ro("genome", &Individual::genome, "The Genome.")
       .def_ro("fitness", &Individual::result, "Its Fitness.")
-      .def_ro("tries", &Individual::tries, "Random genomes drawn to find it (initial population only; else 0).")
-      .def("__getstate__", [](const Individual& i) { return nb::make_tuple(i.genome, i.result, i.tries); })
-      .def("__setstate__", [](Individual& i, const std::tuple<Genome, Fitness, int>& t) {
-            new (&i) Individual{std::get<0>(t), std::get<1>(t), std::get<2>(t)};
-          })
+      .def_ro("tries", &Individual::tries,
+              "Random genomes drawn to find it (initial population only; else 0).")
+      .def("__getstate__",
+           [](const Individual& i) { return nb::make_tuple(i.genome, i.result, i.tries); })
+      .def("__setstate__",
+           [](Individual& i, const std::tuple<Genome, Fitness, int>& t) {
+             new (&i) Individual{std::get<0>(t), std::get<1>(t), std::get<2>(t)};
+           })
       .def("__copy__", [](const Individual& i) { return i; })
-      .def("__deepcopy__", [](const Individual& i, nb::handle) { return i; }, "memo"_a)
+      .def(
+          "__deepcopy__", [](const Individual& i, nb::handle) { return i; }, "memo"_a)
       .def("__repr__", [](const Individual& i) {
-        return fmt::format("<animat.Individual fitness={:.6g}{} cells={} ({} elements)>", i.result.fitness,
-                           i.result.viable ? "" : " non-viable", i.result.cell_count, i.genome.size());
+        return fmt::format("<animat.Individual fitness={:.6g}{} cells={} ({} elements)>",
+                           i.result.fitness, i.result.viable ? "" : " non-viable",
+                           i.result.cell_count, i.genome.size());
       });
 
-  nb::class_<Evolution>(m, "Evolution",
-                        "The GA engine behind animat.evolve, driven by ask()/tell() (animat.GA wraps it).")
-      .def("__init__", [](Evolution* e, const Config& c, nb::handle objective) {
-            // The exploit guard, as animat.evolve has it: each new best re-evaluated at the reference
-            // step with the run's objective (evaluation.reference_check "record" or "select").
+  nb::class_<Evolution>(
+      m, "Evolution",
+      "The GA engine behind animat.evolve, driven by ask()/tell() (animat.GA wraps it).")
+      .def(
+          "__init__",
+          [](Evolution* e, const Config& c, nb::handle objective) {
+            // The exploit guard, as animat.evolve has it: each new best re-evaluated at the
+            // reference step with the run's objective (evaluation.reference_check "record" or
+            // "select").
             FitnessFunction reference;
             if (c.evaluation.reference_check != "off")
-              reference = objective_fitness(reference_config(c), objective_from_python(objective, c));
+              reference =
+                  objective_fitness(reference_config(c), objective_from_python(objective, c));
             new (e) Evolution(c, {}, std::move(reference));
-          }, "config"_a, "objective"_a = nb::none(),
-          "An engine for ask()/tell(). objective: None (the config's evaluation.objective), a built-in name or\n"
+          },
+          "config"_a, "objective"_a = nb::none(),
+          "An engine for ask()/tell(). objective: None (the config's evaluation.objective), a "
+          "built-in name or\n"
           "a Python objective: what the exploit guard re-evaluates each new best with (unless\n"
-          "evaluation.reference_check = \"off\"), at physics.substeps x evaluation.reference_substeps.")
-      .def("ask", [](Evolution& e, int lookahead) {
+          "evaluation.reference_check = \"off\"), at physics.substeps x "
+          "evaluation.reference_substeps.")
+      .def(
+          "ask",
+          [](Evolution& e, int lookahead) {
             EngineLease lease(e, "ask");
             nb::gil_scoped_release release;  // "select" evaluates the elite candidates' references
             return e.ask(lookahead);
-          }, "lookahead"_a = 1, "The genomes that need a fitness next (see animat.GA.ask).")
-      .def("tell", [](Evolution& e, const std::vector<Fitness>& fitness) {
+          },
+          "lookahead"_a = 1, "The genomes that need a fitness next (see animat.GA.ask).")
+      .def(
+          "tell",
+          [](Evolution& e, const std::vector<Fitness>& fitness) {
             EngineLease lease(e, "tell");
             nb::gil_scoped_release release;  // the exploit guard evaluates a new best's reference
             return e.tell(fitness);
-          }, "fitness"_a,
-           "The Fitness of every genome of the last ask(), in order; True when a generation completed. Refuses\n"
-           "(ValueError naming the value's index) what the engine's own evaluations refuse: a fitness that is\n"
-           "not finite, a negative one under a distance objective, a negative cell_count.")
-      .def_prop_ro("asked", [](const Evolution& e) { EngineLease l(e, "asked"); return e.asked(); },
-                   "Whether an ask() awaits its tell().")
-      .def_prop_ro("generation", [](const Evolution& e) { EngineLease l(e, "generation"); return e.generation(); },
-                   "Last completed generation (-1 while drawing the initial population).")
-      .def_prop_ro("population", [](const Evolution& e) { EngineLease l(e, "population"); return e.population(); },
-                   "The population (list of Individual).")
-      .def_prop_ro("best", [](const Evolution& e) { EngineLease l(e, "best"); return e.best(); },
-                   "The best Individual (first of the fittest).")
-      .def_prop_ro("history", [](const Evolution& e) { EngineLease l(e, "history"); return e.history(); },
-                   "GenerationStats of every generation.")
-      .def_prop_ro("evaluations", [](const Evolution& e) { EngineLease l(e, "evaluations"); return e.evaluations(); },
-                   "Fitness evaluations counted so far.")
-      .def_prop_ro("generations_without_improvement", [](const Evolution& e) {
-            EngineLease l(e, "generations_without_improvement");
-            return e.generations_without_improvement();
-          })
-      .def("stop_reason", [](const Evolution& e) { EngineLease l(e, "stop_reason"); return e.stop_reason(); },
-           "Why the run should stop now ('' = keep going).")
-      .def("initial_tries", [](const Evolution& e) { EngineLease l(e, "initial_tries"); return e.initial_tries(); },
-           "Random genomes drawn per initial individual.")
-      .def("checkpoint", [](const Evolution& e) { EngineLease l(e, "checkpoint"); return e.checkpoint(); },
-           "The whole state as checkpoint JSON text (the run directory's format).")
-      .def("restore", [](Evolution& e, const std::string& text, const std::string& source) {
+          },
+          "fitness"_a,
+          "The Fitness of every genome of the last ask(), in order; True when a generation "
+          "completed. Refuses\n"
+          "(ValueError naming the value's index) what the engine's own evaluations refuse: a "
+          "fitness that is\n"
+          "not finite, a negative one under a distance objective, a negative cell_count.")
+      .def_prop_ro(
+          "asked",
+          [](const Evolution& e) {
+            EngineLease l(e, "asked");
+            return e.asked();
+          },
+          "Whether an ask() awaits its tell().")
+      .def_prop_ro(
+          "generation",
+          [](const Evolution& e) {
+            EngineLease l(e, "generation");
+            return e.generation();
+          },
+          "Last completed generation (-1 while drawing the initial population).")
+      .def_prop_ro(
+          "population",
+          [](const Evolution& e) {
+            EngineLease l(e, "population");
+            return e.population();
+          },
+          "The population (list of Individual).")
+      .def_prop_ro(
+          "best",
+          [](const Evolution& e) {
+            EngineLease l(e, "best");
+            return e.best();
+          },
+          "The best Individual (first of the fittest).")
+      .def_prop_ro(
+          "history",
+          [](const Evolution& e) {
+            EngineLease l(e, "history");
+            return e.history();
+          },
+          "GenerationStats of every generation.")
+      .def_prop_ro(
+          "evaluations",
+          [](const Evolution& e) {
+            EngineLease l(e, "evaluations");
+            return e.evaluations();
+          },
+          "Fitness evaluations counted so far.")
+      .def_prop_ro("generations_without_improvement",
+                   [](const Evolution& e) {
+                     EngineLease l(e, "generations_without_improvement");
+                     return e.generations_without_improvement();
+                   })
+      .def(
+          "stop_reason",
+          [](const Evolution& e) {
+            EngineLease l(e, "stop_reason");
+            return e.stop_reason();
+          },
+          "Why the run should stop now ('' = keep going).")
+      .def(
+          "initial_tries",
+          [](const Evolution& e) {
+            EngineLease l(e, "initial_tries");
+            return e.initial_tries();
+          },
+          "Random genomes drawn per initial individual.")
+      .def(
+          "checkpoint",
+          [](const Evolution& e) {
+            EngineLease l(e, "checkpoint");
+            return e.checkpoint();
+          },
+          "The whole state as checkpoint JSON text (the run directory's format).")
+      .def(
+          "restore",
+          [](Evolution& e, const std::string& text, const std::string& source) {
             EngineLease l(e, "restore");
             e.restore(text, source);
-          }, "text"_a, "source"_a = "checkpoint", "Restore a checkpoint (refused if corrupt or of another config).");
+          },
+          "text"_a, "source"_a = "checkpoint",
+          "Restore a checkpoint (refused if corrupt or of another config).");
 
-  nb::class_<RunSummary>(m, "EvolutionSummary", "What animat._core.evolve returns (animat.evolve wraps it).")
+  nb::class_<RunSummary>(m, "EvolutionSummary",
+                         "What animat._core.evolve returns (animat.evolve wraps it).")
       .def_ro("history", &RunSummary::history, "List of GenerationStats, generation 0 first.")
       .def_ro("best", &RunSummary::best, "The best Individual of the last generation.")
       .def_ro("population", &RunSummary::population, "The final population (list of Individual).")
-      .def_prop_ro("best_genome", [](const RunSummary& r) { return r.best.genome; }, "The best genome of the last generation.")
-      .def_prop_ro("best_fitness", [](const RunSummary& r) { return r.best.result; }, "Its Fitness.")
+      .def_prop_ro(
+          "best_genome", [](const RunSummary& r) { return r.best.genome; },
+          "The best genome of the last generation.")
+      .def_prop_ro(
+          "best_fitness", [](const RunSummary& r) { return r.best.result; }, "Its Fitness.")
       .def_ro("stop_reason", &RunSummary::stop_reason, "Why the run stopped.")
       .def("__repr__", [](const RunSummary& r) {
-        return "<animat.EvolutionSummary " + std::to_string(r.history.size()) + " generations, best " +
-               std::to_string(r.best.result.fitness) + ", stopped: " + r.stop_reason + ">";
+        return "<animat.EvolutionSummary " + std::to_string(r.history.size()) +
+               " generations, best " + std::to_string(r.best.result.fitness) +
+               ", stopped: " + r.stop_reason + ">";
       });
 
-  m.def("evolve", [](std::optional<Config> config, std::optional<std::filesystem::path> out, bool resume,
-                     std::optional<nb::callable> callback, bool quiet, nb::object stop, nb::handle objective,
-                     bool overwrite) {
-          const Config c = config.value_or(Config{});
-          RunOptions opt;
-          if (out) opt.out = *out;
-          opt.resume = resume;
-          opt.overwrite = overwrite;
-          opt.quiet = quiet;
-          // A Python exception raised while the run is in progress (Ctrl-C's KeyboardInterrupt, an error
-          // in or about the callback) stops the run like a signal does: the last complete generation is
-          // checkpointed, and the exception is raised afterwards with the partial result as `.result`.
-          // Touched with the GIL held only.
-          std::optional<nb::python_error> pending;
-          auto keep = [&pending] {
-            if (!pending) pending.emplace();  // fetches the error indicator
-            else PyErr_Clear();
-          };
-          if (callback) {
-            nb::callable cb = *callback;
-            opt.callback = [cb, &keep](const GenerationStats& s, const Evolution&) {
-              nb::gil_scoped_acquire gil;
-              try {
-                nb::object r = cb(s);
-                if (r.is_none()) return true;
-                const std::string type = nb::type_name(r.type()).c_str();
-                const bool numpy_bool = nb::hasattr(r.type(), "__module__") &&
-                                        nb::str(r.type().attr("__module__")).equal(nb::str("numpy")) &&
-                                        (type == "bool" || type == "bool_" || type == "numpy.bool_" || type == "numpy.bool");
-                if (PyBool_Check(r.ptr()) || numpy_bool) return PyObject_IsTrue(r.ptr()) == 1;
-                const std::string shown = nb::repr(r).c_str();
-                PyErr_SetString(PyExc_TypeError,
-                                ("evolve: the callback must return True, False or None (None = go on), got " + type + " " +
-                                 (shown.size() > 60 ? shown.substr(0, 57) + "..." : shown)).c_str());
-              } catch (nb::python_error& e) {
-                e.restore();
-              }
-              keep();
-              return false;
-            };
-          }
-          // Polled between evaluations (about every 20 ms) on this thread: Ctrl-C, and the `stop` event.
-          opt.stop_poll = [&stop, &keep]() -> bool {
+  m.def(
+      "evolve",
+      [](std::optional<Config> config, std::optional<std::filesystem::path> out, bool resume,
+         std::optional<nb::callable> callback, bool quiet, nb::object stop, nb::handle objective,
+         bool overwrite) {
+        const Config c = config.value_or(Config{});
+        RunOptions opt;
+        if (out) opt.out = *out;
+        opt.resume = resume;
+        opt.overwrite = overwrite;
+        opt.quiet = quiet;
+        // A Python exception raised while the run is in progress (Ctrl-C's KeyboardInterrupt, an
+        // error in or about the callback) stops the run like a signal does: the last complete
+        // generation is checkpointed, and the exception is raised afterwards with the partial
+        // result as `.result`. Touched with the GIL held only.
+        std::optional<nb::python_error> pending;
+        auto keep = [&pending] {
+          if (!pending)
+            pending.emplace();  // fetches the error indicator
+          else
+            PyErr_Clear();
+        };
+        if (callback) {
+          nb::callable cb = *callback;
+          opt.callback = [cb, &keep](const GenerationStats& s, const Evolution&) {
             nb::gil_scoped_acquire gil;
-            if (PyErr_CheckSignals() != 0) {
-              keep();
-              return true;
+            try {
+              nb::object r = cb(s);
+              if (r.is_none()) return true;
+              const std::string type = nb::type_name(r.type()).c_str();
+              const bool numpy_bool =
+                  nb::hasattr(r.type(), "__module__") &&
+                  nb::str(r.type().attr("__module__")).equal(nb::str("numpy")) &&
+                  (type == "bool" || type == "bool_" || type == "numpy.bool_" ||
+                   type == "numpy.bool");
+              if (PyBool_Check(r.ptr()) || numpy_bool) return PyObject_IsTrue(r.ptr()) == 1;
+              const std::string shown = nb::repr(r).c_str();
+              PyErr_SetString(
+                  PyExc_TypeError,
+                  ("evolve: the callback must return True, False or None (None = go on), got " +
+                   type + " " + (shown.size() > 60 ? shown.substr(0, 57) + "..." : shown))
+                      .c_str());
+            } catch (nb::python_error& e) {
+              e.restore();
             }
-            if (stop.is_none()) return false;
-            nb::object set = nb::steal(PyObject_CallMethod(stop.ptr(), "is_set", nullptr));
-            if (!set.is_valid()) {
-              keep();
-              return true;
-            }
-            return PyObject_IsTrue(set.ptr()) == 1;
+            keep();
+            return false;
           };
-          // The objective scores every swim; the exploit guard re-evaluates each new best with the same
-          // objective at the reference step.
-          const auto scored_by = objective_from_python(objective, c);
-          FitnessFunction fitness = objective_fitness(c, scored_by);
-          FitnessFunction reference;
-          if (c.evaluation.reference_check != "off") reference = objective_fitness(reference_config(c), scored_by);
-          RunSummary summary;
-          {
-            nb::gil_scoped_release release;
-            summary = run_evolution(c, opt, std::move(fitness), std::move(reference));
+        }
+        // Polled between evaluations (about every 20 ms) on this thread: Ctrl-C, and the `stop`
+        // event.
+        opt.stop_poll = [&stop, &keep]() -> bool {
+          nb::gil_scoped_acquire gil;
+          if (PyErr_CheckSignals() != 0) {
+            keep();
+            return true;
           }
-          // Ctrl-C while the Python objective ran: its KeyboardInterrupt (the run stopped as for a signal).
-          if (auto interrupt = take_interrupt(scored_by); interrupt && !pending) pending.emplace(std::move(*interrupt));
-          // A Ctrl-C is an interruption wherever it landed (in the callback too), not the callback's answer.
-          if (pending && pending->matches(PyExc_KeyboardInterrupt)) summary.stop_reason = "interrupted";
-          if (pending) {
-            nb::object result = nb::cast(std::move(summary));
-            PyObject_SetAttrString(pending->value().ptr(), "result", result.ptr());
-            pending->restore();
-            throw nb::python_error();
+          if (stop.is_none()) return false;
+          nb::object set = nb::steal(PyObject_CallMethod(stop.ptr(), "is_set", nullptr));
+          if (!set.is_valid()) {
+            keep();
+            return true;
           }
-          return summary;
-        }, "config"_a = nb::none(), "out"_a = nb::none(), "resume"_a = false, "callback"_a = nb::none(), "quiet"_a = true,
-        "stop"_a = nb::none(), "objective"_a = nb::none(), "overwrite"_a = false,
-        "Run the paper's genetic algorithm (the engine behind animat_evolve); animat.evolve wraps it.\n\n"
-        "config: animat.Config (default: the embedded paper setting; set evolution.generations!).\n"
-        "out: run directory for config.toml, history.csv, best/ and checkpoint.json (None = write nothing).\n"
-        "resume: continue the run in `out` (settings other than the caps, threads and checkpoint interval\n"
-        "must equal the run's; a difference is a ValueError naming the keys, and nothing is written).\n"
-        "callback: called with each generation's GenerationStats (generation 0 included); return False to stop\n"
-        "(True or None: go on).\n"
-        "stop: an object with is_set() (e.g. threading.Event), polled between evaluations; set = stop.\n"
-        "objective: None (the config's evaluation.objective), a built-in name, or a Python objective.\n"
-        "overwrite: start afresh in `out` even if it holds a run (its run files are removed, under the lock).\n"
-        "The run directory is locked (out/.lock) while it runs: a second writer gets BlockingIOError naming\n"
-        "the holder's pid; a directory holding a run (with or without a checkpoint) gives FileExistsError.\n"
-        "The GIL is released while it runs. Returns an EvolutionSummary (history, best, population);\n"
-        "stop_reason is 'interrupted' when `stop` ended it. Ctrl-C (or an exception from the callback)\n"
-        "stops it within one evaluation, leaves a checkpoint of the last complete generation in `out`\n"
-        "(resume=True continues), and is raised with the partial EvolutionResult as its `.result`.");
-
-  m.def("evaluate_population", [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads,
-                                  nb::handle objective) {
-          const Config c = config.value_or(Config{});
-          const FitnessFunction f = objective_fitness(c, objective_from_python(objective, c));
+          return PyObject_IsTrue(set.ptr()) == 1;
+        };
+        // The objective scores every swim; the exploit guard re-evaluates each new best with the
+        // same objective at the reference step.
+        const auto scored_by = objective_from_python(objective, c);
+        FitnessFunction fitness = objective_fitness(c, scored_by);
+        FitnessFunction reference;
+        if (c.evaluation.reference_check != "off")
+          reference = objective_fitness(reference_config(c), scored_by);
+        RunSummary summary;
+        {
           nb::gil_scoped_release release;
-          return evaluate_all(genomes, f, threads);
-        }, "genomes"_a, "config"_a = nb::none(), "threads"_a = 0, "objective"_a = nb::none(),
-        "Evaluate genomes in parallel (OpenMP, one Box2D world each); returns a list of Fitness in input order,\n"
-        "identical for any thread count. objective: None (the config's), a built-in name or a Python objective.");
+          summary = run_evolution(c, opt, std::move(fitness), std::move(reference));
+        }
+        // Ctrl-C while the Python objective ran: its KeyboardInterrupt (the run stopped as for a
+        // signal).
+        if (auto interrupt = take_interrupt(scored_by); interrupt && !pending)
+          pending.emplace(std::move(*interrupt));
+        // A Ctrl-C is an interruption wherever it landed (in the callback too), not the callback's
+        // answer.
+        if (pending && pending->matches(PyExc_KeyboardInterrupt))
+          summary.stop_reason = "interrupted";
+        if (pending) {
+          nb::object result = nb::cast(std::move(summary));
+          PyObject_SetAttrString(pending->value().ptr(), "result", result.ptr());
+          pending->restore();
+          throw nb::python_error();
+        }
+        return summary;
+      },
+      "config"_a = nb::none(), "out"_a = nb::none(), "resume"_a = false, "callback"_a = nb::none(),
+      "quiet"_a = true, "stop"_a = nb::none(), "objective"_a = nb::none(), "overwrite"_a = false,
+      "Run the paper's genetic algorithm (the engine behind animat_evolve); animat.evolve wraps "
+      "it.\n\n"
+      "config: animat.Config (default: the embedded paper setting; set evolution.generations!).\n"
+      "out: run directory for config.toml, history.csv, best/ and checkpoint.json (None = write "
+      "nothing).\n"
+      "resume: continue the run in `out` (settings other than the caps, threads and checkpoint "
+      "interval\n"
+      "must equal the run's; a difference is a ValueError naming the keys, and nothing is "
+      "written).\n"
+      "callback: called with each generation's GenerationStats (generation 0 included); return "
+      "False to stop\n"
+      "(True or None: go on).\n"
+      "stop: an object with is_set() (e.g. threading.Event), polled between evaluations; set = "
+      "stop.\n"
+      "objective: None (the config's evaluation.objective), a built-in name, or a Python "
+      "objective.\n"
+      "overwrite: start afresh in `out` even if it holds a run (its run files are removed, under "
+      "the lock).\n"
+      "The run directory is locked (out/.lock) while it runs: a second writer gets BlockingIOError "
+      "naming\n"
+      "the holder's pid; a directory holding a run (with or without a checkpoint) gives "
+      "FileExistsError.\n"
+      "The GIL is released while it runs. Returns an EvolutionSummary (history, best, "
+      "population);\n"
+      "stop_reason is 'interrupted' when `stop` ended it. Ctrl-C (or an exception from the "
+      "callback)\n"
+      "stops it within one evaluation, leaves a checkpoint of the last complete generation in "
+      "`out`\n"
+      "(resume=True continues), and is raised with the partial EvolutionResult as its `.result`.");
 
-  m.def("tournament_probability", [](int generation, std::optional<Config> config) {
-          return tournament_probability(config.value_or(Config{}).evolution, generation);
-        }, "generation"_a, "config"_a = nb::none(),
-        "Probability that the fitter of two wins a tournament at a generation (0.8 rising to 1 over 1000).");
+  m.def(
+      "evaluate_population",
+      [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads,
+         nb::handle objective) {
+        const Config c = config.value_or(Config{});
+        const FitnessFunction f = objective_fitness(c, objective_from_python(objective, c));
+        nb::gil_scoped_release release;
+        return evaluate_all(genomes, f, threads);
+      },
+      "genomes"_a, "config"_a = nb::none(), "threads"_a = 0, "objective"_a = nb::none(),
+      "Evaluate genomes in parallel (OpenMP, one Box2D world each); returns a list of Fitness in "
+      "input order,\n"
+      "identical for any thread count. objective: None (the config's), a built-in name or a Python "
+      "objective.");
 
-  m.def("reference_disagrees", [](double fitness, double reference, std::optional<Config> config) {
-          return reference_disagrees(fitness, reference, config.value_or(Config{}).evaluation);
-        }, "fitness"_a, "reference"_a, "config"_a = nb::none(),
-        "The exploit guard's rule: whether a fitness and its reference-step fitness differ by more than both\n"
-        "evaluation.reference_tolerance (relative to the reference) and evaluation.reference_abs_tolerance.");
+  m.def(
+      "tournament_probability",
+      [](int generation, std::optional<Config> config) {
+        return tournament_probability(config.value_or(Config{}).evolution, generation);
+      },
+      "generation"_a, "config"_a = nb::none(),
+      "Probability that the fitter of two wins a tournament at a generation (0.8 rising to 1 over "
+      "1000).");
+
+  m.def(
+      "reference_disagrees",
+      [](double fitness, double reference, std::optional<Config> config) {
+        return reference_disagrees(fitness, reference, config.value_or(Config{}).evaluation);
+      },
+      "fitness"_a, "reference"_a, "config"_a = nb::none(),
+      "The exploit guard's rule: whether a fitness and its reference-step fitness differ by more "
+      "than both\n"
+      "evaluation.reference_tolerance (relative to the reference) and "
+      "evaluation.reference_abs_tolerance.");
 }
 
 }  // namespace animat::py

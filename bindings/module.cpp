@@ -10,9 +10,11 @@
 namespace nb = nanobind;
 
 namespace {
-// Messages can quote bytes of a bad input file; invalid UTF-8 is replaced, never a second exception.
+// Messages can quote bytes of a bad input file; invalid UTF-8 is replaced, never a second
+// exception.
 void set_error(PyObject* type, const char* message) {
-  PyObject* text = PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)), "replace");
+  PyObject* text =
+      PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)), "replace");
   if (!text) {
     PyErr_Clear();
     PyErr_SetString(type, "animat: error message could not be decoded");
@@ -24,7 +26,9 @@ void set_error(PyObject* type, const char* message) {
 }  // namespace
 
 NB_MODULE(_core, m) {
-  m.doc() = "animat: co-evolution of morphology and control of soft-bodied multicellular animats (compiled core)";
+  m.doc() =
+      "animat: co-evolution of morphology and control of soft-bodied multicellular animats "
+      "(compiled core)";
   m.attr("__version__") = ANIMAT_VERSION;
   // C++ errors become Python exceptions carrying the C++ message.
   nb::register_exception_translator([](const std::exception_ptr& p, void*) {
@@ -36,7 +40,8 @@ NB_MODULE(_core, m) {
       set_error(PyExc_FileExistsError, e.what());
     } catch (const animat::IoError& e) {
       set_error(PyExc_OSError, e.what());
-    } catch (const animat::Interrupted& e) {  // Ctrl-C in a Python objective (animat.evaluate, GA.step, ...)
+    } catch (const animat::Interrupted& e) {
+      // Ctrl-C in a Python objective (animat.evaluate, GA.step, ...)
       set_error(PyExc_KeyboardInterrupt, e.what());
     } catch (const animat::SimulationError& e) {
       set_error(PyExc_RuntimeError, e.what());

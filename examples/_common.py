@@ -4,6 +4,7 @@ Run the examples from the repository root with the built module on the path, e.g
 
     PYTHONPATH=build/python .venv/bin/python examples/fig4_motion_cycle.py
 """
+
 import argparse
 import io
 import tempfile

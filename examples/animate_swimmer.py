@@ -1,8 +1,10 @@
 """An animation of the best swimmer of a fresh run: GIF (or MP4 where ffmpeg is available).
 
-    PYTHONPATH=build/python .venv/bin/python examples/animate_swimmer.py [--run DIR] [--out swimmer.gif]
+PYTHONPATH=build/python .venv/bin/python examples/animate_swimmer.py [--run DIR] [--out swimmer.gif]
 """
+
 import animat
+
 from _common import fresh_run, parser
 
 p = parser(__doc__, "swimmer.gif")

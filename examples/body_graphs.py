@@ -4,18 +4,22 @@ boundary is drawn as skin (thick).
 
     PYTHONPATH=build/python .venv/bin/python examples/body_graphs.py [--run DIR] [--out PNG]
 """
+
 import matplotlib.pyplot as plt
 
 import animat
+
 from _common import fresh_run, parser, save_png
 
 args = parser(__doc__, "body_graphs.png").parse_args()
 run = fresh_run(args)
 embryo = animat.develop(run.best().genome, run.config)
-panels = [("gabriel", {}, "gabriel (paper)"),
-          ("distance", {"body.distance_threshold": 1.5}, "distance, threshold 1.5"),
-          ("alpha_shape", {"body.alpha": 1.0}, "alpha_shape, alpha 1.0"),
-          ("alpha_shape", {"body.alpha": 0.6}, "alpha_shape, alpha 0.6")]
+panels = [
+    ("gabriel", {}, "gabriel (paper)"),
+    ("distance", {"body.distance_threshold": 1.5}, "distance, threshold 1.5"),
+    ("alpha_shape", {"body.alpha": 1.0}, "alpha_shape, alpha 1.0"),
+    ("alpha_shape", {"body.alpha": 0.6}, "alpha_shape, alpha 0.6"),
+]
 fig, axes = plt.subplots(1, len(panels), figsize=(3.2 * len(panels), 3.4))
 for ax, (graph, extra, title) in zip(axes, panels):
     c = animat.Config()

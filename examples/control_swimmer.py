@@ -3,6 +3,7 @@ hand-written travelling wave, compared by the distance they swim.
 
     PYTHONPATH=build/python .venv/bin/python examples/control_swimmer.py [--seed 3] [--steps 300]
 """
+
 import argparse
 from typing import Callable
 

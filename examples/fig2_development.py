@@ -9,12 +9,14 @@ express `rotate`, so their daughters all point the same way and form a straight 
 --steps, animat.plot.development picks: the first cell, every round of division (daughters still
 overlapping their mothers), 30 steps after the last one (pushed apart) and the end of development.
 """
+
 import argparse
 import pathlib
 
 import numpy as np
 
 import animat
+
 from _common import ROOT, save_png
 
 
@@ -50,8 +52,7 @@ def main():
     config.development.trace_every = 1  # record every step
     embryo = animat.develop(genome, config)
     print(f"{label}: {embryo}")
-    fig = animat.plot.development(embryo, steps=args.steps,
-                                  title=f"Development of {label}; lines: orientation vectors")
+    fig = animat.plot.development(embryo, steps=args.steps, title=f"Development of {label}; lines: orientation vectors")
     save_png(fig, args.out, dpi=110)
 
 

@@ -11,12 +11,14 @@ Without --seed or --run, the script develops random genomes (seeds 0, 1, ...) an
 viable embryo whose body has at least --min-regions regions. If none of the --scan seeds gives one,
 it draws a synthetic embryo (a random packing of unit cells) and says so in the title.
 """
+
 import argparse
 from pathlib import Path
 
 import numpy as np
 
 import animat
+
 from _common import ROOT, save_png
 
 

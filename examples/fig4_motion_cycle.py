@@ -3,7 +3,9 @@ blue (contracting) or green (neutral) from eq. 2, rotated so that it swims to th
 
     PYTHONPATH=build/python .venv/bin/python examples/fig4_motion_cycle.py [--run DIR] [--out PNG]
 """
+
 import animat
+
 from _common import fresh_run, parser, save_png
 
 args = parser(__doc__, "motion_cycle.png").parse_args()

@@ -3,7 +3,9 @@ shift (colour range normalised to the body, maximum indicated).
 
     PYTHONPATH=build/python .venv/bin/python examples/fig7_phase_map.py [--run DIR] [--out PNG]
 """
+
 import animat
+
 from _common import fresh_run, parser, save_png
 
 args = parser(__doc__, "phase_map.png").parse_args()

@@ -3,7 +3,9 @@ morphology changed marked, with thumbnails of those bodies (coloured by phase sh
 
     PYTHONPATH=build/python .venv/bin/python examples/fig8_fitness_history.py [--run DIR] [--out PNG]
 """
+
 import animat
+
 from _common import fresh_run, parser, save_png
 
 p = parser(__doc__, "fitness_history.png")

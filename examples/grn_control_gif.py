@@ -8,6 +8,7 @@ panel) and the centre-of-mass path so far (blue). The panels are centred on the 
 
     PYTHONPATH=build/python .venv/bin/python examples/grn_control_gif.py
 """
+
 import math
 import pathlib
 
@@ -50,8 +51,12 @@ def main() -> None:
             p = t["positions"][k]
             c0 = t["com"][0]
             u = (src - t["com"][0]) / np.linalg.norm(src - t["com"][0])
-            ax.annotate("", xy=t["com"][0] + 5.0 * u, xytext=t["com"][0] + 3.0 * u,
-                        arrowprops=dict(arrowstyle="->", color="#d62728", lw=1.5))
+            ax.annotate(
+                "",
+                xy=t["com"][0] + 5.0 * u,
+                xytext=t["com"][0] + 3.0 * u,
+                arrowprops=dict(arrowstyle="->", color="#d62728", lw=1.5),
+            )
             ax.plot(t["com"][: k + 1, 0], t["com"][: k + 1, 1], color="#1f77b4", lw=1)
             for s in springs:
                 ax.plot(p[s, 0], p[s, 1], color="#999999", lw=0.4)

@@ -8,9 +8,10 @@ Reads the best genome of a short chemotaxis run (data/control/<run>_*) and write
 
 RUN defaults to chemotaxis_grn_seed1 and chemotaxis_amplitude_seed2 (docs/control.md).
 """
-import sys
+
 import math
 import pathlib
+import sys
 
 import matplotlib
 
@@ -37,9 +38,15 @@ def main(run: str) -> None:
     if cfg["control.actuation"] == "amplitude":  # show the first 8 time units: the oscillation
         keep = t["times"] <= 8.0
         t = {k: v[keep] for k, v in t.items()}
-    im = ax.imshow(t["terms"][:, order].T, aspect="auto", cmap="coolwarm", origin="lower",
-                   extent=(float(t["times"][0]), float(t["times"][-1]), 0.0, float(t["terms"].shape[1])),
-                   vmin=-cfg["development.amplitude_max"], vmax=cfg["development.amplitude_max"])
+    im = ax.imshow(
+        t["terms"][:, order].T,
+        aspect="auto",
+        cmap="coolwarm",
+        origin="lower",
+        extent=(float(t["times"][0]), float(t["times"][-1]), 0.0, float(t["terms"].shape[1])),
+        vmin=-cfg["development.amplitude_max"],
+        vmax=cfg["development.amplitude_max"],
+    )
     ax.set_xlabel("time")
     ax.set_ylabel("cell (sorted by final u)")
     ax.set_title(f"{run}: u_i per cell (source at +x)", fontsize=9)
@@ -54,8 +61,12 @@ def main(run: str) -> None:
         tr = animat.grn_swim(genome, cfg, steps=steps, every=20, source=src)
         com = tr["com"] - tr["com"][0]
         (line,) = ax.plot(com[:, 0], com[:, 1], lw=1.2)
-        ax.annotate("", xy=(0.25 * math.cos(a), 0.25 * math.sin(a)), xytext=(0, 0),
-                    arrowprops=dict(arrowstyle="->", color=line.get_color(), alpha=0.6))
+        ax.annotate(
+            "",
+            xy=(0.25 * math.cos(a), 0.25 * math.sin(a)),
+            xytext=(0, 0),
+            arrowprops=dict(arrowstyle="->", color=line.get_color(), alpha=0.6),
+        )
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_title("COM paths (same colour: source direction)", fontsize=9)
     ax.set_xlabel("x")

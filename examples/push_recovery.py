@@ -17,6 +17,7 @@ steps 3000-4000 (what the push changed for good).
 
 Each argument is LABEL=PACKED_ENV_DIR:RUNS[@GENERATION] (the best at or before GENERATION; default the last).
 """
+
 import argparse
 import math
 import pathlib
@@ -67,22 +68,37 @@ def analyse(entry, cfg, impulse, cells):
     # What the push changed: the pushed swim's heading over steps 3000-4000 against the undisturbed one's.
     deflection = math.degrees(math.atan2(d_after0[0] * d_after[1] - d_after0[1] * d_after[0], d_after0 @ d_after))
     sp_b, sp_a, sp_a0 = (float(np.linalg.norm(v)) for v in (v_before, v_after, v_after0))
-    return {"valid": bool(rec.result.valid), "speed_before": sp_b, "speed_after": sp_a,
-            "recovery": sp_a / sp_b, "recovery_undisturbed": sp_a0 / sp_b, "turn": turn,
-            "speed_vs_undisturbed": sp_a / sp_a0, "deflection": deflection}
+    return {
+        "valid": bool(rec.result.valid),
+        "speed_before": sp_b,
+        "speed_after": sp_a,
+        "recovery": sp_a / sp_b,
+        "recovery_undisturbed": sp_a0 / sp_b,
+        "turn": turn,
+        "speed_vs_undisturbed": sp_a / sp_a0,
+        "deflection": deflection,
+    }
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
     p.add_argument("groups", nargs="+", help="LABEL=PACKED_ENV_DIR:RUNS[@GENERATION]")
     p.add_argument("--impulse", type=float, default=1.0, help="impulse per cell (cell mass 1: the velocity change)")
-    p.add_argument("--cells", choices=("all", "front"), default="all",
-                   help="cells pushed: all, or those at x >= the centre's x (evaluation.push_cells): a torque")
+    p.add_argument(
+        "--cells",
+        choices=("all", "front"),
+        default="all",
+        help="cells pushed: all, or those at x >= the centre's x (evaluation.push_cells): a torque",
+    )
     args = p.parse_args(argv)
-    print(f"push at step {PUSH_STEP} of 4000, impulse {args.impulse} per cell ({args.cells} cells), perpendicular "
-          "to the heading of steps 1000-2000")
-    print("| controller | run | best of generation | fitness | speed before | speed after | after / before "
-          "| same, undisturbed | speed after, pushed / undisturbed | heading turn (°) | deflection by the push (°) |")
+    print(
+        f"push at step {PUSH_STEP} of 4000, impulse {args.impulse} per cell ({args.cells} cells), perpendicular "
+        "to the heading of steps 1000-2000"
+    )
+    print(
+        "| controller | run | best of generation | fitness | speed before | speed after | after / before "
+        "| same, undisturbed | speed after, pushed / undisturbed | heading turn (°) | deflection by the push (°) |"
+    )
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     summary = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -99,15 +115,20 @@ def main(argv=None) -> int:
                 entry = lineage[-1]
                 r = analyse(entry, run.config, args.impulse, args.cells)
                 summary.setdefault(label, []).append(r)
-                print(f"| {label} | {i} | {entry.generation} | {entry.fitness:.2f} | {r['speed_before']:.3f} | "
-                      f"{r['speed_after']:.3f} | {r['recovery']:.2f} | {r['recovery_undisturbed']:.2f} | "
-                      f"{r['speed_vs_undisturbed']:.3f} | {r['turn']:+.0f} | {r['deflection']:+.0f} |" + ("" if r["valid"] else " invalid swim"))
+                print(
+                    f"| {label} | {i} | {entry.generation} | {entry.fitness:.2f} | {r['speed_before']:.3f} | "
+                    f"{r['speed_after']:.3f} | {r['recovery']:.2f} | {r['recovery_undisturbed']:.2f} | "
+                    f"{r['speed_vs_undisturbed']:.3f} | {r['turn']:+.0f} | {r['deflection']:+.0f} |"
+                    + ("" if r["valid"] else " invalid swim")
+                )
     print()
     for label, rs in summary.items():
-        print(f"{label}: mean after/before {np.mean([r['recovery'] for r in rs]):.2f} (undisturbed "
-              f"{np.mean([r['recovery_undisturbed'] for r in rs]):.2f}), mean |turn| "
-              f"{np.mean([abs(r['turn']) for r in rs]):.0f}°, mean |deflection by the push| "
-              f"{np.mean([abs(r['deflection']) for r in rs]):.0f}°")
+        print(
+            f"{label}: mean after/before {np.mean([r['recovery'] for r in rs]):.2f} (undisturbed "
+            f"{np.mean([r['recovery_undisturbed'] for r in rs]):.2f}), mean |turn| "
+            f"{np.mean([abs(r['turn']) for r in rs]):.0f}°, mean |deflection by the push| "
+            f"{np.mean([abs(r['deflection']) for r in rs]):.0f}°"
+        )
     return 0
 
 

@@ -27,23 +27,26 @@ using std::size_t;
 
 void check_params(const BodyParams& params, std::string_view who) {
   if (!(params.merge_distance >= 0.0) || !std::isfinite(params.merge_distance)) {
-    throw ConfigError(fmt::format("{}: body.merge_distance must be a finite number >= 0, got {}", who,
-                                  params.merge_distance));
+    throw ConfigError(fmt::format("{}: body.merge_distance must be a finite number >= 0, got {}",
+                                  who, params.merge_distance));
   }
   if (!(params.max_coordinate > 0.0)) {
     throw ConfigError(
         fmt::format("{}: body.max_coordinate must be > 0, got {}", who, params.max_coordinate));
   }
-  if (std::find(std::begin(kBodyGraphNames), std::end(kBodyGraphNames), params.graph) == std::end(kBodyGraphNames)) {
-    throw ConfigError(fmt::format("{}: body.graph must be one of gabriel, distance, alpha_shape, got \"{}\"", who,
-                                  params.graph));
+  if (std::find(std::begin(kBodyGraphNames), std::end(kBodyGraphNames), params.graph) ==
+      std::end(kBodyGraphNames)) {
+    throw ConfigError(
+        fmt::format("{}: body.graph must be one of gabriel, distance, alpha_shape, got \"{}\"", who,
+                    params.graph));
   }
   if (!(params.distance_threshold > 0.0) || !(params.distance_threshold <= kMaxLength)) {
-    throw ConfigError(fmt::format("{}: body.distance_threshold must be in (0, {}], got {}", who, kMaxLength,
-                                  params.distance_threshold));
+    throw ConfigError(fmt::format("{}: body.distance_threshold must be in (0, {}], got {}", who,
+                                  kMaxLength, params.distance_threshold));
   }
   if (!(params.alpha > 0.0) || !(params.alpha <= kMaxLength)) {
-    throw ConfigError(fmt::format("{}: body.alpha must be in (0, {}], got {}", who, kMaxLength, params.alpha));
+    throw ConfigError(
+        fmt::format("{}: body.alpha must be in (0, {}], got {}", who, kMaxLength, params.alpha));
   }
 }
 
@@ -66,11 +69,13 @@ void check_points(const Points& points, const BodyParams& params, std::string_vi
       const double x = points(i, c);
       const char axis = c == 0 ? 'x' : 'y';
       if (!std::isfinite(x)) {
-        throw GeometryError(fmt::format("{}: point {} has a non-finite coordinate {} = {}", who, i, axis, x));
+        throw GeometryError(
+            fmt::format("{}: point {} has a non-finite coordinate {} = {}", who, i, axis, x));
       }
       if (std::abs(x) > params.max_coordinate) {
-        throw GeometryError(fmt::format("{}: point {} has coordinate {} = {}, beyond max_coordinate = {}", who, i,
-                                        axis, x, params.max_coordinate));
+        throw GeometryError(
+            fmt::format("{}: point {} has coordinate {} = {}, beyond max_coordinate = {}", who, i,
+                        axis, x, params.max_coordinate));
       }
     }
   }
@@ -91,19 +96,22 @@ void check_points(const Points& points, const BodyParams& params, std::string_vi
     }
   }
   if (first.first >= 0) {
-    throw GeometryError(fmt::format("{}: points {} and {} coincide at ({}, {}) (distance 0); duplicate cell centres "
-                                    "are rejected",
-                                    who, first.first, first.second, points(first.first, 0), points(first.first, 1)));
+    throw GeometryError(fmt::format(
+        "{}: points {} and {} coincide at ({}, {}) (distance 0); duplicate cell centres "
+        "are rejected",
+        who, first.first, first.second, points(first.first, 0), points(first.first, 1)));
   }
 }
 
-double distance(const Points& p, int a, int b) { return std::hypot(p(b, 0) - p(a, 0), p(b, 1) - p(a, 1)); }
+double distance(const Points& p, int a, int b) {
+  return std::hypot(p(b, 0) - p(a, 0), p(b, 1) - p(a, 1));
+}
 
 /// The closest pair of points is a Delaunay edge (every point's nearest neighbour is a Delaunay
 /// neighbour), so checking the Delaunay edges finds every point closer than merge_distance to
 /// another one. Reports the closest such pair (lowest indices on ties).
-void check_merge_distance(const Points& points, const IndexPairs& delaunay, const BodyParams& params,
-                          std::string_view who) {
+void check_merge_distance(const Points& points, const IndexPairs& delaunay,
+                          const BodyParams& params, std::string_view who) {
   int best = -1;
   double best_d = std::numeric_limits<double>::infinity();
   for (Eigen::Index e = 0; e < delaunay.rows(); ++e) {
@@ -114,16 +122,18 @@ void check_merge_distance(const Points& points, const IndexPairs& delaunay, cons
     }
   }
   if (best >= 0) {
-    throw GeometryError(fmt::format("{}: points {} and {} are {} apart, closer than merge_distance = {}; "
-                                    "near-coincident cell centres are rejected",
-                                    who, delaunay(best, 0), delaunay(best, 1), best_d, params.merge_distance));
+    throw GeometryError(
+        fmt::format("{}: points {} and {} are {} apart, closer than merge_distance = {}; "
+                    "near-coincident cell centres are rejected",
+                    who, delaunay(best, 0), delaunay(best, 1), best_d, params.merge_distance));
   }
 }
 
-detail::GabrielGeometry checked_geometry(const Points& points, const BodyParams& params, std::string_view who,
-                                         bool body_graph = false) {
+detail::GabrielGeometry checked_geometry(const Points& points, const BodyParams& params,
+                                         std::string_view who, bool body_graph = false) {
   check_points(points, params, who);
-  detail::GabrielGeometry g = detail::compute_gabriel_geometry(points, body_graph ? graph_spec(params) : detail::GraphSpec{});
+  detail::GabrielGeometry g = detail::compute_gabriel_geometry(
+      points, body_graph ? graph_spec(params) : detail::GraphSpec{});
   check_merge_distance(points, g.delaunay, params, who);
   return g;
 }
@@ -146,10 +156,12 @@ Vector oscillator(const Vector& v, int n, std::string_view name, std::string_vie
   if (v.size() == 0) return Vector::Zero(n);
   if (v.size() != n) {
     throw GeometryError(
-        fmt::format("{}: {} has {} entries, expected {} (one per node) or 0 (all zero)", who, name, v.size(), n));
+        fmt::format("{}: {} has {} entries, expected {} (one per node) or 0 (all zero)", who, name,
+                    v.size(), n));
   }
   for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v(i))) throw GeometryError(fmt::format("{}: {}[{}] = {} is not finite", who, name, i, v(i)));
+    if (!std::isfinite(v(i)))
+      throw GeometryError(fmt::format("{}: {}[{}] = {} is not finite", who, name, i, v(i)));
   }
   return v;
 }
@@ -178,8 +190,8 @@ IndexPairs gabriel_graph(const Points& points, const BodyParams& params) {
   return checked_geometry(points, params, "gabriel_graph").gabriel;
 }
 
-Body build_body(const Points& positions, const Vector& amplitude, const Vector& frequency, const Vector& phase,
-                const BodyParams& params) {
+Body build_body(const Points& positions, const Vector& amplitude, const Vector& frequency,
+                const Vector& phase, const BodyParams& params) {
   constexpr std::string_view who = "build_body";
   const int n = static_cast<int>(positions.rows());
   const detail::GabrielGeometry g = checked_geometry(positions, params, who, true);
@@ -191,16 +203,18 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
   body.springs = g.edges;
   const Eigen::Index m = body.springs.rows();
   body.rest_lengths.resize(m);
-  for (Eigen::Index e = 0; e < m; ++e) body.rest_lengths(e) = distance(positions, body.springs(e, 0), body.springs(e, 1));
+  for (Eigen::Index e = 0; e < m; ++e)
+    body.rest_lengths(e) = distance(positions, body.springs(e, 0), body.springs(e, 1));
   body.skin.resize(0, 2);
   body.rest_areas.resize(0);
   if (m == 0) return body;
 
-  // Half-edge structure from the rotation system. Half-edge h = (from[h] -> to[h]); the out-edges of
-  // v are first[v] .. first[v+1]-1, in CCW order around v.
+  // Half-edge structure from the rotation system. Half-edge h = (from[h] -> to[h]); the out-edges
+  // of v are first[v] .. first[v+1]-1, in CCW order around v.
   std::vector<int> first(static_cast<size_t>(n) + 1, 0);
-  for (int v = 0; v < n; ++v) first[static_cast<size_t>(v) + 1] = first[static_cast<size_t>(v)] +
-                                                                  static_cast<int>(g.rotation[static_cast<size_t>(v)].size());
+  for (int v = 0; v < n; ++v)
+    first[static_cast<size_t>(v) + 1] =
+        first[static_cast<size_t>(v)] + static_cast<int>(g.rotation[static_cast<size_t>(v)].size());
   const int halfedges = first[static_cast<size_t>(n)];
   std::vector<int> from(static_cast<size_t>(halfedges)), to(static_cast<size_t>(halfedges));
   for (int v = 0; v < n; ++v) {
@@ -213,15 +227,19 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
   // twin[h]: the half-edge (to[h] -> from[h]), found by binary search over (from, to)-sorted ids.
   std::vector<int> by_key(static_cast<size_t>(halfedges));
   std::iota(by_key.begin(), by_key.end(), 0);
-  const auto key = [&](int h) { return std::pair{from[static_cast<size_t>(h)], to[static_cast<size_t>(h)]}; };
+  const auto key = [&](int h) {
+    return std::pair{from[static_cast<size_t>(h)], to[static_cast<size_t>(h)]};
+  };
   std::sort(by_key.begin(), by_key.end(), [&](int a, int b) { return key(a) < key(b); });
   const auto find_halfedge = [&](int u, int v) {
-    const auto it = std::lower_bound(by_key.begin(), by_key.end(), std::pair{u, v},
-                                     [&](int h, const std::pair<int, int>& k) { return key(h) < k; });
+    const auto it =
+        std::lower_bound(by_key.begin(), by_key.end(), std::pair{u, v},
+                         [&](int h, const std::pair<int, int>& k) { return key(h) < k; });
     return *it;  // present: the rotation system is symmetric
   };
-  // next(u -> v) = (v -> w), w = the neighbour of v just before u in CCW order around v (the next one
-  // clockwise). This walks each face with the face on its left: bounded faces CCW, the outer face CW.
+  // next(u -> v) = (v -> w), w = the neighbour of v just before u in CCW order around v (the next
+  // one clockwise). This walks each face with the face on its left: bounded faces CCW, the outer
+  // face CW.
   std::vector<int> next(static_cast<size_t>(halfedges));
   for (int h = 0; h < halfedges; ++h) {
     const int t = find_halfedge(to[static_cast<size_t>(h)], from[static_cast<size_t>(h)]);
@@ -265,9 +283,10 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
     if (!(area > 0.0) || !std::isfinite(area)) {
       // A bounded face is CCW by construction (exact predicates), so only round-off far beyond what
       // merge_distance allows can get here.
-      throw GeometryError(fmt::format("{}: region {} (starting at point {}) has computed area {} <= 0; the points "
-                                      "are too close for double precision (raise merge_distance)",
-                                      who, r, body.regions[r][0], area));
+      throw GeometryError(
+          fmt::format("{}: region {} (starting at point {}) has computed area {} <= 0; the points "
+                      "are too close for double precision (raise merge_distance)",
+                      who, r, body.regions[r][0], area));
     }
     body.rest_areas(static_cast<Eigen::Index>(r)) = area;
   }
@@ -303,12 +322,14 @@ Body build_body(const Points& positions, const Vector& amplitude, const Vector& 
 }
 
 Body build_body(const Embryo& embryo, const BodyParams& params) {
-  Body body = build_body(embryo.positions, embryo.amplitude, embryo.frequency, embryo.phase, params);
+  Body body =
+      build_body(embryo.positions, embryo.amplitude, embryo.frequency, embryo.phase, params);
   if (embryo.stiffness.size() != 0) {
     body.stiffness = oscillator(embryo.stiffness, body.node_count(), "stiffness", "build_body");
     for (int i = 0; i < body.node_count(); ++i) {
       if (!(body.stiffness(i) > 0.0)) {
-        throw GeometryError(fmt::format("build_body: stiffness[{}] = {} is not > 0", i, body.stiffness(i)));
+        throw GeometryError(
+            fmt::format("build_body: stiffness[{}] = {} is not > 0", i, body.stiffness(i)));
       }
     }
   }

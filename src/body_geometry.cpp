@@ -49,7 +49,9 @@ IndexPairs to_index_pairs(std::vector<std::pair<int, int>>& edges) {
 
 std::pair<int, int> ordered(int a, int b) { return a < b ? std::pair{a, b} : std::pair{b, a}; }
 
-double point_distance(const Points& p, int a, int b) { return std::hypot(p(b, 0) - p(a, 0), p(b, 1) - p(a, 1)); }
+double point_distance(const Points& p, int a, int b) {
+  return std::hypot(p(b, 0) - p(a, 0), p(b, 1) - p(a, 1));
+}
 
 double squared_distance(const Points& p, int a, int b) {
   const double dx = p(b, 0) - p(a, 0), dy = p(b, 1) - p(a, 1);
@@ -58,7 +60,8 @@ double squared_distance(const Points& p, int a, int b) {
 
 /// Mean over the points (in index order) of the distance to the nearest other point. Every point's
 /// nearest neighbour is a Delaunay neighbour, so the Delaunay edges suffice.
-double mean_nearest_neighbour(const Points& points, const std::vector<std::pair<int, int>>& delaunay) {
+double mean_nearest_neighbour(const Points& points,
+                              const std::vector<std::pair<int, int>>& delaunay) {
   const int n = static_cast<int>(points.rows());
   if (n <= 1) return 0.0;
   std::vector<double> nearest(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
@@ -114,12 +117,12 @@ void fill_chain(const Points& points, GabrielGeometry& g) {
   }
 }
 
-
 /// Everything after the triangulation, for the plain Delaunay triangulation (gabriel, distance) and
-/// for the alpha shape (which is-a Delaunay triangulation). `alpha` is null unless kind is alpha_shape.
+/// for the alpha shape (which is-a Delaunay triangulation). `alpha` is null unless kind is
+/// alpha_shape.
 template <class Dt>
-GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphSpec& spec, GabrielGeometry g,
-                                [[maybe_unused]] AlphaShape* alpha) {
+GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphSpec& spec,
+                                GabrielGeometry g, [[maybe_unused]] AlphaShape* alpha) {
   const int n = static_cast<int>(points.rows());
   using Face_handle = typename Dt::Face_handle;
   using Vertex_handle = typename Dt::Vertex_handle;
@@ -147,7 +150,8 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
     bool gabriel = true;
     for (const Vertex_handle c : {f->vertex(i), dt.mirror_vertex(f, i)}) {
       if (dt.is_infinite(c)) continue;
-      if (CGAL::side_of_bounded_circle(a->point(), b->point(), c->point()) != CGAL::ON_UNBOUNDED_SIDE) {
+      if (CGAL::side_of_bounded_circle(a->point(), b->point(), c->point()) !=
+          CGAL::ON_UNBOUNDED_SIDE) {
         gabriel = false;
         break;
       }
@@ -172,12 +176,15 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
       // arbitrarily (a grid square's diagonal). Never kept: the graphs stay independent of CGAL's
       // choice and of the input order.
       const bool ambiguous = !dt.is_infinite(f) && !dt.is_infinite(m) &&
-                             dt.side_of_oriented_circle(f, dt.mirror_vertex(f, i)->point(), false) ==
-                                 CGAL::ON_ORIENTED_BOUNDARY;
-      const auto rng = [&] { return info.gabriel && relative_neighbours(points, info.ends.first, info.ends.second); };
+                             dt.side_of_oriented_circle(f, dt.mirror_vertex(f, i)->point(),
+                                                        false) == CGAL::ON_ORIENTED_BOUNDARY;
+      const auto rng = [&] {
+        return info.gabriel && relative_neighbours(points, info.ends.first, info.ends.second);
+      };
       bool keep = false;
       if constexpr (!std::is_same_v<Dt, ADelaunay>) {
-        keep = !ambiguous && (point_distance(points, info.ends.first, info.ends.second) <= limit || rng());
+        keep = !ambiguous &&
+               (point_distance(points, info.ends.first, info.ends.second) <= limit || rng());
       } else {
         const auto cls = alpha->classify(f, i);
         const bool in_complex = cls == AlphaShape::REGULAR || cls == AlphaShape::INTERIOR;
@@ -187,8 +194,10 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
         if (keep) {
           // f is on the left of ccw(i) -> cw(i), the mirror face on the left of cw(i) -> ccw(i).
           const int a = f->vertex(Dt::cw(i))->info(), b = f->vertex(Dt::ccw(i))->info();
-          if (!dt.is_infinite(f) && alpha->classify(f) == AlphaShape::EXTERIOR) holes.emplace_back(b, a);
-          if (!dt.is_infinite(m) && alpha->classify(m) == AlphaShape::EXTERIOR) holes.emplace_back(a, b);
+          if (!dt.is_infinite(f) && alpha->classify(f) == AlphaShape::EXTERIOR)
+            holes.emplace_back(b, a);
+          if (!dt.is_infinite(m) && alpha->classify(m) == AlphaShape::EXTERIOR)
+            holes.emplace_back(a, b);
         }
       }
       if (keep) kept_edges.push_back(info.ends);
@@ -237,7 +246,8 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
       ring.push_back(dt.is_infinite(w) ? -1 : w->info());
     } while (++circ != done);
   }
-  const auto inf_at = static_cast<std::size_t>(std::find(ring.begin(), ring.end(), -1) - ring.begin());
+  const auto inf_at =
+      static_cast<std::size_t>(std::find(ring.begin(), ring.end(), -1) - ring.begin());
   for (std::size_t step = 1; step < ring.size(); ++step) {
     const int w = ring[(inf_at + ring.size() - step) % ring.size()];
     if (is_kept(hull->info(), w)) {
@@ -246,7 +256,8 @@ GabrielGeometry finish_geometry(const Dt& dt, const Points& points, const GraphS
       break;
     }
   }
-  if (g.outer_from < 0) throw GeometryError("gabriel_graph: internal error: hull vertex without a body-graph edge");
+  if (g.outer_from < 0)
+    throw GeometryError("gabriel_graph: internal error: hull vertex without a body-graph edge");
   return g;
 }
 
@@ -259,7 +270,8 @@ void insert_checked(Dt& dt, const Points& points) {
   dt.insert(input.begin(), input.end());  // spatially sorted insertion, O(n log n) expected
   if (static_cast<int>(dt.number_of_vertices()) != n) {
     // The caller rejects duplicates before we get here; this is a safety net, not a code path.
-    throw GeometryError("gabriel_graph: CGAL merged " + std::to_string(n - static_cast<int>(dt.number_of_vertices())) +
+    throw GeometryError("gabriel_graph: CGAL merged " +
+                        std::to_string(n - static_cast<int>(dt.number_of_vertices())) +
                         " coincident point(s); duplicates must be rejected before triangulation");
   }
 }

@@ -21,7 +21,8 @@ struct GraphSpec {
 /// graph's rotation system (neighbours of each vertex in counter-clockwise order), which is all the
 /// combinatorial information needed to walk the faces of the planar body graph.
 struct GabrielGeometry {
-  int dimension = -1;  ///< affine dimension of the input: -1 (empty), 0 (one point), 1 (collinear), 2
+  /// affine dimension of the input: -1 (empty), 0 (one point), 1 (collinear), 2
+  int dimension = -1;
   IndexPairs delaunay;  ///< Delaunay edges (i < j), sorted lexicographically
   IndexPairs gabriel;   ///< Gabriel edges (i < j), sorted lexicographically
   IndexPairs edges;     ///< the body graph's edges (= gabriel for GraphKind::gabriel)
@@ -44,6 +45,7 @@ struct GabrielGeometry {
 /// Gabriel subgraph (closed diametral disc) and the body graph of `spec`. Preconditions, checked
 /// by the caller: every coordinate is finite and no two points coincide. Throws GeometryError if
 /// CGAL merged points anyway. O(n log n) for the Gabriel graph.
-[[nodiscard]] GabrielGeometry compute_gabriel_geometry(const Points& points, const GraphSpec& spec = {});
+[[nodiscard]] GabrielGeometry compute_gabriel_geometry(const Points& points,
+                                                       const GraphSpec& spec = {});
 
 }  // namespace animat::detail

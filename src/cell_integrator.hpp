@@ -23,10 +23,11 @@
 namespace animat {
 
 struct CellIntegrator {
-  std::vector<float> px, py, vx, vy;  ///< Box2D's m_sweep.c (= position, the mass centre is the origin) and velocity
-  float mass = 1.0f;                  ///< b2MassData::mass as Box2D stores it
-  float inv_mass = 1.0f;              ///< Box2D's m_invMass = 1 / mass
-  float damping = 0.0f;               ///< b2BodyDef::linearDamping
+  /// Box2D's m_sweep.c (= position, the mass centre is the origin) and velocity
+  std::vector<float> px, py, vx, vy;
+  float mass = 1.0f;      ///< b2MassData::mass as Box2D stores it
+  float inv_mass = 1.0f;  ///< Box2D's m_invMass = 1 / mass
+  float damping = 0.0f;   ///< b2BodyDef::linearDamping
 
   void set_mass(double m) {
     mass = static_cast<float>(m);

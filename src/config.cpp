@@ -2,20 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <toml++/toml.h>
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
-#include <cstring>
-#include <iterator>
 #include <cmath>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
-#include <toml++/toml.h>
 #include <type_traits>
 
 #include "animat/errors.hpp"
-#include "animat/objective.hpp"
 #include "animat/islands.hpp"
+#include "animat/objective.hpp"
 
 namespace animat {
 
@@ -62,7 +62,10 @@ std::string suggestion(std::string_view word, const std::vector<std::string>& ca
   std::size_t best_d = 4;
   for (const auto& c : candidates) {
     const std::size_t d = edit_distance(word, c);
-    if (d < best_d) { best_d = d; best = c; }
+    if (d < best_d) {
+      best_d = d;
+      best = c;
+    }
   }
   return best.empty() ? std::string{} : fmt::format(" (did you mean '{}'?)", best);
 }
@@ -85,12 +88,18 @@ std::vector<std::string> field_names(std::string_view section) {
 
 template <class T>
 constexpr std::string_view type_name() {
-  if constexpr (std::is_same_v<T, bool>) return "a boolean (true or false)";
-  else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) return "an integer";
-  else if constexpr (std::is_same_v<T, double>) return "a number";
-  else if constexpr (std::is_same_v<T, std::string>) return "a string";
-  else if constexpr (std::is_same_v<T, std::vector<std::string>>) return "an array of strings";
-  else return "an array of numbers";
+  if constexpr (std::is_same_v<T, bool>)
+    return "a boolean (true or false)";
+  else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>)
+    return "an integer";
+  else if constexpr (std::is_same_v<T, double>)
+    return "a number";
+  else if constexpr (std::is_same_v<T, std::string>)
+    return "a string";
+  else if constexpr (std::is_same_v<T, std::vector<std::string>>)
+    return "an array of strings";
+  else
+    return "an array of numbers";
 }
 
 std::string format_double(double x) {
@@ -114,10 +123,14 @@ std::string quote(std::string_view s) {
 
 std::string format_value(const auto& value) {
   using T = std::decay_t<decltype(value)>;
-  if constexpr (std::is_same_v<T, bool>) return value ? "true" : "false";
-  else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) return std::to_string(value);
-  else if constexpr (std::is_same_v<T, double>) return format_double(value);
-  else if constexpr (std::is_same_v<T, std::string>) return quote(value);
+  if constexpr (std::is_same_v<T, bool>)
+    return value ? "true" : "false";
+  else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>)
+    return std::to_string(value);
+  else if constexpr (std::is_same_v<T, double>)
+    return format_double(value);
+  else if constexpr (std::is_same_v<T, std::string>)
+    return quote(value);
   else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
     std::vector<std::string> q;
     for (const auto& s : value) q.push_back(quote(s));
@@ -134,29 +147,36 @@ template <class T>
 std::string check(const FieldInfo& info, const T& value) {
   auto check_number = [&](double x) -> std::string {
     if (!std::isfinite(x)) return fmt::format("must be finite, {}", info.bounds.describe());
-    if (!info.bounds.contains(x)) return fmt::format("out of range: expected {}", info.bounds.describe());
+    if (!info.bounds.contains(x))
+      return fmt::format("out of range: expected {}", info.bounds.describe());
     return {};
   };
   auto allowed = [&](const std::string& s) {
-    // A choice ending in '*' admits every value with that prefix (evaluation.objective = "python:NAME").
-    return info.choices.empty() || std::any_of(info.choices.begin(), info.choices.end(), [&](std::string_view c) {
-             return c == s || (c.ends_with('*') && s.size() >= c.size() && s.starts_with(c.substr(0, c.size() - 1)));
+    // A choice ending in '*' admits every value with that prefix (evaluation.objective =
+    // "python:NAME").
+    return info.choices.empty() ||
+           std::any_of(info.choices.begin(), info.choices.end(), [&](std::string_view c) {
+             return c == s || (c.ends_with('*') && s.size() >= c.size() &&
+                               s.starts_with(c.substr(0, c.size() - 1)));
            });
   };
-  if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t> || std::is_same_v<T, double>) {
+  if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t> ||
+                std::is_same_v<T, double>) {
     return check_number(static_cast<double>(value));
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (!allowed(value)) return fmt::format("expected one of {}", fmt::join(info.choices, ", "));
   } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
     for (std::size_t i = 0; i < value.size(); ++i) {
       if (!allowed(value[i]))
-        return fmt::format("unknown entry {} (expected any of {})", quote(value[i]), fmt::join(info.choices, ", "));
+        return fmt::format("unknown entry {} (expected any of {})", quote(value[i]),
+                           fmt::join(info.choices, ", "));
       for (std::size_t j = 0; j < i; ++j)
         if (value[j] == value[i]) return fmt::format("entry {} is listed twice", quote(value[i]));
     }
   } else if constexpr (std::is_same_v<T, std::vector<double>>) {
     for (double d : value)
-      if (auto e = check_number(d); !e.empty()) return fmt::format("entry {}: {}", format_double(d), e);
+      if (auto e = check_number(d); !e.empty())
+        return fmt::format("entry {}: {}", format_double(d), e);
   }
   return {};
 }
@@ -171,12 +191,16 @@ std::string read_node(const toml::node& node, T& out) {
     if (!node.is_integer()) return "wrong type";
     const std::int64_t v = node.as_integer()->get();
     if constexpr (std::is_same_v<T, int>)
-      if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) return "out of the integer range";
+      if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+        return "out of the integer range";
     out = static_cast<T>(v);
   } else if constexpr (std::is_same_v<T, double>) {
-    if (node.is_integer()) out = static_cast<double>(node.as_integer()->get());
-    else if (node.is_floating_point()) out = node.as_floating_point()->get();
-    else return "wrong type";
+    if (node.is_integer())
+      out = static_cast<double>(node.as_integer()->get());
+    else if (node.is_floating_point())
+      out = node.as_floating_point()->get();
+    else
+      return "wrong type";
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (!node.is_string()) return "wrong type";
     out = node.as_string()->get();
@@ -196,8 +220,10 @@ std::string read_node(const toml::node& node, T& out) {
 
 std::string node_text(const toml::node& node) {
   std::ostringstream ss;
-  if (node.is_string()) ss << quote(node.as_string()->get());
-  else node.visit([&](auto&& n) { ss << n; });
+  if (node.is_string())
+    ss << quote(node.as_string()->get());
+  else
+    node.visit([&](auto&& n) { ss << n; });
   std::string s = ss.str();
   return s.size() > 60 ? s.substr(0, 57) + "..." : s;
 }
@@ -211,27 +237,32 @@ void apply_table(Config& config, const toml::table& root, std::string_view sourc
   for (auto&& [skey, snode] : root) {
     const std::string section(skey.str());
     if (std::find(sections.begin(), sections.end(), section) == sections.end())
-      throw ConfigError(fmt::format("{}: unknown section [{}]{}; sections are: {}", location(source, skey.source()),
-                                    section, suggestion(section, sections), fmt::join(sections, ", ")));
+      throw ConfigError(fmt::format("{}: unknown section [{}]{}; sections are: {}",
+                                    location(source, skey.source()), section,
+                                    suggestion(section, sections), fmt::join(sections, ", ")));
     const toml::table* table = snode.as_table();
     if (!table)
-      throw ConfigError(fmt::format("{}: '{}' must be a table ([{}])", location(source, snode.source()), section, section));
+      throw ConfigError(fmt::format("{}: '{}' must be a table ([{}])",
+                                    location(source, snode.source()), section, section));
     for (auto&& [kkey, kvalue] : *table) {
-      const toml::node& knode = kvalue;  // a named reference: lambdas may not capture structured bindings before C++20 in clang < 16
+      // a named reference: lambdas may not capture structured bindings before C++20 in clang < 16
+      const toml::node& knode = kvalue;
       const std::string key(kkey.str());
       const bool found = with_field(config, section, key, [&](const FieldInfo& info, auto& value) {
         using T = std::decay_t<decltype(value)>;
         T parsed = value;
-        const std::string where = fmt::format("{}: {}.{} = {}", location(source, knode.source()), section, key, node_text(knode));
+        const std::string where = fmt::format("{}: {}.{} = {}", location(source, knode.source()),
+                                              section, key, node_text(knode));
         if (auto e = read_node(knode, parsed); !e.empty())
           throw ConfigError(fmt::format("{}: {}, expected {}", where, e, type_name<T>()));
-        if (auto e = check(info, parsed); !e.empty()) throw ConfigError(fmt::format("{}: {}", where, e));
+        if (auto e = check(info, parsed); !e.empty())
+          throw ConfigError(fmt::format("{}: {}", where, e));
         value = std::move(parsed);
       });
       if (!found) {
         const auto names = field_names(section);
-        throw ConfigError(fmt::format("{}: unknown key '{}.{}'{}", location(source, kkey.source()), section, key,
-                                      suggestion(key, names)));
+        throw ConfigError(fmt::format("{}: unknown key '{}.{}'{}", location(source, kkey.source()),
+                                      section, key, suggestion(key, names)));
       }
     }
   }
@@ -266,7 +297,9 @@ Config load_config(const std::filesystem::path& path) {
     throw IoError(fmt::format("{}: cannot open config file: {}", path.string(),
                               errno ? std::strerror(errno) : "unknown error"));
   std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw IoError(fmt::format("{}: cannot read config file: {}", path.string(), std::strerror(errno)));
+  if (in.bad())
+    throw IoError(
+        fmt::format("{}: cannot read config file: {}", path.string(), std::strerror(errno)));
   return config_from_toml(text, path.string());
 }
 
@@ -275,7 +308,8 @@ std::string to_toml(const Config& config, std::string_view version,
   Config copy = config;
   std::string out = fmt::format(
       "# animat {} configuration. Every key is listed with its default or resolved value.\n"
-      "# [paper] marks values fixed by Joachimczak & Wrobel (GECCO 2012); [choose] marks project choices\n"
+      "# [paper] marks values fixed by Joachimczak & Wrobel (GECCO 2012); [choose] marks project "
+      "choices\n"
       "# documented in docs/model.md.\n",
       version);
   std::string_view current;
@@ -284,21 +318,24 @@ std::string to_toml(const Config& config, std::string_view version,
       out += fmt::format("\n[{}]\n", section);
       current = section;
     }
-    out += fmt::format("# {}\n{} = {}\n", comment(fmt::format("{}.{}", section, info.name), info.doc), info.name,
-                       format_value(value));
+    out +=
+        fmt::format("# {}\n{} = {}\n", comment(fmt::format("{}.{}", section, info.name), info.doc),
+                    info.name, format_value(value));
   });
   return out;
 }
 
 std::string to_toml(const Config& config) {
-  return to_toml(config, ANIMAT_VERSION, [](std::string_view, std::string_view doc) { return std::string(doc); });
+  return to_toml(config, ANIMAT_VERSION,
+                 [](std::string_view, std::string_view doc) { return std::string(doc); });
 }
 
 namespace {
 // One "section.key=value": the value checked on its own (type, range), the cross-key rules not yet.
 void apply_override_unvalidated(Config& target, std::string_view assignment) {
   if (assignment.find_first_of("\r\n") != std::string_view::npos)
-    throw ConfigError(fmt::format("--set {}: one assignment per --set; newlines are not allowed", assignment));
+    throw ConfigError(
+        fmt::format("--set {}: one assignment per --set; newlines are not allowed", assignment));
   Config config = target;  // applied to a copy: a rejected override leaves the config unchanged
   const auto eq = assignment.find('=');
   const auto dot = assignment.find('.');
@@ -326,8 +363,8 @@ void apply_override_unvalidated(Config& target, std::string_view assignment) {
     table = toml::parse(std::string_view(doc), std::string_view("--set"));
   } catch (const toml::parse_error&) {
     if (!expected.empty())
-      throw ConfigError(fmt::format("--set {}: '{}' is not a valid value for {}.{} (expected {})", assignment, value,
-                                    section, key, expected));
+      throw ConfigError(fmt::format("--set {}: '{}' is not a valid value for {}.{} (expected {})",
+                                    assignment, value, section, key, expected));
     throw ConfigError(fmt::format("--set {}: malformed value", assignment));
   }
   try {
@@ -359,7 +396,8 @@ void apply_overrides(Config& target, const std::vector<std::string>& assignments
 namespace {
 std::pair<std::string, std::string> split_key(std::string_view dotted) {
   const auto dot = dotted.find('.');
-  if (dot == std::string_view::npos) throw ConfigError(fmt::format("config key '{}' must be 'section.key'", dotted));
+  if (dot == std::string_view::npos)
+    throw ConfigError(fmt::format("config key '{}' must be 'section.key'", dotted));
   return {std::string(dotted.substr(0, dot)), std::string(dotted.substr(dot + 1))};
 }
 }  // namespace
@@ -370,22 +408,34 @@ void set_value(Config& config, std::string_view dotted, const ConfigValue& cv) {
     using T = std::decay_t<decltype(value)>;
     T parsed{};
     bool ok = true;
-    std::visit([&](const auto& x) {
-      using X = std::decay_t<decltype(x)>;
-      if constexpr (std::is_same_v<T, X>) parsed = x;
-      else if constexpr ((std::is_same_v<T, int>)&&std::is_same_v<X, std::int64_t>) {
-        if (x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max()) ok = false;
-        else parsed = static_cast<T>(x);
-      } else if constexpr (std::is_same_v<T, double> && std::is_same_v<X, std::int64_t>) parsed = static_cast<T>(x);
-      else if constexpr (std::is_same_v<T, std::vector<double>> && std::is_same_v<X, std::vector<std::string>>) ok = x.empty();
-      else if constexpr (std::is_same_v<T, std::vector<std::string>> && std::is_same_v<X, std::vector<double>>) ok = x.empty();
-      else ok = false;
-    }, cv);
+    std::visit(
+        [&](const auto& x) {
+          using X = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, X>)
+            parsed = x;
+          else if constexpr ((std::is_same_v<T, int>) && std::is_same_v<X, std::int64_t>) {
+            if (x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max())
+              ok = false;
+            else
+              parsed = static_cast<T>(x);
+          } else if constexpr (std::is_same_v<T, double> && std::is_same_v<X, std::int64_t>)
+            parsed = static_cast<T>(x);
+          else if constexpr (std::is_same_v<T, std::vector<double>> &&
+                             std::is_same_v<X, std::vector<std::string>>)
+            ok = x.empty();
+          else if constexpr (std::is_same_v<T, std::vector<std::string>> &&
+                             std::is_same_v<X, std::vector<double>>)
+            ok = x.empty();
+          else
+            ok = false;
+        },
+        cv);
     if (!ok && std::is_same_v<T, int> && std::holds_alternative<std::int64_t>(cv))
-      throw ConfigError(fmt::format("{} = {}: out of the integer range, expected {}", dotted, std::get<std::int64_t>(cv),
-                                    info.bounds.describe()));
+      throw ConfigError(fmt::format("{} = {}: out of the integer range, expected {}", dotted,
+                                    std::get<std::int64_t>(cv), info.bounds.describe()));
     if (!ok) throw ConfigError(fmt::format("{}: wrong type, expected {}", dotted, type_name<T>()));
-    if (auto e = check(info, parsed); !e.empty()) throw ConfigError(fmt::format("{} = {}: {}", dotted, format_value(parsed), e));
+    if (auto e = check(info, parsed); !e.empty())
+      throw ConfigError(fmt::format("{} = {}: {}", dotted, format_value(parsed), e));
     value = std::move(parsed);
   });
   if (!found) {
@@ -400,8 +450,10 @@ ConfigValue get_value(const Config& config, std::string_view dotted) {
   ConfigValue out;
   const bool found = with_field(copy, section, key, [&](const FieldInfo&, auto& value) {
     using T = std::decay_t<decltype(value)>;
-    if constexpr (std::is_same_v<T, int>) out = static_cast<std::int64_t>(value);
-    else out = value;
+    if constexpr (std::is_same_v<T, int>)
+      out = static_cast<std::int64_t>(value);
+    else
+      out = value;
   });
   if (!found) {
     std::vector<std::string> keys = config_keys();
@@ -413,7 +465,9 @@ ConfigValue get_value(const Config& config, std::string_view dotted) {
 std::vector<std::string> config_keys() {
   std::vector<std::string> out;
   Config c;
-  for_each_field(c, [&](std::string_view s, const FieldInfo& info, auto&) { out.push_back(fmt::format("{}.{}", s, info.name)); });
+  for_each_field(c, [&](std::string_view s, const FieldInfo& info, auto&) {
+    out.push_back(fmt::format("{}.{}", s, info.name));
+  });
   return out;
 }
 
@@ -441,12 +495,13 @@ void validate(const Config& config, std::string_view source) {
   Config copy = config;
   for_each_field(copy, [&](std::string_view section, const FieldInfo& info, auto& value) {
     if (auto e = check(info, value); !e.empty())
-      throw ConfigError(fmt::format("{}: {}.{} = {}: {}", source, section, info.name, format_value(value), e));
+      throw ConfigError(
+          fmt::format("{}: {}.{} = {}: {}", source, section, info.name, format_value(value), e));
   });
   auto fail = [&](std::string_view msg) { throw ConfigError(fmt::format("{}: {}", source, msg)); };
   if (config.evolution.elites >= config.evolution.population)
-    fail(fmt::format("evolution.elites = {} must be smaller than evolution.population = {}", config.evolution.elites,
-                     config.evolution.population));
+    fail(fmt::format("evolution.elites = {} must be smaller than evolution.population = {}",
+                     config.evolution.elites, config.evolution.population));
   if (config.development.stiffness_min > config.development.stiffness_max)
     fail(fmt::format("development.stiffness_min = {} exceeds development.stiffness_max = {}",
                      config.development.stiffness_min, config.development.stiffness_max));
@@ -455,14 +510,17 @@ void validate(const Config& config, std::string_view source) {
                      config.development.frequency_min, config.development.frequency_max));
   std::size_t specials = 0;
   try {
-    specials = enabled_input_channels(config.genome).size() + enabled_output_channels(config.genome).size();
+    specials = enabled_input_channels(config.genome).size() +
+               enabled_output_channels(config.genome).size();
   } catch (const ConfigError& e) {
     fail(e.what());  // names genome.extra_inputs / extra_outputs and the value
   }
   if (config.genome.max_elements < 2 * config.genome.initial_units + static_cast<int>(specials))
-    fail(fmt::format("genome.max_elements = {} cannot hold a random genome of genome.initial_units = {} units "
-                     "(needs at least {} elements)", config.genome.max_elements, config.genome.initial_units,
-                     2 * config.genome.initial_units + static_cast<int>(specials)));
+    fail(fmt::format(
+        "genome.max_elements = {} cannot hold a random genome of genome.initial_units = {} units "
+        "(needs at least {} elements)",
+        config.genome.max_elements, config.genome.initial_units,
+        2 * config.genome.initial_units + static_cast<int>(specials)));
   try {
     validate(config.development);
     validate(config.evaluation);
@@ -472,16 +530,20 @@ void validate(const Config& config, std::string_view source) {
   } catch (const ConfigError& e) {
     fail(e.what());
   }
-  if (const std::string e = island_config_error(config.evolution); !e.empty()) fail(e);  // [islands]
+  // [islands]
+  if (const std::string e = island_config_error(config.evolution); !e.empty()) fail(e);
   if (config.development.min_cells > config.development.max_cells)
-    fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}", config.development.min_cells,
-                     config.development.max_cells));
+    fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}",
+                     config.development.min_cells, config.development.max_cells));
   if (config.evaluation.reference_check != "off" &&
       static_cast<long long>(config.physics.substeps) * config.evaluation.reference_substeps > 1000)
-    fail(fmt::format("the exploit guard's reference step needs physics.substeps x evaluation.reference_substeps = {} x {} "
-                     "Box2D steps per control step, more than physics.substeps allows (1000); lower one of them or "
-                     "set evaluation.reference_check = \"off\"",
-                     config.physics.substeps, config.evaluation.reference_substeps));
+    fail(
+        fmt::format("the exploit guard's reference step needs physics.substeps x "
+                    "evaluation.reference_substeps = {} x {} "
+                    "Box2D steps per control step, more than physics.substeps allows (1000); lower "
+                    "one of them or "
+                    "set evaluation.reference_check = \"off\"",
+                    config.physics.substeps, config.evaluation.reference_substeps));
 }
 
 std::vector<std::string> config_differences(const Config& a, const Config& b) {

@@ -14,14 +14,18 @@ inline double orient(double ax, double ay, double bx, double by, double cx, doub
   return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
 }
 
-inline bool within(double a, double b, double c) { return std::min(a, b) <= c && c <= std::max(a, b); }
+inline bool within(double a, double b, double c) {
+  return std::min(a, b) <= c && c <= std::max(a, b);
+}
 
 }  // namespace
 
-bool segments_intersect(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy) {
+bool segments_intersect(double ax, double ay, double bx, double by, double cx, double cy, double dx,
+                        double dy) {
   const double o1 = orient(ax, ay, bx, by, cx, cy), o2 = orient(ax, ay, bx, by, dx, dy);
   const double o3 = orient(cx, cy, dx, dy, ax, ay), o4 = orient(cx, cy, dx, dy, bx, by);
-  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+    return true;
   // Touching or collinear overlap: an end lies on the other segment.
   if (o1 == 0 && within(ax, bx, cx) && within(ay, by, cy)) return true;
   if (o2 == 0 && within(ax, bx, dx) && within(ay, by, dy)) return true;
@@ -58,20 +62,25 @@ int EmbeddingMonitor::count_skin_crossings(std::span<const double> x, std::span<
   }
   // Insertion sort by the smallest x: the order barely changes between frames, so this is ~O(m).
   for (std::size_t q = 1; q < m; ++q)
-    for (std::size_t r = q; r > 0 && lo_[effects::at(order_[r])] < lo_[effects::at(order_[r - 1])]; --r)
+    for (std::size_t r = q; r > 0 && lo_[effects::at(order_[r])] < lo_[effects::at(order_[r - 1])];
+         --r)
       std::swap(order_[r], order_[r - 1]);
   int count = 0;
   for (std::size_t q = 0; q < m; ++q) {
     const auto e = effects::at(order_[q]);
     const int a = sa_[e], b = sb_[e];
-    const double ymin = std::min(y[effects::at(a)], y[effects::at(b)]), ymax = std::max(y[effects::at(a)], y[effects::at(b)]);
+    const double ymin = std::min(y[effects::at(a)], y[effects::at(b)]),
+                 ymax = std::max(y[effects::at(a)], y[effects::at(b)]);
     for (std::size_t r = q + 1; r < m && lo_[effects::at(order_[r])] <= hi_[e]; ++r) {
       const auto f = effects::at(order_[r]);
       const int c = sa_[f], d = sb_[f];
       if (c == a || c == b || d == a || d == b) continue;
-      if (std::max(y[effects::at(c)], y[effects::at(d)]) < ymin || std::min(y[effects::at(c)], y[effects::at(d)]) > ymax) continue;
-      if (segments_intersect(x[effects::at(a)], y[effects::at(a)], x[effects::at(b)], y[effects::at(b)], x[effects::at(c)],
-                             y[effects::at(c)], x[effects::at(d)], y[effects::at(d)]))
+      if (std::max(y[effects::at(c)], y[effects::at(d)]) < ymin ||
+          std::min(y[effects::at(c)], y[effects::at(d)]) > ymax)
+        continue;
+      if (segments_intersect(x[effects::at(a)], y[effects::at(a)], x[effects::at(b)],
+                             y[effects::at(b)], x[effects::at(c)], y[effects::at(c)],
+                             x[effects::at(d)], y[effects::at(d)]))
         ++count;
     }
   }
@@ -85,7 +94,8 @@ bool EmbeddingMonitor::observe(std::span<const double> x, std::span<const double
   const double* py = y.data();
   const int* nodes = region_nodes_.data();
   for (std::size_t r = 0; r < rest_twice_.size(); ++r) {
-    // Doubled signed area, as effects::twice_area computes it (the same operations, so the same bits).
+    // Doubled signed area, as effects::twice_area computes it (the same operations, so the same
+    // bits).
     const int* loop = nodes + region_start_[r];
     const auto k = static_cast<std::size_t>(region_start_[r + 1] - region_start_[r]);
     double twice = 0.0;
@@ -93,7 +103,8 @@ bool EmbeddingMonitor::observe(std::span<const double> x, std::span<const double
       const int a = loop[0], b = loop[1], c = loop[2];
       twice = (px[b] - px[a]) * (py[c] - py[a]) - (px[c] - px[a]) * (py[b] - py[a]);
     } else {
-      for (std::size_t q = 0; q < k; ++q) twice += px[loop[q]] * (py[loop[(q + 1) % k]] - py[loop[(q + k - 1) % k]]);
+      for (std::size_t q = 0; q < k; ++q)
+        twice += px[loop[q]] * (py[loop[(q + 1) % k]] - py[loop[(q + k - 1) % k]]);
     }
     const double ratio = twice / rest_twice_[r];
     min_ratio_ = std::min(min_ratio_, ratio);

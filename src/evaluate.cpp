@@ -7,9 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <vector>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "animat/body.hpp"
 #include "animat/development.hpp"
@@ -31,7 +31,8 @@ double seconds_since(Clock::time_point t0) {
 /// Half the median rest length: the floor of the stretch denominators.
 double stretch_floor(const Body& body) {
   if (body.spring_count() == 0) return 0.0;
-  std::vector<double> l(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
+  std::vector<double> l(body.rest_lengths.data(),
+                        body.rest_lengths.data() + body.rest_lengths.size());
   std::nth_element(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(l.size() / 2), l.end());
   return 0.5 * l[l.size() / 2];
 }
@@ -43,7 +44,8 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
   const SwimState& st = sim.state();
   for (int s = 0; s < body.spring_count(); ++s) {
     const double l0 = body.rest_lengths(s);
-    const auto i = static_cast<std::size_t>(body.springs(s, 0)), j = static_cast<std::size_t>(body.springs(s, 1));
+    const auto i = static_cast<std::size_t>(body.springs(s, 0)),
+               j = static_cast<std::size_t>(body.springs(s, 1));
     const double len = std::hypot(st.x[j] - st.x[i], st.y[j] - st.y[i]);
     r.max_stretch = std::max(r.max_stretch, len / std::max(l0, floor));
     if (l0 >= floor && l0 > 0.0) r.min_stretch = std::min(r.min_stretch, len / l0);
@@ -53,22 +55,27 @@ void sample(const Simulation& sim, const Body& body, double floor, SwimResult& r
 
 }  // namespace
 
-GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo, const Config& config) {
+GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo,
+                                  const Config& config) {
   GrnControlStart start;
   start.grn = Grn(genome, config.genome);
   start.grn_params = config.grn;
   start.amplitude_max = config.development.amplitude_max;
   const int n = embryo.cell_count();
   if (embryo.grn_levels.rows() == n && embryo.grn_levels.cols() == start.grn.node_count()) {
-    start.levels.assign(embryo.grn_levels.data(), embryo.grn_levels.data() + embryo.grn_levels.size());
+    start.levels.assign(embryo.grn_levels.data(),
+                        embryo.grn_levels.data() + embryo.grn_levels.size());
   } else {
-    start.levels.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(start.grn.node_count()), 0.0);
+    start.levels.assign(
+        static_cast<std::size_t>(n) * static_cast<std::size_t>(start.grn.node_count()), 0.0);
   }
   if (embryo.grn_maternal.rows() == n && embryo.grn_maternal.cols() == 3)
-    start.maternal.assign(embryo.grn_maternal.data(), embryo.grn_maternal.data() + embryo.grn_maternal.size());
+    start.maternal.assign(embryo.grn_maternal.data(),
+                          embryo.grn_maternal.data() + embryo.grn_maternal.size());
   const auto morph = static_cast<Eigen::Index>(start.grn.morphogen_units().size());
   if (morph > 0 && embryo.grn_sensed.rows() == n && embryo.grn_sensed.cols() == morph)
-    start.sensed.assign(embryo.grn_sensed.data(), embryo.grn_sensed.data() + embryo.grn_sensed.size());
+    start.sensed.assign(embryo.grn_sensed.data(),
+                        embryo.grn_sensed.data() + embryo.grn_sensed.size());
   return start;
 }
 
@@ -86,9 +93,11 @@ std::vector<double> source_direction(const Config& config, int trial) {
   return {c * x - s * y, s * x + c * y};
 }
 
-StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long settle_steps) {
+StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics,
+                       long settle_steps) {
   if (settle_steps < 0)
-    throw ConfigError(fmt::format("evaluation.settle_steps: {} is out of range (expected >= 0)", settle_steps));
+    throw ConfigError(
+        fmt::format("evaluation.settle_steps: {} is out of range (expected >= 0)", settle_steps));
   StartState out;
   out.body = body;
   if (has_effect(scene.effects, "ground") && body.node_count() > 0)
@@ -106,8 +115,8 @@ StartState start_state(const Body& body, const SceneParams& scene, const Physics
   return out;
 }
 
-SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsParams& physics, long steps,
-                const SwimOptions& options) {
+SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsParams& physics,
+                long steps, const SwimOptions& options) {
   constexpr long kSampleEvery = 16;
   SwimResult r;
   StartState begin;
@@ -128,8 +137,10 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   Simulation sim(body, swim_scene, physics);
   const GrnControl* controller = nullptr;
   if (options.control_start) {
-    if (!options.control) throw ConfigError("swim: SwimOptions::control_start needs SwimOptions::control");
-    auto effect = std::make_unique<GrnControl>(body, *options.control_start, *options.control, scene, physics);
+    if (!options.control)
+      throw ConfigError("swim: SwimOptions::control_start needs SwimOptions::control");
+    auto effect = std::make_unique<GrnControl>(body, *options.control_start, *options.control,
+                                               scene, physics);
     controller = effect.get();
     sim.add_effect(std::move(effect));
   }
@@ -156,14 +167,17 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
       // one step at a time so that it stops at the first broken invariant.
       long next = std::min(steps, (done / kSampleEvery + 1) * kSampleEvery);
       if (every > 0) next = std::min(next, (done / every + 1) * every);
-      if (options.push_step >= 0 && done < options.push_step) next = std::min(next, options.push_step);
-      if (options.push_step >= 0 && done == options.push_step && sim.steps_done() == options.push_step) {
+      if (options.push_step >= 0 && done < options.push_step)
+        next = std::min(next, options.push_step);
+      if (options.push_step >= 0 && done == options.push_step &&
+          sim.steps_done() == options.push_step) {
         const SwimState& st = sim.state();
         const Eigen::Vector2d com = sim.center_of_mass();
         r.displacement_at_push = com - start;
         pushed.clear();
         for (int i = 0; i < st.n; ++i)
-          if (!options.push_front_only || st.x[static_cast<std::size_t>(i)] >= com.x()) pushed.push_back(i);
+          if (!options.push_front_only || st.x[static_cast<std::size_t>(i)] >= com.x())
+            pushed.push_back(i);
         sim.push(pushed, options.push_impulse);
       }
       if (stop_early) {
@@ -194,7 +208,8 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
     r.stable = false;
     r.failure = "unstable swim: non-finite centre of mass";
   }
-  r.max_kinetic_energy_per_cell = body.node_count() > 0 ? r.max_kinetic_energy / body.node_count() : 0.0;
+  r.max_kinetic_energy_per_cell =
+      body.node_count() > 0 ? r.max_kinetic_energy / body.node_count() : 0.0;
   const SwimCounters& c = sim.counters();
   r.collisions = c.collisions;
   r.collisions_inelastic = c.collisions_inelastic;
@@ -209,8 +224,10 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   if (const Effect* springs = sim.effect("springs")) {
     std::vector<double> pos, abs;
     if (actuation_work_per_cell(*springs, pos, abs)) {
-      r.cell_work_positive = Eigen::Map<const Eigen::VectorXd>(pos.data(), static_cast<Eigen::Index>(pos.size()));
-      r.cell_work_absolute = Eigen::Map<const Eigen::VectorXd>(abs.data(), static_cast<Eigen::Index>(abs.size()));
+      r.cell_work_positive =
+          Eigen::Map<const Eigen::VectorXd>(pos.data(), static_cast<Eigen::Index>(pos.size()));
+      r.cell_work_absolute =
+          Eigen::Map<const Eigen::VectorXd>(abs.data(), static_cast<Eigen::Index>(abs.size()));
     }
   }
   if (r.cell_work_positive.size() == 0) {
@@ -224,14 +241,17 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
     r.skin_crossing_steps = m->skin_crossing_frames();
     r.first_invalid_step = sim.first_broken_step();
   }
-  r.valid = r.stable && r.inverted_region_steps == 0 && r.skin_crossing_steps == 0 && r.collisions_unresolved == 0;
+  r.valid = r.stable && r.inverted_region_steps == 0 && r.skin_crossing_steps == 0 &&
+            r.collisions_unresolved == 0;
   if (r.stable && !r.valid) {
     std::vector<std::string> what;
     if (r.inverted_region_steps > 0)
-      what.push_back(fmt::format("a region turned inside out (smallest S/S0 {:.3g})", r.min_area_ratio));
+      what.push_back(
+          fmt::format("a region turned inside out (smallest S/S0 {:.3g})", r.min_area_ratio));
     if (r.skin_crossing_steps > 0) what.push_back("the skin crossed itself");
     if (r.collisions_unresolved > 0)
-      what.push_back(fmt::format("{} steps with an unresolved cell-edge collision", r.collisions_unresolved));
+      what.push_back(
+          fmt::format("{} steps with an unresolved cell-edge collision", r.collisions_unresolved));
     r.failure = fmt::format("invalid swim: {} (first at step {})", fmt::join(what, "; "),
                             r.first_invalid_step >= 0 ? r.first_invalid_step : r.steps);
   }
@@ -240,9 +260,11 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   return r;
 }
 
-EvaluationResult evaluate(const Genome& genome, const Config& config, EvaluationObserver* observer) {
+EvaluationResult evaluate(const Genome& genome, const Config& config,
+                          EvaluationObserver* observer) {
   EvaluationResult out;
-  validate(genome, config.genome, "evaluate");  // a genome no loader would accept is an error, not UB
+  // a genome no loader would accept is an error, not UB
+  validate(genome, config.genome, "evaluate");
   validate(config.scene);
   validate(config.physics);
   auto t0 = Clock::now();
@@ -291,7 +313,8 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
   if (config.evaluation.push_impulse.size() != 2)
     throw ConfigError(fmt::format("evaluation.push_impulse: expected 2 numbers [Jx, Jy], got {}",
                                   config.evaluation.push_impulse.size()));
-  options.push_impulse = Eigen::Vector2d(config.evaluation.push_impulse[0], config.evaluation.push_impulse[1]);
+  options.push_impulse =
+      Eigen::Vector2d(config.evaluation.push_impulse[0], config.evaluation.push_impulse[1]);
   options.push_front_only = config.evaluation.push_cells == "front";
   GrnControlStart control_start;
   if (config.control.mode == "grn") {
@@ -300,8 +323,9 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, Evaluation
     options.control = &config.control;
   }
   if (observer) observer->on_body(body);
-  // An objective that one swim does not decide (chemotaxis): one swim per source direction (the first
-  // is observed and gives the diagnostics), the fitness their mean progress toward the source.
+  // An objective that one swim does not decide (chemotaxis): one swim per source direction (the
+  // first is observed and gives the diagnostics), the fitness their mean progress toward the
+  // source.
   const ObjectiveSpec* spec = find_objective(config.evaluation.objective);
   const bool chemotaxis = spec != nullptr && !spec->one_swim;
   const int trials = chemotaxis ? config.evaluation.source_directions : 1;

@@ -20,7 +20,8 @@ double now_seconds() {
 }
 
 // Watches a StopRequest during one parallel piece of work. Any thread may ask stopped(); only the
-// thread that created it (OpenMP's thread 0 of the regions it runs) calls the poll, at most every 20 ms.
+// thread that created it (OpenMP's thread 0 of the regions it runs) calls the poll, at most every
+// 20 ms.
 class StopWatch {
  public:
   explicit StopWatch(const StopRequest& request) : request_(request) {}
@@ -39,7 +40,8 @@ class StopWatch {
   }
   /// Whether a stop was seen (no new poll).
   [[nodiscard]] bool fired() const { return stopped_.load(); }
-  /// Stops the work from within (an evaluation that was itself interrupted): stopped() is true from now on.
+  /// Stops the work from within (an evaluation that was itself interrupted): stopped() is true from
+  /// now on.
   void request_stop() { stop(); }
 
  private:
@@ -54,12 +56,14 @@ class StopWatch {
 
 class LocalEvaluator final : public Evaluator {
  public:
-  LocalEvaluator(FitnessFunction fitness, int threads) : fitness_(std::move(fitness)), threads_(resolve_threads(threads)) {
+  LocalEvaluator(FitnessFunction fitness, int threads)
+      : fitness_(std::move(fitness)), threads_(resolve_threads(threads)) {
     if (!fitness_) throw Error("LocalEvaluator: no fitness function");
   }
 
   // One genome per chunk: an evaluation takes 0.1 to 30 ms, and chunks of one keep the tail short.
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest& stop) override {
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes,
+                                const StopRequest& stop) override {
     prepare_parallel_evaluation();
     std::vector<Fitness> out(genomes.size());
     StopWatch watch(stop);
@@ -67,7 +71,8 @@ class LocalEvaluator final : public Evaluator {
       if (watch.stopped()) return;
       try {
         out[i] = fitness_(*genomes[i]);
-      } catch (const Interrupted&) {  // the fitness function itself was interrupted (Ctrl-C in a Python objective)
+      } catch (const Interrupted&) {
+        // the fitness function itself was interrupted (Ctrl-C in a Python objective)
         watch.request_stop();
       }
     });
@@ -75,7 +80,9 @@ class LocalEvaluator final : public Evaluator {
     return out;
   }
 
-  std::string describe() const override { return fmt::format("OpenMP, {} thread{}", threads_, threads_ == 1 ? "" : "s"); }
+  std::string describe() const override {
+    return fmt::format("OpenMP, {} thread{}", threads_, threads_ == 1 ? "" : "s");
+  }
 
  private:
   FitnessFunction fitness_;
@@ -84,7 +91,8 @@ class LocalEvaluator final : public Evaluator {
 
 }  // namespace
 
-std::vector<Fitness> Evaluator::evaluate(const std::vector<Genome>& genomes, const StopRequest& stop) {
+std::vector<Fitness> Evaluator::evaluate(const std::vector<Genome>& genomes,
+                                         const StopRequest& stop) {
   std::vector<const Genome*> ptrs;
   ptrs.reserve(genomes.size());
   for (const auto& g : genomes) ptrs.push_back(&g);
@@ -101,7 +109,8 @@ std::shared_ptr<Evaluator> make_local_evaluator(const Config& config, FitnessFun
   return make_local_evaluator(std::move(fitness), config.evolution.threads);
 }
 
-std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes, const FitnessFunction& fitness, int threads) {
+std::vector<Fitness> evaluate_all(const std::vector<Genome>& genomes,
+                                  const FitnessFunction& fitness, int threads) {
   return make_local_evaluator(fitness, threads)->evaluate(genomes);
 }
 

@@ -38,7 +38,8 @@ double now_seconds() {
 
 std::string hex(std::uint64_t x) { return fmt::format("{:016x}", x); }
 
-// The built-in objectives that are never negative, for messages: "distance, distance_per_size, ...".
+// The built-in objectives that are never negative, for messages: "distance, distance_per_size,
+// ...".
 std::string nonnegative_names() {
   std::string out;
   for (const auto& spec : kObjectives)
@@ -53,14 +54,17 @@ bool nonnegative_objective(const Config& c) {
   return spec != nullptr && spec->nonnegative;
 }
 
-// A fitness the GA can rank and a checkpoint can hold (restore() refuses anything else): finite, and
-// >= 0 under an objective that is never negative; cell_count and drag_limited >= 0. "" = acceptable, else what is wrong.
-// The one rule for every way a fitness reaches the engine: its own evaluations, tell() (animat.GA) and
-// the exploit guard's reference evaluations.
+// A fitness the GA can rank and a checkpoint can hold (restore() refuses anything else): finite,
+// and
+// >= 0 under an objective that is never negative; cell_count and drag_limited >= 0. "" =
+// acceptable, else what is wrong. The one rule for every way a fitness reaches the engine: its own
+// evaluations, tell() (animat.GA) and the exploit guard's reference evaluations.
 std::string fitness_problem(const Fitness& f, bool nonnegative) {
   if (!std::isfinite(f.fitness) || (nonnegative && f.fitness < 0.0))
-    return fmt::format("fitness {} (a fitness must be finite{})", f.fitness,
-                       nonnegative ? " and >= 0 under an objective that is never negative: " + nonnegative_names() : "");
+    return fmt::format(
+        "fitness {} (a fitness must be finite{})", f.fitness,
+        nonnegative ? " and >= 0 under an objective that is never negative: " + nonnegative_names()
+                    : "");
   if (f.cell_count < 0) return fmt::format("cell_count {} (must be >= 0)", f.cell_count);
   if (f.drag_limited < 0) return fmt::format("drag_limited {} (must be >= 0)", f.drag_limited);
   return {};
@@ -71,10 +75,11 @@ void check_fitness(const Fitness& f, std::string_view where, bool nonnegative) {
     throw Error(fmt::format("{}: the fitness function returned {}", where, problem));
 }
 
-// The mean of finite values, never overflowing: their plain sum / n (bit for bit the value every run
-// so far recorded) when that sum is finite; otherwise the sum of the values scaled by 2^-(k+1), with
-// 2^k > n, which cannot overflow (|sum| <= n max|x| 2^-(k+1) < max|x| / 2), clamped to [min, max],
-// where the true mean lies. So a generation of finite fitnesses has a finite mean (docs/reliability.md).
+// The mean of finite values, never overflowing: their plain sum / n (bit for bit the value every
+// run so far recorded) when that sum is finite; otherwise the sum of the values scaled by 2^-(k+1),
+// with 2^k > n, which cannot overflow (|sum| <= n max|x| 2^-(k+1) < max|x| / 2), clamped to [min,
+// max], where the true mean lies. So a generation of finite fitnesses has a finite mean
+// (docs/reliability.md).
 double finite_mean(const std::vector<double>& v) {
   const double n = static_cast<double>(v.size());
   const double sum = std::accumulate(v.begin(), v.end(), 0.0);
@@ -87,8 +92,8 @@ double finite_mean(const std::vector<double>& v) {
   return std::clamp(std::ldexp(scaled / n, k + 1), *lo, *hi);
 }
 
-// The midpoint of two finite values, never overflowing: 0.5 (a + b) (bit for bit today's) when a + b
-// is finite, else 0.5 a + 0.5 b.
+// The midpoint of two finite values, never overflowing: 0.5 (a + b) (bit for bit today's) when a +
+// b is finite, else 0.5 a + 0.5 b.
 double finite_midpoint(double a, double b) {
   const double sum = a + b;
   return std::isfinite(sum) ? 0.5 * sum : 0.5 * a + 0.5 * b;
@@ -103,12 +108,13 @@ bool fitter(const Individual& a, const Individual& b) {
 
 double tournament_probability(const EvolutionParams& p, int generation) {
   if (p.tournament_ramp_generations <= 0) return p.tournament_p_end;
-  const double t = std::clamp(static_cast<double>(generation) / p.tournament_ramp_generations, 0.0, 1.0);
+  const double t =
+      std::clamp(static_cast<double>(generation) / p.tournament_ramp_generations, 0.0, 1.0);
   return p.tournament_p_start + (p.tournament_p_end - p.tournament_p_start) * t;
 }
 
-std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std::size_t>& eligible, double p_fitter,
-                       Rng& rng) {
+std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std::size_t>& eligible,
+                       double p_fitter, Rng& rng) {
   if (eligible.empty()) throw Error("tournament: no eligible individual");
   if (eligible.size() == 1) return eligible[0];
   const std::size_t a = eligible[rng.below(eligible.size())];
@@ -123,7 +129,8 @@ void prepare_parallel_evaluation() { warm_up_box2d(); }
 
 bool reference_disagrees(double fitness, double reference, const EvaluationParams& params) {
   const double diff = std::abs(fitness - reference);
-  return diff > params.reference_abs_tolerance && diff > params.reference_tolerance * std::abs(reference);
+  return diff > params.reference_abs_tolerance &&
+         diff > params.reference_tolerance * std::abs(reference);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -148,14 +155,17 @@ void Evolution::check_reference() {
   Individual& mutable_best = population_[static_cast<std::size_t>(&b - population_.data())];
   if (std::isnan(mutable_best.reference)) {
     const Fitness r = reference_(mutable_best.genome);
-    check_fitness(r, fmt::format("exploit guard, generation {}: the reference evaluation of the best", generation_),
+    check_fitness(r,
+                  fmt::format("exploit guard, generation {}: the reference evaluation of the best",
+                              generation_),
                   nonnegative_objective(*config_));
     mutable_best.reference = r.fitness;
   }
   history_.back().best_reference = mutable_best.reference;
 }
 
-std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size_t>& order, std::size_t elites) {
+std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size_t>& order,
+                                                     std::size_t elites) {
   // Candidates: the 2·elites fittest viable individuals by their nominal fitness.
   std::vector<std::size_t> cand;
   for (std::size_t k = 0; k < order.size() && cand.size() < 2 * elites; ++k)
@@ -165,21 +175,27 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
     if (std::isnan(population_[c].reference)) todo.push_back(c);
   std::vector<const Genome*> genomes;
   for (std::size_t c : todo) genomes.push_back(&population_[c].genome);
-  const std::vector<Fitness> refs = reference_evaluator_->evaluate(genomes, StopRequest{});  // inside tell(): not stoppable
+  // inside tell(): not stoppable
+  const std::vector<Fitness> refs = reference_evaluator_->evaluate(genomes, StopRequest{});
   for (std::size_t k = 0; k < todo.size(); ++k)
-    check_fitness(refs[k], fmt::format("exploit guard (select): the reference evaluation of individual {}", todo[k]),
-                  nonnegative_objective(*config_));
-  // Stored only once every one is known and acceptable: an exception leaves the population as it was.
+    check_fitness(
+        refs[k],
+        fmt::format("exploit guard (select): the reference evaluation of individual {}", todo[k]),
+        nonnegative_objective(*config_));
+  // Stored only once every one is known and acceptable: an exception leaves the population as it
+  // was.
   for (std::size_t k = 0; k < todo.size(); ++k) population_[todo[k]].reference = refs[k].fitness;
-  std::stable_sort(cand.begin(), cand.end(),
-                   [&](std::size_t a, std::size_t b) { return population_[a].reference > population_[b].reference; });
+  std::stable_sort(cand.begin(), cand.end(), [&](std::size_t a, std::size_t b) {
+    return population_[a].reference > population_[b].reference;
+  });
   if (cand.size() > elites) cand.resize(elites);
   return cand;
 }
 
 void Evolution::initialize() {
   if (!evaluator_)
-    throw Error("Evolution::initialize: no fitness function (drive this engine with ask() and tell())");
+    throw Error(
+        "Evolution::initialize: no fitness function (drive this engine with ask() and tell())");
   if (generation_ >= 0) throw Error("Evolution::initialize: the initial population exists already");
   const EvolutionParams& ep = config_->evolution;
   while (generation_ < 0) {
@@ -189,7 +205,8 @@ void Evolution::initialize() {
     for (const auto& slot : slots_) open += slot.filled ? 0 : 1;
     if (slots_.empty()) open = static_cast<std::size_t>(ep.population);
     const auto width = 4 * static_cast<std::size_t>(ep.population);
-    const int lookahead = static_cast<int>(std::max<std::size_t>(1, (width + open - 1) / std::max<std::size_t>(open, 1)));
+    const int lookahead = static_cast<int>(
+        std::max<std::size_t>(1, (width + open - 1) / std::max<std::size_t>(open, 1)));
     const std::vector<Genome> genomes = ask(lookahead);
     tell(evaluate_genomes(genomes, "initial population"));
   }
@@ -210,20 +227,23 @@ std::vector<int> Evolution::initial_tries() const {
 }
 
 GenerationStats Evolution::step() {
-  if (!evaluator_) throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
+  if (!evaluator_)
+    throw Error("Evolution::step: no fitness function (drive this engine with ask() and tell())");
   if (generation_ < 0) throw Error("Evolution::step: call initialize() first");
   const std::vector<Genome> genomes = ask();
   tell(evaluate_genomes(genomes, fmt::format("generation {}", generation_ + 1)));
   return history_.back();
 }
 
-std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what) {
+std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& genomes,
+                                                 const std::string& what) {
   std::vector<Fitness> out;
   try {
     out = evaluator_->evaluate(genomes, stop_);
   } catch (const Interrupted&) {
-    throw Interrupted(generation_ < 0 ? std::string("interrupted while drawing the initial population")
-                                      : fmt::format("interrupted during {}", what));
+    throw Interrupted(generation_ < 0
+                          ? std::string("interrupted while drawing the initial population")
+                          : fmt::format("interrupted during {}", what));
   }
   for (std::size_t k = 0; k < out.size(); ++k)
     check_fitness(out[k], fmt::format("{}, genome {}", what, k), nonnegative_objective(*config_));
@@ -231,7 +251,8 @@ std::vector<Fitness> Evolution::evaluate_genomes(const std::vector<Genome>& geno
 }
 
 std::vector<Genome> Evolution::ask(int lookahead) {
-  if (lookahead < 1) throw Error(fmt::format("Evolution::ask: lookahead must be >= 1, got {}", lookahead));
+  if (lookahead < 1)
+    throw Error(fmt::format("Evolution::ask: lookahead must be >= 1, got {}", lookahead));
   if (pending_) return asked_;
   asked_ = generation_ < 0 ? ask_initial(lookahead) : ask_generation();
   pending_ = true;
@@ -241,20 +262,23 @@ std::vector<Genome> Evolution::ask(int lookahead) {
 bool Evolution::tell(const std::vector<Fitness>& fitness) {
   if (!pending_) throw Error("Evolution::tell: nothing was asked (call ask() first)");
   if (fitness.size() != asked_.size())
-    throw Error(fmt::format("Evolution::tell: {} fitness values for the {} genomes of the last ask()", fitness.size(),
-                            asked_.size()));
-  // The engine's own rule for its evaluations (check_fitness): what tell() accepts, a checkpoint holds
-  // and restore() reads back.
+    throw Error(
+        fmt::format("Evolution::tell: {} fitness values for the {} genomes of the last ask()",
+                    fitness.size(), asked_.size()));
+  // The engine's own rule for its evaluations (check_fitness): what tell() accepts, a checkpoint
+  // holds and restore() reads back.
   for (std::size_t k = 0; k < fitness.size(); ++k)
-    if (const std::string problem = fitness_problem(fitness[k], nonnegative_objective(*config_)); !problem.empty())
-      throw Error(fmt::format("Evolution::tell: value {} (genome {} of the last ask()) is refused: {}", k, k, problem));
+    if (const std::string problem = fitness_problem(fitness[k], nonnegative_objective(*config_));
+        !problem.empty())
+      throw Error(fmt::format(
+          "Evolution::tell: value {} (genome {} of the last ask()) is refused: {}", k, k, problem));
   bool done = false;
   if (!reference_) {
     done = generation_ < 0 ? tell_initial(fitness) : tell_generation(fitness);
   } else {
-    // The exploit guard evaluates the new best at the end of the tell; if that throws (an interrupted
-    // Python objective, a refused reference fitness), the engine is put back as it was before this
-    // tell, the ask still pending: the same tell can be repeated.
+    // The exploit guard evaluates the new best at the end of the tell; if that throws (an
+    // interrupted Python objective, a refused reference fitness), the engine is put back as it was
+    // before this tell, the ask still pending: the same tell can be repeated.
     auto saved_population = population_;
     auto saved_slots = slots_;
     auto saved_next = next_;
@@ -287,7 +311,9 @@ std::vector<Genome> Evolution::ask_initial(int lookahead) {
     const auto n = static_cast<std::size_t>(ep.population);
     slots_.clear();
     for (std::size_t i = 0; i < n; ++i)
-      slots_.push_back(InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialStreamKey, i), 0, false, Individual{}});
+      slots_.push_back(
+          InitialSlot{Rng::derive(static_cast<std::uint64_t>(ep.seed), kInitialStreamKey, i), 0,
+                      false, Individual{}});
   }
   std::vector<Genome> out;
   asked_index_.clear();
@@ -319,9 +345,10 @@ bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
   }
   for (std::size_t i = 0; i < slots_.size(); ++i)
     if (!slots_[i].filled && slots_[i].tries >= ep.max_init_tries)
-      throw Error(fmt::format("initial population: no viable random genome in evolution.max_init_tries = {} tries "
-                              "(individual {}); the development or genome settings make viability too rare",
-                              ep.max_init_tries, i));
+      throw Error(fmt::format(
+          "initial population: no viable random genome in evolution.max_init_tries = {} tries "
+          "(individual {}); the development or genome settings make viability too rare",
+          ep.max_init_tries, i));
   for (const auto& slot : slots_)
     if (!slot.filled) return false;
   population_.clear();
@@ -352,12 +379,15 @@ std::vector<Genome> Evolution::ask_generation() {
     const std::vector<std::size_t> order = island_ranking(population_, layout, isl);
     for (std::size_t i = layout.begin(isl); i < layout.end(isl); ++i)
       if (population_[i].result.viable) eligible[isl].push_back(i);
-    if (eligible[isl].empty()) {  // nobody viable (possible only without elites): fall back to everyone
+    if (eligible[isl].empty()) {
+      // nobody viable (possible only without elites): fall back to everyone
       eligible[isl].resize(layout.size(isl));
       std::iota(eligible[isl].begin(), eligible[isl].end(), layout.begin(isl));
     }
-    const std::size_t elites = std::min<std::size_t>(static_cast<std::size_t>(ep.elites), order.size());
-    if (select_by_reference) {  // exploit guard "select": the elites are the best at the reference step
+    const std::size_t elites =
+        std::min<std::size_t>(static_cast<std::size_t>(ep.elites), order.size());
+    if (select_by_reference) {
+      // exploit guard "select": the elites are the best at the reference step
       for (std::size_t i : reference_ranked(order, elites)) {
         Individual& elite = next[layout.begin(isl) + copied[isl]++];
         elite = population_[i];
@@ -374,7 +404,8 @@ std::vector<Genome> Evolution::ask_generation() {
   }
   const double p = tournament_probability(ep, g);
   int crossovers = 0;
-  // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated twice).
+  // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated
+  // twice).
   std::unordered_multimap<std::uint64_t, std::size_t> known;
   for (std::size_t i = 0; i < n; ++i) known.emplace(genome_hash(population_[i].genome), i);
   for (std::size_t i = 0; i < n; ++i) {
@@ -386,7 +417,8 @@ std::vector<Genome> Evolution::ask_generation() {
       const std::size_t a = tournament(population_, eligible[isl], p, rng);
       const std::size_t b = tournament(population_, eligible[isl], p, rng);
       ++crossovers;
-      child.genome = crossover(population_[a].genome, population_[b].genome, config_->mutation.crossover_points, rng);
+      child.genome = crossover(population_[a].genome, population_[b].genome,
+                               config_->mutation.crossover_points, rng);
     } else {
       child.genome = population_[tournament(population_, eligible[isl], p, rng)].genome;
     }
@@ -422,7 +454,8 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
   const EvolutionParams& ep = config_->evolution;
   migrations_.clear();  // [islands] copies of evaluated individuals: nothing to evaluate
   if (is_migration_generation(ep, generation_))
-    migrations_ = migrate(population_, island_layout(population_.size(), ep.islands), ep.migrants, generation_);
+    migrations_ = migrate(population_, island_layout(population_.size(), ep.islands), ep.migrants,
+                          generation_);
   const Individual& b = best();
   if (b.result.fitness > best_ever_) {
     best_ever_ = b.result.fitness;
@@ -430,7 +463,8 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
   } else {
     ++stall_;
   }
-  history_.push_back(statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_));
+  history_.push_back(
+      statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_));
   history_.back().crossovers = next_crossovers_;
   check_reference();
   return true;
@@ -447,8 +481,9 @@ GenerationStats population_statistics(const std::vector<Individual>& population)
     if (ind.result.drag_limited > 0) ++s.drag_limited;
   }
   // The first of the fittest, by index (as Evolution::best()).
-  const Individual& b = *std::min_element(population.begin(), population.end(),
-                                          [](const Individual& x, const Individual& y) { return fitter(x, y); });
+  const Individual& b =
+      *std::min_element(population.begin(), population.end(),
+                        [](const Individual& x, const Individual& y) { return fitter(x, y); });
   s.best = b.result.fitness;
   s.best_cells = b.result.cell_count;
   s.viable_fraction = static_cast<double>(viable.size()) / static_cast<double>(population.size());
@@ -482,7 +517,8 @@ std::string Evolution::stop_reason() const {
   if (ep.generations > 0 && generation_ >= ep.generations)
     return fmt::format("generation cap evolution.generations = {} reached", ep.generations);
   if (ep.stall_generations > 0 && stall_ >= ep.stall_generations)
-    return fmt::format("no improvement for evolution.stall_generations = {} generations", ep.stall_generations);
+    return fmt::format("no improvement for evolution.stall_generations = {} generations",
+                       ep.stall_generations);
   if (ep.wall_seconds > 0 && wall_offset_ + now_seconds() - started_ >= ep.wall_seconds)
     return fmt::format("wall-clock budget evolution.wall_seconds = {} s used", ep.wall_seconds);
   return {};
@@ -512,18 +548,24 @@ json stats_to_json(const GenerationStats& s) {
 // Integer and number fields of a checkpoint: type- and range-checked, never converted out of range.
 long long int_field(const json& j, const char* key, long long lo, long long hi) {
   const auto v = detail::int_in(j.at(key), lo, hi);
-  if (!v) throw CheckpointError(fmt::format("field \"{}\" is {}, expected an integer in [{}, {}]", key, detail::describe(j.at(key)), lo, hi));
+  if (!v)
+    throw CheckpointError(fmt::format("field \"{}\" is {}, expected an integer in [{}, {}]", key,
+                                      detail::describe(j.at(key)), lo, hi));
   return *v;
 }
 
 double number_field(const json& j, const char* key) {
   const auto v = detail::finite_number(j.at(key));
-  if (!v) throw CheckpointError(fmt::format("field \"{}\" is {}, expected a finite number", key, detail::describe(j.at(key))));
+  if (!v)
+    throw CheckpointError(fmt::format("field \"{}\" is {}, expected a finite number", key,
+                                      detail::describe(j.at(key))));
   return *v;
 }
 
 bool bool_field(const json& j, const char* key) {
-  if (!j.at(key).is_boolean()) throw CheckpointError(fmt::format("field \"{}\" is {}, expected true or false", key, detail::describe(j.at(key))));
+  if (!j.at(key).is_boolean())
+    throw CheckpointError(fmt::format("field \"{}\" is {}, expected true or false", key,
+                                      detail::describe(j.at(key))));
   return j.at(key).get<bool>();
 }
 
@@ -535,40 +577,57 @@ GenerationStats stats_from_json(const json& j) {
   visit_fields(s, [&](const StatsField& f, auto& value) {
     using T = std::decay_t<decltype(value)>;
     if (f.checkpoint == StatsField::Checkpoint::none) return;
-    if (f.checkpoint != StatsField::Checkpoint::required && !j.contains(f.name)) return;  // its default
-    if constexpr (std::is_same_v<T, bool>) value = bool_field(j, f.name);
-    else if constexpr (std::is_same_v<T, int>) value = static_cast<int>(int_field(j, f.name, 0, kIntMax));
-    else if constexpr (std::is_same_v<T, std::int64_t>) value = int_field(j, f.name, 0, kInt64Max);
-    else value = number_field(j, f.name);
+    // its default
+    if (f.checkpoint != StatsField::Checkpoint::required && !j.contains(f.name)) return;
+    if constexpr (std::is_same_v<T, bool>)
+      value = bool_field(j, f.name);
+    else if constexpr (std::is_same_v<T, int>)
+      value = static_cast<int>(int_field(j, f.name, 0, kIntMax));
+    else if constexpr (std::is_same_v<T, std::int64_t>)
+      value = int_field(j, f.name, 0, kInt64Max);
+    else
+      value = number_field(j, f.name);
   });
   return s;
 }
 
 // What a checksum cannot catch: a hand-edited checkpoint whose content the engine could never have
-// written. Everything is compared with what the engine computes from the same population and history.
-void check_semantics(const std::vector<Individual>& pop, const std::vector<GenerationStats>& hist, int stall,
-                     double best_ever, std::int64_t evaluations, double wall, bool nonnegative, std::string_view source) {
-  auto fail = [&](const std::string& what) { throw CheckpointError(fmt::format("{}: inconsistent checkpoint: {}", source, what)); };
+// written. Everything is compared with what the engine computes from the same population and
+// history.
+void check_semantics(const std::vector<Individual>& pop, const std::vector<GenerationStats>& hist,
+                     int stall, double best_ever, std::int64_t evaluations, double wall,
+                     bool nonnegative, std::string_view source) {
+  auto fail = [&](const std::string& what) {
+    throw CheckpointError(fmt::format("{}: inconsistent checkpoint: {}", source, what));
+  };
   for (std::size_t i = 0; i < pop.size(); ++i) {
     const Fitness& f = pop[i].result;
-    if (nonnegative && f.fitness < 0.0) fail(fmt::format("individual {} has fitness {} (a fitness is >= 0)", i, f.fitness));
-    if (f.viable && pop[i].genome.elements.empty()) fail(fmt::format("individual {} is viable with an empty genome", i));
+    if (nonnegative && f.fitness < 0.0)
+      fail(fmt::format("individual {} has fitness {} (a fitness is >= 0)", i, f.fitness));
+    if (f.viable && pop[i].genome.elements.empty())
+      fail(fmt::format("individual {} is viable with an empty genome", i));
   }
   double best_so_far = -std::numeric_limits<double>::infinity();
   int expected_stall = 0;
   for (std::size_t k = 0; k < hist.size(); ++k) {
     const GenerationStats& s = hist[k];
     if (s.generation != static_cast<int>(k))
-      fail(fmt::format("history row {} is generation {}; the history must count 0, 1, 2, ... without gaps", k, s.generation));
+      fail(fmt::format(
+          "history row {} is generation {}; the history must count 0, 1, 2, ... without gaps", k,
+          s.generation));
     if (nonnegative && (s.best < 0.0 || s.mean < 0.0 || s.median < 0.0))
       fail(fmt::format("history row {} has a negative fitness statistic", k));
     if (!(s.viable_fraction >= 0.0 && s.viable_fraction <= 1.0))
-      fail(fmt::format("history row {} has viable_fraction {} (expected in [0, 1])", k, s.viable_fraction));
-    if (s.wall_seconds < 0.0) fail(fmt::format("history row {} has wall_seconds {} (expected >= 0)", k, s.wall_seconds));
+      fail(fmt::format("history row {} has viable_fraction {} (expected in [0, 1])", k,
+                       s.viable_fraction));
+    if (s.wall_seconds < 0.0)
+      fail(fmt::format("history row {} has wall_seconds {} (expected >= 0)", k, s.wall_seconds));
     if (k > 0 && s.evaluations < hist[k - 1].evaluations)
-      fail(fmt::format("history row {}: evaluations decrease ({} after {})", k, s.evaluations, hist[k - 1].evaluations));
+      fail(fmt::format("history row {}: evaluations decrease ({} after {})", k, s.evaluations,
+                       hist[k - 1].evaluations));
     if (k > 0 && s.wall_seconds < hist[k - 1].wall_seconds)
-      fail(fmt::format("history row {}: wall_seconds decrease ({} after {})", k, s.wall_seconds, hist[k - 1].wall_seconds));
+      fail(fmt::format("history row {}: wall_seconds decrease ({} after {})", k, s.wall_seconds,
+                       hist[k - 1].wall_seconds));
     if (k == 0 || s.best > best_so_far) {
       best_so_far = s.best;
       expected_stall = 0;
@@ -579,25 +638,34 @@ void check_semantics(const std::vector<Individual>& pop, const std::vector<Gener
   if (best_ever != best_so_far)
     fail(fmt::format("best_ever is {}, but the best of the history is {}", best_ever, best_so_far));
   if (stall != expected_stall)
-    fail(fmt::format("stall is {}, but the history has {} generations without improvement", stall, expected_stall));
+    fail(fmt::format("stall is {}, but the history has {} generations without improvement", stall,
+                     expected_stall));
   const GenerationStats& last = hist.back();
   if (evaluations != last.evaluations)
-    fail(fmt::format("evaluations is {}, but the last history row counts {}", evaluations, last.evaluations));
+    fail(fmt::format("evaluations is {}, but the last history row counts {}", evaluations,
+                     last.evaluations));
   if (wall != last.wall_seconds)
-    fail(fmt::format("wall_seconds is {}, but the last history row has {}", wall, last.wall_seconds));
+    fail(fmt::format("wall_seconds is {}, but the last history row has {}", wall,
+                     last.wall_seconds));
   const GenerationStats now = population_statistics(pop);
-  if (now.best != last.best || now.best_cells != last.best_cells || now.viable_fraction != last.viable_fraction ||
-      now.mean != last.mean || now.median != last.median)
-    fail(fmt::format("the last history row (generation {}: best {}, mean {}, median {}, viable {}, {} cells) does not "
-                     "describe the population (best {}, mean {}, median {}, viable {}, {} cells)",
-                     last.generation, last.best, last.mean, last.median, last.viable_fraction, last.best_cells, now.best,
-                     now.mean, now.median, now.viable_fraction, now.best_cells));
+  if (now.best != last.best || now.best_cells != last.best_cells ||
+      now.viable_fraction != last.viable_fraction || now.mean != last.mean ||
+      now.median != last.median)
+    fail(fmt::format(
+        "the last history row (generation {}: best {}, mean {}, median {}, viable {}, {} cells) "
+        "does not "
+        "describe the population (best {}, mean {}, median {}, viable {}, {} cells)",
+        last.generation, last.best, last.mean, last.median, last.viable_fraction, last.best_cells,
+        now.best, now.mean, now.median, now.viable_fraction, now.best_cells));
 }
 
 }  // namespace
 
 std::string Evolution::checkpoint() const {
-  if (generation_ < 0) throw Error("Evolution::checkpoint: no generation completed yet (the initial population is being drawn)");
+  if (generation_ < 0)
+    throw Error(
+        "Evolution::checkpoint: no generation completed yet (the initial population is being "
+        "drawn)");
   json payload;
   payload["format"] = "animat.checkpoint";
   payload["version"] = kCheckpointVersion;
@@ -608,8 +676,9 @@ std::string Evolution::checkpoint() const {
   payload["best_ever"] = best_ever_;
   payload["evaluations"] = evaluations_;
   payload["wall_seconds"] = history_.empty() ? 0.0 : history_.back().wall_seconds;
-  // The individuals are serialised on the evaluation threads: on many cores the checkpoint is most of
-  // the serial part of a generation, and two thirds of it is this loop (docs/performance.md, issue 20).
+  // The individuals are serialised on the evaluation threads: on many cores the checkpoint is most
+  // of the serial part of a generation, and two thirds of it is this loop (docs/performance.md,
+  // issue 20).
   std::vector<json> individuals(population_.size());
 #pragma omp parallel for schedule(static) num_threads(resolve_threads(config_->evolution.threads))
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(population_.size()); ++i) {
@@ -642,35 +711,46 @@ void Evolution::restore(std::string_view text, std::string_view source) {
   } catch (const detail::JsonLimit& e) {
     throw CheckpointError(fmt::format("{}: not an animat checkpoint ({})", source, e.what()));
   } catch (const json::parse_error& e) {
-    throw CheckpointError(fmt::format("{}: corrupt checkpoint (not valid JSON at byte {}; truncated?)", source, e.byte));
+    throw CheckpointError(fmt::format(
+        "{}: corrupt checkpoint (not valid JSON at byte {}; truncated?)", source, e.byte));
   } catch (const json::exception& e) {
     throw CheckpointError(fmt::format("{}: corrupt checkpoint ({})", source, e.what()));
   }
   try {
-    if (!outer.is_object() || !outer.contains("checksum") || !outer.contains("payload") || !outer["payload"].is_string())
-      throw CheckpointError(fmt::format("{}: not an animat checkpoint (missing checksum/payload)", source));
+    if (!outer.is_object() || !outer.contains("checksum") || !outer.contains("payload") ||
+        !outer["payload"].is_string())
+      throw CheckpointError(
+          fmt::format("{}: not an animat checkpoint (missing checksum/payload)", source));
     const std::string body = outer["payload"].get<std::string>();
     if (outer["checksum"] != hex(fnv1a(body)))
-      throw CheckpointError(fmt::format("{}: corrupt checkpoint: checksum {} does not match its content ({})", source,
-                                        detail::describe(outer["checksum"]), hex(fnv1a(body))));
+      throw CheckpointError(
+          fmt::format("{}: corrupt checkpoint: checksum {} does not match its content ({})", source,
+                      detail::describe(outer["checksum"]), hex(fnv1a(body))));
     const json p = detail::parse_bounded(body, 64);
     if (p.value("format", "") != "animat.checkpoint")
-      throw CheckpointError(fmt::format("{}: not an animat checkpoint (format {})", source, p.value("format", "?")));
+      throw CheckpointError(
+          fmt::format("{}: not an animat checkpoint (format {})", source, p.value("format", "?")));
     if (!detail::int_in(p.at("version"), kCheckpointVersion, kCheckpointVersion))
-      throw CheckpointError(fmt::format("{}: checkpoint version {} is not supported (this build reads version {})", source,
-                                        detail::describe(p.at("version")), kCheckpointVersion));
-    if (!p.at("identity").is_string()) throw CheckpointError(fmt::format("{}: field \"identity\" must be a string", source));
+      throw CheckpointError(
+          fmt::format("{}: checkpoint version {} is not supported (this build reads version {})",
+                      source, detail::describe(p.at("version")), kCheckpointVersion));
+    if (!p.at("identity").is_string())
+      throw CheckpointError(fmt::format("{}: field \"identity\" must be a string", source));
     // Checkpoints without "identity_scheme" were identified by scheme 1 (run_identity.hpp).
     const bool scheme_1 = !p.contains("identity_scheme");
-    if (!scheme_1 && !detail::int_in(p.at("identity_scheme"), kRunIdentityScheme, kRunIdentityScheme))
-      throw CheckpointError(fmt::format("{}: identity scheme {} is not supported (this build reads 1 and {})", source,
-                                        detail::describe(p.at("identity_scheme")), kRunIdentityScheme));
+    if (!scheme_1 &&
+        !detail::int_in(p.at("identity_scheme"), kRunIdentityScheme, kRunIdentityScheme))
+      throw CheckpointError(
+          fmt::format("{}: identity scheme {} is not supported (this build reads 1 and {})", source,
+                      detail::describe(p.at("identity_scheme")), kRunIdentityScheme));
     const std::string expected = hex(scheme_1 ? run_identity_v1(*config_) : identity_);
     if (p.at("identity").get<std::string>() != expected)
-      throw CheckpointError(fmt::format(
-          "{}: checkpoint belongs to a different run configuration (identity {} vs {} for the current config); "
-          "only {} may change on resume",
-          source, p.at("identity").get<std::string>(), expected, fmt::join(resumable_keys(), ", ")));
+      throw CheckpointError(
+          fmt::format("{}: checkpoint belongs to a different run configuration (identity {} vs {} "
+                      "for the current config); "
+                      "only {} may change on resume",
+                      source, p.at("identity").get<std::string>(), expected,
+                      fmt::join(resumable_keys(), ", ")));
     std::vector<Individual> pop;
     for (const json& ji : p.at("population")) {
       Individual ind;
@@ -680,32 +760,38 @@ void Evolution::restore(std::string_view text, std::string_view source) {
       ind.result.stable = bool_field(ji, "stable");
       if (ji.contains("valid")) ind.result.valid = bool_field(ji, "valid");
       if (ji.contains("reference")) ind.reference = number_field(ji, "reference");
-      if (ji.contains("drag_limited")) ind.result.drag_limited = static_cast<long>(int_field(ji, "drag_limited", 0, kInt64Max));
+      if (ji.contains("drag_limited"))
+        ind.result.drag_limited = static_cast<long>(int_field(ji, "drag_limited", 0, kInt64Max));
       ind.result.cell_count = static_cast<int>(int_field(ji, "cell_count", 0, kIntMax));
       ind.tries = static_cast<int>(int_field(ji, "tries", 0, kIntMax));
       pop.push_back(std::move(ind));
     }
     if (pop.size() != static_cast<std::size_t>(config_->evolution.population))
-      throw CheckpointError(fmt::format("{}: checkpoint holds {} individuals, evolution.population is {}", source, pop.size(),
-                                        config_->evolution.population));
+      throw CheckpointError(
+          fmt::format("{}: checkpoint holds {} individuals, evolution.population is {}", source,
+                      pop.size(), config_->evolution.population));
     std::vector<GenerationStats> hist;
     for (const json& js : p.at("history")) {
       GenerationStats st = stats_from_json(js);
-      const double seconds = hist.empty() ? st.wall_seconds : st.wall_seconds - hist.back().wall_seconds;
+      const double seconds =
+          hist.empty() ? st.wall_seconds : st.wall_seconds - hist.back().wall_seconds;
       const auto evaluated = st.evaluations - (hist.empty() ? 0 : hist.back().evaluations);
       st.evaluations_per_second = seconds > 0 ? static_cast<double>(evaluated) / seconds : 0.0;
       hist.push_back(st);
     }
     const int generation = static_cast<int>(int_field(p, "generation", 0, kIntMax));
-    if (hist.empty()) throw CheckpointError(fmt::format("{}: checkpoint has an empty history", source));
+    if (hist.empty())
+      throw CheckpointError(fmt::format("{}: checkpoint has an empty history", source));
     if (hist.back().generation != generation)
-      throw CheckpointError(fmt::format("{}: checkpoint generation {} does not match its history, which ends at generation {}",
-                                        source, generation, hist.back().generation));
+      throw CheckpointError(fmt::format(
+          "{}: checkpoint generation {} does not match its history, which ends at generation {}",
+          source, generation, hist.back().generation));
     const int stall = static_cast<int>(int_field(p, "stall", 0, kIntMax));
     const double best_ever = number_field(p, "best_ever");
     const std::int64_t evaluations = int_field(p, "evaluations", 0, kInt64Max);
     const double wall = number_field(p, "wall_seconds");
-    check_semantics(pop, hist, stall, best_ever, evaluations, wall, nonnegative_objective(*config_), source);
+    check_semantics(pop, hist, stall, best_ever, evaluations, wall, nonnegative_objective(*config_),
+                    source);
     population_ = std::move(pop);
     slots_.clear();
     next_.clear();

@@ -10,9 +10,12 @@
 
 namespace animat {
 
-FitnessFunction swim_fitness(const Config& config) { return objective_fitness(config, make_objective(config.evaluation)); }
+FitnessFunction swim_fitness(const Config& config) {
+  return objective_fitness(config, make_objective(config.evaluation));
+}
 
-FitnessFunction objective_fitness(const Config& config, std::shared_ptr<const Objective> objective) {
+FitnessFunction objective_fitness(const Config& config,
+                                  std::shared_ptr<const Objective> objective) {
   validate(config);
   if (!objective) throw Error("objective_fitness: no objective");
   auto shared = std::make_shared<const Config>(config);

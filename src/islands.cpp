@@ -1,5 +1,5 @@
-#include <unistd.h>
 #include "animat/islands.hpp"
+#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -21,18 +21,21 @@ bool fitter(const Individual& a, const Individual& b) {
   return a.result.fitness > b.result.fitness;
 }
 
-constexpr std::string_view kHeader = "generation,island,best,mean,viable_fraction,best_cells,immigrants\n";
+constexpr std::string_view kHeader =
+    "generation,island,best,mean,viable_fraction,best_cells,immigrants\n";
 
 std::string row(const IslandStats& s) {
-  return fmt::format("{},{},{},{},{},{},{}\n", s.generation, s.island, s.best, s.mean, s.viable_fraction, s.best_cells,
-                     s.immigrants);
+  return fmt::format("{},{},{},{},{},{},{}\n", s.generation, s.island, s.best, s.mean,
+                     s.viable_fraction, s.best_cells, s.immigrants);
 }
 
 void write_replacing(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + "." + std::to_string(::getpid()) + ".tmp";  // one per process
+  // one per process
+  const std::filesystem::path tmp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out || !(out << text) || !out.flush()) throw IoError(fmt::format("{}: cannot write", tmp.string()));
+    if (!out || !(out << text) || !out.flush())
+      throw IoError(fmt::format("{}: cannot write", tmp.string()));
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
@@ -50,7 +53,8 @@ IslandLayout island_layout(std::size_t population, int islands) {
   const std::size_t k = static_cast<std::size_t>(std::max(1, islands));
   IslandLayout layout;
   layout.offsets.resize(k + 1, 0);
-  for (std::size_t i = 0; i < k; ++i) layout.offsets[i + 1] = layout.offsets[i] + population / k + (i < population % k ? 1 : 0);
+  for (std::size_t i = 0; i < k; ++i)
+    layout.offsets[i + 1] = layout.offsets[i] + population / k + (i < population % k ? 1 : 0);
   return layout;
 }
 
@@ -58,34 +62,41 @@ std::string island_config_error(const EvolutionParams& p) {
   if (p.islands <= 1) return {};
   const int smallest = p.population / p.islands;
   if (smallest < 2)
-    return fmt::format("evolution.islands = {} leaves fewer than 2 individuals per island (evolution.population = {})",
-                       p.islands, p.population);
+    return fmt::format(
+        "evolution.islands = {} leaves fewer than 2 individuals per island (evolution.population = "
+        "{})",
+        p.islands, p.population);
   if (p.elites >= smallest)
-    return fmt::format("evolution.elites = {} (per island) must be smaller than the smallest island ({} of "
-                       "evolution.population = {} in evolution.islands = {})",
-                       p.elites, smallest, p.population, p.islands);
+    return fmt::format(
+        "evolution.elites = {} (per island) must be smaller than the smallest island ({} of "
+        "evolution.population = {} in evolution.islands = {})",
+        p.elites, smallest, p.population, p.islands);
   if (2 * p.migrants > smallest || p.elites + p.migrants > smallest)
-    return fmt::format("evolution.migrants = {} is too many for the smallest island ({} individuals, evolution.elites = {}): "
-                       "at most {} (half an island, and never an elite)",
-                       p.migrants, smallest, p.elites, std::min(smallest / 2, smallest - p.elites));
+    return fmt::format(
+        "evolution.migrants = {} is too many for the smallest island ({} individuals, "
+        "evolution.elites = {}): "
+        "at most {} (half an island, and never an elite)",
+        p.migrants, smallest, p.elites, std::min(smallest / 2, smallest - p.elites));
   return {};
 }
 
 bool is_migration_generation(const EvolutionParams& p, int generation) {
-  return p.islands > 1 && p.migrants > 0 && generation > 0 && generation % p.migration_interval == 0;
+  return p.islands > 1 && p.migrants > 0 && generation > 0 &&
+         generation % p.migration_interval == 0;
 }
 
-std::vector<std::size_t> island_ranking(const std::vector<Individual>& population, const IslandLayout& layout,
-                                        std::size_t k) {
+std::vector<std::size_t> island_ranking(const std::vector<Individual>& population,
+                                        const IslandLayout& layout, std::size_t k) {
   std::vector<std::size_t> order(layout.size(k));
   std::iota(order.begin(), order.end(), layout.begin(k));
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return fitter(population[a], population[b]); });
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return fitter(population[a], population[b]);
+  });
   return order;
 }
 
-std::vector<Migration> migrate(std::vector<Individual>& population, const IslandLayout& layout, int migrants,
-                               int generation) {
+std::vector<Migration> migrate(std::vector<Individual>& population, const IslandLayout& layout,
+                               int migrants, int generation) {
   const std::size_t K = layout.count();
   std::vector<Migration> moves;
   if (K < 2 || migrants <= 0) return moves;
@@ -93,7 +104,9 @@ std::vector<Migration> migrate(std::vector<Individual>& population, const Island
   std::vector<std::vector<std::size_t>> ranking(K);
   for (std::size_t k = 0; k < K; ++k) {
     ranking[k] = island_ranking(population, layout, k);
-    if (2 * m > ranking[k].size()) throw Error(fmt::format("migrate: {} migrants do not fit island {} of {}", m, k, ranking[k].size()));
+    if (2 * m > ranking[k].size())
+      throw Error(
+          fmt::format("migrate: {} migrants do not fit island {} of {}", m, k, ranking[k].size()));
   }
   // Every emigrant is copied before any replacement: the best and the worst halves never overlap.
   std::vector<Individual> copies;
@@ -111,8 +124,9 @@ std::vector<Migration> migrate(std::vector<Individual>& population, const Island
   return moves;
 }
 
-std::vector<IslandStats> island_statistics(const std::vector<Individual>& population, const IslandLayout& layout,
-                                           int generation, int immigrants) {
+std::vector<IslandStats> island_statistics(const std::vector<Individual>& population,
+                                           const IslandLayout& layout, int generation,
+                                           int immigrants) {
   std::vector<IslandStats> out;
   for (std::size_t k = 0; k < layout.count(); ++k) {
     IslandStats s;
@@ -138,7 +152,9 @@ std::vector<IslandStats> island_statistics(const std::vector<Individual>& popula
 }
 
 IslandLog::IslandLog(const std::filesystem::path& run_dir, const EvolutionParams& params)
-    : path_(run_dir / "islands.csv"), params_(params), enabled_(!run_dir.empty() && params.islands > 1) {}
+    : path_(run_dir / "islands.csv"),
+      params_(params),
+      enabled_(!run_dir.empty() && params.islands > 1) {}
 
 void IslandLog::start(const Evolution& evolution) {
   if (!enabled_) return;
@@ -153,7 +169,8 @@ void IslandLog::resume(int generation) {
   std::string line;
   for (bool header = true; std::getline(in, line); header = false) {
     int g = -1;
-    if (!header && std::sscanf(line.c_str(), "%d,", &g) == 1 && g <= generation) kept += line + "\n";
+    if (!header && std::sscanf(line.c_str(), "%d,", &g) == 1 && g <= generation)
+      kept += line + "\n";
   }
   in.close();
   write_replacing(path_, kept);
@@ -164,11 +181,13 @@ void IslandLog::append(const Evolution& evolution) {
   const int g = evolution.generation();
   const IslandLayout layout = island_layout(evolution.population().size(), params_.islands);
   std::string text;
-  for (const auto& s : island_statistics(evolution.population(), layout, g,
-                                         is_migration_generation(params_, g) ? params_.migrants : 0))
+  for (const auto& s :
+       island_statistics(evolution.population(), layout, g,
+                         is_migration_generation(params_, g) ? params_.migrants : 0))
     text += row(s);
   std::ofstream out(path_, std::ios::app | std::ios::binary);
-  if (!out || !(out << text) || !out.flush()) throw IoError(fmt::format("{}: cannot append", path_.string()));
+  if (!out || !(out << text) || !out.flush())
+    throw IoError(fmt::format("{}: cannot append", path_.string()));
 }
 
 }  // namespace animat

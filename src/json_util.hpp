@@ -24,14 +24,16 @@ struct JsonLimit : std::runtime_error {
 /// `Json` is nlohmann::json everywhere but in tests/cpp/test_parse_cost.cpp, which parses into a
 /// basic_json whose arrays count the iterator steps taken over them, to prove the linearity.
 template <class Json = nlohmann::json>
-Json parse_bounded(std::string_view text, int max_depth, int item_depth = -1, long long max_items = -1) {
+Json parse_bounded(std::string_view text, int max_depth, int item_depth = -1,
+                   long long max_items = -1) {
   struct Counter {
     int max_depth, item_depth;
     long long max_items;
     int depth = 0;
     long long items = 0;
     bool open() {
-      if (depth >= max_depth) throw JsonLimit("nesting deeper than " + std::to_string(max_depth) + " levels");
+      if (depth >= max_depth)
+        throw JsonLimit("nesting deeper than " + std::to_string(max_depth) + " levels");
       ++depth;
       return true;
     }
@@ -45,7 +47,9 @@ Json parse_bounded(std::string_view text, int max_depth, int item_depth = -1, lo
     bool boolean(bool) { return true; }
     bool number_integer(typename Json::number_integer_t) { return true; }
     bool number_unsigned(typename Json::number_unsigned_t) { return true; }
-    bool number_float(typename Json::number_float_t, const typename Json::string_t&) { return true; }
+    bool number_float(typename Json::number_float_t, const typename Json::string_t&) {
+      return true;
+    }
     bool string(typename Json::string_t&) { return true; }
     bool binary(typename Json::binary_t&) { return true; }
     bool start_object(std::size_t) { return open(); }
@@ -56,8 +60,11 @@ Json parse_bounded(std::string_view text, int max_depth, int item_depth = -1, lo
       --depth;
       return true;
     }
-    // A syntax error stops the count; the building pass below then reports it exactly as parse() does.
-    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) { return false; }
+    // A syntax error stops the count; the building pass below then reports it exactly as parse()
+    // does.
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) {
+      return false;
+    }
   };
   Counter counter{max_depth, item_depth, max_items};
   Json::sax_parse(text.begin(), text.end(), &counter);

@@ -56,7 +56,8 @@ std::vector<std::string_view> objective_names() {
 /// A built-in objective: a row of kObjectives with the evaluation parameters it reads.
 class Builtin final : public Objective {
  public:
-  Builtin(const ObjectiveSpec& spec, const EvaluationParams& params) : spec_(spec), params_(params) {}
+  Builtin(const ObjectiveSpec& spec, const EvaluationParams& params)
+      : spec_(spec), params_(params) {}
   std::string name() const override { return std::string(spec_.name); }
   bool needs_body() const override { return spec_.needs_body; }
   double value(const EvaluationRecord& r) const override {
@@ -110,11 +111,13 @@ std::shared_ptr<const Objective> make_objective(const EvaluationParams& p) {
     return std::make_shared<Builtin>(*spec, p);
   }
   if (std::string_view(p.objective).starts_with(kPythonObjectivePrefix))
-    throw ConfigError(fmt::format("evaluation.objective = \"{}\" is a Python objective: run it from Python with "
-                                  "animat.evolve(config, objective=...) (the C++ engine cannot call it)",
-                                  p.objective));
-  throw ConfigError(fmt::format("evaluation.objective: unknown objective \"{}\" (expected one of {}, or python:NAME)",
-                                p.objective, fmt::join(objective_names(), ", ")));
+    throw ConfigError(
+        fmt::format("evaluation.objective = \"{}\" is a Python objective: run it from Python with "
+                    "animat.evolve(config, objective=...) (the C++ engine cannot call it)",
+                    p.objective));
+  throw ConfigError(fmt::format(
+      "evaluation.objective: unknown objective \"{}\" (expected one of {}, or python:NAME)",
+      p.objective, fmt::join(objective_names(), ", ")));
 }
 
 void validate(const EvaluationParams& p) {
@@ -122,22 +125,29 @@ void validate(const EvaluationParams& p) {
   const bool builtin = find_objective(name) != nullptr;
   if (name.starts_with(kPythonObjectivePrefix)) {
     if (name.size() == kPythonObjectivePrefix.size())
-      throw ConfigError("evaluation.objective = \"python:\": a Python objective needs a name (python:NAME)");
+      throw ConfigError(
+          "evaluation.objective = \"python:\": a Python objective needs a name (python:NAME)");
   } else if (!builtin) {
-    throw ConfigError(fmt::format("evaluation.objective: unknown objective \"{}\" (expected one of {}, or python:NAME)",
-                                  p.objective, fmt::join(objective_names(), ", ")));
+    throw ConfigError(fmt::format(
+        "evaluation.objective: unknown objective \"{}\" (expected one of {}, or python:NAME)",
+        p.objective, fmt::join(objective_names(), ", ")));
   }
   if (p.direction.size() != 2)
-    throw ConfigError(fmt::format("evaluation.direction: expected 2 numbers [x, y], got {}", p.direction.size()));
-  if (!std::isfinite(p.direction[0]) || !std::isfinite(p.direction[1]) || (p.direction[0] == 0.0 && p.direction[1] == 0.0))
-    throw ConfigError(fmt::format("evaluation.direction = [{}, {}]: must be finite and not both 0", p.direction[0],
-                                  p.direction[1]));
+    throw ConfigError(
+        fmt::format("evaluation.direction: expected 2 numbers [x, y], got {}", p.direction.size()));
+  if (!std::isfinite(p.direction[0]) || !std::isfinite(p.direction[1]) ||
+      (p.direction[0] == 0.0 && p.direction[1] == 0.0))
+    throw ConfigError(fmt::format("evaluation.direction = [{}, {}]: must be finite and not both 0",
+                                  p.direction[0], p.direction[1]));
   if (!(p.energy_weight >= 0.0) || !std::isfinite(p.energy_weight))
-    throw ConfigError(fmt::format("evaluation.energy_weight = {}: must be finite and >= 0", p.energy_weight));
+    throw ConfigError(
+        fmt::format("evaluation.energy_weight = {}: must be finite and >= 0", p.energy_weight));
   if (!(p.energy_offset > 0.0) || !std::isfinite(p.energy_offset))
-    throw ConfigError(fmt::format("evaluation.energy_offset = {}: must be finite and > 0", p.energy_offset));
+    throw ConfigError(
+        fmt::format("evaluation.energy_offset = {}: must be finite and > 0", p.energy_offset));
   if (p.push_impulse.size() != 2)
-    throw ConfigError(fmt::format("evaluation.push_impulse: expected 2 numbers [Jx, Jy], got {}", p.push_impulse.size()));
+    throw ConfigError(fmt::format("evaluation.push_impulse: expected 2 numbers [Jx, Jy], got {}",
+                                  p.push_impulse.size()));
 }
 
 double body_length(const Body& body) {
@@ -151,8 +161,10 @@ double body_length(const Body& body) {
   return longest + 1.0;
 }
 
-EvaluationRecord record_evaluation(const Genome& genome, const Config& config, bool keep_body, long every) {
-  if (every < 0) throw ConfigError(fmt::format("record_evaluation: every must be >= 0, got {}", every));
+EvaluationRecord record_evaluation(const Genome& genome, const Config& config, bool keep_body,
+                                   long every) {
+  if (every < 0)
+    throw ConfigError(fmt::format("record_evaluation: every must be >= 0, got {}", every));
   EvaluationRecord record;
   record.every = every;
   if (!keep_body && every == 0) {
@@ -165,7 +177,8 @@ EvaluationRecord record_evaluation(const Genome& genome, const Config& config, b
 }
 
 EvaluationResult evaluate(const Genome& genome, const Config& config, const Objective& objective) {
-  EvaluationRecord record = record_evaluation(genome, config, objective.needs_body(), objective.sample_every());
+  EvaluationRecord record =
+      record_evaluation(genome, config, objective.needs_body(), objective.sample_every());
   // Non-viable genomes are never swum, and an unstable or invalid swim (one that broke the planar
   // embedding or an invariant) is worth nothing whatever the objective: no objective scores them.
   if (!record.result.viable || !record.result.stable || !record.result.valid) {
@@ -174,7 +187,8 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, const Obje
   }
   const double v = objective.value(record);
   if (!std::isfinite(v))
-    throw Error(fmt::format("objective \"{}\" returned {} (objectives must be finite)", objective.name(), v));
+    throw Error(fmt::format("objective \"{}\" returned {} (objectives must be finite)",
+                            objective.name(), v));
   record.result.fitness = v;
   return std::move(record.result);
 }

@@ -36,7 +36,8 @@ void check_body(const Body& b) {
     if (!std::isfinite(b.positions(i, 0)) || !std::isfinite(b.positions(i, 1)))
       fail(fmt::format("node {} has a non-finite position", i));
   auto check_index = [&](int v, const char* what) {
-    if (v < 0 || v >= n) fail(fmt::format("{} refers to node {}, but there are {} nodes", what, v, n));
+    if (v < 0 || v >= n)
+      fail(fmt::format("{} refers to node {}, but there are {} nodes", what, v, n));
   };
   for (int s = 0; s < b.spring_count(); ++s) {
     check_index(b.springs(s, 0), "a spring");
@@ -47,7 +48,8 @@ void check_body(const Body& b) {
   for (const auto& loop : b.regions)
     for (int v : loop) check_index(v, "a region");
   for (int r = 0; r < b.region_count(); ++r)
-    if (!std::isfinite(b.rest_areas(r))) fail(fmt::format("region {} has rest area {}", r, b.rest_areas(r)));
+    if (!std::isfinite(b.rest_areas(r)))
+      fail(fmt::format("region {} has rest area {}", r, b.rest_areas(r)));
   for (int e = 0; e < b.skin.rows(); ++e) {
     check_index(b.skin(e, 0), "a skin edge");
     check_index(b.skin(e, 1), "a skin edge");
@@ -56,12 +58,14 @@ void check_body(const Body& b) {
     fail(fmt::format("stiffness must have {} entries (or none), got {}", n, b.stiffness.size()));
   for (Eigen::Index i = 0; i < b.stiffness.size(); ++i)
     if (!(b.stiffness(i) > 0.0) || !std::isfinite(b.stiffness(i)))
-      fail(fmt::format("node {} has stiffness factor {} (must be finite and > 0)", i, b.stiffness(i)));
+      fail(fmt::format("node {} has stiffness factor {} (must be finite and > 0)", i,
+                       b.stiffness(i)));
   for (const Vector* v : {&b.amplitude, &b.frequency, &b.phase}) {
     if (v->size() != 0 && v->size() != n)
       fail(fmt::format("oscillator vectors must have {} entries (or none), got {}", n, v->size()));
     for (Eigen::Index i = 0; i < v->size(); ++i)
-      if (!std::isfinite((*v)(i))) fail(fmt::format("node {} has a non-finite oscillator parameter", i));
+      if (!std::isfinite((*v)(i)))
+        fail(fmt::format("node {} has a non-finite oscillator parameter", i));
   }
 }
 
@@ -113,17 +117,19 @@ enum class Sink : int { none, drag, drag_normal, spring_damping, collisions, gro
 
 struct EnergyBooks {
   bool on = false;
-  std::vector<int> force_bucket, velocity_bucket, constraint_bucket;  // per effect of each list; -1: not booked
-  std::vector<double> work;                  // per bucket: the work of its forces so far
-  std::vector<double> step_work;             // per bucket: in the current step
-  std::vector<double> fx, fy;                // buckets × n: this step's forces per bucket
-  std::vector<double> prev_fx, prev_fy;      // state.fx, fy before the current effect pass
-  std::vector<double> ux, uy;                // per cell: the end velocity v' of the step
-  std::vector<double> wx, wy;                // per cell: v' without the collisions' impulses
-  double external = 0.0;                     // kinetic energy added by pushes
+  // per effect of each list; -1: not booked
+  std::vector<int> force_bucket, velocity_bucket, constraint_bucket;
+  std::vector<double> work;              // per bucket: the work of its forces so far
+  std::vector<double> step_work;         // per bucket: in the current step
+  std::vector<double> fx, fy;            // buckets × n: this step's forces per bucket
+  std::vector<double> prev_fx, prev_fy;  // state.fx, fy before the current effect pass
+  std::vector<double> ux, uy;            // per cell: the end velocity v' of the step
+  std::vector<double> wx, wy;            // per cell: v' without the collisions' impulses
+  double external = 0.0;                 // kinetic energy added by pushes
   double actuation_start = 0.0;
-  double kinetic_start = 0.0, elastic_start = 0.0, pressure_start = 0.0, gravity_start = 0.0, other_start = 0.0;
-  std::vector<Sink> sink;                    // per bucket: where its work goes
+  double kinetic_start = 0.0, elastic_start = 0.0, pressure_start = 0.0, gravity_start = 0.0,
+         other_start = 0.0;
+  std::vector<Sink> sink;  // per bucket: where its work goes
 };
 
 }  // namespace
@@ -133,13 +139,15 @@ struct Simulation::Impl {
   PhysicsParams physics;
   std::unique_ptr<b2World> world;  // physics.integrator = "box2d" only
   std::vector<b2Body*> bodies;     // idem
-  CellIntegrator cells;            // the cells' float state (both integrators; "box2d" copies it from the world)
+  // the cells' float state (both integrators; "box2d" copies it from the world)
+  CellIntegrator cells;
   std::vector<std::unique_ptr<Effect>> effects;  // in run order
-  std::vector<Effect*> force_effects;             // modifier and force stages, in run order
-  std::vector<Effect*> velocity_effects;          // those with velocity-dependent forces, in run order
-  std::vector<Effect*> constraint_effects;        // run after every force is known
+  std::vector<Effect*> force_effects;            // modifier and force stages, in run order
+  // those with velocity-dependent forces, in run order
+  std::vector<Effect*> velocity_effects;
+  std::vector<Effect*> constraint_effects;  // run after every force is known
   bool midpoint = true;
-  std::vector<double> fx_pos, fy_pos;             // position-dependent forces (midpoint scheme)
+  std::vector<double> fx_pos, fy_pos;  // position-dependent forces (midpoint scheme)
   SwimState state;
   double h = 0.0;
   float hf = 0.0f;
@@ -182,11 +190,14 @@ struct Simulation::Impl {
       sinks.push_back(k);
       return static_cast<int>(sinks.size()) - 1;
     };
-    for (std::size_t k = 0; k < force_effects.size(); ++k) b.force_bucket[k] = bucket(*force_effects[k], false);
-    for (std::size_t k = 0; k < velocity_effects.size(); ++k) b.velocity_bucket[k] = bucket(*velocity_effects[k], true);
+    for (std::size_t k = 0; k < force_effects.size(); ++k)
+      b.force_bucket[k] = bucket(*force_effects[k], false);
+    for (std::size_t k = 0; k < velocity_effects.size(); ++k)
+      b.velocity_bucket[k] = bucket(*velocity_effects[k], true);
     for (std::size_t k = 0; k < constraint_effects.size(); ++k)
       b.constraint_bucket[k] = bucket(*constraint_effects[k], false);
-    sinks.push_back(Sink::drag_normal);  // the last bucket: drag's normal part (state.normal_drag_fx)
+    // the last bucket: drag's normal part (state.normal_drag_fx)
+    sinks.push_back(Sink::drag_normal);
     const std::size_t buckets = sinks.size();
     b.sink = std::move(sinks);
     b.work.resize(buckets, 0.0);  // keeps what was booked so far
@@ -252,11 +263,11 @@ struct Simulation::Impl {
       constraint_effects[k]->apply(state);
       book(b.constraint_bucket[k]);
     }
-    // Every force and impulse is known. The collisions' impulses J_c act at an instant (a cell turns
-    // back when it meets an edge); every other force, the floor's included, acts over the step. So
-    // with v' = v + h·ΣF/m the end velocity and u = v' − J_c/m the end velocity without the
-    // collisions, a force's work is h·F·(v + u)/2 and a collision impulse's J_c·(u + v')/2 (zero for
-    // an elastic one). Together they are ½m(v'² − v²) exactly.
+    // Every force and impulse is known. The collisions' impulses J_c act at an instant (a cell
+    // turns back when it meets an edge); every other force, the floor's included, acts over the
+    // step. So with v' = v + h·ΣF/m the end velocity and u = v' − J_c/m the end velocity without
+    // the collisions, a force's work is h·F·(v + u)/2 and a collision impulse's J_c·(u + v')/2
+    // (zero for an elastic one). Together they are ½m(v'² − v²) exactly.
     const double kv = h * state.inv_mass;
     for (std::size_t i = 0; i < n; ++i) {
       b.ux[i] = state.vx[i] + kv * state.fx[i];  // v'
@@ -293,7 +304,8 @@ struct Simulation::Impl {
     for (std::size_t k = 0; k < b.sink.size(); ++k) b.work[k] += b.step_work[k];
   }
 
-  /// Potentials of the conservative effects at the current state: elastic, pressure, gravity, other.
+  /// Potentials of the conservative effects at the current state: elastic, pressure, gravity,
+  /// other.
   void potentials(double& elastic, double& pressure, double& gravity, double& other) const {
     elastic = pressure = gravity = other = 0.0;
     for (const auto& e : effects) {
@@ -308,7 +320,8 @@ struct Simulation::Impl {
   double kinetic() const {
     double e = 0.0;
     for (std::size_t i = 0; i < cells.size(); ++i)
-      e += static_cast<double>(cells.vx[i]) * cells.vx[i] + static_cast<double>(cells.vy[i]) * cells.vy[i];
+      e += static_cast<double>(cells.vx[i]) * cells.vx[i] +
+           static_cast<double>(cells.vy[i]) * cells.vy[i];
     return 0.5 * state.mass * e;
   }
 
@@ -391,19 +404,23 @@ struct Simulation::Impl {
     const double speed = std::sqrt(worst);
     if (!std::isfinite(speed)) {
       const auto u = static_cast<std::size_t>(worst_i);
-      fail(fmt::format("unstable swim: step {} (t = {:.6g}): cell {} has a non-finite state (position ({}, {}), "
-                       "velocity ({}, {}), force ({}, {}))",
-                       control_steps, state.time, worst_i, state.x[u], state.y[u], state.vx[u], state.vy[u],
-                       state.fx[u], state.fy[u]));
+      fail(fmt::format(
+          "unstable swim: step {} (t = {:.6g}): cell {} has a non-finite state (position ({}, {}), "
+          "velocity ({}, {}), force ({}, {}))",
+          control_steps, state.time, worst_i, state.x[u], state.y[u], state.vx[u], state.vy[u],
+          state.fx[u], state.fy[u]));
     }
     const double disp = speed * h;
     max_speed = std::max(max_speed, speed);
     max_disp = std::max(max_disp, disp);
     if (disp > physics.max_step_displacement) {
-      fail(fmt::format("unstable swim: step {} (t = {:.6g}): cell {} would move {:.6g} length units in one Box2D "
-                       "step (speed {:.6g}), beyond physics.max_step_displacement = {} (Box2D silently caps at {})",
-                       control_steps, state.time, worst_i, disp, speed, physics.max_step_displacement,
-                       kMaxTranslation));
+      fail(
+          fmt::format("unstable swim: step {} (t = {:.6g}): cell {} would move {:.6g} length units "
+                      "in one Box2D "
+                      "step (speed {:.6g}), beyond physics.max_step_displacement = {} (Box2D "
+                      "silently caps at {})",
+                      control_steps, state.time, worst_i, disp, speed,
+                      physics.max_step_displacement, kMaxTranslation));
     }
   }
 
@@ -416,7 +433,8 @@ struct Simulation::Impl {
     check_forces();
     if (world) {
       for (std::size_t i = 0; i < bodies.size(); ++i)
-        bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(state.fx[i]), static_cast<float>(state.fy[i])), true);
+        bodies[i]->ApplyForceToCenter(
+            b2Vec2(static_cast<float>(state.fx[i]), static_cast<float>(state.fy[i])), true);
       world->Step(hf, physics.velocity_iterations, physics.position_iterations);
     } else {
       cells.step(hf, state.fx.data(), state.fy.data());
@@ -439,18 +457,21 @@ struct Simulation::Impl {
     }
     read_state();
     if (books.on) close_books_of_step();
-    if (monitoring && !monitor.observe(state.x, state.y) && first_broken_step < 0) first_broken_step = control_steps;
+    if (monitoring && !monitor.observe(state.x, state.y) && first_broken_step < 0)
+      first_broken_step = control_steps;
   }
 
   void insert(std::unique_ptr<Effect> e) {
     const auto stage = e->stage();
-    auto pos = std::find_if(effects.begin(), effects.end(), [&](const auto& x) { return x->stage() > stage; });
+    auto pos = std::find_if(effects.begin(), effects.end(),
+                            [&](const auto& x) { return x->stage() > stage; });
     effects.insert(pos, std::move(e));
     force_effects.clear();
     velocity_effects.clear();
     constraint_effects.clear();
     for (const auto& x : effects) {
-      (x->stage() == Effect::Stage::constraint ? constraint_effects : force_effects).push_back(x.get());
+      (x->stage() == Effect::Stage::constraint ? constraint_effects : force_effects)
+          .push_back(x.get());
       if (x->velocity_dependent()) velocity_effects.push_back(x.get());
     }
     if (books.on) layout_books();
@@ -486,7 +507,8 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
     for (int i = 0; i < n; ++i) {
       b2BodyDef def;
       def.type = b2_dynamicBody;
-      def.position.Set(static_cast<float>(body.positions(i, 0)), static_cast<float>(body.positions(i, 1)));
+      def.position.Set(static_cast<float>(body.positions(i, 0)),
+                       static_cast<float>(body.positions(i, 1)));
       def.allowSleep = false;
       def.awake = true;
       def.fixedRotation = true;
@@ -505,7 +527,8 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   st.h = s.h;
   st.mass = static_cast<double>(static_cast<float>(scene.cell_mass));  // what Box2D integrates with
   st.inv_mass = 1.0 / st.mass;
-  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &st.cx, &st.cy, &st.ground_fx, &st.ground_fy, &s.fx_pos, &s.fy_pos})
+  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.ux, &st.uy, &st.fx, &st.fy, &st.cx, &st.cy,
+                  &st.ground_fx, &st.ground_fy, &s.fx_pos, &s.fy_pos})
     v->assign(static_cast<std::size_t>(n), 0.0);
   s.midpoint = physics.velocity_forces == "midpoint";
   st.rest.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
@@ -516,8 +539,8 @@ Simulation::Simulation(const Body& body_in, const SceneParams& scene, const Phys
   }
   for (const auto& e : s.effects)
     if (e->needs_box2d_collisions())
-      throw ConfigError(fmt::format("effect '{}' needs Box2D collisions, which the swim world does not provide",
-                                    e->name()));
+      throw ConfigError(fmt::format(
+          "effect '{}' needs Box2D collisions, which the swim world does not provide", e->name()));
   s.read_state();
 }
 
@@ -528,8 +551,9 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 void Simulation::add_effect(std::unique_ptr<Effect> effect) {
   if (!effect) throw ConfigError("Simulation::add_effect: null effect");
   if (effect->needs_box2d_collisions())
-    throw ConfigError(fmt::format("effect '{}' needs Box2D collisions, which the swim world does not provide",
-                                  effect->name()));
+    throw ConfigError(
+        fmt::format("effect '{}' needs Box2D collisions, which the swim world does not provide",
+                    effect->name()));
   impl_->insert(std::move(effect));
 }
 
@@ -550,22 +574,26 @@ void Simulation::compute_forces() {
 void Simulation::monitor_embedding(const Body& body) {
   Impl& s = *impl_;
   if (body.node_count() != s.state.n)
-    throw GeometryError(fmt::format("Simulation::monitor_embedding: the body has {} nodes, the simulation {}",
-                                    body.node_count(), s.state.n));
+    throw GeometryError(
+        fmt::format("Simulation::monitor_embedding: the body has {} nodes, the simulation {}",
+                    body.node_count(), s.state.n));
   s.monitor = EmbeddingMonitor(body);
   s.monitoring = true;
   s.first_broken_step = -1;
   if (!s.monitor.observe(s.state.x, s.state.y)) s.first_broken_step = s.control_steps;
 }
 
-const EmbeddingMonitor* Simulation::embedding_monitor() const { return impl_->monitoring ? &impl_->monitor : nullptr; }
+const EmbeddingMonitor* Simulation::embedding_monitor() const {
+  return impl_->monitoring ? &impl_->monitor : nullptr;
+}
 long Simulation::first_broken_step() const { return impl_->first_broken_step; }
 const SwimCounters& Simulation::counters() const { return impl_->state.counters; }
 
 void Simulation::set_velocities(const Points& v) {
   Impl& s = *impl_;
   if (v.rows() != s.state.n)
-    throw GeometryError(fmt::format("Simulation::set_velocities: expected {} rows, got {}", s.state.n, v.rows()));
+    throw GeometryError(
+        fmt::format("Simulation::set_velocities: expected {} rows, got {}", s.state.n, v.rows()));
   if (!v.allFinite()) throw GeometryError("Simulation::set_velocities: non-finite velocity");
   for (int i = 0; i < s.state.n; ++i) {
     const auto u = static_cast<std::size_t>(i);
@@ -581,7 +609,8 @@ void Simulation::push(std::span<const int> cells, const Eigen::Vector2d& impulse
   if (!impulse.allFinite()) throw GeometryError("Simulation::push: non-finite impulse");
   for (int c : cells)
     if (c < 0 || c >= s.state.n)
-      throw GeometryError(fmt::format("Simulation::push: cell {} out of range [0, {})", c, s.state.n));
+      throw GeometryError(
+          fmt::format("Simulation::push: cell {} out of range [0, {})", c, s.state.n));
   const double inv_mass = s.state.inv_mass;
   const double kinetic_before = s.books.on ? s.kinetic() : 0.0;
   for (int c : cells) {
@@ -684,7 +713,8 @@ double Simulation::kinetic_energy() const {
   double e = 0.0;
   const CellIntegrator& cells = impl_->cells;
   for (std::size_t i = 0; i < cells.size(); ++i)
-    e += static_cast<double>(cells.vx[i]) * cells.vx[i] + static_cast<double>(cells.vy[i]) * cells.vy[i];
+    e += static_cast<double>(cells.vx[i]) * cells.vx[i] +
+         static_cast<double>(cells.vy[i]) * cells.vy[i];
   return 0.5 * impl_->state.mass * e;
 }
 
@@ -713,8 +743,9 @@ const SceneParams& Simulation::scene() const { return impl_->scene; }
 const PhysicsParams& Simulation::physics() const { return impl_->physics; }
 namespace {
 [[noreturn]] void no_world() {
-  throw ConfigError("Simulation::world(): physics.integrator = \"native\" moves the cells without a Box2D world; "
-                    "set physics.integrator = \"box2d\" to get one");
+  throw ConfigError(
+      "Simulation::world(): physics.integrator = \"native\" moves the cells without a Box2D world; "
+      "set physics.integrator = \"box2d\" to get one");
 }
 }  // namespace
 b2World& Simulation::world() {

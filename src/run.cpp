@@ -3,10 +3,10 @@
 #include "animat/run.hpp"
 
 #include <fcntl.h>
-#include <sys/file.h>
-#include <sys/stat.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,9 +23,9 @@
 #include <sstream>
 
 #include "animat/config.hpp"
-#include "animat/run_identity.hpp"
 #include "animat/errors.hpp"
 #include "animat/islands.hpp"
+#include "animat/run_identity.hpp"
 
 namespace animat {
 
@@ -51,7 +51,8 @@ std::filesystem::path temporary_name(const std::filesystem::path& path) {
 void write_atomically(const std::filesystem::path& path, std::string_view content) {
   const std::filesystem::path tmp = temporary_name(path);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw IoError(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
+  if (fd < 0)
+    throw IoError(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
   std::size_t done = 0;
   while (done < content.size()) {
     const ssize_t w = ::write(fd, content.data() + done, content.size() - done);
@@ -115,7 +116,8 @@ std::string history_row(const GenerationStats& s) {
 
 void append(const std::filesystem::path& path, std::string_view text) {
   std::ofstream out(path, std::ios::app | std::ios::binary);
-  if (!out || !(out << text) || !out.flush()) throw IoError(fmt::format("{}: cannot append", path.string()));
+  if (!out || !(out << text) || !out.flush())
+    throw IoError(fmt::format("{}: cannot append", path.string()));
 }
 
 void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
@@ -125,7 +127,8 @@ void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
          {"reference_fitness", std::isnan(b.reference) ? json(nullptr) : json(b.reference)},
          {"cell_count", b.result.cell_count},
          {"genome", json::parse(to_json(b.genome))}};
-  write_atomically(dir / "best" / fmt::format("gen_{:06d}.json", evo.generation()), j.dump(1) + "\n");
+  write_atomically(dir / "best" / fmt::format("gen_{:06d}.json", evo.generation()),
+                   j.dump(1) + "\n");
 }
 
 std::string duration(double s) {
@@ -137,30 +140,36 @@ std::string duration(double s) {
 
 namespace {
 
-// A run directory the file system can hold: every component within NAME_MAX, the whole within PATH_MAX
-// (with room for "/best/gen_000000.json.PID.tmp"). Checked before anything is created.
+// A run directory the file system can hold: every component within NAME_MAX, the whole within
+// PATH_MAX (with room for "/best/gen_000000.json.PID.tmp"). Checked before anything is created.
 void check_run_path(const std::filesystem::path& dir) {
   auto shown = [](const std::string& s) { return s.size() > 60 ? s.substr(0, 57) + "..." : s; };
   for (const auto& part : dir) {
     const std::string name = part.string();
     if (name.size() > static_cast<std::size_t>(NAME_MAX))
-      throw IoError(fmt::format("{}: a component of the run directory's path has {} characters; the file system allows "
-                                "at most {} (NAME_MAX)", shown(dir.string()), name.size(), NAME_MAX));
+      throw IoError(fmt::format(
+          "{}: a component of the run directory's path has {} characters; the file system allows "
+          "at most {} (NAME_MAX)",
+          shown(dir.string()), name.size(), NAME_MAX));
   }
   std::error_code ec;
   const std::filesystem::path absolute = std::filesystem::absolute(dir, ec);
   const std::size_t length = (ec ? dir : absolute).string().size() + 48;
   if (length > static_cast<std::size_t>(PATH_MAX))
-    throw IoError(fmt::format("{}: the run directory's path has {} characters; with its file names it must stay within "
-                              "{} (PATH_MAX)", shown(dir.string()), length - 48, PATH_MAX));
+    throw IoError(fmt::format(
+        "{}: the run directory's path has {} characters; with its file names it must stay within "
+        "{} (PATH_MAX)",
+        shown(dir.string()), length - 48, PATH_MAX));
 }
 
-// Refuses a resume whose settings differ from the run's own config.toml in a key that defines the run,
-// naming every such key; returns the resumable keys that changed (accepted).
-std::vector<std::string> check_resume_settings(const Config& config, const std::filesystem::path& dir) {
+// Refuses a resume whose settings differ from the run's own config.toml in a key that defines the
+// run, naming every such key; returns the resumable keys that changed (accepted).
+std::vector<std::string> check_resume_settings(const Config& config,
+                                               const std::filesystem::path& dir) {
   const std::filesystem::path stored_path = dir / "config.toml";
   std::error_code ec;
-  if (!std::filesystem::exists(stored_path, ec)) return {};  // the checkpoint's identity still decides
+  // the checkpoint's identity still decides
+  if (!std::filesystem::exists(stored_path, ec)) return {};
   const Config stored = load_config(stored_path);
   const auto& resumable = resumable_keys();
   std::vector<std::string> refused, accepted;
@@ -172,11 +181,13 @@ std::vector<std::string> check_resume_settings(const Config& config, const std::
     std::vector<std::string> parts;
     for (const auto& key : refused)
       parts.push_back(fmt::format("{} (the run has {}, this command gives {})", key,
-                                  format_config_value(get_value(stored, key)), format_config_value(get_value(config, key))));
-    throw ConfigError(fmt::format(
-        "{}: cannot resume with changed settings: {}. Only {} may change on resume; start a new run (another --out) "
-        "to change the others. Nothing was written.",
-        dir.string(), fmt::join(parts, ", "), fmt::join(resumable, ", ")));
+                                  format_config_value(get_value(stored, key)),
+                                  format_config_value(get_value(config, key))));
+    throw ConfigError(
+        fmt::format("{}: cannot resume with changed settings: {}. Only {} may change on resume; "
+                    "start a new run (another --out) "
+                    "to change the others. Nothing was written.",
+                    dir.string(), fmt::join(parts, ", "), fmt::join(resumable, ", ")));
   }
   return accepted;
 }
@@ -200,11 +211,13 @@ std::string lock_holder(int fd) {
 }
 
 [[noreturn]] void throw_busy(const std::filesystem::path& dir, const std::string& holder) {
-  throw RunDirectoryBusy(fmt::format(
-      "{}: the run directory is in use by another animat process ({}, holding {}); one process writes a run "
-      "directory at a time. Wait for it to end or stop it (Ctrl-C or kill -TERM checkpoints), then resume; or use "
-      "another directory. Nothing was written.",
-      dir.string(), holder, (dir / kLockName).string()));
+  throw RunDirectoryBusy(
+      fmt::format("{}: the run directory is in use by another animat process ({}, holding {}); one "
+                  "process writes a run "
+                  "directory at a time. Wait for it to end or stop it (Ctrl-C or kill -TERM "
+                  "checkpoints), then resume; or use "
+                  "another directory. Nothing was written.",
+                  dir.string(), holder, (dir / kLockName).string()));
 }
 
 // Refuses a directory another process holds, without creating or changing any file.
@@ -230,32 +243,39 @@ class RunLock {
       fd_ = ::open(path_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
       if (fd_ < 0 && errno == ENOENT) {
         fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
-        if (fd_ < 0 && errno == EEXIST && attempt < 100) continue;  // another process made it just now
+        // another process made it just now
+        if (fd_ < 0 && errno == EEXIST && attempt < 100) continue;
         created_ = fd_ >= 0;
       }
       if (fd_ < 0)
-        throw IoError(fmt::format("{}: cannot open the run directory's lock file: {}", path_.string(), std::strerror(errno)));
+        throw IoError(fmt::format("{}: cannot open the run directory's lock file: {}",
+                                  path_.string(), std::strerror(errno)));
       if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
         const int err = errno;
         const std::string holder = lock_holder(fd_);
         ::close(fd_);
         fd_ = -1;
         if (err == EWOULDBLOCK) throw_busy(dir, holder);
-        throw IoError(fmt::format("{}: cannot lock the run directory: {}", path_.string(), std::strerror(err)));
+        throw IoError(fmt::format("{}: cannot lock the run directory: {}", path_.string(),
+                                  std::strerror(err)));
       }
       // Its last holder removes the file on release: make sure the file locked is the one on disk.
-      struct stat held {}, on_disk {};
-      if (::fstat(fd_, &held) == 0 && ::stat(path_.c_str(), &on_disk) == 0 && held.st_dev == on_disk.st_dev &&
-          held.st_ino == on_disk.st_ino)
+      struct stat held{}, on_disk{};
+      if (::fstat(fd_, &held) == 0 && ::stat(path_.c_str(), &on_disk) == 0 &&
+          held.st_dev == on_disk.st_dev && held.st_ino == on_disk.st_ino)
         break;
       ::close(fd_);
       fd_ = -1;
-      if (attempt >= 100) throw IoError(fmt::format("{}: cannot lock the run directory: the lock file keeps being replaced", path_.string()));
+      if (attempt >= 100)
+        throw IoError(
+            fmt::format("{}: cannot lock the run directory: the lock file keeps being replaced",
+                        path_.string()));
     }
     char host[256] = {};
     if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') std::strcpy(host, "unknown");
     const std::string text = fmt::format("pid {}\nhost {}\n", ::getpid(), host);
-    // Best effort: the lock holds without it; only the message of a refused writer would lack the pid.
+    // Best effort: the lock holds without it; only the message of a refused writer would lack the
+    // pid.
     if (::ftruncate(fd_, 0) == 0) {
       const ssize_t written = ::pwrite(fd_, text.data(), text.size(), 0);
       (void)written;
@@ -279,15 +299,17 @@ class RunLock {
 };
 
 // What a run writes into its directory (RunOptions::overwrite removes these and nothing else).
-const std::vector<std::string> kRunFiles = {"config.toml", "history.csv", "checkpoint.json", "islands.csv",
-                                            "resume.log",  "stopped.txt", "best",            "figures"};
+const std::vector<std::string> kRunFiles = {"config.toml", "history.csv", "checkpoint.json",
+                                            "islands.csv", "resume.log",  "stopped.txt",
+                                            "best",        "figures"};
 
 // NAME.PID.tmp or NAME.tmp next to a run file: left by a process killed while writing NAME.
 bool is_leftover_temporary(const std::string& name) {
   if (name.size() < 5 || name.compare(name.size() - 4, 4, ".tmp") != 0) return false;
   std::string stem = name.substr(0, name.size() - 4);
-  if (const auto dot = stem.rfind('.'); dot != std::string::npos && dot + 1 < stem.size() &&
-                                        stem.find_first_not_of("0123456789", dot + 1) == std::string::npos)
+  if (const auto dot = stem.rfind('.');
+      dot != std::string::npos && dot + 1 < stem.size() &&
+      stem.find_first_not_of("0123456789", dot + 1) == std::string::npos)
     stem.resize(dot);
   if (stem.rfind("gen_", 0) == 0) return true;
   return std::find(kRunFiles.begin(), kRunFiles.end(), stem) != kRunFiles.end();
@@ -300,7 +322,8 @@ void remove_leftover_temporaries(const std::filesystem::path& dir) {
     if (!std::filesystem::is_directory(folder, ec)) continue;
     std::vector<std::filesystem::path> doomed;
     for (const auto& entry : std::filesystem::directory_iterator(folder))
-      if (is_leftover_temporary(entry.path().filename().string()) && !entry.is_directory(ec)) doomed.push_back(entry.path());
+      if (is_leftover_temporary(entry.path().filename().string()) && !entry.is_directory(ec))
+        doomed.push_back(entry.path());
     for (const auto& p : doomed) std::filesystem::remove(p);
   }
 }
@@ -325,9 +348,10 @@ void refuse_existing_run(const Config& config, const std::filesystem::path& dir)
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) return;
   if (std::filesystem::exists(dir / "checkpoint.json", ec))
-    throw RunExists(fmt::format("{}: already holds a run (checkpoint.json); resume it (--resume {} / resume=True), replace "
-                                "it (--overwrite / overwrite=True) or choose another directory. Nothing was written.",
-                                dir.string(), dir.string()));
+    throw RunExists(fmt::format(
+        "{}: already holds a run (checkpoint.json); resume it (--resume {} / resume=True), replace "
+        "it (--overwrite / overwrite=True) or choose another directory. Nothing was written.",
+        dir.string(), dir.string()));
   std::vector<std::string> found;
   bool restartable = true;
   const std::filesystem::path stored = dir / "config.toml";
@@ -336,8 +360,10 @@ void refuse_existing_run(const Config& config, const std::filesystem::path& dir)
     try {
       const auto keys = config_differences(load_config(stored), config);
       if (!keys.empty())
-        why = fmt::format("a different config: {}{}", fmt::join(keys.begin(), keys.begin() + std::min<std::size_t>(keys.size(), 4), ", "),
-                          keys.size() > 4 ? fmt::format(" and {} more", keys.size() - 4) : "");
+        why = fmt::format(
+            "a different config: {}{}",
+            fmt::join(keys.begin(), keys.begin() + std::min<std::size_t>(keys.size(), 4), ", "),
+            keys.size() > 4 ? fmt::format(" and {} more", keys.size() - 4) : "");
     } catch (const Error&) {
       why = "not a valid config";
     }
@@ -374,10 +400,12 @@ void refuse_existing_run(const Config& config, const std::filesystem::path& dir)
     restartable = false;
   }
   if (found.empty() || restartable) return;
-  throw RunExists(fmt::format(
-      "{}: holds the files of a run but no checkpoint.json to resume from: {}; starting a new run here would mix two "
-      "runs. Replace it (--overwrite / overwrite=True) or choose another directory. Nothing was written.",
-      dir.string(), fmt::join(found, ", ")));
+  throw RunExists(
+      fmt::format("{}: holds the files of a run but no checkpoint.json to resume from: {}; "
+                  "starting a new run here would mix two "
+                  "runs. Replace it (--overwrite / overwrite=True) or choose another directory. "
+                  "Nothing was written.",
+                  dir.string(), fmt::join(found, ", ")));
 }
 
 // RunOptions::overwrite: removes what a run wrote, nothing else.
@@ -399,17 +427,20 @@ std::string local_time_stamp() {
 
 namespace {
 
-RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, FitnessFunction fitness,
-                                   FitnessFunction reference) {
+RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
+                                   FitnessFunction fitness, FitnessFunction reference) {
   validate(config);
-  if (!fitness) {  // the real swim: its exploit guard re-evaluates each new best at the reference step
+  if (!fitness) {
+    // the real swim: its exploit guard re-evaluates each new best at the reference step
     fitness = swim_fitness(config);
-    if (config.evaluation.reference_check != "off") reference = swim_fitness(reference_config(config));
+    if (config.evaluation.reference_check != "off")
+      reference = swim_fitness(reference_config(config));
   }
   Evolution evo(config, std::move(fitness), std::move(reference), opt.evaluator);
   evo.set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
   const bool writing = !opt.out.empty();
-  IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);  // [islands] islands.csv
+  // [islands] islands.csv
+  IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
   // 1. Everything that can refuse the command, before any file is written: checked once without the
@@ -417,7 +448,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
   // holding it (another process may have written in between).
   std::vector<std::string> changed_on_resume;
   if (opt.resume && !writing) throw Error("run_evolution: resume needs a run directory");
-  if (opt.resume && opt.overwrite) throw Error("run_evolution: resume and overwrite contradict each other");
+  if (opt.resume && opt.overwrite)
+    throw Error("run_evolution: resume and overwrite contradict each other");
   std::optional<RunLock> lock;
   if (writing) {
     check_run_path(opt.out);
@@ -427,7 +459,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
         if (!std::filesystem::is_directory(opt.out, ec))
           throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
         if (!std::filesystem::exists(ckpt, ec))
-          throw CheckpointError(fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
+          throw CheckpointError(
+              fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
         changed_on_resume = check_resume_settings(config, opt.out);
         return read_file(ckpt);
       }
@@ -439,10 +472,13 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     if (opt.resume) evo.restore(checkpoint_text, ckpt.string());
     if (!opt.resume) {
       std::filesystem::create_directories(opt.out, ec);
-      if (ec) throw IoError(fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
+      if (ec)
+        throw IoError(
+            fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
     }
     lock.emplace(opt.out);
-    if (const std::string again = check(); again != checkpoint_text) evo.restore(again, ckpt.string());
+    if (const std::string again = check(); again != checkpoint_text)
+      evo.restore(again, ckpt.string());
     lock->started();
     if (opt.on_start) opt.on_start();
     if (opt.overwrite) clear_run_directory(opt.out);
@@ -453,15 +489,19 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
   if (writing) {
     std::error_code ec;
     std::filesystem::create_directories(opt.out / "best", ec);
-    if (ec) throw IoError(fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
+    if (ec)
+      throw IoError(
+          fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
     if (!changed_on_resume.empty()) {
       const Config stored = load_config(opt.out / "config.toml");
-      std::string note = fmt::format("{} resumed at generation {}:", local_time_stamp(), evo.generation());
+      std::string note =
+          fmt::format("{} resumed at generation {}:", local_time_stamp(), evo.generation());
       for (const auto& key : changed_on_resume) {
         note += fmt::format(" {} {} -> {};", key, format_config_value(get_value(stored, key)),
                             format_config_value(get_value(config, key)));
         if (!opt.quiet)
-          spdlog::info("resume: {} changed from {} to {}", key, format_config_value(get_value(stored, key)),
+          spdlog::info("resume: {} changed from {} to {}", key,
+                       format_config_value(get_value(stored, key)),
                        format_config_value(get_value(config, key)));
       }
       note.back() = '\n';
@@ -475,28 +515,36 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
     island_log.resume(evo.generation());
-    // Lineage files of generations after the checkpoint belong to the lost future; they are rewritten.
+    // Lineage files of generations after the checkpoint belong to the lost future; they are
+    // rewritten.
     for (const auto& entry : std::filesystem::directory_iterator(opt.out / "best")) {
       const std::string name = entry.path().filename().string();
       int g = -1;
-      if (std::sscanf(name.c_str(), "gen_%d.json", &g) == 1 && g > evo.generation()) std::filesystem::remove(entry.path());
+      if (std::sscanf(name.c_str(), "gen_%d.json", &g) == 1 && g > evo.generation())
+        std::filesystem::remove(entry.path());
     }
     if (!opt.quiet) spdlog::info("resumed {} at generation {}", opt.out.string(), evo.generation());
   } else {
-    if (!opt.quiet) spdlog::info("drawing {} viable random individuals...", config.evolution.population);
+    if (!opt.quiet)
+      spdlog::info("drawing {} viable random individuals...", config.evolution.population);
     try {
       evo.initialize();
     } catch (const Interrupted&) {
-      if (!opt.quiet) spdlog::info("stopped: interrupted before the initial population was complete (nothing to resume)");
+      if (!opt.quiet)
+        spdlog::info(
+            "stopped: interrupted before the initial population was complete (nothing to resume)");
       RunSummary summary;
       summary.stop_reason = "interrupted";
       return summary;
     }
     const auto tries = evo.initial_tries();
-    const double mean_tries = std::accumulate(tries.begin(), tries.end(), 0.0) / static_cast<double>(tries.size());
+    const double mean_tries =
+        std::accumulate(tries.begin(), tries.end(), 0.0) / static_cast<double>(tries.size());
     if (!opt.quiet)
-      spdlog::info("initial population: {:.0f} random genomes per viable individual on average (paper: \"a few hundred\")",
-                   mean_tries);
+      spdlog::info(
+          "initial population: {:.0f} random genomes per viable individual on average (paper: \"a "
+          "few hundred\")",
+          mean_tries);
     if (writing) {
       write_atomically(hist, history_header() + history_row(evo.history().back()));
       write_lineage(opt.out, evo);
@@ -505,7 +553,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     }
   }
   bool stopped_by_callback = false;
-  if (!opt.resume && opt.callback && !opt.callback(evo.history().back(), evo)) stopped_by_callback = true;
+  if (!opt.resume && opt.callback && !opt.callback(evo.history().back(), evo))
+    stopped_by_callback = true;
 
   RunSummary summary;
   double last_print = 0.0;
@@ -522,24 +571,29 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
     std::string left;
     if (config.evolution.generations > 0 && s.generation > 0 && pace > 0) {
       double eta = pace * (config.evolution.generations - s.generation);
-      if (config.evolution.wall_seconds > 0) eta = std::min(eta, config.evolution.wall_seconds - s.wall_seconds);
+      if (config.evolution.wall_seconds > 0)
+        eta = std::min(eta, config.evolution.wall_seconds - s.wall_seconds);
       left = fmt::format(", ETA {}", duration(eta));
     } else if (config.evolution.wall_seconds > 0) {
-      left = fmt::format(", {} left of budget", duration(config.evolution.wall_seconds - s.wall_seconds));
+      left = fmt::format(", {} left of budget",
+                         duration(config.evolution.wall_seconds - s.wall_seconds));
     }
-    spdlog::info("gen {:5d} | best {:8.4f} mean {:8.4f} median {:8.4f} | viable {:5.1f}% | {:6.1f} eval/s | {} elapsed{}",
-                 s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.evaluations_per_second,
-                 duration(s.wall_seconds), left);
+    spdlog::info(
+        "gen {:5d} | best {:8.4f} mean {:8.4f} median {:8.4f} | viable {:5.1f}% | {:6.1f} eval/s | "
+        "{} elapsed{}",
+        s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.evaluations_per_second,
+        duration(s.wall_seconds), left);
   };
   // Exploit guard: a best whose fitness the reference step does not confirm is reported.
   const EvaluationParams& ev = config.evaluation;
   auto guard = [&](const GenerationStats& s) {
     if (opt.quiet || !s.best_changed || std::isnan(s.best_reference)) return;
     if (reference_disagrees(s.best, s.best_reference, ev))
-      spdlog::warn("gen {}: the new best's fitness {:.4f} is not confirmed at the reference step "
-                   "(physics.substeps x {}: {:.4f}, {:+.1f}%): its swim depends on the step size",
-                   s.generation, s.best, ev.reference_substeps, s.best_reference,
-                   100.0 * (s.best - s.best_reference) / std::max(std::abs(s.best_reference), 1e-12));
+      spdlog::warn(
+          "gen {}: the new best's fitness {:.4f} is not confirmed at the reference step "
+          "(physics.substeps x {}: {:.4f}, {:+.1f}%): its swim depends on the step size",
+          s.generation, s.best, ev.reference_substeps, s.best_reference,
+          100.0 * (s.best - s.best_reference) / std::max(std::abs(s.best_reference), 1e-12));
   };
   report(evo.history().back(), true);
   guard(evo.history().back());
@@ -551,14 +605,16 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt, 
       break;
     }
     summary.stop_reason = evo.stop_reason();
-    if (summary.stop_reason.empty() && ((opt.stop_flag && opt.stop_flag->load()) || (opt.stop_poll && opt.stop_poll())))
+    if (summary.stop_reason.empty() &&
+        ((opt.stop_flag && opt.stop_flag->load()) || (opt.stop_poll && opt.stop_poll())))
       summary.stop_reason = "interrupted";
     if (!summary.stop_reason.empty()) break;
     GenerationStats s;
     try {
       s = evo.step();
     } catch (const Interrupted&) {
-      summary.stop_reason = "interrupted";  // the generation in progress is dropped; resuming recomputes it
+      // the generation in progress is dropped; resuming recomputes it
+      summary.stop_reason = "interrupted";
       break;
     }
     report(s, false);
@@ -596,7 +652,8 @@ RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFun
                          FitnessFunction reference) {
   try {
     return run_evolution_unchecked(config, opt, std::move(fitness), std::move(reference));
-  } catch (const std::filesystem::filesystem_error& e) {  // never an "internal error": name the path and the reason
+  } catch (const std::filesystem::filesystem_error& e) {
+    // never an "internal error": name the path and the reason
     throw IoError(fmt::format("{}: {}", e.path1().string(), e.code().message()));
   }
 }

@@ -1,4 +1,5 @@
-// A run's identity (run_identity.hpp): scheme 2 from the keys' descriptors, scheme 1 for older checkpoints.
+// A run's identity (run_identity.hpp): scheme 2 from the keys' descriptors, scheme 1 for older
+// checkpoints.
 #include "animat/run_identity.hpp"
 
 #include <fmt/format.h>
@@ -16,7 +17,8 @@ namespace {
 // islands existed resume).
 bool unused_island_key(const Config& c, std::string_view key) {
   return c.evolution.islands <= 1 &&
-         (key == "evolution.islands" || key == "evolution.migration_interval" || key == "evolution.migrants");
+         (key == "evolution.islands" || key == "evolution.migration_interval" ||
+          key == "evolution.migrants");
 }
 
 std::vector<std::string> keys_with(Identity identity) {
@@ -86,20 +88,23 @@ std::uint64_t run_identity_v1(const Config& config) {
   std::string text = to_toml(c, kV1Version, [](std::string_view key, std::string_view doc) {
     for (const auto& [k, comment] : kV1Comments)
       if (k == key) return std::string(comment);
-    return std::string(doc);  // a key newer than scheme 2: left out below unless away from its default
+    // a key newer than scheme 2: left out below unless away from its default
+    return std::string(doc);
   });
   // The late keys at their defaults go, each with its comment line; so does every key newer than
   // scheme 2 (no scheme-1 run had it).
   for (const auto& key : config_keys()) {
-    const bool late = contains(kV1LateKeys, key) ||
-                      std::none_of(std::begin(kV1Comments), std::end(kV1Comments), [&](const auto& e) { return e.first == key; });
+    const bool late =
+        contains(kV1LateKeys, key) || std::none_of(std::begin(kV1Comments), std::end(kV1Comments),
+                                                   [&](const auto& e) { return e.first == key; });
     if (late && get_value(c, key) == get_value(defaults, key)) erase_key_lines(text, key);
   }
   // A section left without keys ([control] at its defaults) goes with its header.
   for (auto at = text.find("\n["); at != std::string::npos;) {
     const auto close = text.find("]\n", at);
     const auto after = close == std::string::npos ? std::string::npos : close + 2;
-    if (after != std::string::npos && (after == text.size() || text.compare(after, 2, "\n[") == 0)) {
+    if (after != std::string::npos &&
+        (after == text.size() || text.compare(after, 2, "\n[") == 0)) {
       text.erase(at, after - at);
       at = text.find("\n[", at);
     } else {
@@ -112,7 +117,7 @@ std::uint64_t run_identity_v1(const Config& config) {
     const auto last = text.find("\nmigrants = ", key == std::string::npos ? 0 : key);
     if (key != std::string::npos && last != std::string::npos) {
       const auto begin = text.rfind('\n', key - 1) + 1;  // the comment line of `islands`
-      const auto end = text.find('\n', last + 1);       // the end of the `migrants` line
+      const auto end = text.find('\n', last + 1);        // the end of the `migrants` line
       text.erase(begin, end == std::string::npos ? std::string::npos : end + 1 - begin);
     }
   }

@@ -1,6 +1,6 @@
-// The scene: the registry of built-in swim effects (each in its own file in src/effects/), parameter
-// checks, and the pure pieces of the effects that tests use directly. Units and coefficient
-// choices: docs/notes/physics.md.
+// The scene: the registry of built-in swim effects (each in its own file in src/effects/),
+// parameter checks, and the pure pieces of the effects that tests use directly. Units and
+// coefficient choices: docs/notes/physics.md.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -35,15 +35,20 @@ void check_fields(P params, std::string_view section) {
       throw ConfigError(fmt::format("{}.{}: {}", section, info.name, what));
     };
     if constexpr (std::is_same_v<T, double> || std::is_same_v<T, int>) {
-      if (!std::isfinite(static_cast<double>(value)) || !info.bounds.contains(static_cast<double>(value)))
+      if (!std::isfinite(static_cast<double>(value)) ||
+          !info.bounds.contains(static_cast<double>(value)))
         fail(fmt::format("{} is out of range ({})", value, info.bounds.describe()));
     } else if constexpr (std::is_same_v<T, std::string>) {
-      if (!info.choices.empty() && std::find(info.choices.begin(), info.choices.end(), value) == info.choices.end())
-        fail(fmt::format("unknown value '{}' (expected one of {})", value, fmt::join(info.choices, ", ")));
+      if (!info.choices.empty() &&
+          std::find(info.choices.begin(), info.choices.end(), value) == info.choices.end())
+        fail(fmt::format("unknown value '{}' (expected one of {})", value,
+                         fmt::join(info.choices, ", ")));
     } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
       for (std::size_t i = 0; i < value.size(); ++i) {
-        if (!info.choices.empty() && std::find(info.choices.begin(), info.choices.end(), value[i]) == info.choices.end())
-          fail(fmt::format("unknown entry '{}' (expected any of {})", value[i], fmt::join(info.choices, ", ")));
+        if (!info.choices.empty() &&
+            std::find(info.choices.begin(), info.choices.end(), value[i]) == info.choices.end())
+          fail(fmt::format("unknown entry '{}' (expected any of {})", value[i],
+                           fmt::join(info.choices, ", ")));
         for (std::size_t j = 0; j < i; ++j)
           if (value[j] == value[i]) fail(fmt::format("entry '{}' is listed twice", value[i]));
       }
@@ -69,7 +74,8 @@ Body swim_body(const Body& in) {
   for (int s = 0; s < b.spring_count() && s < b.rest_lengths.size(); ++s) {
     const int i = b.springs(s, 0), j = b.springs(s, 1);
     if (i < 0 || j < 0 || i >= n || j >= n) continue;
-    const double dx = b.positions(j, 0) - b.positions(i, 0), dy = b.positions(j, 1) - b.positions(i, 1);
+    const double dx = b.positions(j, 0) - b.positions(i, 0),
+                 dy = b.positions(j, 1) - b.positions(i, 1);
     const double len = std::sqrt(dx * dx + dy * dy);  // as Springs measures it
     if (std::abs(len - b.rest_lengths(s)) <= tol) b.rest_lengths(s) = len;
   }
@@ -109,21 +115,24 @@ double implicit_quadratic_drag(double w, double c_dt) {
 void validate(const SceneParams& params) {
   check_fields(params, "scene");
   if (params.ground_friction_kinetic > params.ground_friction_static)
-    throw ConfigError(fmt::format("scene.ground_friction_kinetic: {} is above scene.ground_friction_static = {} "
-                                  "(Coulomb friction needs mu_k <= mu_s)",
-                                  params.ground_friction_kinetic, params.ground_friction_static));
+    throw ConfigError(
+        fmt::format("scene.ground_friction_kinetic: {} is above scene.ground_friction_static = {} "
+                    "(Coulomb friction needs mu_k <= mu_s)",
+                    params.ground_friction_kinetic, params.ground_friction_static));
   if (params.chemical_source.size() != 2)
-    throw ConfigError(fmt::format("scene.chemical_source: expected [x, y] (2 numbers), got {} numbers",
-                                  params.chemical_source.size()));
+    throw ConfigError(
+        fmt::format("scene.chemical_source: expected [x, y] (2 numbers), got {} numbers",
+                    params.chemical_source.size()));
   for (double v : params.chemical_source)
     if (!std::isfinite(v) || std::abs(v) > kMaxLength)
-      throw ConfigError(fmt::format("scene.chemical_source: {} is out of range (finite, |x| <= {})", v, kMaxLength));
+      throw ConfigError(fmt::format("scene.chemical_source: {} is out of range (finite, |x| <= {})",
+                                    v, kMaxLength));
 }
 
 void validate(const PhysicsParams& params) { check_fields(params, "physics"); }
 
-std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body, const SceneParams& scene,
-                                    const PhysicsParams& physics) {
+std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body,
+                                    const SceneParams& scene, const PhysicsParams& physics) {
   if (name == "springs") return effects::make_springs(body, scene);
   if (name == "actuation") return effects::make_actuation(body, physics);
   if (name == "pressure") return effects::make_pressure(body, scene);

@@ -20,7 +20,8 @@ void Writer::genome(const Genome& g) {
   put(static_cast<std::int32_t>(g.dimensions));
   put(static_cast<std::uint32_t>(g.elements.size()));
   for (const Element& e : g.elements) {
-    const auto& [type, sign, channel, coords] = e;  // a new Element field must be added here (and in Reader)
+    const auto& [type, sign, channel, coords] =
+        e;  // a new Element field must be added here (and in Reader)
     put(static_cast<std::uint8_t>(type));
     put(static_cast<std::int8_t>(sign));
     put(static_cast<std::int32_t>(channel));
@@ -29,21 +30,26 @@ void Writer::genome(const Genome& g) {
   }
 }
 
-// A Fitness field by field, in its descriptor's order (evolution.hpp): f64, bools as u8, int as i32,
-// long as i64.
+// A Fitness field by field, in its descriptor's order (evolution.hpp): f64, bools as u8, int as
+// i32, long as i64.
 void Writer::fitness(const Fitness& f) {
   visit_fields(f, [this](const char*, const char*, const auto& value) {
     using T = std::decay_t<decltype(value)>;
-    if constexpr (std::is_same_v<T, bool>) put(static_cast<std::uint8_t>(value));
-    else if constexpr (std::is_same_v<T, int>) put(static_cast<std::int32_t>(value));
-    else if constexpr (std::is_same_v<T, long>) put(static_cast<std::int64_t>(value));
-    else put(value);
+    if constexpr (std::is_same_v<T, bool>)
+      put(static_cast<std::uint8_t>(value));
+    else if constexpr (std::is_same_v<T, int>)
+      put(static_cast<std::int32_t>(value));
+    else if constexpr (std::is_same_v<T, long>)
+      put(static_cast<std::int64_t>(value));
+    else
+      put(value);
   });
 }
 
 void Reader::need(std::size_t n) const {
   if (n > size_ - pos_)
-    throw Error(fmt::format("MPI message truncated: {} more bytes needed at byte {} of {}", n, pos_, size_));
+    throw Error(fmt::format("MPI message truncated: {} more bytes needed at byte {} of {}", n, pos_,
+                            size_));
 }
 
 std::string Reader::string() {
@@ -79,10 +85,14 @@ Fitness Reader::fitness() {
   Fitness f;
   visit_fields(f, [this](const char*, const char*, auto& value) {
     using T = std::decay_t<decltype(value)>;
-    if constexpr (std::is_same_v<T, bool>) value = get<std::uint8_t>() != 0;
-    else if constexpr (std::is_same_v<T, int>) value = get<std::int32_t>();
-    else if constexpr (std::is_same_v<T, long>) value = static_cast<long>(get<std::int64_t>());
-    else value = get<T>();
+    if constexpr (std::is_same_v<T, bool>)
+      value = get<std::uint8_t>() != 0;
+    else if constexpr (std::is_same_v<T, int>)
+      value = get<std::int32_t>();
+    else if constexpr (std::is_same_v<T, long>)
+      value = static_cast<long>(get<std::int64_t>());
+    else
+      value = get<T>();
   });
   return f;
 }

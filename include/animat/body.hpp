@@ -15,21 +15,47 @@ struct Embryo;
 inline constexpr std::string_view kBodyGraphNames[] = {"gabriel", "distance", "alpha_shape"};
 
 struct BodyParams {
-  double merge_distance = 1e-6;    ///< points closer than this are duplicates (rejected) [choose]
-  double max_coordinate = 1e6;     ///< |x| or |y| above this is rejected as absurd [choose]
-  std::string graph = "gabriel";   ///< gabriel [paper] | distance | alpha_shape [issue 17]
-  /// distance graph: Delaunay-tessellation edges up to this length, in mean nearest-neighbour distances
+  double merge_distance = 1e-6;   ///< points closer than this are duplicates (rejected) [choose]
+  double max_coordinate = 1e6;    ///< |x| or |y| above this is rejected as absurd [choose]
+  std::string graph = "gabriel";  ///< gabriel [paper] | distance | alpha_shape [issue 17]
+  /// distance graph: Delaunay-tessellation edges up to this length, in mean nearest-neighbour
+  /// distances
   double distance_threshold = 1.5;
-  double alpha = 1.0;              ///< alpha_shape: largest circumradius, in mean nearest-neighbour distances
+  /// alpha_shape: largest circumradius, in mean nearest-neighbour distances
+  double alpha = 1.0;
 };
 
 template <class V>
 void visit_fields(BodyParams& p, V&& v) {
-  v(FieldInfo{"merge_distance", "centres closer than this are duplicates and are rejected [choose]", Bounds::upto(kMaxLength)}, p.merge_distance);
-  v(FieldInfo{"max_coordinate", "coordinates beyond this magnitude are rejected [choose]", Bounds::positive_upto(kMaxLength)}, p.max_coordinate);
-  v(FieldInfo{"graph", "body graph: gabriel (paper: Gabriel graph, closed disc); distance (Delaunay-tessellation edges not longer than distance_threshold, plus the relative-neighbourhood edges that keep the body in one piece); alpha_shape (regularized alpha complex of radius alpha, same connecting edges; bounded faces outside the complex are holes: no pressure, skin) [issue 17]", Bounds::any(), kBodyGraphNames, Identity::late}, p.graph);
-  v(FieldInfo{"distance_threshold", "graph = distance: longest spring, in units of the mean nearest-neighbour distance of the cell centres (1 = a packed cell diameter), (0, 1e6] [issue 17]", Bounds::positive_upto(kMaxLength), {}, Identity::late}, p.distance_threshold);
-  v(FieldInfo{"alpha", "graph = alpha_shape: largest circumradius of a filled triangle, in units of the mean nearest-neighbour distance of the cell centres (CGAL's alpha is its square), (0, 1e6] [issue 17]", Bounds::positive_upto(kMaxLength), {}, Identity::late}, p.alpha);
+  v(FieldInfo{"merge_distance", "centres closer than this are duplicates and are rejected [choose]",
+              Bounds::upto(kMaxLength)},
+    p.merge_distance);
+  v(FieldInfo{"max_coordinate", "coordinates beyond this magnitude are rejected [choose]",
+              Bounds::positive_upto(kMaxLength)},
+    p.max_coordinate);
+  v(FieldInfo{"graph",
+              "body graph: gabriel (paper: Gabriel graph, closed disc); distance "
+              "(Delaunay-tessellation edges not longer than distance_threshold, plus the "
+              "relative-neighbourhood edges that keep the body in one piece); alpha_shape "
+              "(regularized alpha complex of radius alpha, same connecting edges; bounded faces "
+              "outside the complex are holes: no pressure, skin) [issue 17]",
+              Bounds::any(), kBodyGraphNames, Identity::late},
+    p.graph);
+  v(FieldInfo{"distance_threshold",
+              "graph = distance: longest spring, in units of the mean nearest-neighbour distance "
+              "of the cell centres (1 = a packed cell diameter), (0, 1e6] [issue 17]",
+              Bounds::positive_upto(kMaxLength),
+              {},
+              Identity::late},
+    p.distance_threshold);
+  v(FieldInfo{"alpha",
+              "graph = alpha_shape: largest circumradius of a filled triangle, in units of the "
+              "mean nearest-neighbour distance of the cell centres (CGAL's alpha is its square), "
+              "(0, 1e6] [issue 17]",
+              Bounds::positive_upto(kMaxLength),
+              {},
+              Identity::late},
+    p.alpha);
 }
 
 /// The spring-mass structure an embryo becomes.
@@ -41,21 +67,23 @@ void visit_fields(BodyParams& p, V&& v) {
 /// implicit closing edge (last -> first); each starts at its lexicographically smallest directed
 /// edge (loop[0], loop[1]). See docs/notes/body.md for every choice and degenerate case.
 struct Body {
-  Points positions;                          ///< node (cell centre) positions at rest, n × 2
-  IndexPairs springs;                        ///< body-graph edges (i < j), sorted lexicographically
-  Vector rest_lengths;                       ///< L0 per spring
-  /// Bounded faces, vertex loops in CCW order (face on the left), sorted lexicographically. A loop is
-  /// the face's boundary walk: an edge that hangs into the face (a bridge) appears twice in it.
+  Points positions;     ///< node (cell centre) positions at rest, n × 2
+  IndexPairs springs;   ///< body-graph edges (i < j), sorted lexicographically
+  Vector rest_lengths;  ///< L0 per spring
+  /// Bounded faces, vertex loops in CCW order (face on the left), sorted lexicographically. A loop
+  /// is the face's boundary walk: an edge that hangs into the face (a bridge) appears twice in it.
   std::vector<std::vector<int>> regions;
-  Vector rest_areas;                         ///< S0 per region (> 0 by CCW orientation)
-  IndexPairs skin;                           ///< edges bordering the unbounded face or a hole, each once (i < j)
+  Vector rest_areas;  ///< S0 per region (> 0 by CCW orientation)
+  /// edges bordering the unbounded face or a hole, each once (i < j)
+  IndexPairs skin;
   /// Closed walks around the boundary, body on the left; dangling edges twice. skin_loops[0] is the
   /// outer boundary (CCW around the body; one for n >= 2: every body graph is connected), then one
   /// walk per hole (clockwise around the hole), sorted; none for n <= 1.
   std::vector<std::vector<int>> skin_loops;
-  Vector amplitude, frequency, phase;        ///< per-node oscillator parameters (zeros if none given)
-  /// Per-node stiffness factor f (issue 17 part 3, GRN output `stiffness`); empty = every spring has
-  /// scene.spring_stiffness (the paper's uniform stiffness). Spring (i, j) then has stiffness
+  /// per-node oscillator parameters (zeros if none given)
+  Vector amplitude, frequency, phase;
+  /// Per-node stiffness factor f (issue 17 part 3, GRN output `stiffness`); empty = every spring
+  /// has scene.spring_stiffness (the paper's uniform stiffness). Spring (i, j) then has stiffness
   /// k·spring_stiffness_factor(f_i, f_j).
   Vector stiffness;
 
@@ -67,7 +95,9 @@ struct Body {
 /// Stiffness factor of a spring between cells with factors fi and fj: their harmonic mean
 /// 2·fi·fj/(fi + fj). Each cell owns half the spring; the halves (stiffness 2k·fi and 2k·fj) act in
 /// series, so 1/k_spring = 1/(2k·fi) + 1/(2k·fj). Exactly 1 when fi = fj = 1.
-[[nodiscard]] inline double spring_stiffness_factor(double fi, double fj) { return 2.0 * fi * fj / (fi + fj); }
+[[nodiscard]] inline double spring_stiffness_factor(double fi, double fj) {
+  return 2.0 * fi * fj / (fi + fj);
+}
 
 /// Delaunay edges (i < j, sorted) of the points; for Fig. 3(b). Same validation as gabriel_graph.
 [[nodiscard]] IndexPairs delaunay_edges(const Points& points, const BodyParams& params = {});
@@ -78,8 +108,9 @@ struct Body {
 [[nodiscard]] IndexPairs gabriel_graph(const Points& points, const BodyParams& params = {});
 /// Builds the body from any point set; oscillator vectors may be empty (zeros), else length n and
 /// finite (GeometryError otherwise). Same point validation as gabriel_graph.
-[[nodiscard]] Body build_body(const Points& positions, const Vector& amplitude, const Vector& frequency,
-                              const Vector& phase, const BodyParams& params = {});
+[[nodiscard]] Body build_body(const Points& positions, const Vector& amplitude,
+                              const Vector& frequency, const Vector& phase,
+                              const BodyParams& params = {});
 /// Builds the body from an embryo's cell centres and oscillator parameters (radii are ignored).
 [[nodiscard]] Body build_body(const Embryo& embryo, const BodyParams& params = {});
 

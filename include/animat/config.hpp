@@ -49,18 +49,21 @@ void visit_sections(C& c, V&& v) {
 }
 
 /// A config value, as seen by --set and the Python dict view.
-using ConfigValue = std::variant<bool, std::int64_t, double, std::string, std::vector<std::string>, std::vector<double>>;
+using ConfigValue = std::variant<bool, std::int64_t, double, std::string, std::vector<std::string>,
+                                 std::vector<double>>;
 
 /// Parses TOML text. Unknown keys, wrong types, out-of-range values and malformed TOML throw
-/// ConfigError naming `source`, the line, the key and what was expected. Missing keys keep defaults.
+/// ConfigError naming `source`, the line, the key and what was expected. Missing keys keep
+/// defaults.
 [[nodiscard]] Config config_from_toml(std::string_view text, std::string_view source = "<string>");
 [[nodiscard]] Config load_config(const std::filesystem::path& path);
 /// The complete config as commented TOML; config_from_toml(to_toml(c)) == c.
 [[nodiscard]] std::string to_toml(const Config& config);
 /// to_toml() with the version in its first line and each key's comment chosen by the caller:
 /// comment(dotted_key, doc) gives the text of the key's comment line.
-[[nodiscard]] std::string to_toml(const Config& config, std::string_view version,
-                                  const std::function<std::string(std::string_view dotted_key, std::string_view doc)>& comment);
+[[nodiscard]] std::string to_toml(
+    const Config& config, std::string_view version,
+    const std::function<std::string(std::string_view dotted_key, std::string_view doc)>& comment);
 /// Applies "section.key=value"; the value is parsed by the field's type, then the whole config is
 /// validated (the cross-key rules included). A rejected override leaves the config unchanged.
 void apply_override(Config& config, std::string_view assignment);
@@ -72,8 +75,8 @@ void set_value(Config& config, std::string_view dotted_key, const ConfigValue& v
 /// Every "section.key", in order.
 [[nodiscard]] std::vector<std::string> config_keys();
 [[nodiscard]] std::string config_doc(std::string_view dotted_key);
-/// The key's part in a run's identity (its descriptor's FieldInfo::identity); throws ConfigError for
-/// an unknown key.
+/// The key's part in a run's identity (its descriptor's FieldInfo::identity); throws ConfigError
+/// for an unknown key.
 [[nodiscard]] Identity config_identity(std::string_view dotted_key);
 /// Checks every field's range and the cross-field rules; throws ConfigError naming the key.
 void validate(const Config& config, std::string_view source = "config");

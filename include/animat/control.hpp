@@ -1,10 +1,11 @@
 #pragma once
-// Active control beyond the paper (issue 18, docs/control.md): the GRN keeps running while the animat
-// swims. With control.mode = "grn" every cell's network (its state at the end of development carried
-// over) is stepped every control.update_interval Box2D steps; its `actuation` output sets the cell's
-// term u_i of eq. 2, its inputs read sensors (strain, pressure, the scene's chemical field) and the
-// products of its neighbours, which diffuse along the springs (signalling). "open_loop" (default) is
-// the paper: the oscillators of eq. 2 with the parameters development left.
+// Active control beyond the paper (issue 18, docs/control.md): the GRN keeps running while the
+// animat swims. With control.mode = "grn" every cell's network (its state at the end of development
+// carried over) is stepped every control.update_interval Box2D steps; its `actuation` output sets
+// the cell's term u_i of eq. 2, its inputs read sensors (strain, pressure, the scene's chemical
+// field) and the products of its neighbours, which diffuse along the springs (signalling).
+// "open_loop" (default) is the paper: the oscillators of eq. 2 with the parameters development
+// left.
 #include <array>
 #include <span>
 #include <string>
@@ -32,11 +33,12 @@ struct ControlParams {
   /// "amplitude": u_i = amplitude_max·L·sin(f_i·t + φ_i), the paper's oscillator (f_i, φ_i from
   /// development, the same phase-delayed start) with its amplitude under the GRN's control.
   std::string actuation = "direct";
-  /// k: Box2D steps between two GRN updates (sensors, signalling and eq. 1 advance together) [choose:
-  /// the bench of docs/control.md]
+  /// k: Box2D steps between two GRN updates (sensors, signalling and eq. 1 advance together)
+  /// [choose: the bench of docs/control.md]
   int update_interval = 10;
   /// Rate of eq. 1 in swim time: one update advances eq. 1 by dt = grn_rate·k·h (h the Box2D step),
-  /// so a level relaxes with time constant 1/grn_rate whatever k. k·h·grn_rate must be <= 1 [choose]
+  /// so a level relaxes with time constant 1/grn_rate whatever k. k·h·grn_rate must be <= 1
+  /// [choose]
   double grn_rate = 3.0;
   /// D: diffusion rate of cell products along the springs, per time unit (graph Laplacian) [choose]
   double signal_rate = 0.0;
@@ -51,13 +53,54 @@ struct ControlParams {
 
 template <class V>
 void visit_fields(ControlParams& p, V&& v) {
-  v(FieldInfo{"mode", "what drives actuation while swimming: open_loop (the paper's sinusoids) or grn (the GRN keeps running, its actuation output sets u_i; docs/control.md) [beyond the paper]", Bounds::any(), kControlModeNames, Identity::late}, p.mode);
-  v(FieldInfo{"actuation", "what the GRN's actuation output L sets in mode grn: direct (u_i = amplitude_max*(2L-1)) or amplitude (u_i = amplitude_max*L*sin(f_i t + phi_i), the developed oscillator with a GRN-controlled amplitude) [choose]", Bounds::any(), kControlActuationNames, Identity::late}, p.actuation);
-  v(FieldInfo{"update_interval", "k, Box2D steps between GRN updates in mode grn (sensors, signalling and eq. 1 advance together), 1 to 1000 [choose]", Bounds::closed(1, 1000), {}, Identity::late}, p.update_interval);
-  v(FieldInfo{"grn_rate", "rate of eq. 1 while swimming, per time unit: an update advances eq. 1 by grn_rate*k*h (h = physics.dt/substeps, must be <= 1) [choose]", Bounds::positive_upto(1e6), {}, Identity::late}, p.grn_rate);
-  v(FieldInfo{"signal_rate", "D, diffusion rate of cell products along the springs while swimming (graph Laplacian), per time unit, >= 0 [choose]", Bounds::upto(1e6), {}, Identity::late}, p.signal_rate);
-  v(FieldInfo{"signal_decay", "lambda, rate at which a cell's sensed product relaxes to its own product level (secretion = decay), per time unit, >= 0 [choose]", Bounds::upto(1e6), {}, Identity::late}, p.signal_decay);
-  v(FieldInfo{"start_ramp", "time units over which the GRN's actuation terms ramp in from 0 at the start of a swim (rest lengths do not jump), 0 = none [choose]", Bounds::upto(1e6), {}, Identity::late}, p.start_ramp);
+  v(
+      FieldInfo{
+          "mode",
+          "what drives actuation while swimming: open_loop (the paper's sinusoids) or grn (the GRN "
+          "keeps running, its actuation output sets u_i; docs/control.md) [beyond the paper]",
+          Bounds::any(), kControlModeNames, Identity::late},
+      p.mode);
+  v(FieldInfo{"actuation",
+              "what the GRN's actuation output L sets in mode grn: direct (u_i = "
+              "amplitude_max*(2L-1)) or amplitude (u_i = amplitude_max*L*sin(f_i t + phi_i), the "
+              "developed oscillator with a GRN-controlled amplitude) [choose]",
+              Bounds::any(), kControlActuationNames, Identity::late},
+    p.actuation);
+  v(FieldInfo{"update_interval",
+              "k, Box2D steps between GRN updates in mode grn (sensors, signalling and eq. 1 "
+              "advance together), 1 to 1000 [choose]",
+              Bounds::closed(1, 1000),
+              {},
+              Identity::late},
+    p.update_interval);
+  v(FieldInfo{"grn_rate",
+              "rate of eq. 1 while swimming, per time unit: an update advances eq. 1 by "
+              "grn_rate*k*h (h = physics.dt/substeps, must be <= 1) [choose]",
+              Bounds::positive_upto(1e6),
+              {},
+              Identity::late},
+    p.grn_rate);
+  v(FieldInfo{"signal_rate",
+              "D, diffusion rate of cell products along the springs while swimming (graph "
+              "Laplacian), per time unit, >= 0 [choose]",
+              Bounds::upto(1e6),
+              {},
+              Identity::late},
+    p.signal_rate);
+  v(FieldInfo{"signal_decay",
+              "lambda, rate at which a cell's sensed product relaxes to its own product level "
+              "(secretion = decay), per time unit, >= 0 [choose]",
+              Bounds::upto(1e6),
+              {},
+              Identity::late},
+    p.signal_decay);
+  v(FieldInfo{"start_ramp",
+              "time units over which the GRN's actuation terms ramp in from 0 at the start of a "
+              "swim (rest lengths do not jump), 0 = none [choose]",
+              Bounds::upto(1e6),
+              {},
+              Identity::late},
+    p.start_ramp);
 }
 
 /// Checks what bounds cannot: the eq. 1 step grn_rate·k·h <= 1 (signalling stays stable by taking
@@ -66,19 +109,23 @@ void validate(const ControlParams& control, const PhysicsParams& physics);
 
 /// The scene's chemical field at a point (scene.chemical): "point": exp(−|x − x_s|/ℓ); "plane":
 /// exp(−max(0, (x_s − x)·n)/ℓ), n the unit vector from the body's start centre towards x_s, so 1 on
-/// and beyond the plane through x_s; "none": 0. `source` is absolute (start centre + scene.chemical_source).
-[[nodiscard]] double chemical_field(std::string_view kind, double source_x, double source_y, double normal_x,
-                                    double normal_y, double decay_length, double x, double y);
+/// and beyond the plane through x_s; "none": 0. `source` is absolute (start centre +
+/// scene.chemical_source).
+[[nodiscard]] double chemical_field(std::string_view kind, double source_x, double source_y,
+                                    double normal_x, double normal_y, double decay_length, double x,
+                                    double y);
 
-/// The GRN of one genome with every cell's state at the end of development: what mode "grn" starts from.
+/// The GRN of one genome with every cell's state at the end of development: what mode "grn" starts
+/// from.
 struct GrnControlStart {
   Grn grn;
   GrnParams grn_params;
   /// n × node_count levels, row-major (cell i's levels at [i·node_count, (i+1)·node_count)).
   std::vector<double> levels;
   std::vector<double> maternal;  ///< n × 3, held fixed while swimming
-  std::vector<double> sensed;    ///< n × morphogen units: the signalling field's start (empty: own levels)
-  double amplitude_max = 0.2;    ///< development.amplitude_max: |u_i| <= this
+  /// n × morphogen units: the signalling field's start (empty: own levels)
+  std::vector<double> sensed;
+  double amplitude_max = 0.2;  ///< development.amplitude_max: |u_i| <= this
 };
 
 /// The controller effect (modifier stage, like actuation): see the file comment. Allocation-free
@@ -87,8 +134,8 @@ class GrnControl final : public Effect {
  public:
   /// `body` must be the body the simulation swims (springs in order, rest lengths as swim_body()
   /// measures them); its cells are the GRN's cells.
-  GrnControl(const Body& body, GrnControlStart start, const ControlParams& control, const SceneParams& scene,
-             const PhysicsParams& physics);
+  GrnControl(const Body& body, GrnControlStart start, const ControlParams& control,
+             const SceneParams& scene, const PhysicsParams& physics);
 
   [[nodiscard]] std::string_view name() const override { return "grn_control"; }
   [[nodiscard]] Stage stage() const override { return Stage::modifier; }
@@ -98,7 +145,9 @@ class GrnControl final : public Effect {
   /// The cells' terms u_i of eq. 2 (as of the last update).
   [[nodiscard]] const std::vector<double>& terms() const { return terms_; }
   /// Cell i's GRN state (levels: units, then outputs).
-  [[nodiscard]] const GrnState& state(int cell) const { return states_[static_cast<std::size_t>(cell)]; }
+  [[nodiscard]] const GrnState& state(int cell) const {
+    return states_[static_cast<std::size_t>(cell)];
+  }
   /// The signalling field (n × morphogen units, row-major).
   [[nodiscard]] const std::vector<double>& signals() const { return field_; }
   /// Sensor values of the last update: strain, pressure, chemical (n × 3, row-major).
@@ -135,7 +184,7 @@ class GrnControl final : public Effect {
   std::string chemical_;
   double source_x_ = 0, source_y_ = 0, normal_x_ = 1, normal_y_ = 0, decay_length_ = 1;
   int signal_substeps_ = 1;
-  bool modulate_ = false;                        ///< control.actuation = "amplitude"
+  bool modulate_ = false;  ///< control.actuation = "amplitude"
   std::vector<double> amplitude_, frequency_, phase_, start_time_;
   long updates_ = 0;
   long last_update_step_ = -1;

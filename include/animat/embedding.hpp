@@ -34,12 +34,13 @@ class EmbeddingMonitor {
   [[nodiscard]] int count_skin_crossings(std::span<const double> x, std::span<const double> y);
 
  private:
-  std::vector<int> region_nodes_;    // the vertices of every region with a rest area, one after another
-  std::vector<int> region_start_;    // where each such region starts in region_nodes_ (and the end)
-  std::vector<double> rest_twice_;   // 2·S0 per such region
-  std::vector<int> sa_, sb_;         // skin edges
-  std::vector<int> order_;           // skin edges sorted by their smallest x (kept between frames)
-  std::vector<double> lo_, hi_;      // per skin edge, x extent of this frame
+  // the vertices of every region with a rest area, one after another
+  std::vector<int> region_nodes_;
+  std::vector<int> region_start_;   // where each such region starts in region_nodes_ (and the end)
+  std::vector<double> rest_twice_;  // 2·S0 per such region
+  std::vector<int> sa_, sb_;        // skin edges
+  std::vector<int> order_;          // skin edges sorted by their smallest x (kept between frames)
+  std::vector<double> lo_, hi_;     // per skin edge, x extent of this frame
   long frames_ = 0;
   double min_ratio_ = 1.0;
   long inverted_ = 0;
@@ -48,7 +49,7 @@ class EmbeddingMonitor {
 };
 
 /// Whether closed segments ab and cd intersect (touching counts), in double arithmetic.
-[[nodiscard]] bool segments_intersect(double ax, double ay, double bx, double by, double cx, double cy, double dx,
-                                      double dy);
+[[nodiscard]] bool segments_intersect(double ax, double ay, double bx, double by, double cx,
+                                      double cy, double dx, double dy);
 
 }  // namespace animat

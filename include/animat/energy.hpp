@@ -21,23 +21,27 @@ namespace animat {
 struct EnergyAccount {
   bool measured = false;  ///< whether the simulation kept the books (off by default: it costs time)
   // In.
-  double actuation = 0.0;  ///< net work of actuation on the springs (= SwimCounters::actuation_work)
-  double external = 0.0;   ///< kinetic energy added by pushes (Simulation::push)
-  // Dissipated (energy removed from the body: minus the work of the forces, >= 0 for drag and damping).
+  /// net work of actuation on the springs (= SwimCounters::actuation_work)
+  double actuation = 0.0;
+  double external = 0.0;  ///< kinetic energy added by pushes (Simulation::push)
+  // Dissipated (energy removed from the body: minus the work of the forces, >= 0 for drag and
+  // damping).
   double drag_normal = 0.0;      ///< by the normal part of eq. 5 (effect drag)
   double drag_tangential = 0.0;  ///< by the tangential part of eq. 4 (effect drag)
   double spring_damping = 0.0;   ///< by the springs' dampers (effect springs)
-  double collisions = 0.0;       ///< by cell-edge collision impulses (0 for elastic ones, up to rounding)
-  double ground = 0.0;           ///< by the floor's normal and friction impulses (effect ground)
+  /// by cell-edge collision impulses (0 for elastic ones, up to rounding)
+  double collisions = 0.0;
+  double ground = 0.0;  ///< by the floor's normal and friction impulses (effect ground)
   /// by every other force that no potential accounts for (custom effects, the skin_collision
   /// penalty, GRN-driven external actuation forces)
   double other = 0.0;
   // Stored, at the start and at the end of the measured swim.
-  double kinetic_start = 0.0, kinetic_end = 0.0;      ///< Σ ½·m·v²
-  double elastic_start = 0.0, elastic_end = 0.0;      ///< springs: Σ ½·k·(ℓ − r)²
-  double pressure_start = 0.0, pressure_end = 0.0;    ///< pressure: Σ c_p·(S − S0)²/(2A)
-  double gravity_start = 0.0, gravity_end = 0.0;      ///< gravity: Σ m·g·y
-  double other_potential_start = 0.0, other_potential_end = 0.0;  ///< custom effects with a potential
+  double kinetic_start = 0.0, kinetic_end = 0.0;    ///< Σ ½·m·v²
+  double elastic_start = 0.0, elastic_end = 0.0;    ///< springs: Σ ½·k·(ℓ − r)²
+  double pressure_start = 0.0, pressure_end = 0.0;  ///< pressure: Σ c_p·(S − S0)²/(2A)
+  double gravity_start = 0.0, gravity_end = 0.0;    ///< gravity: Σ m·g·y
+  /// custom effects with a potential
+  double other_potential_start = 0.0, other_potential_end = 0.0;
 
   bool operator==(const EnergyAccount&) const = default;
 
@@ -46,11 +50,14 @@ struct EnergyAccount {
     return drag_normal + drag_tangential + spring_damping + collisions + ground + other;
   }
   [[nodiscard]] double stored_change() const {
-    return (kinetic_end - kinetic_start) + (elastic_end - elastic_start) + (pressure_end - pressure_start) +
-           (gravity_end - gravity_start) + (other_potential_end - other_potential_start);
+    return (kinetic_end - kinetic_start) + (elastic_end - elastic_start) +
+           (pressure_end - pressure_start) + (gravity_end - gravity_start) +
+           (other_potential_end - other_potential_start);
   }
   /// What the books leave unexplained: in − dissipated − stored change.
-  [[nodiscard]] double residual() const { return actuation + external - dissipated() - stored_change(); }
+  [[nodiscard]] double residual() const {
+    return actuation + external - dissipated() - stored_change();
+  }
   /// The fluid's share of the dissipated energy (0 when nothing was dissipated).
   [[nodiscard]] double fluid_share() const {
     const double d = dissipated();
@@ -68,11 +75,14 @@ void visit_fields(A& a, V&& v)
   v("actuation", "net work of actuation on the springs (in)", a.actuation);
   v("external", "kinetic energy added by pushes (in)", a.external);
   v("drag_normal", "dissipated by the normal part of the fluid drag, eq. 5", a.drag_normal);
-  v("drag_tangential", "dissipated by the tangential part of the fluid drag, eq. 4", a.drag_tangential);
+  v("drag_tangential", "dissipated by the tangential part of the fluid drag, eq. 4",
+    a.drag_tangential);
   v("spring_damping", "dissipated by the springs' dampers", a.spring_damping);
-  v("collisions", "dissipated by cell-edge collision impulses (0 for elastic ones, up to rounding)", a.collisions);
+  v("collisions", "dissipated by cell-edge collision impulses (0 for elastic ones, up to rounding)",
+    a.collisions);
   v("ground", "dissipated by the floor's impulses", a.ground);
-  v("other", "dissipated by forces no potential accounts for (custom effects, skin_collision)", a.other);
+  v("other", "dissipated by forces no potential accounts for (custom effects, skin_collision)",
+    a.other);
   v("kinetic_start", "kinetic energy at the start", a.kinetic_start);
   v("kinetic_end", "kinetic energy at the end", a.kinetic_end);
   v("elastic_start", "spring elastic energy at the start", a.elastic_start);
@@ -81,8 +91,10 @@ void visit_fields(A& a, V&& v)
   v("pressure_end", "pressure potential at the end", a.pressure_end);
   v("gravity_start", "gravitational potential at the start", a.gravity_start);
   v("gravity_end", "gravitational potential at the end", a.gravity_end);
-  v("other_potential_start", "potential of custom conservative effects at the start", a.other_potential_start);
-  v("other_potential_end", "potential of custom conservative effects at the end", a.other_potential_end);
+  v("other_potential_start", "potential of custom conservative effects at the start",
+    a.other_potential_start);
+  v("other_potential_end", "potential of custom conservative effects at the end",
+    a.other_potential_end);
 }
 
 }  // namespace animat

@@ -32,63 +32,73 @@ struct EvaluationObserver {
 
 /// What a swim did.
 struct SwimResult {
-  double distance = 0.0;                        ///< |COM(end) − COM(start)| (0 when unstable)
-  Eigen::Vector2d displacement{0.0, 0.0};       ///< COM(end) − COM(start), as simulated
-  bool stable = true;                           ///< false if a step left the valid domain
-  std::string failure;                          ///< the SimulationError message when !stable
-  long steps = 0;                               ///< control steps completed
+  double distance = 0.0;                   ///< |COM(end) − COM(start)| (0 when unstable)
+  Eigen::Vector2d displacement{0.0, 0.0};  ///< COM(end) − COM(start), as simulated
+  bool stable = true;                      ///< false if a step left the valid domain
+  std::string failure;                     ///< the SimulationError message when !stable
+  long steps = 0;                          ///< control steps completed
   double simulated_time = 0.0;
-  double max_speed = 0.0;                       ///< largest cell speed seen
-  double max_step_displacement = 0.0;           ///< largest |v|·h of one Box2D step seen
+  double max_speed = 0.0;              ///< largest cell speed seen
+  double max_step_displacement = 0.0;  ///< largest |v|·h of one Box2D step seen
   /// Largest spring length / max(L0, median L0 / 2), sampled every 16 steps and at the end (the
   /// floor keeps near-zero rest lengths of slivers and near-coincident cells meaningful).
   double max_stretch = 0.0;
-  /// Smallest spring length / L0 over springs with L0 >= median L0 / 2 (same samples); 0 with no springs.
+  /// Smallest spring length / L0 over springs with L0 >= median L0 / 2 (same samples); 0 with no
+  /// springs.
   double min_stretch = 0.0;
   double final_kinetic_energy = 0.0;
-  double max_kinetic_energy = 0.0;              ///< largest kinetic energy (same samples)
-  double max_kinetic_energy_per_cell = 0.0;     ///< max_kinetic_energy / cells
+  double max_kinetic_energy = 0.0;           ///< largest kinetic energy (same samples)
+  double max_kinetic_energy_per_cell = 0.0;  ///< max_kinetic_energy / cells
   // Invariants and counted deviations (every one is reported, never silent).
-  bool valid = true;                  ///< stable, embedding intact, every collision resolved
-  bool embedding_checked = false;     ///< whether the embedding was checked after every step
-  double min_area_ratio = 1.0;        ///< smallest S/S0 of any region seen (checked steps)
-  long inverted_region_steps = 0;     ///< (region, step) pairs with S/S0 <= 0
-  long skin_crossing_steps = 0;       ///< steps in which two skin edges intersected
-  long first_invalid_step = -1;       ///< control step at whose end an invariant first broke (-1: never)
-  long collisions = 0;                ///< cell-edge collisions resolved (SwimCounters)
+  bool valid = true;               ///< stable, embedding intact, every collision resolved
+  bool embedding_checked = false;  ///< whether the embedding was checked after every step
+  double min_area_ratio = 1.0;     ///< smallest S/S0 of any region seen (checked steps)
+  long inverted_region_steps = 0;  ///< (region, step) pairs with S/S0 <= 0
+  long skin_crossing_steps = 0;    ///< steps in which two skin edges intersected
+  long first_invalid_step = -1;  ///< control step at whose end an invariant first broke (-1: never)
+  long collisions = 0;           ///< cell-edge collisions resolved (SwimCounters)
   long collisions_inelastic = 0;
   long collisions_unresolved = 0;
-  long drag_limited = 0;              ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
+  long drag_limited = 0;  ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
   // Crawl world and cost of actuation (docs/worlds.md).
-  long settle_steps = 0;              ///< control steps settled (actuation off) before the fitness clock started
-  long ground_contacts = 0;           ///< (cell, Box2D step) contacts with the floor (effect ground; SwimCounters)
-  long ground_slips = 0;              ///< of those, sliding ones (kinetic friction)
-  double actuation_work = 0.0;        ///< net mechanical work of actuation on the springs (measured phase)
-  double actuation_work_positive = 0.0;  ///< positive work, per spring and Box2D step (what an actuator spends)
+  long settle_steps =
+      0;  ///< control steps settled (actuation off) before the fitness clock started
+  long ground_contacts =
+      0;  ///< (cell, Box2D step) contacts with the floor (effect ground; SwimCounters)
+  long ground_slips = 0;  ///< of those, sliding ones (kinetic friction)
+  double actuation_work =
+      0.0;  ///< net mechanical work of actuation on the springs (measured phase)
+  double actuation_work_positive =
+      0.0;  ///< positive work, per spring and Box2D step (what an actuator spends)
   double actuation_work_absolute = 0.0;  ///< absolute work, per spring and Box2D step
-  Eigen::VectorXd cell_work_positive;    ///< per cell: half the positive work of each spring it ends (n)
-  Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each spring it ends (n)
-  long grn_updates = 0;                  ///< GRN updates while swimming (control.mode = "grn")
+  Eigen::VectorXd
+      cell_work_positive;  ///< per cell: half the positive work of each spring it ends (n)
+  Eigen::VectorXd
+      cell_work_absolute;  ///< per cell: half the absolute work of each spring it ends (n)
+  long grn_updates = 0;    ///< GRN updates while swimming (control.mode = "grn")
   Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (push_step >= 0)
-  EnergyAccount energy;                  ///< where the energy went (SwimOptions::account_energy)
+  EnergyAccount energy;  ///< where the energy went (SwimOptions::account_energy)
 };
 
 /// Options of swim() beyond the scene and physics.
 struct SwimOptions {
   /// Control steps simulated before the fitness clock starts, with the scene minus actuation
   /// (evaluation.settle_steps): the swim then starts from the settled positions and velocities, at
-  /// time 0. With effect "ground" the body is first moved vertically so that its lowest cell lies on
-  /// the floor (whatever settle_steps).
+  /// time 0. With effect "ground" the body is first moved vertically so that its lowest cell lies
+  /// on the floor (whatever settle_steps).
   long settle_steps = 0;
-  bool check_embedding = true;   ///< check the planar embedding after every Box2D step
-  bool stop_when_invalid = true; ///< stop at the first broken invariant (the fitness is 0 anyway)
+  bool check_embedding = true;    ///< check the planar embedding after every Box2D step
+  bool stop_when_invalid = true;  ///< stop at the first broken invariant (the fitness is 0 anyway)
   /// Keep the energy books of the measured swim (SwimResult::energy; settling is not included).
   bool account_energy = false;
-  EvaluationObserver* observer = nullptr;  ///< sees the simulation every observer->sample_every() steps
+  EvaluationObserver* observer =
+      nullptr;  ///< sees the simulation every observer->sample_every() steps
   /// control.mode = "grn": where every cell's GRN starts (nullptr: open loop, the scene's own
-  /// actuation). With it, "actuation" is dropped from the scene and a GrnControl effect drives eq. 2.
+  /// actuation). With it, "actuation" is dropped from the scene and a GrnControl effect drives
+  /// eq. 2.
   const GrnControlStart* control_start = nullptr;
-  const ControlParams* control = nullptr;  ///< the controller's params (required with control_start)
+  const ControlParams* control =
+      nullptr;  ///< the controller's params (required with control_start)
   /// A disruption (evaluation.push_step, push_impulse, push_cells): at the start of control step
   /// push_step (counted from the fitness clock's start; -1 = never) every pushed cell gets
   /// push_impulse (per cell; velocity change impulse/m). push_cells: "all", or "front" (the cells
@@ -101,9 +111,9 @@ struct SwimOptions {
 
 /// Where a swim starts (the crawl world, docs/worlds.md): the body and its velocities.
 struct StartState {
-  Body body;            ///< the body at its starting positions (rest lengths and areas as given)
-  Points velocities;    ///< n × 2 starting velocities (zeros unless settled)
-  long settled = 0;     ///< control steps settled
+  Body body;          ///< the body at its starting positions (rest lengths and areas as given)
+  Points velocities;  ///< n × 2 starting velocities (zeros unless settled)
+  long settled = 0;   ///< control steps settled
 };
 
 /// The start of a swim: with effect "ground" in the scene, `body` moved vertically so that its
@@ -111,21 +121,22 @@ struct StartState {
 /// the scene without actuation from rest, whose end positions and velocities are the start. Without
 /// ground and settling: the body unchanged, at rest. Throws SimulationError if settling leaves the
 /// valid domain, ConfigError for settle_steps < 0. swim() and animat.replay start here.
-[[nodiscard]] StartState start_state(const Body& body, const SceneParams& scene, const PhysicsParams& physics,
-                                     long settle_steps);
+[[nodiscard]] StartState start_state(const Body& body, const SceneParams& scene,
+                                     const PhysicsParams& physics, long settle_steps);
 
 /// Swims `body` for `steps` control steps with the scene and physics params. Never throws for a
 /// simulation failure: it returns stable = false, distance 0 and the message. A swim that breaks
 /// the planar embedding (a region inverted, the skin not simple) or leaves a collision unresolved
 /// is invalid: valid = false, distance 0 and the reason in `failure`. Throws ConfigError for
 /// invalid params.
-[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene, const PhysicsParams& physics, long steps,
+[[nodiscard]] SwimResult swim(const Body& body, const SceneParams& scene,
+                              const PhysicsParams& physics, long steps,
                               const SwimOptions& options = {});
 
 struct EvaluationResult {
-  double fitness = 0.0;          ///< straight-line distance of the centre of mass, start -> end
-  bool viable = false;           ///< development verdict; non-viable genomes are never swum
-  bool stable = true;            ///< false if the swim (or development) left the valid domain
+  double fitness = 0.0;  ///< straight-line distance of the centre of mass, start -> end
+  bool viable = false;   ///< development verdict; non-viable genomes are never swum
+  bool stable = true;    ///< false if the swim (or development) left the valid domain
   /// False if the swim broke an invariant: unstable, a region inverted, the skin not simple, or a
   /// collision left unresolved (fitness 0). True for non-viable genomes (never swum).
   bool valid = true;
@@ -136,9 +147,9 @@ struct EvaluationResult {
   int spring_count = 0;
   int region_count = 0;
   int skin_edge_count = 0;
-  int development_steps = 0;     ///< development steps actually run (early exits are shorter)
-  long swim_steps = 0;           ///< control steps swum
-  double simulated_time = 0.0;   ///< simulated swim time
+  int development_steps = 0;    ///< development steps actually run (early exits are shorter)
+  long swim_steps = 0;          ///< control steps swum
+  double simulated_time = 0.0;  ///< simulated swim time
   double max_speed = 0.0;
   double max_step_displacement = 0.0;
   double max_stretch = 0.0;
@@ -146,29 +157,31 @@ struct EvaluationResult {
   double max_kinetic_energy = 0.0;
   double final_kinetic_energy = 0.0;
   double max_kinetic_energy_per_cell = 0.0;
-  double min_area_ratio = 1.0;      ///< smallest S/S0 of any region over the swim
-  long inverted_region_steps = 0;   ///< (region, step) pairs with S/S0 <= 0 (must be 0)
-  long skin_crossing_steps = 0;     ///< steps with intersecting skin edges (must be 0)
-  long first_invalid_step = -1;     ///< control step at whose end an invariant first broke (-1: never)
-  long collisions = 0;              ///< cell-edge collisions resolved
-  long collisions_inelastic = 0;    ///< of those, by the inelastic fallback
-  long collisions_unresolved = 0;   ///< steps with a crossing no impulse could prevent (must be 0)
-  long drag_limited = 0;            ///< drag limiter engagements (drag_scheme "stable" only)
-  long settle_steps = 0;            ///< control steps settled before the fitness clock started
-  long ground_contacts = 0;         ///< (cell, Box2D step) contacts with the floor (effect ground)
-  long ground_slips = 0;            ///< of those, sliding ones
-  double actuation_work = 0.0;           ///< net mechanical work of actuation (docs/worlds.md)
+  double min_area_ratio = 1.0;     ///< smallest S/S0 of any region over the swim
+  long inverted_region_steps = 0;  ///< (region, step) pairs with S/S0 <= 0 (must be 0)
+  long skin_crossing_steps = 0;    ///< steps with intersecting skin edges (must be 0)
+  long first_invalid_step = -1;  ///< control step at whose end an invariant first broke (-1: never)
+  long collisions = 0;           ///< cell-edge collisions resolved
+  long collisions_inelastic = 0;   ///< of those, by the inelastic fallback
+  long collisions_unresolved = 0;  ///< steps with a crossing no impulse could prevent (must be 0)
+  long drag_limited = 0;           ///< drag limiter engagements (drag_scheme "stable" only)
+  long settle_steps = 0;           ///< control steps settled before the fitness clock started
+  long ground_contacts = 0;        ///< (cell, Box2D step) contacts with the floor (effect ground)
+  long ground_slips = 0;           ///< of those, sliding ones
+  double actuation_work = 0.0;     ///< net mechanical work of actuation (docs/worlds.md)
   double actuation_work_positive = 0.0;  ///< positive actuation work (per spring and Box2D step)
   double actuation_work_absolute = 0.0;  ///< absolute actuation work (per spring and Box2D step)
-  Eigen::VectorXd cell_work_positive;    ///< per cell: half the positive work of each of its springs
-  Eigen::VectorXd cell_work_absolute;    ///< per cell: half the absolute work of each of its springs
+  Eigen::VectorXd cell_work_positive;  ///< per cell: half the positive work of each of its springs
+  Eigen::VectorXd cell_work_absolute;  ///< per cell: half the absolute work of each of its springs
   /// Objective chemotaxis: the mean over evaluation.source_directions swims (the source at
-  /// scene.chemical_source rotated to a random angle each, deterministic from evaluation.source_seed)
-  /// of the progress toward the source, |x_s| − |x_s − displacement| (length units; 0 unless
-  /// chemotaxis). The directions are evenly spaced, turned by a random offset (source_direction()).
+  /// scene.chemical_source rotated to a random angle each, deterministic from
+  /// evaluation.source_seed) of the progress toward the source, |x_s| − |x_s − displacement|
+  /// (length units; 0 unless chemotaxis). The directions are evenly spaced, turned by a random
+  /// offset (source_direction()).
   double source_progress = 0.0;
-  long grn_updates = 0;            ///< GRN updates while swimming (control.mode = "grn"), first swim
-  Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (evaluation.push_step >= 0)
+  long grn_updates = 0;  ///< GRN updates while swimming (control.mode = "grn"), first swim
+  Eigen::Vector2d displacement_at_push{
+      0.0, 0.0};  ///< COM(push) − COM(start) (evaluation.push_step >= 0)
   /// Where the actuation work went in the (first) swim, with evaluation.energy_accounting.
   EnergyAccount energy;
   double seconds_development = 0.0;  ///< wall time per stage (not deterministic; diagnostics only)
@@ -182,12 +195,18 @@ template <class R, class V>
 void visit_fields(R& r, V&& v)
   requires std::is_same_v<std::remove_const_t<R>, EvaluationResult>
 {
-  v("fitness", "The objective's value (default: the paper's straight-line distance of the centre of mass, start "
-               "to end); 0 if not viable, unstable or invalid.", r.fitness);
+  v("fitness",
+    "The objective's value (default: the paper's straight-line distance of the centre of mass, "
+    "start "
+    "to end); 0 if not viable, unstable or invalid.",
+    r.fitness);
   v("viable", "Development verdict; non-viable genomes are never swum.", r.viable);
   v("stable", "False if the development or the swim left the valid domain.", r.stable);
-  v("valid", "False if the swim broke an invariant: unstable, a region inverted, the skin crossed itself, or a\n"
-             "collision could not be resolved. An invalid swim has fitness/distance 0.", r.valid);
+  v("valid",
+    "False if the swim broke an invariant: unstable, a region inverted, the skin crossed itself, "
+    "or a\n"
+    "collision could not be resolved. An invalid swim has fitness/distance 0.",
+    r.valid);
   v("cell_count", "Cells of the embryo.", r.cell_count);
   v("reasons", "Non-viability reasons, or the instability description.", r.reasons);
   v("displacement", "COM(end) - COM(start) as a (2,) array.", r.displacement);
@@ -203,38 +222,60 @@ void visit_fields(R& r, V&& v)
   v("min_stretch", "Smallest spring length / L0 (same samples).", r.min_stretch);
   v("max_kinetic_energy", "Largest kinetic energy (same samples).", r.max_kinetic_energy);
   v("final_kinetic_energy", "Kinetic energy at the end.", r.final_kinetic_energy);
-  v("max_kinetic_energy_per_cell", "Largest kinetic energy / cells.", r.max_kinetic_energy_per_cell);
-  v("min_area_ratio", "Smallest S/S0 of any region over the swim (must stay > 0).", r.min_area_ratio);
-  v("inverted_region_steps", "(region, step) pairs with S/S0 <= 0 (must be 0).", r.inverted_region_steps);
-  v("skin_crossing_steps", "Steps in which two skin edges intersected (must be 0).", r.skin_crossing_steps);
-  v("first_invalid_step", "Step at whose end an invariant first broke (-1: never).", r.first_invalid_step);
+  v("max_kinetic_energy_per_cell", "Largest kinetic energy / cells.",
+    r.max_kinetic_energy_per_cell);
+  v("min_area_ratio", "Smallest S/S0 of any region over the swim (must stay > 0).",
+    r.min_area_ratio);
+  v("inverted_region_steps", "(region, step) pairs with S/S0 <= 0 (must be 0).",
+    r.inverted_region_steps);
+  v("skin_crossing_steps", "Steps in which two skin edges intersected (must be 0).",
+    r.skin_crossing_steps);
+  v("first_invalid_step", "Step at whose end an invariant first broke (-1: never).",
+    r.first_invalid_step);
   v("collisions", "Cell-edge collisions resolved by an impulse.", r.collisions);
-  v("collisions_inelastic", "Collisions resolved by the inelastic fallback.", r.collisions_inelastic);
-  v("collisions_unresolved", "Steps with a crossing no impulse prevented (must be 0).", r.collisions_unresolved);
-  v("drag_limited", "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.", r.drag_limited);
-  v("settle_steps", "Control steps settled (actuation off) before the fitness clock started.", r.settle_steps);
-  v("ground_contacts", "(cell, Box2D step) contacts with the floor (effect ground).", r.ground_contacts);
+  v("collisions_inelastic", "Collisions resolved by the inelastic fallback.",
+    r.collisions_inelastic);
+  v("collisions_unresolved", "Steps with a crossing no impulse prevented (must be 0).",
+    r.collisions_unresolved);
+  v("drag_limited", "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.",
+    r.drag_limited);
+  v("settle_steps", "Control steps settled (actuation off) before the fitness clock started.",
+    r.settle_steps);
+  v("ground_contacts", "(cell, Box2D step) contacts with the floor (effect ground).",
+    r.ground_contacts);
   v("ground_slips", "Of the floor contacts, those that slid (kinetic friction).", r.ground_slips);
-  v("actuation_work", "Net mechanical work of actuation on the springs (docs/worlds.md).", r.actuation_work);
-  v("actuation_work_positive", "Positive actuation work, summed per spring and Box2D step (what the actuators spend).",
+  v("actuation_work", "Net mechanical work of actuation on the springs (docs/worlds.md).",
+    r.actuation_work);
+  v("actuation_work_positive",
+    "Positive actuation work, summed per spring and Box2D step (what the actuators spend).",
     r.actuation_work_positive);
-  v("actuation_work_absolute", "Absolute actuation work, summed per spring and Box2D step.", r.actuation_work_absolute);
-  v("cell_work_positive", "Per cell (n,): half the positive actuation work of each spring it ends.", r.cell_work_positive);
-  v("cell_work_absolute", "Per cell (n,): half the absolute actuation work of each spring it ends.", r.cell_work_absolute);
-  v("source_progress", "Objective chemotaxis: mean progress toward the chemical source over "
-                       "evaluation.source_directions swims (|x_s| - |x_s - displacement|; 0 otherwise).",
+  v("actuation_work_absolute", "Absolute actuation work, summed per spring and Box2D step.",
+    r.actuation_work_absolute);
+  v("cell_work_positive", "Per cell (n,): half the positive actuation work of each spring it ends.",
+    r.cell_work_positive);
+  v("cell_work_absolute", "Per cell (n,): half the absolute actuation work of each spring it ends.",
+    r.cell_work_absolute);
+  v("source_progress",
+    "Objective chemotaxis: mean progress toward the chemical source over "
+    "evaluation.source_directions swims (|x_s| - |x_s - displacement|; 0 otherwise).",
     r.source_progress);
-  v("grn_updates", "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).", r.grn_updates);
-  v("displacement_at_push", "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).",
+  v("grn_updates", "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).",
+    r.grn_updates);
+  v("displacement_at_push",
+    "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).",
     r.displacement_at_push);
-  v("energy", "Where the energy went (an EnergyAccount; measured only with evaluation.energy_accounting).", r.energy);
+  v("energy",
+    "Where the energy went (an EnergyAccount; measured only with evaluation.energy_accounting).",
+    r.energy);
   v("seconds_development", "Wall time of development (diagnostic).", r.seconds_development);
   v("seconds_body", "Wall time of body construction (diagnostic).", r.seconds_body);
   v("seconds_swim", "Wall time of the swim (diagnostic).", r.seconds_swim);
 }
 
-/// Where control.mode = "grn" starts: the genome's GRN and every cell's state at the end of `embryo`.
-[[nodiscard]] GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo, const Config& config);
+/// Where control.mode = "grn" starts: the genome's GRN and every cell's state at the end of
+/// `embryo`.
+[[nodiscard]] GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo,
+                                                const Config& config);
 /// Objective chemotaxis: the source of trial `trial`, scene.chemical_source rotated by
 /// offset + 2π·trial/source_directions, the offset uniform in [0, 2π) drawn from
 /// evaluation.source_seed (the same for every genome): an evenly spaced fan at a random angle.

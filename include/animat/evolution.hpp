@@ -23,14 +23,16 @@ namespace animat {
 struct Config;
 /// Whether a fitness and its reference differ by more than both evaluation.reference_tolerance
 /// (relative to the reference) and evaluation.reference_abs_tolerance: the exploit guard warns.
-[[nodiscard]] bool reference_disagrees(double fitness, double reference, const EvaluationParams& params);
+[[nodiscard]] bool reference_disagrees(double fitness, double reference,
+                                       const EvaluationParams& params);
 /// The config of the reference evaluation of the exploit guard: physics.substeps multiplied by
 /// evaluation.reference_substeps, everything else equal.
 [[nodiscard]] Config reference_config(const Config& config);
 
 class Evaluator;  // evaluator.hpp
 
-/// [islands] One migrant (islands.hpp): a copy of population[from] (island from_island) replaced population[to].
+/// [islands] One migrant (islands.hpp): a copy of population[from] (island from_island) replaced
+/// population[to].
 struct Migration {
   int generation = 0;
   std::size_t from_island = 0, to_island = 0;
@@ -44,7 +46,7 @@ struct Fitness {
   bool viable = false;  ///< non-viable individuals take no part in creating the next generation
   bool stable = true;   ///< false if the swim was flagged unstable (its fitness is 0)
   int cell_count = 0;
-  bool valid = true;    ///< false if the swim broke an invariant (embedding, collisions); fitness 0
+  bool valid = true;  ///< false if the swim broke an invariant (embedding, collisions); fitness 0
   /// Edge-component steps where drag_scheme "stable" scaled eq. 5 down (0 with every other scheme):
   /// the swim was not integrated as written there.
   long drag_limited = 0;
@@ -57,14 +59,18 @@ template <class F, class V>
 void visit_fields(F& f, V&& v)
   requires std::is_same_v<std::remove_const_t<F>, Fitness>
 {
-  v("fitness", "The objective's value (the paper's: distance travelled by the centre of mass); 0 if not viable.",
+  v("fitness",
+    "The objective's value (the paper's: distance travelled by the centre of mass); 0 if not "
+    "viable.",
     f.fitness);
   v("viable", "Development verdict; non-viable genomes are never swum.", f.viable);
   v("stable", "False if the swim was flagged unstable.", f.stable);
   v("cell_count", "Cells of the embryo.", f.cell_count);
-  v("valid", "False if the swim broke an invariant (embedding, collisions); its fitness is 0.", f.valid);
+  v("valid", "False if the swim broke an invariant (embedding, collisions); its fitness is 0.",
+    f.valid);
   v("drag_limited",
-    "Edge-component steps where physics.drag_scheme = \"stable\" scaled eq. 5 down (0 with every other scheme).",
+    "Edge-component steps where physics.drag_scheme = \"stable\" scaled eq. 5 down (0 with every "
+    "other scheme).",
     f.drag_limited);
 }
 
@@ -78,7 +84,8 @@ class Objective;
 /// objective (evaluation.objective; objective.hpp).
 [[nodiscard]] FitnessFunction swim_fitness(const Config& config);
 /// The same chain scored by `objective` (e.g. a Python callable) instead of the config's.
-[[nodiscard]] FitnessFunction objective_fitness(const Config& config, std::shared_ptr<const Objective> objective);
+[[nodiscard]] FitnessFunction objective_fitness(const Config& config,
+                                                std::shared_ptr<const Objective> objective);
 
 struct Individual {
   Genome genome;
@@ -92,22 +99,27 @@ struct Individual {
 /// One row of history.csv.
 struct GenerationStats {
   int generation = 0;
-  double best = 0.0;     ///< best fitness in the population (all-time best, thanks to elitism)
+  double best = 0.0;  ///< best fitness in the population (all-time best, thanks to elitism)
   /// Over viable individuals; finite whenever their fitnesses are (no overflow: see finite_mean in
   /// evolution.cpp), so that a checkpoint always holds it.
   double mean = 0.0;
-  double median = 0.0;   ///< over viable individuals (finite likewise)
+  double median = 0.0;  ///< over viable individuals (finite likewise)
   double viable_fraction = 0.0;
   int best_cells = 0;
-  std::int64_t evaluations = 0;  ///< cumulative fitness evaluations (swims and non-viable developments)
-  double wall_seconds = 0.0;     ///< cumulative wall time of the run (the only machine-dependent column)
-  double evaluations_per_second = 0.0;  ///< of this generation alone (its evaluations / its wall time)
-  bool best_changed = false;     ///< the best genome differs from the previous generation's
-  int crossovers = 0;            ///< offspring made by crossover in this generation
+  /// cumulative fitness evaluations (swims and non-viable developments)
+  std::int64_t evaluations = 0;
+  /// cumulative wall time of the run (the only machine-dependent column)
+  double wall_seconds = 0.0;
+  /// of this generation alone (its evaluations / its wall time)
+  double evaluations_per_second = 0.0;
+  bool best_changed = false;  ///< the best genome differs from the previous generation's
+  int crossovers = 0;         ///< offspring made by crossover in this generation
   /// The best's fitness at the reference step (evaluation.reference_check); NaN when off.
   double best_reference = std::numeric_limits<double>::quiet_NaN();
-  int invalid = 0;               ///< viable individuals whose swim was unstable or broke an invariant (fitness 0)
-  /// Individuals whose swim the drag limiter altered (drag_scheme "stable" only; Fitness::drag_limited > 0).
+  /// viable individuals whose swim was unstable or broke an invariant (fitness 0)
+  int invalid = 0;
+  /// Individuals whose swim the drag limiter altered (drag_scheme "stable" only;
+  /// Fitness::drag_limited > 0).
   int drag_limited = 0;
 };
 
@@ -117,68 +129,87 @@ struct StatsField {
     none,      ///< not in a checkpoint (a per-session figure)
     required,  ///< always written; a checkpoint without it is refused
     later,     ///< always written; absent from older checkpoints, where it reads as its default
-    when_set,  ///< written only when it holds information (not NaN, not 0); absent reads as its default
+    /// written only when it holds information (not NaN, not 0); absent reads as its default
+    when_set,
   };
   const char* name;
   const char* doc;
-  bool csv;                 ///< a column of history.csv (columns in visiting order)
+  bool csv;  ///< a column of history.csv (columns in visiting order)
   Checkpoint checkpoint;
-  int decimals = -1;        ///< history.csv: fixed decimals (-1: the shortest form that reads back exactly)
+  /// history.csv: fixed decimals (-1: the shortest form that reads back exactly)
+  int decimals = -1;
 };
 
-/// GenerationStats' fields with their documentation, in history.csv's column order: the one list from
-/// which history.csv, a checkpoint's history, the Python class (fields, to_dict, pickling) and
+/// GenerationStats' fields with their documentation, in history.csv's column order: the one list
+/// from which history.csv, a checkpoint's history, the Python class (fields, to_dict, pickling) and
 /// animat.HISTORY_DTYPE follow. A new field is one line here.
 template <class S, class V>
 void visit_fields(S& s, V&& v)
   requires std::is_same_v<std::remove_const_t<S>, GenerationStats>
 {
   using C = StatsField::Checkpoint;
-  v(StatsField{"generation", "Generation number (0 = the initial population).", true, C::required}, s.generation);
+  v(StatsField{"generation", "Generation number (0 = the initial population).", true, C::required},
+    s.generation);
   v(StatsField{"best", "Best fitness in the population.", true, C::required}, s.best);
   v(StatsField{"mean", "Mean fitness of the viable individuals.", true, C::required}, s.mean);
   v(StatsField{"median", "Median fitness of the viable individuals.", true, C::required}, s.median);
-  v(StatsField{"viable_fraction", "Share of viable individuals.", true, C::required}, s.viable_fraction);
+  v(StatsField{"viable_fraction", "Share of viable individuals.", true, C::required},
+    s.viable_fraction);
   v(StatsField{"best_cells", "Cells of the best individual.", true, C::required}, s.best_cells);
-  v(StatsField{"evaluations", "Cumulative fitness evaluations (swims and non-viable developments).", true, C::required},
+  v(StatsField{"evaluations", "Cumulative fitness evaluations (swims and non-viable developments).",
+               true, C::required},
     s.evaluations);
-  v(StatsField{"best_reference", "The best's fitness at the reference step (evaluation.reference_check); NaN when off.",
-               true, C::when_set},
-    s.best_reference);
-  v(StatsField{"invalid", "Viable individuals whose swim was unstable or broke an invariant (fitness 0).", true, C::later},
+  v(
+      StatsField{
+          "best_reference",
+          "The best's fitness at the reference step (evaluation.reference_check); NaN when off.",
+          true, C::when_set},
+      s.best_reference);
+  v(StatsField{"invalid",
+               "Viable individuals whose swim was unstable or broke an invariant (fitness 0).",
+               true, C::later},
     s.invalid);
   v(StatsField{"drag_limited",
-               "Individuals whose swim the drag limiter altered (physics.drag_scheme = \"stable\" only; 0 otherwise).",
+               "Individuals whose swim the drag limiter altered (physics.drag_scheme = \"stable\" "
+               "only; 0 otherwise).",
                true, C::when_set},
     s.drag_limited);
   // Last column: the only machine-dependent one.
-  v(StatsField{"wall_seconds", "Cumulative wall time of the run, seconds.", true, C::required, 3}, s.wall_seconds);
-  v(StatsField{"best_changed", "Whether the best genome changed in this generation.", false, C::required}, s.best_changed);
-  v(StatsField{"evaluations_per_second", "Evaluations per second of this generation alone.", false, C::none},
+  v(StatsField{"wall_seconds", "Cumulative wall time of the run, seconds.", true, C::required, 3},
+    s.wall_seconds);
+  v(StatsField{"best_changed", "Whether the best genome changed in this generation.", false,
+               C::required},
+    s.best_changed);
+  v(StatsField{"evaluations_per_second", "Evaluations per second of this generation alone.", false,
+               C::none},
     s.evaluations_per_second);
-  v(StatsField{"crossovers", "Offspring made by crossover in this generation.", false, C::none}, s.crossovers);
+  v(StatsField{"crossovers", "Offspring made by crossover in this generation.", false, C::none},
+    s.crossovers);
 }
 
 /// Probability that the fitter of two wins a tournament at generation g (linear ramp, paper §5).
 [[nodiscard]] double tournament_probability(const EvolutionParams& p, int generation);
 
 /// Index of the tournament winner among two distinct random eligible individuals.
-[[nodiscard]] std::size_t tournament(const std::vector<Individual>& population, const std::vector<std::size_t>& eligible,
-                                     double p_fitter, Rng& rng);
+[[nodiscard]] std::size_t tournament(const std::vector<Individual>& population,
+                                     const std::vector<std::size_t>& eligible, double p_fitter,
+                                     Rng& rng);
 
-/// A run (or its initial population, or one generation) stopped by a StopRequest before it finished;
-/// what was completed before it is kept (see Evolution::initialize and Evolution::step).
+/// A run (or its initial population, or one generation) stopped by a StopRequest before it
+/// finished; what was completed before it is kept (see Evolution::initialize and Evolution::step).
 struct Interrupted : Error {
   using Error::Error;
 };
 
-/// Asks a running evolution to stop early. Checked between evaluations and between the random genomes
-/// drawn for the initial population, so a stop is honoured within one evaluation (27 ms at the paper's
-/// setting), not only between generations.
+/// Asks a running evolution to stop early. Checked between evaluations and between the random
+/// genomes drawn for the initial population, so a stop is honoured within one evaluation (27 ms at
+/// the paper's setting), not only between generations.
 struct StopRequest {
-  const std::atomic<bool>* flag = nullptr;  ///< set asynchronously (a signal handler, another thread)
-  /// Called on the thread that runs the evolution only, about every 20 ms while it works (e.g. Python's
-  /// PyErr_CheckSignals with the GIL briefly acquired); returning true stops the run. Must not throw.
+  /// set asynchronously (a signal handler, another thread)
+  const std::atomic<bool>* flag = nullptr;
+  /// Called on the thread that runs the evolution only, about every 20 ms while it works (e.g.
+  /// Python's PyErr_CheckSignals with the GIL briefly acquired); returning true stops the run. Must
+  /// not throw.
   std::function<bool()> poll;
 
   [[nodiscard]] bool empty() const { return flag == nullptr && !poll; }
@@ -187,7 +218,6 @@ struct StopRequest {
 /// Calls once, before any parallel region: Box2D's lazily-initialised globals (docs/model.md §4,
 /// "Evaluation, determinism, threads").
 void prepare_parallel_evaluation();
-
 
 /// The genetic algorithm (paper §5). Every random number of generation g, offspring i derives from
 /// Rng::derive(seed, g, i), so a run is bit-identical for any thread count and across resumes.
@@ -201,18 +231,19 @@ class Evolution {
   /// exploit guard's fitness at the reference step (reference_config()); with none,
   /// evaluation.reference_check has no effect. `evaluator` runs the evaluations (evaluator.hpp);
   /// null = the OpenMP threads of this process with `fitness`.
-  explicit Evolution(const Config& config, FitnessFunction fitness = {}, FitnessFunction reference = {},
+  explicit Evolution(const Config& config, FitnessFunction fitness = {},
+                     FitnessFunction reference = {},
                      std::shared_ptr<Evaluator> evaluator = nullptr);
 
   /// Draws the initial population: random genomes regenerated until viable (ask/evaluate/tell
   /// rounds with speculative draws; the result equals one-at-a-time drawing). Throws Interrupted
   /// (and stays uninitialised) if the stop request fires first.
   void initialize();
-  /// Makes and evaluates the next generation; returns its statistics. Throws Interrupted if the stop
-  /// request fires before the generation is complete: the state stays at the previous generation
-  /// (resuming recomputes the same generation, every random number derives from (seed, g, i)).
-  /// Throws Error if the fitness function returns a non-finite fitness, or a negative one under an
-  /// objective that is never negative (ObjectiveSpec::nonnegative).
+  /// Makes and evaluates the next generation; returns its statistics. Throws Interrupted if the
+  /// stop request fires before the generation is complete: the state stays at the previous
+  /// generation (resuming recomputes the same generation, every random number derives from (seed,
+  /// g, i)). Throws Error if the fitness function returns a non-finite fitness, or a negative one
+  /// under an objective that is never negative (ObjectiveSpec::nonnegative).
   GenerationStats step();
   /// Checked by initialize() and step() (see StopRequest); empty = never stop.
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
@@ -221,9 +252,9 @@ class Evolution {
   /// every initial slot not yet holding a viable individual (slot i draws from
   /// Rng::derive(seed, initial, i)); with `lookahead` > 1, that many consecutive draws per slot
   /// (speculative: those after a slot's first viable draw are discarded and not counted, so the run
-  /// does not depend on it). After that: the offspring of the next generation that are not copies of
-  /// an evaluated genome (elites and unchanged copies keep their fitness; the list may be empty).
-  /// ask() again before tell() returns the same genomes.
+  /// does not depend on it). After that: the offspring of the next generation that are not copies
+  /// of an evaluated genome (elites and unchanged copies keep their fitness; the list may be
+  /// empty). ask() again before tell() returns the same genomes.
   std::vector<Genome> ask(int lookahead = 1);
   /// The fitness of every genome of the last ask(), in order. Returns true when this completed a
   /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a value
@@ -247,11 +278,12 @@ class Evolution {
   /// Tries per initial individual (paper: "a few hundred").
   [[nodiscard]] std::vector<int> initial_tries() const;
 
-  /// Whole state as JSON text with a checksum; restore() refuses a corrupt or mismatched one, and one
-  /// whose content is inconsistent even with a valid checksum (hand-edited): a fitness that is not
-  /// finite (and >= 0 under a distance objective), a genome that does not validate or is empty, a history that does not count
-  /// 0, 1, ..., generation or whose last row disagrees with the population, a population of the wrong
-  /// size, a best_ever or stall counter that the history contradicts.
+  /// Whole state as JSON text with a checksum; restore() refuses a corrupt or mismatched one, and
+  /// one whose content is inconsistent even with a valid checksum (hand-edited): a fitness that is
+  /// not finite (and >= 0 under a distance objective), a genome that does not validate or is empty,
+  /// a history that does not count 0, 1, ..., generation or whose last row disagrees with the
+  /// population, a population of the wrong size, a best_ever or stall counter that the history
+  /// contradicts.
   [[nodiscard]] std::string checkpoint() const;
   void restore(std::string_view checkpoint_text, std::string_view source = "checkpoint");
 
@@ -267,9 +299,11 @@ class Evolution {
   void check_reference();
   /// The evaluator's fitness of every genome, honouring the stop request (throws Interrupted), each
   /// checked by fitness_problem.
-  std::vector<Fitness> evaluate_genomes(const std::vector<Genome>& genomes, const std::string& what);
+  std::vector<Fitness> evaluate_genomes(const std::vector<Genome>& genomes,
+                                        const std::string& what);
   /// "select": reference fitness of the elite candidates, which are then ranked by it.
-  std::vector<std::size_t> reference_ranked(const std::vector<std::size_t>& order, std::size_t elites);
+  std::vector<std::size_t> reference_ranked(const std::vector<std::size_t>& order,
+                                            std::size_t elites);
 
   std::vector<Genome> ask_initial(int lookahead);
   std::vector<Genome> ask_generation();
@@ -281,22 +315,24 @@ class Evolution {
     Rng rng;
     int tries = 0;
     bool filled = false;
-    Individual individual;  ///< its first viable draw; the population exists only once every slot is filled
+    /// its first viable draw; the population exists only once every slot is filled
+    Individual individual;
   };
 
   std::shared_ptr<const Config> config_;  ///< own copy: the engine outlives no caller state
   std::uint64_t identity_;
   FitnessFunction fitness_;
   FitnessFunction reference_;
-  std::shared_ptr<Evaluator> evaluator_;            ///< runs fitness_ (or the given evaluator); null: ask/tell only
+  /// runs fitness_ (or the given evaluator); null: ask/tell only
+  std::shared_ptr<Evaluator> evaluator_;
   std::shared_ptr<Evaluator> reference_evaluator_;  ///< runs reference_ on this process's threads
-  std::vector<Migration> migrations_;  // [islands]
+  std::vector<Migration> migrations_;               // [islands]
   std::vector<Individual> population_;
-  std::vector<InitialSlot> slots_;          ///< before generation 0 only
-  bool pending_ = false;                    ///< an ask() awaits its tell()
-  std::vector<Genome> asked_;               ///< the genomes of that ask()
-  std::vector<std::size_t> asked_index_;    ///< their initial slot, or their index in next_
-  std::vector<Individual> next_;            ///< the generation being made
+  std::vector<InitialSlot> slots_;        ///< before generation 0 only
+  bool pending_ = false;                  ///< an ask() awaits its tell()
+  std::vector<Genome> asked_;             ///< the genomes of that ask()
+  std::vector<std::size_t> asked_index_;  ///< their initial slot, or their index in next_
+  std::vector<Individual> next_;          ///< the generation being made
   int next_crossovers_ = 0;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()

@@ -31,7 +31,8 @@ class ExternalActuation final : public Effect {
 
   [[nodiscard]] Mode mode() const { return mode_; }
   [[nodiscard]] int node_count() const { return static_cast<int>(terms_.size()); }
-  /// Mode::rest_length: the cell terms u_i (n values, each finite with |u| < 0.5); GeometryError otherwise.
+  /// Mode::rest_length: the cell terms u_i (n values, each finite with |u| < 0.5); GeometryError
+  /// otherwise.
   void set_terms(std::span<const double> terms);
   /// Mode::oscillator: amplitudes a_i (n values in [0, 0.5)) and phases φ_i (n finite values).
   void set_oscillators(std::span<const double> amplitude, std::span<const double> phase);

@@ -36,17 +36,19 @@ struct IslandLayout {
 /// Cross-field rules of the island keys (sizes, elites and migrants that fit); "" when valid.
 [[nodiscard]] std::string island_config_error(const EvolutionParams& p);
 
-/// True when migrants arrive at the end of `generation` (a positive multiple of the interval, K > 1, migrants > 0).
+/// True when migrants arrive at the end of `generation` (a positive multiple of the interval, K >
+/// 1, migrants > 0).
 [[nodiscard]] bool is_migration_generation(const EvolutionParams& p, int generation);
 
-/// Indices of island k from the fittest to the least fit (viable first, then fitness; ties by index).
-[[nodiscard]] std::vector<std::size_t> island_ranking(const std::vector<Individual>& population, const IslandLayout& layout,
-                                                      std::size_t k);
+/// Indices of island k from the fittest to the least fit (viable first, then fitness; ties by
+/// index).
+[[nodiscard]] std::vector<std::size_t> island_ranking(const std::vector<Individual>& population,
+                                                      const IslandLayout& layout, std::size_t k);
 
 /// Ring migration: every island's `migrants` best (chosen before any replacement) replace the
 /// `migrants` worst of the next island. Deterministic; returns what moved, by destination island.
-std::vector<Migration> migrate(std::vector<Individual>& population, const IslandLayout& layout, int migrants,
-                               int generation);
+std::vector<Migration> migrate(std::vector<Individual>& population, const IslandLayout& layout,
+                               int migrants, int generation);
 
 /// Per-island statistics of one generation, written to RUN_DIR/islands.csv.
 struct IslandStats {
@@ -60,7 +62,8 @@ struct IslandStats {
 };
 
 [[nodiscard]] std::vector<IslandStats> island_statistics(const std::vector<Individual>& population,
-                                                         const IslandLayout& layout, int generation, int immigrants);
+                                                         const IslandLayout& layout, int generation,
+                                                         int immigrants);
 
 /// RUN_DIR/islands.csv: one row per island and generation; written only when evolution.islands > 1
 /// and the run has a directory.

@@ -6,7 +6,8 @@
 
 namespace animat {
 
-/// Sets the level from a name (trace, debug, info, warn, error, critical, off); throws ConfigError otherwise.
+/// Sets the level from a name (trace, debug, info, warn, error, critical, off); throws ConfigError
+/// otherwise.
 void set_log_level(std::string_view level);
 
 }  // namespace animat

@@ -1,10 +1,10 @@
 #pragma once
 // One GA over the ranks of an MPI job (Open MPI; `mpirun -np R animat_evolve ...`):
-// rank 0 owns the population, the checkpoints and the output; every rank, rank 0 too, evaluates with
-// its OpenMP threads. Rank 0 hands out genomes (or initial individuals to seed) in small batches
-// as ranks ask for them: an evaluation takes 0.1 ms (non-viable) to 30 ms (a viable swim), so a
-// static split would leave ranks idle. Results are stored by index: bit-identical to one process
-// with one thread, for any ranks x threads, and the rank count may change across a resume.
+// rank 0 owns the population, the checkpoints and the output; every rank, rank 0 too, evaluates
+// with its OpenMP threads. Rank 0 hands out genomes (or initial individuals to seed) in small
+// batches as ranks ask for them: an evaluation takes 0.1 ms (non-viable) to 30 ms (a viable swim),
+// so a static split would leave ranks idle. Results are stored by index: bit-identical to one
+// process with one thread, for any ranks x threads, and the rank count may change across a resume.
 //
 // This header needs no MPI headers; without MPI (ANIMAT_WITH_MPI=OFF or Open MPI absent at build
 // time) Job throws an Error that says how to get it.
@@ -26,7 +26,7 @@ struct Launch {
   bool launched = false;  ///< started by an MPI launcher
   int size = 1;           ///< ranks in the job (1 when unknown)
   int rank = 0;
-  std::string variable;   ///< the variable that told, e.g. "OMPI_COMM_WORLD_SIZE=3"
+  std::string variable;  ///< the variable that told, e.g. "OMPI_COMM_WORLD_SIZE=3"
 };
 [[nodiscard]] Launch detect_launch();
 
@@ -75,7 +75,8 @@ class Job {
 
   /// Rank 0: sends the config to every rank and returns the evaluator that uses them all. `stop`
   /// (a signal flag) interrupts an evaluation with JobStopped.
-  [[nodiscard]] std::shared_ptr<Evaluator> start(const Config& config, const std::atomic<bool>* stop);
+  [[nodiscard]] std::shared_ptr<Evaluator> start(const Config& config,
+                                                 const std::atomic<bool>* stop);
 
   /// Rank 0, after a JobStopped or a RankFailure: end this process now without waiting for ranks
   /// that may be gone (no MPI_Finalize; the launcher ends the others).

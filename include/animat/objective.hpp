@@ -4,8 +4,8 @@
 // by name (evaluation.objective) and Python can bring its own callable (named "python:NAME").
 //
 // The built-ins are the rows of kObjectives (objective_table.hpp); make_objective() wraps one. The
-// energy objectives (distance_minus_energy, distance_per_energy) read the positive actuation work of
-// the swim (docs/worlds.md).
+// energy objectives (distance_minus_energy, distance_per_energy) read the positive actuation work
+// of the swim (docs/worlds.md).
 #include <memory>
 #include <string>
 #include <string_view>
@@ -23,15 +23,16 @@ struct EvaluationParams;
 
 /// Everything an objective may look at: the evaluation result (fitness = the paper's distance, and
 /// every diagnostic), the body that swam, and its trajectory sampled every `every` control steps
-/// (frame 0 is the start; empty when the objective asked for no samples or the genome was not viable).
+/// (frame 0 is the start; empty when the objective asked for no samples or the genome was not
+/// viable).
 struct EvaluationRecord {
   EvaluationResult result;
-  Body body;                        ///< empty (0 nodes) when the genome was not viable
-  long every = 0;                   ///< sampling of the trajectory, control steps (0 = none)
-  std::vector<long> steps;          ///< F control steps of the frames
-  std::vector<double> times;        ///< F simulated times
-  std::vector<double> positions;    ///< F × n × 2, row-major
-  std::vector<double> velocities;   ///< F × n × 2, row-major
+  Body body;                       ///< empty (0 nodes) when the genome was not viable
+  long every = 0;                  ///< sampling of the trajectory, control steps (0 = none)
+  std::vector<long> steps;         ///< F control steps of the frames
+  std::vector<double> times;       ///< F simulated times
+  std::vector<double> positions;   ///< F × n × 2, row-major
+  std::vector<double> velocities;  ///< F × n × 2, row-major
   [[nodiscard]] std::size_t frame_count() const { return times.size(); }
 };
 
@@ -54,8 +55,8 @@ class Objective {
 /// for a "python:..." name: such a run needs its callable, which only Python can supply).
 [[nodiscard]] std::shared_ptr<const Objective> make_objective(const EvaluationParams& params);
 
-/// Checks evaluation.objective (a built-in name or "python:NAME") and evaluation.direction (2 finite
-/// numbers, not both 0); throws ConfigError naming the key.
+/// Checks evaluation.objective (a built-in name or "python:NAME") and evaluation.direction (2
+/// finite numbers, not both 0); throws ConfigError naming the key.
 void validate(const EvaluationParams& params);
 
 /// Length of a body along its longest axis: the largest distance between two cell centres at rest
@@ -65,12 +66,13 @@ void validate(const EvaluationParams& params);
 /// genome -> development -> body -> swim (exactly evaluate()), keeping the body when `keep_body`
 /// and the trajectory every `every` control steps (0 = none). The result's fitness is still the
 /// paper's distance.
-[[nodiscard]] EvaluationRecord record_evaluation(const Genome& genome, const Config& config, bool keep_body,
-                                                 long every);
+[[nodiscard]] EvaluationRecord record_evaluation(const Genome& genome, const Config& config,
+                                                 bool keep_body, long every);
 
 /// evaluate() scored by `objective`: result.fitness = objective.value(record) for a viable genome
 /// (0 otherwise). For the `distance` objective this is evaluate() itself, bit for bit. Throws Error
 /// if the objective returns a non-finite value.
-[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config, const Objective& objective);
+[[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config,
+                                        const Objective& objective);
 
 }  // namespace animat

@@ -23,10 +23,16 @@ struct Bounds {
   bool hi_open = false;
 
   static constexpr Bounds any() { return {}; }
-  static constexpr Bounds positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
-  static constexpr Bounds non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static constexpr Bounds positive() {
+    return {0.0, std::numeric_limits<double>::infinity(), true, false};
+  }
+  static constexpr Bounds non_negative() {
+    return {0.0, std::numeric_limits<double>::infinity(), false, false};
+  }
   static constexpr Bounds closed(double a, double b) { return {a, b, false, false}; }
-  static constexpr Bounds at_least(double a) { return {a, std::numeric_limits<double>::infinity(), false, false}; }
+  static constexpr Bounds at_least(double a) {
+    return {a, std::numeric_limits<double>::infinity(), false, false};
+  }
   static constexpr Bounds unit() { return closed(0.0, 1.0); }
   /// (0, b]: a strictly positive quantity with a representable maximum.
   static constexpr Bounds positive_upto(double b) { return {0.0, b, true, false}; }
@@ -44,12 +50,12 @@ struct Bounds {
 
 /// Limits derived from what the code can represent (docs/reliability.md, "Bounds from
 /// representation"). Cell positions, forces, masses, damping and time steps reach Box2D as float
-/// (FLT_MAX = 3.4e38, b2Assert(b2IsValid(...)) on positions and damping); a mass below FLT_MIN would
-/// become 0, which Box2D silently replaces by 1. With every length <= kMaxLength, every coefficient
-/// (stiffness, damping, drag, pressure, force cap, frequency) <= kMaxCoefficient and every mass in
-/// [kMinMass, kMaxMass], the largest development force on a cell (4095 neighbours x 1e12 x an overlap
-/// of 2.2e7) is 9e22 and the velocity it adds in one step at most 9e34, below FLT_MAX; the swim checks
-/// every step in double before Box2D sees it (physics.cpp, check_forces).
+/// (FLT_MAX = 3.4e38, b2Assert(b2IsValid(...)) on positions and damping); a mass below FLT_MIN
+/// would become 0, which Box2D silently replaces by 1. With every length <= kMaxLength, every
+/// coefficient (stiffness, damping, drag, pressure, force cap, frequency) <= kMaxCoefficient and
+/// every mass in [kMinMass, kMaxMass], the largest development force on a cell (4095 neighbours x
+/// 1e12 x an overlap of 2.2e7) is 9e22 and the velocity it adds in one step at most 9e34, below
+/// FLT_MAX; the swim checks every step in double before Box2D sees it (physics.cpp, check_forces).
 inline constexpr double kMaxLength = 1e6;
 inline constexpr double kMaxCoefficient = 1e12;
 inline constexpr double kMinMass = 1e-12;
@@ -61,8 +67,9 @@ inline constexpr double kMinTimeStep = 1e-9;
 enum class Identity : std::uint8_t {
   defines_run,  ///< part of the identity: a resume may not change it
   resumable,    ///< a stopping or resource knob (generations, threads, ...): a resume may change it
-  late,         ///< added after runs were first checkpointed, with a default that reproduces them: part
-                ///< of the identity only away from its default, so those runs still resume
+  /// added after runs were first checkpointed, with a default that reproduces them: part
+  late,
+  ///< of the identity only away from its default, so those runs still resume
 };
 
 /// Static description of one field: name, meaning, allowed values, part in a run's identity.
@@ -78,12 +85,14 @@ struct FieldInfo {
 
 /// Field value types a params struct may use.
 template <class T>
-concept ParamValue = std::same_as<T, bool> || std::same_as<T, int> || std::same_as<T, std::int64_t> ||
-                     std::same_as<T, double> || std::same_as<T, std::string> ||
-                     std::same_as<T, std::vector<std::string>> || std::same_as<T, std::vector<double>>;
+concept ParamValue =
+    std::same_as<T, bool> || std::same_as<T, int> || std::same_as<T, std::int64_t> ||
+    std::same_as<T, double> || std::same_as<T, std::string> ||
+    std::same_as<T, std::vector<std::string>> || std::same_as<T, std::vector<double>>;
 
 /// Whether `name` is listed in an effects list (scene.effects, development.effects).
-[[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects, std::string_view name) {
+[[nodiscard]] inline bool has_effect(const std::vector<std::string>& effects,
+                                     std::string_view name) {
   for (const auto& e : effects)
     if (e == name) return true;
   return false;

@@ -1,7 +1,7 @@
 #pragma once
-// Swimming physics (paper §4): a Box2D world with one fixture-less body per cell, plus our own force
-// effects (springs, actuation, pressure, drag, skin collision; see scene.hpp) applied before every
-// Step. Units and every coefficient choice: docs/notes/physics.md.
+// Swimming physics (paper §4): a Box2D world with one fixture-less body per cell, plus our own
+// force effects (springs, actuation, pressure, drag, skin collision; see scene.hpp) applied before
+// every Step. Units and every coefficient choice: docs/notes/physics.md.
 #include <Eigen/Core>
 #include <memory>
 #include <span>
@@ -22,15 +22,17 @@ namespace animat {
 struct Body;
 class EmbeddingMonitor;
 
-inline constexpr std::string_view kDragSchemeNames[] = {"semi_implicit", "explicit", "stable", "implicit"};
+inline constexpr std::string_view kDragSchemeNames[] = {"semi_implicit", "explicit", "stable",
+                                                        "implicit"};
 inline constexpr std::string_view kVelocityForceNames[] = {"midpoint", "start"};
 inline constexpr std::string_view kIntegratorNames[] = {"native", "box2d"};
 
 /// The accuracy knobs: what trades accuracy for speed (docs/accuracy.md measures them).
 struct PhysicsParams {
-  double dt = 1.0 / 60.0;          ///< control step, simulated time units [choose]
-  int substeps = 1;                ///< Box2D steps per control step (forces recomputed each) [choose]
-  int velocity_iterations = 1;     ///< Box2D solver iterations (no joints or contacts: 1 suffices)
+  double dt = 1.0 / 60.0;  ///< control step, simulated time units [choose]
+  /// Box2D steps per control step (forces recomputed each) [choose]
+  int substeps = 1;
+  int velocity_iterations = 1;  ///< Box2D solver iterations (no joints or contacts: 1 suffices)
   int position_iterations = 1;
   /// "semi_implicit" (eq. 5 as F = −d·L·|u_start|·u_end, solved for the end-of-step velocity:
   /// second order, exact for a free edge and at terminal velocity, never reverses a velocity),
@@ -41,8 +43,8 @@ struct PhysicsParams {
   /// estimates the velocity at the middle of the step; second order, two evaluations) or "start"
   /// (the velocity at the start of the step; first order, one evaluation).
   std::string velocity_forces = "midpoint";
-  /// A Box2D step that would move a cell farther than this is reported as unstable (SimulationError)
-  /// before Box2D's own cap of b2_maxTranslation = 2 silently clamps it [choose].
+  /// A Box2D step that would move a cell farther than this is reported as unstable
+  /// (SimulationError) before Box2D's own cap of b2_maxTranslation = 2 silently clamps it [choose].
   double max_step_displacement = 1.0;
   /// Who moves the cells: "native" performs Box2D 2.4's integration step for fixture-less bodies
   /// (the same float operations in the same order, bitwise the same positions and velocities) on
@@ -53,14 +55,39 @@ struct PhysicsParams {
 
 template <class V>
 void visit_fields(PhysicsParams& p, V&& v) {
-  v(FieldInfo{"dt", "control time step in simulated time units [choose]", Bounds::closed(kMinTimeStep, 1.0)}, p.dt);
-  v(FieldInfo{"substeps", "Box2D steps per control step, forces recomputed each [choose]", Bounds::closed(1, 1000)}, p.substeps);
-  v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.velocity_iterations);
-  v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)", Bounds::closed(1, 100)}, p.position_iterations);
-  v(FieldInfo{"drag_scheme", "drag integration: semi_implicit (F = -d L |u_start| u_end, second order, never reverses an edge velocity); explicit; stable (explicit, scaled down where it would overshoot, counted); implicit (backward Euler)", Bounds::any(), kDragSchemeNames}, p.drag_scheme);
-  v(FieldInfo{"velocity_forces", "velocity that damping and drag use: midpoint (predicted, second order) or start (first order) [choose]", Bounds::any(), kVelocityForceNames}, p.velocity_forces);
-  v(FieldInfo{"max_step_displacement", "a Box2D step moving a cell farther than this is an instability error; Box2D itself clamps at 2 [choose]", Bounds{0.0, 2.0, true, false}}, p.max_step_displacement);
-  v(FieldInfo{"integrator", "who moves the cells: native (Box2D's float step for fixture-less bodies, bit for bit, without its overhead) or box2d (a real b2World); same results", Bounds::any(), kIntegratorNames, Identity::resumable}, p.integrator);
+  v(FieldInfo{"dt", "control time step in simulated time units [choose]",
+              Bounds::closed(kMinTimeStep, 1.0)},
+    p.dt);
+  v(FieldInfo{"substeps", "Box2D steps per control step, forces recomputed each [choose]",
+              Bounds::closed(1, 1000)},
+    p.substeps);
+  v(FieldInfo{"velocity_iterations", "Box2D velocity iterations (no contacts or joints: no effect)",
+              Bounds::closed(1, 100)},
+    p.velocity_iterations);
+  v(FieldInfo{"position_iterations", "Box2D position iterations (no contacts or joints: no effect)",
+              Bounds::closed(1, 100)},
+    p.position_iterations);
+  v(FieldInfo{"drag_scheme",
+              "drag integration: semi_implicit (F = -d L |u_start| u_end, second order, never "
+              "reverses an edge velocity); explicit; stable (explicit, scaled down where it would "
+              "overshoot, counted); implicit (backward Euler)",
+              Bounds::any(), kDragSchemeNames},
+    p.drag_scheme);
+  v(FieldInfo{"velocity_forces",
+              "velocity that damping and drag use: midpoint (predicted, second order) or start "
+              "(first order) [choose]",
+              Bounds::any(), kVelocityForceNames},
+    p.velocity_forces);
+  v(FieldInfo{"max_step_displacement",
+              "a Box2D step moving a cell farther than this is an instability error; Box2D itself "
+              "clamps at 2 [choose]",
+              Bounds{0.0, 2.0, true, false}},
+    p.max_step_displacement);
+  v(FieldInfo{"integrator",
+              "who moves the cells: native (Box2D's float step for fixture-less bodies, bit for "
+              "bit, without its overhead) or box2d (a real b2World); same results",
+              Bounds::any(), kIntegratorNames, Identity::resumable},
+    p.integrator);
 }
 
 /// Checks what visit_fields bounds cannot say (finite dt, known drag scheme); throws ConfigError.
@@ -78,8 +105,8 @@ void warm_up_box2d();
 /// One control step = `substeps` Box2D steps of h = dt/substeps. Each Box2D step:
 ///   1. reads positions and velocities into the SoA state and zeroes the force buffer;
 ///   2. runs apply() of the enabled effects in stage order (modifiers, then position-dependent
-///      forces), then the velocity-dependent forces (spring damping, drag) at the velocity chosen by
-///      physics.velocity_forces: "start" = v; "midpoint" = v + (h/2)·F(v)/m, which needs a
+///      forces), then the velocity-dependent forces (spring damping, drag) at the velocity chosen
+///      by physics.velocity_forces: "start" = v; "midpoint" = v + (h/2)·F(v)/m, which needs a
 ///      predictor pass at v first (second order: v lives at half steps in symplectic Euler), then
 ///      the constraint effects (collisions), which change the end-of-step velocities by impulses;
 ///   3. checks the predicted velocity v + h·F/m of every cell: a non-finite value, or a
@@ -151,7 +178,8 @@ class Simulation {
   void account_energy();
   /// The books since account_energy() (measured = false if it was never called).
   [[nodiscard]] EnergyAccount energy_account() const;
-  /// Control step at the end of which the embedding was first seen broken (-1: never, or no monitor).
+  /// Control step at the end of which the embedding was first seen broken (-1: never, or no
+  /// monitor).
   [[nodiscard]] long first_broken_step() const;
   [[nodiscard]] bool failed() const;
   [[nodiscard]] const std::string& failure() const;  ///< empty unless failed()

@@ -61,16 +61,20 @@ class Rng {
     if (n == 0) return 0;
     const std::uint64_t limit = max() - max() % n;
     std::uint64_t x;
-    do { x = (*this)(); } while (x >= limit);
+    do {
+      x = (*this)();
+    } while (x >= limit);
     return x % n;
   }
-  /// Uniform integer in [a, b] inclusive; a <= b (callers check; a > b gives a and draws nothing). The span is
-  /// computed in unsigned arithmetic, so the whole int64 range is allowed.
+  /// Uniform integer in [a, b] inclusive; a <= b (callers check; a > b gives a and draws nothing).
+  /// The span is computed in unsigned arithmetic, so the whole int64 range is allowed.
   std::int64_t integer(std::int64_t a, std::int64_t b) {
     if (a > b) return a;
-    const std::uint64_t span = static_cast<std::uint64_t>(b) - static_cast<std::uint64_t>(a);  // b - a, no overflow
+    // b - a, no overflow
+    const std::uint64_t span = static_cast<std::uint64_t>(b) - static_cast<std::uint64_t>(a);
     const std::uint64_t offset = span == max() ? (*this)() : below(span + 1);
-    return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) + offset);  // wraps to the exact result
+    // wraps to the exact result
+    return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) + offset);
   }
   bool bernoulli(double p) { return uniform() < p; }
   /// Standard normal deviate (Marsaglia polar method, no cached spare: state is only s_).

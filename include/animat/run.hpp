@@ -16,22 +16,25 @@ namespace animat {
 
 /// Options of a run on disk (animat_evolve and animat.evolve).
 struct RunOptions {
-  std::filesystem::path out;           ///< run directory ("" = write nothing)
-  bool resume = false;                 ///< continue the run in `out`
+  std::filesystem::path out;  ///< run directory ("" = write nothing)
+  bool resume = false;        ///< continue the run in `out`
   /// Start afresh in `out` even when it holds a run: the run's files (run_file_names()) are removed
   /// once the directory is locked. Contradicts `resume`.
   bool overwrite = false;
   bool quiet = false;
-  double progress_interval = 1.0;      ///< seconds between progress lines
+  double progress_interval = 1.0;                ///< seconds between progress lines
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
-  /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint and stop.
+  /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint
+  /// and stop.
   std::function<bool()> stop_poll;
-  std::shared_ptr<Evaluator> evaluator;           ///< how to evaluate (evaluator.hpp); null = OpenMP threads
+  /// how to evaluate (evaluator.hpp); null = OpenMP threads
+  std::shared_ptr<Evaluator> evaluator;
   /// Called after every generation, generation 0 of a new run included; return false to stop
   /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;
-  /// Called once every check has passed and the run directory is locked, before the first write to it
-  /// (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in place).
+  /// Called once every check has passed and the run directory is locked, before the first write to
+  /// it (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in
+  /// place).
   std::function<void()> on_start;
 };
 
@@ -39,8 +42,8 @@ struct RunOptions {
 struct RunDirectoryBusy : IoError {
   using IoError::IoError;
 };
-/// The run directory holds a run (a checkpoint, or the files of a run without one) and neither resume
-/// nor overwrite was asked for.
+/// The run directory holds a run (a checkpoint, or the files of a run without one) and neither
+/// resume nor overwrite was asked for.
 struct RunExists : IoError {
   using IoError::IoError;
 };
@@ -57,15 +60,15 @@ struct RunSummary {
 
 /// Runs (or resumes) an evolution, writing config.toml, history.csv, best/ lineage and checkpoints.
 /// Everything that can refuse the command is checked before any file is written: the run directory
-/// (path length, an existing run, a missing checkpoint), and on resume the checkpoint itself and the
-/// settings, which may differ from the run's config.toml only in resumable_keys() (the others are
-/// named in the ConfigError). Accepted changes are written to config.toml and noted in resume.log.
-/// A stop (stop_flag, stop_poll, or the callback returning false) leaves a checkpoint of the last
-/// complete generation; stop_reason is then "interrupted" (history empty if it came before
-/// generation 0 was complete, and nothing to resume).
-/// `fitness` defaults to swim_fitness(config), and then `reference` to the exploit guard's
+/// (path length, an existing run, a missing checkpoint), and on resume the checkpoint itself and
+/// the settings, which may differ from the run's config.toml only in resumable_keys() (the others
+/// are named in the ConfigError). Accepted changes are written to config.toml and noted in
+/// resume.log. A stop (stop_flag, stop_poll, or the callback returning false) leaves a checkpoint
+/// of the last complete generation; stop_reason is then "interrupted" (history empty if it came
+/// before generation 0 was complete, and nothing to resume). `fitness` defaults to
+/// swim_fitness(config), and then `reference` to the exploit guard's
 /// swim_fitness(reference_config(config)) unless evaluation.reference_check is "off".
-RunSummary run_evolution(const Config& config, const RunOptions& options, FitnessFunction fitness = {},
-                         FitnessFunction reference = {});
+RunSummary run_evolution(const Config& config, const RunOptions& options,
+                         FitnessFunction fitness = {}, FitnessFunction reference = {});
 
 }  // namespace animat

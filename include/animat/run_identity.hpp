@@ -20,8 +20,9 @@ inline constexpr int kRunIdentityScheme = 2;
 
 /// Scheme 1, that of checkpoints without "identity_scheme" (written before scheme 2): FNV-1a of the
 /// config's commented TOML with the comments and version line of that time (frozen in
-/// src/run_identity_v1_comments.inc), the resumable keys at their defaults, a late key at its default
-/// (and any key newer than scheme 2) left out with its comment, and the island keys without islands.
+/// src/run_identity_v1_comments.inc), the resumable keys at their defaults, a late key at its
+/// default (and any key newer than scheme 2) left out with its comment, and the island keys without
+/// islands.
 [[nodiscard]] std::uint64_t run_identity_v1(const Config& config);
 
 /// The keys a resume may change (Identity::resumable: caps, budgets, threads, checkpoint interval,

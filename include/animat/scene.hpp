@@ -15,18 +15,19 @@
 //      which the stepper runs them twice (predictor, then corrector). An effect sees the forces of
 //      the effects before it in s.fx, s.fy, so an implicit scheme (drag) can solve for the
 //      velocity at the end of the step, v + h·F/m;
-//   3. apply() of the constraint effects (collisions, then ground), which see every force and change
-//      the end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h). With both in the
-//      scene, the floor contacts are events of the collisions' event loop (so no floor impulse can
-//      undo a collision guarantee), and ground only adds the floor impulses collisions computed.
+//   3. apply() of the constraint effects (collisions, then ground), which see every force and
+//      change the end-of-step velocities by impulses (added to s.fx, s.fy as impulse/h). With both
+//      in the scene, the floor contacts are events of the collisions' event loop (so no floor
+//      impulse can undo a collision guarantee), and ground only adds the floor impulses collisions
+//      computed.
 // Effects loop over their own elements inside apply(): one virtual call per effect per pass, never
 // one per element. New effects (like gravity and ground, docs/worlds.md) are new Effect
 // subclasses (one file each in src/effects/) plus a name in make_effect(); the stepper does not
 // change.
 #include <memory>
 #include <string>
-#include <type_traits>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "animat/params.hpp"
@@ -36,8 +37,9 @@ namespace animat {
 struct Body;
 struct PhysicsParams;
 
-inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation", "pressure", "drag", "collisions",
-                                                         "skin_collision", "gravity", "ground"};
+inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation",  "pressure",
+                                                         "drag",    "collisions", "skin_collision",
+                                                         "gravity", "ground"};
 inline constexpr std::string_view kCollisionEdgeNames[] = {"all", "skin"};
 inline constexpr std::string_view kChemicalNames[] = {"none", "point", "plane"};
 
@@ -46,27 +48,37 @@ inline constexpr std::string_view kChemicalNames[] = {"none", "point", "plane"};
 /// oscillator frequencies (rad per time unit). Forces are mass·length/time².
 struct SceneParams {
   std::vector<std::string> effects = {"springs", "actuation", "pressure", "drag", "collisions"};
-  double cell_mass = 1.0;             ///< equal mass m of every cell [paper: equal; value: choose, the mass unit]
-  double spring_stiffness = 100.0;    ///< Hooke constant k of every spring [choose]
-  double spring_damping = 4.0;        ///< damping coefficient c of every spring (force per unit stretching speed) [choose]
-  double pressure = 300.0;            ///< c_p of eq. 3, force per unit edge length at S = 0 [choose: docs/model.md]
-  double pressure_area_floor = 0.3;   ///< eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
-  double drag_normal = 2.0;           ///< d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]
-  double drag_tangential = -1.0;      ///< d_T of eq. 4; negative means d_N/200 [paper §6: d_N/200]
+  /// equal mass m of every cell [paper: equal; value: choose, the mass unit]
+  double cell_mass = 1.0;
+  double spring_stiffness = 100.0;  ///< Hooke constant k of every spring [choose]
+  /// damping coefficient c of every spring (force per unit stretching speed) [choose]
+  double spring_damping = 4.0;
+  /// c_p of eq. 3, force per unit edge length at S = 0 [choose: docs/model.md]
+  double pressure = 300.0;
+  /// eq. 3 divides by max(S0, floor·(longest rest edge)²): bounds sliver stiffness [choose]
+  double pressure_area_floor = 0.3;
+  double drag_normal = 2.0;       ///< d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]
+  double drag_tangential = -1.0;  ///< d_T of eq. 4; negative means d_N/200 [paper §6: d_N/200]
   /// Edges a cell may not cross (effect "collisions"): "all" springs (keeps the planar embedding:
   /// no region inverts, the skin stays simple) or only "skin" edges [choose].
   std::string collision_edges = "all";
-  double collision_restitution = 1.0; ///< normal restitution of cell-edge collisions [paper: elastic, 1]
+  /// normal restitution of cell-edge collisions [paper: elastic, 1]
+  double collision_restitution = 1.0;
   /// A cell that would come closer than this to an edge it is not an end of collides (a band that
   /// float rounding of Box2D's positions cannot jump) [choose]
   double collision_tolerance = 1e-3;
-  double collision_stiffness = 500.0; ///< penalty stiffness of the optional "skin_collision" effect [choose]
-  double collision_radius = 0.25;     ///< distance from a skin edge at which that penalty starts [choose]
+  /// penalty stiffness of the optional "skin_collision" effect [choose]
+  double collision_stiffness = 500.0;
+  /// distance from a skin edge at which that penalty starts [choose]
+  double collision_radius = 0.25;
   // The crawl world (docs/worlds.md): effects "gravity" and "ground", off in the default scene.
-  double gravity = 1.0;                  ///< g of effect "gravity": force −m·g along y on every cell [choose]
-  double ground_height = 0.0;            ///< y of the floor of effect "ground" (cell centres stay at or above it) [choose]
-  double ground_friction_static = 0.8;   ///< Coulomb static coefficient μ_s of the floor [choose]
-  double ground_friction_kinetic = 0.5;  ///< Coulomb kinetic coefficient μ_k of the floor, <= μ_s [choose]
+  /// g of effect "gravity": force −m·g along y on every cell [choose]
+  double gravity = 1.0;
+  /// y of the floor of effect "ground" (cell centres stay at or above it) [choose]
+  double ground_height = 0.0;
+  double ground_friction_static = 0.8;  ///< Coulomb static coefficient μ_s of the floor [choose]
+  /// Coulomb kinetic coefficient μ_k of the floor, <= μ_s [choose]
+  double ground_friction_kinetic = 0.5;
   // A chemical field the cells sense under control.mode = "grn" (docs/control.md).
   /// "none", "point" (exp(−|x − x_s|/ℓ)) or "plane" (exp(−max(0, (x_s − x)·n)/ℓ), n from the body's
   /// start centre towards x_s) [beyond the paper]
@@ -78,26 +90,106 @@ struct SceneParams {
 
 template <class V>
 void visit_fields(SceneParams& p, V&& v) {
-  v(FieldInfo{"effects", "effects simulated while swimming", Bounds::any(), kSceneEffectNames}, p.effects);
-  v(FieldInfo{"cell_mass", "mass of every cell, the mass unit [paper: equal masses; value: choose]", Bounds::closed(kMinMass, kMaxMass)}, p.cell_mass);
-  v(FieldInfo{"spring_stiffness", "Hooke stiffness k of every spring [choose]", Bounds::upto(kMaxCoefficient)}, p.spring_stiffness);
-  v(FieldInfo{"spring_damping", "damping coefficient of every spring, force per unit stretching speed [choose]", Bounds::upto(kMaxCoefficient)}, p.spring_damping);
-  v(FieldInfo{"pressure", "region pressure coefficient c_p of eq. 3 [choose]", Bounds::upto(kMaxCoefficient)}, p.pressure);
-  v(FieldInfo{"pressure_area_floor", "eq. 3 uses max(S0, floor*(longest rest edge)^2) as its denominator, so sliver regions stay stable [choose]", Bounds::upto(kMaxLength)}, p.pressure_area_floor);
-  v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]", Bounds::upto(kMaxCoefficient)}, p.drag_normal);
-  v(FieldInfo{"drag_tangential", "tangential drag coefficient d_T of eq. 4; negative = drag_normal/200 [paper: d_N/200]", Bounds::closed(-1.0, kMaxCoefficient)}, p.drag_tangential);
-  v(FieldInfo{"collision_edges", "edges a cell may not cross (effect collisions): all springs, or skin edges only [choose]", Bounds::any(), kCollisionEdgeNames}, p.collision_edges);
-  v(FieldInfo{"collision_restitution", "normal restitution of cell-edge collisions: 1 = elastic [paper: elastic]", Bounds::unit()}, p.collision_restitution);
-  v(FieldInfo{"collision_tolerance", "a cell closer than this to an edge it is not an end of collides (length units) [choose]", Bounds{0.0, 0.1, true, false}}, p.collision_tolerance);
-  v(FieldInfo{"collision_stiffness", "penalty stiffness of the optional skin_collision effect (a soft force, lets cells through) [choose]", Bounds::upto(kMaxCoefficient)}, p.collision_stiffness);
-  v(FieldInfo{"collision_radius", "distance from a skin edge where the skin_collision penalty starts [choose]", Bounds::upto(kMaxLength)}, p.collision_radius);
-  v(FieldInfo{"gravity", "g of effect gravity: force -m*g along y on every cell, length/time^2 (crawl world, docs/worlds.md) [choose]", Bounds::upto(kMaxCoefficient), {}, Identity::late}, p.gravity);
-  v(FieldInfo{"ground_height", "y of the floor of effect ground, length units; the body is placed with its lowest cell on it [choose]", Bounds::closed(-kMaxLength, kMaxLength), {}, Identity::late}, p.ground_height);
-  v(FieldInfo{"ground_friction_static", "Coulomb static friction coefficient mu_s of the floor: a contact sticks while the tangential impulse needed is <= mu_s * normal impulse [choose]", Bounds::upto(100.0), {}, Identity::late}, p.ground_friction_static);
-  v(FieldInfo{"ground_friction_kinetic", "Coulomb kinetic friction coefficient mu_k of the floor (sliding contacts), at most ground_friction_static [choose]", Bounds::upto(100.0), {}, Identity::late}, p.ground_friction_kinetic);
-  v(FieldInfo{"chemical", "chemical field sensed by the GRN's chemical input under control.mode = grn: none, point (exp(-|x - x_s|/l)) or plane (exp(-max(0, (x_s - x).n)/l), n from the start centre to x_s) (docs/control.md) [beyond the paper]", Bounds::any(), kChemicalNames, Identity::late}, p.chemical);
-  v(FieldInfo{"chemical_source", "source x_s [x, y] of the chemical field, relative to the body's centre at the start of the swim, length units [choose]", Bounds::closed(-kMaxLength, kMaxLength), {}, Identity::late}, p.chemical_source);
-  v(FieldInfo{"chemical_decay_length", "decay length l of the chemical field, length units, > 0 [choose]", Bounds::positive_upto(kMaxLength), {}, Identity::late}, p.chemical_decay_length);
+  v(FieldInfo{"effects", "effects simulated while swimming", Bounds::any(), kSceneEffectNames},
+    p.effects);
+  v(FieldInfo{"cell_mass", "mass of every cell, the mass unit [paper: equal masses; value: choose]",
+              Bounds::closed(kMinMass, kMaxMass)},
+    p.cell_mass);
+  v(FieldInfo{"spring_stiffness", "Hooke stiffness k of every spring [choose]",
+              Bounds::upto(kMaxCoefficient)},
+    p.spring_stiffness);
+  v(FieldInfo{"spring_damping",
+              "damping coefficient of every spring, force per unit stretching speed [choose]",
+              Bounds::upto(kMaxCoefficient)},
+    p.spring_damping);
+  v(FieldInfo{"pressure", "region pressure coefficient c_p of eq. 3 [choose]",
+              Bounds::upto(kMaxCoefficient)},
+    p.pressure);
+  v(FieldInfo{"pressure_area_floor",
+              "eq. 3 uses max(S0, floor*(longest rest edge)^2) as its denominator, so sliver "
+              "regions stay stable [choose]",
+              Bounds::upto(kMaxLength)},
+    p.pressure_area_floor);
+  v(FieldInfo{"drag_normal", "normal drag coefficient d_N of eq. 5 [paper: 0.2, 0.5, 2, 10]",
+              Bounds::upto(kMaxCoefficient)},
+    p.drag_normal);
+  v(
+      FieldInfo{
+          "drag_tangential",
+          "tangential drag coefficient d_T of eq. 4; negative = drag_normal/200 [paper: d_N/200]",
+          Bounds::closed(-1.0, kMaxCoefficient)},
+      p.drag_tangential);
+  v(FieldInfo{"collision_edges",
+              "edges a cell may not cross (effect collisions): all springs, or skin edges only "
+              "[choose]",
+              Bounds::any(), kCollisionEdgeNames},
+    p.collision_edges);
+  v(FieldInfo{"collision_restitution",
+              "normal restitution of cell-edge collisions: 1 = elastic [paper: elastic]",
+              Bounds::unit()},
+    p.collision_restitution);
+  v(
+      FieldInfo{
+          "collision_tolerance",
+          "a cell closer than this to an edge it is not an end of collides (length units) [choose]",
+          Bounds{0.0, 0.1, true, false}},
+      p.collision_tolerance);
+  v(FieldInfo{"collision_stiffness",
+              "penalty stiffness of the optional skin_collision effect (a soft force, lets cells "
+              "through) [choose]",
+              Bounds::upto(kMaxCoefficient)},
+    p.collision_stiffness);
+  v(FieldInfo{"collision_radius",
+              "distance from a skin edge where the skin_collision penalty starts [choose]",
+              Bounds::upto(kMaxLength)},
+    p.collision_radius);
+  v(FieldInfo{"gravity",
+              "g of effect gravity: force -m*g along y on every cell, length/time^2 (crawl world, "
+              "docs/worlds.md) [choose]",
+              Bounds::upto(kMaxCoefficient),
+              {},
+              Identity::late},
+    p.gravity);
+  v(FieldInfo{"ground_height",
+              "y of the floor of effect ground, length units; the body is placed with its lowest "
+              "cell on it [choose]",
+              Bounds::closed(-kMaxLength, kMaxLength),
+              {},
+              Identity::late},
+    p.ground_height);
+  v(FieldInfo{"ground_friction_static",
+              "Coulomb static friction coefficient mu_s of the floor: a contact sticks while the "
+              "tangential impulse needed is <= mu_s * normal impulse [choose]",
+              Bounds::upto(100.0),
+              {},
+              Identity::late},
+    p.ground_friction_static);
+  v(FieldInfo{"ground_friction_kinetic",
+              "Coulomb kinetic friction coefficient mu_k of the floor (sliding contacts), at most "
+              "ground_friction_static [choose]",
+              Bounds::upto(100.0),
+              {},
+              Identity::late},
+    p.ground_friction_kinetic);
+  v(FieldInfo{"chemical",
+              "chemical field sensed by the GRN's chemical input under control.mode = grn: none, "
+              "point (exp(-|x - x_s|/l)) or plane (exp(-max(0, (x_s - x).n)/l), n from the start "
+              "centre to x_s) (docs/control.md) [beyond the paper]",
+              Bounds::any(), kChemicalNames, Identity::late},
+    p.chemical);
+  v(FieldInfo{"chemical_source",
+              "source x_s [x, y] of the chemical field, relative to the body's centre at the start "
+              "of the swim, length units [choose]",
+              Bounds::closed(-kMaxLength, kMaxLength),
+              {},
+              Identity::late},
+    p.chemical_source);
+  v(FieldInfo{"chemical_decay_length",
+              "decay length l of the chemical field, length units, > 0 [choose]",
+              Bounds::positive_upto(kMaxLength),
+              {},
+              Identity::late},
+    p.chemical_decay_length);
 }
 
 // has_effect(effects, name): params.hpp (development.effects uses it too).
@@ -114,13 +206,16 @@ void validate(const SceneParams& params);
 /// What the effects count while a body swims (totals since the simulation started). Every deviation
 /// from the equations as written is counted here, never silent.
 struct SwimCounters {
-  long collisions = 0;             ///< cell-edge collisions resolved by an impulse (effect collisions)
+  /// cell-edge collisions resolved by an impulse (effect collisions)
+  long collisions = 0;
   long collisions_inelastic = 0;   ///< of those, resolved by the inelastic fallback (restitution 0)
   long collisions_unresolved = 0;  ///< Box2D steps after which a crossing could not be prevented
   long collision_max_passes = 0;   ///< most resolution passes one step needed
-  long drag_limited = 0;           ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
-  long ground_contacts = 0;        ///< (cell, Box2D step) pairs in which the floor pushed a cell (effect ground)
-  long ground_slips = 0;           ///< of those, contacts that slid (kinetic friction)
+  /// edge-component steps where drag_scheme "stable" scaled eq. 5 down
+  long drag_limited = 0;
+  /// (cell, Box2D step) pairs in which the floor pushed a cell (effect ground)
+  long ground_contacts = 0;
+  long ground_slips = 0;  ///< of those, contacts that slid (kinetic friction)
   /// Mechanical work of actuation (effect springs, while actuation changes the rest lengths): per
   /// spring and Box2D step ΔW = k·(r_k − r_{k−1})·((r_k + r_{k−1})/2 − (ℓ_k + ℓ_{k−1})/2), the
   /// midpoint rule of ∫ k·(r − ℓ)·dr/dt dt (r rest length, ℓ length; docs/worlds.md).
@@ -135,26 +230,32 @@ void visit_fields(C& c, V&& v)
   requires std::is_same_v<std::remove_const_t<C>, SwimCounters>
 {
   v("collisions", "cell-edge collisions resolved by an impulse (effect collisions)", c.collisions);
-  v("collisions_inelastic", "of those, resolved by the inelastic fallback (restitution 0)", c.collisions_inelastic);
-  v("collisions_unresolved", "Box2D steps after which a crossing could not be prevented", c.collisions_unresolved);
+  v("collisions_inelastic", "of those, resolved by the inelastic fallback (restitution 0)",
+    c.collisions_inelastic);
+  v("collisions_unresolved", "Box2D steps after which a crossing could not be prevented",
+    c.collisions_unresolved);
   v("collision_max_passes", "most resolution passes one step needed", c.collision_max_passes);
-  v("drag_limited", "edge-component steps where drag_scheme \"stable\" scaled eq. 5 down", c.drag_limited);
-  v("ground_contacts", "(cell, Box2D step) pairs in which the floor pushed a cell (effect ground)", c.ground_contacts);
+  v("drag_limited", "edge-component steps where drag_scheme \"stable\" scaled eq. 5 down",
+    c.drag_limited);
+  v("ground_contacts", "(cell, Box2D step) pairs in which the floor pushed a cell (effect ground)",
+    c.ground_contacts);
   v("ground_slips", "of those, contacts that slid (kinetic friction)", c.ground_slips);
   v("actuation_work", "net mechanical work of actuation", c.actuation_work);
-  v("actuation_work_positive", "positive work, per spring and Box2D step", c.actuation_work_positive);
-  v("actuation_work_absolute", "absolute work, per spring and Box2D step", c.actuation_work_absolute);
+  v("actuation_work_positive", "positive work, per spring and Box2D step",
+    c.actuation_work_positive);
+  v("actuation_work_absolute", "absolute work, per spring and Box2D step",
+    c.actuation_work_absolute);
 }
 
 /// The state every effect reads and writes during one Box2D step, structure-of-arrays, sized once
 /// by the simulation (never resized in the step loop). Positions and velocities are Box2D's (float)
 /// values widened to double; forces are zeroed before the first effect runs.
 struct SwimState {
-  int n = 0;              ///< cells
-  long step = 0;          ///< Box2D steps done before this one
-  double time = 0.0;      ///< simulated time at the start of this Box2D step
-  double h = 0.0;         ///< length of this Box2D step (dt / substeps)
-  double mass = 1.0;      ///< every cell's mass
+  int n = 0;          ///< cells
+  long step = 0;      ///< Box2D steps done before this one
+  double time = 0.0;  ///< simulated time at the start of this Box2D step
+  double h = 0.0;     ///< length of this Box2D step (dt / substeps)
+  double mass = 1.0;  ///< every cell's mass
   double inv_mass = 1.0;
   std::vector<double> x, y, vx, vy;  ///< n each: positions and velocities at the start of the step
   std::vector<double> ux, uy;        ///< n each: the velocity apply_velocity() evaluates forces at
@@ -168,13 +269,14 @@ struct SwimState {
   /// τ, not at the start of the step, so its end position differs from x + h·v by this much.
   std::vector<double> cx, cy;
   bool position_corrected = false;
-  /// The floor's impulses (as forces J/h, n each) when effect collisions resolves the floor contacts
-  /// inside its event loop (a scene with both collisions and ground): collisions writes them here,
-  /// and effect ground, which runs after it, adds them to s.fx, s.fy (so the energy books keep the
-  /// floor's work apart from the collisions').
+  /// The floor's impulses (as forces J/h, n each) when effect collisions resolves the floor
+  /// contacts inside its event loop (a scene with both collisions and ground): collisions writes
+  /// them here, and effect ground, which runs after it, adds them to s.fx, s.fy (so the energy
+  /// books keep the floor's work apart from the collisions').
   std::vector<double> ground_fx, ground_fy;
   /// Energy accounting only (null otherwise): drag adds the normal part of its forces here too, so
-  /// that the books can split the fluid's dissipation into its normal and tangential parts (n each).
+  /// that the books can split the fluid's dissipation into its normal and tangential parts (n
+  /// each).
   double* normal_drag_fx = nullptr;
   double* normal_drag_fy = nullptr;
   SwimCounters counters;
@@ -220,11 +322,13 @@ class Effect {
 /// Actuation work per cell accumulated so far by effect `springs` (any other effect: false, outputs
 /// untouched): each spring's positive and absolute work (SwimCounters) split evenly between its two
 /// end cells. Resizes the outputs to the cell count.
-bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positive, std::vector<double>& absolute);
+bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positive,
+                             std::vector<double>& absolute);
 
 /// The built-in effect `name` (one of kSceneEffectNames) for `body`; throws ConfigError for an
 /// unknown name.
-[[nodiscard]] std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body, const SceneParams& scene,
+[[nodiscard]] std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body,
+                                                  const SceneParams& scene,
                                                   const PhysicsParams& physics);
 
 /// The body as a swim simulation sees it: positions rounded to Box2D's float, and rest lengths and
@@ -241,8 +345,8 @@ bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positiv
 /// otherwise (π − (phi mod π)) / f, which is less than half a period. A cell with f <= 0 and
 /// sin(phi) != 0 never starts (+infinity).
 [[nodiscard]] double actuation_start_time(double frequency, double phase);
-/// A cell's term of eq. 2 at time t: a·sin(f·t + phi) once t >= actuation_start_time(f, phi), else 0.
-/// It is 0 at the start time and continuous in t.
+/// A cell's term of eq. 2 at time t: a·sin(f·t + phi) once t >= actuation_start_time(f, phi), else
+/// 0. It is 0 at the start time and continuous in t.
 [[nodiscard]] double actuation_term(double amplitude, double frequency, double phase, double t);
 
 /// The fully implicit drag update of one velocity component: the backward-Euler solution u' of

@@ -6,8 +6,9 @@
 
 namespace animat {
 
-using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;      ///< n × 2 positions
-using IndexPairs = Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor>;     ///< m × 2 node indices
+using Points = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;  ///< n × 2 positions
+/// m × 2 node indices
+using IndexPairs = Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor>;
 using Vector = Eigen::VectorXd;
 
 }  // namespace animat

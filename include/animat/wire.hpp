@@ -37,7 +37,8 @@ class Writer {
   std::vector<unsigned char> bytes_;
 };
 
-/// Reads what a Writer wrote; a truncated or malformed message throws Error (never reads past the end).
+/// Reads what a Writer wrote; a truncated or malformed message throws Error (never reads past the
+/// end).
 class Reader {
  public:
   Reader(const unsigned char* data, std::size_t size) : data_(data), size_(size) {}

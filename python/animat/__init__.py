@@ -15,13 +15,12 @@ organised by task:
 
 Every value type pickles and copies. ``animat.plot`` imports matplotlib on first use only.
 """
+
 from typing import TYPE_CHECKING
 
 from . import _core
-
 from ._core import (
     OBJECTIVES,
-    ObjectiveSpec,
     Body,
     Config,
     ConfigSection,
@@ -32,13 +31,14 @@ from ._core import (
     EvaluationRecord,
     EvaluationResult,
     ExternalActuation,
-    GrnControl,
     Fitness,
     GenerationStats,
     Genome,
     Grn,
+    GrnControl,
     Individual,
     InputChannel,
+    ObjectiveSpec,
     OutputChannel,
     Rng,
     Scene,
@@ -84,7 +84,8 @@ from .trajectory import (
     replay,
 )
 
-__version__: str = getattr(_core, "__version__")
+# getattr: the generated _core stub does not declare __version__ (a module attribute), so pyright would.
+__version__: str = getattr(_core, "__version__")  # noqa: B009
 
 # The compiled functions, as Python functions (help() shows their documentation).
 actuation_start_time = documented(_core.actuation_start_time)
@@ -107,24 +108,95 @@ if TYPE_CHECKING:  # animat.plot is imported lazily at run time (it pulls in mat
 
 __all__ = [
     # the pipeline
-    "Config", "ConfigSection", "Genome", "Rng", "ElementType", "InputChannel", "OutputChannel", "Grn", "affinity",
-    "develop", "Embryo", "DevelopmentTrace", "build_body", "Body", "gabriel_graph", "delaunay_edges", "polygon_area",
-    "body_length", "Scene", "Simulation", "ExternalActuation", "GrnControl", "swim", "SwimResult", "evaluate", "EvaluationResult",
+    "Config",
+    "ConfigSection",
+    "Genome",
+    "Rng",
+    "ElementType",
+    "InputChannel",
+    "OutputChannel",
+    "Grn",
+    "affinity",
+    "develop",
+    "Embryo",
+    "DevelopmentTrace",
+    "build_body",
+    "Body",
+    "gabriel_graph",
+    "delaunay_edges",
+    "polygon_area",
+    "body_length",
+    "Scene",
+    "Simulation",
+    "ExternalActuation",
+    "GrnControl",
+    "swim",
+    "SwimResult",
+    "evaluate",
+    "EvaluationResult",
     "EnergyAccount",
-    "EvaluationRecord", "record_evaluation", "actuation_start_time", "actuation_term", "warm_up_box2d",
-    "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
+    "EvaluationRecord",
+    "record_evaluation",
+    "actuation_start_time",
+    "actuation_term",
+    "warm_up_box2d",
+    "load_config",
+    "config_path",
+    "paper_configs",
+    "set_log_level",
+    "__version__",
     # evolution
-    "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "ObjectiveSpec", "objectives", "objective_value", "Fitness", "Individual", "GenerationStats",
-    "History", "evaluate_population", "to_fitness", "tournament_probability", "reference_disagrees", "run_experiment",
+    "evolve",
+    "EvolutionResult",
+    "GA",
+    "Objective",
+    "OBJECTIVES",
+    "ObjectiveSpec",
+    "objectives",
+    "objective_value",
+    "Fitness",
+    "Individual",
+    "GenerationStats",
+    "History",
+    "evaluate_population",
+    "to_fitness",
+    "tournament_probability",
+    "reference_disagrees",
+    "run_experiment",
     "run_study",
     # control
-    "SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available", "grn_swim",
+    "SwimEnv",
+    "SWIM_ENV_OBJECTIVES",
+    "gymnasium_available",
+    "grn_swim",
     # analysis
-    "Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE",
-    "Trajectory", "replay", "actuation_terms", "actuation_rates", "EXPANDING", "CONTRACTING", "NEUTRAL",
-    "STATE_NAMES", "DEFAULT_NEUTRAL", "animate", "mp4_available", "LocomotionMode", "classify_locomotion",
-    "best_statistics", "grow_output", "last_morphology_change", "morphology_changes", "oscillator_spread",
-    "phase_spread", "tries_per_viable", "plot",
+    "Run",
+    "LineageEntry",
+    "HISTORY_DTYPE",
+    "read_history",
+    "morphology_distance",
+    "MORPHOLOGY_TOLERANCE",
+    "Trajectory",
+    "replay",
+    "actuation_terms",
+    "actuation_rates",
+    "EXPANDING",
+    "CONTRACTING",
+    "NEUTRAL",
+    "STATE_NAMES",
+    "DEFAULT_NEUTRAL",
+    "animate",
+    "mp4_available",
+    "LocomotionMode",
+    "classify_locomotion",
+    "best_statistics",
+    "grow_output",
+    "last_morphology_change",
+    "morphology_changes",
+    "oscillator_spread",
+    "phase_spread",
+    "tries_per_viable",
+    "plot",
 ]
 
 

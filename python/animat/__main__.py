@@ -1,4 +1,5 @@
 """``python -m animat``: see :mod:`animat.cli`."""
+
 import sys
 
 from .cli import main

@@ -25,6 +25,7 @@ scene) every episode starts where an evaluation does: the body placed on the flo
 ``evaluation.settle_steps`` steps without actuation (``animat._core.start_state``). An episode ends (``terminated``) when the swim
 leaves the simulator's valid domain, and is truncated after ``max_episode_steps`` steps.
 """
+
 from __future__ import annotations
 
 import math
@@ -75,9 +76,18 @@ class SwimEnv(_EnvBase):
 
     metadata: Dict[str, Any] = {"render_modes": []}
 
-    def __init__(self, body: Any, config: Any = None, *, mode: str = "rest_length", frame_skip: int = 4,
-                 max_episode_steps: Optional[int] = None, objective: Optional[str] = None,
-                 frequency: Any = None, velocity_noise: float = 0.0) -> None:
+    def __init__(
+        self,
+        body: Any,
+        config: Any = None,
+        *,
+        mode: str = "rest_length",
+        frame_skip: int = 4,
+        max_episode_steps: Optional[int] = None,
+        objective: Optional[str] = None,
+        frequency: Any = None,
+        velocity_noise: float = 0.0,
+    ) -> None:
         if _gym is None or _spaces is None:
             raise ImportError("animat.SwimEnv needs gymnasium: pip install gymnasium (or animat[control])")
         super().__init__()
@@ -95,12 +105,16 @@ class SwimEnv(_EnvBase):
         self.frame_skip = int(frame_skip)
         self.dt = float(self.config["physics.dt"]) * self.frame_skip  # simulated time per env step
         steps = int(self.config["evaluation.steps"])
-        self.max_episode_steps = int(max_episode_steps) if max_episode_steps is not None else max(1, steps // frame_skip)
+        self.max_episode_steps = (
+            int(max_episode_steps) if max_episode_steps is not None else max(1, steps // frame_skip)
+        )
         if self.max_episode_steps < 1:
             raise ValueError(f"SwimEnv: max_episode_steps must be >= 1, got {self.max_episode_steps}")
         self.objective = str(self.config["evaluation.objective"]) if objective is None else objective
         if self.objective not in SWIM_ENV_OBJECTIVES:
-            raise ValueError(f"SwimEnv: objective must be one of {', '.join(SWIM_ENV_OBJECTIVES)}, got {self.objective!r}")
+            raise ValueError(
+                f"SwimEnv: objective must be one of {', '.join(SWIM_ENV_OBJECTIVES)}, got {self.objective!r}"
+            )
         self._length = float(_core.body_length(self.body))
         self._frequency = frequency
         self.velocity_noise = float(velocity_noise)
@@ -143,16 +157,29 @@ class SwimEnv(_EnvBase):
         """The objective of the swim so far (the rewards of an episode add up to it)."""
         disp = np.asarray(self._sim.center_of_mass()) - self._com0
         return _core.objective_value(
-            self.objective, distance=float(np.linalg.norm(disp)), dx=float(disp[0]), dy=float(disp[1]),
-            duration=self.max_episode_steps * self.dt, body_length=self._length,
-            actuation_work_positive=float(self._sim.counters["actuation_work_positive"]), config=self.config)
+            self.objective,
+            distance=float(np.linalg.norm(disp)),
+            dx=float(disp[0]),
+            dy=float(disp[1]),
+            duration=self.max_episode_steps * self.dt,
+            body_length=self._length,
+            actuation_work_positive=float(self._sim.counters["actuation_work_positive"]),
+            config=self.config,
+        )
 
     def _info(self) -> Dict[str, Any]:
-        return {"time": float(self._sim.time), "steps": int(self._sim.steps_done),
-                "com": np.asarray(self._sim.center_of_mass()), "objective": self._value, "failure": self._failure}
+        return {
+            "time": float(self._sim.time),
+            "steps": int(self._sim.steps_done),
+            "com": np.asarray(self._sim.center_of_mass()),
+            "objective": self._value,
+            "failure": self._failure,
+        }
 
     # --- Gymnasium API ------------------------------------------------------------------------------
-    def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None) -> Tuple[np.ndarray, Dict[str, Any]]:
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None
+    ) -> Tuple[np.ndarray, Dict[str, Any]]:
         """Start an episode: the body at rest (plus ``velocity_noise``), actuation off. Returns (obs, info)."""
         super().reset(seed=seed)
         self._sim = _core.Simulation(self._start_body, self._scene, self.config)
@@ -180,10 +207,20 @@ class SwimEnv(_EnvBase):
         a = np.asarray(action, dtype=np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(f"SwimEnv.step: action has shape {a.shape}, expected {self.action_space.shape}")
-        if not np.all(np.isfinite(a)) or np.any(a < self.action_space.low - 1e-12) or np.any(a > self.action_space.high + 1e-12):
-            bad = int(np.flatnonzero(~np.isfinite(a) | (a < self.action_space.low - 1e-12) | (a > self.action_space.high + 1e-12))[0])
-            raise ValueError(f"SwimEnv.step: action[{bad}] = {a[bad]} is outside the action space "
-                             f"[{self.action_space.low[bad]}, {self.action_space.high[bad]}]")
+        if (
+            not np.all(np.isfinite(a))
+            or np.any(a < self.action_space.low - 1e-12)
+            or np.any(a > self.action_space.high + 1e-12)
+        ):
+            bad = int(
+                np.flatnonzero(
+                    ~np.isfinite(a) | (a < self.action_space.low - 1e-12) | (a > self.action_space.high + 1e-12)
+                )[0]
+            )
+            raise ValueError(
+                f"SwimEnv.step: action[{bad}] = {a[bad]} is outside the action space "
+                f"[{self.action_space.low[bad]}, {self.action_space.high[bad]}]"
+            )
         a = np.clip(a, self.action_space.low, self.action_space.high)  # only the 1e-12 rounding slack
         n = self.body.node_count
         if self.mode == "rest_length":

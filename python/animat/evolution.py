@@ -5,12 +5,13 @@ fitness) and :class:`History` (the one history type: a structured array, ``.to_p
 Every random number of generation g, individual i derives from (seed, g, i): a run is bit-identical
 for any thread count, across kill/resume, and between ``evolve`` and a ``GA`` loop.
 """
+
 from __future__ import annotations
 
 import math
 import os
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, List, Optional, Sequence, Union
 
@@ -19,8 +20,17 @@ import numpy as np
 from . import _core
 from .run import HISTORY_DTYPE
 
-__all__ = ["History", "EvolutionResult", "Objective", "GA", "evolve", "evaluate", "evaluate_population",
-           "record_evaluation", "to_fitness"]
+__all__ = [
+    "History",
+    "EvolutionResult",
+    "Objective",
+    "GA",
+    "evolve",
+    "evaluate",
+    "evaluate_population",
+    "record_evaluation",
+    "to_fitness",
+]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -49,7 +59,7 @@ class History(np.recarray):
         return pd.DataFrame.from_records(np.asarray(self).view(np.ndarray), columns=list(HISTORY_DTYPE.names or ()))
 
     @staticmethod
-    def from_rows(rows: Iterable[Any]) -> "History":
+    def from_rows(rows: Iterable[Any]) -> History:
         """A History from GenerationStats objects (or anything with those attributes)."""
         records = [tuple(getattr(r, name) for name in HISTORY_DTYPE.names or ()) for r in rows]
         return np.array(records, dtype=HISTORY_DTYPE).view(History)  # type: ignore[return-value]
@@ -86,8 +96,10 @@ class EvolutionResult:
         return self.best.fitness
 
     def __repr__(self) -> str:
-        return (f"<animat.EvolutionResult {len(self.history)} generations, best {self.best.fitness.fitness:.6g}, "
-                f"stopped: {self.stop_reason}>")
+        return (
+            f"<animat.EvolutionResult {len(self.history)} generations, best {self.best.fitness.fitness:.6g}, "
+            f"stopped: {self.stop_reason}>"
+        )
 
 
 @dataclass
@@ -151,8 +163,10 @@ def _core_objective(cfg: Any, objective: Union[None, str, Objective]) -> Any:
         return objective
     name = str(cfg["evaluation.objective"])
     if name.startswith("python:"):
-        raise ValueError(f"evaluation.objective = {name!r} is a Python objective: pass objective=animat.Objective(...) "
-                         "with that name")
+        raise ValueError(
+            f"evaluation.objective = {name!r} is a Python objective: pass objective=animat.Objective(...) "
+            "with that name"
+        )
     return None
 
 
@@ -168,8 +182,9 @@ def evaluate(genome: Any, config: Any = None, objective: ObjectiveLike = None) -
     return _core.evaluate(genome, config, _objective(objective))
 
 
-def evaluate_population(genomes: Sequence[Any], config: Any = None, threads: int = 0,
-                        objective: ObjectiveLike = None) -> List[Any]:
+def evaluate_population(
+    genomes: Sequence[Any], config: Any = None, threads: int = 0, objective: ObjectiveLike = None
+) -> List[Any]:
     """Evaluate genomes in parallel (OpenMP threads, the GIL released) and return one
     :class:`animat.Fitness` per genome, in order, identical for any thread count (0 = all cores)."""
     return _core.evaluate_population(list(genomes), config, threads, _objective(objective))
@@ -188,8 +203,9 @@ def to_fitness(value: Any) -> Any:
     if isinstance(value, _core.Fitness):
         return value
     if isinstance(value, _core.EvaluationResult):
-        return _core.Fitness(value.fitness, value.viable, value.stable, value.cell_count, value.valid,
-                             value.drag_limited)
+        return _core.Fitness(
+            value.fitness, value.viable, value.stable, value.cell_count, value.valid, value.drag_limited
+        )
     if value is None:
         return _core.Fitness(0.0, False, True, 0)
     if isinstance(value, (bool, np.bool_)):
@@ -197,8 +213,10 @@ def to_fitness(value: Any) -> Any:
     try:
         number = float(value)
     except (TypeError, ValueError):
-        raise TypeError("a fitness must be a number, None, an animat.Fitness or an animat.EvaluationResult, got "
-                        f"{type(value).__name__}") from None
+        raise TypeError(
+            "a fitness must be a number, None, an animat.Fitness or an animat.EvaluationResult, got "
+            f"{type(value).__name__}"
+        ) from None
     if not math.isfinite(number):
         raise ValueError(f"a fitness must be finite, got {number} (tell None for a non-viable genome)")
     return _core.Fitness(number, True, True, 0)
@@ -245,9 +263,11 @@ class GA:
         name = str(self._config["evaluation.objective"])
         guard = str(self._config["evaluation.reference_check"])
         if name.startswith("python:") and self._objective is None and guard != "off":
-            raise ValueError(f"GA: evaluation.objective = {name!r} is a Python objective and the exploit guard "
-                             f"(evaluation.reference_check = {guard!r}) re-evaluates each new best with it: pass "
-                             "objective=animat.Objective(...) with that name, or set evaluation.reference_check = 'off'")
+            raise ValueError(
+                f"GA: evaluation.objective = {name!r} is a Python objective and the exploit guard "
+                f"(evaluation.reference_check = {guard!r}) re-evaluates each new best with it: pass "
+                "objective=animat.Objective(...) with that name, or set evaluation.reference_check = 'off'"
+            )
         self._engine = _core.Evolution(self._config, self._objective)
 
     # --- the loop ---------------------------------------------------------------------------------
@@ -282,7 +302,9 @@ class GA:
             return self._engine.history[-1]
         return None
 
-    def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None, threads: Optional[int] = None) -> Any:
+    def step(
+        self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None, threads: Optional[int] = None
+    ) -> Any:
         """Ask, evaluate and tell until the next generation is complete; returns its GenerationStats.
 
         ``evaluate`` maps a list of genomes to their fitness values (default: :func:`evaluate_population`
@@ -357,7 +379,7 @@ class GA:
         return path
 
     @classmethod
-    def from_checkpoint(cls, text: str, config: Any, source: str = "checkpoint", objective: ObjectiveLike = None) -> "GA":
+    def from_checkpoint(cls, text: str, config: Any, source: str = "checkpoint", objective: ObjectiveLike = None) -> GA:
         """A GA restored from checkpoint text; ``config`` must be the run's (only its stopping and
         resource knobs may differ), else ValueError. ``objective``: as for :class:`GA`."""
         ga = cls(config, objective)
@@ -365,7 +387,7 @@ class GA:
         return ga
 
     @classmethod
-    def load(cls, path: PathLike, config: Any = None, objective: ObjectiveLike = None) -> "GA":
+    def load(cls, path: PathLike, config: Any = None, objective: ObjectiveLike = None) -> GA:
         """A GA restored from a checkpoint file: one written by :meth:`save`, or a run directory's
         ``checkpoint.json`` (or the run directory itself: its config.toml is then the default config)."""
         path = Path(path)
@@ -395,6 +417,7 @@ class GA:
 
 # --- evolve ---------------------------------------------------------------------------------------------
 
+
 def _progress_bar(total: Optional[int], enabled: bool) -> Any:
     if not enabled:
         return None
@@ -403,11 +426,22 @@ def _progress_bar(total: Optional[int], enabled: bool) -> Any:
     return tqdm(total=total, desc="evolve", unit="gen", dynamic_ncols=True)
 
 
-def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: Optional[int] = None,
-           wall_seconds: Optional[float] = None, seed: Optional[int] = None, threads: Optional[int] = None,
-           objective: ObjectiveLike = None, resume: bool = False, overwrite: bool = False,
-           callback: Optional[Callable[[Any], Optional[bool]]] = None, quiet: bool = False,
-           progress: Optional[bool] = None, stop: Any = None) -> EvolutionResult:
+def evolve(
+    config: Any = None,
+    out: Optional[PathLike] = None,
+    *,
+    generations: Optional[int] = None,
+    wall_seconds: Optional[float] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    objective: ObjectiveLike = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    callback: Optional[Callable[[Any], Optional[bool]]] = None,
+    quiet: bool = False,
+    progress: Optional[bool] = None,
+    stop: Any = None,
+) -> EvolutionResult:
     """Run the paper's genetic algorithm: the engine, checkpoints and run directory of ``animat_evolve``.
 
     Args:
@@ -471,9 +505,12 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
         cfg["evolution.threads"] = int(threads)
     core_objective = _core_objective(cfg, obj)
     if int(cfg["evolution.generations"]) == 0 and float(cfg["evolution.wall_seconds"]) == 0:
-        warnings.warn("evolve: no generation cap (generations=) and no wall-clock budget (wall_seconds=): the run stops "
-                      f"only after {int(cfg['evolution.stall_generations'])} generations without improvement (hours)",
-                      UserWarning, stacklevel=2)
+        warnings.warn(
+            "evolve: no generation cap (generations=) and no wall-clock budget (wall_seconds=): the run stops "
+            f"only after {int(cfg['evolution.stall_generations'])} generations without improvement (hours)",
+            UserWarning,
+            stacklevel=2,
+        )
     # The engine refuses a directory that holds a run (FileExistsError) or that another process is
     # writing (BlockingIOError), and clears it for overwrite=True only once it holds the directory's lock.
 
@@ -485,8 +522,12 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
     def on_generation(stats: Any) -> bool:
         if bar is not None:
             bar.n = stats.generation + 1  # generations 0..g done (a resumed run continues the count)
-            bar.set_postfix(best=f"{stats.best:.4g}", viable=f"{100 * stats.viable_fraction:.0f}%",
-                            evals_per_s=f"{stats.evaluations_per_second:.0f}", refresh=False)
+            bar.set_postfix(
+                best=f"{stats.best:.4g}",
+                viable=f"{100 * stats.viable_fraction:.0f}%",
+                evals_per_s=f"{stats.evaluations_per_second:.0f}",
+                refresh=False,
+            )
             bar.refresh()
         state["last"] = stats
         if callback is not None:
@@ -494,19 +535,34 @@ def evolve(config: Any = None, out: Optional[PathLike] = None, *, generations: O
             if answer is None:
                 return True
             if not isinstance(answer, (bool, np.bool_)):
-                raise TypeError(f"evolve: the callback must return True, False or None (None = go on), "
-                                f"got {type(answer).__name__} {answer!r:.60}")
+                raise TypeError(
+                    f"evolve: the callback must return True, False or None (None = go on), "
+                    f"got {type(answer).__name__} {answer!r:.60}"
+                )
             return bool(answer)
         return True
 
     def result_of(summary: Any) -> EvolutionResult:
-        return EvolutionResult(history=History.from_rows(summary.history), best=summary.best,
-                               population=list(summary.population), stop_reason=summary.stop_reason, config=cfg,
-                               out=out_path)
+        return EvolutionResult(
+            history=History.from_rows(summary.history),
+            best=summary.best,
+            population=list(summary.population),
+            stop_reason=summary.stop_reason,
+            config=cfg,
+            out=out_path,
+        )
 
     try:
-        summary = _core.evolve(cfg, None if out_path is None else str(out_path), resume, on_generation,
-                               quiet or bar is not None, stop=stop, objective=core_objective, overwrite=overwrite)
+        summary = _core.evolve(
+            cfg,
+            None if out_path is None else str(out_path),
+            resume,
+            on_generation,
+            quiet or bar is not None,
+            stop=stop,
+            objective=core_objective,
+            overwrite=overwrite,
+        )
     except KeyboardInterrupt as e:
         partial = getattr(e, "result", None)
         if partial is not None:

@@ -14,6 +14,7 @@ job (``mpirun -np R python -m animat experiment ... --mpi``, needs mpi4py), ``--
 run I of the study (one task of a Slurm array). Every run depends only on its config and seed, never
 on where it ran.
 """
+
 from __future__ import annotations
 
 import json
@@ -41,16 +42,24 @@ class RunRecord:
     wall_seconds: float
 
 
-def _run_one(config: "_core.Config", out: Path, index: int, quiet: bool,
-             stop: Optional[threading.Event] = None) -> Optional[RunRecord]:
+def _run_one(
+    config: _core.Config, out: Path, index: int, quiet: bool, stop: Optional[threading.Event] = None
+) -> Optional[RunRecord]:
     resume = (out / "checkpoint.json").exists()
     result = _core.evolve(config, out=str(out), resume=resume, quiet=quiet, stop=stop)
     if not result.history:  # stopped before its initial population was complete: nothing to record
         return None
     last = result.history[-1]
-    return RunRecord(index=index, seed=int(config["evolution.seed"]), path=str(out), best=last.best,
-                     generations=last.generation, best_cells=last.best_cells, stop_reason=result.stop_reason,
-                     wall_seconds=last.wall_seconds)
+    return RunRecord(
+        index=index,
+        seed=int(config["evolution.seed"]),
+        path=str(out),
+        best=last.best,
+        generations=last.generation,
+        best_cells=last.best_cells,
+        stop_reason=result.stop_reason,
+        wall_seconds=last.wall_seconds,
+    )
 
 
 def summarize(records: Sequence[RunRecord]) -> Dict[str, float]:
@@ -59,13 +68,27 @@ def summarize(records: Sequence[RunRecord]) -> Dict[str, float]:
     if not bests:
         return {}
     q = statistics.quantiles(bests, n=4) if len(bests) >= 2 else [bests[0]] * 3
-    return {"runs": len(bests), "median": statistics.median(bests), "min": bests[0], "max": bests[-1],
-            "q1": q[0], "q3": q[2]}
+    return {
+        "runs": len(bests),
+        "median": statistics.median(bests),
+        "min": bests[0],
+        "max": bests[-1],
+        "q1": q[0],
+        "q3": q[2],
+    }
 
 
-def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, threads: int = 0,
-                   generations: Optional[int] = None, wall_seconds: Optional[float] = None,
-                   overrides: Sequence[str] = (), quiet: bool = True) -> List[RunRecord]:
+def run_experiment(
+    config_path: str,
+    runs: int,
+    out: str,
+    parallel: int = 1,
+    threads: int = 0,
+    generations: Optional[int] = None,
+    wall_seconds: Optional[float] = None,
+    overrides: Sequence[str] = (),
+    quiet: bool = True,
+) -> List[RunRecord]:
     """Run (or resume) ``runs`` independent seeds of a config; returns one record per run.
 
     config_path: TOML file. out: experiment directory (OUT/run_<i>, summary.json, summary.md).
@@ -73,27 +96,49 @@ def run_experiment(config_path: str, runs: int, out: str, parallel: int = 1, thr
     and budget overriding the config. overrides: "section.key=value" strings applied to the config.
     One environment of :func:`run_study`.
     """
-    by_env = run_study([config_path], runs, out, parallel=parallel, threads=threads, generations=generations,
-                       wall_seconds=wall_seconds, overrides=overrides, quiet=quiet)
+    by_env = run_study(
+        [config_path],
+        runs,
+        out,
+        parallel=parallel,
+        threads=threads,
+        generations=generations,
+        wall_seconds=wall_seconds,
+        overrides=overrides,
+        quiet=quiet,
+    )
     return next(iter(by_env.values()))
 
 
 def write_summary(root: Path, config_path: str, records: Sequence[RunRecord]) -> None:
     """Write OUT/summary.json and OUT/summary.md."""
     stats = summarize(records)
-    (root / "summary.json").write_text(json.dumps(
-        {"config": str(config_path), "runs": [asdict(r) for r in records], "best_fitness": stats}, indent=1) + "\n")
-    lines = [f"# Experiment {root}", "", f"config: `{config_path}`", "",
-             "| run | seed | best fitness | generations | cells of best | stop |", "| --- | --- | --- | --- | --- | --- |"]
-    lines += [f"| {r.index} | {r.seed} | {r.best:.4f} | {r.generations} | {r.best_cells} | {r.stop_reason} |"
-              for r in records]
+    (root / "summary.json").write_text(
+        json.dumps({"config": str(config_path), "runs": [asdict(r) for r in records], "best_fitness": stats}, indent=1)
+        + "\n"
+    )
+    lines = [
+        f"# Experiment {root}",
+        "",
+        f"config: `{config_path}`",
+        "",
+        "| run | seed | best fitness | generations | cells of best | stop |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    lines += [
+        f"| {r.index} | {r.seed} | {r.best:.4f} | {r.generations} | {r.best_cells} | {r.stop_reason} |" for r in records
+    ]
     if stats:
-        lines += ["", f"median best fitness {stats['median']:.4f} (min {stats['min']:.4f}, max {stats['max']:.4f}, "
-                      f"quartiles {stats['q1']:.4f} to {stats['q3']:.4f}) over {stats['runs']} runs"]
+        lines += [
+            "",
+            f"median best fitness {stats['median']:.4f} (min {stats['min']:.4f}, max {stats['max']:.4f}, "
+            f"quartiles {stats['q1']:.4f} to {stats['q3']:.4f}) over {stats['runs']} runs",
+        ]
     (root / "summary.md").write_text("\n".join(lines) + "\n")
 
 
 # --- Studies: several environments, on MPI ranks or as array tasks (issue 20) ------------------------
+
 
 @dataclass
 class _Task:
@@ -124,8 +169,10 @@ def _mpi_world():
     try:
         from mpi4py import MPI  # noqa: PLC0415 - optional dependency
     except ImportError as e:
-        raise RuntimeError("--mpi needs mpi4py: .venv/bin/pip install mpi4py (and an MPI: apt-get install "
-                           "libopenmpi-dev openmpi-bin, as scripts/setup.sh does)") from e
+        raise RuntimeError(
+            "--mpi needs mpi4py: .venv/bin/pip install mpi4py (and an MPI: apt-get install "
+            "libopenmpi-dev openmpi-bin, as scripts/setup.sh does)"
+        ) from e
     return MPI.COMM_WORLD
 
 
@@ -137,10 +184,21 @@ def launched_ranks() -> int:
     return 1
 
 
-def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False, index: Optional[Sequence[int]] = None,
-              parallel: int = 1, threads: int = 0, generations: Optional[int] = None,
-              wall_seconds: Optional[float] = None, overrides: Sequence[str] = (), quiet: bool = True,
-              log=print) -> Dict[str, List[RunRecord]]:
+def run_study(
+    configs: Sequence[str],
+    runs: int,
+    out: str,
+    *,
+    mpi: bool = False,
+    index: Optional[Sequence[int]] = None,
+    parallel: int = 1,
+    threads: int = 0,
+    generations: Optional[int] = None,
+    wall_seconds: Optional[float] = None,
+    overrides: Sequence[str] = (),
+    quiet: bool = True,
+    log=print,
+) -> Dict[str, List[RunRecord]]:
     """Run (or resume) ``runs`` seeds of every environment; returns the records by environment name.
 
     configs: ``PATH`` or ``NAME=PATH``; one plain PATH keeps the single-experiment layout OUT/run_<i>,
@@ -156,17 +214,22 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
     envs = _environments(configs)
     nested = len(envs) > 1 or "=" in configs[0]
     root = Path(out)
-    tasks = [_Task(name, path, i, (root / name if nested else root) / f"run_{i}")
-             for name, path in envs for i in range(runs)]
+    tasks = [
+        _Task(name, path, i, (root / name if nested else root) / f"run_{i}") for name, path in envs for i in range(runs)
+    ]
     if index is not None:
         for t in index:
             if not 0 <= t < len(tasks):
-                raise ValueError(f"experiment: --index {t} is outside the study's {len(tasks)} runs "
-                                 f"(0 to {len(tasks) - 1}: {len(envs)} environment(s) x {runs} runs)")
+                raise ValueError(
+                    f"experiment: --index {t} is outside the study's {len(tasks)} runs "
+                    f"(0 to {len(tasks) - 1}: {len(envs)} environment(s) x {runs} runs)"
+                )
     ranks = launched_ranks()
     if ranks > 1 and not mpi:
-        raise RuntimeError(f"experiment: started as one of {ranks} MPI ranks without --mpi: every rank would run "
-                           "every run; add --mpi to place the runs on the ranks")
+        raise RuntimeError(
+            f"experiment: started as one of {ranks} MPI ranks without --mpi: every rank would run "
+            "every run; add --mpi to place the runs on the ranks"
+        )
     comm = _mpi_world() if mpi else None
     rank, size = (comm.Get_rank(), comm.Get_size()) if comm is not None else (0, 1)
     local = 1
@@ -174,7 +237,13 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
         from mpi4py import MPI  # noqa: PLC0415
 
         local = comm.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
-    cores = threads if threads > 0 else len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    cores = (
+        threads
+        if threads > 0
+        else len(os.sched_getaffinity(0))
+        if hasattr(os, "sched_getaffinity")
+        else (os.cpu_count() or 1)
+    )
     per_run = max(1, cores // max(1, local) // parallel)
 
     bases = {}
@@ -219,8 +288,10 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
                         return
                     raise RuntimeError(f"{task.out}: the run ended before its initial population was complete")
                 if not quiet:
-                    log(f"{task.env} run {task.index} (rank {rank}): best {rec.best:.4f} after {rec.generations} "
-                        f"generations ({rec.stop_reason})")
+                    log(
+                        f"{task.env} run {task.index} (rank {rank}): best {rec.best:.4f} after {rec.generations} "
+                        f"generations ({rec.stop_reason})"
+                    )
                 with lock:
                     results.append((t, rec, None))
             except Exception as e:  # noqa: BLE001 - reported with the others by rank 0
@@ -236,8 +307,9 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
                 if active[0] == 0:
                     all_done.set()
 
-    workers = [threading.Thread(target=worker, name=f"animat-study-{k}")
-               for k in range(min(parallel, max(1, len(mine))))]
+    workers = [
+        threading.Thread(target=worker, name=f"animat-study-{k}") for k in range(min(parallel, max(1, len(mine))))
+    ]
     active[0] = len(workers)
     for w in workers:
         w.start()
@@ -255,11 +327,15 @@ def run_study(configs: Sequence[str], runs: int, out: str, *, mpi: bool = False,
     if interrupted:
         if index is None and comm is None:  # the finished runs are summarised; the others resume
             for name, path in envs:
-                done = [rec for t, rec, _ in sorted(results, key=lambda r: r[0]) if rec is not None and tasks[t].env == name]
+                done = [
+                    rec for t, rec, _ in sorted(results, key=lambda r: r[0]) if rec is not None and tasks[t].env == name
+                ]
                 if done:
                     write_summary(root / name if nested else root, path, done)
-        raise KeyboardInterrupt(f"experiment {root}: interrupted; every run stopped with a checkpoint of its last "
-                                f"complete generation; run the same command again to resume")
+        raise KeyboardInterrupt(
+            f"experiment {root}: interrupted; every run stopped with a checkpoint of its last "
+            f"complete generation; run the same command again to resume"
+        )
     if comm is not None:
         gathered = comm.gather(results, root=0)
         if rank != 0 or gathered is None:  # only rank 0 receives the gathered list

@@ -114,6 +114,7 @@ paper's claims about the best individuals: cell count, the grow output (size inc
 frequency and phase differentiation, tries per viable random individual, and when the best's
 morphology last changed.
 """
+
 from __future__ import annotations
 
 import math
@@ -127,14 +128,44 @@ from .run import MORPHOLOGY_TOLERANCE, LineageEntry, Run, morphology_distance
 from .trajectory import Trajectory, body_of, replay
 
 __all__ = [
-    "LocomotionMode", "WaveFit", "classify_locomotion", "classify_motion", "MODES",
-    "NONE_DEFORMATION", "PROTRUSION_CONCENTRATION", "WAVE_FIT", "WAVE_LAG", "WAVE_TI", "SYNC_COHERENCE",
-    "TOP_FRACTION", "LOCAL_CONTRAST", "procrustes_frames", "circular_linear_fit", "travelling_index", "phase_coherence",
-    "harmonic_amplitudes", "GrowOutput", "OscillatorSpread", "PhaseSpread", "BestStatistics",
-    "grow_output", "oscillator_spread", "phase_spread", "tries_per_viable", "morphology_changes",
-    "last_morphology_change", "best_statistics", "PHASE_DIFFERENTIATED", "AMPLITUDE_DIFFERENTIATED",
-    "FREQUENCY_DIFFERENTIATED", "CONTRACTION_FLOOR", "Paddling", "paddling", "paddling_motion",
-    "PADDLE_SPIKE", "PADDLE_ROWING",
+    "LocomotionMode",
+    "WaveFit",
+    "classify_locomotion",
+    "classify_motion",
+    "MODES",
+    "NONE_DEFORMATION",
+    "PROTRUSION_CONCENTRATION",
+    "WAVE_FIT",
+    "WAVE_LAG",
+    "WAVE_TI",
+    "SYNC_COHERENCE",
+    "TOP_FRACTION",
+    "LOCAL_CONTRAST",
+    "procrustes_frames",
+    "circular_linear_fit",
+    "travelling_index",
+    "phase_coherence",
+    "harmonic_amplitudes",
+    "GrowOutput",
+    "OscillatorSpread",
+    "PhaseSpread",
+    "BestStatistics",
+    "grow_output",
+    "oscillator_spread",
+    "phase_spread",
+    "tries_per_viable",
+    "morphology_changes",
+    "last_morphology_change",
+    "best_statistics",
+    "PHASE_DIFFERENTIATED",
+    "AMPLITUDE_DIFFERENTIATED",
+    "FREQUENCY_DIFFERENTIATED",
+    "CONTRACTION_FLOOR",
+    "Paddling",
+    "paddling",
+    "paddling_motion",
+    "PADDLE_SPIKE",
+    "PADDLE_ROWING",
 ]
 
 #: The modes :func:`classify_locomotion` returns.
@@ -180,6 +211,7 @@ ArrayLike = Union[np.ndarray, Sequence]
 
 
 # --- geometry and signal helpers ------------------------------------------------------------------------
+
 
 def _kabsch_batch(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
     """Rotations R_t (F, 2, 2), no reflection, minimising ||X_t R_t - Y|| for centred X (F, n, 2), Y (n, 2)."""
@@ -296,8 +328,9 @@ class WaveFit:
         return "forward" if self.angle < 45 else ("backward" if self.angle > 135 else "across")
 
 
-def circular_linear_fit(phases: ArrayLike, weights: ArrayLike, coords: ArrayLike,
-                        max_gradient: float = math.pi, grid: int = 81) -> Tuple[Union[float, np.ndarray], float]:
+def circular_linear_fit(
+    phases: ArrayLike, weights: ArrayLike, coords: ArrayLike, max_gradient: float = math.pi, grid: int = 81
+) -> Tuple[Union[float, np.ndarray], float]:
     """Best linear phase gradient: maximise ``|Σ w_i e^{i(φ_i − g·x_i)}| / Σ w_i`` over g.
 
     Args:
@@ -337,6 +370,7 @@ def circular_linear_fit(phases: ArrayLike, weights: ArrayLike, coords: ArrayLike
 
 
 # --- classification --------------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True, eq=False)
 class LocomotionMode:
@@ -390,10 +424,15 @@ class LocomotionMode:
 
     def __str__(self) -> str:
         w = self.wave
-        wave = (f", phase lag {w.lag:.2f} rad (fit {w.fit:.2f}, TI {w.travelling_index:.2f}, travels {w.travel})"
-                if w is not None else "")
-        return (f"{self.label}: deformation {self.deformation:.3f}, coherence {self.coherence:.2f}, "
-                f"concentration {self.concentration:.2f}{wave}")
+        wave = (
+            f", phase lag {w.lag:.2f} rad (fit {w.fit:.2f}, TI {w.travelling_index:.2f}, travels {w.travel})"
+            if w is not None
+            else ""
+        )
+        return (
+            f"{self.label}: deformation {self.deformation:.3f}, coherence {self.coherence:.2f}, "
+            f"concentration {self.concentration:.2f}{wave}"
+        )
 
 
 def _dominant_omega(Q: np.ndarray, times: np.ndarray) -> float:
@@ -470,9 +509,16 @@ def _no_wave(w: WaveFit) -> str:
     return "no travelling wave (" + ", ".join(failed) + ")"
 
 
-def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional[ArrayLike] = None,
-                    omega: Optional[float] = None, cycles: float = 4, outline: Optional[Sequence[int]] = None,
-                    rest_positions: Optional[ArrayLike] = None) -> LocomotionMode:
+def classify_motion(
+    positions: ArrayLike,
+    times: ArrayLike,
+    *,
+    springs: Optional[ArrayLike] = None,
+    omega: Optional[float] = None,
+    cycles: float = 4,
+    outline: Optional[Sequence[int]] = None,
+    rest_positions: Optional[ArrayLike] = None,
+) -> LocomotionMode:
     """Classify the locomotion of recorded node positions (the array core of :func:`classify_locomotion`).
 
     Args:
@@ -498,12 +544,15 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
     if len(P) < 8:
         raise ValueError(f"classify_motion: need at least 8 frames, got {len(P)}")
     F, n, _ = P.shape
-    sp = (np.asarray(_core.gabriel_graph(P[0]), dtype=np.int64) if springs is None
-          else np.asarray(springs, dtype=np.int64).reshape(-1, 2))
+    sp = (
+        np.asarray(_core.gabriel_graph(P[0]), dtype=np.int64)
+        if springs is None
+        else np.asarray(springs, dtype=np.int64).reshape(-1, 2)
+    )
     if omega is None:
-        half = P[F // 2:]
+        half = P[F // 2 :]
         Qh, _, _ = procrustes_frames(half)
-        omega = _dominant_omega(Qh, t[F // 2:])
+        omega = _dominant_omega(Qh, t[F // 2 :])
     omega = float(omega)
     duration = float(t[-1] - t[0])
     if omega > 0 and math.isfinite(omega):
@@ -523,7 +572,7 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
 
     Q, R, mean_shape = procrustes_frames(W)
     centred = mean_shape - mean_shape.mean(axis=0)
-    size = float(np.sqrt(np.mean(np.sum(centred ** 2, axis=1)))) if n else 0.0
+    size = float(np.sqrt(np.mean(np.sum(centred**2, axis=1)))) if n else 0.0
 
     com = W.mean(axis=1)
     steps = np.einsum("fi,fij->fj", np.diff(com, axis=0), R[:-1])
@@ -537,8 +586,24 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
 
     if omega <= 0 or not math.isfinite(omega) or size == 0:
         zeros = np.zeros(n)
-        return LocomotionMode("none", (), 0.0, 0.0, 0.0, 0.0, None, omega, k, int(sel.sum()), motion, speed,
-                              np.zeros(0, dtype=np.int64), "no oscillation to analyse", zeros, zeros)
+        return LocomotionMode(
+            "none",
+            (),
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            None,
+            omega,
+            k,
+            int(sel.sum()),
+            motion,
+            speed,
+            np.zeros(0, dtype=np.int64),
+            "no oscillation to analyse",
+            zeros,
+            zeros,
+        )
 
     disp = harmonic_amplitudes(Q, tw, omega)  # (n, 2) complex
     amp2 = np.sum(np.abs(disp) ** 2, axis=1)  # (n,)
@@ -554,10 +619,24 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
     concentration = float(amp2[top].sum() / amp2.sum()) if amp2.sum() > 0 else 0.0
 
     if deformation < NONE_DEFORMATION:
-        return LocomotionMode("none", (), deformation, coherence, concentration, ti, None, omega, k,
-                              int(sel.sum()), motion, speed, top,
-                              f"deformation {deformation:.4f} < {NONE_DEFORMATION}: the body does not deform",
-                              np.angle(contraction), np.abs(contraction))
+        return LocomotionMode(
+            "none",
+            (),
+            deformation,
+            coherence,
+            concentration,
+            ti,
+            None,
+            omega,
+            k,
+            int(sel.sum()),
+            motion,
+            speed,
+            top,
+            f"deformation {deformation:.4f} < {NONE_DEFORMATION}: the body does not deform",
+            np.angle(contraction),
+            np.abs(contraction),
+        )
 
     wave = _wave_fit(contraction, centred, motion)
     is_wave = wave.is_wave
@@ -566,8 +645,11 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
     c_order = np.argsort(-ca, kind="stable")
     c_top = np.sort(c_order[:n_top])
     median = float(np.median(ca))
-    contrast = (float(np.sqrt(np.mean(ca[c_top] ** 2))) / median if median > 0
-                else (float("inf") if ca.max(initial=0.0) > 0 else 0.0))
+    contrast = (
+        float(np.sqrt(np.mean(ca[c_top] ** 2))) / median
+        if median > 0
+        else (float("inf") if ca.max(initial=0.0) > 0 else 0.0)
+    )
     local = contrast >= LOCAL_CONTRAST
     prot = concentration >= PROTRUSION_CONCENTRATION or local
     from .protrusion import STROKE_AREA, STROKE_SCORE, stroke_motion  # noqa: PLC0415 - avoids an import cycle
@@ -582,9 +664,11 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
         mode = "protrusions"
         groups = len(stroke.protrusions)
         a, b = stroke.pair
-        reason = (f"a symmetric pair of protrusions ({len(stroke.protrusions[a])} and {len(stroke.protrusions[b])} "
-                  f"cells) rows: extended while moving backwards, pair score {stroke.score:.2f} >= {STROKE_SCORE}, "
-                  f"stroke area {stroke.area:.3f} >= {STROKE_AREA}")
+        reason = (
+            f"a symmetric pair of protrusions ({len(stroke.protrusions[a])} and {len(stroke.protrusions[b])} "
+            f"cells) rows: extended while moving backwards, pair score {stroke.score:.2f} >= {STROKE_SCORE}, "
+            f"stroke area {stroke.area:.3f} >= {STROKE_AREA}"
+        )
         if is_wave:
             mixed.append("undulation")
     elif prot:
@@ -593,37 +677,71 @@ def classify_motion(positions: ArrayLike, times: ArrayLike, *, springs: Optional
         mode = "protrusions" if groups >= 2 else "tail"
         why = []
         if local:
-            why.append(f"the most strained {n_top} of {n} cells contract {contrast:.1f} times as much as the "
-                       f"median cell (>= {LOCAL_CONTRAST})")
+            why.append(
+                f"the most strained {n_top} of {n} cells contract {contrast:.1f} times as much as the "
+                f"median cell (>= {LOCAL_CONTRAST})"
+            )
         if concentration >= PROTRUSION_CONCENTRATION:
-            why.append(f"the most mobile {n_top} of {n} cells carry {concentration:.0%} of the motion "
-                       f"(>= {PROTRUSION_CONCENTRATION:.0%})")
-        reason = (" and ".join(why) + f"; these cells form {groups} group{'s' if groups != 1 else ''} "
-                  + ("(appendages)" if groups >= 2 else "(one appendage: a tail)"))
+            why.append(
+                f"the most mobile {n_top} of {n} cells carry {concentration:.0%} of the motion "
+                f"(>= {PROTRUSION_CONCENTRATION:.0%})"
+            )
+        reason = (
+            " and ".join(why)
+            + f"; these cells form {groups} group{'s' if groups != 1 else ''} "
+            + ("(appendages)" if groups >= 2 else "(one appendage: a tail)")
+        )
         if is_wave:
             mixed.append("undulation")
     elif is_wave:
         mode = "undulation"
-        reason = (f"contraction phases have a consistent gradient (fit {wave.fit:.2f} >= {WAVE_FIT}) with "
-                  f"a lag of {wave.lag:.2f} rad >= pi/2 and travelling index {wave.travelling_index:.2f} "
-                  f">= {WAVE_TI}")
+        reason = (
+            f"contraction phases have a consistent gradient (fit {wave.fit:.2f} >= {WAVE_FIT}) with "
+            f"a lag of {wave.lag:.2f} rad >= pi/2 and travelling index {wave.travelling_index:.2f} "
+            f">= {WAVE_TI}"
+        )
         if sync:
             mixed.append("synchronous contraction")
     elif sync:
         mode = "synchronous contraction"
-        reason = (f"contraction phases coherent (R = {coherence:.2f} >= {SYNC_COHERENCE}) and "
-                  f"{_no_wave(wave)}")
+        reason = f"contraction phases coherent (R = {coherence:.2f} >= {SYNC_COHERENCE}) and {_no_wave(wave)}"
     else:
         mode = "other"
         reason = f"{_no_wave(wave)} and contraction phases incoherent (R = {coherence:.2f} < {SYNC_COHERENCE})"
-    return LocomotionMode(mode, tuple(mixed), deformation, coherence, concentration, ti, wave, omega, k,
-                          int(sel.sum()), motion, speed, top, reason, np.angle(contraction), np.abs(contraction),
-                          contrast=contrast, groups=groups, stroke=stroke)
+    return LocomotionMode(
+        mode,
+        tuple(mixed),
+        deformation,
+        coherence,
+        concentration,
+        ti,
+        wave,
+        omega,
+        k,
+        int(sel.sum()),
+        motion,
+        speed,
+        top,
+        reason,
+        np.angle(contraction),
+        np.abs(contraction),
+        contrast=contrast,
+        groups=groups,
+        stroke=stroke,
+    )
 
 
-def classify_locomotion(thing: Any, config: Optional[Any] = None, *, times: Optional[ArrayLike] = None,
-                        springs: Optional[ArrayLike] = None, omega: Optional[float] = None, cycles: float = 4,
-                        every: int = 1, stroke: bool = False) -> LocomotionMode:
+def classify_locomotion(
+    thing: Any,
+    config: Optional[Any] = None,
+    *,
+    times: Optional[ArrayLike] = None,
+    springs: Optional[ArrayLike] = None,
+    omega: Optional[float] = None,
+    cycles: float = 4,
+    every: int = 1,
+    stroke: bool = False,
+) -> LocomotionMode:
     """Classify how a swimmer moves: undulation, synchronous contraction, protrusions, other or none.
 
     See the module docstring for the method and the thresholds.
@@ -660,11 +778,19 @@ def classify_locomotion(thing: Any, config: Optional[Any] = None, *, times: Opti
         raise ValueError(f"classify_locomotion: trajectory too short ({tr.frame_count} frames)")
     loops = tr.body.skin_loops
     outline = loops[0] if stroke and len(loops) else None
-    return classify_motion(tr.positions, tr.times, springs=tr.body.springs, omega=omega, cycles=cycles,
-                           outline=outline, rest_positions=tr.body.positions if outline is not None else None)
+    return classify_motion(
+        tr.positions,
+        tr.times,
+        springs=tr.body.springs,
+        omega=omega,
+        cycles=cycles,
+        outline=outline,
+        rest_positions=tr.body.positions if outline is not None else None,
+    )
 
 
 # --- the paper's stroke -------------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True, eq=False)
 class Paddling:
@@ -702,8 +828,13 @@ class Paddling:
         return self.cells[self.spike >= self.spike_threshold]
 
 
-def paddling_motion(positions: ArrayLike, skin_loop: Sequence[int], rest_length: float, direction: ArrayLike,
-                    spike: float = PADDLE_SPIKE) -> Paddling:
+def paddling_motion(
+    positions: ArrayLike,
+    skin_loop: Sequence[int],
+    rest_length: float,
+    direction: ArrayLike,
+    spike: float = PADDLE_SPIKE,
+) -> Paddling:
     """:class:`Paddling` of a window of frames.
 
     Args:
@@ -718,8 +849,10 @@ def paddling_motion(positions: ArrayLike, skin_loop: Sequence[int], rest_length:
     loop = [int(v) for v in skin_loop]
     m = len(loop)
     if m < 3 or not rest_length > 0:
-        raise ValueError(f"paddling_motion: need a skin loop of 3 or more cells and a rest length > 0, "
-                         f"got {m} cells and {rest_length}")
+        raise ValueError(
+            f"paddling_motion: need a skin loop of 3 or more cells and a rest length > 0, "
+            f"got {m} cells and {rest_length}"
+        )
     heights: dict = {}
     for p in range(m):
         i, j, k = loop[p], loop[p - 1], loop[(p + 1) % m]
@@ -764,12 +897,13 @@ def paddling(trajectory: Trajectory, mode: Optional[LocomotionMode] = None) -> P
     :func:`classify_locomotion` of the trajectory."""
     if mode is None:
         mode = classify_locomotion(trajectory)
-    window = np.asarray(trajectory.positions)[-max(int(mode.frames), 2):]  # the classifier's window: a suffix
+    window = np.asarray(trajectory.positions)[-max(int(mode.frames), 2) :]  # the classifier's window: a suffix
     rest = float(np.median(np.asarray(trajectory.body.rest_lengths)))
     return paddling_motion(window, trajectory.body.skin_loops[0], rest, mode.direction)
 
 
 # --- statistics of the best individuals ------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class GrowOutput:
@@ -809,8 +943,9 @@ def grow_output(embryo: Any, config: Optional[Any] = None) -> GrowOutput:
     mg = float(cfg["development.max_growth"])
     radii = np.asarray(thing.radii)[1:]
     realized = (radii / r0 - 1.0) / mg if mg > 0 and len(radii) else np.array([np.nan])
-    return GrowOutput(float(grow.mean()), float(grow.min()), float(grow.max()), float(np.mean(realized)),
-                      float(np.min(realized)))
+    return GrowOutput(
+        float(grow.mean()), float(grow.min()), float(grow.max()), float(np.mean(realized)), float(np.min(realized))
+    )
 
 
 @dataclass(frozen=True)
@@ -903,10 +1038,21 @@ def oscillator_spread(body: Any, config: Optional[Any] = None) -> OscillatorSpre
         return OscillatorSpread(0, 0, 0, 0, 0, False, 0, 0, 0, False, phase_spread(p), s_mean, s_range)
     arange = float(np.ptp(a) / amax) if amax > 0 else 0.0
     frange = float(np.ptp(f) / fspan) if fspan > 0 else 0.0
-    return OscillatorSpread(float(a.mean()), float(a.min()), float(a.max()),
-                            float(a.mean() / amax) if amax > 0 else 0.0, arange,
-                            arange > AMPLITUDE_DIFFERENTIATED, float(f.min()), float(f.max()), frange,
-                            frange > FREQUENCY_DIFFERENTIATED, phase_spread(p), s_mean, s_range)
+    return OscillatorSpread(
+        float(a.mean()),
+        float(a.min()),
+        float(a.max()),
+        float(a.mean() / amax) if amax > 0 else 0.0,
+        arange,
+        arange > AMPLITUDE_DIFFERENTIATED,
+        float(f.min()),
+        float(f.max()),
+        frange,
+        frange > FREQUENCY_DIFFERENTIATED,
+        phase_spread(p),
+        s_mean,
+        s_range,
+    )
 
 
 def tries_per_viable(history: Any, population: Optional[int] = None) -> float:
@@ -945,8 +1091,12 @@ def _morphology(entry: Any, config: Any):
     return pos, graph
 
 
-def morphology_changes(lineage: Union[Run, Sequence[LineageEntry]], config: Optional[Any] = None,
-                       tolerance: float = MORPHOLOGY_TOLERANCE, graph: bool = True) -> List[LineageEntry]:
+def morphology_changes(
+    lineage: Union[Run, Sequence[LineageEntry]],
+    config: Optional[Any] = None,
+    tolerance: float = MORPHOLOGY_TOLERANCE,
+    graph: bool = True,
+) -> List[LineageEntry]:
     """The lineage entries at which the best individual's morphology changed.
 
     Every lineage genome is developed (``animat.develop``); an entry is a change when its cell count
@@ -975,16 +1125,23 @@ def morphology_changes(lineage: Union[Run, Sequence[LineageEntry]], config: Opti
         if previous is None:
             out.append(e)
         else:
-            changed = (len(m[0]) != len(previous[0]) or morphology_distance(previous[0], m[0]) > tolerance
-                       or (graph and m[1] != previous[1]))
+            changed = (
+                len(m[0]) != len(previous[0])
+                or morphology_distance(previous[0], m[0]) > tolerance
+                or (graph and m[1] != previous[1])
+            )
             if changed:
                 out.append(e)
         previous = m
     return out
 
 
-def last_morphology_change(lineage: Union[Run, Sequence[LineageEntry]], config: Optional[Any] = None,
-                           tolerance: float = MORPHOLOGY_TOLERANCE, graph: bool = True) -> Optional[int]:
+def last_morphology_change(
+    lineage: Union[Run, Sequence[LineageEntry]],
+    config: Optional[Any] = None,
+    tolerance: float = MORPHOLOGY_TOLERANCE,
+    graph: bool = True,
+) -> Optional[int]:
     """The generation at which the best's morphology last differed from its predecessor's (see
     :func:`morphology_changes`); the generation of the first entry when it never changed; None for an
     empty lineage."""
@@ -1014,5 +1171,9 @@ def best_statistics(entry: Any, config: Optional[Any] = None) -> BestStatistics:
     embryo = _core.develop(genome, cfg)
     if not embryo.viable:
         raise ValueError("best_statistics: genome is not viable: " + "; ".join(embryo.reasons))
-    return BestStatistics(int(embryo.cell_count), int(cfg["development.max_cells"]), grow_output(embryo, cfg),
-                          oscillator_spread(_core.build_body(embryo, cfg), cfg))
+    return BestStatistics(
+        int(embryo.cell_count),
+        int(cfg["development.max_cells"]),
+        grow_output(embryo, cfg),
+        oscillator_spread(_core.build_body(embryo, cfg), cfg),
+    )

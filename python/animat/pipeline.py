@@ -1,5 +1,6 @@
 """The pipeline genome -> embryo -> body -> swim as typed Python functions (thin wrappers over
 ``animat._core`` with the documentation ``help()`` shows), and the paper's configs."""
+
 from __future__ import annotations
 
 import functools
@@ -40,8 +41,9 @@ def develop(genome: Any, config: Any = None) -> Any:
     return _core.develop(genome, config)
 
 
-def build_body(embryo_or_positions: Any, *args: Any, config: Any = None, allow_nonviable: bool = False,
-               **kwargs: Any) -> Any:
+def build_body(
+    embryo_or_positions: Any, *args: Any, config: Any = None, allow_nonviable: bool = False, **kwargs: Any
+) -> Any:
     """Build the spring-mass :class:`animat.Body` (paper §3, Fig. 3) of an :class:`animat.Embryo`,
     or of cell centres: ``build_body(positions, amplitude=None, frequency=None, phase=None)``.
 
@@ -57,8 +59,9 @@ def build_body(embryo_or_positions: Any, *args: Any, config: Any = None, allow_n
     return _core.build_body(embryo_or_positions, *args, config=config, **kwargs)
 
 
-def swim(body: Any, scene: Any = None, config: Any = None, steps: Optional[int] = None,
-         settle_steps: Optional[int] = None) -> Any:
+def swim(
+    body: Any, scene: Any = None, config: Any = None, steps: Optional[int] = None, settle_steps: Optional[int] = None
+) -> Any:
     """Swim a body for ``steps`` control steps (default ``config.evaluation.steps``) and return an
     :class:`animat.SwimResult` (distance, displacement, stability and diagnostics). Never raises for
     an unstable swim: it returns ``stable=False`` and distance 0. ``settle_steps`` (default
@@ -67,7 +70,7 @@ def swim(body: Any, scene: Any = None, config: Any = None, steps: Optional[int] 
     return _core.swim(body, scene, config, steps, settle_steps=settle_steps)
 
 
-def load_config(path: Union[str, "os.PathLike[str]"]) -> Any:
+def load_config(path: Union[str, os.PathLike[str]]) -> Any:
     """Load a TOML config file into an :class:`animat.Config`; ValueError naming the file, line and key
     for a bad one (see also :func:`config_path` for the paper's)."""
     return _core.load_config(str(path))

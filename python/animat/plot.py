@@ -31,14 +31,14 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
-from numpy.typing import ArrayLike
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from matplotlib.collections import EllipseCollection, LineCollection, PatchCollection, PolyCollection
 from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, ConnectionPatch, Polygon
 from matplotlib.ticker import MaxNLocator
+from numpy.typing import ArrayLike
 
 from . import _core
 from .run import MORPHOLOGY_TOLERANCE, Run

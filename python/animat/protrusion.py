@@ -35,18 +35,27 @@ The thresholds were set on the hand-built swimmers of ``paper_calibration_set`` 
 studies/locomotion/known_swimmers.py (swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; :func:`animat.locomotion.classify_motion`
 uses the rule as its first test for "protrusions" (docs/locomotion.md).
 """
+
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .shape import Protrusion, ShapeParams, cell_heights, cell_spacing, connected_groups, symmetric_pairs
 
-__all__ = ["ProtrusionStroke", "stroke_motion", "protrusion_stroke", "cell_strokes", "rowing",
-           "STROKE_SCORE", "STROKE_AREA", "STROKE_SAMPLES"]
+__all__ = [
+    "ProtrusionStroke",
+    "stroke_motion",
+    "protrusion_stroke",
+    "cell_strokes",
+    "rowing",
+    "STROKE_SCORE",
+    "STROKE_AREA",
+    "STROKE_SAMPLES",
+]
 
 #: Pair score (the smaller of the two protrusions' weighted rowing correlations) from which a swim
 #: strokes as the paper's protrusion swimmers do. Set between the calibration set's groups (see
@@ -59,8 +68,9 @@ STROKE_AREA = 0.1
 STROKE_SAMPLES = 8
 
 
-def cell_strokes(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any, cells: Sequence[int],
-                 base: np.ndarray, outward: Any) -> Tuple[np.ndarray, np.ndarray]:
+def cell_strokes(
+    Q: np.ndarray, times: np.ndarray, omega: float, direction: Any, cells: Sequence[int], base: np.ndarray, outward: Any
+) -> Tuple[np.ndarray, np.ndarray]:
     """Complex amplitudes at ``omega`` of the sweep ``X`` (position along ``direction``) and the
     extension ``E`` (offset from ``base`` along ``outward``) of ``cells``.
 
@@ -81,7 +91,9 @@ def cell_strokes(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any,
     b = np.broadcast_to(b if b.ndim == 2 else b[None, :], (len(Q), 2))
     sweep = Q[:, c] @ d
     ext = (Q[:, c] - b[:, None, :]) @ u
-    return np.atleast_1d(harmonic_amplitudes(sweep, times, omega)), np.atleast_1d(harmonic_amplitudes(ext, times, omega))
+    return np.atleast_1d(harmonic_amplitudes(sweep, times, omega)), np.atleast_1d(
+        harmonic_amplitudes(ext, times, omega)
+    )
 
 
 def rowing(X: np.ndarray, E: np.ndarray) -> float:
@@ -131,17 +143,26 @@ def _empty() -> ProtrusionStroke:
     return ProtrusionStroke((), (), np.zeros(0), np.zeros(0), (), np.zeros(0), (), float("nan"), float("nan"))
 
 
-def _protruding(positions: np.ndarray, outline: Sequence[int], springs: np.ndarray, params: ShapeParams,
-                spacing: float) -> List[int]:
+def _protruding(
+    positions: np.ndarray, outline: Sequence[int], springs: np.ndarray, params: ShapeParams, spacing: float
+) -> List[int]:
     h = cell_heights(positions, outline, params, spacing)
     if h is None:
         return []
     return [int(i) for i in np.flatnonzero(h >= params.min_height)]
 
 
-def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any, outline: Sequence[int],
-                  springs: Any, rest_positions: Optional[Any] = None, samples: int = STROKE_SAMPLES,
-                  params: ShapeParams = ShapeParams()) -> ProtrusionStroke:
+def stroke_motion(
+    Q: np.ndarray,
+    times: np.ndarray,
+    omega: float,
+    direction: Any,
+    outline: Sequence[int],
+    springs: Any,
+    rest_positions: Optional[Any] = None,
+    samples: int = STROKE_SAMPLES,
+    params: ShapeParams = ShapeParams(),
+) -> ProtrusionStroke:
     """:class:`ProtrusionStroke` of a window of body-frame frames.
 
     Args:
@@ -174,7 +195,8 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
     if not cells:
         return _empty()
     links = [(int(loop[k]), int(loop[(k + 1) % len(loop)])) for k in range(len(loop))] + [
-        (int(e[0]), int(e[1])) for e in sp]
+        (int(e[0]), int(e[1])) for e in sp
+    ]
     groups = connected_groups(cells, links)
     rest_set = set(rest)
     groups.sort(key=lambda g: (not (set(g) & rest_set), -len(g), g))
@@ -199,14 +221,16 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
             continue
         X, E = cell_strokes(Q, t, omega, d, g, base, outward)
         scores.append(rowing(X, E))
-        areas.append(float(np.mean(-math.pi * np.imag(E * np.conj(X)))) / s ** 2)
+        areas.append(float(np.mean(-math.pi * np.imag(E * np.conj(X)))) / s**2)
         cx, cy = mean[list(g)].mean(axis=0)
         found.append(Protrusion(tuple(g), 0.0, (float(cx), float(cy))))
     pairs = tuple(symmetric_pairs(mean, found, params, s))
     sc = np.array(scores, dtype=np.float64)
     ar = np.array(areas, dtype=np.float64)
-    pair_scores = np.array([np.fmin(sc[a], sc[b]) if np.isfinite(sc[a]) and np.isfinite(sc[b]) else np.nan
-                            for a, b in pairs], dtype=np.float64)
+    pair_scores = np.array(
+        [np.fmin(sc[a], sc[b]) if np.isfinite(sc[a]) and np.isfinite(sc[b]) else np.nan for a, b in pairs],
+        dtype=np.float64,
+    )
     best: Tuple[int, ...] = ()
     score = area = float("nan")
     if len(pairs) and np.isfinite(pair_scores).any():
@@ -214,8 +238,17 @@ def stroke_motion(Q: np.ndarray, times: np.ndarray, omega: float, direction: Any
         best = tuple(pairs[k])
         score = float(pair_scores[k])
         area = float(min(ar[best[0]], ar[best[1]]))
-    return ProtrusionStroke(tuple(tuple(g) for g in groups), tuple(bool(set(g) & rest_set) for g in groups),
-                            sc, ar, pairs, pair_scores, best, score, area)
+    return ProtrusionStroke(
+        tuple(tuple(g) for g in groups),
+        tuple(bool(set(g) & rest_set) for g in groups),
+        sc,
+        ar,
+        pairs,
+        pair_scores,
+        best,
+        score,
+        area,
+    )
 
 
 def protrusion_stroke(trajectory: Any, mode: Optional[Any] = None) -> ProtrusionStroke:
@@ -233,5 +266,6 @@ def protrusion_stroke(trajectory: Any, mode: Optional[Any] = None) -> Protrusion
     loops = body.skin_loops
     if not len(loops):
         return _empty()
-    return stroke_motion(Q, np.asarray(trajectory.times)[-frames:], mode.omega, mode.direction, loops[0],
-                         body.springs, body.positions)
+    return stroke_motion(
+        Q, np.asarray(trajectory.times)[-frames:], mode.omega, mode.direction, loops[0], body.springs, body.positions
+    )

@@ -11,6 +11,7 @@ A run directory holds::
 :class:`Run` reads all of it, including runs that are still going (a half-written last line of
 ``history.csv`` is ignored, and a missing checkpoint is fine).
 """
+
 from __future__ import annotations
 
 import json
@@ -65,8 +66,7 @@ class LineageEntry:
         return _core.develop(self.genome, config)
 
     def __repr__(self) -> str:
-        return (f"<LineageEntry generation={self.generation} fitness={self.fitness:.6g} "
-                f"cells={self.cell_count}>")
+        return f"<LineageEntry generation={self.generation} fitness={self.fitness:.6g} cells={self.cell_count}>"
 
 
 def _history_type() -> type:
@@ -115,11 +115,20 @@ def read_history(path: PathLike) -> np.ndarray:
             continue
         fields = line.strip().split(",")
         if len(fields) != len(header):
-            raise ValueError(f"{path}:{number}: expected {len(header)} comma-separated values, got {len(fields)}: {line!r}")
+            raise ValueError(
+                f"{path}:{number}: expected {len(header)} comma-separated values, got {len(fields)}: {line!r}"
+            )
         try:
-            rows.append(tuple(_LATER_COLUMNS[name] if name not in column
-                              else int(fields[column[name]]) if HISTORY_DTYPE[name].kind == "i"
-                              else float(fields[column[name]]) for name in expected))
+            rows.append(
+                tuple(
+                    _LATER_COLUMNS[name]
+                    if name not in column
+                    else int(fields[column[name]])
+                    if HISTORY_DTYPE[name].kind == "i"
+                    else float(fields[column[name]])
+                    for name in expected
+                )
+            )
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
     return np.array(rows, dtype=HISTORY_DTYPE).view(_history_type())
@@ -140,8 +149,14 @@ def _read_lineage_file(path: Path) -> LineageEntry:
     except ValueError as e:
         raise ValueError(f"{path}: invalid genome: {e}") from None
     reference = data.get("reference_fitness")
-    return LineageEntry(int(data["generation"]), float(data["fitness"]), int(data["cell_count"]), genome, path,
-                        float("nan") if reference is None else float(reference))
+    return LineageEntry(
+        int(data["generation"]),
+        float(data["fitness"]),
+        int(data["cell_count"]),
+        genome,
+        path,
+        float("nan") if reference is None else float(reference),
+    )
 
 
 def morphology_distance(a, b) -> float:
@@ -199,7 +214,8 @@ class Run:
         if not config_path.is_file():
             raise FileNotFoundError(
                 f"{config_path}: missing; {self.path} is not a run directory written by animat_evolve "
-                "(expected config.toml, history.csv, best/)")
+                "(expected config.toml, history.csv, best/)"
+            )
         self._config = _core.load_config(str(config_path))
 
     @property
@@ -265,13 +281,17 @@ class Run:
         lines = [f"run {self.path}: {len(h)} generation(s) recorded"]
         if len(h):
             last = h[-1]
-            lines.append(f"  generation {int(last['generation'])}: best {last['best']:.4f}, mean {last['mean']:.4f}, "
-                         f"viable {100 * last['viable_fraction']:.0f}%, {int(last['evaluations'])} evaluations, "
-                         f"{last['wall_seconds']:.1f} s")
+            lines.append(
+                f"  generation {int(last['generation'])}: best {last['best']:.4f}, mean {last['mean']:.4f}, "
+                f"viable {100 * last['viable_fraction']:.0f}%, {int(last['evaluations'])} evaluations, "
+                f"{last['wall_seconds']:.1f} s"
+            )
         if lineage:
             b = lineage[-1]
-            lines.append(f"  best genome: generation {b.generation}, fitness {b.fitness:.4f}, {b.cell_count} cells "
-                         f"({len(lineage)} improvement(s))")
+            lines.append(
+                f"  best genome: generation {b.generation}, fitness {b.fitness:.4f}, {b.cell_count} cells "
+                f"({len(lineage)} improvement(s))"
+            )
         return "\n".join(lines)
 
     def morphology_changes(self, tolerance: float = MORPHOLOGY_TOLERANCE, config=None) -> List[LineageEntry]:
@@ -298,5 +318,6 @@ class Run:
         return out
 
     def __repr__(self) -> str:
-        return f"<animat.Run {str(self.path)!r}: {self.generations} generations, {len(self.best_genomes)} lineage entries>"
-
+        return (
+            f"<animat.Run {str(self.path)!r}: {self.generations} generations, {len(self.best_genomes)} lineage entries>"
+        )

@@ -70,6 +70,7 @@ Example::
     print(shape.elongation, shape.concavity, shape.protrusion_count, shape.symmetric_pair)
     row = shape.as_dict()                                  # flat scalars, for a CSV row
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -77,17 +78,30 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-__all__ = ["ShapeParams", "Protrusion", "Shape", "describe", "body_shape", "genome_shape", "cell_spacing",
-           "principal_axes", "elongation", "concavity", "cell_heights", "connected_groups", "symmetric_pairs"]
+__all__ = [
+    "ShapeParams",
+    "Protrusion",
+    "Shape",
+    "describe",
+    "body_shape",
+    "genome_shape",
+    "cell_spacing",
+    "principal_axes",
+    "elongation",
+    "concavity",
+    "cell_heights",
+    "connected_groups",
+    "symmetric_pairs",
+]
 
 
 @dataclass(frozen=True)
 class ShapeParams:
     """Parameters of the descriptors, every length in cell spacings (see the module docstring)."""
 
-    cell_diameter: float = 1.0   #: each cell is a disc of this diameter in the second moments (elongation)
-    core_radius: float = 0.75    #: ρ: radius of the disc that defines the core (the opening of the outline)
-    min_height: float = 0.5      #: a cell protrudes when its centre is at least this far from the core
+    cell_diameter: float = 1.0  #: each cell is a disc of this diameter in the second moments (elongation)
+    core_radius: float = 0.75  #: ρ: radius of the disc that defines the core (the opening of the outline)
+    min_height: float = 0.5  #: a cell protrudes when its centre is at least this far from the core
     pair_tolerance: float = 1.0  #: largest distance between a protrusion's mirror image and its partner
 
     def __post_init__(self) -> None:
@@ -118,13 +132,13 @@ class Shape:
     """The descriptors of one body (see the module docstring for the definitions)."""
 
     cell_count: int
-    spacing: float                      #: s, the median nearest-neighbour distance (length units)
+    spacing: float  #: s, the median nearest-neighbour distance (length units)
     elongation: float
     concavity: float
-    outline_area: float                 #: in s²
-    hull_area: float                    #: in s²
-    core_cells: int                     #: cells that do not protrude (0 when the body has no core)
-    heights: Tuple[float, ...]          #: per cell, spacings (all 0 when the body has no core)
+    outline_area: float  #: in s²
+    hull_area: float  #: in s²
+    core_cells: int  #: cells that do not protrude (0 when the body has no core)
+    heights: Tuple[float, ...]  #: per cell, spacings (all 0 when the body has no core)
     protrusions: Tuple[Protrusion, ...]  #: largest first (size, then height)
     symmetric_pairs: Tuple[Tuple[int, int], ...] = field(default=())  #: indices into protrusions
 
@@ -167,6 +181,7 @@ class Shape:
 
 # --- geometry -------------------------------------------------------------------------------------
 
+
 def cell_spacing(positions: np.ndarray) -> float:
     """s: the median distance from a cell centre to its nearest neighbour (1.0 for fewer than 2 cells)."""
     p = np.asarray(positions, dtype=float)
@@ -178,8 +193,9 @@ def cell_spacing(positions: np.ndarray) -> float:
     return s if s > 0 else 1.0
 
 
-def principal_axes(positions: np.ndarray, params: ShapeParams = ShapeParams(),
-                   spacing: Optional[float] = None) -> Tuple[np.ndarray, np.ndarray]:
+def principal_axes(
+    positions: np.ndarray, params: ShapeParams = ShapeParams(), spacing: Optional[float] = None
+) -> Tuple[np.ndarray, np.ndarray]:
     """The cells' principal second moments about their centroid and the principal axes (module
     docstring, "Elongation"): the eigenvalues λ2 ≤ λ1 (ascending, squared length units) and the unit
     eigenvectors (the columns of a 2 × 2 array, in the same order) of the covariance matrix of the
@@ -318,18 +334,19 @@ def _in_core_erosion(q: np.ndarray, a: np.ndarray, b: np.ndarray, rho: float) ->
     """(N,) bool: q inside the polygon at depth >= ρ (up to rounding)."""
     out = np.zeros(len(q), dtype=bool)
     for start in range(0, len(q), 2048):
-        chunk = q[start:start + 2048]
+        chunk = q[start : start + 2048]
         depth = _segment_distances(chunk, a, b).min(axis=1)
         deep = depth >= rho * (1 - 1e-9) - 1e-12
         if deep.any():
             idx = np.nonzero(deep)[0]
             deep[idx] = _inside(chunk[idx], a, b)
-        out[start:start + 2048] = deep
+        out[start : start + 2048] = deep
     return out
 
 
-def cell_heights(positions: np.ndarray, outline: Sequence[int], params: ShapeParams = ShapeParams(),
-                 spacing: Optional[float] = None) -> Optional[np.ndarray]:
+def cell_heights(
+    positions: np.ndarray, outline: Sequence[int], params: ShapeParams = ShapeParams(), spacing: Optional[float] = None
+) -> Optional[np.ndarray]:
     """Each cell's distance from the body's core, in spacings (module docstring); None when the body
     has no core (no disc of radius ``core_radius`` fits in its outline: with the defaults, it is
     nowhere three hexagonally packed rows wide).
@@ -394,8 +411,12 @@ def connected_groups(members: Sequence[int], links: Sequence[Tuple[int, int]]) -
     return [sorted(g) for g in out.values()]
 
 
-def symmetric_pairs(positions: np.ndarray, protrusions: Sequence[Protrusion], params: ShapeParams = ShapeParams(),
-                    spacing: Optional[float] = None) -> List[Tuple[int, int]]:
+def symmetric_pairs(
+    positions: np.ndarray,
+    protrusions: Sequence[Protrusion],
+    params: ShapeParams = ShapeParams(),
+    spacing: Optional[float] = None,
+) -> List[Tuple[int, int]]:
     """The symmetric pairs among ``protrusions`` (module docstring, "Symmetric pair"): index pairs
     ``(i, j)``, i < j, of protrusions whose centroids, taken relative to the centroid of the cells at
     ``positions``, are mirror images of each other about one of the principal axes of those cells
@@ -420,8 +441,9 @@ def symmetric_pairs(positions: np.ndarray, protrusions: Sequence[Protrusion], pa
     return pairs
 
 
-def describe(positions: Any, outline: Optional[Sequence[int]], springs: Any = None,
-             params: ShapeParams = ShapeParams()) -> Shape:
+def describe(
+    positions: Any, outline: Optional[Sequence[int]], springs: Any = None, params: ShapeParams = ShapeParams()
+) -> Shape:
     """The descriptors of cells at ``positions`` (n, 2) with the outer ``outline`` (cell indices,
     counter-clockwise; ``Body.skin_loops[0]``; None or empty for fewer than two cells) and optional
     ``springs`` (m, 2) used to group protruding cells."""
@@ -450,8 +472,18 @@ def describe(positions: Any, outline: Optional[Sequence[int]], springs: Any = No
         found.append(Protrusion(tuple(g), float(max(heights[g])), (float(cx), float(cy))))
     found.sort(key=lambda pr: (-pr.size, -pr.height, pr.cells))
     pairs = symmetric_pairs(p, found, params, s)
-    return Shape(n, s, el, conc, a_out / s**2, a_hull / s**2, n - len(protruding),
-                 tuple(map(float, heights)), tuple(found), tuple(pairs))
+    return Shape(
+        n,
+        s,
+        el,
+        conc,
+        a_out / s**2,
+        a_hull / s**2,
+        n - len(protruding),
+        tuple(map(float, heights)),
+        tuple(found),
+        tuple(pairs),
+    )
 
 
 def body_shape(body: Any, params: ShapeParams = ShapeParams()) -> Shape:

@@ -1,8 +1,8 @@
 // animat_evolve: run an evolution experiment (paper §5) from the embedded default or a TOML config.
 // animat_evolve_main() is the whole command line; src/cli/main.cpp calls it, and so does the Python
 // module (animat._core.evolve_cli, `animat evolve`), which links the same library (animat_cli).
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <charconv>
 #include <chrono>
@@ -11,18 +11,18 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <iostream>
+#include <iterator>
 #include <memory>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
-#include "animat/run.hpp"
 #include "animat/log.hpp"
 #include "animat/mpi.hpp"
 #include "animat/objective_table.hpp"
+#include "animat/run.hpp"
 
 namespace {
 
@@ -33,17 +33,21 @@ extern "C" void on_signal(int) { g_stop.store(true); }
 // [mpi] Rank 0 after a lost rank or a signal mid-evaluation: say what happened and what is on disk,
 // then leave at once (the launcher ends the other ranks; waiting for them could hang). mpirun stops
 // forwarding output as soon as a rank dies, so the message also goes to RUN_DIR/stopped.txt, first.
-[[noreturn]] void mpi_stopped(const animat::Error& e, const std::filesystem::path& out, const animat::Config& config) {
+[[noreturn]] void mpi_stopped(const animat::Error& e, const std::filesystem::path& out,
+                              const animat::Config& config) {
   std::signal(SIGPIPE, SIG_IGN);  // the launcher may have closed our stderr
   std::string text = fmt::format("animat_evolve: error: MPI job stopped: {}\n", e.what());
   const auto ckpt = out / "checkpoint.json";
   try {
     animat::Evolution probe(config, [](const animat::Genome&) { return animat::Fitness{}; });
     std::ifstream in(ckpt, std::ios::binary);
-    probe.restore(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), ckpt.string());
-    text += fmt::format("animat_evolve: {} is intact (generation {}; the generation being evaluated is lost).\n"
-                        "Continue with any number of ranks:  mpirun -np RANKS animat_evolve --resume {}\n",
-                        ckpt.string(), probe.generation(), out.string());
+    probe.restore(
+        std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()),
+        ckpt.string());
+    text += fmt::format(
+        "animat_evolve: {} is intact (generation {}; the generation being evaluated is lost).\n"
+        "Continue with any number of ranks:  mpirun -np RANKS animat_evolve --resume {}\n",
+        ckpt.string(), probe.generation(), out.string());
   } catch (const std::exception& c) {
     text += fmt::format("animat_evolve: no checkpoint to resume from ({})\n", c.what());
   }
@@ -65,37 +69,48 @@ std::int64_t parse_seed(const std::string& text) {
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, value);
   if (ec == std::errc::result_out_of_range)
-    throw animat::ConfigError("--seed " + text + ": evolution.seed is out of range: expected an integer in [0, 9223372036854775807]");
+    throw animat::ConfigError(
+        "--seed " + text +
+        ": evolution.seed is out of range: expected an integer in [0, 9223372036854775807]");
   if (ec != std::errc() || ptr != end || value < 0)
-    throw animat::ConfigError("--seed " + text + ": evolution.seed must be an integer in [0, 9223372036854775807]");
+    throw animat::ConfigError("--seed " + text +
+                              ": evolution.seed must be an integer in [0, 9223372036854775807]");
   return value;
 }
 
 }  // namespace
 
 int animat_evolve_main(int argc, char** argv) {
-  CLI::App app{"animat_evolve: co-evolve the morphology and control of soft-bodied swimmers (Joachimczak & Wrobel 2012)"};
+  CLI::App app{
+      "animat_evolve: co-evolve the morphology and control of soft-bodied swimmers (Joachimczak & "
+      "Wrobel 2012)"};
   std::string config_path, out_dir, resume_dir, log_level = "info", seed_text;
   std::vector<std::string> overrides;
   int generations = -1, threads = -1;
   bool print_config = false, quiet = false, use_mpi = false, overwrite = false;
-  app.add_option("--config", config_path, "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
+  app.add_option("--config", config_path,
+                 "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
       ->check(CLI::ExistingFile);
   app.add_option("--set", overrides, "override one value: section.key=value (repeatable)");
   // Read as text: CLI11 would clamp a seed beyond int64 to 2^63-1 silently.
   app.add_option("--seed", seed_text, "run seed (evolution.seed), an integer in [0, 2^63-1]");
-  app.add_option("--generations", generations, "generation cap, 0 = none (evolution.generations)")->check(CLI::NonNegativeNumber);
-  app.add_option("--threads", threads, "OpenMP threads (per rank under mpirun), 0 = all cores (evolution.threads)")
+  app.add_option("--generations", generations, "generation cap, 0 = none (evolution.generations)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", threads,
+                 "OpenMP threads (per rank under mpirun), 0 = all cores (evolution.threads)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out_dir, "run directory to write (default: runs/<time>-seed<seed>)");
-  app.add_option("--resume", resume_dir, "run directory to resume; its config.toml is the base config");
+  app.add_option("--resume", resume_dir,
+                 "run directory to resume; its config.toml is the base config");
   app.add_flag("--overwrite", overwrite,
-               "start afresh in --out even if it holds a run: removes its config.toml, history.csv, checkpoint.json, "
+               "start afresh in --out even if it holds a run: removes its config.toml, "
+               "history.csv, checkpoint.json, "
                "islands.csv, resume.log, stopped.txt, best/ and figures/ (nothing else)");
   app.add_flag("--print-config", print_config, "print the resolved config as TOML and exit");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
   app.add_flag("--quiet", quiet, "only warnings and errors");
-  app.add_flag("--mpi", use_mpi, "require an MPI job (mpirun -np R animat_evolve ...; automatic under mpirun)");
+  app.add_flag("--mpi", use_mpi,
+               "require an MPI job (mpirun -np R animat_evolve ...; automatic under mpirun)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -107,40 +122,49 @@ int animat_evolve_main(int argc, char** argv) {
   const animat::mpi::Launch launch = animat::mpi::detect_launch();
   try {
     if (use_mpi && !launch.launched)
-      throw animat::ConfigError("--mpi: not started by an MPI launcher; run mpirun -np RANKS animat_evolve ...");
+      throw animat::ConfigError(
+          "--mpi: not started by an MPI launcher; run mpirun -np RANKS animat_evolve ...");
     if ((use_mpi || launch.size > 1) && !animat::mpi::built_with_mpi())
-      throw animat::Error(fmt::format("started as one of {} MPI ranks ({}), but {}", launch.size, launch.variable,
-                                      animat::mpi::how_to_get_mpi()));
+      throw animat::Error(fmt::format("started as one of {} MPI ranks ({}), but {}", launch.size,
+                                      launch.variable, animat::mpi::how_to_get_mpi()));
     if (launch.launched && animat::mpi::built_with_mpi()) {
       mpi_job = std::make_unique<animat::mpi::Job>(argc, argv);
       if (mpi_job->rank() != 0) return mpi_job->serve();
     }
   } catch (const animat::Error& e) {
-    if (launch.rank == 0) std::fprintf(stderr, "animat_evolve: error: %s\n", e.what());
-    else std::fprintf(stderr, "animat_evolve (rank %d): error: %s\n", launch.rank, e.what());
+    if (launch.rank == 0)
+      std::fprintf(stderr, "animat_evolve: error: %s\n", e.what());
+    else
+      std::fprintf(stderr, "animat_evolve (rank %d): error: %s\n", launch.rank, e.what());
     return 2;
   }
 
   try {
     animat::set_log_level(quiet ? "warn" : log_level);
-    if (!resume_dir.empty() && !out_dir.empty() && std::filesystem::path(resume_dir) != std::filesystem::path(out_dir))
-      throw animat::ConfigError("--resume and --out name different directories; --resume continues in place");
+    if (!resume_dir.empty() && !out_dir.empty() &&
+        std::filesystem::path(resume_dir) != std::filesystem::path(out_dir))
+      throw animat::ConfigError(
+          "--resume and --out name different directories; --resume continues in place");
     if (!resume_dir.empty() && overwrite)
-      throw animat::ConfigError("--resume continues the run and --overwrite replaces it; pass one of them");
+      throw animat::ConfigError(
+          "--resume continues the run and --overwrite replaces it; pass one of them");
     if (!resume_dir.empty() && !config_path.empty())
-      throw animat::ConfigError("--resume takes its config from the run directory; do not also pass --config");
+      throw animat::ConfigError(
+          "--resume takes its config from the run directory; do not also pass --config");
     animat::Config config;
     if (!resume_dir.empty()) {
       const auto base = std::filesystem::path(resume_dir) / "config.toml";
       std::error_code ec;
       if (!std::filesystem::is_directory(resume_dir, ec))
-        throw animat::IoError(resume_dir + ": resume directory does not exist" +
-                              (ec && ec != std::errc::no_such_file_or_directory ? " (" + ec.message() + ")" : ""));
+        throw animat::IoError(
+            resume_dir + ": resume directory does not exist" +
+            (ec && ec != std::errc::no_such_file_or_directory ? " (" + ec.message() + ")" : ""));
       config = animat::load_config(base);
     } else if (!config_path.empty()) {
       config = animat::load_config(config_path);
     }
-    animat::apply_overrides(config, overrides);  // validated together: the order of the --set flags does not matter
+    // validated together: the order of the --set flags does not matter
+    animat::apply_overrides(config, overrides);
     if (!seed_text.empty()) config.evolution.seed = parse_seed(seed_text);
     if (generations >= 0) config.evolution.generations = generations;
     if (threads >= 0) config.evolution.threads = threads;
@@ -152,30 +176,38 @@ int animat_evolve_main(int argc, char** argv) {
 
     animat::RunOptions options;
     options.resume = !resume_dir.empty();
-    options.out = options.resume ? resume_dir : (out_dir.empty() ? default_run_dir(config.evolution.seed) : out_dir);
+    options.out = options.resume
+                      ? resume_dir
+                      : (out_dir.empty() ? default_run_dir(config.evolution.seed) : out_dir);
     options.overwrite = overwrite;
     options.quiet = quiet;
     options.stop_flag = &g_stop;
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     if (!quiet)
-      spdlog::info("animat {} | population {} | {} cells max | d_N = {} | {} swim steps | seed {} | run dir {}",
-                   ANIMAT_VERSION, config.evolution.population, config.development.max_cells, config.scene.drag_normal,
-                   config.evaluation.steps, config.evolution.seed, options.out.string());
+      spdlog::info(
+          "animat {} | population {} | {} cells max | d_N = {} | {} swim steps | seed {} | run dir "
+          "{}",
+          ANIMAT_VERSION, config.evolution.population, config.development.max_cells,
+          config.scene.drag_normal, config.evaluation.steps, config.evolution.seed,
+          options.out.string());
     if (mpi_job) {  // [mpi]
-      // mpirun closes our output when a rank dies: a hang-up (output on a pty) or a broken pipe must
-      // not kill rank 0 before it has said what is on disk.
+      // mpirun closes our output when a rank dies: a hang-up (output on a pty) or a broken pipe
+      // must not kill rank 0 before it has said what is on disk.
       std::signal(SIGHUP, on_signal);
       std::signal(SIGPIPE, SIG_IGN);
       options.evaluator = mpi_job->start(config, &g_stop);
       if (!quiet) spdlog::info("evaluation: {}", options.evaluator->describe());
     }
-    // Once every check has passed and the directory is locked: a refused command leaves stopped.txt.
+    // Once every check has passed and the directory is locked: a refused command leaves
+    // stopped.txt.
     options.on_start = [&options] {
-      if (const auto stopped = options.out / "stopped.txt"; options.resume && std::filesystem::exists(stopped)) {
+      if (const auto stopped = options.out / "stopped.txt";
+          options.resume && std::filesystem::exists(stopped)) {
         std::ifstream in(stopped, std::ios::binary);
-        spdlog::warn("the last job in {} ended so:\n{}", options.out.string(),
-                     std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+        spdlog::warn(
+            "the last job in {} ended so:\n{}", options.out.string(),
+            std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
         std::filesystem::remove(stopped);
       }
     };
@@ -188,21 +220,29 @@ int animat_evolve_main(int argc, char** argv) {
       mpi_stopped(e, options.out, config);
     }
     if (summary.history.empty()) {  // stopped while the initial population was drawn
-      std::printf("\nStopped: %s, before the initial population was complete; nothing to resume (run the same "
-                  "command again to start over)\n", summary.stop_reason.c_str());
+      std::printf(
+          "\nStopped: %s, before the initial population was complete; nothing to resume (run the "
+          "same "
+          "command again to start over)\n",
+          summary.stop_reason.c_str());
       return 130;
     }
     const auto& best = summary.best;
     const std::string& objective = config.evaluation.objective;
     const animat::ObjectiveSpec* spec = animat::find_objective(objective);
-    const std::string meaning = spec ? std::string(spec->meaning) : "evaluation.objective = " + objective;
+    const std::string meaning =
+        spec ? std::string(spec->meaning) : "evaluation.objective = " + objective;
     std::printf("\nBest swimmer: fitness %.4f (%s), %d cells, generation %d\n", best.result.fitness,
                 meaning.c_str(), best.result.cell_count, summary.history.back().generation);
     std::printf("Stopped: %s\n", summary.stop_reason.c_str());
-    std::printf("Results in %s: config.toml, history.csv, best/ (lineage of best genomes), checkpoint.json\n",
-                options.out.c_str());
-    std::printf("View them:  animat show %s   (in a source tree: PYTHONPATH=build/python .venv/bin/python -m animat show %s)\n",
-                options.out.c_str(), options.out.c_str());
+    std::printf(
+        "Results in %s: config.toml, history.csv, best/ (lineage of best genomes), "
+        "checkpoint.json\n",
+        options.out.c_str());
+    std::printf(
+        "View them:  animat show %s   (in a source tree: PYTHONPATH=build/python .venv/bin/python "
+        "-m animat show %s)\n",
+        options.out.c_str(), options.out.c_str());
     std::printf("Resume:     animat_evolve --resume %s --generations N\n", options.out.c_str());
     return summary.stop_reason == "interrupted" ? 130 : 0;
   } catch (const animat::Error& e) {
@@ -213,4 +253,3 @@ int animat_evolve_main(int argc, char** argv) {
     return 3;
   }
 }
-

@@ -14,7 +14,8 @@ namespace {
 
 /// Eq. 2: rest = (1 + term_1 + term_2)·L0, term = a·sin(f·t + φ) once the cell has started
 /// (actuation_start_time). sin/cos are advanced by an exact-angle rotation each step and recomputed
-/// directly every kResync steps; a cell starts exactly at its first step at or after its start time.
+/// directly every kResync steps; a cell starts exactly at its first step at or after its start
+/// time.
 class Actuation final : public Effect {
  public:
   static constexpr long kResync = 1024;
@@ -31,7 +32,8 @@ class Actuation final : public Effect {
       c.phase = body.phase.size() == n ? body.phase(i) : 0.0;
       const double t0 = actuation_start_time(c.frequency, c.phase);
       const double k0 = std::ceil(t0 / h);
-      c.start_step = (std::isfinite(k0) && k0 < 1e15) ? static_cast<long>(k0) : std::numeric_limits<long>::max();
+      c.start_step = (std::isfinite(k0) && k0 < 1e15) ? static_cast<long>(k0)
+                                                      : std::numeric_limits<long>::max();
       c.cos_step = std::cos(c.frequency * h);
       c.sin_step = std::sin(c.frequency * h);
       if (c.amplitude == 0.0) c.start_step = std::numeric_limits<long>::max();  // never contributes

@@ -1,21 +1,21 @@
 // Effect "collisions": "penetration of an edge by a cell is not allowed and results in an elastic
 // collision" [paper §4]. A cell never crosses an edge it is not an end of: within every Box2D step,
-// the motion of each (cell, edge) pair that could meet is tested (a swept point-versus-moving-segment
-// test), and a crossing is resolved, at its time within the step, by an elastic impulse between the
-// cell and the edge's two end cells.
+// the motion of each (cell, edge) pair that could meet is tested (a swept
+// point-versus-moving-segment test), and a crossing is resolved, at its time within the step, by an
+// elastic impulse between the cell and the edge's two end cells.
 //
-// Which pairs can meet follows from the planar embedding itself. Just before a cell first touches an
-// edge it is not an end of, the body is still planar, so the cell and the edge lie on a common face:
-// a region (then the edge is an edge of that region) or the outer face (then both are on the skin).
-// So with collision_edges = "all" it suffices to test, per region, its vertices against its edges,
-// and skin vertices against skin edges; preventing those crossings keeps the embedding: no region
-// turns inside out (a triangle inverts only when a vertex crosses the opposite edge) and the skin
-// stays simple (two edges can only come to cross after an end of one has touched the other).
+// Which pairs can meet follows from the planar embedding itself. Just before a cell first touches
+// an edge it is not an end of, the body is still planar, so the cell and the edge lie on a common
+// face: a region (then the edge is an edge of that region) or the outer face (then both are on the
+// skin). So with collision_edges = "all" it suffices to test, per region, its vertices against its
+// edges, and skin vertices against skin edges; preventing those crossings keeps the embedding: no
+// region turns inside out (a triangle inverts only when a vertex crosses the opposite edge) and the
+// skin stays simple (two edges can only come to cross after an end of one has touched the other).
 // collision_edges = "skin" tests only the skin pairs (measured: internal regions then invert).
 //
 // With effect "ground" in the scene, the floor contacts are events of the same loop (class comment,
-// step 4b): a floor impulse changes velocities only at its event time, and every edge event after it
-// is still found, so the floor cannot undo the guarantee above.
+// step 4b): a floor impulse changes velocities only at its event time, and every edge event after
+// it is still found, so the floor cannot undo the guarantee above.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -64,33 +64,34 @@ int roots_in_unit_interval(double A, double B, double C, std::array<double, 2>& 
 ///     straight lines at w (what symplectic Euler does);
 ///  2. the candidate pairs are gathered: the three vertex-edge pairs of every triangular region
 ///     whose signed area can come within the band in the rest of the step (one quadratic per
-///     triangle: the doubled area is the cross product of all three pairs), the vertex-edge pairs of
-///     larger regions whose swept boxes overlap, and the skin vertices against the skin edges whose
-///     swept boxes overlap (sort and sweep along x);
+///     triangle: the doubled area is the cross product of all three pairs), the vertex-edge pairs
+///     of larger regions whose swept boxes overlap, and the skin vertices against the skin edges
+///     whose swept boxes overlap (sort and sweep along x);
 ///  3. for each candidate (cell i, edge ab) the gap function cross(b − a, p − a), quadratic in time
 ///     under that motion, gives the pair's first event: the first time at which the cell comes
 ///     within the tolerance band of the edge (on the side it is on) or reaches the segment (from
 ///     either side), with its projection inside the segment, while approaching the edge point
 ///     q = (1 − s)·a + s·b (relative normal velocity v_n < 0);
 ///  4. the earliest event of all is processed: every cell advances to that time, and the impulse
-///     J = −(1 + e)·v_n / (1/m_i + (1 − s)²/m_a + s²/m_b) along the normal changes w_i by +J/m_i and
-///     w_a, w_b by −(1 − s)·J/m_a and −s·J/m_b: momentum is conserved exactly and, for e = 1,
+///     J = −(1 + e)·v_n / (1/m_i + (1 − s)²/m_a + s²/m_b) along the normal changes w_i by +J/m_i
+///     and w_a, w_b by −(1 − s)·J/m_a and −s·J/m_b: momentum is conserved exactly and, for e = 1,
 ///     kinetic energy too. Then steps 2–4 again from that time on, until no event is left in the
 ///     step. After kMaxEvents events in one step the rest are resolved with e = 0 (counted as
 ///     inelastic); a step that still has events after 2·kMaxEvents is counted as unresolved (the
 ///     swim is then invalid);
-///  4b. with effect ground (the floor y = y0, docs/worlds.md), a cell reaching the floor is an event
-///     too (the floor wins ties): at its time the cell is put exactly on the floor and the floor's
-///     inelastic normal impulse sets its vertical velocity to 0 (or, for a cell that float rounding
-///     left below the floor at the start of the step, to the velocity that brings it back onto the
-///     floor by the end of the step: the old projection), together with the Coulomb friction impulse
-///     of that normal impulse (floor_friction(): sticking if the impulse that stops the cell is
-///     within μ_s·J_n, else sliding with μ_k·J_n). The floor events at the start of the step (cells
-///     resting on it) are resolved before the first search. A cell-edge impulse that would push a
-///     cell lying on the floor (and not moving up) into it is solved together with the floor: that
-///     cell's vertical inverse mass is 0 in the impulse, the floor takes the vertical part (a normal
-///     impulse, with its friction as above), so an edge pressing a cell onto the floor bounces off it
-///     like off a wall instead of an endless sequence of ever smaller events;
+///  4b. with effect ground (the floor y = y0, docs/worlds.md), a cell reaching the floor is an
+///     event too (the floor wins ties): at its time the cell is put exactly on the floor and the
+///     floor's inelastic normal impulse sets its vertical velocity to 0 (or, for a cell that float
+///     rounding left below the floor at the start of the step, to the velocity that brings it back
+///     onto the floor by the end of the step: the old projection), together with the Coulomb
+///     friction impulse of that normal impulse (floor_friction(): sticking if the impulse that
+///     stops the cell is within μ_s·J_n, else sliding with μ_k·J_n). The floor events at the start
+///     of the step (cells resting on it) are resolved before the first search. A cell-edge impulse
+///     that would push a cell lying on the floor (and not moving up) into it is solved together
+///     with the floor: that cell's vertical inverse mass is 0 in the impulse, the floor takes the
+///     vertical part (a normal impulse, with its friction as above), so an edge pressing a cell
+///     onto the floor bounces off it like off a wall instead of an endless sequence of ever smaller
+///     events;
 ///  5. the velocity changes go to Box2D as forces m·Δw/h, and since a bounce happens at its event
 ///     time and not at the start of the step, the end positions of the cells involved differ from
 ///     x + h·w; the stepper applies that difference after Box2D's step (SwimState::cx, cy). Events
@@ -130,7 +131,8 @@ class Collisions final : public Effect {
     if (all)
       for (int s = 0; s < body.spring_count(); ++s) edge_of(body.springs(s, 0), body.springs(s, 1));
     std::vector<int> skin_edges;
-    for (int s = 0; s < as_int(body.skin.rows()); ++s) skin_edges.push_back(edge_of(body.skin(s, 0), body.skin(s, 1)));
+    for (int s = 0; s < as_int(body.skin.rows()); ++s)
+      skin_edges.push_back(edge_of(body.skin(s, 0), body.skin(s, 1)));
     opposite_.assign(a_.size(), -1);
     if (all) {
       std::vector<std::pair<int, int>> region_pairs;
@@ -162,7 +164,8 @@ class Collisions final : public Effect {
       for (const auto& [v, e] : region_pairs) fixed_.push_back({v, e, band_of(v, e)});
     }
     // Skin items for the sort and sweep: skin vertices and skin edges.
-    // Cells on the outer face: the ends of skin edges, and cells without any edge (a hand-made body).
+    // Cells on the outer face: the ends of skin edges, and cells without any edge (a hand-made
+    // body).
     std::vector<char> on_skin(at(n_), 1);
     for (int s = 0; s < body.spring_count(); ++s) {
       on_skin[at(body.springs(s, 0))] = 0;
@@ -172,8 +175,8 @@ class Collisions final : public Effect {
       on_skin[at(a_[at(e)])] = 1;
       on_skin[at(b_[at(e)])] = 1;
     }
-    // A skin vertex farther than 2·tolerance (at rest) from every skin edge not its own has the band
-    // `tolerance` with all of them; the others get theirs computed per candidate.
+    // A skin vertex farther than 2·tolerance (at rest) from every skin edge not its own has the
+    // band `tolerance` with all of them; the others get theirs computed per candidate.
     exact_band_.assign(at(n_), 0);
     for (int i = 0; i < n_; ++i) {
       if (!on_skin[at(i)]) continue;
@@ -184,7 +187,8 @@ class Collisions final : public Effect {
     for (int e : skin_edges) items_.push_back({0, 0, 0, 0, -1, e});
     for (std::size_t k = 0; k < items_.size(); ++k) order_.push_back(static_cast<int>(k));
 
-    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &motion_, &ex_, &ey_}) v->assign(at(n_), 0.0);
+    for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &motion_, &ex_, &ey_})
+      v->assign(at(n_), 0.0);
     kicked_.assign(at(n_), 0);
     if (floor_) {
       for (auto* v : {&fvx_, &fvy_, &floor_wy_, &floor_u_}) v->assign(at(n_), 0.0);
@@ -266,7 +270,8 @@ class Collisions final : public Effect {
     }
     s.counters.collisions += collisions;
     s.counters.collisions_inelastic += inelastic;
-    s.counters.collision_max_passes = std::max(s.counters.collision_max_passes, static_cast<long>(events + floor_passes));
+    s.counters.collision_max_passes =
+        std::max(s.counters.collision_max_passes, static_cast<long>(events + floor_passes));
     if (!resolved) ++s.counters.collisions_unresolved;
     const double mh = s.mass / s.h;
     if (floor_) {
@@ -312,7 +317,8 @@ class Collisions final : public Effect {
     std::array<int, 3> e;        // e[c]: the edge opposite v[c]
     std::array<double, 3> band;  // band of the pair (v[c], e[c])
     double band_max;
-    double band4;                // 4·band_max·(1 + 1e-12): the cheaper test's bound on band_max·lmax per (reach + d)
+    // 4·band_max·(1 + 1e-12): the cheaper test's bound on band_max·lmax per (reach + d)
+    double band4;
   };
   struct Item {  // a skin vertex (vertex >= 0) or a skin edge (edge >= 0) in the sort and sweep
     double lo, hi, ylo, yhi;
@@ -320,8 +326,9 @@ class Collisions final : public Effect {
   };
 
   double band_of(int v, int e) const {
-    const SegmentHit rest = closest_on_segment(rx_[at(v)], ry_[at(v)], rx_[at(a_[at(e)])], ry_[at(a_[at(e)])],
-                                               rx_[at(b_[at(e)])], ry_[at(b_[at(e)])]);
+    const SegmentHit rest =
+        closest_on_segment(rx_[at(v)], ry_[at(v)], rx_[at(a_[at(e)])], ry_[at(a_[at(e)])],
+                           rx_[at(b_[at(e)])], ry_[at(b_[at(e)])]);
     return std::min(tol_, 0.5 * std::sqrt(rest.d2));
   }
 
@@ -337,12 +344,14 @@ class Collisions final : public Effect {
     double* ey = ey_.data();
     for (int i = 0; i < n_; ++i) {
       motion[i] = span * (std::abs(wx[i]) + std::abs(wy[i]));  // (a sum: NaN stays NaN)
-      ex[i] = qx[i] + span * wx[i];                           // where the cell is at the end of the span
+      // where the cell is at the end of the span
+      ex[i] = qx[i] + span * wx[i];
       ey[i] = qy[i] + span * wy[i];
     }
     for (const Triangle& t : tris_) {
       const int a = t.v[0], b = t.v[1], c = t.v[2];
-      const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a], acy = qy[c] - qy[a];
+      const double abx = qx[b] - qx[a], aby = qy[b] - qy[a], acx = qx[c] - qx[a],
+                   acy = qy[c] - qy[a];
       // The cheaper test first: it only rejects triangles the full test rejects too.
       if (triangle_surely_clear(abx, aby, acx, acy, motion[a] + motion[b] + motion[c], t.band4)) {
 #if ANIMAT_SELF_CHECK
@@ -389,7 +398,8 @@ class Collisions final : public Effect {
         if (o.ylo > p.yhi || o.yhi < p.ylo) continue;
         const int v = p.vertex >= 0 ? p.vertex : o.vertex;
         const int e = p.vertex >= 0 ? o.edge : p.edge;
-        if (v == a_[at(e)] || v == b_[at(e)] || v == opposite_[at(e)]) continue;  // own edge, or its triangle's
+        // own edge, or its triangle's
+        if (v == a_[at(e)] || v == b_[at(e)] || v == opposite_[at(e)]) continue;
         candidates_.push_back({v, e, exact_band_[at(v)] ? band_of(v, e) : tol_});
       }
     }
@@ -400,11 +410,13 @@ class Collisions final : public Effect {
   bool full_test_rejects(const Triangle& t, double span) const {
     const int a = t.v[0], b = t.v[1], c = t.v[2];
     return triangle_stays_clear(qx_[b] - qx_[a], qy_[b] - qy_[a], qx_[c] - qx_[a], qy_[c] - qy_[a],
-                                span * (wx_[b] - wx_[a]), span * (wy_[b] - wy_[a]), span * (wx_[c] - wx_[a]),
-                                span * (wy_[c] - wy_[a]), t.band_max);
+                                span * (wx_[b] - wx_[a]), span * (wy_[b] - wy_[a]),
+                                span * (wx_[c] - wx_[a]), span * (wy_[c] - wy_[a]), t.band_max);
   }
   [[noreturn]] static void self_check_failed(const Triangle& t, double span) {
-    std::fprintf(stderr, "collisions: the cheaper triangle test rejected triangle (%d, %d, %d) at span %.17g, the full test does not\n",
+    std::fprintf(stderr,
+                 "collisions: the cheaper triangle test rejected triangle (%d, %d, %d) at span "
+                 "%.17g, the full test does not\n",
                  t.v[0], t.v[1], t.v[2], span);
     std::abort();
   }
@@ -438,12 +450,13 @@ class Collisions final : public Effect {
     const double drx = span * (wx_[i] - wx_[a]), dry = span * (wy_[i] - wy_[a]);
     const double l2 = ex0 * ex0 + ey0 * ey0;
     if (!(l2 > 0.0)) return 2.0;
-    if (approaching_within(pr, 0.0, span, l2)) return 0.0;  // inside the capsule already, closing in
+    // inside the capsule already, closing in
+    if (approaching_within(pr, 0.0, span, l2)) return 0.0;
     std::array<double, 8> times{};  // two roots per side and per cap
     int count = 0;
     std::array<double, 2> r{};
-    // Sides: the signed distance cross(e, r)/|e0| reaches ±band (|e| taken at the start: the band is
-    // a tolerance).
+    // Sides: the signed distance cross(e, r)/|e0| reaches ±band (|e| taken at the start: the band
+    // is a tolerance).
     const double len = std::sqrt(l2);
     const double c0 = ex0 * ry0 - ey0 * rx0;
     const double c1 = ex0 * dry - ey0 * drx + dex * ry0 - dey * rx0;
@@ -453,7 +466,8 @@ class Collisions final : public Effect {
       for (int q = 0; q < k; ++q) times[at(count++)] = r[at(q)];
     }
     // End caps: |cell − a| or |cell − b| reaches band.
-    const double sx0 = rx0 - ex0, sy0 = ry0 - ey0, dsx = drx - dex, dsy = dry - dey;  // cell relative to b
+    // cell relative to b
+    const double sx0 = rx0 - ex0, sy0 = ry0 - ey0, dsx = drx - dex, dsy = dry - dey;
     const int ka = roots_in_unit_interval(drx * drx + dry * dry, 2.0 * (rx0 * drx + ry0 * dry),
                                           rx0 * rx0 + ry0 * ry0 - band * band, r);
     for (int q = 0; q < ka; ++q) times[at(count++)] = r[at(q)];
@@ -461,7 +475,8 @@ class Collisions final : public Effect {
                                           sx0 * sx0 + sy0 * sy0 - band * band, r);
     for (int q = 0; q < kb; ++q) times[at(count++)] = r[at(q)];
     for (int q = 1; q < count; ++q)  // insertion sort: at most eight
-      for (int k = q; k > 0 && times[at(k)] < times[at(k - 1)]; --k) std::swap(times[at(k)], times[at(k - 1)]);
+      for (int k = q; k > 0 && times[at(k)] < times[at(k - 1)]; --k)
+        std::swap(times[at(k)], times[at(k - 1)]);
     for (int q = 0; q < count; ++q)
       if (approaching_within(pr, times[at(q)], span, l2)) return times[at(q)];
     return 2.0;
@@ -487,8 +502,8 @@ class Collisions final : public Effect {
     return (px - hit.qx) * vx + (py - hit.qy) * vy < 0.0;
   }
 
-  /// The elastic (e = 1) or partly inelastic impulse of a pair whose cells are at their event: along
-  /// the direction from the closest point of the edge to the cell.
+  /// The elastic (e = 1) or partly inelastic impulse of a pair whose cells are at their event:
+  /// along the direction from the closest point of the edge to the cell.
   void bounce(const Pair& pr, double e) {
     const auto i = at(pr.cell), a = at(a_[at(pr.edge)]), b = at(b_[at(pr.edge)]);
     const SegmentHit hit = closest_on_segment(qx_[i], qy_[i], qx_[a], qy_[a], qx_[b], qy_[b]);
@@ -569,16 +584,20 @@ class Collisions final : public Effect {
 
   /// bounce() when a cell the impulse pushes down lies on the floor (pinned()): the impulse along n
   /// with that cell's vertical inverse mass 0 (the floor takes the vertical part: a normal impulse,
-  /// with its friction). Returns false when no cell is in that case (bounce() then goes on as usual).
-  bool bounce_on_floor(std::size_t i, std::size_t a, std::size_t b, double sc, double nx, double ny, double vn, double e) {
-    // The impulse acts on i along +n and on a, b along −n: downwards on i if ny < 0, on a, b if ny > 0.
+  /// with its friction). Returns false when no cell is in that case (bounce() then goes on as
+  /// usual).
+  bool bounce_on_floor(std::size_t i, std::size_t a, std::size_t b, double sc, double nx, double ny,
+                       double vn, double e) {
+    // The impulse acts on i along +n and on a, b along −n: downwards on i if ny < 0, on a, b if ny
+    // > 0.
     const bool pi = ny < 0.0 && pinned(i);
     const bool pa = ny > 0.0 && sc < 1.0 && pinned(a);
     const bool pb = ny > 0.0 && sc > 0.0 && pinned(b);
     if (!(pi || pa || pb)) return false;
     const double nx2 = nx * nx, ra = 1.0 - sc;
     const double inv = (pi ? nx2 : 1.0) + ra * ra * (pa ? nx2 : 1.0) + sc * sc * (pb ? nx2 : 1.0);
-    const double dv = -(1.0 + e) * vn / inv;  // at least 1/2: i and {a, b} are never pinned together
+    // at least 1/2: i and {a, b} are never pinned together
+    const double dv = -(1.0 + e) * vn / inv;
     auto push = [&](std::size_t k, bool pin, double w) {
       const double dvx = w * dv * nx, dvy = w * dv * ny;
       if (!pin) {
@@ -602,30 +621,35 @@ class Collisions final : public Effect {
   }
 
   double restitution_, tol_;
-  bool floor_;                      // effect ground is in the scene: floor contacts are events here
-  double y0_, mu_s_, mu_k_;         // the floor (effect ground)
+  bool floor_;               // effect ground is in the scene: floor contacts are events here
+  double y0_, mu_s_, mu_k_;  // the floor (effect ground)
   int n_ = 0;
-  std::vector<int> a_, b_;          // edges a cell may not cross
-  std::vector<int> opposite_;       // per edge: the opposite vertex of its triangular region (-1: none)
-  std::vector<double> rx_, ry_;     // rest positions (per-pair tolerance)
-  std::vector<Triangle> tris_;      // triangular regions
-  std::vector<Pair> fixed_;         // vertex-edge pairs of larger regions
-  std::vector<Item> items_;         // skin vertices and skin edges
-  std::vector<int> order_;          // items sorted by their swept x-extent (kept between steps)
-  std::vector<char> exact_band_;    // skin vertices whose band differs from the tolerance for some edge
+  std::vector<int> a_, b_;  // edges a cell may not cross
+  // per edge: the opposite vertex of its triangular region (-1: none)
+  std::vector<int> opposite_;
+  std::vector<double> rx_, ry_;  // rest positions (per-pair tolerance)
+  std::vector<Triangle> tris_;   // triangular regions
+  std::vector<Pair> fixed_;      // vertex-edge pairs of larger regions
+  std::vector<Item> items_;      // skin vertices and skin edges
+  std::vector<int> order_;       // items sorted by their swept x-extent (kept between steps)
+  // skin vertices whose band differs from the tolerance for some edge
+  std::vector<char> exact_band_;
   std::vector<Pair> candidates_;
-  std::vector<double> w0x_, w0y_;   // end-of-step velocities before any bounce
-  std::vector<double> wx_, wy_;     // current velocities while the events are processed
-  std::vector<double> qx_, qy_;     // positions at the current event time
-  std::vector<double> motion_;      // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
-  std::vector<double> ex_, ey_;     // per cell, q + span·w: its position at the end of the span (gather)
-  std::vector<char> kicked_;        // cells whose velocity a bounce changed this step
-  std::vector<double> fvx_, fvy_;   // per cell, the floor's velocity changes this step (floor_ only)
-  std::vector<double> floor_wy_;    // per cell, the vertical velocity the floor last gave it this step
-  std::vector<double> floor_u_;     // per cell, its floor event in the current span (> 1: none)
-  std::vector<char> floor_state_;   // per cell, this step: 1 the floor pushed it, 2 it slid
-  double tau_ = 0.0;                // fraction of the step done
-  double h_ = 0.0;                  // the step
+  std::vector<double> w0x_, w0y_;  // end-of-step velocities before any bounce
+  std::vector<double> wx_, wy_;    // current velocities while the events are processed
+  std::vector<double> qx_, qy_;    // positions at the current event time
+  std::vector<double> motion_;     // per cell, span·(|wx| + |wy|) (the triangles' cheaper test)
+  // per cell, q + span·w: its position at the end of the span (gather)
+  std::vector<double> ex_, ey_;
+  std::vector<char> kicked_;  // cells whose velocity a bounce changed this step
+  // per cell, the floor's velocity changes this step (floor_ only)
+  std::vector<double> fvx_, fvy_;
+  // per cell, the vertical velocity the floor last gave it this step
+  std::vector<double> floor_wy_;
+  std::vector<double> floor_u_;    // per cell, its floor event in the current span (> 1: none)
+  std::vector<char> floor_state_;  // per cell, this step: 1 the floor pushed it, 2 it slid
+  double tau_ = 0.0;               // fraction of the step done
+  double h_ = 0.0;                 // the step
 };
 
 }  // namespace

@@ -1,5 +1,6 @@
-// Effect "drag": eqs. 4–5 on skin edges only [paper §4]. The midpoint velocity u of an edge is split
-// into normal and tangential parts, F = −d·L·u·|u| per part (d_N, d_T), half the force to each end.
+// Effect "drag": eqs. 4–5 on skin edges only [paper §4]. The midpoint velocity u of an edge is
+// split into normal and tangential parts, F = −d·L·u·|u| per part (d_N, d_T), half the force to
+// each end.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -164,8 +165,9 @@ class Drag final : public Effect {
   /// (fn_, ft_); W = v + h·(F_other + F_drag)/m is kept per skin node while the sweeps run.
   void semi_implicit(SwimState& s) {
     const double h = s.h;
-    const double kv = h * s.inv_mass;          // velocity change per unit force on one node
-    const double k_edge = 0.5 * kv;             // midpoint velocity change per unit edge force (½ to each end)
+    const double kv = h * s.inv_mass;  // velocity change per unit force on one node
+    // midpoint velocity change per unit edge force (½ to each end)
+    const double k_edge = 0.5 * kv;
     const double* vx = s.vx.data();
     const double* vy = s.vy.data();
     double* fx = s.fx.data();
@@ -209,7 +211,8 @@ class Drag final : public Effect {
         const double dft = -(gt * ct + ft_[e]) * rt_[e];
         fn_[e] += dfn;
         ft_[e] += dft;
-        const double dvx = 0.5 * kv * (-dfn * ty + dft * tx), dvy = 0.5 * kv * (dfn * tx + dft * ty);
+        const double dvx = 0.5 * kv * (-dfn * ty + dft * tx),
+                     dvy = 0.5 * kv * (dfn * tx + dft * ty);
         wx_[at(p)] += dvx;
         wy_[at(p)] += dvy;
         wx_[at(q)] += dvx;
@@ -235,7 +238,8 @@ class Drag final : public Effect {
       fy[j] += gy;
     }
     if (s.normal_drag_fx != nullptr && !s.predictor)
-      for (std::size_t e = 0; e < a_.size(); ++e) add_normal_part(s, a_[e], b_[e], fn_[e], tx_[e], ty_[e]);
+      for (std::size_t e = 0; e < a_.size(); ++e)
+        add_normal_part(s, a_[e], b_[e], fn_[e], tx_[e], ty_[e]);
   }
 
   /// Energy accounting: the normal part of one edge's force, half to each end, into the state's
@@ -250,20 +254,21 @@ class Drag final : public Effect {
 
   double dn_, dt_;
   Scheme scheme_;
-  std::vector<int> a_, b_;      // end nodes of each skin edge
-  std::vector<int> la_, lb_;    // their local (skin node) indices
-  std::vector<int> nodes_;      // skin nodes
+  std::vector<int> a_, b_;    // end nodes of each skin edge
+  std::vector<int> la_, lb_;  // their local (skin node) indices
+  std::vector<int> nodes_;    // skin nodes
   std::vector<double> edge_mass_;
-  std::vector<double> len_, tx_, ty_;  // edge geometry of the current step
+  std::vector<double> len_, tx_, ty_;      // edge geometry of the current step
   std::vector<double> gn_, gt_, rn_, rt_;  // d·L·|u₀| per part, and 1/(1 + g·h/(2m))
   std::vector<double> fn_, ft_;            // edge forces (kept: the next predictor pass uses them)
-  std::vector<double> wx_, wy_;        // end-of-step velocity estimate per skin node
-  std::vector<double> wxn_, wyn_;      // implicit scheme: predicted velocity of every node
+  std::vector<double> wx_, wy_;            // end-of-step velocity estimate per skin node
+  std::vector<double> wxn_, wyn_;          // implicit scheme: predicted velocity of every node
 };
 
 }  // namespace
 
-std::unique_ptr<Effect> make_drag(const Body& body, const SceneParams& scene, const PhysicsParams& physics) {
+std::unique_ptr<Effect> make_drag(const Body& body, const SceneParams& scene,
+                                  const PhysicsParams& physics) {
   return std::make_unique<Drag>(body, scene, physics);
 }
 

@@ -16,10 +16,13 @@
 namespace animat::effects {
 
 [[nodiscard]] std::unique_ptr<Effect> make_springs(const Body& body, const SceneParams& scene);
-[[nodiscard]] std::unique_ptr<Effect> make_actuation(const Body& body, const PhysicsParams& physics);
+[[nodiscard]] std::unique_ptr<Effect> make_actuation(const Body& body,
+                                                     const PhysicsParams& physics);
 [[nodiscard]] std::unique_ptr<Effect> make_pressure(const Body& body, const SceneParams& scene);
-[[nodiscard]] std::unique_ptr<Effect> make_drag(const Body& body, const SceneParams& scene, const PhysicsParams& physics);
-[[nodiscard]] std::unique_ptr<Effect> make_skin_collision(const Body& body, const SceneParams& scene);
+[[nodiscard]] std::unique_ptr<Effect> make_drag(const Body& body, const SceneParams& scene,
+                                                const PhysicsParams& physics);
+[[nodiscard]] std::unique_ptr<Effect> make_skin_collision(const Body& body,
+                                                          const SceneParams& scene);
 [[nodiscard]] std::unique_ptr<Effect> make_collisions(const Body& body, const SceneParams& scene);
 [[nodiscard]] std::unique_ptr<Effect> make_gravity(const SceneParams& scene);
 [[nodiscard]] std::unique_ptr<Effect> make_ground(const SceneParams& scene);
@@ -37,7 +40,8 @@ double twice_area(const X& x, const Y& y, const std::vector<int>& loop) {
     return (x(b) - x(a)) * (y(c) - y(a)) - (x(c) - x(a)) * (y(b) - y(a));
   }
   double twice = 0.0;
-  for (std::size_t q = 0; q < k; ++q) twice += x(loop[q]) * (y(loop[(q + 1) % k]) - y(loop[(q + k - 1) % k]));
+  for (std::size_t q = 0; q < k; ++q)
+    twice += x(loop[q]) * (y(loop[(q + 1) % k]) - y(loop[(q + k - 1) % k]));
   return twice;
 }
 
@@ -45,7 +49,8 @@ double twice_area(const X& x, const Y& y, const std::vector<int>& loop) {
 struct SegmentHit {
   double t, qx, qy, d2;
 };
-inline SegmentHit closest_on_segment(double px, double py, double ax, double ay, double bx, double by) {
+inline SegmentHit closest_on_segment(double px, double py, double ax, double ay, double bx,
+                                     double by) {
   const double ex = bx - ax, ey = by - ay;
   const double l2 = ex * ex + ey * ey;
   double t = l2 > 0.0 ? ((px - ax) * ex + (py - ay) * ey) / l2 : 0.0;

@@ -34,6 +34,8 @@ class Gravity final : public Effect {
 
 }  // namespace
 
-std::unique_ptr<Effect> make_gravity(const SceneParams& scene) { return std::make_unique<Gravity>(scene); }
+std::unique_ptr<Effect> make_gravity(const SceneParams& scene) {
+  return std::make_unique<Gravity>(scene);
+}
 
 }  // namespace animat::effects

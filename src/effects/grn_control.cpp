@@ -1,5 +1,5 @@
-// Effect "grn_control" (control.mode = "grn", issue 18): the GRN keeps running while the animat swims
-// and its actuation output drives eq. 2 (control.hpp, docs/control.md).
+// Effect "grn_control" (control.mode = "grn", issue 18): the GRN keeps running while the animat
+// swims and its actuation output drives eq. 2 (control.hpp, docs/control.md).
 //
 // Every k = control.update_interval Box2D steps (at steps 0, k, 2k, ...) one update:
 //   1. sensors from the positions at the start of that step: strain (mean of ℓ/L0 − 1 over the
@@ -31,32 +31,38 @@ void validate(const ControlParams& c, const PhysicsParams& physics) {
   const double h = physics.dt / physics.substeps;
   const double step = c.grn_rate * c.update_interval * h;
   if (c.mode == "grn" && !(step <= 1.0))
-    throw ConfigError(fmt::format("control.grn_rate = {} x control.update_interval = {} x h = {} (physics.dt / "
-                                  "physics.substeps) is {}: one GRN update would advance eq. 1 by more than 1 "
-                                  "(levels would overshoot); lower grn_rate or update_interval",
-                                  c.grn_rate, c.update_interval, h, step));
+    throw ConfigError(
+        fmt::format("control.grn_rate = {} x control.update_interval = {} x h = {} (physics.dt / "
+                    "physics.substeps) is {}: one GRN update would advance eq. 1 by more than 1 "
+                    "(levels would overshoot); lower grn_rate or update_interval",
+                    c.grn_rate, c.update_interval, h, step));
 }
 
-double chemical_field(std::string_view kind, double sx, double sy, double nx, double ny, double decay_length, double x,
-                      double y) {
+double chemical_field(std::string_view kind, double sx, double sy, double nx, double ny,
+                      double decay_length, double x, double y) {
   if (kind == "point") return std::exp(-std::hypot(x - sx, y - sy) / decay_length);
-  if (kind == "plane") return std::exp(-std::max(0.0, (sx - x) * nx + (sy - y) * ny) / decay_length);
+  if (kind == "plane")
+    return std::exp(-std::max(0.0, (sx - x) * nx + (sy - y) * ny) / decay_length);
   return 0.0;
 }
 
 namespace {
 
-void csr(int n, const std::vector<std::vector<int>>& lists, std::vector<int>& begin, std::vector<int>& flat) {
+void csr(int n, const std::vector<std::vector<int>>& lists, std::vector<int>& begin,
+         std::vector<int>& flat) {
   begin.assign(static_cast<std::size_t>(n) + 1, 0);
-  for (int i = 0; i < n; ++i) begin[static_cast<std::size_t>(i) + 1] = begin[static_cast<std::size_t>(i)] + static_cast<int>(lists[static_cast<std::size_t>(i)].size());
+  for (int i = 0; i < n; ++i)
+    begin[static_cast<std::size_t>(i) + 1] =
+        begin[static_cast<std::size_t>(i)] +
+        static_cast<int>(lists[static_cast<std::size_t>(i)].size());
   flat.clear();
   for (const auto& l : lists) flat.insert(flat.end(), l.begin(), l.end());
 }
 
 }  // namespace
 
-GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const ControlParams& control, const SceneParams& scene,
-                       const PhysicsParams& physics)
+GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const ControlParams& control,
+                       const SceneParams& scene, const PhysicsParams& physics)
     : start_(std::move(start)), control_(control) {
   validate(control_, physics);
   const Body body = swim_body(body_in);
@@ -69,7 +75,8 @@ GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const Control
   step_params_.dt = control_.grn_rate * update_dt_;
   const auto n = static_cast<std::size_t>(n_);
   if (start_.levels.size() != n * static_cast<std::size_t>(nodes_))
-    throw ConfigError(fmt::format("grn control: {} start levels for {} cells of {} nodes", start_.levels.size(), n_, nodes_));
+    throw ConfigError(fmt::format("grn control: {} start levels for {} cells of {} nodes",
+                                  start_.levels.size(), n_, nodes_));
   if (start_.maternal.size() != n * 3) start_.maternal.assign(n * 3, 0.0);
 
   std::vector<std::vector<int>> cell_springs(n), cell_regions(n);
@@ -98,16 +105,19 @@ GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const Control
   if (morph_ > 0) {
     std::size_t most = 0;
     for (const auto& l : cell_springs) most = std::max(most, l.size());
-    const double worst = update_dt_ * (control_.signal_rate * static_cast<double>(most) + control_.signal_decay);
-    if (!std::isfinite(worst)) throw ConfigError("control.signal_rate / signal_decay: non-finite signalling step");
+    const double worst =
+        update_dt_ * (control_.signal_rate * static_cast<double>(most) + control_.signal_decay);
+    if (!std::isfinite(worst))
+      throw ConfigError("control.signal_rate / signal_decay: non-finite signalling step");
     signal_substeps_ = std::max(1, static_cast<int>(std::ceil(worst)));
   }
 
   states_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     states_[i] = start_.grn.initial_state();
-    std::copy_n(start_.levels.begin() + static_cast<std::ptrdiff_t>(i * static_cast<std::size_t>(nodes_)), nodes_,
-                states_[i].levels.begin());
+    std::copy_n(
+        start_.levels.begin() + static_cast<std::ptrdiff_t>(i * static_cast<std::size_t>(nodes_)),
+        nodes_, states_[i].levels.begin());
   }
   const auto m = static_cast<std::size_t>(morph_);
   field_.assign(n * m, 0.0);
@@ -116,7 +126,8 @@ GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const Control
   } else {
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t k = 0; k < m; ++k)
-        field_[i * m + k] = states_[i].levels[static_cast<std::size_t>(start_.grn.morphogen_units()[k])];
+        field_[i * m + k] =
+            states_[i].levels[static_cast<std::size_t>(start_.grn.morphogen_units()[k])];
   }
   next_field_.assign(n * m, 0.0);
   sensors_.assign(n * 3, 0.0);
@@ -163,7 +174,8 @@ void GrnControl::update(const SwimState& s) {
   const double* y = s.y.data();
   // 1. Sensors.
   for (std::size_t r = 0; r < regions_.size(); ++r) {
-    const double twice = effects::twice_area([x](int i) { return x[i]; }, [y](int i) { return y[i]; }, regions_[r]);
+    const double twice =
+        effects::twice_area([x](int i) { return x[i]; }, [y](int i) { return y[i]; }, regions_[r]);
     region_ratio_[r] = 0.5 * twice / area0_[r];
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -178,13 +190,15 @@ void GrnControl::update(const SwimState& s) {
     const int rb = region_begin_[i], re = region_begin_[i + 1];
     if (re > rb) {
       pressure = 0.0;
-      for (int q = rb; q < re; ++q) pressure += region_ratio_[static_cast<std::size_t>(region_list_[static_cast<std::size_t>(q)])];
+      for (int q = rb; q < re; ++q)
+        pressure +=
+            region_ratio_[static_cast<std::size_t>(region_list_[static_cast<std::size_t>(q)])];
       pressure /= (re - rb);
     }
     sensors_[3 * i] = se > sb ? strain / (se - sb) : 0.0;
     sensors_[3 * i + 1] = pressure;
-    sensors_[3 * i + 2] =
-        chemical_field(chemical_, source_x_, source_y_, normal_x_, normal_y_, decay_length_, x[i], y[i]);
+    sensors_[3 * i + 2] = chemical_field(chemical_, source_x_, source_y_, normal_x_, normal_y_,
+                                         decay_length_, x[i], y[i]);
   }
   // 2. Signalling: relaxation towards the own product, then the Laplacian spring by spring.
   const auto m = static_cast<std::size_t>(morph_);
@@ -193,21 +207,23 @@ void GrnControl::update(const SwimState& s) {
     const double flow = update_dt_ / signal_substeps_ * control_.signal_rate;
     const auto& units = start_.grn.morphogen_units();
     for (int sub = 0; sub < signal_substeps_; ++sub) {
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t k = 0; k < m; ++k) {
-        const double f = field_[i * m + k];
-        next_field_[i * m + k] = f + relax * (states_[i].levels[static_cast<std::size_t>(units[k])] - f);
-      }
-    if (flow != 0.0)
-      for (std::size_t e = 0; e < a_.size(); ++e) {
-        const auto a = static_cast<std::size_t>(a_[e]) * m, b = static_cast<std::size_t>(b_[e]) * m;
+      for (std::size_t i = 0; i < n; ++i)
         for (std::size_t k = 0; k < m; ++k) {
-          const double q = flow * (field_[b + k] - field_[a + k]);
-          next_field_[a + k] += q;
-          next_field_[b + k] -= q;
+          const double f = field_[i * m + k];
+          next_field_[i * m + k] =
+              f + relax * (states_[i].levels[static_cast<std::size_t>(units[k])] - f);
         }
-      }
-    field_.swap(next_field_);
+      if (flow != 0.0)
+        for (std::size_t e = 0; e < a_.size(); ++e) {
+          const auto a = static_cast<std::size_t>(a_[e]) * m,
+                     b = static_cast<std::size_t>(b_[e]) * m;
+          for (std::size_t k = 0; k < m; ++k) {
+            const double q = flow * (field_[b + k] - field_[a + k]);
+            next_field_[a + k] += q;
+            next_field_[b + k] -= q;
+          }
+        }
+      field_.swap(next_field_);
     }
   }
   // 3. Eq. 1 in every cell; 4. the terms.
@@ -220,8 +236,10 @@ void GrnControl::update(const SwimState& s) {
     in.sensors = {sensors_[3 * i], sensors_[3 * i + 1], sensors_[3 * i + 2]};
     start_.grn.step(states_[i], in, step_params_);
     const double level = start_.grn.output(states_[i], OutputChannel::actuation);
-    if (modulate_) amplitude_[i] = ramp * amax * level;
-    else terms_[i] = ramp * term_of_level(level, amax);
+    if (modulate_)
+      amplitude_[i] = ramp * amax * level;
+    else
+      terms_[i] = ramp * term_of_level(level, amax);
   }
   ++updates_;
 }
@@ -234,11 +252,12 @@ void GrnControl::apply(SwimState& s) {
   }
   if (modulate_)  // eq. 2's oscillator with the GRN's amplitude, from the cell's start time on
     for (std::size_t i = 0; i < terms_.size(); ++i)
-      terms_[i] = s.time >= start_time_[i] ? amplitude_[i] * std::sin(frequency_[i] * s.time + phase_[i]) : 0.0;
+      terms_[i] = s.time >= start_time_[i]
+                      ? amplitude_[i] * std::sin(frequency_[i] * s.time + phase_[i])
+                      : 0.0;
   const double* t = terms_.data();
   double* rest = s.rest.data();
-  for (std::size_t e = 0; e < a_.size(); ++e)
-    rest[e] = (1.0 + t[a_[e]] + t[b_[e]]) * rest0_[e];
+  for (std::size_t e = 0; e < a_.size(); ++e) rest[e] = (1.0 + t[a_[e]] + t[b_[e]]) * rest0_[e];
 }
 
 }  // namespace animat

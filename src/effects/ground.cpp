@@ -12,12 +12,13 @@ namespace animat::effects {
 namespace {
 
 /// A constraint effect, resolved within the step like "collisions" (it runs after it). With every
-/// force already in s.fx, s.fy, the velocity Box2D will give cell i is w = v + h·F/m, and within the
-/// step the cell moves in a straight line at w. A floor contact is an event at the time τ·h the
+/// force already in s.fx, s.fy, the velocity Box2D will give cell i is w = v + h·F/m, and within
+/// the step the cell moves in a straight line at w. A floor contact is an event at the time τ·h the
 /// cell reaches the floor y0 (τ = 0 for a cell on it, moving down):
 ///  - normal (inelastic): the cell is put on the floor and its vertical velocity becomes w_y' = 0
 ///    (a cell that float rounding left below the floor gets w_y' = (y0 − y)/h instead, which puts
-///    it back on the floor by the end of the step); J_n = m·(w_y' − w_y) > 0 (the floor only pushes);
+///    it back on the floor by the end of the step); J_n = m·(w_y' − w_y) > 0 (the floor only
+///    pushes);
 ///  - tangential (Coulomb, impulse form, floor_friction()): the impulse that stops the cell,
 ///    J_stick = −m·w_x, is taken if |J_stick| <= μ_s·J_n (sticking: no sliding below the static
 ///    limit); otherwise the cell slides and J_t = −sign(w_x)·μ_k·J_n (kinetic friction; μ_k <= μ_s,
@@ -31,10 +32,10 @@ namespace {
 ///
 /// With effect collisions in the scene these events are resolved inside the collisions' event
 /// loop (src/effects/collisions.cpp, the same law), so that no floor impulse can undo a collision
-/// guarantee; this effect then only adds the floor impulses that loop computed (SwimState::ground_fx,
-/// ground_fy), booked as the floor's. Without collisions it resolves each cell's contact itself.
-/// Counted: contacts (cell-steps in which the floor pushed) and slips (of those, sliding ones).
-/// Nothing is allocated.
+/// guarantee; this effect then only adds the floor impulses that loop computed
+/// (SwimState::ground_fx, ground_fy), booked as the floor's. Without collisions it resolves each
+/// cell's contact itself. Counted: contacts (cell-steps in which the floor pushed) and slips (of
+/// those, sliding ones). Nothing is allocated.
 class Ground final : public Effect {
  public:
   explicit Ground(const SceneParams& p)
@@ -75,7 +76,8 @@ class Ground final : public Effect {
       s.fy[k] += m * jn * inv_h;
       ++contacts;
       slips += f.slid ? 1 : 0;
-      if (tau > 0.0) {  // moved at w until τ, then at w': ends at (x + τ·h·w_x + (1 − τ)·h·w_x', y0)
+      if (tau > 0.0) {
+        // moved at w until τ, then at w': ends at (x + τ·h·w_x + (1 − τ)·h·w_x', y0)
         if (!s.position_corrected) {
           for (int j = 0; j < s.n; ++j) s.cx[at(j)] = s.cy[at(j)] = 0.0;
           s.position_corrected = true;
@@ -95,6 +97,8 @@ class Ground final : public Effect {
 
 }  // namespace
 
-std::unique_ptr<Effect> make_ground(const SceneParams& scene) { return std::make_unique<Ground>(scene); }
+std::unique_ptr<Effect> make_ground(const SceneParams& scene) {
+  return std::make_unique<Ground>(scene);
+}
 
 }  // namespace animat::effects

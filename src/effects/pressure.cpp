@@ -65,7 +65,8 @@ class Pressure final : public Effect {
     }
     for (std::size_t r = 0; r < rest_area_.size(); ++r) {
       double twice_area = 0.0;
-      for (int q = offset_[r]; q < offset_[r + 1]; ++q) twice_area += x[node_[at(q)]] * (y[next_[at(q)]] - y[prev_[at(q)]]);
+      for (int q = offset_[r]; q < offset_[r + 1]; ++q)
+        twice_area += x[node_[at(q)]] * (y[next_[at(q)]] - y[prev_[at(q)]]);
       const double d = 0.5 * twice_area - rest_area_[r];
       u += 0.5 * coef_[r] * d * d;
     }

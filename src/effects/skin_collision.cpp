@@ -25,7 +25,8 @@ class SkinCollision final : public Effect {
  public:
   static constexpr double kMargin = 0.4;
 
-  SkinCollision(const Body& body, const SceneParams& p) : k_(p.collision_stiffness), r_(p.collision_radius) {
+  SkinCollision(const Body& body, const SceneParams& p)
+      : k_(p.collision_stiffness), r_(p.collision_radius) {
     n_ = body.node_count();
     for (int e = 0; e < as_int(body.skin.rows()); ++e) {
       a_.push_back(body.skin(e, 0));
@@ -54,8 +55,8 @@ class SkinCollision final : public Effect {
       const int i = p.cell, a = a_[at(p.edge)], b = b_[at(p.edge)];
       // Cheap rejection: the cell is farther than the radius from the edge's bounding box.
       const double r = p.radius;
-      if (x[i] + r < std::min(x[a], x[b]) || x[i] - r > std::max(x[a], x[b]) || y[i] + r < std::min(y[a], y[b]) ||
-          y[i] - r > std::max(y[a], y[b]))
+      if (x[i] + r < std::min(x[a], x[b]) || x[i] - r > std::max(x[a], x[b]) ||
+          y[i] + r < std::min(y[a], y[b]) || y[i] - r > std::max(y[a], y[b]))
         continue;
       const SegmentHit hit = closest_on_segment(x[i], y[i], x[a], y[a], x[b], y[b]);
       if (!(hit.d2 < r * r)) continue;
@@ -82,7 +83,6 @@ class SkinCollision final : public Effect {
     }
   }
   [[nodiscard]] long rebuilds() const { return rebuilds_; }
-
 
  private:
   struct Pair {
@@ -130,10 +130,13 @@ class SkinCollision final : public Effect {
       const double y0 = std::min(s.y[au], s.y[bu]) - reach, y1 = std::max(s.y[au], s.y[bu]) + reach;
       for (int i = 0; i < n_; ++i) {
         const auto iu = at(i);
-        if (s.x[iu] < x0 || s.x[iu] > x1 || s.y[iu] < y0 || s.y[iu] > y1 || a == i || b == i) continue;
-        const SegmentHit now = closest_on_segment(s.x[iu], s.y[iu], s.x[au], s.y[au], s.x[bu], s.y[bu]);
+        if (s.x[iu] < x0 || s.x[iu] > x1 || s.y[iu] < y0 || s.y[iu] > y1 || a == i || b == i)
+          continue;
+        const SegmentHit now =
+            closest_on_segment(s.x[iu], s.y[iu], s.x[au], s.y[au], s.x[bu], s.y[bu]);
         if (!(now.d2 < reach * reach)) continue;
-        const SegmentHit rest = closest_on_segment(x0_[iu], y0_[iu], x0_[au], y0_[au], x0_[bu], y0_[bu]);
+        const SegmentHit rest =
+            closest_on_segment(x0_[iu], y0_[iu], x0_[au], y0_[au], x0_[bu], y0_[bu]);
         const double radius = std::min(r_, 0.5 * std::sqrt(rest.d2));
         if (radius > 0.0) pairs_.push_back({i, static_cast<int>(e), radius});
       }

@@ -33,13 +33,15 @@ class Springs final : public Effect {
     ex_.assign(at(m), 0.0);
     ey_.assign(at(m), 0.0);
     n_ = body.node_count();
-    prev_rest_.assign(body.rest_lengths.data(), body.rest_lengths.data() + body.rest_lengths.size());
+    prev_rest_.assign(body.rest_lengths.data(),
+                      body.rest_lengths.data() + body.rest_lengths.size());
     prev_rest_.resize(at(m), 0.0);
     prev_len_.assign(at(m), 0.0);
     for (int s = 0; s < m; ++s) {
       const int i = a_[at(s)], j = b_[at(s)];
       if (i < 0 || j < 0 || i >= n_ || j >= n_) continue;
-      prev_len_[at(s)] = std::hypot(body.positions(j, 0) - body.positions(i, 0), body.positions(j, 1) - body.positions(i, 1));
+      prev_len_[at(s)] = std::hypot(body.positions(j, 0) - body.positions(i, 0),
+                                    body.positions(j, 1) - body.positions(i, 1));
     }
     work_positive_.assign(at(m), 0.0);
     work_absolute_.assign(at(m), 0.0);
@@ -191,7 +193,8 @@ std::unique_ptr<Effect> make_springs(const Body& body, const SceneParams& scene)
 
 namespace animat {
 
-bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positive, std::vector<double>& absolute) {
+bool actuation_work_per_cell(const Effect& springs, std::vector<double>& positive,
+                             std::vector<double>& absolute) {
   const auto* s = dynamic_cast<const effects::Springs*>(&springs);
   if (s == nullptr) return false;
   s->work_per_cell(positive, absolute);

@@ -43,15 +43,18 @@ Launch detect_launch() {
 }
 
 std::string how_to_get_mpi() {
-  return "this animat_evolve was built without MPI. Install Open MPI (Debian: apt-get install libopenmpi-dev "
-         "openmpi-bin; scripts/setup.sh does) and rebuild (scripts/build.sh, or cmake -DANIMAT_WITH_MPI=ON)";
+  return "this animat_evolve was built without MPI. Install Open MPI (Debian: apt-get install "
+         "libopenmpi-dev "
+         "openmpi-bin; scripts/setup.sh does) and rebuild (scripts/build.sh, or cmake "
+         "-DANIMAT_WITH_MPI=ON)";
 }
 
 int threads_per_rank(int requested, int local_ranks) {
   if (requested > 0) return requested;
-  const int allowed = omp_get_num_procs();                        // this process's affinity mask
+  const int allowed = omp_get_num_procs();  // this process's affinity mask
   const long online = sysconf(_SC_NPROCESSORS_ONLN);
-  if (online > 0 && allowed < online) return std::max(1, allowed);  // bound by the launcher: its cores are ours
+  // bound by the launcher: its cores are ours
+  if (online > 0 && allowed < online) return std::max(1, allowed);
   return std::max(1, allowed / std::max(1, local_ranks));
 }
 

@@ -10,16 +10,17 @@
 //   r -> 0  kResult  u8 kind, u32 n, n x (u32 task, u8 ok, fitness | string error)
 //   0 -> r  kStop    (empty): finish, answer kBye
 //   r -> 0  kBye     (empty): nothing more comes from this rank
-//   0 -> r  kPing    (empty): answer kPong at once (the comm thread answers even while all threads evaluate)
+//   0 -> r  kPing    (empty): answer kPong at once (the comm thread answers even while all
+//                     threads evaluate)
 //
 // A lost rank. mpirun ends the whole job when a rank dies: SIGCONT to every rank at once, SIGTERM a
 // second later, SIGKILL a second after that; and Open MPI aborts a rank as soon as it hears of the
-// failure, so rank 0 cannot count on surviving the SIGTERM. Rank 0 therefore pings every rank as soon
-// as it gets a SIGCONT (also sent when a suspended job resumes: then every rank answers and nothing
-// happens); a rank that does not answer within kPingAfterSignal is lost, and rank 0 stops with a
-// message while it still can. Launchers that do not end the job (srun without --kill-on-bad-exit)
-// are covered by a heartbeat: a rank silent for kSilence while it holds work is pinged, and lost if
-// it does not answer within kSilence either.
+// failure, so rank 0 cannot count on surviving the SIGTERM. Rank 0 therefore pings every rank as
+// soon as it gets a SIGCONT (also sent when a suspended job resumes: then every rank answers and
+// nothing happens); a rank that does not answer within kPingAfterSignal is lost, and rank 0 stops
+// with a message while it still can. Launchers that do not end the job (srun without
+// --kill-on-bad-exit) are covered by a heartbeat: a rank silent for kSilence while it holds work is
+// pinged, and lost if it does not answer within kSilence either.
 #define OMPI_SKIP_MPICXX 1
 #include <fmt/format.h>
 #include <mpi.h>
@@ -48,14 +49,24 @@ bool built_with_mpi() { return true; }
 
 namespace {
 
-enum Tag : int { kConfig = 101, kHello = 102, kWork = 103, kResult = 104, kStop = 105, kBye = 106, kPing = 107, kPong = 108 };
+enum Tag : int {
+  kConfig = 101,
+  kHello = 102,
+  kWork = 103,
+  kResult = 104,
+  kStop = 105,
+  kBye = 106,
+  kPing = 107,
+  kPong = 108
+};
 using Clock = std::chrono::steady_clock;
 constexpr auto kPingAfterSignal = std::chrono::milliseconds(400);
 constexpr auto kSilence = std::chrono::seconds(20);
 
 std::atomic<unsigned> g_sigcont{0};
 extern "C" void on_sigcont(int) { g_sigcont.fetch_add(1); }
-enum class Kind : std::uint8_t { evaluate = 1 };  // the only task kind (the byte keeps the protocol extensible)
+// the only task kind (the byte keeps the protocol extensible)
+enum class Kind : std::uint8_t { evaluate = 1 };
 
 std::string error_string(int code) {
   char text[MPI_MAX_ERROR_STRING];
@@ -100,13 +111,15 @@ bool poll(int source, Message& m) {
   m.source = st.MPI_SOURCE;
   m.tag = st.MPI_TAG;
   m.bytes.resize(static_cast<std::size_t>(count));
-  check(MPI_Recv(m.bytes.data(), count, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
+  check(MPI_Recv(m.bytes.data(), count, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE),
         "MPI_Recv");
   return true;
 }
 
 void send(int dest, int tag, const Bytes& bytes) {
-  check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD), "MPI_Send");
+  check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD),
+        "MPI_Send");
 }
 
 }  // namespace
@@ -114,16 +127,16 @@ void send(int dest, int tag, const Bytes& bytes) {
 struct Job::State {
   int rank = 0, size = 1, local_ranks = 1;
   std::string host;
-  bool started = false;  // rank 0: the config went out
-  bool broken = false;   // a rank may be gone: never wait for the others again
+  bool started = false;       // rank 0: the config went out
+  bool broken = false;        // a rank may be gone: never wait for the others again
   unsigned sigcont_seen = 0;  // SIGCONTs already answered by a ping
   // Rank 0
   const std::atomic<bool>* stop = nullptr;
   std::shared_ptr<const Config> config;
   FitnessFunction fitness;
-  int threads = 1;                  // this rank's evaluation threads
-  std::vector<int> rank_threads;    // every rank's
-  std::vector<std::string> hosts;   // every rank's
+  int threads = 1;                 // this rank's evaluation threads
+  std::vector<int> rank_threads;   // every rank's
+  std::vector<std::string> hosts;  // every rank's
   // Isends in flight (rank 0 never blocks on a worker) with their buffers.
   std::deque<std::pair<MPI_Request, std::shared_ptr<Bytes>>> sends;
 
@@ -132,7 +145,8 @@ struct Job::State {
   void isend(int dest, int tag, Bytes bytes) {
     auto buffer = std::make_shared<Bytes>(std::move(bytes));
     MPI_Request req;
-    check(MPI_Isend(buffer->data(), static_cast<int>(buffer->size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &req),
+    check(MPI_Isend(buffer->data(), static_cast<int>(buffer->size()), MPI_BYTE, dest, tag,
+                    MPI_COMM_WORLD, &req),
           "MPI_Isend");
     sends.emplace_back(req, std::move(buffer));
   }
@@ -177,8 +191,8 @@ struct Job::State {
     Kind kind;
     std::size_t count;
     std::function<void(wire::Writer&, std::size_t)> encode;  // the task's payload for another rank
-    std::function<void(std::size_t)> run_local;               // evaluate here and store
-    std::function<void(wire::Reader&, std::size_t)> decode;   // store another rank's result
+    std::function<void(std::size_t)> run_local;              // evaluate here and store
+    std::function<void(wire::Reader&, std::size_t)> decode;  // store another rank's result
   };
   void run(const Tasks& t);
 };
@@ -187,8 +201,8 @@ struct Job::State {
 void Job::State::run(const Tasks& t) {
   if (broken) throw RankFailure("the MPI job lost a rank earlier; it cannot evaluate any more");
   const std::size_t n = t.count;
-  std::mutex mutex;             // guards next
-  std::size_t next = 0;         // first task not handed out
+  std::mutex mutex;      // guards next
+  std::size_t next = 0;  // first task not handed out
   std::atomic<std::size_t> completed{0};
   std::atomic<bool> abort{false};
   std::vector<std::exception_ptr> errors(n);
@@ -198,8 +212,10 @@ void Job::State::run(const Tasks& t) {
   std::exception_ptr comm_error;
   bool interrupted = false;
   const Clock::time_point began = Clock::now();
-  std::vector<Clock::time_point> heard(static_cast<std::size_t>(size), began);      // last message from each rank
-  std::vector<Clock::time_point> ping_due(static_cast<std::size_t>(size), Clock::time_point::max());  // pong deadline
+  // last message from each rank
+  std::vector<Clock::time_point> heard(static_cast<std::size_t>(size), began);
+  // pong deadline
+  std::vector<Clock::time_point> ping_due(static_cast<std::size_t>(size), Clock::time_point::max());
   auto ping = [&](int r, Clock::duration within) {
     auto& due = ping_due[static_cast<std::size_t>(r)];
     if (due != Clock::time_point::max()) return;  // one ping at a time
@@ -208,7 +224,8 @@ void Job::State::run(const Tasks& t) {
   };
   auto check_alive = [&]() {
     const auto now = Clock::now();
-    if (const unsigned c = g_sigcont.load(); c != sigcont_seen) {  // maybe mpirun is ending the job (also between calls)
+    if (const unsigned c = g_sigcont.load(); c != sigcont_seen) {
+      // maybe mpirun is ending the job (also between calls)
       sigcont_seen = c;
       for (int r = 1; r < size; ++r) ping(r, kPingAfterSignal);
     }
@@ -216,9 +233,10 @@ void Job::State::run(const Tasks& t) {
       const auto ru = static_cast<std::size_t>(r);
       if (outstanding[ru] > 0 && now - heard[ru] > kSilence) ping(r, kSilence);
       if (now > ping_due[ru])
-        throw RankFailure(fmt::format("rank {} ({}) stopped answering ({:.1f} s without a sign of life): it died or "
-                                      "hangs",
-                                      r, hosts[ru], std::chrono::duration<double>(now - heard[ru]).count()));
+        throw RankFailure(fmt::format(
+            "rank {} ({}) stopped answering ({:.1f} s without a sign of life): it died or "
+            "hangs",
+            r, hosts[ru], std::chrono::duration<double>(now - heard[ru]).count()));
     }
   };
 
@@ -269,7 +287,8 @@ void Job::State::run(const Tasks& t) {
 #pragma omp parallel num_threads(threads + 1)
   {
     if (omp_get_thread_num() == 0) {
-      const bool alone = omp_get_num_threads() == 1;  // no evaluation thread: evaluate between polls
+      // no evaluation thread: evaluate between polls
+      const bool alone = omp_get_num_threads() == 1;
       try {
         for (int r = 1; r < size; ++r) refill(r);
         Backoff backoff;
@@ -285,24 +304,29 @@ void Job::State::run(const Tasks& t) {
               continue;
             }
             if (m.tag != kResult)
-              throw RankFailure(fmt::format("rank {} sent message tag {} during an evaluation", m.source, m.tag));
+              throw RankFailure(
+                  fmt::format("rank {} sent message tag {} during an evaluation", m.source, m.tag));
             wire::Reader rd(m.bytes);
             if (rd.get<std::uint8_t>() != static_cast<std::uint8_t>(t.kind))
               throw RankFailure(fmt::format("rank {} answered a different kind of task", m.source));
             const auto k = rd.get<std::uint32_t>();
             for (std::uint32_t j = 0; j < k; ++j) {
               const auto i = rd.get<std::uint32_t>();
-              if (i >= n) throw RankFailure(fmt::format("rank {} answered task {} of {}", m.source, i, n));
+              if (i >= n)
+                throw RankFailure(fmt::format("rank {} answered task {} of {}", m.source, i, n));
               if (rd.get<std::uint8_t>()) {
                 t.decode(rd, i);
               } else {
                 const std::string what = rd.string();
                 errors[i] = std::make_exception_ptr(
-                    Error(fmt::format("rank {} ({}): {}", m.source, hosts[static_cast<std::size_t>(m.source)], what)));
+                    Error(fmt::format("rank {} ({}): {}", m.source,
+                                      hosts[static_cast<std::size_t>(m.source)], what)));
               }
             }
             auto& out = outstanding[static_cast<std::size_t>(m.source)];
-            if (k > out) throw RankFailure(fmt::format("rank {} answered more tasks than it was given", m.source));
+            if (k > out)
+              throw RankFailure(
+                  fmt::format("rank {} answered more tasks than it was given", m.source));
             out -= k;
             completed.fetch_add(k);
             refill(m.source);
@@ -313,8 +337,10 @@ void Job::State::run(const Tasks& t) {
           }
           check_alive();
           if (alone && run_one_local()) active = true;
-          if (active) backoff.reset();
-          else backoff.wait();
+          if (active)
+            backoff.reset();
+          else
+            backoff.wait();
         }
       } catch (...) {
         comm_error = std::current_exception();
@@ -327,10 +353,11 @@ void Job::State::run(const Tasks& t) {
   }
   if (interrupted) {
     broken = true;
-    throw JobStopped(fmt::format("stopped by a signal during an evaluation on {} ranks ({} of {} tasks done); under "
-                                  "mpirun this means that a rank died (see mpirun's message above) or that the job "
-                                  "was cancelled",
-                                  size, completed.load(), n));
+    throw JobStopped(fmt::format(
+        "stopped by a signal during an evaluation on {} ranks ({} of {} tasks done); under "
+        "mpirun this means that a rank died (see mpirun's message above) or that the job "
+        "was cancelled",
+        size, completed.load(), n));
   }
   if (comm_error) {
     broken = true;
@@ -349,7 +376,8 @@ class MpiEvaluator final : public Evaluator {
   explicit MpiEvaluator(std::shared_ptr<Job::State> state) : state_(std::move(state)) {}
 
   // The job honours its own stop flag (Job::start), which the CLI sets from the same signal.
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest&) override {
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes,
+                                const StopRequest&) override {
     std::vector<Fitness> out(genomes.size());
     Job::State::Tasks t{Kind::evaluate, genomes.size(),
                         [&](wire::Writer& w, std::size_t i) { w.genome(*genomes[i]); },
@@ -365,9 +393,9 @@ class MpiEvaluator final : public Evaluator {
     std::vector<std::string> hosts = state_->hosts;
     std::sort(hosts.begin(), hosts.end());
     hosts.erase(std::unique(hosts.begin(), hosts.end()), hosts.end());
-    return fmt::format("MPI, {} rank{} on {} host{}, {} evaluation threads ({} on rank 0)", state_->size,
-                       state_->size == 1 ? "" : "s", hosts.size(), hosts.size() == 1 ? "" : "s", total,
-                       state_->threads);
+    return fmt::format("MPI, {} rank{} on {} host{}, {} evaluation threads ({} on rank 0)",
+                       state_->size, state_->size == 1 ? "" : "s", hosts.size(),
+                       hosts.size() == 1 ? "" : "s", total, state_->threads);
   }
 
  private:
@@ -430,7 +458,8 @@ void serve_tasks(const FitnessFunction& fitness, int threads) {
               send(0, kPong, {});
               continue;
             }
-            if (m.tag != kWork) throw RankFailure(fmt::format("unexpected message tag {} from rank 0", m.tag));
+            if (m.tag != kWork)
+              throw RankFailure(fmt::format("unexpected message tag {} from rank 0", m.tag));
             wire::Reader rd(m.bytes);
             const auto kind = rd.get<std::uint8_t>();
             if (kind != static_cast<std::uint8_t>(Kind::evaluate))
@@ -480,8 +509,10 @@ void serve_tasks(const FitnessFunction& fitness, int threads) {
               active = true;
             }
           }
-          if (active) backoff.reset();
-          else backoff.wait();
+          if (active)
+            backoff.reset();
+          else
+            backoff.wait();
         }
       } catch (...) {
         comm_error = std::current_exception();
@@ -513,11 +544,13 @@ Job::Job(int& argc, char**& argv) : state_(std::make_shared<State>()) {
   int provided = 0;
   if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
     throw Error("MPI_Init_thread failed: this process could not join the MPI job");
-  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);  // errors become RankFailure with a message
+  // errors become RankFailure with a message
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   MPI_Comm_rank(MPI_COMM_WORLD, &state_->rank);
   MPI_Comm_size(MPI_COMM_WORLD, &state_->size);
   MPI_Comm node;
-  if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+  if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) ==
+      MPI_SUCCESS) {
     MPI_Comm_size(node, &state_->local_ranks);
     MPI_Comm_free(&node);
   }
@@ -546,7 +579,8 @@ Job::~Job() {
     s.broken = true;
     std::fprintf(stderr, "animat_evolve (rank 0): %s\n", e.what());
   }
-  if (s.broken || s.stopping()) return;  // a rank may be gone: MPI_Finalize could wait for it forever
+  // a rank may be gone: MPI_Finalize could wait for it forever
+  if (s.broken || s.stopping()) return;
   MPI_Finalize();
 }
 
@@ -589,7 +623,9 @@ std::shared_ptr<Evaluator> Job::start(const Config& config, const std::atomic<bo
       backoff.wait();
       continue;
     }
-    if (m.tag != kHello) throw RankFailure(fmt::format("rank {} sent message tag {} instead of its hello", m.source, m.tag));
+    if (m.tag != kHello)
+      throw RankFailure(
+          fmt::format("rank {} sent message tag {} instead of its hello", m.source, m.tag));
     wire::Reader rd(m.bytes);
     const bool ok = rd.get<std::uint8_t>() != 0;
     const int threads = rd.get<std::int32_t>();
@@ -609,7 +645,8 @@ int Job::serve() {
   Message m;
   Backoff backoff;
   while (!poll(0, m)) backoff.wait();
-  if (m.tag != kConfig) throw RankFailure(fmt::format("rank 0 sent message tag {} instead of the config", m.tag));
+  if (m.tag != kConfig)
+    throw RankFailure(fmt::format("rank 0 sent message tag {} instead of the config", m.tag));
   wire::Reader rd(m.bytes);
   if (rd.get<std::uint8_t>() == 0) {  // rank 0 ended without a run
     s.broken = false;

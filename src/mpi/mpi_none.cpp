@@ -15,7 +15,9 @@ Job::~Job() = default;
 int Job::rank() const { return 0; }
 int Job::size() const { return 1; }
 int Job::serve() { throw Error(how_to_get_mpi()); }
-std::shared_ptr<Evaluator> Job::start(const Config&, const std::atomic<bool>*) { throw Error(how_to_get_mpi()); }
+std::shared_ptr<Evaluator> Job::start(const Config&, const std::atomic<bool>*) {
+  throw Error(how_to_get_mpi());
+}
 void Job::abandon(int status) { std::_Exit(status); }
 
 }  // namespace animat::mpi

@@ -8,6 +8,7 @@ prints one line per swim (distance, expected and found mode, the stroke's pair s
 matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
 then none, unstable).
 """
+
 import argparse
 import warnings
 
@@ -23,18 +24,28 @@ def main(names):
         res = K.classify_known(SETS[name](), drags=(0.5, 2.0), steps=2000, stroke_rule=True)
         for r in res:
             st = r.mode.stroke if r.mode is not None else None
-            sc = (f"pair score {st.score:+.2f}, area {st.area:.3f}, {len(st.protrusions)} protrusions, "
-                  f"{len(st.pairs)} pairs" if st is not None else "-")
-            print(f"{name} {r.swimmer.name:28s} dN={r.drag_normal:g} distance={r.distance:6.2f} "
-                  f"built={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}")
+            sc = (
+                f"pair score {st.score:+.2f}, area {st.area:.3f}, {len(st.protrusions)} protrusions, "
+                f"{len(st.pairs)} pairs"
+                if st is not None
+                else "-"
+            )
+            print(
+                f"{name} {r.swimmer.name:28s} dN={r.drag_normal:g} distance={r.distance:6.2f} "
+                f"built={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}"
+            )
         print(name)
         print(K.confusion_matrix(res, CLASSES, CLASSES + ["none", "unstable"]))
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("sets", nargs="?", default=",".join(SETS),
-                    help="comma-separated sets to swim: " + ", ".join(SETS) + " (default: both)")
+    ap.add_argument(
+        "sets",
+        nargs="?",
+        default=",".join(SETS),
+        help="comma-separated sets to swim: " + ", ".join(SETS) + " (default: both)",
+    )
     names = ap.parse_args().sets.split(",")
     unknown = [n for n in names if n not in SETS]
     if unknown:

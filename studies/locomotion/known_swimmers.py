@@ -33,11 +33,12 @@ out one uses other shapes, sizes, appendage lengths and frequencies; it was not 
 threshold), :func:`classify_known` swims and classifies them. :func:`paper_calibration_set` and
 :func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind.
 """
+
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from dataclasses import dataclass
+from typing import Any, Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -45,10 +46,27 @@ import animat
 from animat.locomotion import classify_locomotion, paddling, procrustes_frames
 from animat.trajectory import replay
 
-__all__ = ["KnownSwimmer", "hex_region", "undulator", "synchronous_contractor", "protrusion_swimmer",
-           "tail_swimmer", "calibration_set", "held_out_set", "KnownResult", "classify_known",
-           "confusion_matrix", "Stroke", "appendage_stroke", "AMPLITUDE", "APPENDAGE_KINDS", "appendage_swimmer",
-           "standing_swimmer", "paper_calibration_set", "paper_held_out_set"]
+__all__ = [
+    "KnownSwimmer",
+    "hex_region",
+    "undulator",
+    "synchronous_contractor",
+    "protrusion_swimmer",
+    "tail_swimmer",
+    "calibration_set",
+    "held_out_set",
+    "KnownResult",
+    "classify_known",
+    "confusion_matrix",
+    "Stroke",
+    "appendage_stroke",
+    "AMPLITUDE",
+    "APPENDAGE_KINDS",
+    "appendage_swimmer",
+    "standing_swimmer",
+    "paper_calibration_set",
+    "paper_held_out_set",
+]
 
 #: The paper's largest amplitude (development.amplitude_max): a cell changes its springs by ±20 %.
 AMPLITUDE = 0.2
@@ -84,8 +102,9 @@ class KnownSwimmer:
         return animat.build_body(self.positions, self.amplitude, self.frequency, self.phase, config=config)
 
 
-def hex_region(inside: Callable[[float, float], bool], spacing: float = 1.0, extent: int = 12,
-               jitter: float = 0.02, seed: int = 0) -> np.ndarray:
+def hex_region(
+    inside: Callable[[float, float], bool], spacing: float = 1.0, extent: int = 12, jitter: float = 0.02, seed: int = 0
+) -> np.ndarray:
     """Points of a triangular lattice (rows along x, ``spacing`` apart) with ``inside(x, y)`` true,
     jittered by up to ``jitter`` × spacing (no four points on a circle, so the Gabriel graph is unique)."""
     h = spacing * math.sqrt(3) / 2
@@ -100,16 +119,39 @@ def hex_region(inside: Callable[[float, float], bool], spacing: float = 1.0, ext
     return p
 
 
-def _swimmer(name: str, expected: str, positions: np.ndarray, amplitude: np.ndarray, frequency: float,
-             phase: np.ndarray, description: str, mixed: str = "") -> KnownSwimmer:
+def _swimmer(
+    name: str,
+    expected: str,
+    positions: np.ndarray,
+    amplitude: np.ndarray,
+    frequency: float,
+    phase: np.ndarray,
+    description: str,
+    mixed: str = "",
+) -> KnownSwimmer:
     n = len(positions)
-    return KnownSwimmer(name, expected, positions, np.asarray(amplitude, dtype=np.float64),
-                        np.full(n, float(frequency)), np.mod(np.asarray(phase, dtype=np.float64), 2 * math.pi),
-                        description, mixed)
+    return KnownSwimmer(
+        name,
+        expected,
+        positions,
+        np.asarray(amplitude, dtype=np.float64),
+        np.full(n, float(frequency)),
+        np.mod(np.asarray(phase, dtype=np.float64), 2 * math.pi),
+        description,
+        mixed,
+    )
 
 
-def undulator(kind: str = "contraction", length: float = 9.0, width: float = 2.6, frequency: float = 8.0,
-              wavelengths: float = 1.0, spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+def undulator(
+    kind: str = "contraction",
+    length: float = 9.0,
+    width: float = 2.6,
+    frequency: float = 8.0,
+    wavelengths: float = 1.0,
+    spacing: float = 1.0,
+    seed: int = 0,
+    name: Optional[str] = None,
+) -> KnownSwimmer:
     """An elongated (rectangular, rounded) body with a travelling wave of contraction.
 
     Args:
@@ -130,13 +172,26 @@ def undulator(kind: str = "contraction", length: float = 9.0, width: float = 2.6
         phase = -k * (y - y.min()) / np.ptp(y)
     else:
         raise ValueError(f"undulator: kind must be contraction, bending or across, got {kind!r}")
-    return _swimmer(name or f"undulator_{kind}", "undulation", pos, np.full(len(pos), AMPLITUDE), frequency, phase,
-                    f"{len(pos)} cells, {length:g} x {width:g}, wave of {wavelengths:g} period(s) "
-                    f"({kind}), f = {frequency:g}")
+    return _swimmer(
+        name or f"undulator_{kind}",
+        "undulation",
+        pos,
+        np.full(len(pos), AMPLITUDE),
+        frequency,
+        phase,
+        f"{len(pos)} cells, {length:g} x {width:g}, wave of {wavelengths:g} period(s) ({kind}), f = {frequency:g}",
+    )
 
 
-def synchronous_contractor(length: float = 8.0, width: float = 5.0, frequency: float = 8.0, lag: float = 0.0,
-                           spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+def synchronous_contractor(
+    length: float = 8.0,
+    width: float = 5.0,
+    frequency: float = 8.0,
+    lag: float = 0.0,
+    spacing: float = 1.0,
+    seed: int = 0,
+    name: Optional[str] = None,
+) -> KnownSwimmer:
     """A tear-drop body (wide and round at the back, -x; pointed at the front, +x), every cell in phase.
 
     ``lag`` > 0 adds a phase ramp of ``lag`` rad along the body (a mixture: mostly synchronous with a
@@ -147,7 +202,7 @@ def synchronous_contractor(length: float = 8.0, width: float = 5.0, frequency: f
     def inside(x: float, y: float) -> bool:
         back = x <= -length / 2 + r
         if back:
-            return (x - (-length / 2 + r)) ** 2 + y ** 2 <= r * r
+            return (x - (-length / 2 + r)) ** 2 + y**2 <= r * r
         half = r * (length / 2 - x) / (length - r)  # straight flanks narrowing to the tip at x = length/2
         return x <= length / 2 and abs(y) <= half + 0.05
 
@@ -155,14 +210,23 @@ def synchronous_contractor(length: float = 8.0, width: float = 5.0, frequency: f
     x = pos[:, 0]
     phase = -lag * (x - x.min()) / np.ptp(x)
     mixed = "undulation" if lag >= math.pi / 2 else ""
-    return _swimmer(name or ("synchronous_teardrop" if lag == 0 else f"synchronous_lag{lag:.1f}"),
-                    "synchronous contraction", pos, np.full(len(pos), AMPLITUDE), frequency, phase,
-                    f"{len(pos)} cells, tear-drop {length:g} x {width:g}, all in phase" +
-                    (f" but a lag of {lag:.2f} rad along the body" if lag else "") + f", f = {frequency:g}", mixed)
+    return _swimmer(
+        name or ("synchronous_teardrop" if lag == 0 else f"synchronous_lag{lag:.1f}"),
+        "synchronous contraction",
+        pos,
+        np.full(len(pos), AMPLITUDE),
+        frequency,
+        phase,
+        f"{len(pos)} cells, tear-drop {length:g} x {width:g}, all in phase"
+        + (f" but a lag of {lag:.2f} rad along the body" if lag else "")
+        + f", f = {frequency:g}",
+        mixed,
+    )
 
 
-def _appendage(base: np.ndarray, direction: np.ndarray, along: np.ndarray, length: int, wide: bool,
-               spacing: float) -> List[np.ndarray]:
+def _appendage(
+    base: np.ndarray, direction: np.ndarray, along: np.ndarray, length: int, wide: bool, spacing: float
+) -> List[np.ndarray]:
     """Cells of an appendage growing from ``base`` along ``direction``: one per row, or two (offset
     along ``along`` by ±spacing/2) per row when ``wide``. Rows are spacing·√3/2 apart."""
     h = spacing * math.sqrt(3) / 2
@@ -176,9 +240,18 @@ def _appendage(base: np.ndarray, direction: np.ndarray, along: np.ndarray, lengt
     return out
 
 
-def protrusion_swimmer(length: int = 1, wide: bool = False, core_radius: float = 2.3, frequency: float = 8.0,
-                       core_amplitude: float = 0.0, anchor_amplitude: float = 0.1, core_wave: float = 0.0,
-                       spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+def protrusion_swimmer(
+    length: int = 1,
+    wide: bool = False,
+    core_radius: float = 2.3,
+    frequency: float = 8.0,
+    core_amplitude: float = 0.0,
+    anchor_amplitude: float = 0.1,
+    core_wave: float = 0.0,
+    spacing: float = 1.0,
+    seed: int = 0,
+    name: Optional[str] = None,
+) -> KnownSwimmer:
     """A round core with two symmetric appendages (at ±y) actuated to row: extended while they sweep
     backwards (-x), contracted on the way forward (paper §6, Fig. 6). The swims follow this only loosely
     (:func:`appendage_stroke`: the extension correlates weakly with the backward velocity).
@@ -194,7 +267,7 @@ def protrusion_swimmer(length: int = 1, wide: bool = False, core_radius: float =
         core_wave: a phase ramp of this many rad along x on the core cells (with ``core_amplitude`` > 0
             this is a mixture: protrusions plus undulation when it is at least π/2).
     """
-    core = hex_region(lambda x, y: x * x + y * y <= core_radius ** 2, spacing, seed=seed)
+    core = hex_region(lambda x, y: x * x + y * y <= core_radius**2, spacing, seed=seed)
     extra: List[np.ndarray] = []
     for s in (+1.0, -1.0):
         top = core[np.argmax(s * core[:, 1] - 0.3 * np.abs(core[:, 0]))]
@@ -218,19 +291,32 @@ def protrusion_swimmer(length: int = 1, wide: bool = False, core_radius: float =
     phase[n_core:] = math.pi / 2
     mixed = "undulation" if core_wave >= math.pi / 2 and core_amplitude > 0 else ""
     shape = f"{'two-cell-wide ' if wide else ''}{length}-cell"
-    return _swimmer(name or f"protrusions_{'wide' if wide else 'single'}{length}" + ("_wave" if core_wave else ""),
-                    "protrusions", pos, amp, frequency, phase,
-                    f"{len(pos)} cells: core radius {core_radius:g} ({n_core} cells, amplitude {core_amplitude:g}"
-                    + (f", wave {core_wave:.2f} rad" if core_wave else "")
-                    + f"), two {shape} appendages at full amplitude, anchors {anchor_amplitude:g}, f = {frequency:g}",
-                    mixed)
+    return _swimmer(
+        name or f"protrusions_{'wide' if wide else 'single'}{length}" + ("_wave" if core_wave else ""),
+        "protrusions",
+        pos,
+        amp,
+        frequency,
+        phase,
+        f"{len(pos)} cells: core radius {core_radius:g} ({n_core} cells, amplitude {core_amplitude:g}"
+        + (f", wave {core_wave:.2f} rad" if core_wave else "")
+        + f"), two {shape} appendages at full amplitude, anchors {anchor_amplitude:g}, f = {frequency:g}",
+        mixed,
+    )
 
 
-def tail_swimmer(length: int = 4, core_radius: float = 2.3, frequency: float = 8.0, wavelengths: float = 0.5,
-                 spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+def tail_swimmer(
+    length: int = 4,
+    core_radius: float = 2.3,
+    frequency: float = 8.0,
+    wavelengths: float = 0.5,
+    spacing: float = 1.0,
+    seed: int = 0,
+    name: Optional[str] = None,
+) -> KnownSwimmer:
     """A passive round core with one two-cell-wide tail at the back (-x) beating with a bending wave
     (the two rows of the tail in antiphase, a phase ramp of ``wavelengths`` periods from base to tip)."""
-    core = hex_region(lambda x, y: x * x + y * y <= core_radius ** 2, spacing, seed=seed)
+    core = hex_region(lambda x, y: x * x + y * y <= core_radius**2, spacing, seed=seed)
     back = core[np.argmin(core[:, 0] - 0.3 * np.abs(core[:, 1]))]
     # the tail grows along -x: its two rows lie at ±spacing/2 in y
     h = spacing * math.sqrt(3) / 2
@@ -244,13 +330,20 @@ def tail_swimmer(length: int = 4, core_radius: float = 2.3, frequency: float = 8
     tail = np.array(cells) + np.random.default_rng(seed + 1).uniform(-0.02, 0.02, (len(cells), 2)) * spacing
     pos = np.vstack([core, tail])
     amp = np.zeros(len(pos))
-    amp[len(core):] = AMPLITUDE
+    amp[len(core) :] = AMPLITUDE
     phase = np.zeros(len(pos))
     k = 2 * math.pi * wavelengths
-    phase[len(core):] = -k * (np.array(rows) - 1) / max(1, length - 1) + np.where(np.array(sides) > 0, math.pi, 0.0)
-    return _swimmer(name or f"tail{length}", "tail", pos, amp, frequency, phase,
-                    f"{len(pos)} cells: passive core radius {core_radius:g}, a {length}-row two-cell-wide tail "
-                    f"with a bending wave of {wavelengths:g} period, f = {frequency:g}")
+    phase[len(core) :] = -k * (np.array(rows) - 1) / max(1, length - 1) + np.where(np.array(sides) > 0, math.pi, 0.0)
+    return _swimmer(
+        name or f"tail{length}",
+        "tail",
+        pos,
+        amp,
+        frequency,
+        phase,
+        f"{len(pos)} cells: passive core radius {core_radius:g}, a {length}-row two-cell-wide tail "
+        f"with a bending wave of {wavelengths:g} period, f = {frequency:g}",
+    )
 
 
 def calibration_set() -> List[KnownSwimmer]:
@@ -272,9 +365,15 @@ def calibration_set() -> List[KnownSwimmer]:
 def _held_out_whole_body() -> List[KnownSwimmer]:
     """The held-out undulators and synchronous contractors (both held-out sets use them)."""
     return [
-        undulator("contraction", length=12.0, width=1.8, frequency=5.0, wavelengths=1.5, seed=3, name="ho_undulator_long"),
-        undulator("bending", length=7.0, width=2.6, frequency=11.0, wavelengths=0.75, seed=4, name="ho_undulator_bend_fast"),
-        undulator("contraction", length=8.0, width=3.5, frequency=3.0, wavelengths=0.5, seed=5, name="ho_undulator_slow"),
+        undulator(
+            "contraction", length=12.0, width=1.8, frequency=5.0, wavelengths=1.5, seed=3, name="ho_undulator_long"
+        ),
+        undulator(
+            "bending", length=7.0, width=2.6, frequency=11.0, wavelengths=0.75, seed=4, name="ho_undulator_bend_fast"
+        ),
+        undulator(
+            "contraction", length=8.0, width=3.5, frequency=3.0, wavelengths=0.5, seed=5, name="ho_undulator_slow"
+        ),
         synchronous_contractor(length=10.0, width=4.0, frequency=5.0, seed=6, name="ho_sync_slender"),
         synchronous_contractor(length=6.0, width=5.5, frequency=11.0, seed=7, name="ho_sync_stubby_fast"),
         synchronous_contractor(length=7.0, width=4.5, frequency=3.0, lag=0.6, seed=8, name="ho_sync_lag_slow"),
@@ -286,10 +385,24 @@ def held_out_set() -> List[KnownSwimmer]:
     return _held_out_whole_body() + [
         protrusion_swimmer(length=2, core_radius=2.0, frequency=5.0, seed=9, name="ho_protrusions_single2"),
         protrusion_swimmer(length=4, wide=True, core_radius=3.2, frequency=6.0, seed=10, name="ho_protrusions_wide4"),
-        protrusion_swimmer(length=2, wide=True, core_radius=2.6, frequency=11.0, anchor_amplitude=0.15, seed=11,
-                           name="ho_protrusions_wide2_fast"),
-        protrusion_swimmer(length=1, core_radius=2.8, frequency=4.0, core_amplitude=0.03, core_wave=math.pi,
-                           seed=12, name="ho_protrusions_wave"),
+        protrusion_swimmer(
+            length=2,
+            wide=True,
+            core_radius=2.6,
+            frequency=11.0,
+            anchor_amplitude=0.15,
+            seed=11,
+            name="ho_protrusions_wide2_fast",
+        ),
+        protrusion_swimmer(
+            length=1,
+            core_radius=2.8,
+            frequency=4.0,
+            core_amplitude=0.03,
+            core_wave=math.pi,
+            seed=12,
+            name="ho_protrusions_wave",
+        ),
         tail_swimmer(length=6, core_radius=2.0, frequency=6.0, wavelengths=0.75, seed=13, name="ho_tail6"),
         tail_swimmer(length=3, core_radius=2.8, frequency=10.0, wavelengths=0.25, seed=14, name="ho_tail3_fast"),
     ]
@@ -320,14 +433,20 @@ def appendage_stroke(swimmer: KnownSwimmer, trajectory: Any, mode: Any) -> Optio
     if swimmer.expected not in ("protrusions", "tail") or len(app) == 0 or not mode.omega > 0:
         return None
     # the classifier's own window (a suffix of mode.frames frames), as paddling() takes it
-    Q, _, _ = procrustes_frames(np.asarray(trajectory.positions)[-max(int(mode.frames), 2):])
+    Q, _, _ = procrustes_frames(np.asarray(trajectory.positions)[-max(int(mode.frames), 2) :])
     along = Q[:, app] @ np.asarray(mode.direction)
     radius = np.linalg.norm(Q[:, app], axis=2)
     backward = -np.gradient(along, axis=0)
-    corr = [float(np.corrcoef(radius[:, k], backward[:, k])[0, 1]) for k in range(len(app))
-            if np.ptp(radius[:, k]) > 0 and np.ptp(backward[:, k]) > 0]
-    return Stroke(float(np.ptp(along, axis=0).mean()), float(np.ptp(radius, axis=0).mean()),
-                  float(np.mean(corr)) if corr else float("nan"))
+    corr = [
+        float(np.corrcoef(radius[:, k], backward[:, k])[0, 1])
+        for k in range(len(app))
+        if np.ptp(radius[:, k]) > 0 and np.ptp(backward[:, k]) > 0
+    ]
+    return Stroke(
+        float(np.ptp(along, axis=0).mean()),
+        float(np.ptp(radius, axis=0).mean()),
+        float(np.mean(corr)) if corr else float("nan"),
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -352,14 +471,19 @@ class KnownResult:
         return self.found == self.swimmer.expected
 
 
-def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0.5, 2.0), steps: int = 2000,
-                   config: Optional[Any] = None, stroke_rule: bool = False) -> List[KnownResult]:
+def classify_known(
+    swimmers: Sequence[KnownSwimmer],
+    drags: Sequence[float] = (0.5, 2.0),
+    steps: int = 2000,
+    config: Optional[Any] = None,
+    stroke_rule: bool = False,
+) -> List[KnownResult]:
     """Swim every swimmer ``steps`` steps at every normal drag (d_T = d_N / 200, the paper's ratio, via the
     config default) and classify the recorded swim with :func:`animat.classify_locomotion`
     (``stroke_rule``: with the paper's stroke rule, its ``stroke`` argument)."""
     out = []
     for dn in drags:
-        cfg = (config.copy() if config is not None else animat.Config())
+        cfg = config.copy() if config is not None else animat.Config()
         cfg["scene.drag_normal"] = float(dn)
         cfg["evaluation.steps"] = int(steps)
         for s in swimmers:
@@ -367,13 +491,11 @@ def classify_known(swimmers: Sequence[KnownSwimmer], drags: Sequence[float] = (0
             mode = classify_locomotion(tr, stroke=stroke_rule) if tr.stable else None
             stroke = appendage_stroke(s, tr, mode) if mode is not None else None
             paddle = paddling(tr, mode) if mode is not None else None
-            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke,
-                                   paddle))
+            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke, paddle))
     return out
 
 
-def confusion_matrix(results: Sequence[KnownResult], expected: Sequence[str], found: Sequence[str]
-                     ) -> np.ndarray:
+def confusion_matrix(results: Sequence[KnownResult], expected: Sequence[str], found: Sequence[str]) -> np.ndarray:
     """counts[i, j]: swims built as ``expected[i]`` classified as ``found[j]``."""
     m = np.zeros((len(expected), len(found)), dtype=np.int64)
     for r in results:
@@ -391,10 +513,21 @@ def _lattice(i: int, j: int, spacing: float) -> Tuple[float, float]:
     return ((i + 0.5 * (j % 2)) * spacing, j * spacing * math.sqrt(3) / 2)
 
 
-def appendage_swimmer(kind: str = "single", core_length: float = 9.0, core_width: float = 4.6,
-                      at: Sequence[float] = (1.5,), frequency: float = 8.0, appendage_phase: float = math.pi,
-                      core_jitter: float = 0.3, back_shift: float = 0.0, anchor_shift: float = 0.0,
-                      appendage_bend: float = 0.0, spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+def appendage_swimmer(
+    kind: str = "single",
+    core_length: float = 9.0,
+    core_width: float = 4.6,
+    at: Sequence[float] = (1.5,),
+    frequency: float = 8.0,
+    appendage_phase: float = math.pi,
+    core_jitter: float = 0.3,
+    back_shift: float = 0.0,
+    anchor_shift: float = 0.0,
+    appendage_bend: float = 0.0,
+    spacing: float = 1.0,
+    seed: int = 0,
+    name: Optional[str] = None,
+) -> KnownSwimmer:
     """An elliptic body (long axis x) with symmetric pairs of appendages on its flanks (±y), every cell
     actuated as the paper describes its protrusion swimmers (§6, Fig. 6, 7b).
 
@@ -415,8 +548,12 @@ def appendage_swimmer(kind: str = "single", core_length: float = 9.0, core_width
     rows, width = APPENDAGE_KINDS[kind]
     a, b = core_length / 2, core_width / 2
     ext = int(core_length / spacing) + 4
-    core_sites = {(i, j) for j in range(-ext, ext + 1) for i in range(-ext, ext + 1)
-                  if (_lattice(i, j, spacing)[0] / a) ** 2 + (_lattice(i, j, spacing)[1] / b) ** 2 <= 1.0}
+    core_sites = {
+        (i, j)
+        for j in range(-ext, ext + 1)
+        for i in range(-ext, ext + 1)
+        if (_lattice(i, j, spacing)[0] / a) ** 2 + (_lattice(i, j, spacing)[1] / b) ** 2 <= 1.0
+    }
     app_sites: List[Tuple[int, int]] = []
     for xa in at:
         for s in (+1, -1):
@@ -444,7 +581,7 @@ def appendage_swimmer(kind: str = "single", core_length: float = 9.0, core_width
     phase[n_core:] += appendage_phase
     if appendage_bend:  # the hind cells of each appendage row (-x of the row's middle): they bend it back
         rows_of = {}
-        for k, (i, j) in enumerate(sites[n_core:]):
+        for k, (_i, j) in enumerate(sites[n_core:]):
             rows_of.setdefault(j, []).append(n_core + k)
         for members in rows_of.values():
             mid = np.mean(pos[members, 0])
@@ -459,15 +596,30 @@ def appendage_swimmer(kind: str = "single", core_length: float = 9.0, core_width
             if d[near] <= 1.2 * spacing and pos[k, 0] < app[near, 0] - 0.2 * spacing:
                 phase[k] += anchor_shift
     label = name or f"appendages_{kind}_x{len(at)}"
-    return _swimmer(label, "protrusions", pos, amp, frequency, phase,
-                    f"{len(pos)} cells: elliptic core {core_length:g} x {core_width:g} ({n_core} cells, phase 0 "
-                    f"± {core_jitter / 2:g}" + (f", back line +{back_shift:.2f}" if back_shift else "")
-                    + f"), {len(at)} pair(s) of {kind} appendages at x = {', '.join(f'{v:g}' for v in at)} "
-                    f"(phase {appendage_phase:.2f}), every cell at amplitude 0.18-0.2, f = {frequency:g}")
+    return _swimmer(
+        label,
+        "protrusions",
+        pos,
+        amp,
+        frequency,
+        phase,
+        f"{len(pos)} cells: elliptic core {core_length:g} x {core_width:g} ({n_core} cells, phase 0 "
+        f"± {core_jitter / 2:g}"
+        + (f", back line +{back_shift:.2f}" if back_shift else "")
+        + f"), {len(at)} pair(s) of {kind} appendages at x = {', '.join(f'{v:g}' for v in at)} "
+        f"(phase {appendage_phase:.2f}), every cell at amplitude 0.18-0.2, f = {frequency:g}",
+    )
 
 
-def standing_swimmer(kind: str = "halves", length: float = 8.0, width: float = 4.0, frequency: float = 8.0,
-                     spacing: float = 1.0, seed: int = 0, name: Optional[str] = None) -> KnownSwimmer:
+def standing_swimmer(
+    kind: str = "halves",
+    length: float = 8.0,
+    width: float = 4.0,
+    frequency: float = 8.0,
+    spacing: float = 1.0,
+    seed: int = 0,
+    name: Optional[str] = None,
+) -> KnownSwimmer:
     """An elliptic body, every cell at full amplitude, with a phase pattern that is neither a travelling
     wave nor synchronous: ``kind="halves"`` (front and back halves in antiphase, a standing pattern) or
     ``kind="random"`` (independent uniform phases). Expected "other"."""
@@ -478,8 +630,15 @@ def standing_swimmer(kind: str = "halves", length: float = 8.0, width: float = 4
         phase = np.random.default_rng(seed + 100).uniform(0, 2 * math.pi, len(pos))
     else:
         raise ValueError(f"standing_swimmer: kind must be halves or random, got {kind!r}")
-    return _swimmer(name or f"standing_{kind}", "other", pos, np.full(len(pos), AMPLITUDE), frequency, phase,
-                    f"{len(pos)} cells, ellipse {length:g} x {width:g}, phases: {kind}, f = {frequency:g}")
+    return _swimmer(
+        name or f"standing_{kind}",
+        "other",
+        pos,
+        np.full(len(pos), AMPLITUDE),
+        frequency,
+        phase,
+        f"{len(pos)} cells, ellipse {length:g} x {width:g}, phases: {kind}, f = {frequency:g}",
+    )
 
 
 def paper_calibration_set() -> List[KnownSwimmer]:
@@ -506,16 +665,58 @@ def paper_held_out_set() -> List[KnownSwimmer]:
     """Other core sizes, appendage lengths, positions, phases and frequencies; not used to set anything."""
     pi = math.pi
     return [
-        appendage_swimmer("single", core_length=8.0, core_width=4.0, at=(-1.0,), frequency=6.0,
-                          appendage_phase=pi / 2, anchor_shift=pi, seed=21, name="ho_paper_single_small"),
-        appendage_swimmer("single", core_length=10.0, core_width=5.0, at=(-2.0,), frequency=10.0,
-                          appendage_phase=pi / 4, anchor_shift=pi, seed=22, name="ho_paper_single_fast"),
-        appendage_swimmer("chain2", core_length=10.0, core_width=5.0, at=(-1.5,), frequency=6.0,
-                          appendage_phase=3 * pi / 8, anchor_shift=pi, seed=23, name="ho_paper_chain2_big"),
-        appendage_swimmer("chain3", at=(-1.5,), frequency=8.0, appendage_phase=pi / 4, anchor_shift=pi, seed=24,
-                          name="ho_paper_chain3"),
-        appendage_swimmer("single", at=(-1.5,), frequency=8.0, appendage_phase=pi / 4, anchor_shift=pi,
-                          back_shift=pi / 2, seed=25, name="ho_paper_single_backline"),
+        appendage_swimmer(
+            "single",
+            core_length=8.0,
+            core_width=4.0,
+            at=(-1.0,),
+            frequency=6.0,
+            appendage_phase=pi / 2,
+            anchor_shift=pi,
+            seed=21,
+            name="ho_paper_single_small",
+        ),
+        appendage_swimmer(
+            "single",
+            core_length=10.0,
+            core_width=5.0,
+            at=(-2.0,),
+            frequency=10.0,
+            appendage_phase=pi / 4,
+            anchor_shift=pi,
+            seed=22,
+            name="ho_paper_single_fast",
+        ),
+        appendage_swimmer(
+            "chain2",
+            core_length=10.0,
+            core_width=5.0,
+            at=(-1.5,),
+            frequency=6.0,
+            appendage_phase=3 * pi / 8,
+            anchor_shift=pi,
+            seed=23,
+            name="ho_paper_chain2_big",
+        ),
+        appendage_swimmer(
+            "chain3",
+            at=(-1.5,),
+            frequency=8.0,
+            appendage_phase=pi / 4,
+            anchor_shift=pi,
+            seed=24,
+            name="ho_paper_chain3",
+        ),
+        appendage_swimmer(
+            "single",
+            at=(-1.5,),
+            frequency=8.0,
+            appendage_phase=pi / 4,
+            anchor_shift=pi,
+            back_shift=pi / 2,
+            seed=25,
+            name="ho_paper_single_backline",
+        ),
         *_held_out_whole_body(),
         tail_swimmer(length=6, core_radius=2.0, frequency=6.0, wavelengths=0.75, seed=13, name="ho_tail6"),
         tail_swimmer(length=3, core_radius=2.8, frequency=10.0, wavelengths=0.25, seed=14, name="ho_tail3_fast"),

@@ -9,6 +9,7 @@ oscillators sit to their bounds. The criteria are defined in docs/regime.md.
 writes one row per best and prints the per-environment medians that docs/regime.md quotes.
 ``--set scene.spring_damping=1`` re-swims the same bodies with a constant changed.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -25,10 +26,27 @@ import animat
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "replication"))
 from replication_store import packed_runs, unpack_run  # noqa: E402
 
-COLUMNS = ["environment", "run", "fitness", "cells", "actuation", "fluid_share", "drag_normal_share",
-           "drag_tangential_share", "damping_share", "collision_share", "residual_share", "frequency_median",
-           "frequency_max", "at_frequency_bound", "amplitude_median_of_max", "mode_lowest", "mode_median",
-           "modes_in_range", "damping_ratio_at_frequency"]
+COLUMNS = [
+    "environment",
+    "run",
+    "fitness",
+    "cells",
+    "actuation",
+    "fluid_share",
+    "drag_normal_share",
+    "drag_tangential_share",
+    "damping_share",
+    "collision_share",
+    "residual_share",
+    "frequency_median",
+    "frequency_max",
+    "at_frequency_bound",
+    "amplitude_median_of_max",
+    "mode_lowest",
+    "mode_median",
+    "modes_in_range",
+    "damping_ratio_at_frequency",
+]
 
 
 def elastic_modes(body, config):
@@ -44,13 +62,13 @@ def elastic_modes(body, config):
     m = config["scene.cell_mass"]
     K = np.zeros((2 * n, 2 * n))
     C = np.zeros((2 * n, 2 * n))
-    for (i, j) in np.asarray(body.springs):
+    for i, j in np.asarray(body.springs):
         e = p[j] - p[i]
         e = e / np.linalg.norm(e)
         block = np.outer(e, e)
         for a, b, s in ((i, i, 1), (j, j, 1), (i, j, -1), (j, i, -1)):
-            K[2 * a:2 * a + 2, 2 * b:2 * b + 2] += s * k * block
-            C[2 * a:2 * a + 2, 2 * b:2 * b + 2] += s * c * block
+            K[2 * a : 2 * a + 2, 2 * b : 2 * b + 2] += s * k * block
+            C[2 * a : 2 * a + 2, 2 * b : 2 * b + 2] += s * c * block
     for loop, s0 in zip(body.regions, np.asarray(body.rest_areas)):
         loop = list(loop)
         L = len(loop)
@@ -85,12 +103,20 @@ def measure(genome, config):
     zeta_at_f = float(np.interp(fmed, w, zeta)) if len(w) else float("nan")
     total = e.actuation + e.external
     return {
-        "fitness": r.fitness, "cells": r.cell_count, "actuation": e.actuation,
-        "fluid_share": e.fluid / e.dissipated, "drag_normal_share": e.drag_normal / e.dissipated,
-        "drag_tangential_share": e.drag_tangential / e.dissipated, "damping_share": e.spring_damping / e.dissipated,
-        "collision_share": e.collisions / e.dissipated, "residual_share": e.residual / total,
-        "frequency_median": fmed, "frequency_max": fmax, "at_frequency_bound": float(np.mean(f >= 0.95 * fmax)),
-        "amplitude_median_of_max": float(np.median(a) / amax), "mode_lowest": float(w[0]) if len(w) else float("nan"),
+        "fitness": r.fitness,
+        "cells": r.cell_count,
+        "actuation": e.actuation,
+        "fluid_share": e.fluid / e.dissipated,
+        "drag_normal_share": e.drag_normal / e.dissipated,
+        "drag_tangential_share": e.drag_tangential / e.dissipated,
+        "damping_share": e.spring_damping / e.dissipated,
+        "collision_share": e.collisions / e.dissipated,
+        "residual_share": e.residual / total,
+        "frequency_median": fmed,
+        "frequency_max": fmax,
+        "at_frequency_bound": float(np.mean(f >= 0.95 * fmax)),
+        "amplitude_median_of_max": float(np.median(a) / amax),
+        "mode_lowest": float(w[0]) if len(w) else float("nan"),
         "mode_median": float(np.median(w)) if len(w) else float("nan"),
         "modes_in_range": int(np.sum((w >= config["development.frequency_min"]) & (w <= fmax))),
         "damping_ratio_at_frequency": zeta_at_f,
@@ -101,9 +127,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data", type=Path, default=Path("data/replication"))
     ap.add_argument("--out", type=Path, required=True)
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                    help="re-swim every best with this config value changed (e.g. scene.spring_damping=1): how "
-                         "the constants move the split for the same bodies")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="re-swim every best with this config value changed (e.g. scene.spring_damping=1): how "
+        "the constants move the split for the same bodies",
+    )
     args = ap.parse_args(argv)
     overrides = []
     for item in args.set:
@@ -124,23 +155,30 @@ def main(argv=None) -> int:
                 row = {"environment": env, "run": packed.name}
                 row.update(measure(run.best().genome, config))
                 rows.append(row)
-                print(f"{env} {packed.name}: fluid {row['fluid_share']:.3f} damping {row['damping_share']:.3f} "
-                      f"f {row['frequency_median']:.2f} lowest mode {row['mode_lowest']:.2f}", file=sys.stderr)
+                print(
+                    f"{env} {packed.name}: fluid {row['fluid_share']:.3f} damping {row['damping_share']:.3f} "
+                    f"f {row['frequency_median']:.2f} lowest mode {row['mode_lowest']:.2f}",
+                    file=sys.stderr,
+                )
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COLUMNS, lineterminator="\n")
         w.writeheader()
         for row in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
-    print("environment | bests | fluid share | damping share | frequency (median) | at bound (>= 0.95 f_max) | "
-          "lowest elastic mode | modes within [f_min, f_max] | damping ratio at the frequency | max |residual|")
+    print(
+        "environment | bests | fluid share | damping share | frequency (median) | at bound (>= 0.95 f_max) | "
+        "lowest elastic mode | modes within [f_min, f_max] | damping ratio at the frequency | max |residual|"
+    )
     for env in sorted({r["environment"] for r in rows}):
         sel = [r for r in rows if r["environment"] == env]
-        med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731
-        print(f"{env} | {len(sel)} | {med('fluid_share'):.2f} | {med('damping_share'):.2f} | "
-              f"{med('frequency_median'):.2f} | {sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | "
-              f"{med('mode_lowest'):.2f} | {med('modes_in_range'):.0f} | {med('damping_ratio_at_frequency'):.2f} | "
-              f"{max(abs(r['residual_share']) for r in sel):.4f}")
+        med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731, B023 (used in this iteration)
+        print(
+            f"{env} | {len(sel)} | {med('fluid_share'):.2f} | {med('damping_share'):.2f} | "
+            f"{med('frequency_median'):.2f} | {sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | "
+            f"{med('mode_lowest'):.2f} | {med('modes_in_range'):.0f} | {med('damping_ratio_at_frequency'):.2f} | "
+            f"{max(abs(r['residual_share']) for r in sel):.4f}"
+        )
     return 0
 
 

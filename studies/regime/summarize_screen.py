@@ -6,6 +6,7 @@ medians per grid point. Writes studies/regime/results/screen.csv and studies/reg
 
     PYTHONPATH=build/python .venv/bin/python studies/regime/summarize_screen.py
 """
+
 from __future__ import annotations
 
 import csv
@@ -13,8 +14,6 @@ import json
 import statistics
 import sys
 from pathlib import Path
-
-import numpy as np
 
 import animat
 from animat import shape
@@ -40,13 +39,25 @@ def summarise_run(folder: Path) -> dict:
     with open(folder / "history.csv") as fh:
         last = list(csv.DictReader(fh))[-1]
     env, c, k, seed = point_of(folder.name)
-    row = {"environment": env, "spring_damping": c, "spring_stiffness": k, "seed": seed,
-           "generations": int(last["generation"]), "best_reference": float(last["best_reference"])}
+    row = {
+        "environment": env,
+        "spring_damping": c,
+        "spring_stiffness": k,
+        "seed": seed,
+        "generations": int(last["generation"]),
+        "best_reference": float(last["best_reference"]),
+    }
     row.update(measure(genome, config))
     row["reference_error"] = (row["fitness"] - row["best_reference"]) / row["best_reference"]
     s = shape.genome_shape(genome, config)
-    row.update({"elongation": s.elongation, "concavity": s.concavity, "protrusions": s.protrusion_count,
-                "symmetric_pair": int(s.symmetric_pair)})
+    row.update(
+        {
+            "elongation": s.elongation,
+            "concavity": s.concavity,
+            "protrusions": s.protrusion_count,
+            "symmetric_pair": int(s.symmetric_pair),
+        }
+    )
     row["mode"] = animat.classify_locomotion(genome, config).label
     return row
 
@@ -63,26 +74,33 @@ def main() -> int:
         w.writeheader()
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
-    lines = ["# Calibration screen: results", "",
-             "Rebuilt by `PYTHONPATH=build/python .venv/bin/python studies/regime/summarize_screen.py` from the",
-             "runs kept in `studies/regime/screen/` (grown by `studies/regime/screen.sh`); per run:",
-             "`studies/regime/results/screen.csv`. Medians over the seeds of each point; the criteria are those",
-             "of `docs/regime.md`.", "",
-             "| environment | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
-             "at frequency bound | median frequency | elongation | protrusions | symmetric pair | modes |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-    points = sorted({(r["environment"], r["spring_damping"], r["spring_stiffness"]) for r in rows},
-                    key=lambda p: (p[0], -p[1], -p[2]))
+    lines = [
+        "# Calibration screen: results",
+        "",
+        "Rebuilt by `PYTHONPATH=build/python .venv/bin/python studies/regime/summarize_screen.py` from the",
+        "runs kept in `studies/regime/screen/` (grown by `studies/regime/screen.sh`); per run:",
+        "`studies/regime/results/screen.csv`. Medians over the seeds of each point; the criteria are those",
+        "of `docs/regime.md`.",
+        "",
+        "| environment | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
+        "at frequency bound | median frequency | elongation | protrusions | symmetric pair | modes |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    points = sorted(
+        {(r["environment"], r["spring_damping"], r["spring_stiffness"]) for r in rows},
+        key=lambda p: (p[0], -p[1], -p[2]),
+    )
     for env, c, k in points:
         sel = [r for r in rows if (r["environment"], r["spring_damping"], r["spring_stiffness"]) == (env, c, k)]
-        med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731
+        med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731, B023 (used in this iteration)
         modes = ", ".join(f"{m} {sum(r['mode'] == m for r in sel)}" for m in sorted({r["mode"] for r in sel}))
         lines.append(
             f"| {env} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
             f"{max(abs(r['reference_error']) for r in sel):.2%} | {med('fluid_share'):.2f} | "
             f"{sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | {med('frequency_median'):.2f} | "
             f"{med('elongation'):.2f} | {med('protrusions'):.0f} | {sum(r['symmetric_pair'] for r in sel)} of {len(sel)} | "
-            f"{modes} |")
+            f"{modes} |"
+        )
     OUT_MD.write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0

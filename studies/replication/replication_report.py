@@ -241,7 +241,7 @@ def read_env(path: Path) -> Optional[EnvReport]:
     for p in run_dirs:
         run = animat.Run(p)
         i = int(p.name[4:])
-        h = _retry(lambda: run.history, f"{p}/history.csv")
+        h = _retry(lambda: run.history, f"{p}/history.csv")  # noqa: B023 (called at once)
         cfg = run.config
         rec = summary.get(i)
         status = json.loads((p / "status.json").read_text()) if (p / "status.json").is_file() else {}

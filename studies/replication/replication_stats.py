@@ -11,6 +11,7 @@
 
 Only ``numpy`` and ``math``; no scipy.
 """
+
 from __future__ import annotations
 
 import math
@@ -49,8 +50,12 @@ def table_log_probability(table: Union[np.ndarray, Sequence[Sequence[int]]]) -> 
     ``P = Π R_i! Π C_j! / (N! Π n_ij!)``."""
     t = np.asarray(table, dtype=np.int64)
     rows, cols, n = t.sum(axis=1), t.sum(axis=0), int(t.sum())
-    return (sum(_log_factorial(int(r)) for r in rows) + sum(_log_factorial(int(c)) for c in cols)
-            - _log_factorial(n) - sum(_log_factorial(int(x)) for x in t.ravel()))
+    return (
+        sum(_log_factorial(int(r)) for r in rows)
+        + sum(_log_factorial(int(c)) for c in cols)
+        - _log_factorial(n)
+        - sum(_log_factorial(int(x)) for x in t.ravel())
+    )
 
 
 def _compositions(total: int, caps: Sequence[int]):
@@ -65,8 +70,13 @@ def _compositions(total: int, caps: Sequence[int]):
             yield (v,) + tail
 
 
-def fisher_exact(table: Union[np.ndarray, Sequence[Sequence[int]]], *, max_tables: int = 2_000_000, samples: int = 200_000,
-                 seed: int = 0) -> FisherResult:
+def fisher_exact(
+    table: Union[np.ndarray, Sequence[Sequence[int]]],
+    *,
+    max_tables: int = 2_000_000,
+    samples: int = 200_000,
+    seed: int = 0,
+) -> FisherResult:
     """Fisher's exact test of independence of an r x c table of counts (rows x columns).
 
     The p-value sums the probabilities of every table with the observed row and column totals whose
@@ -90,8 +100,7 @@ def fisher_exact(table: Union[np.ndarray, Sequence[Sequence[int]]], *, max_table
     rows = [int(x) for x in t.sum(axis=1)]
     cols = [int(x) for x in t.sum(axis=0)]
     observed = table_log_probability(t)
-    const = (sum(_log_factorial(r) for r in rows) + sum(_log_factorial(c) for c in cols)
-             - _log_factorial(int(t.sum())))
+    const = sum(_log_factorial(r) for r in rows) + sum(_log_factorial(c) for c in cols) - _log_factorial(int(t.sum()))
     threshold = observed + math.log1p(1e-7)
 
     # Exact: fill column by column; the column's cells are compositions of its total under the rows'
@@ -157,8 +166,14 @@ class BootstrapCI:
     n: int
 
 
-def bootstrap_ci(values: Sequence[float], statistic: Optional[Callable[[np.ndarray], Any]] = None, *,
-                 level: float = 0.95, resamples: int = 10_000, seed: int = 0) -> BootstrapCI:
+def bootstrap_ci(
+    values: Sequence[float],
+    statistic: Optional[Callable[[np.ndarray], Any]] = None,
+    *,
+    level: float = 0.95,
+    resamples: int = 10_000,
+    seed: int = 0,
+) -> BootstrapCI:
     """Percentile bootstrap interval of ``statistic`` (default: the mean) of ``values``.
 
     ``statistic`` maps a (resamples, n) array to (resamples,) (e.g. ``lambda a: a.mean(axis=1)``) and is
@@ -182,8 +197,9 @@ def bootstrap_ci(values: Sequence[float], statistic: Optional[Callable[[np.ndarr
     return BootstrapCI(est, float(lo), float(hi), level, resamples, len(x))
 
 
-def mode_table(labels_by_group: Dict[str, Sequence[str]], modes: Optional[Sequence[str]] = None
-               ) -> Tuple[List[str], List[str], np.ndarray]:
+def mode_table(
+    labels_by_group: Dict[str, Sequence[str]], modes: Optional[Sequence[str]] = None
+) -> Tuple[List[str], List[str], np.ndarray]:
     """Counts of each label per group: ``(modes, groups, counts)`` with counts[i, j] the number of
     group j's items labelled modes[i]. ``modes`` fixes the row order (labels not in it are added at the end)."""
     groups = list(labels_by_group)

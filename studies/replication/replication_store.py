@@ -34,6 +34,7 @@ status.json) or a consistent re-compression of other content is not detected. Co
 
 Both exit 1 with one line per refused run (naming the run and the file) when something is wrong.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -50,10 +51,22 @@ import tempfile
 import tomllib
 import zlib
 from pathlib import Path
-from typing import Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
-__all__ = ["PACKED_FILES", "MANIFEST", "MAX_UNPACKED_BYTES", "StoreError", "pack_run", "unpack_run", "pack_tree",
-           "unpack_tree", "packed_runs", "is_packed_run", "next_round_cap", "main"]
+__all__ = [
+    "PACKED_FILES",
+    "MANIFEST",
+    "MAX_UNPACKED_BYTES",
+    "StoreError",
+    "pack_run",
+    "unpack_run",
+    "pack_tree",
+    "unpack_tree",
+    "packed_runs",
+    "is_packed_run",
+    "next_round_cap",
+    "main",
+]
 
 PACKED_FILES = ("config.toml", "history.csv.gz", "best.tar.gz", "checkpoint.json.gz", "status.json")
 OPTIONAL_FILES = ("resume.log",)
@@ -210,7 +223,15 @@ def _tar_best(members: Sequence[Tuple[str, bytes]]) -> bytes:
     with tarfile.open(fileobj=raw, mode="w", format=tarfile.PAX_FORMAT) as tar:
         for name, data in members:
             info = tarfile.TarInfo(f"best/{name}")
-            info.size, info.mtime, info.mode, info.uid, info.gid, info.uname, info.gname = len(data), 0, 0o644, 0, 0, "", ""
+            info.size, info.mtime, info.mode, info.uid, info.gid, info.uname, info.gname = (
+                len(data),
+                0,
+                0o644,
+                0,
+                0,
+                "",
+                "",
+            )
             tar.addfile(info, io.BytesIO(data))
     return raw.getvalue()
 
@@ -230,7 +251,9 @@ def _checkpoint_generation(text: bytes, where: str) -> int:
         outer = json.loads(text)
     except (ValueError, RecursionError) as e:
         raise StoreError(f"{where}: not valid JSON (truncated?): {e}") from None
-    if not (isinstance(outer, dict) and isinstance(outer.get("payload"), str) and isinstance(outer.get("checksum"), str)):
+    if not (
+        isinstance(outer, dict) and isinstance(outer.get("payload"), str) and isinstance(outer.get("checksum"), str)
+    ):
         raise StoreError(f"{where}: not an animat checkpoint (no checksum and payload)")
     body = outer["payload"].encode("utf-8")
     if f"{_fnv1a(body):016x}" != outer["checksum"]:
@@ -248,8 +271,9 @@ def _checkpoint_generation(text: bytes, where: str) -> int:
     if not isinstance(hist, list) or not hist or not isinstance(hist[-1], dict):
         raise StoreError(f"{where}: no history")
     if hist[-1].get("generation") != gen:
-        raise StoreError(f"{where}: generation {gen} does not match its history, which ends at "
-                         f"{hist[-1].get('generation')}")
+        raise StoreError(
+            f"{where}: generation {gen} does not match its history, which ends at {hist[-1].get('generation')}"
+        )
     if not isinstance(pop, list) or not pop:
         raise StoreError(f"{where}: no population")
     return gen
@@ -326,8 +350,10 @@ def _packed_generation(dest: Path) -> Optional[Tuple[int, str]]:
         why.append(f"{status}: no generation")
     except (OSError, ValueError, AttributeError) as e:
         why.append(f"{status}: {e}")
-    raise StoreError(f"{dest}: holds files but no readable packed run ({'; '.join(why)}); refusing to pack over it "
-                     f"(move it away first)")
+    raise StoreError(
+        f"{dest}: holds files but no readable packed run ({'; '.join(why)}); refusing to pack over it "
+        f"(move it away first)"
+    )
 
 
 def _prepare_pack(run_dir: Path, dest: Path, stop_reason: Optional[str]) -> Dict[str, bytes]:
@@ -353,8 +379,10 @@ def _prepare_pack(run_dir: Path, dest: Path, stop_reason: Optional[str]) -> Dict
         raise StoreError(f"{run_dir}: no checkpoint.json(.gz); refusing to pack it")
     generation = _checkpoint_generation(ckpt, str(ckpt_path))
     if last_row < generation:
-        raise StoreError(f"{run_dir / 'history.csv'}: ends at generation {last_row}, before the checkpoint's "
-                         f"{generation}; refusing to pack {run_dir}")
+        raise StoreError(
+            f"{run_dir / 'history.csv'}: ends at generation {last_row}, before the checkpoint's "
+            f"{generation}; refusing to pack {run_dir}"
+        )
     best_dir = run_dir / "best"
     if not best_dir.is_dir():
         raise StoreError(f"{best_dir}: missing (the lineage of best individuals); refusing to pack {run_dir}")
@@ -373,8 +401,10 @@ def _prepare_pack(run_dir: Path, dest: Path, stop_reason: Optional[str]) -> Dict
     if old is not None:
         ours, ours_from = (generation, ckpt_path.name) if old[1] == "checkpoint.json.gz" else (last_row, "history.csv")
         if ours < old[0]:
-            raise StoreError(f"{run_dir}: at generation {ours} ({ours_from}), behind the run packed in {dest} at "
-                             f"generation {old[0]} ({old[1]}); refusing to replace it")
+            raise StoreError(
+                f"{run_dir}: at generation {ours} ({ours_from}), behind the run packed in {dest} at "
+                f"generation {old[0]} ({old[1]}); refusing to replace it"
+            )
     lines = [ln for ln in history.decode().splitlines() if ln.strip()]
     try:
         old_status = json.loads((dest / "status.json").read_text()) if (dest / "status.json").is_file() else {}
@@ -383,13 +413,20 @@ def _prepare_pack(run_dir: Path, dest: Path, stop_reason: Optional[str]) -> Dict
     if not isinstance(old_status, dict):
         old_status = {}
     if stop_reason is None:  # unchanged since the last packing: keep its reason; else derive it
-        stop_reason = (old_status.get("stop_reason", "in progress") if old_status.get("generation") == last_row
-                       else _derived_stop(run_dir / "config.toml", lines))
+        stop_reason = (
+            old_status.get("stop_reason", "in progress")
+            if old_status.get("generation") == last_row
+            else _derived_stop(run_dir / "config.toml", lines)
+        )
     status = {"generation": last_row, "stop_reason": stop_reason}
     tar = _tar_best(best)
-    files = {"config.toml": config, "history.csv.gz": _gzip_bytes(history), "best.tar.gz": _gzip_bytes(tar),
-             "checkpoint.json.gz": _gzip_bytes(ckpt),
-             "status.json": (json.dumps(status, indent=1, sort_keys=True) + "\n").encode()}
+    files = {
+        "config.toml": config,
+        "history.csv.gz": _gzip_bytes(history),
+        "best.tar.gz": _gzip_bytes(tar),
+        "checkpoint.json.gz": _gzip_bytes(ckpt),
+        "status.json": (json.dumps(status, indent=1, sort_keys=True) + "\n").encode(),
+    }
     if (run_dir / "resume.log").is_file():
         files["resume.log"] = (run_dir / "resume.log").read_bytes()
     gunzipped = {"history.csv.gz": history, "best.tar.gz": tar, "checkpoint.json.gz": ckpt}
@@ -398,8 +435,12 @@ def _prepare_pack(run_dir: Path, dest: Path, stop_reason: Optional[str]) -> Dict
         packed[name] = _digest(data)
         if name in gunzipped:
             packed[name]["gunzipped"] = _digest(gunzipped[name])
-    unpacked = {"config.toml": _digest(config), "history.csv": _digest(history), "checkpoint.json": _digest(ckpt),
-                "status.json": _digest(files["status.json"])}
+    unpacked = {
+        "config.toml": _digest(config),
+        "history.csv": _digest(history),
+        "checkpoint.json": _digest(ckpt),
+        "status.json": _digest(files["status.json"]),
+    }
     unpacked.update({f"best/{name}": _digest(data) for name, data in best})
     if "resume.log" in files:
         unpacked["resume.log"] = _digest(files["resume.log"])
@@ -428,9 +469,14 @@ def pack_run(run_dir: Path, dest: Path, stop_reason: Optional[str] = None) -> Pa
 
 
 def _is_digest(e: object) -> bool:
-    return (isinstance(e, dict) and isinstance(e.get("sha256"), str)
-            and re.fullmatch(r"[0-9a-f]{64}", e["sha256"]) is not None
-            and isinstance(e.get("size"), int) and not isinstance(e.get("size"), bool) and e["size"] >= 0)
+    return (
+        isinstance(e, dict)
+        and isinstance(e.get("sha256"), str)
+        and re.fullmatch(r"[0-9a-f]{64}", e["sha256"]) is not None
+        and isinstance(e.get("size"), int)
+        and not isinstance(e.get("size"), bool)
+        and e["size"] >= 0
+    )
 
 
 def _read_manifest(packed: Path) -> dict:
@@ -441,10 +487,16 @@ def _read_manifest(packed: Path) -> dict:
         m = json.loads(path.read_bytes())
     except (ValueError, RecursionError) as e:
         raise StoreError(f"{path}: not valid JSON ({e})") from None
-    ok = (isinstance(m, dict) and m.get("format") == MANIFEST_FORMAT and m.get("version") == 1
-          and isinstance(m.get("packed"), dict) and isinstance(m.get("unpacked"), dict)
-          and all(_is_digest(e) for e in m["packed"].values()) and all(_is_digest(e) for e in m["unpacked"].values())
-          and all(_is_digest(m["packed"][n].get("gunzipped")) for n in m["packed"] if n.endswith(".gz")))
+    ok = (
+        isinstance(m, dict)
+        and m.get("format") == MANIFEST_FORMAT
+        and m.get("version") == 1
+        and isinstance(m.get("packed"), dict)
+        and isinstance(m.get("unpacked"), dict)
+        and all(_is_digest(e) for e in m["packed"].values())
+        and all(_is_digest(e) for e in m["unpacked"].values())
+        and all(_is_digest(m["packed"][n].get("gunzipped")) for n in m["packed"] if n.endswith(".gz"))
+    )
     if not ok:
         raise StoreError(f"{path}: not a manifest of format {MANIFEST_FORMAT} version 1")
     return m
@@ -497,7 +549,7 @@ def _stage(packed: Path, staging: Path) -> Dict[str, Path]:
     try:
         with tarfile.open(tar_path, mode="r:") as tar:
             for m in tar:
-                base = m.name[len("best/"):] if m.name.startswith("best/") else ""
+                base = m.name[len("best/") :] if m.name.startswith("best/") else ""
                 if not m.isfile() or not _BEST_NAME.fullmatch(base):
                     raise StoreError(f"{where}: unexpected member {m.name!r}")
                 if f"best/{base}" in staged:
@@ -590,25 +642,34 @@ def _unpack_one(packed: Path, run_dir: Path) -> bool:
         if ckpt.exists():
             state = _compare(ckpt, staged["checkpoint.json"])
             if state == "equal":
-                only = {rel for rel, path in staged.items()
-                        if not (run_dir / rel).is_file() or _compare(run_dir / rel, path) == "prefix"}
+                only = {
+                    rel
+                    for rel, path in staged.items()
+                    if not (run_dir / rel).is_file() or _compare(run_dir / rel, path) == "prefix"
+                }
             elif state == "other":
                 try:
                     ours = _checkpoint_generation(ckpt.read_bytes(), str(ckpt))
                 except StoreError as e:
-                    raise StoreError(f"{e}; nor is it part of the packed run {packed}: move {run_dir} away to "
-                                     f"unpack it") from None
-                theirs = _checkpoint_generation(staged["checkpoint.json"].read_bytes(),
-                                                str(packed / "checkpoint.json.gz"))
+                    raise StoreError(
+                        f"{e}; nor is it part of the packed run {packed}: move {run_dir} away to unpack it"
+                    ) from None
+                theirs = _checkpoint_generation(
+                    staged["checkpoint.json"].read_bytes(), str(packed / "checkpoint.json.gz")
+                )
                 if ours < theirs:
-                    raise StoreError(f"{ckpt}: at generation {ours}, behind the packed run {packed} at generation "
-                                     f"{theirs}: move {run_dir} away to unpack it")
+                    raise StoreError(
+                        f"{ckpt}: at generation {ours}, behind the packed run {packed} at generation "
+                        f"{theirs}: move {run_dir} away to unpack it"
+                    )
                 return False  # a work directory is newer than the repository's copy until it is packed
         installing = True
         return _install(staged, run_dir, only)
     except OSError as e:
-        raise OSError(e.errno, f"unpacking {packed} into {run_dir}: {e.strerror or e}"
-                      + (f" ({e.filename})" if e.filename else "")) from e
+        raise OSError(
+            e.errno,
+            f"unpacking {packed} into {run_dir}: {e.strerror or e}" + (f" ({e.filename})" if e.filename else ""),
+        ) from e
     finally:
         shutil.rmtree(staging, ignore_errors=True)
         if not installing:
@@ -638,8 +699,9 @@ def packed_runs(root: Path) -> Dict[str, List[Path]]:
     """``{env: [run_<i> dirs in index order]}`` of the packed runs under ``root``."""
     out: Dict[str, List[Path]] = {}
     for env in sorted(p for p in Path(root).iterdir() if p.is_dir()):
-        runs = sorted((p for p in env.glob("run_*") if p.name[4:].isdigit() and is_packed_run(p)),
-                      key=lambda p: int(p.name[4:]))
+        runs = sorted(
+            (p for p in env.glob("run_*") if p.name[4:].isdigit() and is_packed_run(p)), key=lambda p: int(p.name[4:])
+        )
         if runs:
             out[env.name] = runs
     return out
@@ -720,8 +782,10 @@ def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int,
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    p = argparse.ArgumentParser(prog="replication_store.py",
-                                description="Pack evolution runs into the repository (data/replication, ...), or unpack them.")
+    p = argparse.ArgumentParser(
+        prog="replication_store.py",
+        description="Pack evolution runs into the repository (data/replication, ...), or unpack them.",
+    )
     sub = p.add_subparsers(dest="command", required=True)
     u = sub.add_parser("unpack", help="unpack DATA/<env>/run_<i> into WORK/<env>/run_<i>")
     u.add_argument("data", type=Path)

@@ -19,6 +19,7 @@ Usage (from the repository root, PYTHONPATH=python):
   python studies/shapes/shape_reachability.py --label baseline
   python studies/shapes/shape_reachability.py --label offset1 --set development.division_offset=1.0
 """
+
 from __future__ import annotations
 
 import argparse
@@ -133,15 +134,25 @@ def select(config: Any, objective: str, seed: int, population: int, generations:
     final = [S.genome_shape(ind.genome, cfg) for ind in ga.population]
     best = S.genome_shape(ga.best.genome, cfg)
     assert best is not None
-    return {"objective": objective, "seed": seed, "best": best, "score": float(ga.best.fitness.fitness),
-            "history": best_history, "final": [f for f in final if f is not None],
-            "genome": ga.best.genome.to_json()}
+    return {
+        "objective": objective,
+        "seed": seed,
+        "best": best,
+        "score": float(ga.best.fitness.fitness),
+        "history": best_history,
+        "final": [f for f in final if f is not None],
+        "genome": ga.best.genome.to_json(),
+    }
 
 
 def distribution(values: List[float]) -> Dict[str, float]:
     a = np.asarray(values, dtype=float)
-    return {"median": float(np.median(a)), "p90": float(np.percentile(a, 90)), "max": float(a.max()),
-            "min": float(a.min())}
+    return {
+        "median": float(np.median(a)),
+        "p90": float(np.percentile(a, 90)),
+        "max": float(a.max()),
+        "min": float(a.min()),
+    }
 
 
 def summarise(shapes: List[Dict[str, Any]]) -> Dict[str, Any]:
@@ -176,13 +187,15 @@ def r4(x: Any) -> Any:
 
 def report(out: Path) -> str:
     """Markdown tables of every summary_*.json under `out` (the README's results)."""
-    head = ("| config | population | n | elongation median / p90 / max | concavity median / p90 / max | "
-            "protrusions median / max | largest protrusion max | ≥1 protrusion | multi-cell protrusion | "
-            "symmetric pair | elongation ≥ 2 |\n|" + "---|" * 11)
+    head = (
+        "| config | population | n | elongation median / p90 / max | concavity median / p90 / max | "
+        "protrusions median / max | largest protrusion max | ≥1 protrusion | multi-cell protrusion | "
+        "symmetric pair | elongation ≥ 2 |\n|" + "---|" * 11
+    )
     lines = [head]
     for path in sorted(out.glob("summary_*.json")):
         s = json.loads(path.read_text())
-        label = path.stem[len("summary_"):]
+        label = path.stem[len("summary_") :]
         groups = [("random viable", s["random"])] if "random" in s else []
         for objective, res in s.get("selection", {}).items():
             if isinstance(res, dict) and "bests" in res:
@@ -190,11 +203,13 @@ def report(out: Path) -> str:
                 groups.append((f"final pops, select {objective}", res["final_populations"]))
         for name, d in groups:
             e, c, p = d["elongation"], d["concavity"], d["protrusions"]
-            lines.append(f"| {label} | {name} | {d['n']} | {e['median']:.2f} / {e['p90']:.2f} / {e['max']:.2f} | "
-                         f"{c['median']:.2f} / {c['p90']:.2f} / {c['max']:.2f} | {p['median']:g} / {p['max']:g} | "
-                         f"{d['largest_protrusion']['max']:g} | {d['fraction_with_protrusion']:.2f} | "
-                         f"{d['fraction_with_multicell_protrusion']:.2f} | {d['fraction_with_symmetric_pair']:.2f} | "
-                         f"{d['fraction_elongation_ge_2']:.2f} |")
+            lines.append(
+                f"| {label} | {name} | {d['n']} | {e['median']:.2f} / {e['p90']:.2f} / {e['max']:.2f} | "
+                f"{c['median']:.2f} / {c['p90']:.2f} / {c['max']:.2f} | {p['median']:g} / {p['max']:g} | "
+                f"{d['largest_protrusion']['max']:g} | {d['fraction_with_protrusion']:.2f} | "
+                f"{d['fraction_with_multicell_protrusion']:.2f} | {d['fraction_with_symmetric_pair']:.2f} | "
+                f"{d['fraction_elongation_ge_2']:.2f} |"
+            )
     return "\n".join(lines)
 
 
@@ -236,17 +251,22 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--generations", type=int, default=100)
     ap.add_argument("--out", default=str(ROOT / "studies/shapes/results"))
     ap.add_argument("--report", action="store_true", help="print the tables of every summary under --out and stop")
-    ap.add_argument("--replication", action="store_true",
-                    help="describe the bests of data/replication into results/replication_bests.csv and stop")
+    ap.add_argument(
+        "--replication",
+        action="store_true",
+        help="describe the bests of data/replication into results/replication_bests.csv and stop",
+    )
     args = ap.parse_args(argv)
     if args.replication:
         rows = replication_bests(Path(args.out))
         for env in sorted({r["environment"] for r in rows}):
             sel = [r for r in rows if r["environment"] == env]
-            print(f"{env}: {len(sel)} bests, elongation max {max(r['elongation'] for r in sel):.2f}, "
-                  f"with >= 1 protrusion {sum(r['protrusions'] >= 1 for r in sel)}, "
-                  f"with a symmetric pair {sum(r['symmetric_pairs'] >= 1 for r in sel)}, "
-                  f"largest protrusion {max(r['largest_protrusion'] for r in sel)}")
+            print(
+                f"{env}: {len(sel)} bests, elongation max {max(r['elongation'] for r in sel):.2f}, "
+                f"with >= 1 protrusion {sum(r['protrusions'] >= 1 for r in sel)}, "
+                f"with a symmetric pair {sum(r['symmetric_pairs'] >= 1 for r in sel)}, "
+                f"largest protrusion {max(r['largest_protrusion'] for r in sel)}"
+            )
         return 0
     if args.report:
         print(report(Path(args.out)))
@@ -256,9 +276,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
-    summary: Dict[str, Any] = {"command": "python studies/shapes/shape_reachability.py " + " ".join(argv or sys.argv[1:]),
-                               "config": args.config, "overrides": args.set,
-                               "shape_params": vars(S.ShapeParams())}
+    summary: Dict[str, Any] = {
+        "command": "python studies/shapes/shape_reachability.py " + " ".join(argv or sys.argv[1:]),
+        "config": args.config,
+        "overrides": args.set,
+        "shape_params": vars(S.ShapeParams()),
+    }
 
     if args.random > 0:
         rows = random_population(config, args.random, args.random_seed)
@@ -281,13 +304,18 @@ def main(argv: Optional[List[str]] = None) -> int:
             row = {"objective": objective, "seed": seed, "score": res["score"]}
             row.update(res["best"].as_dict())
             row["protrusion_sizes"] = " ".join(str(p.size) for p in res["best"].protrusions)
-            row["best_score_by_10_generations"] = " ".join(f"{v:.3f}" for v in res["history"][::10] + res["history"][-1:])
+            row["best_score_by_10_generations"] = " ".join(
+                f"{v:.3f}" for v in res["history"][::10] + res["history"][-1:]
+            )
             sel_rows.append(row)
             bests.append(res["best"].as_dict())
             finals += [f.as_dict() for f in res["final"]]
             (out / f"best_{args.label}_{objective}_seed{seed}.json").write_text(res["genome"])
-            print(f"[{time.time() - t0:.0f}s] {objective} seed {seed}: score {res['score']:.3f} "
-                  f"{json.dumps(r4(res['best'].as_dict()))}", flush=True)
+            print(
+                f"[{time.time() - t0:.0f}s] {objective} seed {seed}: score {res['score']:.3f} "
+                f"{json.dumps(r4(res['best'].as_dict()))}",
+                flush=True,
+            )
         summary["selection"][objective] = {"bests": summarise(bests), "final_populations": summarise(finals)}
     if sel_rows:
         with open(out / f"selection_{args.label}.csv", "w", newline="") as f:

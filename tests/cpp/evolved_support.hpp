@@ -18,7 +18,8 @@
 
 namespace animat {
 
-/// Evolved genomes shipped as test data (tests/data/evolved/*.json): the environment they evolved in
+/// Evolved genomes shipped as test data (tests/data/evolved/*.json): the environment they evolved
+/// in
 /// ("drag_normal", "max_cells", "frequency_max", "pressure", "pressure_area_floor") and "genome".
 struct Evolved {
   std::string name;
@@ -27,7 +28,8 @@ struct Evolved {
 };
 inline std::vector<Evolved> evolved_genomes() {
   std::vector<Evolved> out;
-  const std::filesystem::path dir = std::filesystem::path(ANIMAT_SOURCE_DIR) / "tests" / "data" / "evolved";
+  const std::filesystem::path dir =
+      std::filesystem::path(ANIMAT_SOURCE_DIR) / "tests" / "data" / "evolved";
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(dir))
     if (e.path().extension() == ".json") files.push_back(e.path());

@@ -51,7 +51,8 @@ bool sorted_and_ordered(const IndexPairs& pairs) {
   const EdgeList list = to_list(pairs);
   for (const auto& [a, b] : list)
     if (!(a < b)) return false;
-  return std::is_sorted(list.begin(), list.end()) && std::adjacent_find(list.begin(), list.end()) == list.end();
+  return std::is_sorted(list.begin(), list.end()) &&
+         std::adjacent_find(list.begin(), list.end()) == list.end();
 }
 
 /// Bridges by definition: edges whose removal disconnects the graph. O(E (V + E)).
@@ -61,7 +62,9 @@ std::set<Edge> bridges(int n, const EdgeList& edges) {
     std::vector<int> parent(static_cast<std::size_t>(n));
     std::iota(parent.begin(), parent.end(), 0);
     const auto find = [&](int x) {
-      while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+      while (parent[static_cast<std::size_t>(x)] != x)
+        x = parent[static_cast<std::size_t>(x)] =
+            parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
       return x;
     };
     for (std::size_t e = 0; e < edges.size(); ++e)
@@ -96,7 +99,8 @@ void check_body_invariants(const Body& body, const Points& points) {
   }
   ASSERT_EQ(body.rest_areas.size(), F);
 
-  // Every half-edge lies in exactly one face walk: regions CCW, the outer face = reversed skin loop.
+  // Every half-edge lies in exactly one face walk: regions CCW, the outer face = reversed skin
+  // loop.
   std::map<Edge, int> halfedge_count;
   std::map<Edge, std::set<int>> faces_of_edge;  // face id -1 = outer
   std::map<Edge, int> edge_uses;
@@ -105,7 +109,8 @@ void check_body_invariants(const Body& body, const Points& points) {
     for (std::size_t i = 0; i < k; ++i) {
       int a = loop[i], b = loop[(i + 1) % k];
       const Edge undirected{std::min(a, b), std::max(a, b)};
-      ASSERT_TRUE(spring_set.count(undirected)) << "loop step " << a << "->" << b << " is not a spring";
+      ASSERT_TRUE(spring_set.count(undirected))
+          << "loop step " << a << "->" << b << " is not a spring";
       if (reversed) std::swap(a, b);
       ++halfedge_count[{a, b}];
       faces_of_edge[undirected].insert(face);
@@ -210,7 +215,8 @@ TEST(BodyGabriel, SquareGridHasLatticeEdgesOnly) {
     for (const double spacing : {1.0, 0.25, 3.0}) {
       Points p(k * k, 2);
       for (int i = 0; i < k; ++i)
-        for (int j = 0; j < k; ++j) p(i * k + j, 0) = 17.0 + spacing * j, p(i * k + j, 1) = -5.0 + spacing * i;
+        for (int j = 0; j < k; ++j)
+          p(i * k + j, 0) = 17.0 + spacing * j, p(i * k + j, 1) = -5.0 + spacing * i;
       EdgeList expected;
       for (int i = 0; i < k; ++i) {
         for (int j = 0; j < k; ++j) {
@@ -244,7 +250,8 @@ TEST(BodyGabriel, TriangularGridHasAllLatticeEdges) {
       const EdgeList got = to_list(gabriel_graph(p));
       ASSERT_EQ(got, brute_gabriel(p));
       // (cols - 1) per row + 2 cols - 1 between consecutive rows.
-      ASSERT_EQ(got.size(), static_cast<std::size_t>(rows * (cols - 1) + (rows - 1) * (2 * cols - 1)));
+      ASSERT_EQ(got.size(),
+                static_cast<std::size_t>(rows * (cols - 1) + (rows - 1) * (2 * cols - 1)));
       const Body body = build_body(p, {}, {}, {});
       ASSERT_EQ(body.region_count(), 2 * (rows - 1) * (cols - 1));
       for (int r = 0; r < body.region_count(); ++r) {
@@ -264,11 +271,14 @@ TEST(BodyGabriel, IntegerPointsOnACircleGiveTheCycle) {
     for (int x = -radius; x <= radius; ++x)
       for (int y = -radius; y <= radius; ++y)
         if (x * x + y * y == radius * radius) xy.emplace_back(x, y);
-    std::sort(xy.begin(), xy.end(), [](auto a, auto b) { return std::atan2(a.second, a.first) < std::atan2(b.second, b.first); });
+    std::sort(xy.begin(), xy.end(), [](auto a, auto b) {
+      return std::atan2(a.second, a.first) < std::atan2(b.second, b.first);
+    });
     const Points p = make_points(xy);
     const int k = static_cast<int>(xy.size());
     EdgeList cycle;
-    for (int i = 0; i < k; ++i) cycle.emplace_back(std::min(i, (i + 1) % k), std::max(i, (i + 1) % k));
+    for (int i = 0; i < k; ++i)
+      cycle.emplace_back(std::min(i, (i + 1) % k), std::max(i, (i + 1) % k));
     std::sort(cycle.begin(), cycle.end());
     ASSERT_EQ(to_list(gabriel_graph(p)), cycle) << "radius " << radius;
     ASSERT_EQ(brute_gabriel(p), cycle);
@@ -328,9 +338,12 @@ TEST(BodyGabriel, IndependentOfInputOrder) {
     std::vector<int> perm(80);
     std::iota(perm.begin(), perm.end(), 0);
     Rng rng(seed);
-    for (int i = 79; i > 0; --i) std::swap(perm[static_cast<std::size_t>(i)], perm[rng.below(static_cast<std::uint64_t>(i + 1))]);
+    for (int i = 79; i > 0; --i)
+      std::swap(perm[static_cast<std::size_t>(i)],
+                perm[rng.below(static_cast<std::uint64_t>(i + 1))]);
     Points q(80, 2);
-    for (int i = 0; i < 80; ++i) q.row(i) = p.row(perm[static_cast<std::size_t>(i)]);  // q[i] = p[perm[i]]
+    // q[i] = p[perm[i]]
+    for (int i = 0; i < 80; ++i) q.row(i) = p.row(perm[static_cast<std::size_t>(i)]);
     EdgeList mapped;
     for (const auto& [a, b] : to_list(gabriel_graph(q))) {
       const int x = perm[static_cast<std::size_t>(a)], y = perm[static_cast<std::size_t>(b)];
@@ -361,7 +374,8 @@ TEST(BodyRegions, InvariantsOnRandomSets) {
     for (std::uint64_t seed = 0; seed < 4; ++seed) {
       const Points p = random_points(n, 500 + 1000 * static_cast<std::uint64_t>(n) + seed);
       check_body_invariants(build_body(p, {}, {}, {}), p);
-      const Points q = random_lattice_points(std::min(n, 40), 9, seed + static_cast<std::uint64_t>(n));
+      const Points q =
+          random_lattice_points(std::min(n, 40), 9, seed + static_cast<std::uint64_t>(n));
       check_body_invariants(build_body(q, {}, {}, {}), q);
     }
   }
@@ -442,7 +456,8 @@ TEST(BodyRegions, LargeBodyIsFast) {
 
 TEST(BodyOscillators, CopiedOrZero) {
   const Points p = make_points({{0, 0}, {1, 0}, {0.5, 0.9}});
-  const Vector a = Vector::LinSpaced(3, 0.0, 0.2), f = Vector::Constant(3, 2.0), ph = Vector::LinSpaced(3, 0, 6);
+  const Vector a = Vector::LinSpaced(3, 0.0, 0.2), f = Vector::Constant(3, 2.0),
+               ph = Vector::LinSpaced(3, 0, 6);
   const Body body = build_body(p, a, f, ph);
   EXPECT_EQ(body.amplitude, a);
   EXPECT_EQ(body.frequency, f);
@@ -459,7 +474,8 @@ TEST(BodyOscillators, WrongLengthOrNonFiniteIsRejected) {
     (void)build_body(p, Vector::Zero(2), {}, {});
     FAIL() << "expected GeometryError";
   } catch (const GeometryError& e) {
-    EXPECT_STREQ(e.what(), "build_body: amplitude has 2 entries, expected 3 (one per node) or 0 (all zero)");
+    EXPECT_STREQ(e.what(),
+                 "build_body: amplitude has 2 entries, expected 3 (one per node) or 0 (all zero)");
   }
   Vector ph = Vector::Zero(3);
   ph(1) = std::nan("");
@@ -544,10 +560,13 @@ TEST(BodyDegenerate, CollinearGivesAChain) {
     Rng rng(seed);
     const int n = 3 + static_cast<int>(rng.below(40));
     // Exactly collinear integer points on a random lattice direction, in shuffled order.
-    const int dx = static_cast<int>(rng.integer(-3, 3)), dy = seed % 4 == 0 ? 0 : static_cast<int>(rng.integer(1, 3));
+    const int dx = static_cast<int>(rng.integer(-3, 3)),
+              dy = seed % 4 == 0 ? 0 : static_cast<int>(rng.integer(1, 3));
     std::vector<int> steps(static_cast<std::size_t>(n));
     std::iota(steps.begin(), steps.end(), -n / 2);
-    for (int i = n - 1; i > 0; --i) std::swap(steps[static_cast<std::size_t>(i)], steps[rng.below(static_cast<std::uint64_t>(i + 1))]);
+    for (int i = n - 1; i > 0; --i)
+      std::swap(steps[static_cast<std::size_t>(i)],
+                steps[rng.below(static_cast<std::uint64_t>(i + 1))]);
     Points p(n, 2);
     for (int i = 0; i < n; ++i) {
       p(i, 0) = 4 + (dx == 0 && dy == 0 ? 1 : dx) * steps[static_cast<std::size_t>(i)];
@@ -555,7 +574,8 @@ TEST(BodyDegenerate, CollinearGivesAChain) {
     }
     // Chain: consecutive steps.
     std::vector<int> at(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) at[static_cast<std::size_t>(steps[static_cast<std::size_t>(i)] + n / 2)] = i;
+    for (int i = 0; i < n; ++i)
+      at[static_cast<std::size_t>(steps[static_cast<std::size_t>(i)] + n / 2)] = i;
     EdgeList chain;
     for (int s = 0; s + 1 < n; ++s) {
       const int a = at[static_cast<std::size_t>(s)], b = at[static_cast<std::size_t>(s + 1)];
@@ -576,24 +596,29 @@ TEST(BodyDegenerate, CollinearGivesAChain) {
 TEST(BodyDegenerate, DuplicatePointsAreRejected) {
   const Points p = make_points({{0, 0}, {1, 0}, {0.5, 1}, {3, 3}, {1, 0}, {0.5, 1}});
   EXPECT_EQ(geometry_error([&] { (void)gabriel_graph(p); }),
-            "gabriel_graph: points 1 and 4 coincide at (1, 0) (distance 0); duplicate cell centres are rejected");
+            "gabriel_graph: points 1 and 4 coincide at (1, 0) (distance 0); duplicate cell centres "
+            "are rejected");
   EXPECT_EQ(geometry_error([&] { (void)build_body(p, {}, {}, {}); }),
-            "build_body: points 1 and 4 coincide at (1, 0) (distance 0); duplicate cell centres are rejected");
+            "build_body: points 1 and 4 coincide at (1, 0) (distance 0); duplicate cell centres "
+            "are rejected");
   // Duplicates are rejected even with merge_distance = 0.
   BodyParams params;
   params.merge_distance = 0.0;
   EXPECT_EQ(geometry_error([&] { (void)delaunay_edges(p, params); }),
-            "delaunay_edges: points 1 and 4 coincide at (1, 0) (distance 0); duplicate cell centres are rejected");
+            "delaunay_edges: points 1 and 4 coincide at (1, 0) (distance 0); duplicate cell "
+            "centres are rejected");
   // Collinear duplicates too (CGAL would merge them into a dimension-1 triangulation).
   const Points q = make_points({{0, 0}, {0, 0}});
   EXPECT_EQ(geometry_error([&] { (void)gabriel_graph(q); }),
-            "gabriel_graph: points 0 and 1 coincide at (0, 0) (distance 0); duplicate cell centres are rejected");
+            "gabriel_graph: points 0 and 1 coincide at (0, 0) (distance 0); duplicate cell centres "
+            "are rejected");
 }
 
 TEST(BodyDegenerate, NearlyCoincidentPointsAreRejected) {
   const Points p = make_points({{1, 0}, {0, 1}, {0, 0}, {2.5e-7, 0}, {3, 3}});
   EXPECT_EQ(geometry_error([&] { (void)build_body(p, {}, {}, {}); }),
-            "build_body: points 2 and 3 are 2.5e-07 apart, closer than merge_distance = 1e-06; near-coincident cell "
+            "build_body: points 2 and 3 are 2.5e-07 apart, closer than merge_distance = 1e-06; "
+            "near-coincident cell "
             "centres are rejected");
   BodyParams params;
   params.merge_distance = 1e-7;  // now they are far enough apart
@@ -601,17 +626,20 @@ TEST(BodyDegenerate, NearlyCoincidentPointsAreRejected) {
   check_body_invariants(body, p);
   params.merge_distance = 1.5;  // the closest pair is reported
   EXPECT_EQ(geometry_error([&] { (void)gabriel_graph(p, params); }),
-            "gabriel_graph: points 2 and 3 are 2.5e-07 apart, closer than merge_distance = 1.5; near-coincident cell "
+            "gabriel_graph: points 2 and 3 are 2.5e-07 apart, closer than merge_distance = 1.5; "
+            "near-coincident cell "
             "centres are rejected");
   // Collinear input is checked too.
   const Points q = make_points({{0, 0}, {1, 0}, {1.0000001, 0}});
-  EXPECT_NE(geometry_error([&] { (void)gabriel_graph(q); }).find("points 1 and 2 are "), std::string::npos);
+  EXPECT_NE(geometry_error([&] { (void)gabriel_graph(q); }).find("points 1 and 2 are "),
+            std::string::npos);
 }
 
 TEST(BodyDegenerate, NonFiniteOrHugeCoordinatesAreRejected) {
   Points p = make_points({{0, 0}, {1, 0}, {0.5, 1}});
   p(1, 1) = std::nan("");
-  EXPECT_EQ(geometry_error([&] { (void)gabriel_graph(p); }), "gabriel_graph: point 1 has a non-finite coordinate y = nan");
+  EXPECT_EQ(geometry_error([&] { (void)gabriel_graph(p); }),
+            "gabriel_graph: point 1 has a non-finite coordinate y = nan");
   p(1, 1) = 0;
   p(2, 0) = -std::numeric_limits<double>::infinity();
   EXPECT_EQ(geometry_error([&] { (void)build_body(p, {}, {}, {}); }),

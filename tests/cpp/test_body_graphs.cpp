@@ -8,9 +8,9 @@
 #include <map>
 #include <numbers>
 #include <numeric>
-#include <tuple>
 #include <set>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -18,8 +18,8 @@
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/physics.hpp"
-#include "animat/scene.hpp"
 #include "animat/random.hpp"
+#include "animat/scene.hpp"
 #include "body_support.hpp"
 
 namespace animat {
@@ -60,8 +60,8 @@ double brute_scale(const Points& p) {
 }
 
 /// Delaunay-tessellation edge by definition: some circle through a and b has every other point
-/// strictly outside. Centres c(t) = m + t * perp(b - a); with P = 2p - (a + b), H = perp(b - a).P and
-/// E = |P|^2 - |b - a|^2, p is strictly outside iff t * H < E / 4. Exact on small integers.
+/// strictly outside. Centres c(t) = m + t * perp(b - a); with P = 2p - (a + b), H = perp(b - a).P
+/// and E = |P|^2 - |b - a|^2, p is strictly outside iff t * H < E / 4. Exact on small integers.
 bool brute_tessellation(const Points& p, int a, int b) {
   const int n = static_cast<int>(p.rows());
   const double ax = p(b, 0) - p(a, 0), ay = p(b, 1) - p(a, 1);
@@ -186,9 +186,11 @@ bool segments_cross(const Points& p, Edge e, Edge f) {
     const int s = (a == c || a == d) ? a : b;
     const int u = s == a ? b : a, v = (c == s) ? d : c;
     if (orient(p, s, u, v) != 0.0) return false;
-    return (p(u, 0) - p(s, 0)) * (p(v, 0) - p(s, 0)) + (p(u, 1) - p(s, 1)) * (p(v, 1) - p(s, 1)) > 0;
+    return (p(u, 0) - p(s, 0)) * (p(v, 0) - p(s, 0)) + (p(u, 1) - p(s, 1)) * (p(v, 1) - p(s, 1)) >
+           0;
   }
-  const double o1 = orient(p, a, b, c), o2 = orient(p, a, b, d), o3 = orient(p, c, d, a), o4 = orient(p, c, d, b);
+  const double o1 = orient(p, a, b, c), o2 = orient(p, a, b, d), o3 = orient(p, c, d, a),
+               o4 = orient(p, c, d, b);
   const auto on = [&](int s, int t, int q) {
     return std::min(p(s, 0), p(t, 0)) <= p(q, 0) && p(q, 0) <= std::max(p(s, 0), p(t, 0)) &&
            std::min(p(s, 1), p(t, 1)) <= p(q, 1) && p(q, 1) <= std::max(p(s, 1), p(t, 1));
@@ -197,7 +199,8 @@ bool segments_cross(const Points& p, Edge e, Edge f) {
   if (o2 == 0 && on(a, b, d)) return true;
   if (o3 == 0 && on(c, d, a)) return true;
   if (o4 == 0 && on(c, d, b)) return true;
-  return ((o1 > 0) != (o2 > 0)) && ((o3 > 0) != (o4 > 0)) && o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0;
+  return ((o1 > 0) != (o2 > 0)) && ((o3 > 0) != (o4 > 0)) && o1 != 0 && o2 != 0 && o3 != 0 &&
+         o4 != 0;
 }
 
 /// Every invariant of a body whose graph may have holes: planar, connected, every half-edge in
@@ -219,7 +222,8 @@ void check_graph_body(const Body& body, const Points& points) {
   for (std::size_t i = 0; i < springs.size(); ++i)
     for (std::size_t j = i + 1; j < springs.size(); ++j)
       ASSERT_FALSE(segments_cross(points, springs[i], springs[j]))
-          << springs[i].first << "-" << springs[i].second << " x " << springs[j].first << "-" << springs[j].second;
+          << springs[i].first << "-" << springs[i].second << " x " << springs[j].first << "-"
+          << springs[j].second;
   // Connected.
   std::vector<int> parent(static_cast<std::size_t>(n));
   std::iota(parent.begin(), parent.end(), 0);
@@ -284,7 +288,8 @@ void check_distance(const Points& p, double threshold, const std::string& what) 
   SCOPED_TRACE(what + " threshold=" + std::to_string(threshold));
   const Body body = build_body(p, {}, {}, {}, graph_params("distance", threshold));
   ASSERT_EQ(to_list(body.springs), brute_distance_graph(p, threshold));
-  ASSERT_EQ(body.skin_loops.size(), p.rows() >= 2 ? 1U : 0U);  // no holes: every bounded face is a region
+  // no holes: every bounded face is a region
+  ASSERT_EQ(body.skin_loops.size(), p.rows() >= 2 ? 1U : 0U);
   check_graph_body(body, p);
 }
 
@@ -324,7 +329,8 @@ TEST(BodyGraphDistance, MatchesBruteForceOnIntegerLattices) {
     const int side = 4 + static_cast<int>(seed % 6);
     const int n = 3 + static_cast<int>(seed * 7 % static_cast<std::uint64_t>(side * side - 3));
     for (double t : {0.9, 1.2, 1.5, 2.3, 50.0})
-      check_distance(random_lattice_points(n, side, seed), t, "lattice seed=" + std::to_string(seed));
+      check_distance(random_lattice_points(n, side, seed), t,
+                     "lattice seed=" + std::to_string(seed));
   }
 }
 
@@ -346,7 +352,7 @@ TEST(BodyGraphDistance, SquareGridKeepsItsSquares) {
 TEST(BodyGraphDistance, CircleIsConnectedByRelativeNeighbours) {
   // The 12 integer points of the circle x^2 + y^2 = 25: all cocircular; nearest-neighbour distances
   // sqrt(2) and sqrt(10). A threshold below both still keeps the cycle's RNG edges: one piece.
-  std::vector<std::pair<double, double>> xy{{5, 0}, {4, 3}, {3, 4}, {0, 5}, {-3, 4}, {-4, 3},
+  std::vector<std::pair<double, double>> xy{{5, 0},  {4, 3},   {3, 4},   {0, 5},  {-3, 4}, {-4, 3},
                                             {-5, 0}, {-4, -3}, {-3, -4}, {0, -5}, {3, -4}, {4, -3}};
   const Points p = make_points(xy);
   for (double t : {0.1, 1.0, 3.0, 100.0}) {
@@ -366,7 +372,8 @@ TEST(BodyGraphDistance, NearCollinearAndNearlyDuplicatePoints) {
       p(i, 0) = i + rng.uniform(-0.3, 0.3);
       p(i, 1) = rng.uniform(-1e-6, 1e-6);
     }
-    for (double t : {0.5, 1.5, 20.0}) check_distance(p, t, "near-collinear seed=" + std::to_string(seed));
+    for (double t : {0.5, 1.5, 20.0})
+      check_distance(p, t, "near-collinear seed=" + std::to_string(seed));
   }
   // Pairs 1e-5 apart (above merge_distance): a legal body.
   Points p = random_points(20, 77);
@@ -404,7 +411,9 @@ TEST(BodyGraphDistance, IndependentOfInputOrder) {
     std::vector<int> perm(25);
     std::iota(perm.begin(), perm.end(), 0);
     Rng rng(seed);
-    for (int i = 24; i > 0; --i) std::swap(perm[static_cast<std::size_t>(i)], perm[rng.below(static_cast<std::uint64_t>(i + 1))]);
+    for (int i = 24; i > 0; --i)
+      std::swap(perm[static_cast<std::size_t>(i)],
+                perm[rng.below(static_cast<std::uint64_t>(i + 1))]);
     Points q(25, 2);
     for (int i = 0; i < 25; ++i) q.row(i) = p.row(perm[static_cast<std::size_t>(i)]);
     for (const std::string graph : {"distance", "alpha_shape"}) {
@@ -430,8 +439,8 @@ TEST(BodyGraphAlpha, MatchesBruteForceOnRandomSets) {
   for (int n = 3; n <= 30; n += 3)
     for (std::uint64_t seed = 0; seed < 4; ++seed)
       for (double alpha : {0.3, 0.6, 1.0, 1.7, 100.0})
-        checked += check_alpha(random_points(n, 900 + 100 * static_cast<std::uint64_t>(n) + seed), alpha,
-                               "n=" + std::to_string(n) + " seed=" + std::to_string(seed));
+        checked += check_alpha(random_points(n, 900 + 100 * static_cast<std::uint64_t>(n) + seed),
+                               alpha, "n=" + std::to_string(n) + " seed=" + std::to_string(seed));
   EXPECT_GT(checked, 190);
 }
 
@@ -442,7 +451,8 @@ TEST(BodyGraphAlpha, MatchesBruteForceOnIntegerLattices) {
     const int n = 3 + static_cast<int>(seed * 7 % static_cast<std::uint64_t>(side * side - 3));
     for (double alpha : {0.55, 0.8, 1.1, 1.9, 50.0}) {
       ++total;
-      checked += check_alpha(random_lattice_points(n, side, seed), alpha, "lattice seed=" + std::to_string(seed));
+      checked += check_alpha(random_lattice_points(n, side, seed), alpha,
+                             "lattice seed=" + std::to_string(seed));
     }
   }
   EXPECT_GT(checked, total / 2);
@@ -472,9 +482,12 @@ TEST(BodyGraphAlpha, AnnulusIsHollow) {
   // Two concentric rings of 24 and 18 points: the alpha complex fills the band between them and
   // leaves the middle a hole, whose boundary (the inner ring) is skin and carries no region.
   std::vector<std::pair<double, double>> xy;
-  for (int k = 0; k < 24; ++k) xy.emplace_back(6.0 * std::cos(k * std::numbers::pi / 12), 6.0 * std::sin(k * std::numbers::pi / 12));
+  for (int k = 0; k < 24; ++k)
+    xy.emplace_back(6.0 * std::cos(k * std::numbers::pi / 12),
+                    6.0 * std::sin(k * std::numbers::pi / 12));
   for (int k = 0; k < 18; ++k)
-    xy.emplace_back(5.0 * std::cos((k + 0.5) * std::numbers::pi / 9), 5.0 * std::sin((k + 0.5) * std::numbers::pi / 9));
+    xy.emplace_back(5.0 * std::cos((k + 0.5) * std::numbers::pi / 9),
+                    5.0 * std::sin((k + 0.5) * std::numbers::pi / 9));
   const Points p = make_points(xy);
   ASSERT_TRUE(check_alpha(p, 2.0, "annulus"));
   const Body body = build_body(p, {}, {}, {}, graph_params("alpha_shape", 2.0));
@@ -486,7 +499,8 @@ TEST(BodyGraphAlpha, AnnulusIsHollow) {
   EXPECT_EQ(inner, expected);
   double band = 0.0;
   for (int r = 0; r < body.region_count(); ++r) band += body.rest_areas(r);
-  EXPECT_NEAR(band, polygon_area(p, body.skin_loops[0]) + polygon_area(p, body.skin_loops[1]), 1e-9);
+  EXPECT_NEAR(band, polygon_area(p, body.skin_loops[0]) + polygon_area(p, body.skin_loops[1]),
+              1e-9);
   EXPECT_LT(band, 0.5 * polygon_area(p, body.skin_loops[0]));
   // A large alpha fills the middle too.
   const Body solid = build_body(p, {}, {}, {}, graph_params("alpha_shape", 100.0));
@@ -498,9 +512,12 @@ TEST(BodyGraphAlpha, HollowBodySwimsInThePapersScene) {
   // pressure, drag, collisions): the hole's boundary is skin and feels drag, the hole has no
   // pressure, and nothing in the physics assumes one skin loop.
   std::vector<std::pair<double, double>> xy;
-  for (int k = 0; k < 24; ++k) xy.emplace_back(6.0 * std::cos(k * std::numbers::pi / 12), 6.0 * std::sin(k * std::numbers::pi / 12));
+  for (int k = 0; k < 24; ++k)
+    xy.emplace_back(6.0 * std::cos(k * std::numbers::pi / 12),
+                    6.0 * std::sin(k * std::numbers::pi / 12));
   for (int k = 0; k < 18; ++k)
-    xy.emplace_back(5.0 * std::cos((k + 0.5) * std::numbers::pi / 9), 5.0 * std::sin((k + 0.5) * std::numbers::pi / 9));
+    xy.emplace_back(5.0 * std::cos((k + 0.5) * std::numbers::pi / 9),
+                    5.0 * std::sin((k + 0.5) * std::numbers::pi / 9));
   const Points p = make_points(xy);
   const int n = static_cast<int>(p.rows());
   Vector amplitude = Vector::Constant(n, 0.15), frequency = Vector::Constant(n, 3.0), phase(n);
@@ -516,7 +533,7 @@ TEST(BodyGraphAlpha, HollowBodySwimsInThePapersScene) {
 }
 
 TEST(BodyGraphAlpha, CircleIsARingOrADisc) {
-  std::vector<std::pair<double, double>> xy{{5, 0}, {4, 3}, {3, 4}, {0, 5}, {-3, 4}, {-4, 3},
+  std::vector<std::pair<double, double>> xy{{5, 0},  {4, 3},   {3, 4},   {0, 5},  {-3, 4}, {-4, 3},
                                             {-5, 0}, {-4, -3}, {-3, -4}, {0, -5}, {3, -4}, {4, -3}};
   const Points p = make_points(xy);
   const double scale = brute_scale(p);  // radius 5 = 5 / scale nearest-neighbour distances
@@ -541,7 +558,8 @@ TEST(BodyGraphAlpha, NearCollinearSets) {
       p(i, 0) = i + rng.uniform(-0.3, 0.3);
       p(i, 1) = rng.uniform(-1e-6, 1e-6);
     }
-    for (double alpha : {0.5, 1.5, 1e5}) checked += check_alpha(p, alpha, "near-collinear seed=" + std::to_string(seed));
+    for (double alpha : {0.5, 1.5, 1e5})
+      checked += check_alpha(p, alpha, "near-collinear seed=" + std::to_string(seed));
   }
   EXPECT_GT(checked, 50);
 }
@@ -573,9 +591,10 @@ TEST(BodyGraphConfig, BadValuesAreConfigErrorsNamingKeyAndValue) {
     return std::string("<no error>");
   };
   for (const auto& [assignment, key, value] :
-       std::vector<std::tuple<std::string, std::string, std::string>>{{"body.graph=\"voronoi\"", "graph", "voronoi"},
-                                                                      {"body.distance_threshold=0", "distance_threshold", "0"},
-                                                                      {"body.alpha=-1", "alpha", "-1"}}) {
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"body.graph=\"voronoi\"", "graph", "voronoi"},
+           {"body.distance_threshold=0", "distance_threshold", "0"},
+           {"body.alpha=-1", "alpha", "-1"}}) {
     const std::string msg = message(assignment);
     EXPECT_NE(msg.find(key), std::string::npos) << msg;
     EXPECT_NE(msg.find(value), std::string::npos) << msg;

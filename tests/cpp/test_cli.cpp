@@ -44,8 +44,8 @@ fs::path scratch_dir() {
 // that nothing it might write lands in the source tree.
 Result run(const std::string& args) {
   const fs::path out = scratch_dir() / "stdout.txt", err = scratch_dir() / "stderr.txt";
-  const std::string cmd = "cd '" + scratch_dir().string() + "' && '" + ANIMAT_EVOLVE_EXE + "' " + args + " >'" +
-                          out.string() + "' 2>'" + err.string() + "'";
+  const std::string cmd = "cd '" + scratch_dir().string() + "' && '" + ANIMAT_EVOLVE_EXE + "' " +
+                          args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   Result r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -61,7 +61,8 @@ struct ScratchCleanup : ::testing::Environment {
     fs::remove_all(scratch_dir(), ec);
   }
 };
-[[maybe_unused]] ::testing::Environment* const scratch_cleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+[[maybe_unused]] ::testing::Environment* const scratch_cleanup =
+    ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 fs::path write_file(const std::string& name, const std::string& text) {
   const fs::path p = scratch_dir() / name;
@@ -69,8 +70,9 @@ fs::path write_file(const std::string& name, const std::string& text) {
   return p;
 }
 
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "expected '" << (needle) << "' in: " << (haystack)
+#define EXPECT_CONTAINS(haystack, needle)                          \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) \
+      << "expected '" << (needle) << "' in: " << (haystack)
 
 }  // namespace
 
@@ -87,7 +89,9 @@ TEST(Cli, PrintConfigParsesBackToTheDefault) {
 }
 
 TEST(Cli, SetOverridesAreReflected) {
-  const Result r = run("--print-config --set evolution.population=50 --set grn.dt=0.025 --set physics.drag_scheme=explicit");
+  const Result r =
+      run("--print-config --set evolution.population=50 --set grn.dt=0.025 --set "
+          "physics.drag_scheme=explicit");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Config c = config_from_toml(r.out, "stdout");
   EXPECT_EQ(c.evolution.population, 50);
@@ -124,7 +128,8 @@ TEST(Cli, SetCrossKeyChecksDoNotDependOnTheOrderOfTheFlags) {
   apply_overrides(lib, {"evolution.elites=150", "evolution.population=200"});
   EXPECT_TRUE(lib == c);
   Config untouched;
-  EXPECT_THROW(apply_overrides(untouched, {"evolution.population=20", "evolution.elites=30"}), ConfigError);
+  EXPECT_THROW(apply_overrides(untouched, {"evolution.population=20", "evolution.elites=30"}),
+               ConfigError);
   EXPECT_TRUE(untouched == Config{}) << "a rejected set of overrides leaves the config unchanged";
 }
 
@@ -211,7 +216,8 @@ TEST(CliErrors, BadConfigFileNamesFileLineAndKey) {
   EXPECT_CONTAINS(r.err, "evolution.populaton");
   EXPECT_CONTAINS(r.err, "did you mean 'population'");
   EXPECT_EQ(r.out, "");
-  const fs::path bad_file = fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / "config_dt_nan.toml";
+  const fs::path bad_file =
+      fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / "config_dt_nan.toml";
   const Result r2 = run("--print-config --config '" + bad_file.string() + "'");
   EXPECT_NE(r2.exit_code, 0);
   EXPECT_CONTAINS(r2.err, bad_file.string() + ":6");

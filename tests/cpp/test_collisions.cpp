@@ -1,6 +1,6 @@
 // Trustworthy swimmers (issue 14): cell-edge collisions as the paper states them (elastic,
-// momentum-conserving, never crossed), the planar-embedding invariant, eqs. 4–5 integrated without a
-// limiter, and the diagnostics every swim reports. Analytic wherever the physics allows.
+// momentum-conserving, never crossed), the planar-embedding invariant, eqs. 4–5 integrated without
+// a limiter, and the diagnostics every swim reports. Analytic wherever the physics allows.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../../src/effects/triangle_filter.hpp"
 #include "animat/body.hpp"
 #include "animat/config.hpp"
 #include "animat/development.hpp"
@@ -28,7 +29,6 @@
 #include "animat/scene.hpp"
 #include "evolved_support.hpp"
 #include "physics_support.hpp"
-#include "../../src/effects/triangle_filter.hpp"
 
 namespace animat {
 namespace {
@@ -74,7 +74,8 @@ Outcome analytic_bounce(double s, double vx, double vy) {
   return {{vx, vy + dv}, {0.0, -(1.0 - s) * dv}, {0.0, -s * dv}};
 }
 
-// --- the collision itself --------------------------------------------------------------------------
+// --- the collision itself
+// --------------------------------------------------------------------------
 
 TEST(Collisions, CellThrownAtAFreeEdgeBouncesElasticallyAsTheImpulseSolutionSays) {
   for (double s : {0.5, 0.25, 0.9}) {
@@ -91,12 +92,13 @@ TEST(Collisions, CellThrownAtAFreeEdgeBouncesElasticallyAsTheImpulseSolutionSays
         lowest = std::min(lowest, side_of(sim.positions(), 2, 0, 1));
       }
       EXPECT_GT(lowest, 0.0) << "s=" << s << ": the cell crossed the edge";
-      EXPECT_LT(lowest, 1e-3 + 3.0 * PhysicsParams{}.dt) << "s=" << s << ": the cell never came within a step of the edge";
+      EXPECT_LT(lowest, 1e-3 + 3.0 * PhysicsParams{}.dt)
+          << "s=" << s << ": the cell never came within a step of the edge";
       EXPECT_EQ(sim.counters().collisions, 1);
       const Points v = sim.velocities();
       const double hit = s + vx * (0.3 - 1e-3) / -vy;  // where along the edge it reaches the band
       const Outcome want = analytic_bounce(hit, vx, vy);
-      const double tol = 1e-5 * std::abs(vy);                              // float velocities
+      const double tol = 1e-5 * std::abs(vy);  // float velocities
       EXPECT_NEAR(v(2, 0), want.cell.x(), tol) << "s=" << s;
       EXPECT_NEAR(v(2, 1), want.cell.y(), tol) << "s=" << s;
       EXPECT_NEAR(v(0, 1), want.a.y(), tol) << "s=" << s;
@@ -154,8 +156,8 @@ TEST(Collisions, ACellAimedAtAVertexCrossesNeitherEdge) {
   // Two edges meeting at cell 0 at a right angle; cell 3 flies diagonally at the vertex from inside
   // the wedge.
   for (double offset : {0.0, 1e-9, 1e-4, -1e-4}) {
-    Body b = make_body(points({{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {0.5 + offset, 0.5}}), {{0, 1}, {0, 2}}, {},
-                       {{0, 1}, {0, 2}});
+    Body b = make_body(points({{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {0.5 + offset, 0.5}}),
+                       {{0, 1}, {0, 2}}, {}, {{0, 1}, {0, 2}});
     Points v = Points::Zero(4, 2);
     v(3, 0) = -2.0;
     v(3, 1) = -2.0;
@@ -199,7 +201,6 @@ TEST(Collisions, AFastCellDoesNotTunnelThroughInOneStep) {
   EXPECT_LT(side_of(soft.positions(), 2, 0, 1), 0.0);
 }
 
-
 TEST(Collisions, RestitutionZeroStopsTheApproachAndCostsEnergy) {
   Throw t = throw_at_edge(0.5, 0.3, 0.0, -3.0);
   SceneParams scene = collisions_only();
@@ -215,13 +216,14 @@ TEST(Collisions, RestitutionZeroStopsTheApproachAndCostsEnergy) {
   EXPECT_NEAR(sim.kinetic_energy(), 1.5, 1e-5);  // from 4.5: two thirds lost
 }
 
-// --- the planar embedding --------------------------------------------------------------------------
+// --- the planar embedding
+// --------------------------------------------------------------------------
 
 /// The collisions effect's cheaper triangle test only rejects triangles its full test rejects too
 /// (so the candidates, and every result, stay the same): random triangles from fat to nearly flat,
 /// bands from 0 to the tolerance, vertex velocities random or signed to shrink the area fastest,
-/// their quantities derived as Collisions::gather derives them; for each, the motion is scaled to the
-/// edge of what the cheaper test still rejects (bisection), where its bound is tightest.
+/// their quantities derived as Collisions::gather derives them; for each, the motion is scaled to
+/// the edge of what the cheaper test still rejects (bisection), where its bound is tightest.
 TEST(Collisions, CheaperTriangleTestRejectsOnlyWhatTheFullTestRejects) {
   using animat::effects::triangle_band4;
   using animat::effects::triangle_stays_clear;
@@ -232,7 +234,8 @@ TEST(Collisions, CheaperTriangleTestRejectsOnlyWhatTheFullTestRejects) {
   };
   // Both tests on the case with every velocity scaled by `scale`: {cheaper rejects, full rejects}.
   auto tests = [](const Case& c, double scale) {
-    const double abx = c.qx[1] - c.qx[0], aby = c.qy[1] - c.qy[0], acx = c.qx[2] - c.qx[0], acy = c.qy[2] - c.qy[0];
+    const double abx = c.qx[1] - c.qx[0], aby = c.qy[1] - c.qy[0], acx = c.qx[2] - c.qx[0],
+                 acy = c.qy[2] - c.qy[0];
     std::array<double, 3> wx{}, wy{}, wmax{};
     for (int v = 0; v < 3; ++v) {
       wx[v] = scale * c.wx[v];
@@ -241,7 +244,8 @@ TEST(Collisions, CheaperTriangleTestRejectsOnlyWhatTheFullTestRejects) {
     }
     const double dbx = c.span * (wx[1] - wx[0]), dby = c.span * (wy[1] - wy[0]);
     const double dcx = c.span * (wx[2] - wx[0]), dcy = c.span * (wy[2] - wy[0]);
-    return std::pair{triangle_surely_clear(abx, aby, acx, acy, wmax[0] + wmax[1] + wmax[2], triangle_band4(c.band_max)),
+    return std::pair{triangle_surely_clear(abx, aby, acx, acy, wmax[0] + wmax[1] + wmax[2],
+                                           triangle_band4(c.band_max)),
                      triangle_stays_clear(abx, aby, acx, acy, dbx, dby, dcx, dcy, c.band_max)};
   };
   animat::Rng rng(20261125);
@@ -263,7 +267,8 @@ TEST(Collisions, CheaperTriangleTestRejectsOnlyWhatTheFullTestRejects) {
       c.wy[static_cast<std::size_t>(v)] = size * rng.uniform(-1.0, 1.0);
     }
     if (k % 2 == 0) {  // a stands still, b and c move to shrink the doubled area fastest (c1 < 0)
-      const double abx = c.qx[1] - c.qx[0], aby = c.qy[1] - c.qy[0], acx = c.qx[2] - c.qx[0], acy = c.qy[2] - c.qy[0];
+      const double abx = c.qx[1] - c.qx[0], aby = c.qy[1] - c.qy[0], acx = c.qx[2] - c.qx[0],
+                   acy = c.qy[2] - c.qy[0];
       c.wx[0] = c.wy[0] = 0.0;
       c.wx[1] = -std::copysign(size, acy);
       c.wy[1] = std::copysign(size, acx);
@@ -377,7 +382,8 @@ TEST(Collisions, MomentumIsConservedThroughCollisionsWithDragOff) {
   // impulse is internal.
   const auto genomes = evolved_genomes();
   const Evolved& e = named(genomes, "colliding_f12_dn0.5.json");
-  SceneParams scene = e.config.scene;  // the c_p it evolved with: regions collapse and cells collide
+  // the c_p it evolved with: regions collapse and cells collide
+  SceneParams scene = e.config.scene;
   scene.effects = {"springs", "actuation", "pressure", "collisions"};
   Simulation sim(body_of(e), scene);
   const Eigen::Vector2d c0 = sim.center_of_mass();
@@ -388,14 +394,16 @@ TEST(Collisions, MomentumIsConservedThroughCollisionsWithDragOff) {
   }
   EXPECT_GT(sim.counters().collisions, 50) << "the case must collide to test anything";
   // Float velocities: each Box2D step rounds every velocity (relative 6e-8), a random walk of
-  // ~6e-8·|v|·sqrt(n·steps) ~ 3e-5 for 32 cells at speeds ~2 over 2000 steps; 1e-3 is 30 times that.
+  // ~6e-8·|v|·sqrt(n·steps) ~ 3e-5 for 32 cells at speeds ~2 over 2000 steps; 1e-3 is 30 times
+  // that.
   EXPECT_LT(biggest, 1e-3);
   EXPECT_LT((sim.center_of_mass() - c0).norm(), 1e-3);
 }
 
 TEST(Embedding, TheOldPenaltyLetsAnEvolvedExploitThroughWhereCollisionsDoNot) {
   const auto genomes = evolved_genomes();
-  const Evolved& e = named(genomes, "exploit_old_physics_dn0.5.json");  // with the c_p it evolved under
+  // with the c_p it evolved under
+  const Evolved& e = named(genomes, "exploit_old_physics_dn0.5.json");
   const Body b = body_of(e);
   SceneParams old_scene = e.config.scene;
   old_scene.effects = {"springs", "actuation", "pressure", "drag", "skin_collision"};
@@ -422,7 +430,8 @@ TEST(Embedding, HoldsForEvolvedBestsAtEveryStep) {
   }
 }
 
-// --- eqs. 4–5 without a limiter ---------------------------------------------------------------------
+// --- eqs. 4–5 without a limiter
+// ---------------------------------------------------------------------
 
 TEST(Drag, SemiImplicitTerminalVelocityOfARodIsExactAtTheDefaultStepWithoutALimiter) {
   // One edge pulled normal to itself by F on each end: terminal |u| = sqrt(2F / (d_N·L)).
@@ -460,7 +469,8 @@ TEST(Drag, SemiImplicitIsTheExactSolutionForAFreeEdge) {
     for (int k = 1; k <= 600; ++k) {
       sim.step();
       const double t = k * PhysicsParams{}.dt;
-      EXPECT_NEAR(sim.velocities()(0, 1), 3.0 / (1.0 + c * 3.0 * t), 1e-5 * 3.0) << "d_N=" << dn << " step " << k;
+      EXPECT_NEAR(sim.velocities()(0, 1), 3.0 / (1.0 + c * 3.0 * t), 1e-5 * 3.0)
+          << "d_N=" << dn << " step " << k;
     }
   }
 }
@@ -482,7 +492,8 @@ TEST(Drag, TheStableSchemeCountsEveryLimitedStep) {
   EXPECT_EQ(exact.counters().drag_limited, 0);
 }
 
-// --- diagnostics -----------------------------------------------------------------------------------
+// --- diagnostics
+// -----------------------------------------------------------------------------------
 
 TEST(Diagnostics, EvaluateReportsTheInvariantsAndAnInvalidSwimHasFitnessZero) {
   const auto genomes = evolved_genomes();
@@ -509,7 +520,8 @@ TEST(Diagnostics, EvaluateReportsTheInvariantsAndAnInvalidSwimHasFitnessZero) {
   EXPECT_GT(bad.inverted_region_steps, 0);
   EXPECT_LT(bad.min_area_ratio, 0.0);
   ASSERT_FALSE(bad.reasons.empty());
-  EXPECT_NE(bad.reasons.back().find("invalid swim: a region turned inside out"), std::string::npos) << bad.reasons.back();
+  EXPECT_NE(bad.reasons.back().find("invalid swim: a region turned inside out"), std::string::npos)
+      << bad.reasons.back();
 }
 
 }  // namespace

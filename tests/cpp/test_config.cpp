@@ -33,12 +33,15 @@ std::string message_of(const auto& f) {
   return "<no exception>";
 }
 
-fs::path bad_input(const std::string& name) { return fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / name; }
+fs::path bad_input(const std::string& name) {
+  return fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / name;
+}
 
 // Values compared exactly (doubles by bit pattern).
 bool same_value(const ConfigValue& a, const ConfigValue& b) {
   if (a.index() != b.index()) return false;
-  if (const double* x = std::get_if<double>(&a)) return std::bit_cast<std::uint64_t>(*x) == std::bit_cast<std::uint64_t>(std::get<double>(b));
+  if (const double* x = std::get_if<double>(&a))
+    return std::bit_cast<std::uint64_t>(*x) == std::bit_cast<std::uint64_t>(std::get<double>(b));
   if (const auto* v = std::get_if<std::vector<double>>(&a)) {
     const auto& w = std::get<std::vector<double>>(b);
     if (v->size() != w.size()) return false;
@@ -50,7 +53,8 @@ bool same_value(const ConfigValue& a, const ConfigValue& b) {
 }
 
 void expect_identical(const Config& a, const Config& b) {
-  for (const auto& key : config_keys()) EXPECT_TRUE(same_value(get_value(a, key), get_value(b, key))) << key;
+  for (const auto& key : config_keys())
+    EXPECT_TRUE(same_value(get_value(a, key), get_value(b, key))) << key;
   EXPECT_TRUE(a == b);
   EXPECT_EQ(config_hash(a), config_hash(b));
 }
@@ -71,8 +75,9 @@ std::string expect_config_error(const auto& f) {
   return msg;
 }
 
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "expected '" << (needle) << "' in: " << (haystack)
+#define EXPECT_CONTAINS(haystack, needle)                          \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) \
+      << "expected '" << (needle) << "' in: " << (haystack)
 
 }  // namespace
 
@@ -97,19 +102,21 @@ TEST(ConfigKeys, EveryKeyIsUniqueAndPrintedOnce) {
   const auto keys = config_keys();
   const std::set<std::string> unique(keys.begin(), keys.end());
   EXPECT_EQ(unique.size(), keys.size());
-  for (const char* k : {"genome.dimensions", "genome.affinity_decay", "genome.affinity_cutoff", "genome.max_elements",
-                        "mutation.type_rate", "mutation.crossover_points", "grn.dt", "evolution.population",
-                        "evolution.seed", "scene.drag_normal", "physics.drag_scheme", "development.max_cells"})
+  for (const char* k : {"genome.dimensions", "genome.affinity_decay", "genome.affinity_cutoff",
+                        "genome.max_elements", "mutation.type_rate", "mutation.crossover_points",
+                        "grn.dt", "evolution.population", "evolution.seed", "scene.drag_normal",
+                        "physics.drag_scheme", "development.max_cells"})
     EXPECT_TRUE(unique.count(k)) << k;
   // Every key appears as "key = value" in its section of to_toml.
   const std::string toml = to_toml(Config{});
   std::size_t assignments = 0;
   std::istringstream in(toml);
   for (std::string line; std::getline(in, line);)
-    if (!line.empty() && line[0] != '#' && line[0] != '[' && line.find(" = ") != std::string::npos) ++assignments;
+    if (!line.empty() && line[0] != '#' && line[0] != '[' && line.find(" = ") != std::string::npos)
+      ++assignments;
   EXPECT_EQ(assignments, keys.size());
-  for (const char* s : {"[genome]", "[mutation]", "[grn]", "[development]", "[body]", "[scene]", "[physics]",
-                        "[evaluation]", "[evolution]"})
+  for (const char* s : {"[genome]", "[mutation]", "[grn]", "[development]", "[body]", "[scene]",
+                        "[physics]", "[evaluation]", "[evolution]"})
     EXPECT_CONTAINS(toml, s);
   EXPECT_CONTAINS(toml, "\ndt = 0.05\n");
 }
@@ -148,53 +155,58 @@ TEST(ConfigRoundTrip, EmptyAndPartialTomlKeepDefaults) {
 TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
   // Give every key a non-default value (awkward doubles where allowed), then print and re-read.
   Config c;
-  const double awkward[] = {0.1, 1.0 / 3.0, 1e-300, 0.7000000000000001, 123456.789, 2.5e-7, 1.0, 0.0};
+  const double awkward[] = {0.1,        1.0 / 3.0, 1e-300, 0.7000000000000001,
+                            123456.789, 2.5e-7,    1.0,    0.0};
   int changed = 0;
   // Two passes: a key whose new value is valid only together with a later key's (control.mode =
-  // "grn" needs grn_rate·update_interval·h <= 1, and physics.dt comes earlier) gets its second chance.
+  // "grn" needs grn_rate·update_interval·h <= 1, and physics.dt comes earlier) gets its second
+  // chance.
   std::vector<std::string> done;
   for (int pass = 0; pass < 2; ++pass)
-  for (const auto& key : config_keys()) {
-    if (std::find(done.begin(), done.end(), key) != done.end()) continue;
-    const ConfigValue def = get_value(Config{}, key);
-    std::vector<ConfigValue> candidates;
-    if (const double* d = std::get_if<double>(&def)) {
-      for (double a : awkward) candidates.push_back(a);
-      candidates.push_back(*d * 0.7000000000000001);
-      candidates.push_back(std::nextafter(*d, 0.0));
-    } else if (const auto* i = std::get_if<std::int64_t>(&def)) {
-      candidates.push_back(*i + 1);
-      candidates.push_back(*i - 1);
-      candidates.push_back(std::int64_t{3});
-    } else if (const bool* b = std::get_if<bool>(&def)) {
-      candidates.push_back(!*b);
-    } else if (const auto* s = std::get_if<std::vector<std::string>>(&def)) {
-      auto shorter = *s;
-      if (!shorter.empty()) shorter.pop_back();
-      candidates.push_back(shorter);
-      candidates.push_back(std::vector<std::string>{});
-    } else if (const auto* v = std::get_if<std::vector<double>>(&def)) {
-      auto w = *v;
-      for (double& x : w) x = x * 1.1 + 0.1;
-      candidates.push_back(w);
-    } else if (std::holds_alternative<std::string>(def)) {
-      for (const char* word : {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation", "grn", "point", "distance", "front", "amplitude", "morphogen_gradient"}) candidates.push_back(std::string(word));
-    }
-    for (const auto& cand : candidates) {
-      if (same_value(cand, def)) continue;
-      Config trial = c;
-      try {
-        set_value(trial, key, cand);
-        animat::validate(trial);
-      } catch (const ConfigError&) {
-        continue;
+    for (const auto& key : config_keys()) {
+      if (std::find(done.begin(), done.end(), key) != done.end()) continue;
+      const ConfigValue def = get_value(Config{}, key);
+      std::vector<ConfigValue> candidates;
+      if (const double* d = std::get_if<double>(&def)) {
+        for (double a : awkward) candidates.push_back(a);
+        candidates.push_back(*d * 0.7000000000000001);
+        candidates.push_back(std::nextafter(*d, 0.0));
+      } else if (const auto* i = std::get_if<std::int64_t>(&def)) {
+        candidates.push_back(*i + 1);
+        candidates.push_back(*i - 1);
+        candidates.push_back(std::int64_t{3});
+      } else if (const bool* b = std::get_if<bool>(&def)) {
+        candidates.push_back(!*b);
+      } else if (const auto* s = std::get_if<std::vector<std::string>>(&def)) {
+        auto shorter = *s;
+        if (!shorter.empty()) shorter.pop_back();
+        candidates.push_back(shorter);
+        candidates.push_back(std::vector<std::string>{});
+      } else if (const auto* v = std::get_if<std::vector<double>>(&def)) {
+        auto w = *v;
+        for (double& x : w) x = x * 1.1 + 0.1;
+        candidates.push_back(w);
+      } else if (std::holds_alternative<std::string>(def)) {
+        for (const char* word :
+             {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",
+              "grn", "point", "distance", "front", "amplitude", "morphogen_gradient"})
+          candidates.push_back(std::string(word));
       }
-      c = trial;
-      ++changed;
-      done.push_back(key);
-      break;
+      for (const auto& cand : candidates) {
+        if (same_value(cand, def)) continue;
+        Config trial = c;
+        try {
+          set_value(trial, key, cand);
+          animat::validate(trial);
+        } catch (const ConfigError&) {
+          continue;
+        }
+        c = trial;
+        ++changed;
+        done.push_back(key);
+        break;
+      }
     }
-  }
   EXPECT_GE(changed, static_cast<int>(config_keys().size()) - 3) << "too few keys could be changed";
   EXPECT_FALSE(c == Config{});
   const Config back = config_from_toml(to_toml(c), "nondefault.toml");
@@ -237,7 +249,8 @@ TEST(ConfigRoundTrip, AfterOverrides) {
 }
 
 TEST(ConfigRoundTrip, LoadConfigFromFile) {
-  const fs::path path = fs::temp_directory_path() / ("animat_test_config_" + std::to_string(::getpid()) + ".toml");
+  const fs::path path =
+      fs::temp_directory_path() / ("animat_test_config_" + std::to_string(::getpid()) + ".toml");
   Config c;
   c.evolution.population = 33;
   c.grn.dt = 0.07;
@@ -335,7 +348,8 @@ TEST(ConfigOverride, CrossFieldViolationIsReportedAndLeavesConfigUnchanged) {
   Config c;
   const std::string m = expect_config_error([&] { apply_override(c, "evolution.elites=100"); });
   EXPECT_CONTAINS(m, "evolution.elites = 100 must be smaller than evolution.population");
-  EXPECT_EQ(c.evolution.elites, Config{}.evolution.elites) << "a rejected --set must not leave its value behind";
+  EXPECT_EQ(c.evolution.elites, Config{}.evolution.elites)
+      << "a rejected --set must not leave its value behind";
   EXPECT_NO_THROW(animat::validate(c));
 }
 
@@ -379,22 +393,41 @@ TEST_P(BadToml, IsAConfigErrorNamingFileLineKeyAndExpectation) {
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadToml,
     ::testing::Values(
-        BadTomlCase{"config_unknown_key.toml", 6, {"unknown key 'evolution.populaton'", "did you mean 'population'"}},
-        BadTomlCase{"config_unknown_section.toml", 5, {"unknown section [evolutoin]", "did you mean 'evolution'"}},
-        BadTomlCase{"config_wrong_type.toml", 6, {"evolution.population = \"many\"", "wrong type", "expected an integer"}},
-        BadTomlCase{"config_float_for_integer.toml", 6, {"evolution.population = 10.5", "expected an integer"}},
-        BadTomlCase{"config_population_zero.toml", 6, {"evolution.population = 0", "out of range", "[2, 100000]"}},
-        BadTomlCase{"config_population_negative.toml", 6, {"evolution.population = -5", "out of range", "[2, 100000]"}},
+        BadTomlCase{"config_unknown_key.toml",
+                    6,
+                    {"unknown key 'evolution.populaton'", "did you mean 'population'"}},
+        BadTomlCase{"config_unknown_section.toml",
+                    5,
+                    {"unknown section [evolutoin]", "did you mean 'evolution'"}},
+        BadTomlCase{"config_wrong_type.toml",
+                    6,
+                    {"evolution.population = \"many\"", "wrong type", "expected an integer"}},
+        BadTomlCase{"config_float_for_integer.toml",
+                    6,
+                    {"evolution.population = 10.5", "expected an integer"}},
+        BadTomlCase{"config_population_zero.toml",
+                    6,
+                    {"evolution.population = 0", "out of range", "[2, 100000]"}},
+        BadTomlCase{"config_population_negative.toml",
+                    6,
+                    {"evolution.population = -5", "out of range", "[2, 100000]"}},
         BadTomlCase{"config_dt_zero.toml", 6, {"grn.dt = 0.0", "out of range", "(0, 1]"}},
         BadTomlCase{"config_dt_negative.toml", 6, {"grn.dt = -0.05", "out of range", "(0, 1]"}},
         BadTomlCase{"config_dt_nan.toml", 6, {"grn.dt = nan", "must be finite"}},
         BadTomlCase{"config_dt_inf.toml", 6, {"grn.dt = inf", "must be finite"}},
-        BadTomlCase{"config_integer_overflow.toml", 6, {"evolution.population = 10000000000", "integer range"}},
+        BadTomlCase{"config_integer_overflow.toml",
+                    6,
+                    {"evolution.population = 10000000000", "integer range"}},
         BadTomlCase{"config_malformed.toml", 5, {"malformed TOML"}},
         BadTomlCase{"config_section_not_table.toml", 3, {"'grn' must be a table"}},
-        BadTomlCase{"config_bad_choice.toml", 6, {"physics.drag_scheme = \"magic\"", "expected one of semi_implicit, explicit, stable"}},
+        BadTomlCase{
+            "config_bad_choice.toml",
+            6,
+            {"physics.drag_scheme = \"magic\"", "expected one of semi_implicit, explicit, stable"}},
         BadTomlCase{"config_bad_list_entry.toml", 6, {"scene.effects", "\"buoyancy\""}},
-        BadTomlCase{"config_elites_not_below_population.toml", 0, {"evolution.elites = 10", "evolution.population = 10"}},
+        BadTomlCase{"config_elites_not_below_population.toml",
+                    0,
+                    {"evolution.elites = 10", "evolution.population = 10"}},
         BadTomlCase{"config_duplicate_key.toml", 7, {"malformed TOML", "dt"}}),
     [](const ::testing::TestParamInfo<BadTomlCase>& info) {
       std::string n = info.param.file;
@@ -405,7 +438,8 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(BadTomlString, SourceNameIsUsedForStrings) {
-  const std::string m = expect_config_error([] { (void)config_from_toml("[grn]\n\ndt = -1\n", "my.toml"); });
+  const std::string m =
+      expect_config_error([] { (void)config_from_toml("[grn]\n\ndt = -1\n", "my.toml"); });
   EXPECT_CONTAINS(m, "my.toml:3");
   EXPECT_CONTAINS(m, "grn.dt = -1");
   EXPECT_CONTAINS(m, "(0, 1]");
@@ -416,18 +450,21 @@ TEST(BadTomlString, SourceNameIsUsedForStrings) {
 
 TEST(BadTomlString, BinaryGarbageIsMalformed) {
   const std::string garbage("\x00\xff\xfe[\x01grn]\n\x89PNG", 12);
-  const std::string m = expect_config_error([&] { (void)config_from_toml(garbage, "garbage.toml"); });
+  const std::string m =
+      expect_config_error([&] { (void)config_from_toml(garbage, "garbage.toml"); });
   EXPECT_CONTAINS(m, "garbage.toml");
   EXPECT_CONTAINS(m, "malformed TOML");
 }
 
 TEST(BadTomlString, NothingFallsBackSilently) {
   // Each of these has one bad key and otherwise valid content; none may load.
-  for (const char* text : {"[genome]\ndimensions = 0\n", "[genome]\ndimensions = 17\n", "[mutation]\ntype_rate = 1.5\n",
-                           "[mutation]\nmove_sigma = -0.1\n", "[grn]\ndt = 1.5\n", "[genome]\naffinity_cutoff = 0\n",
-                           "[evolution]\nseed = -1\n", "[evolution]\npopulation = true\n", "[grn]\ndt = [0.05]\n",
-                           "[grn]\ndt = \"0.05\"\n", "[development]\nmin_cells = 40\nmax_cells = 32\n",
-                           "[scene]\ndrag_normal = -inf\n", "[grn]\nDt = 0.05\n", "[Grn]\ndt = 0.05\n"}) {
+  for (const char* text :
+       {"[genome]\ndimensions = 0\n", "[genome]\ndimensions = 17\n",
+        "[mutation]\ntype_rate = 1.5\n", "[mutation]\nmove_sigma = -0.1\n", "[grn]\ndt = 1.5\n",
+        "[genome]\naffinity_cutoff = 0\n", "[evolution]\nseed = -1\n",
+        "[evolution]\npopulation = true\n", "[grn]\ndt = [0.05]\n", "[grn]\ndt = \"0.05\"\n",
+        "[development]\nmin_cells = 40\nmax_cells = 32\n", "[scene]\ndrag_normal = -inf\n",
+        "[grn]\nDt = 0.05\n", "[Grn]\ndt = 0.05\n"}) {
     const std::string m = expect_config_error([&] { (void)config_from_toml(text, "t.toml"); });
     EXPECT_CONTAINS(m, "t.toml");
   }

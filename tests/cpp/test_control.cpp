@@ -1,7 +1,7 @@
-// Active control (issue 18, include/animat/control.hpp, docs/control.md): the GRN keeps running while
-// the animat swims. Analytic checks of the sensors, of eq. 1 driving the actuation, of signalling
-// (the discrete heat equation on a chain), the push, the config keys, and that open loop is the
-// paper's engine.
+// Active control (issue 18, include/animat/control.hpp, docs/control.md): the GRN keeps running
+// while the animat swims. Analytic checks of the sensors, of eq. 1 driving the actuation, of
+// signalling (the discrete heat equation on a chain), the push, the config keys, and that open loop
+// is the paper's engine.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -31,13 +31,16 @@ using namespace animat;
 
 namespace {
 
-Element special(ElementType t, int channel, double x, double y, int sign = 1) { return Element{t, sign, channel, {x, y}}; }
+Element special(ElementType t, int channel, double x, double y, int sign = 1) {
+  return Element{t, sign, channel, {x, y}};
+}
 Element el(ElementType t, double x, double y) { return Element{t, 1, 0, {x, y}}; }
 
 /// input `channel` -> actuation output at distance 0: weight 10, so L -> tanh(5·input).
 Genome follower(InputChannel channel) {
-  return Genome{2, {special(ElementType::input, static_cast<int>(channel), 0, 0),
-                    special(ElementType::output, static_cast<int>(OutputChannel::actuation), 0, 0)}};
+  return Genome{2,
+                {special(ElementType::input, static_cast<int>(channel), 0, 0),
+                 special(ElementType::output, static_cast<int>(OutputChannel::actuation), 0, 0)}};
 }
 
 GrnControlStart start_for(const Genome& g, int cells, double amplitude_max = 0.2) {
@@ -65,7 +68,9 @@ SwimState state_of(const Body& body, long step, double h) {
 }
 
 // Float-exact coordinates: swim_body() rounds positions to float, so the analytic values are exact.
-Body triangle() { return build_body(points({{0.0, 0.0}, {1.0, 0.0}, {0.5, 0.75}}), Vector(), Vector(), Vector()); }
+Body triangle() {
+  return build_body(points({{0.0, 0.0}, {1.0, 0.0}, {0.5, 0.75}}), Vector(), Vector(), Vector());
+}
 
 }  // namespace
 
@@ -86,7 +91,8 @@ TEST(ControlChemical, CellSensorReadsTheFieldAtTheCell) {
     ControlParams control;
     control.mode = "grn";
     control.start_ramp = 0.0;
-    GrnControl c(body, start_for(follower(InputChannel::chemical), 3), control, scene, PhysicsParams{});
+    GrnControl c(body, start_for(follower(InputChannel::chemical), 3), control, scene,
+                 PhysicsParams{});
     SwimState s = state_of(body, 0, 1.0 / 60.0);
     c.apply(s);
     const double cx = 0.5, cy = 0.25;  // centre of the triangle
@@ -95,7 +101,8 @@ TEST(ControlChemical, CellSensorReadsTheFieldAtTheCell) {
       const double x = body.positions(i, 0), y = body.positions(i, 1);
       const double expected = kind == "point" ? std::exp(-std::hypot(x - sx, y - sy) / 3.0)
                                               : std::exp(-((sx - x) * 0.6 + (sy - y) * 0.8) / 3.0);
-      EXPECT_NEAR(c.sensors()[3 * static_cast<std::size_t>(i) + 2], expected, 1e-12) << kind << " cell " << i;
+      EXPECT_NEAR(c.sensors()[3 * static_cast<std::size_t>(i) + 2], expected, 1e-12)
+          << kind << " cell " << i;
     }
   }
 }
@@ -104,7 +111,8 @@ TEST(ControlSensors, StrainAndPressureOfAUniformStretch) {
   const Body body = triangle();
   ControlParams control;
   control.mode = "grn";
-  GrnControl c(body, start_for(follower(InputChannel::strain), 3), control, SceneParams{}, PhysicsParams{});
+  GrnControl c(body, start_for(follower(InputChannel::strain), 3), control, SceneParams{},
+               PhysicsParams{});
   SwimState s = state_of(body, 0, 1.0 / 60.0);
   for (int i = 0; i < 3; ++i) {  // every length × 1.1 about cell 0: strain 0.1, S/S0 = 1.21
     s.x[static_cast<std::size_t>(i)] *= 1.1;
@@ -112,7 +120,8 @@ TEST(ControlSensors, StrainAndPressureOfAUniformStretch) {
   }
   c.apply(s);
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_NEAR(c.sensors()[3 * i], 0.1, 1e-6) << i;  // rest lengths are re-measured in float (swim_body)
+    // rest lengths are re-measured in float (swim_body)
+    EXPECT_NEAR(c.sensors()[3 * i], 0.1, 1e-6) << i;
     EXPECT_NEAR(c.sensors()[3 * i + 1], 1.21, 1e-6) << i;
   }
 }
@@ -141,7 +150,8 @@ TEST(ControlGrn, ActuationFollowsTheInputThroughEq1) {
   for (long step = 0; step < 200; ++step) {
     s.step = step;
     s.time = step * h;
-    const double shift = 0.5 * std::sin(0.05 * static_cast<double>(step / 4));  // the body slides along x
+    // the body slides along x
+    const double shift = 0.5 * std::sin(0.05 * static_cast<double>(step / 4));
     for (std::size_t i = 0; i < 3; ++i) s.x[i] = body.positions(static_cast<int>(i), 0) + shift;
     c.apply(s);
     if (step % 4 == 0)
@@ -150,10 +160,13 @@ TEST(ControlGrn, ActuationFollowsTheInputThroughEq1) {
         level[i] += (std::tanh(10.0 * cval / 2.0) - level[i]) * delta;
       }
     for (std::size_t i = 0; i < 3; ++i)
-      ASSERT_NEAR(c.terms()[i], 0.25 * (2.0 * level[i] - 1.0), 1e-13) << "step " << step << " cell " << i;
+      ASSERT_NEAR(c.terms()[i], 0.25 * (2.0 * level[i] - 1.0), 1e-13)
+          << "step " << step << " cell " << i;
     for (int e = 0; e < swum.spring_count(); ++e) {
-      const auto a = static_cast<std::size_t>(swum.springs(e, 0)), b = static_cast<std::size_t>(swum.springs(e, 1));
-      ASSERT_NEAR(s.rest[static_cast<std::size_t>(e)], (1.0 + c.terms()[a] + c.terms()[b]) * swum.rest_lengths(e), 1e-13);
+      const auto a = static_cast<std::size_t>(swum.springs(e, 0)),
+                 b = static_cast<std::size_t>(swum.springs(e, 1));
+      ASSERT_NEAR(s.rest[static_cast<std::size_t>(e)],
+                  (1.0 + c.terms()[a] + c.terms()[b]) * swum.rest_lengths(e), 1e-13);
     }
   }
   EXPECT_EQ(c.updates(), 50);
@@ -165,7 +178,8 @@ TEST(ControlGrn, StartRampScalesTheTermsFromZero) {
   control.mode = "grn";
   control.update_interval = 1;
   control.start_ramp = 0.5;
-  GrnControl c(body, start_for(follower(InputChannel::bias), 3), control, SceneParams{}, PhysicsParams{});
+  GrnControl c(body, start_for(follower(InputChannel::bias), 3), control, SceneParams{},
+               PhysicsParams{});
   SwimState s = state_of(body, 0, 1.0 / 60.0);
   c.apply(s);
   EXPECT_EQ(c.terms()[0], 0.0);  // t = 0
@@ -179,7 +193,8 @@ TEST(ControlGrn, StartRampScalesTheTermsFromZero) {
 TEST(ControlSignalling, ChainMatchesTheDiscreteHeatEquation) {
   // Five cells on a line: the Gabriel graph is the chain 0-1-2-3-4. One diffusible product, λ = 0:
   // f' = f + Δ·D·(f_{i-1} − 2 f_i + f_{i+1}) with the chain's ends reflecting (no flux).
-  const Body chain = build_body(points({{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}}), Vector(), Vector(), Vector());
+  const Body chain =
+      build_body(points({{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}}), Vector(), Vector(), Vector());
   ASSERT_EQ(chain.spring_count(), 4);
   const Genome g{2, {el(ElementType::promoter, 0, 0), el(ElementType::morphogen_gene, 9, 9)}};
   GrnControlStart start = start_for(g, 5);
@@ -206,7 +221,8 @@ TEST(ControlSignalling, ChainMatchesTheDiscreteHeatEquation) {
       next[i] = f[i] + r * (left + right);
     }
     f = next;
-    for (std::size_t i = 0; i < 5; ++i) ASSERT_NEAR(c.signals()[i], f[i], 1e-15) << "step " << step << " cell " << i;
+    for (std::size_t i = 0; i < 5; ++i)
+      ASSERT_NEAR(c.signals()[i], f[i], 1e-15) << "step " << step << " cell " << i;
   }
   double total = 0.0;
   for (double v : c.signals()) total += v;
@@ -249,7 +265,8 @@ TEST(ControlConfig, KeysValidateAndNameTheValue) {
     validate(c);
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("control.update_interval = 100"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("control.update_interval = 100"), std::string::npos)
+        << e.what();
   }
   c = Config{};
   EXPECT_THROW(apply_override(c, "scene.chemical=ring"), ConfigError);
@@ -280,10 +297,12 @@ TEST(ControlPush, AddsImpulseOverMassToTheListedCells) {
 TEST(ControlGrn, SwimLoopAllocatesNothing) {
   // A controller with sensors, a morphogen (signalling on) and every update interval's code path.
   const Body body = swimmer(lattice_points(8, 4, 0.1, 2), Drive::none);
-  const Genome g{2, {special(ElementType::input, static_cast<int>(InputChannel::bias), 0, 0), el(ElementType::promoter, 0.5, 0),
-                     el(ElementType::morphogen_gene, 1, 0), special(ElementType::input, static_cast<int>(InputChannel::strain), 1, 0.5),
-                     special(ElementType::input, static_cast<int>(InputChannel::chemical), 0, 1),
-                     special(ElementType::output, static_cast<int>(OutputChannel::actuation), 1, 1)}};
+  const Genome g{2,
+                 {special(ElementType::input, static_cast<int>(InputChannel::bias), 0, 0),
+                  el(ElementType::promoter, 0.5, 0), el(ElementType::morphogen_gene, 1, 0),
+                  special(ElementType::input, static_cast<int>(InputChannel::strain), 1, 0.5),
+                  special(ElementType::input, static_cast<int>(InputChannel::chemical), 0, 1),
+                  special(ElementType::output, static_cast<int>(OutputChannel::actuation), 1, 1)}};
   GrnControlStart start = start_for(g, body.node_count());
   ASSERT_EQ(start.grn.morphogen_units().size(), 1u);
   SceneParams scene = scene_with({"springs", "pressure", "drag", "collisions"});
@@ -334,7 +353,8 @@ TEST(ControlEvaluation, OpenLoopIsTheEngineAndGrnModeSwims) {
   Genome active = viable;
   for (const Element& e : viable.elements)
     if (e.type == ElementType::promoter) {
-      active.elements.push_back(Element{ElementType::output, 1, static_cast<int>(OutputChannel::actuation), e.coords});
+      active.elements.push_back(
+          Element{ElementType::output, 1, static_cast<int>(OutputChannel::actuation), e.coords});
       break;
     }
   Config grn = config;
@@ -351,10 +371,11 @@ TEST(ControlEvaluation, ChemotaxisAveragesProgressOverSeededDirections) {
   config.evaluation.source_directions = 3;
   const auto d0 = source_direction(config, 0), d1 = source_direction(config, 1);
   EXPECT_NEAR(std::hypot(d0[0], d0[1]), 20.0, 1e-12);  // |scene.chemical_source|
-  EXPECT_EQ(source_direction(config, 1), d1);  // deterministic
+  EXPECT_EQ(source_direction(config, 1), d1);          // deterministic
   // An evenly spaced fan: 120° apart, so the sources sum to 0 (straight swimming gains nothing).
   const auto d2 = source_direction(config, 2);
-  EXPECT_NEAR(d0[0] * d1[0] + d0[1] * d1[1], 400.0 * std::cos(2.0 * 3.14159265358979323846 / 3.0), 1e-9);
+  EXPECT_NEAR(d0[0] * d1[0] + d0[1] * d1[1], 400.0 * std::cos(2.0 * 3.14159265358979323846 / 3.0),
+              1e-9);
   EXPECT_NEAR(d0[0] + d1[0] + d2[0], 0.0, 1e-12);
   EXPECT_NEAR(d0[1] + d1[1] + d2[1], 0.0, 1e-12);
   Config other = config;
@@ -403,7 +424,8 @@ TEST(ControlGrn, AmplitudeModeModulatesTheDevelopedOscillator) {
   control.start_ramp = 0.0;
   const PhysicsParams physics;
   const double h = physics.dt, delta = control.grn_rate * 3 * h;
-  GrnControl c(body, start_for(follower(InputChannel::bias), 3, 0.2), control, SceneParams{}, physics);
+  GrnControl c(body, start_for(follower(InputChannel::bias), 3, 0.2), control, SceneParams{},
+               physics);
   SwimState s = state_of(body, 0, h);
   double level = 0.0;
   for (long step = 0; step < 300; ++step) {
@@ -414,7 +436,8 @@ TEST(ControlGrn, AmplitudeModeModulatesTheDevelopedOscillator) {
     for (int i = 0; i < 3; ++i) {
       const double t0 = actuation_start_time(f(i), ph(i));
       const double expected = s.time >= t0 ? 0.2 * level * std::sin(f(i) * s.time + ph(i)) : 0.0;
-      ASSERT_NEAR(c.terms()[static_cast<std::size_t>(i)], expected, 1e-13) << "step " << step << " cell " << i;
+      ASSERT_NEAR(c.terms()[static_cast<std::size_t>(i)], expected, 1e-13)
+          << "step " << step << " cell " << i;
     }
   }
   EXPECT_GT(actuation_start_time(f(2), ph(2)), 0.0);  // one cell starts late, as in open loop

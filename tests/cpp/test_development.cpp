@@ -1,4 +1,5 @@
-// Development (paper §2.2, docs/model.md §2): division, physics while growing, morphogens, viability.
+// Development (paper §2.2, docs/model.md §2): division, physics while growing, morphogens,
+// viability.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,14 +24,17 @@ namespace {
 Element el(ElementType type, int channel, double x, double y, int sign = +1) {
   return Element{type, sign, channel, {x, y}};
 }
-Element out(OutputChannel c, double x, double y) { return el(ElementType::output, static_cast<int>(c), x, y); }
+Element out(OutputChannel c, double x, double y) {
+  return el(ElementType::output, static_cast<int>(c), x, y);
+}
 
 /// The bias input drives divide, amplitude, frequency and phase (affinity 10 at distance 0);
 /// rotate and grow sit far away and stay at 0.
 Genome bias_divide_genome() {
   return Genome{2,
-                {el(ElementType::input, 0, 0, 0), out(OutputChannel::divide, 0, 0), out(OutputChannel::amplitude, 0, 0),
-                 out(OutputChannel::frequency, 0, 0), out(OutputChannel::phase, 0, 0), out(OutputChannel::rotate, 5, 5),
+                {el(ElementType::input, 0, 0, 0), out(OutputChannel::divide, 0, 0),
+                 out(OutputChannel::amplitude, 0, 0), out(OutputChannel::frequency, 0, 0),
+                 out(OutputChannel::phase, 0, 0), out(OutputChannel::rotate, 5, 5),
                  out(OutputChannel::grow, 5, 5)}};
 }
 
@@ -144,8 +148,9 @@ TEST(Development, DaughterGeometry) {
   const Vec2 o(std::cos(a), std::sin(a));
   const int m = w.add_cell(Vec2(1.0, 2.0), 0.6, o);
   GrnState& s = w.state(m);
-  s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::rotate))] = 0.25;  // quarter turn
-  s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::grow))] = 1.0;     // full growth
+  // quarter turn
+  s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::rotate))] = 0.25;
+  s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::grow))] = 1.0;  // full growth
   s.levels[0] = 0.123;  // any level, inherited as is
   const GrnState mother_state = w.state(m);
   const int d = w.divide(m);
@@ -224,8 +229,9 @@ TEST(Development, GradientDivisionAxisFollowsMaternalMorphogenZeroTurnedByRotate
   // to the source, (−3, 4)/5.
   DevelopmentWorld probe(grn, GrnParams{}, p);
   const double h = 1e-6;
-  const Vec2 fd((probe.maternal_at(at + Vec2(h, 0))[0] - probe.maternal_at(at - Vec2(h, 0))[0]) / (2 * h),
-                (probe.maternal_at(at + Vec2(0, h))[0] - probe.maternal_at(at - Vec2(0, h))[0]) / (2 * h));
+  const Vec2 fd(
+      (probe.maternal_at(at + Vec2(h, 0))[0] - probe.maternal_at(at - Vec2(h, 0))[0]) / (2 * h),
+      (probe.maternal_at(at + Vec2(0, h))[0] - probe.maternal_at(at - Vec2(0, h))[0]) / (2 * h));
   EXPECT_NEAR(fd.normalized().x(), -0.6, 1e-6);
   EXPECT_NEAR(fd.normalized().y(), 0.8, 1e-6);
   for (const double rotate : {0.0, 0.25, 0.6}) {
@@ -233,7 +239,8 @@ TEST(Development, GradientDivisionAxisFollowsMaternalMorphogenZeroTurnedByRotate
     const int m = w.add_cell(at, 0.5, Vec2(1.0, 0.0));
     w.state(m).levels[static_cast<std::size_t>(grn.output_node(OutputChannel::rotate))] = rotate;
     const int d = w.divide(m);
-    // Placed division_offset·r_mother away along the gradient turned by 2π·rotate (counter-clockwise).
+    // Placed division_offset·r_mother away along the gradient turned by 2π·rotate
+    // (counter-clockwise).
     const double a = std::atan2(0.8, -0.6) + 2.0 * std::numbers::pi * rotate;
     const Vec2 expected = at + p.division_offset * 0.5 * Vec2(std::cos(a), std::sin(a));
     EXPECT_NEAR(w.position(d).x(), expected.x(), 1e-6) << rotate;  // float positions in Box2D
@@ -282,7 +289,8 @@ TEST(Development, UnknownDivisionAxisIsRejectedNamingKeyAndValue) {
     validate(p);
     FAIL() << "no ConfigError";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("development.division_axis"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("development.division_axis"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("'gradient'"), std::string::npos) << e.what();
   }
   EXPECT_THROW((void)develop(bias_divide_genome(), GenomeParams{}, GrnParams{}, p), ConfigError);
@@ -328,9 +336,9 @@ TEST(Development, OverlappingPairSeparatesGraduallyAndMonotonically) {
     EXPECT_GE(d[s], d[s - 1]) << "step " << s;  // monotone
     max_jump = std::max(max_jump, d[s] - d[s - 1]);
   }
-  EXPECT_LT(max_jump, 0.1);       // no jump: at most a tenth of the contact distance per step
-  EXPECT_LT(d[10], 0.85);         // gradual: still clearly overlapping after 10 steps
-  EXPECT_GT(d[30], 0.95);         // about 30 steps to separate (paper Fig. 2)
+  EXPECT_LT(max_jump, 0.1);         // no jump: at most a tenth of the contact distance per step
+  EXPECT_LT(d[10], 0.85);           // gradual: still clearly overlapping after 10 steps
+  EXPECT_GT(d[30], 0.95);           // about 30 steps to separate (paper Fig. 2)
   EXPECT_LE(d.back(), 1.0 + 1e-5);  // overdamped: settles at contact, no overshoot
   EXPECT_GT(d.back(), 1.0 - 1e-3);
   // The centre of mass does not move (equal and opposite forces, equal masses).
@@ -348,7 +356,8 @@ TEST(Development, DisabledRepulsionCostsNothingAndDoesNothing) {
 
 TEST(Development, AdhesionHoldsATouchingPairAgainstASmallPull) {
   const DevelopmentParams p;
-  const double pull = 0.1;  // below the peak adhesion force adhesion_stiffness·adhesion_range/2 = 0.25
+  // below the peak adhesion force adhesion_stiffness·adhesion_range/2 = 0.25
+  const double pull = 0.1;
   ASSERT_LT(pull, p.adhesion_stiffness * p.adhesion_range / 2);
   auto run = [&](std::vector<std::string> effects) {
     DevelopmentParams q = p;
@@ -369,7 +378,8 @@ TEST(Development, AdhesionHoldsATouchingPairAgainstASmallPull) {
   EXPECT_LT(max_gap, p.adhesion_range / 2);
   const auto [free_gap, unused] = run({"repulsion"});
   (void)unused;
-  EXPECT_GT(free_gap, 2 * p.adhesion_range);  // without adhesion the same pull drags them apart (0.6 after 300 steps)
+  // without adhesion the same pull drags them apart (0.6 after 300 steps)
+  EXPECT_GT(free_gap, 2 * p.adhesion_range);
 }
 
 TEST(Development, MaternalMorphogensFallWithDistanceFromFixedSources) {
@@ -391,7 +401,8 @@ TEST(Development, MaternalMorphogensFallWithDistanceFromFixedSources) {
   w.add_cell(Vec2(1, 1), 0.5, Vec2(1, 0));
   w.sense();
   EXPECT_EQ(w.sensed_maternal(0), w.maternal_at(Vec2(1, 1)));
-  DevelopmentWorld off(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"repulsion"}));
+  DevelopmentWorld off(Grn(morphogen_genome(), GenomeParams{}), GrnParams{},
+                       with_effects({"repulsion"}));
   off.add_cell(Vec2(1, 1), 0.5, Vec2(1, 0));
   off.sense();
   EXPECT_EQ(off.sensed_maternal(0), (std::array<double, 3>{0, 0, 0}));
@@ -404,9 +415,9 @@ TEST(Development, CellMorphogenFallsWithDistanceAndLagsByDistanceOverSpeed) {
   DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, p);
   ASSERT_EQ(w.grn().morphogen_units().size(), 1u);
   const int src = w.add_cell(Vec2(0, 0), 0.5, Vec2(1, 0));
-  const int near = w.add_cell(Vec2(2.0, 0), 0.5, Vec2(1, 0));   // delay 2/0.25 = 8 steps
-  const int far = w.add_cell(Vec2(0, -4.0), 0.5, Vec2(1, 0));   // delay 16 steps
-  const int mid = w.add_cell(Vec2(-2.1, 0), 0.5, Vec2(1, 0));   // delay 8.4 steps: interpolated
+  const int near = w.add_cell(Vec2(2.0, 0), 0.5, Vec2(1, 0));  // delay 2/0.25 = 8 steps
+  const int far = w.add_cell(Vec2(0, -4.0), 0.5, Vec2(1, 0));  // delay 16 steps
+  const int mid = w.add_cell(Vec2(-2.1, 0), 0.5, Vec2(1, 0));  // delay 8.4 steps: interpolated
   const double L = 0.8;
   const int switch_on = 10;
   for (int t = 1; t <= 40; ++t) {
@@ -417,7 +428,8 @@ TEST(Development, CellMorphogenFallsWithDistanceAndLagsByDistanceOverSpeed) {
     const double exp_near = t >= switch_on + 8 ? L * std::exp(-dn / 2.0) : 0.0;
     const double exp_far = t >= switch_on + 16 ? L * std::exp(-df / 2.0) : 0.0;
     // Delay 8.4: sample at t − 8.4, linear between t − 8 and t − 9.
-    const double on_newer = (t - 8 >= switch_on) ? L : 0.0, on_older = (t - 9 >= switch_on) ? L : 0.0;
+    const double on_newer = (t - 8 >= switch_on) ? L : 0.0,
+                 on_older = (t - 9 >= switch_on) ? L : 0.0;
     const double exp_mid = std::exp(-dm / 2.0) * (0.6 * on_newer + 0.4 * on_older);
     EXPECT_NEAR(w.sensed_morphogen(near, 0), exp_near, 1e-6) << "t=" << t;
     EXPECT_NEAR(w.sensed_morphogen(far, 0), exp_far, 1e-6) << "t=" << t;
@@ -425,7 +437,8 @@ TEST(Development, CellMorphogenFallsWithDistanceAndLagsByDistanceOverSpeed) {
     EXPECT_DOUBLE_EQ(w.sensed_morphogen(src, 0), t >= switch_on ? L : 0.0);  // own level, no delay
     // sense() computes the same numbers for all cells at once.
     w.sense();
-    for (int c = 0; c < 4; ++c) EXPECT_NEAR(w.sensed_morphogens(c)[0], w.sensed_morphogen(c, 0), 1e-12);
+    for (int c = 0; c < 4; ++c)
+      EXPECT_NEAR(w.sensed_morphogens(c)[0], w.sensed_morphogen(c, 0), 1e-12);
   }
   // After the delay the level falls with distance.
   EXPECT_GT(w.sensed_morphogen(near, 0), w.sensed_morphogen(mid, 0));
@@ -434,13 +447,15 @@ TEST(Development, CellMorphogenFallsWithDistanceAndLagsByDistanceOverSpeed) {
 }
 
 TEST(Development, SensedMorphogenIsCappedAtOne) {
-  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"morphogens"}));
+  DevelopmentWorld w(Grn(morphogen_genome(), GenomeParams{}), GrnParams{},
+                     with_effects({"morphogens"}));
   GrnState s = w.grn().initial_state();
   s.levels[0] = 0.9;
   for (int i = 0; i < 6; ++i) w.add_cell(Vec2(0.01 * i, 0), 0.5, Vec2(1, 0), &s);
   EXPECT_DOUBLE_EQ(w.sensed_morphogen(0, 0), 1.0);
   // A lone cell senses exactly its own level.
-  DevelopmentWorld lone(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"morphogens"}));
+  DevelopmentWorld lone(Grn(morphogen_genome(), GenomeParams{}), GrnParams{},
+                        with_effects({"morphogens"}));
   lone.add_cell(Vec2::Zero(), 0.5, Vec2(1, 0), &s);
   EXPECT_DOUBLE_EQ(lone.sensed_morphogen(0, 0), 0.9);
 }
@@ -508,12 +523,14 @@ TEST(Development, OscillatorParametersAndTrace) {
   EXPECT_EQ(e.trace.positions.back(), e.positions);
   EXPECT_EQ(e.trace.radii.back(), e.radii);
   EXPECT_EQ(e.trace.orientations.back(), e.orientations);
-  // Rotated daughters make a 2-D cluster: no overlap left at the end (repulsion), compact (adhesion).
+  // Rotated daughters make a 2-D cluster: no overlap left at the end (repulsion), compact
+  // (adhesion).
   double min_gap = 1e9, extent = 0.0;
   for (int i = 0; i < n; ++i) {
     extent = std::max(extent, e.positions.row(i).norm());
     for (int j = i + 1; j < n; ++j)
-      min_gap = std::min(min_gap, (e.positions.row(i) - e.positions.row(j)).norm() - e.radii[i] - e.radii[j]);
+      min_gap = std::min(
+          min_gap, (e.positions.row(i) - e.positions.row(j)).norm() - e.radii[i] - e.radii[j]);
   }
   EXPECT_GT(min_gap, -0.15);  // soft cells: adhesion compresses the cluster a little
   EXPECT_LT(extent, 6.0);
@@ -529,8 +546,10 @@ TEST(Development, DeterministicBitIdentical) {
     const Embryo a = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
     const Embryo b = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
     ASSERT_EQ(a.cell_count(), b.cell_count());
-    EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), sizeof(double) * static_cast<std::size_t>(a.positions.size())));
-    EXPECT_EQ(0, std::memcmp(a.outputs.data(), b.outputs.data(), sizeof(double) * static_cast<std::size_t>(a.outputs.size())));
+    EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(),
+                             sizeof(double) * static_cast<std::size_t>(a.positions.size())));
+    EXPECT_EQ(0, std::memcmp(a.outputs.data(), b.outputs.data(),
+                             sizeof(double) * static_cast<std::size_t>(a.outputs.size())));
     EXPECT_EQ(a.division_steps, b.division_steps);
     EXPECT_EQ(a.reasons, b.reasons);
   }
@@ -538,10 +557,12 @@ TEST(Development, DeterministicBitIdentical) {
   const Embryo a = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
   const Embryo b = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
   ASSERT_EQ(a.cell_count(), 32);
-  EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), sizeof(double) * static_cast<std::size_t>(a.positions.size())));
+  EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(),
+                           sizeof(double) * static_cast<std::size_t>(a.positions.size())));
 }
 
-// --- the pair grid (issue 21) ---------------------------------------------------------------------
+// --- the pair grid (issue 21)
+// ---------------------------------------------------------------------
 
 /// The grid must hand out, in the all-pairs order, a superset of the pairs closer than the reach:
 /// uniform, clustered, collinear, coincident and widely spread points.
@@ -561,9 +582,12 @@ TEST(NeighbourGrid, EveryClosePairInTheAllPairsOrder) {
     }
     sets.push_back(std::move(s));
   };
-  add("uniform", 300, [&](int) { return std::pair{rng.uniform(0.0, 10.0), rng.uniform(0.0, 10.0)}; });
-  add("cluster", 100, [&](int) { return std::pair{rng.uniform(0.0, 0.01), rng.uniform(-0.01, 0.0)}; });
-  add("line", 200, [&](int i) { return std::pair{0.37 * i, 0.0}; });  // pairs exactly at bucket edges
+  add("uniform", 300,
+      [&](int) { return std::pair{rng.uniform(0.0, 10.0), rng.uniform(0.0, 10.0)}; });
+  add("cluster", 100,
+      [&](int) { return std::pair{rng.uniform(0.0, 0.01), rng.uniform(-0.01, 0.0)}; });
+  // pairs exactly at bucket edges
+  add("line", 200, [&](int i) { return std::pair{0.37 * i, 0.0}; });
   add("coincident", 70, [&](int) { return std::pair{1.5, -2.5}; });
   add("spread", 60, [&](int i) { return std::pair{i % 2 ? 1e6 : -1e6, rng.uniform(-1e6, 1e6)}; });
   add("two", 2, [&](int i) { return std::pair{0.0, 0.999 * i}; });
@@ -576,7 +600,8 @@ TEST(NeighbourGrid, EveryClosePairInTheAllPairsOrder) {
       std::vector<std::pair<std::size_t, std::size_t>> seen;
       grid.for_each_pair(n, [&](std::size_t i, std::size_t j) { seen.emplace_back(i, j); });
       ASSERT_TRUE(std::is_sorted(seen.begin(), seen.end())) << s.name;
-      ASSERT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << s.name;  // each pair once
+      // each pair once
+      ASSERT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << s.name;
       std::vector<std::pair<std::size_t, std::size_t>> close, close_seen;
       auto near = [&](std::size_t i, std::size_t j) {
         const double dx = s.x[j] - s.x[i], dy = s.y[j] - s.y[i];
@@ -588,7 +613,8 @@ TEST(NeighbourGrid, EveryClosePairInTheAllPairsOrder) {
       for (const auto& [i, j] : seen)
         if (i < j && near(i, j)) close_seen.emplace_back(i, j);
       EXPECT_EQ(close_seen, close) << s.name << " reach " << reach;
-      if (std::string(s.name) == "uniform" && reach == 0.37) {  // and it is a filter: far fewer than all pairs
+      if (std::string(s.name) == "uniform" && reach == 0.37) {
+        // and it is a filter: far fewer than all pairs
         EXPECT_LT(seen.size(), n * (n - 1) / 20);
       }
     }
@@ -629,10 +655,12 @@ struct GridTwins {
     std::vector<int> slot(static_cast<std::size_t>(cells));
     for (int i = 0; i < cells; ++i) slot[static_cast<std::size_t>(i)] = i;
     for (int i = cells - 1; i > 0; --i)
-      std::swap(slot[static_cast<std::size_t>(i)], slot[static_cast<std::size_t>(jitter.below(static_cast<std::uint64_t>(i) + 1))]);
+      std::swap(slot[static_cast<std::size_t>(i)],
+                slot[static_cast<std::size_t>(jitter.below(static_cast<std::uint64_t>(i) + 1))]);
     for (int i = 0; i < cells; ++i) {
       const int k = slot[static_cast<std::size_t>(i)];
-      const Vec2 at(0.9 * (k % side) + jitter.uniform(-0.2, 0.2), 0.8 * (k / side) + jitter.uniform(-0.2, 0.2));
+      const Vec2 at(0.9 * (k % side) + jitter.uniform(-0.2, 0.2),
+                    0.8 * (k / side) + jitter.uniform(-0.2, 0.2));
       const double radius = 0.5 * (1.0 + 0.5 * jitter.uniform(0.0, 1.0));
       GrnState state = a->grn().initial_state();
       for (double& level : state.levels) level = jitter.uniform(0.0, 0.3);
@@ -647,8 +675,10 @@ struct GridTwins {
       b->step();
       ASSERT_EQ(a->cell_count(), b->cell_count());
       for (int i = 0; i < a->cell_count(); ++i) {
-        ASSERT_EQ(0, std::memcmp(a->position(i).data(), b->position(i).data(), 2 * sizeof(double))) << "step " << t << " cell " << i;
-        ASSERT_EQ(0, std::memcmp(a->velocity(i).data(), b->velocity(i).data(), 2 * sizeof(double))) << "step " << t << " cell " << i;
+        ASSERT_EQ(0, std::memcmp(a->position(i).data(), b->position(i).data(), 2 * sizeof(double)))
+            << "step " << t << " cell " << i;
+        ASSERT_EQ(0, std::memcmp(a->velocity(i).data(), b->velocity(i).data(), 2 * sizeof(double)))
+            << "step " << t << " cell " << i;
         ASSERT_EQ(a->state(i).levels, b->state(i).levels) << "step " << t << " cell " << i;
       }
     }
@@ -676,7 +706,8 @@ TEST(Development, PairGridGivesBitwiseTheAllPairsDevelopment) {
     paper.a->step();
     cut.a->step();
     for (int i = 0; i < paper.a->cell_count(); ++i) {
-      ASSERT_EQ(0, std::memcmp(paper.a->position(i).data(), cut.a->position(i).data(), 2 * sizeof(double)));
+      ASSERT_EQ(0, std::memcmp(paper.a->position(i).data(), cut.a->position(i).data(),
+                               2 * sizeof(double)));
       ASSERT_EQ(paper.a->state(i).levels, cut.a->state(i).levels);
     }
   }
@@ -686,7 +717,8 @@ TEST(Development, MorphogenCutoffSilencesOnlyFartherPairs) {
   DevelopmentParams p = with_effects({"morphogens"});
   p.morphogen_cutoff = 3.0;
   DevelopmentWorld cut(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, p);
-  DevelopmentWorld all(Grn(morphogen_genome(), GenomeParams{}), GrnParams{}, with_effects({"morphogens"}));
+  DevelopmentWorld all(Grn(morphogen_genome(), GenomeParams{}), GrnParams{},
+                       with_effects({"morphogens"}));
   for (DevelopmentWorld* w : {&cut, &all}) {
     GrnState s = w->grn().initial_state();
     s.levels[0] = 0.5;
@@ -702,13 +734,15 @@ TEST(Development, MorphogenCutoffSilencesOnlyFartherPairs) {
   EXPECT_EQ(cut.sensed_morphogens(2)[0], all.sensed_morphogens(2)[0]);
   EXPECT_NEAR(all.sensed_morphogens(3)[0], 0.5 * std::exp(-1.75), 1e-12);
   EXPECT_EQ(cut.sensed_morphogens(3)[0], 0.0);
-  for (int c = 0; c < 4; ++c) EXPECT_NEAR(cut.sensed_morphogens(c)[0], cut.sensed_morphogen(c, 0), 1e-12);
+  for (int c = 0; c < 4; ++c)
+    EXPECT_NEAR(cut.sensed_morphogens(c)[0], cut.sensed_morphogen(c, 0), 1e-12);
   p.morphogen_cutoff = -1.0;
   try {
     validate(p);
     FAIL() << "a negative cut-off was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("development.morphogen_cutoff"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("development.morphogen_cutoff"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -726,7 +760,8 @@ TEST(Development, InvalidParamsAreRejected) {
 TEST(Development, RandomGenomesDevelopFiniteAndBounded) {
   const int count = 2000;
   const DevelopmentParams p;
-  const double sane_radius = 2.0 * p.max_cells * p.cell_radius * (1.0 + p.max_growth);  // a straight chain: 48
+  // a straight chain: 48
+  const double sane_radius = 2.0 * p.max_cells * p.cell_radius * (1.0 + p.max_growth);
   int viable = 0, simulated = 0, grown = 0;
   long long total_cells = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -753,9 +788,13 @@ TEST(Development, RandomGenomesDevelopFiniteAndBounded) {
     grown += e.cell_count() > 1 ? 1 : 0;
     total_cells += e.cell_count();
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("[ development ] %d random genomes in %.2f s: viable %d (%.2f%%), simulated %d, grew %d, mean cells %.2f\n",
-              count, seconds, viable, 100.0 * viable / count, simulated, grown, static_cast<double>(total_cells) / count);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf(
+      "[ development ] %d random genomes in %.2f s: viable %d (%.2f%%), simulated %d, grew %d, "
+      "mean cells %.2f\n",
+      count, seconds, viable, 100.0 * viable / count, simulated, grown,
+      static_cast<double>(total_cells) / count);
   EXPECT_GT(viable, 0);  // the paper needed "a few hundred tries" per viable random genome
 }
 
@@ -781,8 +820,10 @@ TEST(Development, DenseDivisionStressStaysFarBelowTheSpeedCap) {
     const Points pos = w.positions();
     EXPECT_TRUE(pos.allFinite());
     EXPECT_LT(pos.rowwise().norm().maxCoeff(), std::sqrt(cap) * 1.5);
-    std::printf("[ development ] %d cells, every cell dividing every step: largest displacement %.3f per step (Box2D cap 2)\n",
-                cap, max_step);
+    std::printf(
+        "[ development ] %d cells, every cell dividing every step: largest displacement %.3f per "
+        "step (Box2D cap 2)\n",
+        cap, max_step);
     // Terminal displacement under the force cap: time_step·max_force/(cell_mass·damping) = 0.25.
     EXPECT_LT(max_step, 0.26);
   }

@@ -1,6 +1,6 @@
-// Energy accounting (include/animat/energy.hpp): the books of a swim close, on analytic cases (a free
-// edge in the fluid, a damped spring, a compressed pressurised region, a body dropped on the floor,
-// a push) and on the evolved swimmers of tests/data/evolved; keeping them changes no result.
+// Energy accounting (include/animat/energy.hpp): the books of a swim close, on analytic cases (a
+// free edge in the fluid, a damped spring, a compressed pressurised region, a body dropped on the
+// floor, a push) and on the evolved swimmers of tests/data/evolved; keeping them changes no result.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -49,8 +49,8 @@ TEST(EnergyAccount, OffUntilAskedAndKeepingTheBooksChangesNoResult) {
 TEST(EnergyAccount, FreeEdgeLosesExactlyTheAnalyticKineticEnergyToDrag) {
   // One skin edge of length L = 1 between two cells of mass m, moving rigidly with speed u0 normal
   // (then tangential) to itself, drag only. The edge force −d·L·u|u| acts on mass 2m, so
-  // du/dt = −c·u|u| with c = d·L/(2m), u(t) = u0/(1 + c·u0·t); the semi-implicit scheme is exact for a
-  // free edge. The fluid takes m·(u0² − u(T)²), all of it through the part the edge moves in.
+  // du/dt = −c·u|u| with c = d·L/(2m), u(t) = u0/(1 + c·u0·t); the semi-implicit scheme is exact
+  // for a free edge. The fluid takes m·(u0² − u(T)²), all of it through the part the edge moves in.
   SceneParams scene = scene_with({"drag"});
   scene.drag_normal = 2.0;
   scene.drag_tangential = 0.3;
@@ -86,7 +86,8 @@ TEST(EnergyAccount, DampedSpringDissipatesTheElasticEnergyItStartedWith) {
   sim.account_energy();
   const EnergyAccount start = sim.energy_account();
   // Positions are Box2D's floats: 1.2 is 1.2 ± 5e-8.
-  EXPECT_NEAR(start.elastic_start, 0.5 * scene.spring_stiffness * 0.2 * 0.2, scene.spring_stiffness * 0.2 * 1e-7);
+  EXPECT_NEAR(start.elastic_start, 0.5 * scene.spring_stiffness * 0.2 * 0.2,
+              scene.spring_stiffness * 0.2 * 1e-7);
   sim.step(1200);
   const EnergyAccount a = sim.energy_account();
   const double e0 = 0.5 * scene.spring_stiffness * 0.04;
@@ -98,8 +99,8 @@ TEST(EnergyAccount, DampedSpringDissipatesTheElasticEnergyItStartedWith) {
 }
 
 TEST(EnergyAccount, CompressedRegionReturnsItsPressureEnergyToTheDampers) {
-  // A unit square scaled by 0.8 about its centre (rest values from the unscaled square): springs and
-  // pressure push it back, the dampers take the potential it started with.
+  // A unit square scaled by 0.8 about its centre (rest values from the unscaled square): springs
+  // and pressure push it back, the dampers take the potential it started with.
   Body b = square();
   for (int i = 0; i < 4; ++i) b.positions.row(i) = 0.5 + 0.8 * (b.positions.row(i).array() - 0.5);
   SceneParams scene = scene_with({"springs", "pressure"});
@@ -109,15 +110,17 @@ TEST(EnergyAccount, CompressedRegionReturnsItsPressureEnergyToTheDampers) {
   const EnergyAccount a = sim.energy_account();
   EXPECT_GT(a.pressure_start, 0.0);
   EXPECT_GT(a.elastic_start, 0.0);
-  EXPECT_LT(a.pressure_end + a.elastic_end + a.kinetic_end, 1e-9 * (a.pressure_start + a.elastic_start));
+  EXPECT_LT(a.pressure_end + a.elastic_end + a.kinetic_end,
+            1e-9 * (a.pressure_start + a.elastic_start));
   EXPECT_LT(std::abs(a.residual()), 0.01 * throughput(a));
-  EXPECT_NEAR(a.spring_damping, a.pressure_start + a.elastic_start, 0.01 * (a.pressure_start + a.elastic_start));
+  EXPECT_NEAR(a.spring_damping, a.pressure_start + a.elastic_start,
+              0.01 * (a.pressure_start + a.elastic_start));
 }
 
 TEST(EnergyAccount, BodyDroppedOnTheFloorBooksTheGroundAndGravity) {
-  // A pressurised square dropped from y = 2 onto the floor at y = 0, under gravity: it lands, bounces
-  // in its springs and comes to rest. The floor's impulses (inelastic in the normal direction) and
-  // the dampers take the potential energy it lost.
+  // A pressurised square dropped from y = 2 onto the floor at y = 0, under gravity: it lands,
+  // bounces in its springs and comes to rest. The floor's impulses (inelastic in the normal
+  // direction) and the dampers take the potential energy it lost.
   Body b = square();
   for (int i = 0; i < 4; ++i) b.positions(i, 1) += 2.0;
   SceneParams scene = scene_with({"springs", "pressure", "gravity", "ground"});
@@ -128,7 +131,8 @@ TEST(EnergyAccount, BodyDroppedOnTheFloorBooksTheGroundAndGravity) {
   const EnergyAccount a = sim.energy_account();
   EXPECT_GT(sim.counters().ground_contacts, 0);
   const double lost = a.gravity_start - a.gravity_end;
-  EXPECT_NEAR(lost, 4.0 * scene.cell_mass * scene.gravity * 2.0, 0.05 * lost);  // fell about 2 (sags a bit)
+  // fell about 2 (sags a bit)
+  EXPECT_NEAR(lost, 4.0 * scene.cell_mass * scene.gravity * 2.0, 0.05 * lost);
   EXPECT_GT(a.ground, 0.0);
   EXPECT_GT(a.spring_damping, 0.0);
   EXPECT_LT(std::abs(a.residual()), 0.01 * throughput(a));
@@ -136,9 +140,9 @@ TEST(EnergyAccount, BodyDroppedOnTheFloorBooksTheGroundAndGravity) {
 
 TEST(EnergyAccount, FloorEventsInTheCollisionLoopAreBookedAsTheGround) {
   // A lattice dropped hard (g = 20, from 4 up) with collisions and ground: the floor contacts are
-  // events of the collision loop, their impulses are still booked as the floor's, and the books close
-  // up to the position corrections of the landings (a cell that lands at τ·h moved down for τ·h only,
-  // the books assume the whole step), which are O(h): the residual shrinks with the step.
+  // events of the collision loop, their impulses are still booked as the floor's, and the books
+  // close up to the position corrections of the landings (a cell that lands at τ·h moved down for
+  // τ·h only, the books assume the whole step), which are O(h): the residual shrinks with the step.
   double previous = 1.0;
   for (int refine : {1, 4, 16}) {
     Body b = swimmer(lattice_points(5, 3, 0.05, 11), Drive::none);
@@ -153,9 +157,11 @@ TEST(EnergyAccount, FloorEventsInTheCollisionLoopAreBookedAsTheGround) {
     const EnergyAccount a = sim.energy_account();
     EXPECT_GT(sim.counters().ground_contacts, 0);
     EXPECT_GT(a.ground, 0.0);
-    EXPECT_GT(a.gravity_start - a.gravity_end, 0.9 * 15.0 * 20.0 * 4.0);  // fell about 4 (sags a bit)
+    // fell about 4 (sags a bit)
+    EXPECT_GT(a.gravity_start - a.gravity_end, 0.9 * 15.0 * 20.0 * 4.0);
     const double relative = std::abs(a.residual()) / throughput(a);
-    std::printf("dt/%d: residual %.6g of throughput %.6g (%.4g)\n", refine, a.residual(), throughput(a), relative);
+    std::printf("dt/%d: residual %.6g of throughput %.6g (%.4g)\n", refine, a.residual(),
+                throughput(a), relative);
     EXPECT_LT(relative, 0.02) << refine;
     EXPECT_LT(relative, previous) << refine;
     previous = relative;
@@ -191,7 +197,8 @@ TEST(EnergyAccount, ElasticCollisionsDissipateNothingAndTheBooksClose) {
 }
 
 TEST(EnergyAccount, EvolvedSwimmersBooksCloseWithinOnePercent) {
-  // The hard cases selection found, in the environments they evolved in, over the paper's 4000 steps.
+  // The hard cases selection found, in the environments they evolved in, over the paper's 4000
+  // steps.
   for (const Evolved& e : evolved_genomes()) {
     SwimOptions options;
     options.account_energy = true;

@@ -3,9 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "animat/config.hpp"
@@ -37,7 +37,8 @@ std::vector<GenerationStats> run(const Config& c, int generations) {
   return evo.history();
 }
 
-void expect_same_history(const std::vector<GenerationStats>& a, const std::vector<GenerationStats>& b) {
+void expect_same_history(const std::vector<GenerationStats>& a,
+                         const std::vector<GenerationStats>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].generation, b[i].generation);
@@ -50,7 +51,9 @@ void expect_same_history(const std::vector<GenerationStats>& a, const std::vecto
   }
 }
 
-std::filesystem::path fresh_dir(const std::string& name) { return animat::test::fresh_dir("animat_test_", name); }
+std::filesystem::path fresh_dir(const std::string& name) {
+  return animat::test::fresh_dir("animat_test_", name);
+}
 
 }  // namespace
 
@@ -73,16 +76,19 @@ TEST(Tournament, FitterWinsWithProbabilityP) {
 
 TEST(Tournament, DrawsTwoDistinctIndividualsUniformly) {
   std::vector<Individual> pop(5);
-  for (int i = 0; i < 5; ++i) pop[static_cast<std::size_t>(i)].result = {static_cast<double>(i), true, true, 3};
+  for (int i = 0; i < 5; ++i)
+    pop[static_cast<std::size_t>(i)].result = {static_cast<double>(i), true, true, 3};
   const std::vector<std::size_t> eligible = {0, 1, 2, 3, 4};
-  // With p = 1 the winner is the fitter of the pair: P(winner = k) = (number of pairs where k is max)/C(5,2) = k/10.
+  // With p = 1 the winner is the fitter of the pair: P(winner = k) = (number of pairs where k is
+  // max)/C(5,2) = k/10.
   Rng rng(3);
   std::vector<int> wins(5, 0);
   const int draws = 200000;
   for (int k = 0; k < draws; ++k) ++wins[tournament(pop, eligible, 1.0, rng)];
   for (int k = 0; k < 5; ++k) {
     const double p = k / 10.0, sigma = std::sqrt(p * (1 - p) / draws) + 1e-12;
-    EXPECT_NEAR(static_cast<double>(wins[static_cast<std::size_t>(k)]) / draws, p, 5 * sigma) << "k = " << k;
+    EXPECT_NEAR(static_cast<double>(wins[static_cast<std::size_t>(k)]) / draws, p, 5 * sigma)
+        << "k = " << k;
   }
 }
 
@@ -93,7 +99,8 @@ TEST(Tournament, ProbabilityRampsLinearlyOverTheFirst1000Generations) {
   EXPECT_DOUBLE_EQ(tournament_probability(p, 500), 0.9);
   EXPECT_DOUBLE_EQ(tournament_probability(p, 1000), 1.0);
   EXPECT_DOUBLE_EQ(tournament_probability(p, 5000), 1.0);
-  for (int g = 1; g <= 1000; ++g) ASSERT_GT(tournament_probability(p, g), tournament_probability(p, g - 1));
+  for (int g = 1; g <= 1000; ++g)
+    ASSERT_GT(tournament_probability(p, g), tournament_probability(p, g - 1));
 }
 
 TEST(Evolution, InitialPopulationIsViableAndCountsTries) {
@@ -146,7 +153,8 @@ TEST(Evolution, StallStopTriggersAfterExactlyNGenerationsWithoutImprovement) {
     evo.step();
     EXPECT_EQ(evo.generations_without_improvement(), g);
   }
-  EXPECT_NE(evo.stop_reason().find("no improvement for evolution.stall_generations = 7"), std::string::npos)
+  EXPECT_NE(evo.stop_reason().find("no improvement for evolution.stall_generations = 7"),
+            std::string::npos)
       << evo.stop_reason();
   EXPECT_EQ(evo.generation(), 7);
 }
@@ -168,7 +176,10 @@ TEST(Evolution, UnchangedOffspringAreNeverReEvaluated) {
   c.mutation = MutationParams{0, 0, 0, 0, 0, 0, 1, 1};  // no mutation at all
   c.evolution.crossover_fraction = 0.0;
   std::atomic<int> calls{0};
-  const FitnessFunction counting = [&](const Genome& g) { ++calls; return stub_fitness(g); };
+  const FitnessFunction counting = [&](const Genome& g) {
+    ++calls;
+    return stub_fitness(g);
+  };
   Evolution evo(c, counting);
   evo.initialize();
   const int after_init = calls.load();
@@ -209,7 +220,8 @@ TEST(Evolution, CheckpointResumeReproducesTheUninterruptedRun) {
   expect_same_history(straight.history(), resumed.history());
   ASSERT_EQ(straight.population().size(), resumed.population().size());
   for (std::size_t i = 0; i < straight.population().size(); ++i) {
-    EXPECT_TRUE(straight.population()[i].genome == resumed.population()[i].genome) << "individual " << i;
+    EXPECT_TRUE(straight.population()[i].genome == resumed.population()[i].genome)
+        << "individual " << i;
     EXPECT_EQ(straight.population()[i].result, resumed.population()[i].result);
   }
 }
@@ -229,7 +241,9 @@ TEST(Evolution, CorruptOrMismatchedCheckpointIsRefused) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message(good.substr(0, good.size() / 2), c).find("run/checkpoint.json: corrupt checkpoint"), std::string::npos);
+  EXPECT_NE(
+      message(good.substr(0, good.size() / 2), c).find("run/checkpoint.json: corrupt checkpoint"),
+      std::string::npos);
   std::string flipped = good;
   const auto pos = flipped.find("fitness");
   ASSERT_NE(pos, std::string::npos);
@@ -241,7 +255,8 @@ TEST(Evolution, CorruptOrMismatchedCheckpointIsRefused) {
   Config longer = c;
   longer.evolution.generations = 500;  // stopping knobs may change on resume
   EXPECT_EQ(message(good, longer), "no error");
-  EXPECT_NE(message("{\"checksum\": \"0\", \"payload\": 3}", c).find("not an animat checkpoint"), std::string::npos);
+  EXPECT_NE(message("{\"checksum\": \"0\", \"payload\": 3}", c).find("not an animat checkpoint"),
+            std::string::npos);
 }
 
 TEST(RunDirectory, WritesConfigHistoryLineageAndCheckpointThenResumes) {
@@ -256,7 +271,10 @@ TEST(RunDirectory, WritesConfigHistoryLineageAndCheckpointThenResumes) {
   EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.json"));
   EXPECT_EQ(load_config(dir / "config.toml"), c);
   const std::string hist = slurp(dir / "history.csv");
-  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,drag_limited,wall_seconds\n", 0), 0u);
+  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,best_"
+                       "reference,invalid,drag_limited,wall_seconds\n",
+                       0),
+            0u);
   EXPECT_EQ(std::count(hist.begin(), hist.end(), '\n'), 1 + 7);  // header + generations 0..6
   EXPECT_TRUE(std::filesystem::exists(dir / "best" / "gen_000000.json"));
 
@@ -288,12 +306,14 @@ TEST(RunDirectory, MissingResumeDirectoryIsAClearError) {
     (void)run_evolution(small_config(), opt, stub_fitness);
     FAIL() << "expected an error";
   } catch (const IoError& e) {
-    EXPECT_NE(std::string(e.what()).find("resume directory does not exist"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("resume directory does not exist"), std::string::npos)
+        << e.what();
   }
 }
 
 TEST(EndToEnd, SmallRealRunImprovesTheBestFitness) {
-  // Real chain (development, body, swim) at a small scale: 16 individuals, 10 generations, 1000 steps.
+  // Real chain (development, body, swim) at a small scale: 16 individuals, 10 generations, 1000
+  // steps.
   Config c;
   c.evolution.population = 16;
   c.evolution.generations = 10;
@@ -328,7 +348,8 @@ TEST(EndToEnd, RealRunIsIdenticalOnOneAndTwoThreads) {
   EXPECT_TRUE(one.best.genome == two.best.genome);
 }
 
-// --- The Python paths held to the engine's rules (tell, statistics, the exploit guard) ----------------
+// --- The Python paths held to the engine's rules (tell, statistics, the exploit guard)
+// ----------------
 
 namespace {
 
@@ -369,7 +390,8 @@ TEST(Evolution, TellRefusesWhatTheEnginesOwnEvaluationsRefuseNamingTheValue) {
   const std::string cells = told(4, Fitness{1.0, true, true, -7});
   EXPECT_NE(cells.find("value 4"), std::string::npos) << cells;
   EXPECT_NE(cells.find("cell_count -7"), std::string::npos) << cells;
-  const std::string infinite = told(0, Fitness{std::numeric_limits<double>::infinity(), true, true, 3});
+  const std::string infinite =
+      told(0, Fitness{std::numeric_limits<double>::infinity(), true, true, 3});
   EXPECT_NE(infinite.find("value 0"), std::string::npos) << infinite;
   EXPECT_NE(infinite.find("fitness inf"), std::string::npos) << infinite;
   // Nothing was taken: the ask is still pending, and a good tell completes generation 0.
@@ -411,7 +433,8 @@ TEST(RunDirectory, HugeFiniteFitnessesGiveAFiniteHistoryAndAResumableCheckpoint)
   // resumed run is the uninterrupted one.
   const FitnessFunction huge = [](const Genome& g) {
     Fitness f = stub_fitness(g);
-    if (f.viable) f.fitness = kHuge * (0.5 + 0.25 * std::clamp(f.fitness, -1.0, 1.0));  // in [DBL_MAX/4, 3 DBL_MAX/4]
+    // in [DBL_MAX/4, 3 DBL_MAX/4]
+    if (f.viable) f.fitness = kHuge * (0.5 + 0.25 * std::clamp(f.fitness, -1.0, 1.0));
     return f;
   };
   const auto dir = fresh_dir("huge");
@@ -449,7 +472,8 @@ TEST(Evolution, ARefusedReferenceLeavesTheEngineAsBeforeTheTell) {
   int calls = 0;
   const FitnessFunction flaky = [&calls](const Genome& g) {
     Fitness f = stub_fitness(g);
-    if (++calls == 1) f.fitness = std::numeric_limits<double>::quiet_NaN();  // first reference: refused
+    // first reference: refused
+    if (++calls == 1) f.fitness = std::numeric_limits<double>::quiet_NaN();
     return f;
   };
   Evolution evo(c, {}, flaky);
@@ -487,8 +511,8 @@ TEST(Evolution, ARefusedReferenceLeavesTheEngineAsBeforeTheTell) {
 }
 
 TEST(Evolution, AFitnessFunctionThatIsInterruptedStopsTheGenerationAtOnce) {
-  // A Python objective hit by Ctrl-C throws Interrupted: no evaluation starts after it (they all did,
-  // one after the other, before), and the run stops "interrupted" with a resumable checkpoint.
+  // A Python objective hit by Ctrl-C throws Interrupted: no evaluation starts after it (they all
+  // did, one after the other, before), and the run stops "interrupted" with a resumable checkpoint.
   Config c = small_config(8);
   c.evolution.generations = 4;
   c.evaluation.reference_check = "off";

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <iomanip>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <numbers>
 #include <set>
@@ -33,7 +33,8 @@ constexpr auto M = ElementType::morphogen_gene;
 constexpr auto I = ElementType::input;
 constexpr auto O = ElementType::output;
 
-// Elements of a hand-built genome get distinct coordinates (x = index) so that they can be told apart.
+// Elements of a hand-built genome get distinct coordinates (x = index) so that they can be told
+// apart.
 Genome make(std::initializer_list<ElementType> types) {
   Genome g;
   g.dimensions = 2;
@@ -45,7 +46,8 @@ Genome make(std::initializer_list<ElementType> types) {
   return g;
 }
 
-std::vector<RegulatoryUnit> units(std::initializer_list<std::pair<std::vector<int>, std::vector<int>>> list) {
+std::vector<RegulatoryUnit> units(
+    std::initializer_list<std::pair<std::vector<int>, std::vector<int>>> list) {
   std::vector<RegulatoryUnit> out;
   for (const auto& [p, g] : list) out.push_back(RegulatoryUnit{p, g});
   return out;
@@ -60,20 +62,26 @@ std::string message_of(const auto& f) {
   return "<no exception>";
 }
 
-fs::path bad_input(const std::string& name) { return fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / name; }
+fs::path bad_input(const std::string& name) {
+  return fs::path(ANIMAT_SOURCE_DIR) / "tests" / "bad_inputs" / name;
+}
 
 fs::path temp_path(const std::string& name) {
   // Per process: ctest runs tests in parallel, and other build trees may run the same tests.
-  return fs::temp_directory_path() / ("animat_test_genome_" + std::to_string(::getpid()) + "_" + name);
+  return fs::temp_directory_path() /
+         ("animat_test_genome_" + std::to_string(::getpid()) + "_" + name);
 }
 
 bool bit_equal(const Genome& a, const Genome& b) {
   if (a.dimensions != b.dimensions || a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const Element &x = a.elements[i], &y = b.elements[i];
-    if (x.type != y.type || x.sign != y.sign || x.channel != y.channel || x.coords.size() != y.coords.size()) return false;
+    if (x.type != y.type || x.sign != y.sign || x.channel != y.channel ||
+        x.coords.size() != y.coords.size())
+      return false;
     for (std::size_t k = 0; k < x.coords.size(); ++k)
-      if (std::bit_cast<std::uint64_t>(x.coords[k]) != std::bit_cast<std::uint64_t>(y.coords[k])) return false;
+      if (std::bit_cast<std::uint64_t>(x.coords[k]) != std::bit_cast<std::uint64_t>(y.coords[k]))
+        return false;
   }
   return true;
 }
@@ -88,9 +96,7 @@ Genome random_with(std::uint64_t seed, const GenomeParams& p = {}) {
 // ---------------------------------------------------------------------------------------------------
 // Affinity
 
-TEST(Affinity, TenAtZeroDistanceForDefaults) {
-  EXPECT_EQ(affinity(0.0, GenomeParams{}), 10.0);
-}
+TEST(Affinity, TenAtZeroDistanceForDefaults) { EXPECT_EQ(affinity(0.0, GenomeParams{}), 10.0); }
 
 TEST(Affinity, ExactlyTenAtZeroDistanceForEveryDecayAndCutoff) {
   // "Affinity weight: 10 at distance 0" must hold for every configured decay and cut-off, exactly.
@@ -103,7 +109,8 @@ TEST(Affinity, ExactlyTenAtZeroDistanceForEveryDecayAndCutoff) {
       p.affinity_cutoff = cutoff;
       const double a = affinity(0.0, p);
       if (a != 10.0) {
-        if (wrong++ == 0) first = "decay " + std::to_string(decay) + ", cutoff " + std::to_string(cutoff);
+        if (wrong++ == 0)
+          first = "decay " + std::to_string(decay) + ", cutoff " + std::to_string(cutoff);
       }
     }
   }
@@ -111,7 +118,8 @@ TEST(Affinity, ExactlyTenAtZeroDistanceForEveryDecayAndCutoff) {
   GenomeParams p;
   p.affinity_decay = 0.5;
   p.affinity_cutoff = 0.5;
-  EXPECT_EQ(affinity(0.0, p), 10.0) << "decay 0.5, cutoff 0.5: affinity(0) = " << std::setprecision(17) << affinity(0.0, p);
+  EXPECT_EQ(affinity(0.0, p), 10.0)
+      << "decay 0.5, cutoff 0.5: affinity(0) = " << std::setprecision(17) << affinity(0.0, p);
 }
 
 TEST(Affinity, MatchesShiftedExponentialClosedForm) {
@@ -121,7 +129,8 @@ TEST(Affinity, MatchesShiftedExponentialClosedForm) {
     const double expected = 10.0 * (std::exp(-d) - tail) / (1.0 - tail);
     EXPECT_NEAR(affinity(d, p), expected, 1e-12) << "d = " << d;
   }
-  EXPECT_NEAR(affinity(1.0, p), 10.0 * (std::exp(-1.0) - std::exp(-2.0)) / (1.0 - std::exp(-2.0)), 1e-12);
+  EXPECT_NEAR(affinity(1.0, p), 10.0 * (std::exp(-1.0) - std::exp(-2.0)) / (1.0 - std::exp(-2.0)),
+              1e-12);
 }
 
 TEST(Affinity, StrictlyDecreasingBelowCutoffAndPositive) {
@@ -205,7 +214,8 @@ TEST(Parse, OnlyPromotersAreNonCoding) {
 }
 
 TEST(Parse, OnlyGenesAreNonCoding) {
-  for (auto g : {make({G}), make({M}), make({G, M, G, G})}) EXPECT_TRUE(parse_units(g).units.empty());
+  for (auto g : {make({G}), make({M}), make({G, M, G, G})})
+    EXPECT_TRUE(parse_units(g).units.empty());
 }
 
 TEST(Parse, SinglePromoterGene) {
@@ -231,7 +241,8 @@ TEST(Parse, TrailingStrayPromoters) {
 }
 
 TEST(Parse, PromoterAfterGenesStartsANewUnit) {
-  EXPECT_EQ(parse_units(make({P, G, G, P, P, G, M})).units, units({{{0}, {1, 2}}, {{3, 4}, {5, 6}}}));
+  EXPECT_EQ(parse_units(make({P, G, G, P, P, G, M})).units,
+            units({{{0}, {1, 2}}, {{3, 4}, {5, 6}}}));
 }
 
 TEST(Parse, SpecialBetweenPromoterAndGeneBreaksTheUnit) {
@@ -285,18 +296,23 @@ TEST(Validate, AcceptsWellFormedAndRejectsEachDefectNamingIt) {
   Genome bad_sign = ok;
   bad_sign.elements[1].sign = 0;
   EXPECT_THROW(validate(bad_sign, GenomeParams{}), GenomeError);
-  EXPECT_NE(message_of([&] { validate(bad_sign, GenomeParams{}, "g.json"); }).find("g.json: element 1: sign = 0"),
+  EXPECT_NE(message_of([&] {
+              validate(bad_sign, GenomeParams{}, "g.json");
+            }).find("g.json: element 1: sign = 0"),
             std::string::npos);
 
   Genome bad_input_channel = ok;
-  bad_input_channel.elements[2].channel = 7;  // 0-3 the paper's, 4-6 the extensions (strain, pressure, chemical)
+  // 0-3 the paper's, 4-6 the extensions (strain, pressure, chemical)
+  bad_input_channel.elements[2].channel = 7;
   const std::string m1 = message_of([&] { validate(bad_input_channel, GenomeParams{}); });
   EXPECT_NE(m1.find("element 2"), std::string::npos) << m1;
   EXPECT_NE(m1.find("channel 7 out of range [0, 7)"), std::string::npos) << m1;
 
   Genome bad_output_channel = ok;
   bad_output_channel.elements[3].channel = 8;  // 0-5 the paper's, 6-7 stiffness and actuation
-  EXPECT_NE(message_of([&] { validate(bad_output_channel, GenomeParams{}); }).find("channel 8 out of range [0, 8)"),
+  EXPECT_NE(message_of([&] {
+              validate(bad_output_channel, GenomeParams{});
+            }).find("channel 8 out of range [0, 8)"),
             std::string::npos);
 
   Genome channel_on_promoter = ok;
@@ -305,13 +321,17 @@ TEST(Validate, AcceptsWellFormedAndRejectsEachDefectNamingIt) {
 
   Genome bad_type = ok;
   bad_type.elements[0].type = static_cast<ElementType>(7);
-  EXPECT_NE(message_of([&] { validate(bad_type, GenomeParams{}); }).find("unknown type 7"), std::string::npos);
+  EXPECT_NE(message_of([&] { validate(bad_type, GenomeParams{}); }).find("unknown type 7"),
+            std::string::npos);
 
   Genome bad_coords = ok;
   bad_coords.elements[1].coords.push_back(1.0);
-  EXPECT_NE(message_of([&] { validate(bad_coords, GenomeParams{}); }).find("3 coordinates, expected 2"), std::string::npos);
+  EXPECT_NE(
+      message_of([&] { validate(bad_coords, GenomeParams{}); }).find("3 coordinates, expected 2"),
+      std::string::npos);
 
-  for (double x : {std::nan(""), std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
+  for (double x : {std::nan(""), std::numeric_limits<double>::infinity(),
+                   -std::numeric_limits<double>::infinity()}) {
     Genome nonfinite = ok;
     nonfinite.elements[3].coords[1] = x;
     const std::string m = message_of([&] { validate(nonfinite, GenomeParams{}); });
@@ -321,11 +341,14 @@ TEST(Validate, AcceptsWellFormedAndRejectsEachDefectNamingIt) {
 
   Genome bad_dims = ok;
   bad_dims.dimensions = 0;
-  EXPECT_NE(message_of([&] { validate(bad_dims, GenomeParams{}); }).find("dimensions = 0"), std::string::npos);
+  EXPECT_NE(message_of([&] { validate(bad_dims, GenomeParams{}); }).find("dimensions = 0"),
+            std::string::npos);
 
   GenomeParams small;
   small.max_elements = 3;
-  EXPECT_NE(message_of([&] { validate(ok, small); }).find("4 elements exceed genome.max_elements = 3"), std::string::npos);
+  EXPECT_NE(
+      message_of([&] { validate(ok, small); }).find("4 elements exceed genome.max_elements = 3"),
+      std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -337,7 +360,8 @@ TEST(RandomGenome, HasThePaperLayout) {
     const Genome g = random_with(seed, p);
     ASSERT_NO_THROW(validate(g, p));
     EXPECT_EQ(g.dimensions, 2);
-    EXPECT_EQ(g.size(), static_cast<std::size_t>(2 * p.initial_units + kPaperInputCount + kPaperOutputCount));
+    EXPECT_EQ(g.size(),
+              static_cast<std::size_t>(2 * p.initial_units + kPaperInputCount + kPaperOutputCount));
     const GenomeLayout l = parse_units(g);
     ASSERT_EQ(l.units.size(), static_cast<std::size_t>(p.initial_units)) << "seed " << seed;
     for (const auto& u : l.units) {
@@ -402,8 +426,9 @@ TEST(RandomGenome, IsValidUnderEveryConfigThatValidates) {
   if (config_accepted) {
     Rng rng(1);
     const Genome g = random_genome(c.genome, rng);
-    EXPECT_NO_THROW(validate(g, c.genome)) << "config with genome.max_elements = 20 validates, but the random genome has "
-                                           << g.size() << " elements";
+    EXPECT_NO_THROW(validate(g, c.genome))
+        << "config with genome.max_elements = 20 validates, but the random genome has " << g.size()
+        << " elements";
   }
 }
 
@@ -449,7 +474,8 @@ TEST(Operators, MutateTypesReachesEveryTypeAndChannel) {
   EXPECT_EQ(seen.size(), 3u + kPaperInputCount + kPaperOutputCount);  // the paper's channels only
 }
 
-// --- Extension channels (genome.extra_inputs / extra_outputs, docs/model.md "Genome channels") ----
+// --- Extension channels (genome.extra_inputs / extra_outputs, docs/model.md "Genome channels")
+// ----
 
 TEST(GenomeChannels, FixedNumbersAndNames) {
   EXPECT_EQ(static_cast<int>(InputChannel::strain), 4);
@@ -490,7 +516,8 @@ TEST(GenomeChannels, EnabledListsParseInChannelOrderAndRejectBadNames) {
     validate(c);
     ADD_FAILURE() << "a paper channel is not an extension";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("genome.extra_outputs = \"divide\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("genome.extra_outputs = \"divide\""), std::string::npos)
+        << e.what();
   }
   apply_override(c, "genome.extra_outputs=actuation");
   EXPECT_NO_THROW(validate(c));
@@ -625,8 +652,10 @@ TEST(Operators, DuplicateSeriesInsertsACopyRightAfter) {
       const std::size_t real = std::min(len, orig.size() - start);
       ASSERT_EQ(g.size(), orig.size() + real) << start << "," << len;
       for (std::size_t i = 0; i < start + real; ++i) EXPECT_EQ(g.elements[i], orig.elements[i]);
-      for (std::size_t i = 0; i < real; ++i) EXPECT_EQ(g.elements[start + real + i], orig.elements[start + i]);
-      for (std::size_t i = start + real; i < orig.size(); ++i) EXPECT_EQ(g.elements[i + real], orig.elements[i]);
+      for (std::size_t i = 0; i < real; ++i)
+        EXPECT_EQ(g.elements[start + real + i], orig.elements[start + i]);
+      for (std::size_t i = start + real; i < orig.size(); ++i)
+        EXPECT_EQ(g.elements[i + real], orig.elements[i]);
       EXPECT_NO_THROW(validate(g, GenomeParams{}));
     }
   }
@@ -646,7 +675,8 @@ TEST(Operators, DeleteSeriesRemovesExactlyTheSeries) {
       const std::size_t real = std::min(len, orig.size() - start);
       ASSERT_EQ(g.size(), orig.size() - real) << start << "," << len;
       for (std::size_t i = 0; i < start; ++i) EXPECT_EQ(g.elements[i], orig.elements[i]);
-      for (std::size_t i = start; i < g.size(); ++i) EXPECT_EQ(g.elements[i], orig.elements[i + real]);
+      for (std::size_t i = start; i < g.size(); ++i)
+        EXPECT_EQ(g.elements[i], orig.elements[i + real]);
       EXPECT_NO_THROW(validate(g, GenomeParams{}));
     }
   }
@@ -750,7 +780,8 @@ TEST(Operators, CrossoverOfIdenticalParentsIsTheSameGenome) {
     const Genome a = random_with(seed);
     for (int points : {1, 2, 3, 7}) {
       Rng rng(seed * 31 + static_cast<std::uint64_t>(points));
-      EXPECT_TRUE(bit_equal(crossover(a, a, points, rng), a)) << "seed " << seed << " points " << points;
+      EXPECT_TRUE(bit_equal(crossover(a, a, points, rng), a))
+          << "seed " << seed << " points " << points;
     }
   }
 }
@@ -781,7 +812,8 @@ TEST(Operators, CrossoverOfDifferentLengthsIsBuiltFromParentSegments) {
       from = now;
     }
     EXPECT_LE(switches, points);
-    // The documented construction: sorted cut points in [0, min(|a|,|b|)], segments alternate from a.
+    // The documented construction: sorted cut points in [0, min(|a|,|b|)], segments alternate from
+    // a.
     const std::size_t shortest = std::min(a.size(), b.size());
     std::vector<std::size_t> cuts;
     for (int k = 0; k < points; ++k) cuts.push_back(replay.below(shortest + 1));
@@ -831,7 +863,8 @@ TEST(Operators, CrossoverOfDifferentDimensionsIsRejectedOrValid) {
     threw = true;
   }
   if (!threw) {
-    EXPECT_NO_THROW(validate(child, GenomeParams{})) << "crossover silently mixed 2-D and 3-D elements";
+    EXPECT_NO_THROW(validate(child, GenomeParams{}))
+        << "crossover silently mixed 2-D and 3-D elements";
   }
 }
 
@@ -867,7 +900,8 @@ TEST(Json, RoundTripIsBitExactIncludingAwkwardDoubles) {
     EXPECT_EQ(to_json(back, indent), text);
     EXPECT_EQ(genome_hash(back), genome_hash(g));
   }
-  EXPECT_TRUE(std::signbit(genome_from_json(to_json(g)).elements[1].coords[0]));  // -0.0 keeps its sign
+  // -0.0 keeps its sign
+  EXPECT_TRUE(std::signbit(genome_from_json(to_json(g)).elements[1].coords[0]));
 }
 
 TEST(Json, RoundTripOfRandomAndMutatedGenomes) {
@@ -930,7 +964,8 @@ TEST(Json, GenomeHashEqualGenomesEqualHashes) {
   z1.elements[0].coords[0] = 0.0;
   z2.elements[0].coords[0] = -0.0;
   ASSERT_TRUE(z1 == z2);
-  EXPECT_EQ(genome_hash(z1), genome_hash(z2)) << "equal genomes (0.0 vs -0.0 coordinate) hash differently";
+  EXPECT_EQ(genome_hash(z1), genome_hash(z2))
+      << "equal genomes (0.0 vs -0.0 coordinate) hash differently";
 }
 
 // --- Bad JSON: every case is a GenomeError whose message names the file and the problem.
@@ -961,7 +996,8 @@ TEST_P(BadGenomeJson, IsAGenomeErrorNamingFileAndProblem) {
   }
   EXPECT_TRUE(genome_error) << c.file << ": " << msg;
   EXPECT_NE(msg.find(path.string()), std::string::npos) << msg;
-  for (const auto& s : c.expect) EXPECT_NE(msg.find(s), std::string::npos) << "expected '" << s << "' in: " << msg;
+  for (const auto& s : c.expect)
+    EXPECT_NE(msg.find(s), std::string::npos) << "expected '" << s << "' in: " << msg;
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -974,7 +1010,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadGenomeCase{"genome_infinity_literal.json", {"not valid JSON"}},
         BadGenomeCase{"genome_overflow.json", {"1e999"}},
         BadGenomeCase{"genome_unknown_type.json", {"element 1", "unknown type \"enhancer\""}},
-        BadGenomeCase{"genome_input_channel_out_of_range.json", {"element 0", "channel \"maternal7\"", "input"}},
+        BadGenomeCase{"genome_input_channel_out_of_range.json",
+                      {"element 0", "channel \"maternal7\"", "input"}},
         BadGenomeCase{"genome_output_channel_number.json", {"element 0", "channel 6", "output"}},
         BadGenomeCase{"genome_missing_coords.json", {"element 0", "missing key \"coords\""}},
         BadGenomeCase{"genome_missing_elements.json", {"missing key \"elements\""}},
@@ -982,8 +1019,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadGenomeCase{"genome_version_wraps_to_1.json", {"\"version\" 4294967297"}},
         BadGenomeCase{"genome_wrong_format.json", {"\"animat.chromosome\"", "\"animat.genome\""}},
         BadGenomeCase{"genome_sign_zero.json", {"element 0", "sign is 0"}},
-        BadGenomeCase{"genome_sign_wraps_to_minus_1.json", {"element 0", "sign is 18446744073709551615"}},
-        BadGenomeCase{"genome_coords_wrong_length.json", {"element 0", "coords must be an array of 2 numbers"}},
+        BadGenomeCase{"genome_sign_wraps_to_minus_1.json",
+                      {"element 0", "sign is 18446744073709551615"}},
+        BadGenomeCase{"genome_coords_wrong_length.json",
+                      {"element 0", "coords must be an array of 2 numbers"}},
         BadGenomeCase{"genome_dimensions_zero.json", {"\"dimensions\" is 0"}},
         BadGenomeCase{"genome_channel_on_promoter.json", {"element 0", "promoter has no channel"}},
         BadGenomeCase{"genome_not_an_object.json", {"expected a JSON object"}}),
@@ -1000,7 +1039,8 @@ TEST(JsonBad, NonFiniteCoordinatesNamedFromString) {
   const std::string text =
       R"({"format":"animat.genome","version":1,"dimensions":2,"elements":[{"type":"promoter","sign":1,"coords":[1,2]},)"
       R"({"type":"input","sign":1,"channel":"bias","coords":[-1e400,0]}]})";
-  const std::string m = message_of([&] { (void)genome_from_json(text, GenomeParams{}, "parents.json"); });
+  const std::string m =
+      message_of([&] { (void)genome_from_json(text, GenomeParams{}, "parents.json"); });
   EXPECT_NE(m.find("parents.json"), std::string::npos) << m;
   EXPECT_NE(m.find("1e400"), std::string::npos) << m;
   EXPECT_THROW((void)genome_from_json(text, GenomeParams{}, "parents.json"), GenomeError);
@@ -1013,8 +1053,11 @@ TEST(JsonBad, TooManyElementsForMaxElements) {
   text.reserve(text.size() + 2 * n + 4);
   for (std::size_t i = 0; i < n; ++i) text += i ? ",0" : "0";
   text += "]}";
-  const std::string m = message_of([&] { (void)genome_from_json(text, GenomeParams{}, "huge.json"); });
-  EXPECT_NE(m.find("huge.json: 10000000 elements exceed genome.max_elements = 10000"), std::string::npos) << m.substr(0, 300);
+  const std::string m =
+      message_of([&] { (void)genome_from_json(text, GenomeParams{}, "huge.json"); });
+  EXPECT_NE(m.find("huge.json: 10000000 elements exceed genome.max_elements = 10000"),
+            std::string::npos)
+      << m.substr(0, 300);
 
   // Valid elements, one more than a small cap.
   GenomeParams p;

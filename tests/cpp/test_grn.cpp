@@ -1,6 +1,6 @@
-// GRN (include/animat/grn.hpp, docs/model.md §1, paper eq. 1): edges from affinities, the relaxation
-// ΔL = (tanh(max(A,0)/2) − L)·Δt against its closed form, levels in [0, 1), inputs (bias, maternal,
-// sensed morphogens), reachability (viability criterion 1) and the DOT export.
+// GRN (include/animat/grn.hpp, docs/model.md §1, paper eq. 1): edges from affinities, the
+// relaxation ΔL = (tanh(max(A,0)/2) − L)·Δt against its closed form, levels in [0, 1), inputs
+// (bias, maternal, sensed morphogens), reachability (viability criterion 1) and the DOT export.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,7 +20,9 @@ constexpr auto P = ElementType::promoter;
 constexpr auto G = ElementType::internal_gene;
 constexpr auto M = ElementType::morphogen_gene;
 
-Element el(ElementType t, double x, double y, int sign = 1, int channel = 0) { return Element{t, sign, channel, {x, y}}; }
+Element el(ElementType t, double x, double y, int sign = 1, int channel = 0) {
+  return Element{t, sign, channel, {x, y}};
+}
 Element in(InputChannel c, double x, double y, int sign = 1) {
   return Element{ElementType::input, sign, static_cast<int>(c), {x, y}};
 }
@@ -29,7 +31,8 @@ Element out(OutputChannel c, double x, double y, int sign = 1) {
 }
 Genome genome(std::vector<Element> els) { return Genome{2, std::move(els)}; }
 
-// Source indices as documented: 0-3 inputs, 4+u internal product of unit u, 4+U+u diffusible product.
+// Source indices as documented: 0-3 inputs, 4+u internal product of unit u, 4+U+u diffusible
+// product.
 int internal_src(int u) { return kPaperInputCount + u; }
 int diffusible_src(const Grn& g, int u) { return kPaperInputCount + g.unit_count() + u; }
 
@@ -51,7 +54,8 @@ bool has_edge(const Grn& g, int source, int target) {
 }
 
 // Runs `steps` steps and returns the trajectory of node `node` (k = 0..steps).
-std::vector<double> trajectory(const Grn& g, int node, int steps, const GrnInputs& inputs = {}, double dt = 0.05) {
+std::vector<double> trajectory(const Grn& g, int node, int steps, const GrnInputs& inputs = {},
+                               double dt = 0.05) {
   GrnState s = g.initial_state();
   GrnParams p;
   p.dt = dt;
@@ -63,7 +67,8 @@ std::vector<double> trajectory(const Grn& g, int node, int steps, const GrnInput
   return out;
 }
 
-void expect_closed_form(const std::vector<double>& L, double T, double dt, const std::string& what) {
+void expect_closed_form(const std::vector<double>& L, double T, double dt,
+                        const std::string& what) {
   for (std::size_t k = 0; k < L.size(); ++k) {
     const double expected = T * (1.0 - std::pow(1.0 - dt, static_cast<double>(k)));
     EXPECT_NEAR(L[k], expected, 1e-12) << what << ", step " << k;
@@ -76,8 +81,8 @@ void expect_closed_form(const std::vector<double>& L, double T, double dt, const
 // Structure
 
 TEST(GrnStructure, NodesAreUnitsThenOutputs) {
-  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 9, 9), el(P, 5, 5), el(M, 5, 5),
-                           out(OutputChannel::divide, 9, 9)});
+  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 9, 9), el(P, 5, 5),
+                           el(M, 5, 5), out(OutputChannel::divide, 9, 9)});
   const Grn grn(g, GenomeParams{});
   EXPECT_EQ(grn.unit_count(), 2);
   EXPECT_EQ(grn.node_count(), 2 + kPaperOutputCount);  // no extension output: the paper's 6
@@ -103,18 +108,22 @@ TEST(GrnStructure, EmptyGenome) {
 TEST(GrnStructure, EdgeWeightIsSumOfAffinityTimesSignProducts) {
   GenomeParams p;
   // Unit 0: promoters at distance 0 and 1 from the bias; unit 1's promoter is inhibited by a
-  // negative maternal0 input at distance 0.5; gene of unit 0 at distance 1.5 from the divide output.
-  const Genome g = genome({in(InputChannel::bias, 0, 0), in(InputChannel::maternal0, 20, 0.5, -1), el(P, 0, 0),
-                           el(P, 1, 0), el(G, 10, 10), el(P, 20, 0), el(G, 30, 30), out(OutputChannel::divide, 10, 11.5),
-                           out(OutputChannel::rotate, 30, 30, -1)});
+  // negative maternal0 input at distance 0.5; gene of unit 0 at distance 1.5 from the divide
+  // output.
+  const Genome g =
+      genome({in(InputChannel::bias, 0, 0), in(InputChannel::maternal0, 20, 0.5, -1), el(P, 0, 0),
+              el(P, 1, 0), el(G, 10, 10), el(P, 20, 0), el(G, 30, 30),
+              out(OutputChannel::divide, 10, 11.5), out(OutputChannel::rotate, 30, 30, -1)});
   const Grn grn(g, p);
   ASSERT_EQ(grn.unit_count(), 2);
   EXPECT_NEAR(weight(grn, 0, 0), 10.0 + affinity(1.0, p), 1e-12);
   EXPECT_NEAR(weight(grn, 1, 1), -affinity(0.5, p), 1e-12);
-  EXPECT_NEAR(weight(grn, internal_src(0), grn.output_node(OutputChannel::divide)), affinity(1.5, p), 1e-12);
+  EXPECT_NEAR(weight(grn, internal_src(0), grn.output_node(OutputChannel::divide)),
+              affinity(1.5, p), 1e-12);
   EXPECT_EQ(weight(grn, internal_src(1), grn.output_node(OutputChannel::rotate)), -10.0);
   EXPECT_EQ(grn.edges().size(), 4u);
-  // Edges beyond the cut-off do not exist; inputs and outputs are never targets/sources respectively.
+  // Edges beyond the cut-off do not exist; inputs and outputs are never targets/sources
+  // respectively.
   EXPECT_FALSE(has_edge(grn, 0, 1));
   for (const auto& e : grn.edges()) {
     EXPECT_LT(e.target, grn.node_count());
@@ -125,7 +134,8 @@ TEST(GrnStructure, EdgeWeightIsSumOfAffinityTimesSignProducts) {
 TEST(GrnStructure, SignIsTheProductOfBothSigns) {
   for (int si : {1, -1}) {
     for (int sp : {1, -1}) {
-      const Grn grn(genome({in(InputChannel::bias, 0, 0, si), el(P, 0, 0, sp), el(G, 9, 9)}), GenomeParams{});
+      const Grn grn(genome({in(InputChannel::bias, 0, 0, si), el(P, 0, 0, sp), el(G, 9, 9)}),
+                    GenomeParams{});
       EXPECT_EQ(weight(grn, 0, 0), 10.0 * si * sp);
     }
   }
@@ -133,10 +143,13 @@ TEST(GrnStructure, SignIsTheProductOfBothSigns) {
 
 TEST(GrnStructure, OutputsAreAcceptorsNotProducts) {
   // An output next to a promoter regulates nothing; an input next to an output drives it.
-  const Grn grn(genome({out(OutputChannel::grow, 0, 0), el(P, 0, 0), el(G, 9, 9), in(InputChannel::maternal2, 9, 9)}),
+  const Grn grn(genome({out(OutputChannel::grow, 0, 0), el(P, 0, 0), el(G, 9, 9),
+                        in(InputChannel::maternal2, 9, 9)}),
                 GenomeParams{});
-  EXPECT_EQ(grn.edges().size(), 0u) << "gene at (9,9) and maternal2 at (9,9) have no acceptor near them";
-  const Grn grn2(genome({out(OutputChannel::grow, 0, 0), in(InputChannel::maternal2, 0, 0)}), GenomeParams{});
+  EXPECT_EQ(grn.edges().size(), 0u)
+      << "gene at (9,9) and maternal2 at (9,9) have no acceptor near them";
+  const Grn grn2(genome({out(OutputChannel::grow, 0, 0), in(InputChannel::maternal2, 0, 0)}),
+                 GenomeParams{});
   ASSERT_EQ(grn2.edges().size(), 1u);
   EXPECT_EQ(grn2.edges()[0].source, 3);
   EXPECT_EQ(grn2.edges()[0].target, grn2.output_node(OutputChannel::grow));
@@ -144,8 +157,8 @@ TEST(GrnStructure, OutputsAreAcceptorsNotProducts) {
 
 TEST(GrnStructure, MorphogenUnitsAndProductSources) {
   // Units: 0 internal only, 1 morphogen only, 2 both kinds, 3 morphogen only.
-  const Genome g = genome({el(P, 0, 0), el(G, 1, 1), el(P, 2, 2), el(M, 3, 3), el(P, 4, 4), el(G, 5, 5), el(M, 6, 6),
-                           el(P, 7, 7), el(M, 8, 8)});
+  const Genome g = genome({el(P, 0, 0), el(G, 1, 1), el(P, 2, 2), el(M, 3, 3), el(P, 4, 4),
+                           el(G, 5, 5), el(M, 6, 6), el(P, 7, 7), el(M, 8, 8)});
   GenomeParams p;
   p.affinity_cutoff = 0.1;  // no edges at all: only the structure matters here
   const Grn grn(g, p);
@@ -189,7 +202,9 @@ TEST(GrnDynamics, ClosedFormForSeveralActivationsAndSigns) {
                         {0.0, -1, 1, -10.0},
                         {1.0, 1, -1, -affinity(1.0, p)}};
   for (const Case& c : cases) {
-    const Grn grn(genome({in(InputChannel::bias, 0, 0, c.sign_in), el(P, c.promoter_x, 0, c.sign_p), el(G, 9, 9)}), p);
+    const Grn grn(genome({in(InputChannel::bias, 0, 0, c.sign_in), el(P, c.promoter_x, 0, c.sign_p),
+                          el(G, 9, 9)}),
+                  p);
     const double T = std::tanh(std::max(c.A, 0.0) / 2.0);
     expect_closed_form(trajectory(grn, 0, 100), T, 0.05, "A = " + std::to_string(c.A));
   }
@@ -197,12 +212,14 @@ TEST(GrnDynamics, ClosedFormForSeveralActivationsAndSigns) {
 
 TEST(GrnDynamics, ClosedFormHoldsForOtherDt) {
   const Grn grn(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 9, 9)}), GenomeParams{});
-  for (double dt : {0.01, 0.1, 0.3}) expect_closed_form(trajectory(grn, 0, 100, {}, dt), std::tanh(5.0), dt, "dt");
+  for (double dt : {0.01, 0.1, 0.3})
+    expect_closed_form(trajectory(grn, 0, 100, {}, dt), std::tanh(5.0), dt, "dt");
 }
 
 TEST(GrnDynamics, PromotersOfAUnitSumTheirActivation) {
   // Two promoters at the bias: A = 20.
-  const Grn grn(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(P, 0, 0), el(G, 9, 9)}), GenomeParams{});
+  const Grn grn(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(P, 0, 0), el(G, 9, 9)}),
+                GenomeParams{});
   expect_closed_form(trajectory(grn, 0, 60), std::tanh(10.0), 0.05, "two promoters");
 }
 
@@ -212,21 +229,24 @@ TEST(GrnDynamics, OutputNodeRelaxesAlongClosedForm) {
                         out(OutputChannel::phase, 0.8, 0)}),
                 p);
   ASSERT_EQ(grn.unit_count(), 0);
-  expect_closed_form(trajectory(grn, grn.output_node(OutputChannel::divide), 100), std::tanh(5.0), 0.05, "divide");
-  expect_closed_form(trajectory(grn, grn.output_node(OutputChannel::phase), 100), std::tanh(affinity(0.8, p) / 2), 0.05,
-                     "phase");
+  expect_closed_form(trajectory(grn, grn.output_node(OutputChannel::divide), 100), std::tanh(5.0),
+                     0.05, "divide");
+  expect_closed_form(trajectory(grn, grn.output_node(OutputChannel::phase), 100),
+                     std::tanh(affinity(0.8, p) / 2), 0.05, "phase");
   // Outputs that nothing drives stay at 0.
   const auto rot = trajectory(grn, grn.output_node(OutputChannel::rotate), 50);
   for (double x : rot) EXPECT_EQ(x, 0.0);
   GrnState s = grn.initial_state();
   grn.step(s, {}, GrnParams{});
-  EXPECT_EQ(grn.output(s, OutputChannel::divide), s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::divide))]);
+  EXPECT_EQ(grn.output(s, OutputChannel::divide),
+            s.levels[static_cast<std::size_t>(grn.output_node(OutputChannel::divide))]);
 }
 
 TEST(GrnDynamics, UpdateIsSynchronousThroughAChain) {
   // bias -> unit 0 (A=10); unit 0's internal product -> divide (weight 10). Divide's activation at
   // step k uses unit 0's level before step k.
-  const Grn grn(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 5, 5), out(OutputChannel::divide, 5, 5)}),
+  const Grn grn(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 5, 5),
+                        out(OutputChannel::divide, 5, 5)}),
                 GenomeParams{});
   GrnState s = grn.initial_state();
   const int d = grn.output_node(OutputChannel::divide);
@@ -257,8 +277,8 @@ TEST(GrnDynamics, SelfInhibitionDecaysToZero) {
 
 TEST(GrnDynamics, MaternalInputsAreTheirGivenValues) {
   GenomeParams p;
-  const Grn grn(genome({in(InputChannel::maternal1, 0, 0), el(P, 0, 0), el(G, 9, 9), in(InputChannel::maternal2, 20, 20),
-                        out(OutputChannel::grow, 20, 20.5)}),
+  const Grn grn(genome({in(InputChannel::maternal1, 0, 0), el(P, 0, 0), el(G, 9, 9),
+                        in(InputChannel::maternal2, 20, 20), out(OutputChannel::grow, 20, 20.5)}),
                 p);
   GrnInputs inputs;
   inputs.maternal = {0.9, 0.3, 0.6};
@@ -271,12 +291,14 @@ TEST(GrnDynamics, MaternalInputsAreTheirGivenValues) {
 
 TEST(GrnDynamics, DiffusibleProductUsesSensedMorphogensWhenGiven) {
   // Unit 0 (bias-driven) makes a morphogen at (5,5) that activates unit 1's promoter at (5,5).
-  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(M, 5, 5), el(P, 5, 5), el(G, 9, 0)});
+  const Genome g =
+      genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(M, 5, 5), el(P, 5, 5), el(G, 9, 0)});
   const Grn grn(g, GenomeParams{});
   ASSERT_EQ(grn.unit_count(), 2);
   ASSERT_EQ(grn.morphogen_units(), std::vector<int>{0});
   EXPECT_EQ(weight(grn, diffusible_src(grn, 0), 1), 10.0);
-  // Given a sensed concentration of 0.4, unit 1 sees A = 4 from the first step, whatever unit 0 does.
+  // Given a sensed concentration of 0.4, unit 1 sees A = 4 from the first step, whatever unit 0
+  // does.
   const std::vector<double> sensed{0.4};
   GrnInputs inputs;
   inputs.morphogens = sensed;
@@ -297,8 +319,8 @@ TEST(GrnDynamics, DiffusibleProductUsesSensedMorphogensWhenGiven) {
 TEST(GrnDynamics, InternalAndDiffusibleProductsOfOneUnitAreSeparateSources) {
   // Unit 0 has an internal gene at (5,5) and a morphogen gene at (9,0); unit 1's promoter sits at
   // (5,5) (internal product), unit 2's at (9,0) (diffusible product).
-  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 5, 5), el(M, 9, 0), el(P, 5, 5), el(G, 20, 20),
-                           el(P, 9, 0), el(G, 30, 30)});
+  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 5, 5), el(M, 9, 0),
+                           el(P, 5, 5), el(G, 20, 20), el(P, 9, 0), el(G, 30, 30)});
   const Grn grn(g, GenomeParams{});
   ASSERT_EQ(grn.unit_count(), 3);
   EXPECT_EQ(weight(grn, internal_src(0), 1), 10.0);
@@ -309,8 +331,8 @@ TEST(GrnDynamics, InternalAndDiffusibleProductsOfOneUnitAreSeparateSources) {
   inputs.morphogens = sensed;
   GrnState s = grn.initial_state();
   for (int k = 0; k < 200; ++k) grn.step(s, inputs, GrnParams{});
-  EXPECT_GT(s.levels[1], 0.5);   // driven by the cell's own internal product
-  EXPECT_EQ(s.levels[2], 0.0);   // the sensed morphogen is 0
+  EXPECT_GT(s.levels[1], 0.5);  // driven by the cell's own internal product
+  EXPECT_EQ(s.levels[2], 0.0);  // the sensed morphogen is 0
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -318,7 +340,8 @@ TEST(GrnDynamics, InternalAndDiffusibleProductsOfOneUnitAreSeparateSources) {
 
 namespace {
 
-void expect_levels_in_unit_interval(const Grn& grn, const GrnInputs& inputs, int steps, double dt, const std::string& what) {
+void expect_levels_in_unit_interval(const Grn& grn, const GrnInputs& inputs, int steps, double dt,
+                                    const std::string& what) {
   GrnState s = grn.initial_state();
   GrnParams p;
   p.dt = dt;
@@ -373,7 +396,8 @@ TEST(GrnBounds, LevelsStayBelowOneForEveryAllowedDt) {
   // grn.dt is allowed in (0, 1]. tanh(A/2) rounds to exactly 1.0 for A >~ 38, so the [0, 1)
   // invariant must not depend on dt being small.
   const Grn grn(extreme_genome(1), GenomeParams{});
-  for (double dt : {0.05, 0.1, 0.25, 0.5, 0.9, 1.0}) expect_levels_in_unit_interval(grn, {}, 2000, dt, "extreme");
+  for (double dt : {0.05, 0.1, 0.25, 0.5, 0.9, 1.0})
+    expect_levels_in_unit_interval(grn, {}, 2000, dt, "extreme");
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -382,8 +406,8 @@ TEST(GrnBounds, LevelsStayBelowOneForEveryAllowedDt) {
 namespace {
 
 std::vector<Element> all_required_outputs(double x, double y) {
-  return {out(OutputChannel::divide, x, y), out(OutputChannel::amplitude, x, y), out(OutputChannel::frequency, x, y),
-          out(OutputChannel::phase, x, y)};
+  return {out(OutputChannel::divide, x, y), out(OutputChannel::amplitude, x, y),
+          out(OutputChannel::frequency, x, y), out(OutputChannel::phase, x, y)};
 }
 
 }  // namespace
@@ -399,7 +423,8 @@ TEST(GrnPaths, DirectPathFromBias) {
 }
 
 TEST(GrnPaths, EachRequiredOutputIsNeeded) {
-  for (OutputChannel missing : {OutputChannel::divide, OutputChannel::amplitude, OutputChannel::frequency, OutputChannel::phase}) {
+  for (OutputChannel missing : {OutputChannel::divide, OutputChannel::amplitude,
+                                OutputChannel::frequency, OutputChannel::phase}) {
     std::vector<Element> els{in(InputChannel::maternal0, 0, 0)};
     for (auto& e : all_required_outputs(0, 0)) {
       if (e.channel == static_cast<int>(missing)) e.coords = {50, 50};  // out of reach
@@ -412,7 +437,8 @@ TEST(GrnPaths, EachRequiredOutputIsNeeded) {
 }
 
 TEST(GrnPaths, RotateAndGrowAreNotRequired) {
-  std::vector<Element> els{in(InputChannel::bias, 0, 0), out(OutputChannel::rotate, 50, 50), out(OutputChannel::grow, 60, 60)};
+  std::vector<Element> els{in(InputChannel::bias, 0, 0), out(OutputChannel::rotate, 50, 50),
+                           out(OutputChannel::grow, 60, 60)};
   for (auto& e : all_required_outputs(0, 0)) els.push_back(e);
   const Grn grn(genome(els), GenomeParams{});
   EXPECT_TRUE(grn.has_required_paths());
@@ -421,7 +447,8 @@ TEST(GrnPaths, RotateAndGrowAreNotRequired) {
 
 TEST(GrnPaths, PathThroughIntermediateUnits) {
   // bias -> unit 0 -> unit 1 (via internal product) -> outputs; no direct bias->output edge.
-  std::vector<Element> els{in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 5, 5), el(P, 5, 5), el(G, 10, 10)};
+  std::vector<Element> els{in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 5, 5), el(P, 5, 5),
+                           el(G, 10, 10)};
   for (auto& e : all_required_outputs(10, 10)) els.push_back(e);
   const Grn grn(genome(els), GenomeParams{});
   ASSERT_EQ(grn.unit_count(), 2);
@@ -429,7 +456,8 @@ TEST(GrnPaths, PathThroughIntermediateUnits) {
   EXPECT_TRUE(grn.has_required_paths());
 
   // Through a diffusible product as well.
-  std::vector<Element> els2{in(InputChannel::bias, 0, 0), el(P, 0, 0), el(M, 5, 5), el(P, 5, 5), el(G, 10, 10)};
+  std::vector<Element> els2{in(InputChannel::bias, 0, 0), el(P, 0, 0), el(M, 5, 5), el(P, 5, 5),
+                            el(G, 10, 10)};
   for (auto& e : all_required_outputs(10, 10)) els2.push_back(e);
   EXPECT_TRUE(Grn(genome(els2), GenomeParams{}).has_required_paths());
 
@@ -437,8 +465,12 @@ TEST(GrnPaths, PathThroughIntermediateUnits) {
   els[3].coords = {30, 30};
   EXPECT_FALSE(Grn(genome(els), GenomeParams{}).has_required_paths());
   // Break the parse: the gene of unit 0 is separated from its promoter by a special element.
-  std::vector<Element> els3{in(InputChannel::bias, 0, 0), el(P, 0, 0), out(OutputChannel::rotate, 40, 40), el(G, 5, 5),
-                            el(P, 5, 5), el(G, 10, 10)};
+  std::vector<Element> els3{in(InputChannel::bias, 0, 0),
+                            el(P, 0, 0),
+                            out(OutputChannel::rotate, 40, 40),
+                            el(G, 5, 5),
+                            el(P, 5, 5),
+                            el(G, 10, 10)};
   for (auto& e : all_required_outputs(10, 10)) els3.push_back(e);
   EXPECT_FALSE(Grn(genome(els3), GenomeParams{}).has_required_paths());
 }
@@ -457,7 +489,8 @@ TEST(GrnPaths, UnitsDrivingOutputsButUnreachedFromInputsDoNotCount) {
 
 TEST(GrnPaths, CyclesTerminateAndInhibitoryEdgesArePaths) {
   // bias -| unit 0 <-> unit 1 -> outputs
-  std::vector<Element> els{in(InputChannel::bias, 0, 0, -1), el(P, 0, 0), el(G, 5, 5), el(P, 5, 5), el(G, 0.5, 0)};
+  std::vector<Element> els{in(InputChannel::bias, 0, 0, -1), el(P, 0, 0), el(G, 5, 5), el(P, 5, 5),
+                           el(G, 0.5, 0)};
   for (auto& e : all_required_outputs(5, 5)) els.push_back(e);
   const Grn grn(genome(els), GenomeParams{});
   EXPECT_LT(weight(grn, 0, 0), 0.0);
@@ -477,19 +510,23 @@ TEST(GrnPaths, CutoffFromConfigDecidesReachability) {
 // DOT export
 
 TEST(GrnDot, ContainsNodesAndEdges) {
-  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(M, 5, 5), el(P, 5, 5, -1), el(G, 10, 10),
-                           out(OutputChannel::divide, 10, 10)});
+  const Genome g = genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(M, 5, 5), el(P, 5, 5, -1),
+                           el(G, 10, 10), out(OutputChannel::divide, 10, 10)});
   const Grn grn(g, GenomeParams{});
   const std::string dot = grn.to_dot();
   EXPECT_EQ(dot.rfind("digraph", 0), 0u) << dot;
   EXPECT_EQ(dot.back(), '\n');
   EXPECT_NE(dot.find("}"), std::string::npos);
-  for (const char* s : {"in0 [label=\"bias\"", "in3 [label=\"maternal2\"", "u0 [label=\"unit 0 (morphogen)\"]", "u1 [label=\"unit 1\"]",
-                        "out0 [label=\"divide\"", "out5 [label=\"phase\"", "in0 -> u0 [label=\"10\", color=black]",
-                        "u0 -> u1 [label=\"-10\", color=red, style=dashed]", "u1 -> out0 [label=\"10\", color=black]"})
+  for (const char* s :
+       {"in0 [label=\"bias\"", "in3 [label=\"maternal2\"", "u0 [label=\"unit 0 (morphogen)\"]",
+        "u1 [label=\"unit 1\"]", "out0 [label=\"divide\"", "out5 [label=\"phase\"",
+        "in0 -> u0 [label=\"10\", color=black]",
+        "u0 -> u1 [label=\"-10\", color=red, style=dashed]",
+        "u1 -> out0 [label=\"10\", color=black]"})
     EXPECT_NE(dot.find(s), std::string::npos) << "missing " << s << " in\n" << dot;
   std::size_t arrows = 0;
-  for (std::size_t pos = dot.find("->"); pos != std::string::npos; pos = dot.find("->", pos + 2)) ++arrows;
+  for (std::size_t pos = dot.find("->"); pos != std::string::npos; pos = dot.find("->", pos + 2))
+    ++arrows;
   EXPECT_EQ(arrows, grn.edges().size());
   EXPECT_EQ(arrows, 3u);
 }
@@ -497,11 +534,13 @@ TEST(GrnDot, ContainsNodesAndEdges) {
 // --- Extension channels (docs/model.md "Genome channels") ----------------------------------------
 
 TEST(GrnChannels, PaperGenomesKeepSixOutputNodesExtensionOutputsAddTwo) {
-  const Grn paper(genome({in(InputChannel::bias, 0, 0), out(OutputChannel::divide, 0, 0)}), GenomeParams{});
+  const Grn paper(genome({in(InputChannel::bias, 0, 0), out(OutputChannel::divide, 0, 0)}),
+                  GenomeParams{});
   EXPECT_EQ(paper.output_count(), kPaperOutputCount);
   EXPECT_EQ(paper.node_count(), kPaperOutputCount);
   EXPECT_EQ(paper.output(paper.initial_state(), OutputChannel::actuation), 0.0);
-  const Grn ext(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 9, 9), out(OutputChannel::actuation, 0, 0)}),
+  const Grn ext(genome({in(InputChannel::bias, 0, 0), el(P, 0, 0), el(G, 9, 9),
+                        out(OutputChannel::actuation, 0, 0)}),
                 GenomeParams{});
   EXPECT_EQ(ext.output_count(), kOutputCount);
   EXPECT_EQ(ext.node_count(), 1 + kOutputCount);
@@ -511,7 +550,8 @@ TEST(GrnChannels, PaperGenomesKeepSixOutputNodesExtensionOutputsAddTwo) {
 
 TEST(GrnChannels, SensorInputsComeAfterTheProductsAndFollowTheirValue) {
   // strain -> actuation at distance 0: weight 10, A = 10·strain, level -> tanh(5·strain).
-  const Grn grn(genome({el(P, 5, 5), el(G, 9, 9), in(InputChannel::strain, 0, 0), out(OutputChannel::actuation, 0, 0)}),
+  const Grn grn(genome({el(P, 5, 5), el(G, 9, 9), in(InputChannel::strain, 0, 0),
+                        out(OutputChannel::actuation, 0, 0)}),
                 GenomeParams{});
   ASSERT_EQ(grn.unit_count(), 1);
   ASSERT_EQ(grn.edges().size(), 1u);

@@ -1,7 +1,7 @@
-// The crawl world (issue 17, part 1): effects "gravity" and "ground" (a floor with Coulomb friction),
-// the settling phase before the fitness clock, and the horizontal-distance objective. Values are
-// asserted against the analytic solutions of the discrete scheme (symplectic Euler, as Box2D
-// integrates) and of the continuous equations.
+// The crawl world (issue 17, part 1): effects "gravity" and "ground" (a floor with Coulomb
+// friction), the settling phase before the fitness clock, and the horizontal-distance objective.
+// Values are asserted against the analytic solutions of the discrete scheme (symplectic Euler, as
+// Box2D integrates) and of the continuous equations.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -31,7 +31,8 @@
 namespace animat {
 namespace {
 
-/// A row of `n` cells on y = y0, spacing 1, neighbours linked by springs (a chain; skin = the chain).
+/// A row of `n` cells on y = y0, spacing 1, neighbours linked by springs (a chain; skin = the
+/// chain).
 Body row_block(int n, double y0 = 0.0) {
   std::vector<std::pair<double, double>> xy;
   std::vector<std::pair<int, int>> springs;
@@ -44,10 +45,12 @@ Body row_block(int n, double y0 = 0.0) {
 Body two_row_block() {
   const Points p = points({{0, 0}, {1, 0}, {2, 0}, {0, 1}, {1, 1}, {2, 1}});
   return make_body(p, {{0, 1}, {1, 2}, {3, 4}, {4, 5}, {0, 3}, {1, 4}, {2, 5}, {0, 4}, {1, 5}},
-                   {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}}, {{0, 1}, {1, 2}, {2, 5}, {5, 4}, {4, 3}, {3, 0}});
+                   {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}},
+                   {{0, 1}, {1, 2}, {2, 5}, {5, 4}, {4, 3}, {3, 0}});
 }
 
-SceneParams floor_scene(std::vector<std::string> effects, double g = 2.0, double mu_s = 0.8, double mu_k = 0.5) {
+SceneParams floor_scene(std::vector<std::string> effects, double g = 2.0, double mu_s = 0.8,
+                        double mu_k = 0.5) {
   SceneParams s = scene_with(std::move(effects));
   s.gravity = g;
   s.ground_friction_static = mu_s;
@@ -67,7 +70,8 @@ double mechanical_energy(const Simulation& sim, const Body& body, double g, doub
   for (int i = 0; i < s.n; ++i) e += s.mass * g * (s.y[static_cast<std::size_t>(i)] - y0);
   const double k = sim.scene().spring_stiffness;
   for (int sp = 0; sp < body.spring_count(); ++sp) {
-    const auto i = static_cast<std::size_t>(body.springs(sp, 0)), j = static_cast<std::size_t>(body.springs(sp, 1));
+    const auto i = static_cast<std::size_t>(body.springs(sp, 0)),
+               j = static_cast<std::size_t>(body.springs(sp, 1));
     const double len = std::hypot(s.x[j] - s.x[i], s.y[j] - s.y[i]);
     e += 0.5 * k * (len - body.rest_lengths(sp)) * (len - body.rest_lengths(sp));
   }
@@ -135,7 +139,8 @@ TEST(Ground, TwoRowBlockBelowTheStaticLimitDoesNotSlide) {
   // cells never slip.
   const double g = 2.0, mu_s = 0.8;
   const Body b = two_row_block();
-  Simulation sim(b, floor_scene({"springs", "pressure", "collisions", "gravity", "ground"}, g, mu_s));
+  Simulation sim(b,
+                 floor_scene({"springs", "pressure", "collisions", "gravity", "ground"}, g, mu_s));
   sim.step(600);  // settle
   const Points p0 = sim.positions();
   const long slips0 = sim.counters().ground_slips;
@@ -166,7 +171,9 @@ TEST(Ground, BlockAboveTheStaticLimitSlidesWithKineticFriction) {
   const Points v = sim.velocities(), p = sim.positions();
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(v(i, 0), a * t, 1e-5 * a * t) << i;
-    EXPECT_NEAR(p(i, 0) - p0(i, 0), a * h * h * static_cast<double>(n * (n + 1)) / 2.0, kFloatPosition) << i;
+    EXPECT_NEAR(p(i, 0) - p0(i, 0), a * h * h * static_cast<double>(n * (n + 1)) / 2.0,
+                kFloatPosition)
+        << i;
     EXPECT_NEAR(p(i, 0) - p0(i, 0), 0.5 * a * t * t, 0.5 * a * h * t + kFloatPosition) << i;
     EXPECT_NEAR(v(i, 1), 0.0, 1e-6);
   }
@@ -175,7 +182,8 @@ TEST(Ground, BlockAboveTheStaticLimitSlidesWithKineticFriction) {
 
 TEST(Ground, LaunchedBlockDeceleratesAtMuKGAndStops) {
   // A row launched at v0 with no applied force: v(t) = v0 − μ_k·g·t until it stops after
-  // t* = v0/(μ_k·g), having slid v0²/(2·μ_k·g) (± one step of travel); then static friction holds it.
+  // t* = v0/(μ_k·g), having slid v0²/(2·μ_k·g) (± one step of travel); then static friction holds
+  // it.
   const double g = 2.0, mu_s = 0.8, mu_k = 0.5, v0 = 3.0;
   Simulation sim(row_block(3), floor_scene({"springs", "gravity", "ground"}, g, mu_s, mu_k));
   sim.set_velocities(Points::Constant(3, 2, 0.0).rowwise() + Eigen::RowVector2d(v0, 0.0));
@@ -195,9 +203,9 @@ TEST(Ground, LaunchedBlockDeceleratesAtMuKGAndStops) {
 TEST(Ground, DroppedBodyEnergyNeverGrowsAndNoCellGoesBelowTheFloor) {
   // A lattice body dropped from 3 length units above a floor at y0 = −2.5 (not 0, to test the
   // height key): mechanical energy (kinetic + gravitational + elastic) never exceeds its initial
-  // value (the floor is inelastic, friction and spring damping dissipate, and symplectic Euler loses
-  // ½·m·g²·h² per cell and free-fall step), and no cell centre is ever below the floor beyond float
-  // rounding of the positions.
+  // value (the floor is inelastic, friction and spring damping dissipate, and symplectic Euler
+  // loses ½·m·g²·h² per cell and free-fall step), and no cell centre is ever below the floor beyond
+  // float rounding of the positions.
   const double g = 2.0, y0 = -2.5;
   Body b = swimmer(lattice_points(4, 3), Drive::none);
   b.positions.col(1).array() += y0 + 3.0;
@@ -221,7 +229,8 @@ TEST(Ground, DroppedBodyEnergyNeverGrowsAndNoCellGoesBelowTheFloor) {
 
 TEST(Ground, ActuatedBodyNeverGoesBelowTheFloor) {
   // A driven lattice on the floor, every Box2D step checked.
-  SceneParams scene = floor_scene({"springs", "actuation", "pressure", "collisions", "gravity", "ground"}, 1.0);
+  SceneParams scene =
+      floor_scene({"springs", "actuation", "pressure", "collisions", "gravity", "ground"}, 1.0);
   Body b = swimmer(lattice_points(5, 3, 0.05, 3), Drive::wave, 0.15, 4.0);
   b.positions.col(1).array() -= b.positions.col(1).minCoeff();
   Simulation sim(b, scene);
@@ -242,7 +251,8 @@ TEST(Ground, ConfigErrorsNameKeyAndValue) {
     validate(s);
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.ground_friction_kinetic"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("scene.ground_friction_kinetic"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("0.5"), std::string::npos) << e.what();
   }
   SceneParams neg;
@@ -259,13 +269,14 @@ TEST(Ground, ConfigErrorsNameKeyAndValue) {
   EXPECT_THROW((void)make_objective(c.evaluation), ConfigError);
 }
 
-// --- the floor and the collisions together: the embedding survives every contact ------------------
+// --- the floor and the collisions together: the embedding survives every contact
+// ------------------
 
-/// One triangle (a region, its three springs, all skin) with the base cells a, b at y = 0.05 and the
-/// apex c at y = 0.3 above the middle of the base.
+/// One triangle (a region, its three springs, all skin) with the base cells a, b at y = 0.05 and
+/// the apex c at y = 0.3 above the middle of the base.
 Body falling_triangle() {
-  return make_body(points({{0.0, 0.05}, {2.0, 0.05}, {1.0, 0.3}}), {{0, 1}, {1, 2}, {0, 2}}, {{0, 1, 2}},
-                   {{0, 1}, {1, 2}, {2, 0}});
+  return make_body(points({{0.0, 0.05}, {2.0, 0.05}, {1.0, 0.3}}), {{0, 1}, {1, 2}, {0, 2}},
+                   {{0, 1, 2}}, {{0, 1}, {1, 2}, {2, 0}});
 }
 
 TEST(FloorAndCollisions, TriangleFallingFlatOntoTheFloorBouncesOffItsBase) {
@@ -325,7 +336,8 @@ FloorRun run_floor_case(FloorCase c, int refine) {
   SceneParams scene = floor_scene({"springs", "pressure", "collisions", "gravity", "ground"}, 1.0);
   const double top = body.positions.col(1).maxCoeff() - 0.1;
   std::vector<double> top_row;
-  for (int i = 0; i < body.node_count(); ++i) top_row.push_back(body.positions(i, 1) > top ? 1.0 : 0.0);
+  for (int i = 0; i < body.node_count(); ++i)
+    top_row.push_back(body.positions(i, 1) > top ? 1.0 : 0.0);
   Points v0 = Points::Zero(body.node_count(), 2);
   switch (c) {
     case FloorCase::pressed: break;
@@ -371,10 +383,12 @@ FloorRun run_floor_case(FloorCase c, int refine) {
 
 TEST(FloorAndCollisions, PressedDroppedRolledAndDraggedBodiesKeepTheirEmbeddingAtEveryStep) {
   const char* names[] = {"pressed", "dropped", "rolled", "dragged"};
-  for (FloorCase c : {FloorCase::pressed, FloorCase::dropped, FloorCase::rolled, FloorCase::dragged})
+  for (FloorCase c :
+       {FloorCase::pressed, FloorCase::dropped, FloorCase::rolled, FloorCase::dragged})
     for (int refine : {1, 4, 16}) {
       const FloorRun r = run_floor_case(c, refine);
-      const std::string what = std::string(names[static_cast<int>(c)]) + " at dt/" + std::to_string(refine);
+      const std::string what =
+          std::string(names[static_cast<int>(c)]) + " at dt/" + std::to_string(refine);
       EXPECT_EQ(r.inverted, 0) << what;
       EXPECT_EQ(r.crossings, 0) << what;
       EXPECT_GT(r.min_area_ratio, 0.0) << what;
@@ -391,7 +405,8 @@ TEST(FloorAndCollisions, PressedDroppedRolledAndDraggedBodiesKeepTheirEmbeddingA
 /// short crawl runs whose swims broke the embedding while the floor was resolved after the
 /// collisions (the skin crossed itself; the step is recorded in the file).
 std::vector<std::pair<std::string, Genome>> crawl_genomes(Config& config) {
-  const std::filesystem::path dir = std::filesystem::path(ANIMAT_SOURCE_DIR) / "tests" / "data" / "crawl";
+  const std::filesystem::path dir =
+      std::filesystem::path(ANIMAT_SOURCE_DIR) / "tests" / "data" / "crawl";
   config = load_config((dir / "crawl.toml").string());
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(dir))
@@ -404,7 +419,8 @@ std::vector<std::pair<std::string, Genome>> crawl_genomes(Config& config) {
     ss << in.rdbuf();
     const auto j = nlohmann::json::parse(ss.str());
     EXPECT_EQ(j.at("config").get<std::string>(), "crawl.toml") << f;
-    out.emplace_back(f.filename().string(), genome_from_json(j.at("genome").dump(), config.genome, f.string()));
+    out.emplace_back(f.filename().string(),
+                     genome_from_json(j.at("genome").dump(), config.genome, f.string()));
   }
   return out;
 }
@@ -425,12 +441,15 @@ TEST(FloorAndCollisions, EvolvedCrawlersThatCrossedTheirSkinAreValid) {
   }
 }
 
-// --- settling and the crawl swim ------------------------------------------------------------------
+// --- settling and the crawl swim
+// ------------------------------------------------------------------
 
 TEST(Settle, BodyIsPlacedOnTheFloorAndFallingIsNotCounted) {
   // A still body (no actuation amplitude) high above the floor: swim() places its lowest cell on
-  // the floor, settles it, and the measured swim then barely moves (the settling sag is not counted).
-  SceneParams scene = floor_scene({"springs", "actuation", "pressure", "collisions", "gravity", "ground"}, 1.0);
+  // the floor, settles it, and the measured swim then barely moves (the settling sag is not
+  // counted).
+  SceneParams scene =
+      floor_scene({"springs", "actuation", "pressure", "collisions", "gravity", "ground"}, 1.0);
   Body b = swimmer(lattice_points(5, 3), Drive::none);
   b.positions.col(1).array() += 7.0;
   PhysicsParams physics;

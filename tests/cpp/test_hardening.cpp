@@ -1,21 +1,24 @@
-// Reliability, round 2 (issue 15): no refused command may damage a run, no accepted value may crash,
-// every stop signal is honoured. docs/reliability.md lists each attack with its count and test.
+// Reliability, round 2 (issue 15): no refused command may damage a run, no accepted value may
+// crash, every stop signal is honoured. docs/reliability.md lists each attack with its count and
+// test.
 //
-//   ConfigSweep.*      every config key (iterated through visit_fields, so new keys are covered) at its
-//                      bounds and just beyond: refused values name the key (set_value, TOML, the CLI)
-//                      and change no file of a run; accepted values evaluate and evolve without a
-//                      signal, in a child process
+//   ConfigSweep.*      every config key (iterated through visit_fields, so new keys are covered)
+//                      at its bounds and just beyond: refused values name the key (set_value,
+//                      TOML, the CLI) and change no file of a run; accepted values evaluate and
+//                      evolve without a signal, in a child process
 //   ResumeSettings.*   --resume with changed settings: refused before any write, naming the keys;
 //                      resumable keys accepted and recorded
-//   StopRequests.*     stops honoured within one evaluation (counted, not timed): seeding, evaluation, the CLI
-//   CheckpointMeaning.* checkpoints with a valid checksum but a content the engine cannot have written
+//   StopRequests.*     stops honoured within one evaluation (counted, not timed): seeding,
+//                      evaluation, the CLI
+//   CheckpointMeaning.* checkpoints with a valid checksum but a content the engine cannot have
+//                      written
 //   Rows.*             the other rows of the issue's table
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <cfloat>
@@ -36,16 +39,17 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
-#include "animat/run_identity.hpp"
-#include "animat/run.hpp"
 #include "animat/genome.hpp"
 #include "animat/random.hpp"
+#include "animat/run.hpp"
+#include "animat/run_identity.hpp"
 #include "test_support.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define ANIMAT_TEST_SANITIZED 1
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
 #define ANIMAT_TEST_SANITIZED 1
 #endif
 #endif
@@ -55,23 +59,28 @@
 
 namespace fs = std::filesystem;
 using namespace animat;
-using nlohmann::json;
 using animat::test::slurp;
 using animat::test::spit;
 using animat::test::stub_fitness;
+using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) { return animat::test::fresh_dir("animat_hard_", name); }
+fs::path fresh_dir(const std::string& name) {
+  return animat::test::fresh_dir("animat_hard_", name);
+}
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 /// Every file under `dir` with its content: a refused command must leave this unchanged.
 std::map<std::string, std::string> snapshot(const fs::path& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(dir))
-    out[fs::relative(e.path(), dir).string()] = e.is_regular_file() ? slurp(e.path()) : std::string("<dir>");
+    out[fs::relative(e.path(), dir).string()] =
+        e.is_regular_file() ? slurp(e.path()) : std::string("<dir>");
   return out;
 }
 
@@ -111,8 +120,9 @@ const std::string kExe = ANIMAT_EVOLVE_EXE;
 const fs::path& small_run() {
   static const fs::path dir = [] {
     const fs::path d = fresh_dir("run");
-    const Shell r = run_exe({kExe, "--quiet", "--threads", "1", "--seed", "3", "--set", "evolution.population=4",
-                             "--set", "evaluation.steps=50", "--generations", "1", "--out", d.string()});
+    const Shell r = run_exe({kExe, "--quiet", "--threads", "1", "--seed", "3", "--set",
+                             "evolution.population=4", "--set", "evaluation.steps=50",
+                             "--generations", "1", "--out", d.string()});
     EXPECT_EQ(r.rc, 0) << r.err;
     return d;
   }();
@@ -128,12 +138,13 @@ struct ChildResult {
 };
 
 /// Only keeps a broken build from hanging the suite: every child's work is bounded (see the sweep
-/// below), so a child still running after this long is a hang, and a failure. Never a verdict on speed.
+/// below), so a child still running after this long is a hang, and a failure. Never a verdict on
+/// speed.
 constexpr double kHangGuardSeconds = 900.0;
 
 /// Runs f in a forked child; f returns a note (e.g. which work budget it reached). The parent must
-/// not have used OpenMP before (each test runs in its own process under ctest), so the child's runtime
-/// starts clean.
+/// not have used OpenMP before (each test runs in its own process under ctest), so the child's
+/// runtime starts clean.
 template <class F>
 ChildResult in_child(F&& f) {
   int fds[2];
@@ -160,7 +171,8 @@ ChildResult in_child(F&& f) {
   const auto t0 = Clock::now();
   int status = 0;
   bool hung = false;
-  while (waitpid(pid, &status, WNOHANG) == 0) {  // polls for the exit; the time decides nothing but a hang
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    // polls for the exit; the time decides nothing but a hang
     if (seconds_since(t0) > kHangGuardSeconds) {
       kill(pid, SIGKILL);
       waitpid(pid, &status, 0);
@@ -171,10 +183,15 @@ ChildResult in_child(F&& f) {
   }
   std::string msg;
   char buf[4096];
-  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) msg.append(buf, static_cast<std::size_t>(n));
+  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;)
+    msg.append(buf, static_cast<std::size_t>(n));
   close(fds[0]);
-  if (hung) return {ChildResult::hung, fmt::format("still running after {} s (hang guard)", kHangGuardSeconds)};
-  if (WIFSIGNALED(status)) return {ChildResult::crashed, fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)))};
+  if (hung)
+    return {ChildResult::hung,
+            fmt::format("still running after {} s (hang guard)", kHangGuardSeconds)};
+  if (WIFSIGNALED(status))
+    return {ChildResult::crashed,
+            fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)))};
   switch (WEXITSTATUS(status)) {
     case 0: return {ChildResult::ok, msg};
     case 3: return {ChildResult::error, msg};
@@ -205,7 +222,8 @@ std::vector<Probe> probes_for(const FieldInfo& info, double) {
   auto add = [&](double x, bool inside) { out.push_back({toml_double(x), x, inside}); };
   constexpr double inf = std::numeric_limits<double>::infinity();
   // Every numeric field must state a finite range: an unbounded value reaches arithmetic or Box2D.
-  EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi)) << info.name << " has an unbounded range " << b.describe();
+  EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi))
+      << info.name << " has an unbounded range " << b.describe();
   const double lo_in = b.lo_open ? std::nextafter(b.lo, inf) : b.lo;
   const double hi_in = b.hi_open ? std::nextafter(b.hi, -inf) : b.hi;
   const double lo_out = b.lo_open ? b.lo : std::nextafter(b.lo, -inf);
@@ -225,7 +243,8 @@ std::vector<Probe> probes_for(const FieldInfo& info, std::int64_t) {
   constexpr auto kMax = std::numeric_limits<std::int64_t>::max();
   const auto lo = static_cast<std::int64_t>(std::ceil(b.lo + (b.lo_open ? 0.5 : 0.0)));
   const bool hi_finite = std::isfinite(b.hi) && b.hi < 9.2e18;
-  const std::int64_t hi = hi_finite ? static_cast<std::int64_t>(std::floor(b.hi - (b.hi_open ? 0.5 : 0.0))) : kMax;
+  const std::int64_t hi =
+      hi_finite ? static_cast<std::int64_t>(std::floor(b.hi - (b.hi_open ? 0.5 : 0.0))) : kMax;
   add(lo, true);
   add(hi, true);
   add(lo - 1, false);
@@ -255,7 +274,9 @@ std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<std::stri
   for (auto c : info.choices) all.emplace_back(c);
   out.push_back({fmt::format("[\"{}\"]", fmt::join(all, "\", \"")), all, true});
   out.push_back({"[\"no_such_effect\"]", std::vector<std::string>{"no_such_effect"}, false});
-  if (!all.empty()) out.push_back({fmt::format("[\"{}\", \"{}\"]", all[0], all[0]), std::vector<std::string>{all[0], all[0]}, false});
+  if (!all.empty())
+    out.push_back({fmt::format("[\"{}\", \"{}\"]", all[0], all[0]),
+                   std::vector<std::string>{all[0], all[0]}, false});
   return out;
 }
 
@@ -269,7 +290,8 @@ std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<double>& 
     out.push_back({fmt::format("[{}]", fmt::join(parts, ", ")), v, inside});
   };
   const Bounds& b = info.bounds;
-  EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi)) << info.name << " has an unbounded range " << b.describe();
+  EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi))
+      << info.name << " has an unbounded range " << b.describe();
   for (std::size_t i : {std::size_t{0}, current.size() - 1}) {
     with(i, b.lo, true);
     with(i, b.hi, true);
@@ -297,10 +319,14 @@ std::vector<KeyProbes> all_probes() {
     visit_fields(params, [&](const FieldInfo& info, auto& value) {
       using T = std::decay_t<decltype(value)>;
       std::vector<Probe> p;
-      if constexpr (std::is_same_v<T, double>) p = probes_for(info, 0.0);
-      else if constexpr (std::is_same_v<T, std::int64_t>) p = probes_for(info, std::int64_t{});
-      else if constexpr (std::is_same_v<T, int>) p = probes_for(info, 0);
-      else p = probes_for(info, value);
+      if constexpr (std::is_same_v<T, double>)
+        p = probes_for(info, 0.0);
+      else if constexpr (std::is_same_v<T, std::int64_t>)
+        p = probes_for(info, std::int64_t{});
+      else if constexpr (std::is_same_v<T, int>)
+        p = probes_for(info, 0);
+      else
+        p = probes_for(info, value);
       out.push_back({std::string(section), std::string(info.name), std::move(p)});
     });
   });
@@ -332,8 +358,8 @@ const Genome& viable_genome() {
   return g;
 }
 
-/// A viable genome with a small body (at most 12 cells; the first one, viable_genome(), has 32): what
-/// the probes of evaluation.settle_steps swim (see the sweep).
+/// A viable genome with a small body (at most 12 cells; the first one, viable_genome(), has 32):
+/// what the probes of evaluation.settle_steps swim (see the sweep).
 const Genome& small_viable_genome() {
   static const Genome g = [] {
     const Config c = sweep_base();
@@ -350,9 +376,11 @@ const Genome& small_viable_genome() {
 }
 
 /// The sweep's work budgets (see EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal).
-constexpr long kSwimStepBudget = 4000;           // control steps of evaluate()'s swim: the paper's horizon
-constexpr long kEvaluationBudget = 5000;         // fitness evaluations of the GA: 400 generations of the base
-struct SwimBudgetReached {};                     // thrown by SwimBudget; no library code catches it
+// control steps of evaluate()'s swim: the paper's horizon
+constexpr long kSwimStepBudget = 4000;
+// fitness evaluations of the GA: 400 generations of the base
+constexpr long kEvaluationBudget = 5000;
+struct SwimBudgetReached {};  // thrown by SwimBudget; no library code catches it
 
 /// Stops evaluate()'s swim once it has run kSwimStepBudget control steps (sampled every 1000 steps:
 /// splitting a swim's steps changes nothing in its motion).
@@ -371,7 +399,9 @@ Fitness sweep_fitness(const Genome& g) {
   return f;
 }
 
-bool names_key(const std::string& message, const std::string& dotted) { return message.find(dotted) != std::string::npos; }
+bool names_key(const std::string& message, const std::string& dotted) {
+  return message.find(dotted) != std::string::npos;
+}
 
 }  // namespace
 
@@ -394,7 +424,8 @@ TEST(ConfigSweep, EveryKeyOutsideItsBoundsIsRefusedNamingTheKey) {
         EXPECT_TRUE(names_key(e.what(), dotted)) << e.what();
       }
       try {
-        (void)config_from_toml(fmt::format("[{}]\n{} = {}\n", kp.section, kp.key, p.text), "sweep.toml");
+        (void)config_from_toml(fmt::format("[{}]\n{} = {}\n", kp.section, kp.key, p.text),
+                               "sweep.toml");
         ADD_FAILURE() << "TOML accepted it";
       } catch (const ConfigError& e) {
         EXPECT_TRUE(names_key(e.what(), dotted)) << e.what();
@@ -402,12 +433,15 @@ TEST(ConfigSweep, EveryKeyOutsideItsBoundsIsRefusedNamingTheKey) {
       ++refused;
     }
   }
-  std::printf("[ sweep    ] %d out-of-bounds values refused by set_value and by TOML, each naming its key\n", refused);
+  std::printf(
+      "[ sweep    ] %d out-of-bounds values refused by set_value and by TOML, each naming its "
+      "key\n",
+      refused);
 }
 
 TEST(ConfigSweep, RefusedValuesOnTheCommandLineChangeNoFileOfARun) {
-  // `--resume R --set key=value` with every refused value, and with every in-bounds value of a key that
-  // defines the run: exit 2, the key in the message, R byte-for-byte unchanged.
+  // `--resume R --set key=value` with every refused value, and with every in-bounds value of a key
+  // that defines the run: exit 2, the key in the message, R byte-for-byte unchanged.
   const fs::path& run = small_run();
   const auto before = snapshot(run);
   const auto& resumable = resumable_keys();
@@ -415,27 +449,31 @@ TEST(ConfigSweep, RefusedValuesOnTheCommandLineChangeNoFileOfARun) {
   int tried = 0;
   for (const auto& kp : all_probes()) {
     const std::string dotted = kp.section + "." + kp.key;
-    const bool may_change = std::find(resumable.begin(), resumable.end(), dotted) != resumable.end();
+    const bool may_change =
+        std::find(resumable.begin(), resumable.end(), dotted) != resumable.end();
     for (const auto& p : kp.probes) {
-      if (p.inside && may_change) continue;              // accepted on resume: it would run
+      if (p.inside && may_change) continue;  // accepted on resume: it would run
       if (p.inside && get_value(stored, dotted) == p.value) continue;  // no change at all
       std::string text = p.text;
       if (text.size() > 1 && text.front() == '"') text = text.substr(1, text.size() - 2);
       SCOPED_TRACE(dotted + " = " + text);
-      const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--set", dotted + "=" + text});
+      const Shell r =
+          run_exe({kExe, "--quiet", "--resume", run.string(), "--set", dotted + "=" + text});
       EXPECT_EQ(r.rc, 2) << r.err;
       EXPECT_TRUE(names_key(r.err, dotted)) << r.err;
       ++tried;
     }
   }
   EXPECT_EQ(snapshot(run), before);
-  std::printf("[ sweep    ] %d refused --resume --set commands: exit 2, key named, no file changed\n", tried);
+  std::printf(
+      "[ sweep    ] %d refused --resume --set commands: exit 2, key named, no file changed\n",
+      tried);
 }
 
 TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
-  // In a child per value: evaluate() of a viable genome and two generations of the GA (stub fitness),
-  // a checkpoint and its restore. A signal is a failure; an animat::Error must name something clear
-  // (the genome not fitting the config).
+  // In a child per value: evaluate() of a viable genome and two generations of the GA (stub
+  // fitness), a checkpoint and its restore. A signal is a failure; an animat::Error must name
+  // something clear (the genome not fitting the config).
   //
   // The work of each child is bounded, not its time (a 3 s limit used to decide which values were
   // checked, so a loaded machine checked fewer, and a crash after the limit passed): the swim stops
@@ -444,8 +482,9 @@ TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
   // Development and settling run before the first step an observer sees and always run to their
   // end: development.steps = 100,000 (1.5 to 4 s) and development.max_cells = 4096 (a 4096-cell
   // embryo, 6 to 14 s) as they are; evaluation.settle_steps = 10^7 on the small body of
-  // small_viable_genome() (11 cells: 8 s; 20 to 38 s on the 32-cell one). Which values reach a budget
-  // is fixed by the values, never by the machine; the children's time limit is only a hang guard.
+  // small_viable_genome() (11 cells: 8 s; 20 to 38 s on the 32-cell one). Which values reach a
+  // budget is fixed by the values, never by the machine; the children's time limit is only a hang
+  // guard.
   const Genome& genome = viable_genome();
   const Genome& small = small_viable_genome();
   ASSERT_FALSE(genome.elements.empty());
@@ -461,7 +500,8 @@ TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
       try {
         set_value(c, dotted, p.value);
         validate(c);
-      } catch (const ConfigError& e) {  // a cross-field rule (elites < population, min_cells <= max_cells...)
+      } catch (const ConfigError& e) {
+        // a cross-field rule (elites < population, min_cells <= max_cells...)
         EXPECT_TRUE(names_key(e.what(), dotted)) << e.what();
         ++cross_refused;
         continue;
@@ -507,22 +547,28 @@ TEST(ConfigSweep, EveryKeyAtItsBoundsEvaluatesAndEvolvesWithoutASignal) {
           break;
         case ChildResult::error:  // clean, but it must say which setting caused it
           ++errors;
-          std::printf("[ sweep    ] %s = %s: %s\n", dotted.c_str(), p.text.c_str(), r.message.c_str());
+          std::printf("[ sweep    ] %s = %s: %s\n", dotted.c_str(), p.text.c_str(),
+                      r.message.c_str());
           EXPECT_TRUE(names_key(r.message, dotted)) << r.message;
           break;
         default: ADD_FAILURE() << r.message;
       }
     }
   }
-  // The values that reach a budget are known: a new one is either a slow new key (give it a budget or
-  // a small body above) or a regression that makes an old one slow.
+  // The values that reach a budget are known: a new one is either a slow new key (give it a budget
+  // or a small body above) or a regression that makes an old one slow.
   const std::map<std::string, std::vector<std::string>> expected = {
-      {"swim", {"evaluation.steps = 10000000"}}, {"evaluations", {"evolution.population = 100000"}}};
+      {"swim", {"evaluation.steps = 10000000"}},
+      {"evaluations", {"evolution.population = 100000"}}};
   EXPECT_EQ(budgets, expected);
   for (const auto& [budget, values] : budgets)
-    std::printf("[ sweep    ] stopped at the %s budget: %s\n", budget.c_str(), fmt::format("{}", fmt::join(values, "; ")).c_str());
-  std::printf("[ sweep    ] %d in-bounds values run in a child (%d animat errors naming the key, no signal); "
-              "%d refused by a cross-field rule naming the key\n", accepted, errors, cross_refused);
+    std::printf("[ sweep    ] stopped at the %s budget: %s\n", budget.c_str(),
+                fmt::format("{}", fmt::join(values, "; ")).c_str());
+  std::printf(
+      "[ sweep    ] %d in-bounds values run in a child (%d animat errors naming the key, no "
+      "signal); "
+      "%d refused by a cross-field rule naming the key\n",
+      accepted, errors, cross_refused);
 }
 
 TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
@@ -530,7 +576,8 @@ TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
   const auto& resumable = resumable_keys();
   for (const auto& kp : all_probes()) {
     const std::string dotted = kp.section + "." + kp.key;
-    const bool may_change = std::find(resumable.begin(), resumable.end(), dotted) != resumable.end();
+    const bool may_change =
+        std::find(resumable.begin(), resumable.end(), dotted) != resumable.end();
     // The migration keys act only with islands (and are left out of the identity without them, so
     // that runs checkpointed before islands existed resume): probe them in a run with islands.
     Config base;
@@ -540,7 +587,8 @@ TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
       Config c = base;
       set_value(c, dotted, p.value);
       EXPECT_EQ(run_identity(c) == run_identity(base), may_change) << dotted << " = " << p.text;
-      EXPECT_EQ(run_identity_v1(c) == run_identity_v1(base), may_change) << dotted << " = " << p.text << " (scheme 1)";
+      EXPECT_EQ(run_identity_v1(c) == run_identity_v1(base), may_change)
+          << dotted << " = " << p.text << " (scheme 1)";
       break;
     }
   }
@@ -551,12 +599,14 @@ TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
 
 TEST(Rows, Box2DAssertValuesAreRefused) {
   // Both were accepted and then aborted in b2Body's constructor (exit 134).
-  for (const std::string o : {"development.damping=1e39", "development.cell_radius=1e39", "scene.cell_mass=1e-300",
-                              "development.cell_mass=1e39", "physics.dt=1e-300", "development.time_step=1e-300"}) {
+  for (const std::string o :
+       {"development.damping=1e39", "development.cell_radius=1e39", "scene.cell_mass=1e-300",
+        "development.cell_mass=1e39", "physics.dt=1e-300", "development.time_step=1e-300"}) {
     Config c;
     EXPECT_THROW(apply_override(c, o), ConfigError) << o;
   }
-  const Shell r = run_exe({kExe, "--quiet", "--set", "development.damping=1e39", "--out", fresh_dir("damping").string()});
+  const Shell r = run_exe({kExe, "--quiet", "--set", "development.damping=1e39", "--out",
+                           fresh_dir("damping").string()});
   EXPECT_EQ(r.rc, 2) << r.err;
   EXPECT_NE(r.err.find("development.damping"), std::string::npos) << r.err;
 }
@@ -564,7 +614,8 @@ TEST(Rows, Box2DAssertValuesAreRefused) {
 TEST(Rows, MoveSigmaCannotOverflowACoordinate) {
   Config c;
   EXPECT_THROW(apply_override(c, "mutation.move_sigma=1e308"), ConfigError);
-  // At its bound every mutation keeps coordinates finite (the largest normal deviate is about 12.1).
+  // At its bound every mutation keeps coordinates finite (the largest normal deviate is
+  // about 12.1).
   apply_override(c, "mutation.move_sigma=1000000");
   apply_override(c, "mutation.move_rate=1");
   Rng rng(3);
@@ -574,7 +625,8 @@ TEST(Rows, MoveSigmaCannotOverflowACoordinate) {
 }
 
 TEST(Rows, SeedBeyondInt64IsAnErrorNotAClamp) {
-  for (const std::string seed : {"99999999999999999999", "9223372036854775808", "-1", "1e3", "12abc"}) {
+  for (const std::string seed :
+       {"99999999999999999999", "9223372036854775808", "-1", "1e3", "12abc"}) {
     const Shell r = run_exe({kExe, "--print-config", "--seed", seed});
     EXPECT_NE(r.rc, 0) << seed;
     EXPECT_NE(r.err.find("--seed"), std::string::npos) << r.err;
@@ -587,12 +639,14 @@ TEST(Rows, LongOutPathIsAClearError) {
   const fs::path base = fresh_dir("long");
   for (const auto& [out, want] : std::vector<std::pair<fs::path, std::string>>{
            {base / std::string(300, 'a'), "NAME_MAX"},
-           {base / fs::path(std::string(200, 'b')) / std::string(200, 'c') / std::string(200, 'd') / std::string(200, 'e') /
-                std::string(200, 'f') / std::string(200, 'g') / std::string(200, 'h') / std::string(200, 'i') /
-                std::string(200, 'j') / std::string(200, 'k') / std::string(200, 'l') / std::string(200, 'm') /
-                std::string(200, 'n') / std::string(200, 'o') / std::string(200, 'p') / std::string(200, 'q') /
-                std::string(200, 'r') / std::string(200, 's') / std::string(200, 't') / std::string(200, 'u') /
-                std::string(200, 'v') / std::string(200, 'w'),
+           {base / fs::path(std::string(200, 'b')) / std::string(200, 'c') / std::string(200, 'd') /
+                std::string(200, 'e') / std::string(200, 'f') / std::string(200, 'g') /
+                std::string(200, 'h') / std::string(200, 'i') / std::string(200, 'j') /
+                std::string(200, 'k') / std::string(200, 'l') / std::string(200, 'm') /
+                std::string(200, 'n') / std::string(200, 'o') / std::string(200, 'p') /
+                std::string(200, 'q') / std::string(200, 'r') / std::string(200, 's') /
+                std::string(200, 't') / std::string(200, 'u') / std::string(200, 'v') /
+                std::string(200, 'w'),
             "PATH_MAX"}}) {
     const Shell r = run_exe({kExe, "--quiet", "--out", out.string(), "--generations", "1"});
     EXPECT_EQ(r.rc, 2) << r.err;
@@ -604,7 +658,8 @@ TEST(Rows, LongOutPathIsAClearError) {
 
 TEST(Rows, RngIntegerCoversTheWholeInt64Range) {
   Rng rng(1);
-  constexpr auto lo = std::numeric_limits<std::int64_t>::min(), hi = std::numeric_limits<std::int64_t>::max();
+  constexpr auto lo = std::numeric_limits<std::int64_t>::min(),
+                 hi = std::numeric_limits<std::int64_t>::max();
   bool negative = false, positive = false;
   for (int i = 0; i < 64; ++i) {
     const std::int64_t x = rng.integer(lo, hi);  // was below(0): SIGFPE
@@ -661,14 +716,16 @@ TEST(Rows, AFitnessFunctionReturningANegativeOrNonFiniteFitnessIsAnError) {
 }
 
 TEST(Rows, ASignedObjectiveMayBeNegativeAndItsCheckpointResumes) {
-  // speed_toward (and a Python objective) is signed: a body swimming backwards scores < 0. Such a run
-  // runs, checkpoints and resumes; only non-finite values are refused.
+  // speed_toward (and a Python objective) is signed: a body swimming backwards scores < 0. Such a
+  // run runs, checkpoints and resumes; only non-finite values are refused.
   Config c;
   c.evolution.population = 4;
   c.evolution.elites = 1;
   c.evolution.threads = 1;
   c.evaluation.objective = "speed_toward";
-  auto signed_fitness = [](const Genome& g) { return Fitness{-1.0 - 0.01 * static_cast<double>(g.elements.size()), true, true, 3}; };
+  auto signed_fitness = [](const Genome& g) {
+    return Fitness{-1.0 - 0.01 * static_cast<double>(g.elements.size()), true, true, 3};
+  };
   Evolution evo(c, signed_fitness);
   evo.initialize();
   (void)evo.step();
@@ -689,10 +746,14 @@ TEST(ResumeSettings, ChangedSettingsAreRefusedBeforeAnyWriteAndNamed) {
   const fs::path run = fresh_dir("resume");
   fs::copy(small_run(), run, fs::copy_options::recursive);
   const auto before = snapshot(run);
-  const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--set", "scene.drag_normal=10", "--seed", "99"});
+  const Shell r = run_exe(
+      {kExe, "--quiet", "--resume", run.string(), "--set", "scene.drag_normal=10", "--seed", "99"});
   EXPECT_EQ(r.rc, 2) << r.err;
-  EXPECT_NE(r.err.find("scene.drag_normal (the run has 2.0, this command gives 10.0)"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("evolution.seed (the run has 3, this command gives 99)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scene.drag_normal (the run has 2.0, this command gives 10.0)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("evolution.seed (the run has 3, this command gives 99)"), std::string::npos)
+      << r.err;
   EXPECT_EQ(snapshot(run), before) << "a refused --resume changed the run directory";
   // ... so the run still resumes, and still repeats from its own config.
   const Shell again = run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "2"});
@@ -703,9 +764,10 @@ TEST(ResumeSettings, ChangedSettingsAreRefusedBeforeAnyWriteAndNamed) {
 TEST(ResumeSettings, ResumableKeysAreAcceptedAndRecorded) {
   const fs::path run = fresh_dir("resume_ok");
   fs::copy(small_run(), run, fs::copy_options::recursive);
-  const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "2", "--threads", "2", "--set",
-                           "evolution.checkpoint_every=3", "--set", "evolution.wall_seconds=1000", "--set",
-                           "evolution.stall_generations=7"});
+  const Shell r =
+      run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "2", "--threads", "2",
+               "--set", "evolution.checkpoint_every=3", "--set", "evolution.wall_seconds=1000",
+               "--set", "evolution.stall_generations=7"});
   ASSERT_EQ(r.rc, 0) << r.err;
   const Config recorded = load_config(run / "config.toml");
   EXPECT_EQ(recorded.evolution.generations, 2);
@@ -713,9 +775,10 @@ TEST(ResumeSettings, ResumableKeysAreAcceptedAndRecorded) {
   EXPECT_EQ(recorded.evolution.checkpoint_every, 3);
   EXPECT_EQ(recorded.evolution.stall_generations, 7);
   const std::string log = slurp(run / "resume.log");
-  for (const char* s : {"resumed at generation 1:", "evolution.generations 1 -> 2", "evolution.threads 1 -> 2",
-                        "evolution.checkpoint_every 1 -> 3", "evolution.wall_seconds 0.0 -> 1000.0",
-                        "evolution.stall_generations 500 -> 7"})
+  for (const char* s :
+       {"resumed at generation 1:", "evolution.generations 1 -> 2", "evolution.threads 1 -> 2",
+        "evolution.checkpoint_every 1 -> 3", "evolution.wall_seconds 0.0 -> 1000.0",
+        "evolution.stall_generations 500 -> 7"})
     EXPECT_NE(log.find(s), std::string::npos) << log;
   fs::remove_all(run);
 }
@@ -734,7 +797,9 @@ TEST(ResumeSettings, InProcessResumeWithAnotherConfigWritesNothing) {
     (void)run_evolution(c, opt, stub_fitness);
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("grn.dt (the run has 0.05, this command gives 0.025)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("grn.dt (the run has 0.05, this command gives 0.025)"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(snapshot(run), before);
   fs::remove_all(run);
@@ -743,9 +808,9 @@ TEST(ResumeSettings, InProcessResumeWithAnotherConfigWritesNothing) {
 // ---------------------------------------------------------------------------------------------------
 // Stop requests
 
-// Deterministic: the stop is raised by the fitness function itself on its k-th call, and the tests count
-// the evaluations started after it (was: a stop from a timer thread and bounds in seconds, which failed on
-// a loaded machine).
+// Deterministic: the stop is raised by the fitness function itself on its k-th call, and the tests
+// count the evaluations started after it (was: a stop from a timer thread and bounds in seconds,
+// which failed on a loaded machine).
 
 TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNothing) {
   Config c;
@@ -772,10 +837,12 @@ TEST(StopRequests, AStopDuringAGenerationIsHonouredWithinOneEvaluationAndLosesNo
   stop_at = 3;  // the third evaluation of generation 2 (of 15)
   EXPECT_THROW((void)evo.step(), Interrupted);
   EXPECT_EQ(calls.load(), 3) << "evaluations started after the stop (one thread: none)";
-  EXPECT_EQ(evo.generation(), 1) << "an interrupted generation must leave the state at the previous one";
+  EXPECT_EQ(evo.generation(), 1)
+      << "an interrupted generation must leave the state at the previous one";
   stop = false;
   stop_at = -1;
-  (void)evo.step();  // the same generation again, from (seed, g, i): identical to the uninterrupted run
+  // the same generation again, from (seed, g, i): identical to the uninterrupted run
+  (void)evo.step();
   EXPECT_EQ(evo.history().back().best, reference.history().back().best);
   EXPECT_EQ(evo.population()[3].genome, reference.population()[3].genome);
 }
@@ -785,8 +852,9 @@ TEST(StopRequests, AStopWhileSeedingIsHonouredWithinOneEvaluation) {
   c.evolution.population = 4;
   c.evolution.threads = 2;
   c.evolution.max_init_tries = 1000000000;
-  // Never viable: seeding would take years. The stop comes from the flag (set by the 50th evaluation)
-  // and from the poll (true from its 3rd call on): at most one evaluation per other thread starts after it.
+  // Never viable: seeding would take years. The stop comes from the flag (set by the 50th
+  // evaluation) and from the poll (true from its 3rd call on): at most one evaluation per other
+  // thread starts after it.
   for (const bool by_poll : {false, true}) {
     std::atomic<bool> stop{false};
     std::atomic<int> calls{0}, after{0};
@@ -809,10 +877,11 @@ TEST(StopRequests, AStopWhileSeedingIsHonouredWithinOneEvaluation) {
 }
 
 namespace {
-// Starts the CLI, waits until `ready` (a condition on its files), sends `sig`; returns the exit status and
-// the seconds from the signal to the exit (printed, never asserted: the in-process tests above count the
-// evaluations after a stop instead).
-std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig, const std::function<bool()>& ready) {
+// Starts the CLI, waits until `ready` (a condition on its files), sends `sig`; returns the exit
+// status and the seconds from the signal to the exit (printed, never asserted: the in-process tests
+// above count the evaluations after a stop instead).
+std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig,
+                                  const std::function<bool()>& ready) {
   std::fflush(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
@@ -825,9 +894,11 @@ std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig,
   }
   const auto started = Clock::now();
   int status = 0;
-  bool exited = false;  // on its own, before the signal: reaped, so never signalled (its pid may be reused)
+  // on its own, before the signal: reaped, so never signalled (its pid may be reused)
+  bool exited = false;
   // Polls the condition; the 900 s only keep a broken build from hanging the suite.
-  while (!ready() && seconds_since(started) < 900 && !(exited = waitpid(pid, &status, WNOHANG) == pid))
+  while (!ready() && seconds_since(started) < 900 &&
+         !(exited = waitpid(pid, &status, WNOHANG) == pid))
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   const auto t0 = Clock::now();
   if (!exited) {
@@ -839,37 +910,45 @@ std::pair<int, double> signal_cli(const std::vector<std::string>& args, int sig,
 }  // namespace
 
 TEST(StopRequests, CliSignalWhileSeedingEndsTheRunWithNothingToResume) {
-  // quiet_steps = steps forbids every division: no random genome is ever viable, seeding runs forever.
-  // Before, the signal was ignored until the population was complete: here, never.
+  // quiet_steps = steps forbids every division: no random genome is ever viable, seeding runs
+  // forever. Before, the signal was ignored until the population was complete: here, never.
   for (int sig : {SIGTERM, SIGINT}) {
     const fs::path out = fresh_dir("seed_signal");
     // config.toml is written after the signal handlers are installed, before seeding starts.
-    const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--set", "development.quiet_steps=400",
-                                           "--set", "evolution.population=100", "--out", out.string()},
-                                          sig, [&] { return fs::exists(out / "config.toml"); });
-    std::printf("[ stop     ] %s while seeding: exit %d, %.3f s after the signal\n", strsignal(sig), rc, seconds);
+    const auto [rc, seconds] =
+        signal_cli({kExe, "--quiet", "--threads", "2", "--set", "development.quiet_steps=400",
+                    "--set", "evolution.population=100", "--out", out.string()},
+                   sig, [&] { return fs::exists(out / "config.toml"); });
+    std::printf("[ stop     ] %s while seeding: exit %d, %.3f s after the signal\n", strsignal(sig),
+                rc, seconds);
     EXPECT_EQ(rc, 130) << strsignal(sig);
     EXPECT_FALSE(fs::exists(out / "checkpoint.json"));
-    // Nothing to resume: another run may replace it when asked (--overwrite; without it, a different
-    // config is refused since the run directory guard: RunDirectory.RunFilesWithoutACheckpoint...).
-    const Shell again = run_exe({kExe, "--quiet", "--threads", "1", "--set", "evolution.population=4", "--set",
-                                 "evaluation.steps=50", "--generations", "1", "--overwrite", "--out", out.string()});
+    // Nothing to resume: another run may replace it when asked (--overwrite; without it, a
+    // different config is refused since the run directory guard:
+    // RunDirectory.RunFilesWithoutACheckpoint...).
+    const Shell again = run_exe({kExe, "--quiet", "--threads", "1", "--set",
+                                 "evolution.population=4", "--set", "evaluation.steps=50",
+                                 "--generations", "1", "--overwrite", "--out", out.string()});
     EXPECT_EQ(again.rc, 0) << again.err;
     fs::remove_all(out);
   }
 }
 
 TEST(StopRequests, CliSignalDuringAGenerationEndsWithAResumableCheckpoint) {
-  // The signal is sent as soon as generation 0's checkpoint exists, so it lands in generation 1 (or in a
-  // later one: nothing here depends on when). The latency is printed only: the in-process tests above
-  // count the evaluations after a stop.
+  // The signal is sent as soon as generation 0's checkpoint exists, so it lands in generation 1 (or
+  // in a later one: nothing here depends on when). The latency is printed only: the in-process
+  // tests above count the evaluations after a stop.
   const fs::path out = fresh_dir("gen_signal");
-  const auto [rc, seconds] = signal_cli({kExe, "--quiet", "--threads", "2", "--seed", "4", "--set",
-                                         "evolution.population=30", "--set", "evaluation.steps=2000", "--set",
-                                         "evolution.checkpoint_every=5", "--out", out.string()},
-                                        SIGTERM, [&] { return fs::exists(out / "checkpoint.json"); });
-  std::printf("[ stop     ] SIGTERM during a generation (population 30, 2000 swim steps): exit %d, %.3f s after the "
-              "signal\n", rc, seconds);
+  const auto [rc, seconds] =
+      signal_cli({kExe, "--quiet", "--threads", "2", "--seed", "4", "--set",
+                  "evolution.population=30", "--set", "evaluation.steps=2000", "--set",
+                  "evolution.checkpoint_every=5", "--out", out.string()},
+                 SIGTERM, [&] { return fs::exists(out / "checkpoint.json"); });
+  std::printf(
+      "[ stop     ] SIGTERM during a generation (population 30, 2000 swim steps): exit %d, %.3f s "
+      "after the "
+      "signal\n",
+      rc, seconds);
   EXPECT_EQ(rc, 130);
   ASSERT_TRUE(fs::exists(out / "checkpoint.json"));
   Config c = load_config(out / "config.toml");
@@ -943,17 +1022,26 @@ TEST(CheckpointMeaning, HandEditedContentIsRefusedNamingWhatIsWrong) {
       {"negative fitness", "fitness -1", [&](json& p) { p["population"][v]["fitness"] = -1.0; }},
       {"empty genome of a viable individual", "viable with an empty genome",
        [&](json& p) { p["population"][v]["genome"]["elements"] = json::array(); }},
-      {"history out of order", "history row 0 is generation 1", [](json& p) { std::swap(p["history"][0], p["history"][1]); }},
-      {"a gap in the history", "history row 2 is generation 3", [](json& p) { p["history"].erase(2); }},
-      {"viable fraction above 1", "viable_fraction 1.5", [](json& p) { p["history"][1]["viable_fraction"] = 1.5; }},
-      {"decreasing evaluations", "evaluations decrease", [](json& p) { p["history"][1]["evaluations"] = 0; }},
-      {"negative wall time", "wall_seconds -1", [](json& p) { p["history"][0]["wall_seconds"] = -1.0; }},
-      {"best_ever above the history", "best_ever is 1000", [](json& p) { p["best_ever"] = 1000.0; }},
+      {"history out of order", "history row 0 is generation 1",
+       [](json& p) { std::swap(p["history"][0], p["history"][1]); }},
+      {"a gap in the history", "history row 2 is generation 3",
+       [](json& p) { p["history"].erase(2); }},
+      {"viable fraction above 1", "viable_fraction 1.5",
+       [](json& p) { p["history"][1]["viable_fraction"] = 1.5; }},
+      {"decreasing evaluations", "evaluations decrease",
+       [](json& p) { p["history"][1]["evaluations"] = 0; }},
+      {"negative wall time", "wall_seconds -1",
+       [](json& p) { p["history"][0]["wall_seconds"] = -1.0; }},
+      {"best_ever above the history", "best_ever is 1000",
+       [](json& p) { p["best_ever"] = 1000.0; }},
       {"stall counter", "stall is 99", [](json& p) { p["stall"] = 99; }},
       {"evaluations counter", "evaluations is 1", [](json& p) { p["evaluations"] = 1; }},
       {"last row not the population", "does not describe the population",
-       [&](json& p) { p["population"][v]["fitness"] = p["population"][v]["fitness"].get<double>() + 0.5; }},
-      {"a genome that does not validate", "sign", [&](json& p) { p["population"][v]["genome"]["elements"][0]["sign"] = 2; }},
+       [&](json& p) {
+         p["population"][v]["fitness"] = p["population"][v]["fitness"].get<double>() + 0.5;
+       }},
+      {"a genome that does not validate", "sign",
+       [&](json& p) { p["population"][v]["genome"]["elements"][0]["sign"] = 2; }},
       {"population size", "individuals", [](json& p) { p["population"].erase(0); }},
   };
   for (const auto& e : edits) {

@@ -8,13 +8,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <limits>
+#include <sstream>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include "../../src/box2d_island.hpp"
 #include "../../src/cell_integrator.hpp"
-#include <nlohmann/json.hpp>
 
 #include "animat/body.hpp"
 #include "animat/config.hpp"
@@ -22,7 +22,8 @@
 #include "animat/genome.hpp"
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
-#pragma GCC diagnostic ignored "-Wunused-function"  // physics_support.hpp's helpers this file does not need
+// physics_support.hpp's helpers this file does not need
+#pragma GCC diagnostic ignored "-Wunused-function"
 #include "physics_support.hpp"
 
 namespace animat {
@@ -31,8 +32,8 @@ namespace {
 std::uint32_t bits(float x) { return std::bit_cast<std::uint32_t>(x); }
 
 /// Cells as the swim and development worlds made them before the native integrator: fixture-less,
-/// fixed-rotation dynamic bodies with SetMassData, sleeping, continuous physics and warm starting off,
-/// optionally linked into one island by zero-force friction joints.
+/// fixed-rotation dynamic bodies with SetMassData, sleeping, continuous physics and warm starting
+/// off, optionally linked into one island by zero-force friction joints.
 struct Box2DCells {
   b2World world{b2Vec2(0.0f, 0.0f)};
   std::vector<b2Body*> bodies;
@@ -60,7 +61,8 @@ struct Box2DCells {
   }
   void step(float h, const std::vector<double>& fx, const std::vector<double>& fy) {
     for (std::size_t i = 0; i < bodies.size(); ++i)
-      bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(fx[i]), static_cast<float>(fy[i])), true);
+      bodies[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(fx[i]), static_cast<float>(fy[i])),
+                                    true);
     world.Step(h, 1, 1);
   }
 };
@@ -81,7 +83,8 @@ TEST_P(IntegratorVersusBox2D, SamePositionsAndVelocitiesBitForBit) {
   CellIntegrator cells;
   cells.set_mass(c.mass);
   cells.damping = c.damping;
-  for (int i = 0; i < n; ++i) cells.add(rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0), rng.uniform(-1.0, 1.0), 0.0);
+  for (int i = 0; i < n; ++i)
+    cells.add(rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0), rng.uniform(-1.0, 1.0), 0.0);
   Box2DCells box2d(cells, c.damping, c.linked);
   std::vector<double> fx(n), fy(n);
   long clamped = 0;
@@ -104,14 +107,16 @@ TEST_P(IntegratorVersusBox2D, SamePositionsAndVelocitiesBitForBit) {
       const b2Body* b = box2d.bodies[static_cast<std::size_t>(i)];
       ASSERT_EQ(bits(cells.px[i]), bits(b->GetPosition().x)) << "step " << step << " cell " << i;
       ASSERT_EQ(bits(cells.py[i]), bits(b->GetPosition().y)) << "step " << step << " cell " << i;
-      // The linking joints may turn a -0 velocity into +0 (their zero impulse is subtracted); values
-      // are the same, and positions (above) are bitwise equal either way.
+      // The linking joints may turn a -0 velocity into +0 (their zero impulse is subtracted);
+      // values are the same, and positions (above) are bitwise equal either way.
       if (c.linked) {
         ASSERT_EQ(cells.vx[i], b->GetLinearVelocity().x) << "step " << step << " cell " << i;
         ASSERT_EQ(cells.vy[i], b->GetLinearVelocity().y) << "step " << step << " cell " << i;
       } else {
-        ASSERT_EQ(bits(cells.vx[i]), bits(b->GetLinearVelocity().x)) << "step " << step << " cell " << i;
-        ASSERT_EQ(bits(cells.vy[i]), bits(b->GetLinearVelocity().y)) << "step " << step << " cell " << i;
+        ASSERT_EQ(bits(cells.vx[i]), bits(b->GetLinearVelocity().x))
+            << "step " << step << " cell " << i;
+        ASSERT_EQ(bits(cells.vy[i]), bits(b->GetLinearVelocity().y))
+            << "step " << step << " cell " << i;
       }
     }
     // Keep the cells within a box (as a body holds together) by resetting the far ones, both ways.
@@ -127,10 +132,12 @@ TEST_P(IntegratorVersusBox2D, SamePositionsAndVelocitiesBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, IntegratorVersusBox2D,
-                         ::testing::Values(Case{1.0, 0.0f, 1.0f / 60.0f, true},    // the swim world
+                         ::testing::Values(Case{1.0, 0.0f, 1.0f / 60.0f, true},  // the swim world
                                            Case{1.0, 0.0f, 1.0f / 60.0f, false},
-                                           Case{2.5, 0.0f, 1.0f / 960.0f, true},   // another mass, dt/16
-                                           Case{1.0, 10.0f, 0.1f, true},           // the development world
+                                           // another mass, dt/16
+                                           Case{2.5, 0.0f, 1.0f / 960.0f, true},
+                                           // the development world
+                                           Case{1.0, 10.0f, 0.1f, true},
                                            Case{0.7, 3.0f, 0.05f, false}));
 
 /// A whole swim, every built-in effect, with collisions (position corrections) and drag: the two
@@ -192,7 +199,8 @@ TEST(IntegratorVersusBox2D, EvaluationsAreBitwiseTheSame) {
     std::stringstream text;
     text << in.rdbuf();
     const auto j = nlohmann::json::parse(text.str());
-    // Each in the environment it evolved in (tests/cpp/test_collisions.cpp reads them the same way).
+    // Each in the environment it evolved in (tests/cpp/test_collisions.cpp reads them the same
+    // way).
     Config a_config;
     a_config.scene.drag_normal = j.at("drag_normal").get<double>();
     a_config.development.max_cells = j.at("max_cells").get<int>();
@@ -201,10 +209,12 @@ TEST(IntegratorVersusBox2D, EvaluationsAreBitwiseTheSame) {
     a_config.scene.pressure_area_floor = j.at("pressure_area_floor").get<double>();
     Config b_config = a_config;
     b_config.physics.integrator = "box2d";
-    const Genome g = genome_from_json(j.at("genome").dump(), a_config.genome, entry.path().string());
+    const Genome g =
+        genome_from_json(j.at("genome").dump(), a_config.genome, entry.path().string());
     const EvaluationResult a = evaluate(g, a_config);
     const EvaluationResult b = evaluate(g, b_config);
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(a.fitness), std::bit_cast<std::uint64_t>(b.fitness)) << entry.path();
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(a.fitness), std::bit_cast<std::uint64_t>(b.fitness))
+        << entry.path();
     EXPECT_EQ(a.collisions, b.collisions) << entry.path();
     collisions += a.collisions;
     ++evolved;

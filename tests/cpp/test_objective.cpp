@@ -9,11 +9,11 @@
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
-#include "animat/run.hpp"
 #include "animat/external_actuation.hpp"
 #include "animat/objective.hpp"
 #include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
+#include "animat/run.hpp"
 #include "test_support.hpp"
 
 using namespace animat;
@@ -51,7 +51,8 @@ void expect_same_population(const Evolution& a, const Evolution& b) {
   }
 }
 
-void expect_same_history(const std::vector<GenerationStats>& a, const std::vector<GenerationStats>& b) {
+void expect_same_history(const std::vector<GenerationStats>& a,
+                         const std::vector<GenerationStats>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
@@ -89,7 +90,8 @@ TEST(AskTell, DrivenFromOutsideEqualsTheEngineRunningItself) {
       driven.tell(f);
       ++rounds;
     }
-    EXPECT_GT(rounds, 15);  // the initial slots needed more than one round (1 genome in 4 is non-viable)
+    // the initial slots needed more than one round (1 genome in 4 is non-viable)
+    EXPECT_GT(rounds, 15);
     expect_same_history(itself.history(), driven.history());
     expect_same_population(itself, driven);
   }
@@ -117,19 +119,20 @@ TEST(AskTell, InitialRoundsCountOnlyTheDrawsUpToEachSlotsFirstViable) {
 
 TEST(AskTell, MisuseIsAClearError) {
   Evolution evo(small_config());
-  EXPECT_THROW((void)evo.tell({}), Error);                 // nothing asked
-  EXPECT_THROW((void)evo.checkpoint(), Error);             // no generation yet
+  EXPECT_THROW((void)evo.tell({}), Error);      // nothing asked
+  EXPECT_THROW((void)evo.checkpoint(), Error);  // no generation yet
   EXPECT_THROW((void)evo.best(), Error);
-  EXPECT_THROW(evo.initialize(), Error);                   // no fitness function
+  EXPECT_THROW(evo.initialize(), Error);  // no fitness function
   const auto first = evo.ask();
-  const auto again = evo.ask();                            // same genomes until tell()
+  const auto again = evo.ask();  // same genomes until tell()
   ASSERT_EQ(first.size(), again.size());
   for (std::size_t i = 0; i < first.size(); ++i) EXPECT_TRUE(first[i] == again[i]);
   try {
     (void)evo.tell(std::vector<Fitness>(first.size() - 1));
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("19 fitness values for the 20 genomes"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("19 fitness values for the 20 genomes"), std::string::npos)
+        << e.what();
   }
   std::vector<Fitness> nan(first.size(), Fitness{std::nan(""), true, true, 3});
   EXPECT_THROW((void)evo.tell(nan), Error);
@@ -147,7 +150,8 @@ TEST(AskTell, ExhaustedInitialSlotNamesMaxInitTries) {
     }
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("evolution.max_init_tries = 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("evolution.max_init_tries = 3"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -196,7 +200,8 @@ TEST(RunEvolution, EvaluationsPerSecondIsThatOfTheGenerationAlone) {
   for (std::size_t i = 1; i < h.size(); ++i) {
     const double seconds = h[i].wall_seconds - h[i - 1].wall_seconds;
     if (seconds > 0) {
-      EXPECT_DOUBLE_EQ(h[i].evaluations_per_second, static_cast<double>(h[i].evaluations - h[i - 1].evaluations) / seconds);
+      EXPECT_DOUBLE_EQ(h[i].evaluations_per_second,
+                       static_cast<double>(h[i].evaluations - h[i - 1].evaluations) / seconds);
     }
   }
 }
@@ -214,9 +219,10 @@ TEST(Objective, ConfigSelectsABuiltInByNameAndRefusesUnknownOnes) {
     apply_override(c, "evaluation.objective=distnce");
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("evaluation.objective = \"distnce\": expected one of distance, "
-                                         "distance_per_size, speed_toward, distance_x, distance_minus_energy, "
-                                         "distance_per_energy, chemotaxis, python:*"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "evaluation.objective = \"distnce\": expected one of distance, "
+                  "distance_per_size, speed_toward, distance_x, distance_minus_energy, "
+                  "distance_per_energy, chemotaxis, python:*"),
               std::string::npos)
         << e.what();
   }
@@ -224,7 +230,7 @@ TEST(Objective, ConfigSelectsABuiltInByNameAndRefusesUnknownOnes) {
   EXPECT_THROW(apply_override(c, "evaluation.direction=[1.0]"), ConfigError);
   EXPECT_THROW(apply_override(c, "evaluation.objective=python:"), ConfigError);  // needs a name
   c.evaluation.objective = "python:mine";
-  validate(c);  // a valid config...
+  validate(c);                                                    // a valid config...
   EXPECT_THROW((void)make_objective(c.evaluation), ConfigError);  // ...that only Python can run
   EXPECT_THROW((void)swim_fitness(c), ConfigError);
 }
@@ -260,16 +266,19 @@ TEST(Objective, DistanceIsEvaluateBitForBitAndObservingChangesNothing) {
 }
 
 TEST(Objective, DistancePerSizeAndSpeedTowardFollowTheirFormulas) {
-  EXPECT_DOUBLE_EQ(body_length(triangle_body()), 5.0 + 1.0);  // the 3-4-5 triangle's hypotenuse + a cell
+  // the 3-4-5 triangle's hypotenuse + a cell
+  EXPECT_DOUBLE_EQ(body_length(triangle_body()), 5.0 + 1.0);
   Config c = small_config();
   const Genome g = viable_genome(c, 5);
   const EvaluationRecord rec = record_evaluation(g, c, true, 0);
   ASSERT_TRUE(rec.result.viable && rec.result.stable);
   c.evaluation.objective = "distance_per_size";
-  EXPECT_DOUBLE_EQ(evaluate(g, c, *make_objective(c.evaluation)).fitness, rec.result.fitness / body_length(rec.body));
+  EXPECT_DOUBLE_EQ(evaluate(g, c, *make_objective(c.evaluation)).fitness,
+                   rec.result.fitness / body_length(rec.body));
   c.evaluation.objective = "speed_toward";
   c.evaluation.direction = {3.0, 4.0};
-  const double toward = (0.6 * rec.result.displacement.x() + 0.8 * rec.result.displacement.y()) / rec.result.simulated_time;
+  const double toward = (0.6 * rec.result.displacement.x() + 0.8 * rec.result.displacement.y()) /
+                        rec.result.simulated_time;
   EXPECT_DOUBLE_EQ(evaluate(g, c, *make_objective(c.evaluation)).fitness, toward);
   c.evaluation.direction = {-3.0, -4.0};
   EXPECT_DOUBLE_EQ(evaluate(g, c, *make_objective(c.evaluation)).fitness, -toward);
@@ -342,8 +351,10 @@ TEST(Objective, CustomObjectiveDrivesTheGAAndStaysThreadCountIndependent) {
       const std::size_t f = r.frame_count(), n = r.positions.size() / (2 * f), half = f / 2;
       double dx = 0, dy = 0;
       for (std::size_t i = 0; i < n; ++i) {
-        dx += (r.positions[((f - 1) * n + i) * 2] - r.positions[(half * n + i) * 2]) / static_cast<double>(n);
-        dy += (r.positions[((f - 1) * n + i) * 2 + 1] - r.positions[(half * n + i) * 2 + 1]) / static_cast<double>(n);
+        dx += (r.positions[((f - 1) * n + i) * 2] - r.positions[(half * n + i) * 2]) /
+              static_cast<double>(n);
+        dy += (r.positions[((f - 1) * n + i) * 2 + 1] - r.positions[(half * n + i) * 2 + 1]) /
+              static_cast<double>(n);
       }
       return std::hypot(dx, dy) / (r.times[f - 1] - r.times[half]);
     }
@@ -360,7 +371,8 @@ TEST(Objective, CustomObjectiveDrivesTheGAAndStaysThreadCountIndependent) {
   };
   const RunSummary one = run(1), two = run(2);
   ASSERT_EQ(one.history.size(), 3u);
-  for (std::size_t i = 0; i < one.history.size(); ++i) EXPECT_EQ(one.history[i].best, two.history[i].best);
+  for (std::size_t i = 0; i < one.history.size(); ++i)
+    EXPECT_EQ(one.history[i].best, two.history[i].best);
   EXPECT_GT(one.history.back().best, 0.0);
   EXPECT_LT(one.history.back().best, 5.0);  // a speed (length per time unit), not a distance
 }
@@ -385,7 +397,8 @@ TEST(ExternalActuation, RestLengthsFollowTheTermsSetFromOutside) {
   sim.step();
   for (int s = 0; s < b.spring_count(); ++s)
     EXPECT_DOUBLE_EQ(sim.rest_lengths_now()[static_cast<std::size_t>(s)],
-                     (1.0 + u[static_cast<std::size_t>(b.springs(s, 0))] + u[static_cast<std::size_t>(b.springs(s, 1))]) *
+                     (1.0 + u[static_cast<std::size_t>(b.springs(s, 0))] +
+                      u[static_cast<std::size_t>(b.springs(s, 1))]) *
                          l0[static_cast<std::size_t>(s)]);
   EXPECT_GT(sim.kinetic_energy(), 0.0);
   EXPECT_THROW(act->set_terms(std::vector<double>{0.1, 0.2}), GeometryError);
@@ -413,10 +426,14 @@ TEST(ExternalActuation, OscillatorModeIsEq2WithoutTheDelayedStart) {
     sim.step();
     const double t = k * h;  // the rest lengths used by step k
     for (int s = 0; s < b.spring_count(); ++s) {
-      const auto i = static_cast<std::size_t>(b.springs(s, 0)), j = static_cast<std::size_t>(b.springs(s, 1));
-      const double expected = (1.0 + a[i] * std::sin(f(static_cast<Eigen::Index>(i)) * t + phase[i]) +
-                               a[j] * std::sin(f(static_cast<Eigen::Index>(j)) * t + phase[j])) * l0[static_cast<std::size_t>(s)];
-      ASSERT_NEAR(sim.rest_lengths_now()[static_cast<std::size_t>(s)], expected, 1e-12) << "step " << k;
+      const auto i = static_cast<std::size_t>(b.springs(s, 0)),
+                 j = static_cast<std::size_t>(b.springs(s, 1));
+      const double expected =
+          (1.0 + a[i] * std::sin(f(static_cast<Eigen::Index>(i)) * t + phase[i]) +
+           a[j] * std::sin(f(static_cast<Eigen::Index>(j)) * t + phase[j])) *
+          l0[static_cast<std::size_t>(s)];
+      ASSERT_NEAR(sim.rest_lengths_now()[static_cast<std::size_t>(s)], expected, 1e-12)
+          << "step " << k;
     }
   }
 }

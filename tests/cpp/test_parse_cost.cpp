@@ -1,12 +1,13 @@
-// The bounded JSON parser (genome files, checkpoints) is linear in the input, proven by counting work,
-// not by timing it: docs/reliability.md, "Resource bounds".
+// The bounded JSON parser (genome files, checkpoints) is linear in the input, proven by counting
+// work, not by timing it: docs/reliability.md, "Resource bounds".
 //
 //   ParseCost.*   detail::parse_bounded parses into a basic_json whose arrays count every iterator
-//                 step taken over them. A linear parser builds each array by appending and never walks
-//                 back over what it built; nlohmann's parse with a callback (what parse_bounded used
-//                 before cd57c5a) walks the whole enclosing array each time an element object closes,
-//                 n^2/2 steps for n elements: a 99 MB genome file took minutes before being refused.
-//                 The count is the same on any machine and under any load.
+//                 step taken over them. A linear parser builds each array by appending and never
+//                 walks back over what it built; nlohmann's parse with a callback (what
+//                 parse_bounded used before cd57c5a) walks the whole enclosing array each time an
+//                 element object closes, n^2/2 steps for n elements: a 99 MB genome file took
+//                 minutes before being refused. The count is the same on any machine and under any
+//                 load.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -70,11 +71,17 @@ class StepCounted {
   friend StepCounted operator+(difference_type n, StepCounted a) { return a += n; }
   friend StepCounted operator-(StepCounted a, difference_type n) { return a -= n; }
   template <class Other>
-  friend difference_type operator-(const StepCounted& a, const StepCounted<Other>& b) { return a.base() - b.base(); }
+  friend difference_type operator-(const StepCounted& a, const StepCounted<Other>& b) {
+    return a.base() - b.base();
+  }
   template <class Other>
-  friend bool operator==(const StepCounted& a, const StepCounted<Other>& b) { return a.base() == b.base(); }
+  friend bool operator==(const StepCounted& a, const StepCounted<Other>& b) {
+    return a.base() == b.base();
+  }
   template <class Other>
-  friend auto operator<=>(const StepCounted& a, const StepCounted<Other>& b) { return a.base() <=> b.base(); }
+  friend auto operator<=>(const StepCounted& a, const StepCounted<Other>& b) {
+    return a.base() <=> b.base();
+  }
 
  private:
   Base it_{};
@@ -104,7 +111,9 @@ class StepCountedVector : public std::vector<T, Alloc> {
   const_reverse_iterator rbegin() const noexcept { return const_reverse_iterator(end()); }
   const_reverse_iterator rend() const noexcept { return const_reverse_iterator(begin()); }
   iterator erase(const_iterator pos) { return iterator(Base::erase(pos.base())); }
-  iterator erase(const_iterator first, const_iterator last) { return iterator(Base::erase(first.base(), last.base())); }
+  iterator erase(const_iterator first, const_iterator last) {
+    return iterator(Base::erase(first.base(), last.base()));
+  }
   template <class... Args>
   iterator insert(const_iterator pos, Args&&... args) {
     return iterator(Base::insert(pos.base(), std::forward<Args>(args)...));
@@ -117,15 +126,17 @@ class StepCountedVector : public std::vector<T, Alloc> {
 
 using CountingJson = nlohmann::basic_json<std::map, StepCountedVector>;
 
-/// What parse_bounded was before cd57c5a (nlohmann's parse with a callback enforcing the same caps),
-/// kept here as the canary below: proof that the count sees the walk that made it quadratic.
+/// What parse_bounded was before cd57c5a (nlohmann's parse with a callback enforcing the same
+/// caps), kept here as the canary below: proof that the count sees the walk that made it quadratic.
 template <class Json>
-Json parse_with_callback(std::string_view text, int max_depth, int item_depth, long long max_items) {
+Json parse_with_callback(std::string_view text, int max_depth, int item_depth,
+                         long long max_items) {
   long long items = 0;
   auto callback = [&](int depth, nlohmann::detail::parse_event_t event, Json&) {
     using E = nlohmann::detail::parse_event_t;
     if ((event == E::object_start || event == E::array_start) && depth >= max_depth)
-      throw animat::detail::JsonLimit("nesting deeper than " + std::to_string(max_depth) + " levels");
+      throw animat::detail::JsonLimit("nesting deeper than " + std::to_string(max_depth) +
+                                      " levels");
     if (max_items >= 0 && event == E::object_end && depth == item_depth && ++items > max_items)
       throw animat::detail::JsonLimit("more than " + std::to_string(max_items) + " items");
     return true;
@@ -139,7 +150,8 @@ std::string genome_text(int n) {
   const animat::Genome seed = animat::random_genome(animat::GenomeParams{}, rng);
   animat::Genome g;
   g.dimensions = seed.dimensions;
-  for (int i = 0; i < n; ++i) g.elements.push_back(seed.elements[static_cast<std::size_t>(i) % seed.size()]);
+  for (int i = 0; i < n; ++i)
+    g.elements.push_back(seed.elements[static_cast<std::size_t>(i) % seed.size()]);
   return animat::to_json(g);
 }
 
@@ -148,7 +160,8 @@ template <class Parse>
 std::pair<long long, std::string> steps_to_parse(const std::string& text, Parse parse) {
   g_array_steps = 0;
   const CountingJson j = parse(text);
-  const long long steps = g_array_steps;  // before j is destroyed (destruction walks each array once)
+  // before j is destroyed (destruction walks each array once)
+  const long long steps = g_array_steps;
   return {steps, j.dump()};
 }
 
@@ -160,12 +173,14 @@ TEST(ParseCost, ParsingAGenomeNeverWalksBackOverItsElements) {
   for (int n : {1000, 4000, 16000}) {
     SCOPED_TRACE(n);
     const std::string text = genome_text(n);
-    const auto [steps, dump] = steps_to_parse(text, [](const std::string& t) {  // genome_from_json's caps at
-      return animat::detail::parse_bounded<CountingJson>(t, 16, 2, 2LL * 1'000'000 + 1000);  // max_elements 10^6
+    const auto [steps, dump] = steps_to_parse(text, [](const std::string& t) {
+      // genome_from_json's caps at max_elements 10^6
+      return animat::detail::parse_bounded<CountingJson>(t, 16, 2, 2LL * 1'000'000 + 1000);
     });
-    std::printf("[ parse    ] %d genome elements (%zu bytes): %lld iterator steps over arrays\n", n, text.size(), steps);
-    EXPECT_LE(steps, n) << "parse_bounded walked back over built arrays: " << steps << " iterator steps for " << n
-                        << " elements (quadratic parsing)";
+    std::printf("[ parse    ] %d genome elements (%zu bytes): %lld iterator steps over arrays\n", n,
+                text.size(), steps);
+    EXPECT_LE(steps, n) << "parse_bounded walked back over built arrays: " << steps
+                        << " iterator steps for " << n << " elements (quadratic parsing)";
     EXPECT_EQ(dump, nlohmann::json::parse(text).dump());  // and it parsed the document
   }
 }
@@ -174,7 +189,9 @@ TEST(ParseCost, ParsingACheckpointShapedDocumentNeverWalksBackOverItsItems) {
   // Checkpoints: an array of objects inside an object (parse_bounded(text, 64), no item cap).
   const int n = 16000;
   std::string text = R"({"population": [)";
-  for (int i = 0; i < n; ++i) text += (i ? "," : "") + std::string(R"({"fitness": 1.5, "viable": true, "genome": {"elements": [0, 1]}})");
+  for (int i = 0; i < n; ++i)
+    text += (i ? "," : "") +
+            std::string(R"({"fitness": 1.5, "viable": true, "genome": {"elements": [0, 1]}})");
   text += "]}";
   const auto [steps, dump] = steps_to_parse(text, [](const std::string& t) {
     return animat::detail::parse_bounded<CountingJson>(t, 64);
@@ -192,7 +209,9 @@ TEST(ParseCost, CanaryTheCountSeesTheCallbackParsersQuadraticWalk) {
   const auto [steps, dump] = steps_to_parse(genome_text(n), [](const std::string& t) {
     return parse_with_callback<CountingJson>(t, 16, 2, 2LL * 1'000'000 + 1000);
   });
-  std::printf("[ parse    ] the callback parser, %d genome elements: %lld iterator steps over arrays\n", n, steps);
+  std::printf(
+      "[ parse    ] the callback parser, %d genome elements: %lld iterator steps over arrays\n", n,
+      steps);
   EXPECT_GT(steps, 100LL * n) << "the counting array no longer sees the callback parser's walk";
   EXPECT_GE(steps, static_cast<long long>(n) * (n - 1) / 2);
 }

@@ -1,9 +1,9 @@
-// Swimming physics (paper §4, docs/model.md §4): analytic checks of every effect, conservation laws,
-// "off means off", the stable drag scheme, error detection, and the named stability cases.
-// No timing assertions anywhere.
-#include <Eigen/LU>
+// Swimming physics (paper §4, docs/model.md §4): analytic checks of every effect, conservation
+// laws, "off means off", the stable drag scheme, error detection, and the named stability cases. No
+// timing assertions anywhere.
 #include <box2d/box2d.h>
 #include <gtest/gtest.h>
+#include <Eigen/LU>
 
 #include <algorithm>
 #include <array>
@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "../../src/box2d_island.hpp"
 #include "animat/body.hpp"
 #include "animat/config.hpp"
 #include "animat/development.hpp"
@@ -27,7 +28,6 @@
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
 #include "animat/scene.hpp"
-#include "../../src/box2d_island.hpp"
 #include "physics_support.hpp"
 
 // Counting allocator: proves the swim loop allocates nothing.
@@ -36,11 +36,10 @@
 namespace animat {
 namespace {
 
-
-
 double signed_area(const Points& p, const std::vector<int>& loop) { return polygon_area(p, loop); }
 
-// --- world setup -------------------------------------------------------------------------------------
+// --- world setup
+// -------------------------------------------------------------------------------------
 
 TEST(SwimWorld, OneFixturelessBodyPerCellEqualMassesNoSleepNoGravity) {
   const Body b = swimmer(lattice_points(8, 4), Drive::wave);
@@ -58,7 +57,8 @@ TEST(SwimWorld, OneFixturelessBodyPerCellEqualMassesNoSleepNoGravity) {
   EXPECT_EQ(w.GetGravity().y, 0.0f);
   for (b2Body* body = w.GetBodyList(); body; body = body->GetNext()) {
     EXPECT_EQ(body->GetType(), b2_dynamicBody);
-    EXPECT_EQ(body->GetFixtureList(), nullptr) << "no effect needs Box2D collisions, so no fixtures";
+    EXPECT_EQ(body->GetFixtureList(), nullptr)
+        << "no effect needs Box2D collisions, so no fixtures";
     EXPECT_FLOAT_EQ(body->GetMass(), 2.5f);
     EXPECT_FALSE(body->IsSleepingAllowed());
   }
@@ -101,7 +101,8 @@ TEST(SwimWorld, DefaultTangentialDragIsNormalOver200) {
   EXPECT_DOUBLE_EQ(tangential_drag(s), 0.3);
 }
 
-// --- springs --------------------------------------------------------------------------------------
+// --- springs
+// --------------------------------------------------------------------------------------
 
 /// Zero crossings of len − L0 (linear interpolation) give the period.
 double measured_period(Simulation& sim, double l0, int steps) {
@@ -110,7 +111,8 @@ double measured_period(Simulation& sim, double l0, int steps) {
   for (int k = 1; k <= steps; ++k) {
     sim.step();
     const double cur = sim.positions()(1, 0) - sim.positions()(0, 0) - l0;
-    if ((prev < 0.0) != (cur < 0.0)) crossings.push_back(sim.time() - sim.physics().dt * cur / (cur - prev));
+    if ((prev < 0.0) != (cur < 0.0))
+      crossings.push_back(sim.time() - sim.physics().dt * cur / (cur - prev));
     prev = cur;
   }
   EXPECT_GE(crossings.size(), 20u);
@@ -130,8 +132,8 @@ TEST(Springs, TwoNodePeriodMatchesAnalyticAtDefaultDt) {
   }
 }
 
-/// The linear map (x, v) -> (x', v') of one Box2D step for a damped oscillator x'' = −ω²x − γv, with
-/// the damping evaluated at the start velocity or at the predicted midpoint velocity.
+/// The linear map (x, v) -> (x', v') of one Box2D step for a damped oscillator x'' = −ω²x − γv,
+/// with the damping evaluated at the start velocity or at the predicted midpoint velocity.
 Eigen::Matrix2d oscillator_step(double w2, double g, double h, bool midpoint) {
   Eigen::Matrix2d a;
   for (int c = 0; c < 2; ++c) {
@@ -162,11 +164,12 @@ Eigen::Matrix2d lyapunov(const Eigen::Matrix2d& a) {
 
 TEST(Springs, DampingMakesEnergyDecayMonotonically) {
   // Box2D integrates with symplectic Euler (v += h·a; x += h·v); spring damping is evaluated at the
-  // start velocity or at the predicted midpoint velocity (physics.velocity_forces). For the stretch x
-  // and stretching speed v of a damped two-node spring (ω² = k/μ, γ = c/μ) a step is a linear map A.
-  // Its discrete energy V = zᵀQz (AᵀQA − Q = −e₂e₂ᵀ, Q positive definite) falls by exactly v² per
-  // step: V must fall at every single step. (For γ = 0 it is the conserved "shadow" energy; the
-  // textbook energy ½μv² + ½kx² wobbles by O(ωh) within a period, so it must fall period by period.)
+  // start velocity or at the predicted midpoint velocity (physics.velocity_forces). For the stretch
+  // x and stretching speed v of a damped two-node spring (ω² = k/μ, γ = c/μ) a step is a linear map
+  // A. Its discrete energy V = zᵀQz (AᵀQA − Q = −e₂e₂ᵀ, Q positive definite) falls by exactly v²
+  // per step: V must fall at every single step. (For γ = 0 it is the conserved "shadow" energy; the
+  // textbook energy ½μv² + ½kx² wobbles by O(ωh) within a period, so it must fall period by
+  // period.)
   for (const std::string mode : {"midpoint", "start"}) {
     SceneParams scene = scene_with({"springs"});
     PhysicsParams physics;
@@ -191,7 +194,8 @@ TEST(Springs, DampingMakesEnergyDecayMonotonically) {
     for (int s = 1; s <= 600; ++s) {
       sim.step();
       const double now = energy(x, v);
-      EXPECT_LE(now, prev + 1e-6 * v0) << mode << " step " << s;  // float state: round-off allowance
+      // float state: round-off allowance
+      EXPECT_LE(now, prev + 1e-6 * v0) << mode << " step " << s;
       prev = now;
       if (s % period_steps == 0) per_period.push_back(0.5 * mu * v * v + 0.5 * k * x * x);
     }
@@ -233,7 +237,8 @@ TEST(Springs, MatchTrajectoryOfIndependentIntegrator) {
   }
 }
 
-// --- rest and conservation ---------------------------------------------------------------------------
+// --- rest and conservation
+// ---------------------------------------------------------------------------
 
 TEST(Conservation, BodyAtRestStaysExactlyAtRest) {
   // All effects on, no actuation, no velocity: every force is exactly zero (the simulation measures
@@ -272,7 +277,8 @@ TEST(Conservation, CentreOfMassFixedWithoutDrag) {
     Simulation with_drag(bodies[k], SceneParams{});
     const Eigen::Vector2d d0 = with_drag.center_of_mass();
     with_drag.step(4000);
-    EXPECT_GT((with_drag.center_of_mass() - d0).norm(), 100.0 * std::max(moved, 1e-4)) << "body " << k;
+    EXPECT_GT((with_drag.center_of_mass() - d0).norm(), 100.0 * std::max(moved, 1e-4))
+        << "body " << k;
   }
 }
 
@@ -280,7 +286,8 @@ TEST(Conservation, CentreOfMassFixedWithoutDrag) {
 
 Eigen::Vector2d total(const Simulation& sim) {
   Eigen::Vector2d s(0, 0);
-  for (int i = 0; i < sim.node_count(); ++i) s += Eigen::Vector2d(sim.forces_x()[i], sim.forces_y()[i]);
+  for (int i = 0; i < sim.node_count(); ++i)
+    s += Eigen::Vector2d(sim.forces_x()[i], sim.forces_y()[i]);
   return s;
 }
 
@@ -289,7 +296,8 @@ Simulation pressure_at(Body b, const Points& p, double floor = 0.1) {
   SceneParams scene = scene_with({"pressure"});
   scene.pressure_area_floor = floor;
   b.rest_areas.resize(b.region_count());
-  for (int r = 0; r < b.region_count(); ++r) b.rest_areas(r) = polygon_area(b.positions, b.regions[r]);
+  for (int r = 0; r < b.region_count(); ++r)
+    b.rest_areas(r) = polygon_area(b.positions, b.regions[r]);
   const Points rest = b.positions;
   b.positions = p;  // rest areas stay those of the rest shape
   Simulation sim(b, scene);
@@ -298,11 +306,13 @@ Simulation pressure_at(Body b, const Points& p, double floor = 0.1) {
 }
 
 TEST(Pressure, ForcesOnAClosedRegionSumToZeroWithoutTorque) {
-  const Body pentagon = make_body(points({{0, 0}, {2, -0.3}, {2.6, 1.2}, {1.1, 2.4}, {-0.4, 1.3}}), {}, {{0, 1, 2, 3, 4}}, {});
+  const Body pentagon = make_body(points({{0, 0}, {2, -0.3}, {2.6, 1.2}, {1.1, 2.4}, {-0.4, 1.3}}),
+                                  {}, {{0, 1, 2, 3, 4}}, {});
   Rng rng(4);
   for (int trial = 0; trial < 50; ++trial) {
     Points p = pentagon.positions;
-    for (int i = 0; i < p.rows(); ++i) p.row(i) += Eigen::RowVector2d(rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6));
+    for (int i = 0; i < p.rows(); ++i)
+      p.row(i) += Eigen::RowVector2d(rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6));
     const Simulation sim = pressure_at(pentagon, p);
     double scale = 0.0, torque = 0.0;
     const Points q = sim.positions();
@@ -326,8 +336,10 @@ TEST(Pressure, CompressedPushesOutStretchedPullsIn) {
     for (int i = 0; i < 4; ++i) {
       const Eigen::Vector2d f(sim.forces_x()[i], sim.forces_y()[i]);
       const Eigen::Vector2d out = (p.row(i) - centre).transpose();
-      if (scale < 1.0) EXPECT_GT(f.dot(out), 0.0) << "compressed region must push out, scale " << scale;
-      else EXPECT_LT(f.dot(out), 0.0) << "stretched region must pull in, scale " << scale;
+      if (scale < 1.0)
+        EXPECT_GT(f.dot(out), 0.0) << "compressed region must push out, scale " << scale;
+      else
+        EXPECT_LT(f.dot(out), 0.0) << "stretched region must pull in, scale " << scale;
       // Eq. 3 per edge: c_p·L·(1 − S/S0) along each of the two adjacent normals, half to each end:
       // at a square corner that is c_p·L·(1 − S)/2 along each axis.
       // (The simulation sees Box2D's float positions: 1e-6 relative.)
@@ -340,7 +352,8 @@ TEST(Pressure, CompressedPushesOutStretchedPullsIn) {
 
 TEST(Pressure, IsMinusTheGradientOfItsPotential) {
   // F = −∇[c_p·(S − S0)² / (2A)], A = max(S0, floor·Lmax²): checked by central differences.
-  const Body pentagon = make_body(points({{0, 0}, {2, -0.3}, {2.6, 1.2}, {1.1, 2.4}, {-0.4, 1.3}}), {}, {{0, 1, 2, 3, 4}}, {});
+  const Body pentagon = make_body(points({{0, 0}, {2, -0.3}, {2.6, 1.2}, {1.1, 2.4}, {-0.4, 1.3}}),
+                                  {}, {{0, 1, 2, 3, 4}}, {});
   const double s0 = polygon_area(pentagon.positions, pentagon.regions[0]);
   Points p = pentagon.positions;
   p(2, 0) += 0.3;
@@ -365,8 +378,8 @@ TEST(Pressure, IsMinusTheGradientOfItsPotential) {
 
 TEST(Pressure, InvertedRegionIsPushedBackAndRecovers) {
   // A triangle whose apex is pushed through its base: signed area −S0/2.
-  const Body tri = make_body(points({{0, 0}, {1, 0}, {0.5, 0.8}}), {{0, 1}, {1, 2}, {0, 2}}, {{0, 1, 2}},
-                             {{0, 1}, {1, 2}, {0, 2}});
+  const Body tri = make_body(points({{0, 0}, {1, 0}, {0.5, 0.8}}), {{0, 1}, {1, 2}, {0, 2}},
+                             {{0, 1, 2}}, {{0, 1}, {1, 2}, {0, 2}});
   Points inverted = tri.positions;
   inverted(2, 1) = -0.4;
   {
@@ -400,7 +413,8 @@ TEST(Pressure, InvertedRegionIsPushedBackAndRecovers) {
 TEST(Pressure, SliverRegionStiffnessIsBounded) {
   // A 1 × 0.01 rectangle: eq. 3 with S0 = 0.01 would be stiffness ~c_p/S0; the floor makes it
   // ~c_p/(floor·1). The force on a corner moved by δ is bounded accordingly.
-  const Body sliver = make_body(points({{0, 0}, {1, 0}, {1, 0.01}, {0, 0.01}}), {}, {{0, 1, 2, 3}}, {});
+  const Body sliver =
+      make_body(points({{0, 0}, {1, 0}, {1, 0.01}, {0, 0.01}}), {}, {{0, 1, 2, 3}}, {});
   Points p = sliver.positions;
   p(2, 1) += 0.01;
   const Simulation floored = pressure_at(sliver, p, 0.1);
@@ -410,13 +424,14 @@ TEST(Pressure, SliverRegionStiffnessIsBounded) {
   EXPECT_LT(std::abs(floored.forces_y()[2]), SceneParams{}.pressure * 0.01 / 0.1);
 }
 
-// --- drag ---------------------------------------------------------------------------------------------
+// --- drag
+// ---------------------------------------------------------------------------------------------
 
 /// Steady velocity of `b` pushed by a total force (fx, fy), split over its cells in proportion to
 /// their share of the skin length (half of each adjacent skin edge), i.e. in proportion to the drag
 /// they feel: a chain of springs has no bending stiffness, and any other split would bend it.
-double terminal_speed(const Body& b, double fx, double fy, const SceneParams& scene, const std::string& scheme,
-                      int steps, int substeps = 1) {
+double terminal_speed(const Body& b, double fx, double fy, const SceneParams& scene,
+                      const std::string& scheme, int steps, int substeps = 1) {
   PhysicsParams physics;
   physics.drag_scheme = scheme;
   physics.substeps = substeps;
@@ -439,12 +454,12 @@ double terminal_speed(const Body& b, double fx, double fy, const SceneParams& sc
 }
 
 TEST(Drag, QuadraticTerminalVelocityNormalToARod) {
-  // v = sqrt(F / (d_N·L)) for a straight rod (one skin edge of length L = 4) pulled normal to itself.
-  // (A chain of several springs has no bending stiffness and buckles when dragged, so the rod is
-  // one edge; the closed square below covers skin nodes shared by two edges.) All schemes, at the
-  // default dt, wherever one explicit step removes at most half the velocity (x = h·d·L·v/M <= 1/2,
-  // M = 2m here); beyond that the stable scheme's limiter is active and it needs a smaller step,
-  // which substeps give.
+  // v = sqrt(F / (d_N·L)) for a straight rod (one skin edge of length L = 4) pulled normal to
+  // itself. (A chain of several springs has no bending stiffness and buckles when dragged, so the
+  // rod is one edge; the closed square below covers skin nodes shared by two edges.) All schemes,
+  // at the default dt, wherever one explicit step removes at most half the velocity (x = h·d·L·v/M
+  // <= 1/2, M = 2m here); beyond that the stable scheme's limiter is active and it needs a smaller
+  // step, which substeps give.
   const Body rod = two_nodes(4.0, 4.0);
   for (const std::string scheme : {"stable", "explicit", "implicit"}) {
     for (double dn : {0.2, 0.5, 2.0, 10.0}) {
@@ -469,7 +484,9 @@ TEST(Drag, QuadraticTerminalVelocityAlongARod) {
   for (const std::string scheme : {"stable", "explicit", "implicit"}) {
     for (double v : {0.5, 2.0}) {
       const double force = 0.5 * 4.0 * v * v;
-      EXPECT_NEAR(terminal_speed(two_nodes(4.0, 4.0), force, 0.0, scene, scheme, 3000) / v, 1.0, 0.01) << scheme;
+      EXPECT_NEAR(terminal_speed(two_nodes(4.0, 4.0), force, 0.0, scene, scheme, 3000) / v, 1.0,
+                  0.01)
+          << scheme;
     }
   }
 }
@@ -486,16 +503,18 @@ TEST(Drag, QuadraticTerminalVelocityOfAClosedSquare) {
     for (double v : {0.5, 1.0, 2.0}) {
       SceneParams scene = scene_with({"springs", "pressure", "drag"});
       const double force = 4.0 * (scene.drag_normal + tangential_drag(scene)) * v * v;
-      EXPECT_NEAR(terminal_speed(sq, force, 0.0, scene, scheme, 2400) / v, 1.0, 0.01) << scheme << " v=" << v;
+      EXPECT_NEAR(terminal_speed(sq, force, 0.0, scene, scheme, 2400) / v, 1.0, 0.01)
+          << scheme << " v=" << v;
     }
   }
 }
 
 TEST(Drag, OnlySkinEdgesFeelDrag) {
   // A square with a centre node: the centre is on no skin edge, so it feels no drag.
-  Body b = make_body(points({{0, 0}, {2, 0}, {2, 2}, {0, 2}, {1, 1}}),
-                     {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {0, 4}, {1, 4}, {2, 4}, {3, 4}},
-                     {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {0, 4, 3}}, {{0, 1}, {1, 2}, {2, 3}, {0, 3}});
+  Body b =
+      make_body(points({{0, 0}, {2, 0}, {2, 2}, {0, 2}, {1, 1}}),
+                {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {0, 4}, {1, 4}, {2, 4}, {3, 4}},
+                {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {0, 4, 3}}, {{0, 1}, {1, 2}, {2, 3}, {0, 3}});
   for (const std::string scheme : {"stable", "explicit", "implicit"}) {
     PhysicsParams physics;
     physics.drag_scheme = scheme;
@@ -530,7 +549,8 @@ TEST(Drag, ImplicitQuadraticNeverReverses) {
 }
 
 /// A free dimer (two nodes, one skin edge, no spring) launched normal to itself at speed v0.
-std::vector<double> launched_dimer_speeds(const std::string& scheme, double dn, double v0, int steps,
+std::vector<double> launched_dimer_speeds(const std::string& scheme, double dn, double v0,
+                                          int steps,
                                           const std::string& velocity_forces = "midpoint") {
   SceneParams scene = scene_with({"drag"});
   scene.drag_normal = dn;
@@ -573,7 +593,8 @@ TEST(Drag, StableSchemeNeverReversesWhereExplicitDoesAndBlowsUp) {
     sim.set_velocities(Points::Constant(2, 2, 0.0).rowwise() + Eigen::RowVector2d(0.0, 10.0));
     sim.step();
     const double v1 = sim.velocities()(0, 1);
-    EXPECT_TRUE(v1 < 0.0 || v1 > 10.0) << mode << ": explicit drag reverses or amplifies, got " << v1;
+    EXPECT_TRUE(v1 < 0.0 || v1 > 10.0)
+        << mode << ": explicit drag reverses or amplifies, got " << v1;
     EXPECT_THROW(sim.step(10), SimulationError) << mode;
     EXPECT_TRUE(sim.failed());
     EXPECT_THROW(sim.step(), SimulationError) << "a failed simulation stays failed";
@@ -600,7 +621,8 @@ TEST(Drag, ExplicitSchemeBlowsUpOnASwimmerWhereStableDoesNot) {
   const Body b = swimmer(lattice_points(8, 4), Drive::wave, 0.2, 12.0);
   SceneParams scene;
   scene.drag_normal = 50.0;
-  const Points launch = Points::Constant(b.node_count(), 2, 0.0).rowwise() + Eigen::RowVector2d(8.0, 0.0);
+  const Points launch =
+      Points::Constant(b.node_count(), 2, 0.0).rowwise() + Eigen::RowVector2d(8.0, 0.0);
   PhysicsParams physics;
   physics.drag_scheme = "explicit";
   Simulation bad(b, scene, physics);
@@ -618,7 +640,8 @@ TEST(Drag, ExplicitSchemeBlowsUpOnASwimmerWhereStableDoesNot) {
   }
 }
 
-// --- actuation --------------------------------------------------------------------------------------
+// --- actuation
+// --------------------------------------------------------------------------------------
 
 TEST(Actuation, StartTimeIsTheNextZeroOfTheSineWithinHalfAPeriod) {
   for (double f : {0.5, 1.0, 3.7, 12.0}) {
@@ -654,7 +677,8 @@ TEST(Actuation, TermStartsAtZeroAndIsContinuous) {
     double prev = actuation_term(a, f, phi, 0.0);
     for (double t = dt; t < t0 + 2.0; t += dt) {
       const double cur = actuation_term(a, f, phi, t);
-      ASSERT_LE(std::abs(cur - prev), a * f * dt * (1.0 + 1e-9) + 1e-15) << "phi " << phi << " t " << t;
+      ASSERT_LE(std::abs(cur - prev), a * f * dt * (1.0 + 1e-9) + 1e-15)
+          << "phi " << phi << " t " << t;
       prev = cur;
     }
   }
@@ -680,15 +704,18 @@ TEST(Actuation, RestLengthsFollowEq2FromEquilibrium) {
       const double ti = actuation_term(b.amplitude(i), b.frequency(i), b.phase(i), t);
       const double tj = actuation_term(b.amplitude(j), b.frequency(j), b.phase(j), t);
       worst = std::max(worst, std::abs(rest[s] - (1.0 + ti + tj) * l0(s)));
-      const double bound = (b.amplitude(i) * b.frequency(i) + b.amplitude(j) * b.frequency(j)) * h * l0(s);
-      ASSERT_LE(std::abs(rest[s] - prev[s]), bound * (1.0 + 1e-6) + 1e-12) << "spring " << s << " step " << k;
+      const double bound =
+          (b.amplitude(i) * b.frequency(i) + b.amplitude(j) * b.frequency(j)) * h * l0(s);
+      ASSERT_LE(std::abs(rest[s] - prev[s]), bound * (1.0 + 1e-6) + 1e-12)
+          << "spring " << s << " step " << k;
       prev[s] = rest[s];
     }
   }
   EXPECT_LT(worst, 1e-12);
 }
 
-// --- effects are really off when off -------------------------------------------------------------------
+// --- effects are really off when off
+// -------------------------------------------------------------------
 
 TEST(Effects, DisabledEffectIsNotInTheLoop) {
   const Body b = swimmer(lattice_points(6, 4), Drive::wave);
@@ -711,7 +738,8 @@ TEST(Effects, DisabledEffectIsNotInTheLoop) {
   for (const Effect* e : sim.effects()) order.emplace_back(e->name());
   // Stage order: modifiers (actuation), force effects in canonical order and custom force effects
   // after them, then constraints (collisions), which need every force.
-  EXPECT_EQ(order, (std::vector<std::string>{"actuation", "springs", "pressure", "drag", "constant_force", "collisions"}));
+  EXPECT_EQ(order, (std::vector<std::string>{"actuation", "springs", "pressure", "drag",
+                                             "constant_force", "collisions"}));
 }
 
 TEST(Effects, ZeroCoefficientTrajectoryEqualsEffectAbsent) {
@@ -726,10 +754,20 @@ TEST(Effects, ZeroCoefficientTrajectoryEqualsEffectAbsent) {
     bool still_body;
   };
   const Case cases[] = {
-      {"springs", [](SceneParams& s) { s.spring_stiffness = 0.0; s.spring_damping = 0.0; }, false},
+      {"springs",
+       [](SceneParams& s) {
+         s.spring_stiffness = 0.0;
+         s.spring_damping = 0.0;
+       },
+       false},
       {"actuation", [](SceneParams&) {}, true},
       {"pressure", [](SceneParams& s) { s.pressure = 0.0; }, false},
-      {"drag", [](SceneParams& s) { s.drag_normal = 0.0; s.drag_tangential = 0.0; }, false},
+      {"drag",
+       [](SceneParams& s) {
+         s.drag_normal = 0.0;
+         s.drag_tangential = 0.0;
+       },
+       false},
       {"skin_collision", [](SceneParams& s) { s.collision_stiffness = 0.0; }, false},
       // Collisions have no coefficient to zero; on a body that never collides they add nothing.
       {"collisions", [](SceneParams&) {}, false},
@@ -760,7 +798,8 @@ TEST(Effects, ZeroCoefficientTrajectoryEqualsEffectAbsent) {
   }
 }
 
-// --- skin collision -------------------------------------------------------------------------------
+// --- skin collision
+// -------------------------------------------------------------------------------
 
 TEST(SkinCollision, CellBouncesElasticallyOffAForeignSkinEdge) {
   // Edge (0, 1) of a free dimer, and a lone cell 2 flying at its middle.
@@ -793,14 +832,16 @@ TEST(SkinCollision, ForcesEqualTheAllPairsComputation) {
   b.phase.setZero();  // the whole body breathes at f = 12: violent, with many skin contacts
   SceneParams scene;
   scene.drag_normal = 0.2;
-  scene.pressure = 100.0;  // the first release's pressure, with which this swim squeezes cells against edges
+  // the first release's pressure, with which this swim squeezes cells against edges
+  scene.pressure = 100.0;
   scene.pressure_area_floor = 0.1;
   Simulation sim(b, scene);
   const auto effect = make_effect("skin_collision", b, scene, PhysicsParams{});
   SwimState st;
   st.n = b.node_count();
   st.h = PhysicsParams{}.dt;
-  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.fx, &st.fy}) v->assign(static_cast<std::size_t>(st.n), 0.0);
+  for (auto* v : {&st.x, &st.y, &st.vx, &st.vy, &st.fx, &st.fy})
+    v->assign(static_cast<std::size_t>(st.n), 0.0);
   int touching_states = 0;
   for (int step = 0; step < 3000; ++step) {
     sim.step();
@@ -818,7 +859,8 @@ TEST(SkinCollision, ForcesEqualTheAllPairsComputation) {
       for (int e = 0; e < b.skin.rows(); ++e) {
         const int a = b.skin(e, 0), c = b.skin(e, 1);
         if (a == i || c == i) continue;
-        const Eigen::Vector2d pa = b.positions.row(a), pc = b.positions.row(c), pi = b.positions.row(i);
+        const Eigen::Vector2d pa = b.positions.row(a), pc = b.positions.row(c),
+                              pi = b.positions.row(i);
         const Eigen::Vector2d ed = pc - pa;
         const double tr = std::clamp((pi - pa).dot(ed) / ed.squaredNorm(), 0.0, 1.0);
         const double r = std::min(scene.collision_radius, 0.5 * (pi - (pa + tr * ed)).norm());
@@ -845,7 +887,8 @@ TEST(SkinCollision, ForcesEqualTheAllPairsComputation) {
   EXPECT_GT(touching_states, 10) << "the swim must produce contacts for this test to mean anything";
 }
 
-// --- error detection ---------------------------------------------------------------------------------
+// --- error detection
+// ---------------------------------------------------------------------------------
 
 TEST(Errors, SpeedCapIsDetectedNotClamped) {
   SceneParams scene = scene_with({"springs"});
@@ -884,7 +927,8 @@ TEST(Errors, NonFiniteStateIsDetected) {
   }
 }
 
-// --- allocation-free loop ------------------------------------------------------------------------------
+// --- allocation-free loop
+// ------------------------------------------------------------------------------
 
 TEST(Performance, SwimLoopAllocatesNothing) {
   for (const std::string scheme : {"stable", "explicit", "implicit"}) {
@@ -914,7 +958,8 @@ long development_steps_without_allocation(const Config& config, std::size_t grid
     DevelopmentWorld world(Grn(g, config.genome), config.grn, config.development);
     world.set_symmetry_seed(genome_hash(g));
     world.set_pair_grid_from(grid_from);
-    world.add_cell(DevelopmentWorld::Vec2::Zero(), config.development.cell_radius, DevelopmentWorld::Vec2(1.0, 0.0));
+    world.add_cell(DevelopmentWorld::Vec2::Zero(), config.development.cell_radius,
+                   DevelopmentWorld::Vec2(1.0, 0.0));
     for (int step = 0; step < config.development.steps; ++step) {
       g_allocations = 0;
       g_counting = true;
@@ -930,13 +975,14 @@ long development_steps_without_allocation(const Config& config, std::size_t grid
   return quiet_steps;
 }
 
-/// Issue 21: development allocates only when a cell is born (its GRN state, history rows and slots);
-/// a step without a division allocates nothing, whatever the genome.
+/// Issue 21: development allocates only when a cell is born (its GRN state, history rows and
+/// slots); a step without a division allocates nothing, whatever the genome.
 TEST(Performance, DevelopmentAllocatesOnlyWhenACellIsBorn) {
   EXPECT_GT(development_steps_without_allocation(Config{}, 64), 900);
 }
 
-/// The same with the pair grid in both pair loops (contacts, and a morphogen cut-off) from 2 cells on.
+/// The same with the pair grid in both pair loops (contacts, and a morphogen cut-off) from 2 cells
+/// on.
 TEST(Performance, DevelopmentWithThePairGridAllocatesOnlyWhenACellIsBorn) {
   Config config;
   config.development.morphogen_cutoff = 3.0;
@@ -961,7 +1007,8 @@ TEST(Performance, CrawlLoopAllocatesNothing) {
   EXPECT_GT(sim.counters().actuation_work_absolute, 0.0);
 }
 
-// --- one Box2D island --------------------------------------------------------------------------------
+// --- one Box2D island
+// --------------------------------------------------------------------------------
 
 /// The island-linking joints (src/box2d_island.hpp) must not change the motion: two worlds with the
 /// same cells and the same random forces, one linked and one not, stay bitwise equal.
@@ -984,9 +1031,12 @@ TEST(Performance, IslandLinkingJointsLeaveTheMotionBitwiseUnchanged) {
       def.type = b2_dynamicBody;
       def.fixedRotation = true;
       def.allowSleep = false;
-      def.linearDamping = warm_starting ? 10.0f : 0.0f;  // the development world damps, the swim world does not
-      def.position.Set(static_cast<float>(rng.uniform(-3.0, 3.0)), static_cast<float>(rng.uniform(-3.0, 3.0)));
-      def.linearVelocity.Set(static_cast<float>(rng.uniform(-1.0, 1.0)), static_cast<float>(rng.uniform(-1.0, 1.0)));
+      // the development world damps, the swim world does not
+      def.linearDamping = warm_starting ? 10.0f : 0.0f;
+      def.position.Set(static_cast<float>(rng.uniform(-3.0, 3.0)),
+                       static_cast<float>(rng.uniform(-3.0, 3.0)));
+      def.linearVelocity.Set(static_cast<float>(rng.uniform(-1.0, 1.0)),
+                             static_cast<float>(rng.uniform(-1.0, 1.0)));
       linked.push_back(w_linked.CreateBody(&def));
       free.push_back(w_free.CreateBody(&def));
       linked.back()->SetMassData(&md);
@@ -996,7 +1046,8 @@ TEST(Performance, IslandLinkingJointsLeaveTheMotionBitwiseUnchanged) {
     EXPECT_EQ(w_linked.GetJointCount(), 23);
     for (int step = 0; step < 500; ++step) {
       for (std::size_t i = 0; i < linked.size(); ++i) {
-        const b2Vec2 f(static_cast<float>(rng.uniform(-50.0, 50.0)), static_cast<float>(rng.uniform(-50.0, 50.0)));
+        const b2Vec2 f(static_cast<float>(rng.uniform(-50.0, 50.0)),
+                       static_cast<float>(rng.uniform(-50.0, 50.0)));
         linked[i]->ApplyForceToCenter(f, true);
         free[i]->ApplyForceToCenter(f, true);
       }
@@ -1021,11 +1072,13 @@ TEST(Performance, SwimWorldIsOneIslandWithoutFixturesOrContacts) {
   EXPECT_EQ(w.GetBodyCount(), 32);
   EXPECT_EQ(w.GetJointCount(), 31);
   EXPECT_EQ(w.GetContactCount(), 0);
-  for (const b2Body* b = w.GetBodyList(); b; b = b->GetNext()) EXPECT_EQ(b->GetFixtureList(), nullptr);
+  for (const b2Body* b = w.GetBodyList(); b; b = b->GetNext())
+    EXPECT_EQ(b->GetFixtureList(), nullptr);
 }
 
 TEST(Performance, TheNativeIntegratorHasNoBox2DWorld) {
-  Simulation sim(swimmer(lattice_points(8, 4), Drive::wave));  // physics.integrator = "native" by default
+  // physics.integrator = "native" by default
+  Simulation sim(swimmer(lattice_points(8, 4), Drive::wave));
   try {
     (void)sim.world();
     FAIL() << "world() must refuse without a Box2D world";
@@ -1034,15 +1087,18 @@ TEST(Performance, TheNativeIntegratorHasNoBox2DWorld) {
   }
 }
 
-// --- stability suite -----------------------------------------------------------------------------------
+// --- stability suite
+// -----------------------------------------------------------------------------------
 
 /// Response of one spring of the body driven through its rest length at frequency ω (the building
 /// block of every swimmer): stiffness k, damping c, the reduced mass m/2 of its two cells, so
 /// ω0 = sqrt(2k/m) (14.1 rad/time at the defaults) and ζ = c/sqrt(2km) (0.28), and the
-/// amplification of the drive M(ω) = 1/sqrt((1 − r²)² + (2ζr)²), r = ω/ω0 (1.17 at ω = 6, 1.80 at 12).
+/// amplification of the drive M(ω) = 1/sqrt((1 − r²)² + (2ζr)²), r = ω/ω0 (1.17 at ω = 6, 1.80 at
+/// 12).
 double amplification(const SceneParams& scene, double omega) {
   const double w0 = std::sqrt(2.0 * scene.spring_stiffness / scene.cell_mass);
-  const double zeta = scene.spring_damping / std::sqrt(2.0 * scene.spring_stiffness * scene.cell_mass);
+  const double zeta =
+      scene.spring_damping / std::sqrt(2.0 * scene.spring_stiffness * scene.cell_mass);
   const double r = omega / w0;
   return 1.0 / std::sqrt((1.0 - r * r) * (1.0 - r * r) + 4.0 * zeta * zeta * r * r);
 }
@@ -1059,16 +1115,18 @@ double amplification(const SceneParams& scene, double omega) {
 ///    collide are held to the embedding and energy bounds only;
 ///  - kinetic energy per cell at most the elastic energy the drive can give the ~3 springs per
 ///    cell at the amplified amplitude, 3·½k·(2a·M(ω)·L0)² (33 at ω = 6, 78 at ω = 12).
-/// swim() measures stretch against max(L0, median L0 / 2), so near-zero rest lengths stay meaningful.
-void expect_sane_swim(const Body& b, const SceneParams& scene, const PhysicsParams& physics, long steps,
-                      const std::string& label, double omega = 12.0) {
+/// swim() measures stretch against max(L0, median L0 / 2), so near-zero rest lengths stay
+/// meaningful.
+void expect_sane_swim(const Body& b, const SceneParams& scene, const PhysicsParams& physics,
+                      long steps, const std::string& label, double omega = 12.0) {
   const SwimResult r = swim(b, scene, physics, steps);
   EXPECT_TRUE(r.stable) << label << ": " << r.failure;
   EXPECT_TRUE(r.valid) << label << ": " << r.failure;
   EXPECT_EQ(r.steps, steps) << label;
   EXPECT_TRUE(std::isfinite(r.distance)) << label;
   const double swing = 2.0 * 0.2 * amplification(scene, omega);
-  EXPECT_LT(r.max_kinetic_energy_per_cell, 3.0 * 0.5 * scene.spring_stiffness * swing * swing) << label;
+  EXPECT_LT(r.max_kinetic_energy_per_cell, 3.0 * 0.5 * scene.spring_stiffness * swing * swing)
+      << label;
   if (r.collisions == 0) {
     EXPECT_LT(r.max_stretch, 1.0 + 1.25 * swing) << label;
     EXPECT_GT(r.min_stretch, 1.0 - 1.25 * swing) << label;
@@ -1081,10 +1139,10 @@ TEST(Stability, HighDrag) {
   for (double dn : {10.0, 50.0}) {
     SceneParams scene;
     scene.drag_normal = dn;
-    expect_sane_swim(swimmer(lattice_points(8, 4), Drive::wave, 0.2, 12.0), scene, PhysicsParams{}, 4000,
-                     "d_N=" + std::to_string(dn) + " wave f=12");
-    expect_sane_swim(swimmer(lattice_points(8, 4, 0.15, 4), Drive::random), scene, PhysicsParams{}, 4000,
-                     "d_N=" + std::to_string(dn) + " random");
+    expect_sane_swim(swimmer(lattice_points(8, 4), Drive::wave, 0.2, 12.0), scene, PhysicsParams{},
+                     4000, "d_N=" + std::to_string(dn) + " wave f=12");
+    expect_sane_swim(swimmer(lattice_points(8, 4, 0.15, 4), Drive::random), scene, PhysicsParams{},
+                     4000, "d_N=" + std::to_string(dn) + " random");
   }
 }
 
@@ -1092,8 +1150,8 @@ TEST(Stability, SixtyFourCells) {
   for (double dn : {0.2, 2.0, 10.0}) {
     SceneParams scene;
     scene.drag_normal = dn;
-    expect_sane_swim(swimmer(lattice_points(8, 8, 0.15, 5), Drive::random, 0.2, 4.0, 5), scene, PhysicsParams{}, 4000,
-                     "64 cells d_N=" + std::to_string(dn));
+    expect_sane_swim(swimmer(lattice_points(8, 8, 0.15, 5), Drive::random, 0.2, 4.0, 5), scene,
+                     PhysicsParams{}, 4000, "64 cells d_N=" + std::to_string(dn));
   }
 }
 
@@ -1143,8 +1201,8 @@ TEST(Stability, NearCoincidentCells) {
 }
 
 TEST(Stability, TwentyThousandSteps) {
-  expect_sane_swim(swimmer(lattice_points(8, 4, 0.1, 12), Drive::random), SceneParams{}, PhysicsParams{}, 20000,
-                   "20000 steps");
+  expect_sane_swim(swimmer(lattice_points(8, 4, 0.1, 12), Drive::random), SceneParams{},
+                   PhysicsParams{}, 20000, "20000 steps");
 }
 
 TEST(Stability, LargestDefaultSafeDt) {
@@ -1157,20 +1215,23 @@ TEST(Stability, LargestDefaultSafeDt) {
     scene.drag_normal = dn;
     expect_sane_swim(swimmer(lattice_points(8, 4), Drive::wave, 0.2, 12.0), scene, physics, 2000,
                      "dt=1/30 d_N=" + std::to_string(dn));
-    expect_sane_swim(swimmer(lattice_points(8, 8, 0.15, 5), Drive::random, 0.2, 4.0, 5), scene, physics, 2000,
-                     "dt=1/30 64 cells d_N=" + std::to_string(dn));
+    expect_sane_swim(swimmer(lattice_points(8, 8, 0.15, 5), Drive::random, 0.2, 4.0, 5), scene,
+                     physics, 2000, "dt=1/30 64 cells d_N=" + std::to_string(dn));
   }
 }
 
-// --- evaluation -----------------------------------------------------------------------------------------
+// --- evaluation
+// -----------------------------------------------------------------------------------------
 
 /// The first `count` viable genomes of the random stream seeded by `seed` (bounded tries).
-std::vector<Genome> viable_genomes(const Config& config, int count, std::uint64_t seed, int max_tries) {
+std::vector<Genome> viable_genomes(const Config& config, int count, std::uint64_t seed,
+                                   int max_tries) {
   std::vector<Genome> out;
   for (int i = 0; i < max_tries && static_cast<int>(out.size()) < count; ++i) {
     Rng rng = Rng::derive(seed, static_cast<std::uint64_t>(i));
     Genome g = random_genome(config.genome, rng);
-    if (develop(g, config.genome, config.grn, config.development).viable) out.push_back(std::move(g));
+    if (develop(g, config.genome, config.grn, config.development).viable)
+      out.push_back(std::move(g));
   }
   return out;
 }
@@ -1194,7 +1255,8 @@ TEST(Evaluate, DeterministicAndThreadSafe) {
   for (std::size_t k = 0; k < genomes.size(); ++k) serial[k] = evaluate(genomes[k], config).fitness;
 #pragma omp parallel for num_threads(2) schedule(dynamic)
   for (int k = 0; k < static_cast<int>(genomes.size()); ++k)
-    parallel[static_cast<std::size_t>(k)] = evaluate(genomes[static_cast<std::size_t>(k)], config).fitness;
+    parallel[static_cast<std::size_t>(k)] =
+        evaluate(genomes[static_cast<std::size_t>(k)], config).fitness;
   for (std::size_t k = 0; k < genomes.size(); ++k) {
     EXPECT_EQ(serial[k], parallel[k]) << k;  // bit-identical
     const EvaluationResult again = evaluate(genomes[k], config);
@@ -1216,7 +1278,8 @@ TEST(Stability, ThousandRandomViableGenomesEndToEndAndForcedToMaximalActuation) 
   std::vector<EvaluationResult> results;
   std::vector<int> seeds;
   const int batch = 2000;
-  for (int start = 0; static_cast<int>(results.size()) < wanted && start < 2000000; start += batch) {
+  for (int start = 0; static_cast<int>(results.size()) < wanted && start < 2000000;
+       start += batch) {
     std::vector<EvaluationResult> r(batch);
 #pragma omp parallel for num_threads(2) schedule(dynamic, 16)
     for (int i = 0; i < batch; ++i) {
@@ -1235,8 +1298,9 @@ TEST(Stability, ThousandRandomViableGenomesEndToEndAndForcedToMaximalActuation) 
     swim_seconds += r.seconds_swim;
     dev_seconds += r.seconds_development;
   }
-  std::printf("viable genomes: %d of the first %d seeds; swim %.1f s, development of the viable %.1f s\n", wanted,
-              seeds.back() + 1, swim_seconds, dev_seconds);
+  std::printf(
+      "viable genomes: %d of the first %d seeds; swim %.1f s, development of the viable %.1f s\n",
+      wanted, seeds.back() + 1, swim_seconds, dev_seconds);
   int moved = 0;
   for (std::size_t k = 0; k < results.size(); ++k) {
     const EvaluationResult& r = results[k];
@@ -1279,7 +1343,8 @@ TEST(Stability, ThousandRandomViableGenomesEndToEndAndForcedToMaximalActuation) 
     EXPECT_EQ(r.collisions_unresolved, 0) << label;
     collisions += r.collisions;
   }
-  std::printf("forced to maximal actuation: %ld collisions resolved over %zu bodies\n", collisions, forced.size());
+  std::printf("forced to maximal actuation: %ld collisions resolved over %zu bodies\n", collisions,
+              forced.size());
 }
 
 }  // namespace

@@ -51,8 +51,9 @@ struct RefXoshiro {
 TEST(RefAlgorithms, SplitMix64MatchesPublishedVectors) {
   // Published SplitMix64 outputs (seed 1234567, and seed 0).
   std::uint64_t x = 1234567;
-  const std::uint64_t expected[] = {6457827717110365317ULL, 3203168211198807973ULL, 9817491932198370423ULL,
-                                    4593380528125082431ULL, 16408922859458223821ULL};
+  const std::uint64_t expected[] = {6457827717110365317ULL, 3203168211198807973ULL,
+                                    9817491932198370423ULL, 4593380528125082431ULL,
+                                    16408922859458223821ULL};
   for (std::uint64_t e : expected) EXPECT_EQ(ref_splitmix64(x), e);
   std::uint64_t z = 0;
   EXPECT_EQ(ref_splitmix64(z), 0xE220A8397B1DCDAFULL);
@@ -89,14 +90,15 @@ TEST(Rng, SeedingIsSplitMix64AndMatchesReference) {
   for (std::uint64_t seed : {0ULL, 1ULL, 42ULL, 1234567ULL, 0xFFFFFFFFFFFFFFFFULL}) {
     Rng rng(seed);
     RefXoshiro ref = RefXoshiro::seeded(seed);
-    for (int w = 0; w < 4; ++w) EXPECT_EQ(rng.state()[static_cast<std::size_t>(w)], ref.s[w]) << "seed " << seed;
+    for (int w = 0; w < 4; ++w)
+      EXPECT_EQ(rng.state()[static_cast<std::size_t>(w)], ref.s[w]) << "seed " << seed;
     for (int i = 0; i < 1000; ++i) ASSERT_EQ(rng(), ref.next()) << "seed " << seed << " draw " << i;
   }
 }
 
 TEST(Rng, HardCodedStreamForSeed42) {
-  // xoshiro256** seeded with four SplitMix64 outputs of 42 (a published cross-implementation value),
-  // so a change of the stream is caught.
+  // xoshiro256** seeded with four SplitMix64 outputs of 42 (a published cross-implementation
+  // value), so a change of the stream is caught.
   Rng rng(42);
   EXPECT_EQ(rng(), 1546998764402558742ULL);
   EXPECT_EQ(rng(), 6990951692964543102ULL);
@@ -120,8 +122,8 @@ TEST(Rng, HardCodedValuesComputedOnceFromTheImplementation) {
 }
 
 TEST(Rng, HardCodedDerivedStreamsAreStable) {
-  // derive(seed, keys...) = Rng(h) with h = mix(seed ^ C0), then h = mix(h ^ (key + golden)) per key.
-  // Recomputed here independently of random.hpp.
+  // derive(seed, keys...) = Rng(h) with h = mix(seed ^ C0), then h = mix(h ^ (key + golden)) per
+  // key. Recomputed here independently of random.hpp.
   auto ref_derive = [](std::uint64_t seed, std::vector<std::uint64_t> keys) {
     std::uint64_t x = seed ^ 0x243f6a8885a308d3ULL;
     std::uint64_t h = ref_splitmix64(x);

@@ -1,25 +1,30 @@
 // Reliability (issue 9): bad input never crashes, long runs survive faults, resources stay bounded.
 //
 //   Catalogue.*        every file in tests/bad_inputs/catalogue/ raises the exact animat error its
-//                      <case>.expected sidecar names (configs, --set overrides, genomes, checkpoints)
-//   GeneratedInput.*   bad inputs too large or too deep to commit (10^7 elements, 10^5 nesting levels)
-//   CheckpointSanity.* checkpoints with a valid checksum but an inconsistent or out-of-range content
+//                      <case>.expected sidecar names (configs, --set overrides, genomes,
+//                      checkpoints)
+//   GeneratedInput.*   bad inputs too large or too deep to commit (10^7 elements, 10^5 nesting
+//                      levels)
+//   CheckpointSanity.* checkpoints with a valid checksum but an inconsistent or out-of-range
+//                      content
 //   ResourceBounds.*   the documented caps (genome length, cells, steps, population) are enforced
 //   Soak.*             20,000 random and mutated genomes through the whole chain (evaluate)
 //   ExtremeConfigs.*   valid but extreme configs: never a NaN, never a crash
-//   DiskFaults.*       unwritable, full or vanishing output: clear error, previous checkpoint intact
-//   FuzzRegressions.*  every crash the fuzzers found, as a plain test (see fuzz/ and docs/reliability.md)
+//   DiskFaults.*       unwritable, full or vanishing output: clear error, previous checkpoint
+//                      intact
+//   FuzzRegressions.*  every crash the fuzzers found, as a plain test (see fuzz/ and
+//                      docs/reliability.md)
 //
 // docs/reliability.md lists every guarantee with the test that checks it.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/mount.h>
+#include <nlohmann/json.hpp>
 
-#include "test_support.hpp"
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "test_support.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -42,9 +47,9 @@
 #include "animat/evaluate.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
-#include "animat/run_identity.hpp"
-#include "animat/run.hpp"
 #include "animat/genome.hpp"
+#include "animat/run.hpp"
+#include "animat/run_identity.hpp"
 
 namespace fs = std::filesystem;
 using namespace animat;
@@ -53,7 +58,8 @@ using nlohmann::json;
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define ANIMAT_TEST_SANITIZED 1
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
 #define ANIMAT_TEST_SANITIZED 1
 #endif
 #endif
@@ -69,7 +75,8 @@ using animat::test::slurp;
 using animat::test::spit;
 
 std::string replace_all(std::string s, std::string_view from, std::string_view to) {
-  for (std::size_t pos = 0; (pos = s.find(from, pos)) != std::string::npos; pos += to.size()) s.replace(pos, from.size(), to);
+  for (std::size_t pos = 0; (pos = s.find(from, pos)) != std::string::npos; pos += to.size())
+    s.replace(pos, from.size(), to);
   return s;
 }
 
@@ -140,10 +147,14 @@ Expected read_expected(const fs::path& p) {
     const auto colon = line.find(": ");
     if (colon == std::string::npos) continue;
     const std::string key = line.substr(0, colon), value = line.substr(colon + 2);
-    if (key == "error") e.error = value;
-    else if (key == "python") e.python = value;
-    else if (key == "message") e.message = value;
-    else if (key == "contains") e.contains.push_back(value);
+    if (key == "error")
+      e.error = value;
+    else if (key == "python")
+      e.python = value;
+    else if (key == "message")
+      e.message = value;
+    else if (key == "contains")
+      e.contains.push_back(value);
   }
   return e;
 }
@@ -224,17 +235,20 @@ TEST(CatalogueIndex, CoversEveryRequiredCaseAndEveryFileHasASidecar) {
   for (const auto& entry : fs::directory_iterator(kCatalogue)) {
     if (entry.path().extension() != ".expected") continue;
     const std::string stem = entry.path().stem().string();
-    const bool has_input = std::any_of(cases.begin(), cases.end(), [&](const std::string& c) { return fs::path(c).stem() == stem; });
+    const bool has_input = std::any_of(cases.begin(), cases.end(), [&](const std::string& c) {
+      return fs::path(c).stem() == stem;
+    });
     EXPECT_TRUE(has_input) << entry.path().filename() << " has no input file";
   }
   // The issue's list: configs, genomes and checkpoints.
   for (const char* required :
-       {"config_unknown_key.toml", "config_wrong_type_string.toml", "config_population_negative.toml",
-        "config_cells_zero.toml", "config_physics_dt_zero.toml", "config_physics_dt_negative.toml",
-        "config_drag_nan.toml", "config_population_zero.toml", "config_population_1e9.toml",
-        "config_cells_4097.toml", "genome_nan_coordinate.json", "genome_inf_coordinate.json",
-        "genome_type_number.json", "genome_input_channel_out_of_range.json", "genome_truncated.json",
-        "genome_binary.json", "checkpoint_truncated.json", "checkpoint_checksum_mismatch.json",
+       {"config_unknown_key.toml", "config_wrong_type_string.toml",
+        "config_population_negative.toml", "config_cells_zero.toml", "config_physics_dt_zero.toml",
+        "config_physics_dt_negative.toml", "config_drag_nan.toml", "config_population_zero.toml",
+        "config_population_1e9.toml", "config_cells_4097.toml", "genome_nan_coordinate.json",
+        "genome_inf_coordinate.json", "genome_type_number.json",
+        "genome_input_channel_out_of_range.json", "genome_truncated.json", "genome_binary.json",
+        "checkpoint_truncated.json", "checkpoint_checksum_mismatch.json",
         "checkpoint_wrong_version.json"})
     EXPECT_NE(std::find(cases.begin(), cases.end(), required), cases.end()) << required;
 }
@@ -242,7 +256,9 @@ TEST(CatalogueIndex, CoversEveryRequiredCaseAndEveryFileHasASidecar) {
 // ---------------------------------------------------------------------------------------------------
 // Generated bad inputs
 
-std::string genome_prefix() { return R"({"format": "animat.genome", "version": 1, "dimensions": 2, "elements": [)"; }
+std::string genome_prefix() {
+  return R"({"format": "animat.genome", "version": 1, "dimensions": 2, "elements": [)";
+}
 
 TEST(GeneratedInput, TenMillionElementGenomeIsRejectedByTheLengthCap) {
   // 10^7 (minimal) elements: rejected by genome.max_elements before any element is read.
@@ -261,7 +277,8 @@ TEST(GeneratedInput, TenMillionElementGenomeIsRejectedByTheLengthCap) {
 TEST(GeneratedInput, TenMillionFullElementGenomeIsRejectedWithinBoundedMemory) {
   // 10^7 complete elements (440 MB of JSON). The loader must reject it without building a DOM of
   // several GB: the child process gets an address-space limit of its current size + 768 MB.
-  if (ANIMAT_TEST_SANITIZED) GTEST_SKIP() << "address-space limits do not mix with sanitizer shadow memory";
+  if (ANIMAT_TEST_SANITIZED)
+    GTEST_SKIP() << "address-space limits do not mix with sanitizer shadow memory";
   const std::string element = R"({"type":"promoter","sign":1,"coords":[0.5,0.5]})";
   std::string text = genome_prefix();
   text.reserve(text.size() + 10'000'000 * (element.size() + 1) + 4);
@@ -286,7 +303,9 @@ TEST(GeneratedInput, TenMillionFullElementGenomeIsRejectedWithinBoundedMemory) {
       (void)genome_from_json(text, GenomeParams{}, "big.json");
       code = 4;
     } catch (const GenomeError& e) {
-      code = std::string(e.what()).find("exceed genome.max_elements = 10000") != std::string::npos ? 0 : 1;
+      code = std::string(e.what()).find("exceed genome.max_elements = 10000") != std::string::npos
+                 ? 0
+                 : 1;
     } catch (const std::bad_alloc&) {
       code = 2;
     } catch (...) {
@@ -298,10 +317,11 @@ TEST(GeneratedInput, TenMillionFullElementGenomeIsRejectedWithinBoundedMemory) {
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status)) << "child died with signal " << WTERMSIG(status);
   const int code = WEXITSTATUS(status);
-  EXPECT_EQ(code, 0) << (code == 2   ? "the loader ran out of memory (> 768 MB) before rejecting 10^7 elements"
-                         : code == 1 ? "GenomeError with another message"
-                         : code == 4 ? "accepted"
-                                     : "foreign exception");
+  EXPECT_EQ(code, 0)
+      << (code == 2   ? "the loader ran out of memory (> 768 MB) before rejecting 10^7 elements"
+          : code == 1 ? "GenomeError with another message"
+          : code == 4 ? "accepted"
+                      : "foreign exception");
 }
 
 std::string nested(int depth, std::string_view inner = "1") {
@@ -312,7 +332,8 @@ std::string nested(int depth, std::string_view inner = "1") {
 }
 
 TEST(GeneratedInput, DeeplyNestedGenomeJsonIsAnErrorNotAStackOverflow) {
-  // 100,000 nested arrays where a value is expected: an error message must not print them recursively.
+  // 100,000 nested arrays where a value is expected: an error message must not print them
+  // recursively.
   const std::string deep = nested(100'000);
   const std::vector<std::string> docs = {
       deep,
@@ -320,7 +341,8 @@ TEST(GeneratedInput, DeeplyNestedGenomeJsonIsAnErrorNotAStackOverflow) {
       R"({"format": "animat.genome", "version": )" + deep + R"(, "dimensions": 2, "elements": []})",
       genome_prefix() + R"({"type": )" + deep + R"(, "sign": 1, "coords": [1, 2]}]})",
       genome_prefix() + R"({"type": "promoter", "sign": 1, "coords": )" + deep + "}]}",
-      genome_prefix() + R"({"type": "output", "sign": 1, "channel": )" + deep + R"(, "coords": [1, 2]}]})",
+      genome_prefix() + R"({"type": "output", "sign": 1, "channel": )" + deep +
+          R"(, "coords": [1, 2]}]})",
   };
   for (std::size_t i = 0; i < docs.size(); ++i) {
     try {
@@ -336,25 +358,29 @@ TEST(GeneratedInput, DeeplyNestedCheckpointIsAnErrorNotAStackOverflow) {
   Evolution evo(catalogue_config(), stub_fitness);
   const std::string deep = nested(100'000);
   for (const std::string& text :
-       {deep, R"({"checksum": )" + deep + R"(, "payload": "{}"})", rewrap(json::parse(R"({"format": "animat.checkpoint", "version": 1})"))}) {
+       {deep, R"({"checksum": )" + deep + R"(, "payload": "{}"})",
+        rewrap(json::parse(R"({"format": "animat.checkpoint", "version": 1})"))}) {
     try {
       evo.restore(text, "deep.json");
       ADD_FAILURE() << "accepted";
     } catch (const CheckpointError&) {
     }
   }
-  // A population genome nested 100,000 deep inside a payload with a valid checksum. The deep array is
-  // spliced in as text: building it as a json value would recurse in dump() in this test already.
+  // A population genome nested 100,000 deep inside a payload with a valid checksum. The deep array
+  // is spliced in as text: building it as a json value would recurse in dump() in this test
+  // already.
   Evolution src(catalogue_config(), stub_fitness);
   src.initialize();
   const std::string body = json::parse(src.checkpoint())["payload"].get<std::string>();
   const std::string key = R"("genome":)";
   const auto at = body.find(key);
   ASSERT_NE(at, std::string::npos);
-  const auto end = body.find(R"(,"stable")", at);  // keys are sorted: cell_count, fitness, genome, stable
+  // keys are sorted: cell_count, fitness, genome, stable
+  const auto end = body.find(R"(,"stable")", at);
   ASSERT_NE(end, std::string::npos);
   const std::string spliced = body.substr(0, at + key.size()) + deep + body.substr(end);
-  const std::string text = R"({"checksum":")" + fnv_hex(spliced) + R"(","payload":)" + json(spliced).dump() + "}";
+  const std::string text =
+      R"({"checksum":")" + fnv_hex(spliced) + R"(","payload":)" + json(spliced).dump() + "}";
   try {
     evo.restore(text, "deep.json");
     ADD_FAILURE() << "accepted";
@@ -374,16 +400,19 @@ TEST(GeneratedInput, OverrideCannotInjectFurtherTomlLines) {
 /// Runs a shell command; returns its exit status and fills `err` with its stderr.
 int shell(const std::string& command, std::string* err = nullptr) {
   const fs::path errfile = fresh_dir("stderr.txt");
-  const int rc = std::system(("bash -c '" + command + "' 2>" + errfile.string() + " >/dev/null").c_str());
+  const int rc =
+      std::system(("bash -c '" + command + "' 2>" + errfile.string() + " >/dev/null").c_str());
   if (err) *err = slurp(errfile);
   fs::remove(errfile);
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
 }
 
-const std::string kSmallRun = " --quiet --threads 1 --seed 3 --set evolution.population=8 --set evaluation.steps=50 ";
+const std::string kSmallRun =
+    " --quiet --threads 1 --seed 3 --set evolution.population=8 --set evaluation.steps=50 ";
 
 // ---------------------------------------------------------------------------------------------------
-// Checkpoints whose checksum is valid but whose content is not (hand edits, a buggy writer, a fuzzer)
+// Checkpoints whose checksum is valid but whose content is not (hand edits, a buggy writer, a
+// fuzzer)
 
 json good_payload(int population = 2) {
   Evolution evo(stub_config(population), stub_fitness);
@@ -421,7 +450,8 @@ TEST(CheckpointSanity, PopulationSizeMismatchIsRefused) {
     evo.restore(rewrap(p), "edited.json");
     FAIL();
   } catch (const CheckpointError& e) {
-    EXPECT_STREQ(e.what(), "edited.json: checkpoint holds 3 individuals, evolution.population is 2");
+    EXPECT_STREQ(e.what(),
+                 "edited.json: checkpoint holds 3 individuals, evolution.population is 2");
   }
 }
 
@@ -445,7 +475,8 @@ TEST(CheckpointSanity, IntegerFieldsHoldingHugeFloatsAreRefused) {
 }
 
 TEST(CheckpointSanity, EmptyHistoryIsRefused) {
-  // run_evolution reports history().back() right after restoring: an empty history must not get there.
+  // run_evolution reports history().back() right after restoring: an empty history must not get
+  // there.
   json p = good_payload();
   p["history"] = json::array();
   expect_refused(p, "history = []");
@@ -474,7 +505,8 @@ TEST(CheckpointSanity, CliResumingAnEmptyHistoryCheckpointIsAnErrorNotACrash) {
   spit(dir / "config.toml", to_toml(stub_config(2)));
   spit(dir / "checkpoint.json", rewrap(p));
   std::string err;
-  const int rc = shell(std::string(ANIMAT_EVOLVE_EXE) + " --resume " + dir.string() + " --generations 2", &err);
+  const int rc = shell(
+      std::string(ANIMAT_EVOLVE_EXE) + " --resume " + dir.string() + " --generations 2", &err);
   EXPECT_EQ(rc, 2) << err;
   EXPECT_NE(err.find("animat_evolve: error: "), std::string::npos) << err;
   fs::remove_all(dir);
@@ -491,16 +523,19 @@ TEST(ResourceBounds, ConfigCapsAreEnforced) {
   for (const Cap cap : {Cap{"evaluation.steps", 10'000'000}, Cap{"development.max_cells", 4096},
                         Cap{"development.steps", 100'000}, Cap{"genome.max_elements", 1'000'000},
                         Cap{"physics.substeps", 1000}, Cap{"evolution.population", 100'000},
-                        Cap{"development.morphogen_max_delay", 100'000}, Cap{"genome.dimensions", 16},
-                        Cap{"evolution.threads", 1024}}) {
+                        Cap{"development.morphogen_max_delay", 100'000},
+                        Cap{"genome.dimensions", 16}, Cap{"evolution.threads", 1024}}) {
     SCOPED_TRACE(cap.key);
     Config c;
     EXPECT_NO_THROW(set_value(c, cap.key, cap.max));
     EXPECT_THROW(set_value(c, cap.key, cap.max + 1), ConfigError);
-    EXPECT_THROW(apply_override(c, std::string(cap.key) + "=" + std::to_string(cap.max + 1)), ConfigError);
-    EXPECT_THROW((void)config_from_toml(fmt::format("[{}]\n{} = {}\n", std::string(cap.key).substr(0, std::string(cap.key).find('.')),
-                                                    std::string(cap.key).substr(std::string(cap.key).find('.') + 1), cap.max + 1)),
+    EXPECT_THROW(apply_override(c, std::string(cap.key) + "=" + std::to_string(cap.max + 1)),
                  ConfigError);
+    EXPECT_THROW(
+        (void)config_from_toml(fmt::format(
+            "[{}]\n{} = {}\n", std::string(cap.key).substr(0, std::string(cap.key).find('.')),
+            std::string(cap.key).substr(std::string(cap.key).find('.') + 1), cap.max + 1)),
+        ConfigError);
   }
 }
 
@@ -561,10 +596,13 @@ TEST(ResourceBounds, DevelopmentNeverExceedsMaxCells) {
     Rng rng = Rng::derive(77, i);
     genomes.push_back(random_genome(c.genome, rng));
   }
-  const auto results = evaluate_all(genomes, [&](const Genome& g) {
-    const EvaluationResult r = evaluate(g, c);
-    return Fitness{r.fitness, r.viable, r.stable, r.cell_count};
-  }, 2);
+  const auto results = evaluate_all(
+      genomes,
+      [&](const Genome& g) {
+        const EvaluationResult r = evaluate(g, c);
+        return Fitness{r.fitness, r.viable, r.stable, r.cell_count};
+      },
+      2);
   for (const auto& r : results) EXPECT_LE(r.cell_count, 4);
 }
 
@@ -577,9 +615,10 @@ int env_int(const char* name, int fallback) {
 }
 
 /// Upper bound on any fitness from the config alone. physics.max_step_displacement caps how far a
-/// cell may move in one Box2D step of h = dt / substeps (a larger step is flagged unstable, fitness 0),
-/// so no cell, and hence not the centre of mass, is faster than v_max = max_step_displacement / h;
-/// over the swim time T = steps·dt it travels at most v_max·T = steps·substeps·max_step_displacement.
+/// cell may move in one Box2D step of h = dt / substeps (a larger step is flagged unstable, fitness
+/// 0), so no cell, and hence not the centre of mass, is faster than v_max = max_step_displacement /
+/// h; over the swim time T = steps·dt it travels at most v_max·T =
+/// steps·substeps·max_step_displacement.
 double fitness_bound(const Config& c) {
   const double h = c.physics.dt / c.physics.substeps;
   const double v_max = c.physics.max_step_displacement / h;
@@ -593,15 +632,19 @@ struct SoakStats {
 };
 
 /// Evaluates `genomes` with evaluate_all on 2 threads and checks every result.
-void soak(const std::vector<Genome>& genomes, const Config& c, SoakStats& st, std::vector<bool>* viable_out = nullptr) {
+void soak(const std::vector<Genome>& genomes, const Config& c, SoakStats& st,
+          std::vector<bool>* viable_out = nullptr) {
   std::vector<EvaluationResult> details(genomes.size());
   const Genome* base = genomes.data();
   const auto t0 = std::chrono::steady_clock::now();
-  const auto results = evaluate_all(genomes, [&](const Genome& g) {
-    const EvaluationResult r = evaluate(g, c);
-    details[static_cast<std::size_t>(&g - base)] = r;
-    return Fitness{r.fitness, r.viable, r.stable, r.cell_count};
-  }, 2);
+  const auto results = evaluate_all(
+      genomes,
+      [&](const Genome& g) {
+        const EvaluationResult r = evaluate(g, c);
+        details[static_cast<std::size_t>(&g - base)] = r;
+        return Fitness{r.fitness, r.viable, r.stable, r.cell_count};
+      },
+      2);
   st.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double bound = fitness_bound(c);
   if (viable_out) viable_out->assign(genomes.size(), false);
@@ -613,7 +656,8 @@ void soak(const std::vector<Genome>& genomes, const Config& c, SoakStats& st, st
     ASSERT_GE(r.fitness, 0.0);
     ASSERT_LE(r.fitness, bound);
     ASSERT_TRUE(std::isfinite(r.max_speed));
-    // The per-swim form of the same bound: the centre of mass is never faster than the fastest cell.
+    // The per-swim form of the same bound: the centre of mass is never faster than the fastest
+    // cell.
     ASSERT_LE(r.fitness, r.max_speed * r.simulated_time * (1.0 + 1e-3) + 1e-6)
         << "max_speed " << r.max_speed << ", simulated time " << r.simulated_time;
     ASSERT_LE(r.cell_count, c.development.max_cells);
@@ -633,14 +677,16 @@ void soak(const std::vector<Genome>& genomes, const Config& c, SoakStats& st, st
       st.max_fitness = std::max(st.max_fitness, r.fitness);
       st.max_speed = std::max(st.max_speed, r.max_speed);
       if (r.max_speed * r.simulated_time > 0)
-        st.max_ratio_to_speed_bound = std::max(st.max_ratio_to_speed_bound, r.fitness / (r.max_speed * r.simulated_time));
+        st.max_ratio_to_speed_bound =
+            std::max(st.max_ratio_to_speed_bound, r.fitness / (r.max_speed * r.simulated_time));
     }
   }
 }
 
 TEST(Soak, RandomAndMutatedGenomesNeverCrashNeverNaNNeverExceedTheSpeedBound) {
-  // Default settings (the paper's d_N = 2, 32 cells, 4000 swim steps); fixed seeds. ANIMAT_SOAK_GENOMES
-  // sets the total (default 20,000; 1,000 in sanitizer builds, where a swim is ~10x slower).
+  // Default settings (the paper's d_N = 2, 32 cells, 4000 swim steps); fixed seeds.
+  // ANIMAT_SOAK_GENOMES sets the total (default 20,000; 1,000 in sanitizer builds, where a swim is
+  // ~10x slower).
   const int total = env_int("ANIMAT_SOAK_GENOMES", ANIMAT_TEST_SANITIZED ? 1000 : 20000);
   const int n_random = total / 2, n_mutated = total - n_random;
   const Config c;
@@ -674,39 +720,46 @@ TEST(Soak, RandomAndMutatedGenomesNeverCrashNeverNaNNeverExceedTheSpeedBound) {
     if (viable[i]) parents.push_back(&random[i]);
   ASSERT_FALSE(parents.empty()) << "no viable random genome among " << random.size();
 
-  // Mutated genomes: 1-4 rounds of the GA's own operators on a viable parent, a fifth of them after a
-  // crossover with a second viable parent, a quarter at 10x the default rates (farther from viability).
+  // Mutated genomes: 1-4 rounds of the GA's own operators on a viable parent, a fifth of them after
+  // a crossover with a second viable parent, a quarter at 10x the default rates (farther from
+  // viability).
   MutationParams strong = c.mutation;
-  for (double* r : {&strong.type_rate, &strong.sign_rate, &strong.move_rate, &strong.duplicate_rate, &strong.delete_rate})
+  for (double* r : {&strong.type_rate, &strong.sign_rate, &strong.move_rate, &strong.duplicate_rate,
+                    &strong.delete_rate})
     *r = std::min(1.0, 10 * *r);
   std::vector<Genome> mutated;
   mutated.reserve(static_cast<std::size_t>(n_mutated));
   for (int i = 0; i < n_mutated; ++i) {
     Rng rng = Rng::derive(20'240'901, 1, i);
     Genome g = *parents[rng.below(parents.size())];
-    if (rng.bernoulli(0.2)) g = crossover(g, *parents[rng.below(parents.size())], c.mutation.crossover_points, rng);
+    if (rng.bernoulli(0.2))
+      g = crossover(g, *parents[rng.below(parents.size())], c.mutation.crossover_points, rng);
     const MutationParams& m = i % 4 == 3 ? strong : c.mutation;
     for (int r = 1 + static_cast<int>(rng.below(4)); r > 0; --r) mutate(g, m, c.genome, rng);
     mutated.push_back(std::move(g));
   }
-  // Mutants of viable parents mostly swim, and a 4000-step swim is the whole cost (~55 ms): the first
-  // 30% swim the default 4000 steps, the other 70% a shortened evaluation.steps = 1000 (all other
-  // settings default), which keeps the soak near one minute on 2 cores.
+  // Mutants of viable parents mostly swim, and a 4000-step swim is the whole cost (~55 ms): the
+  // first 30% swim the default 4000 steps, the other 70% a shortened evaluation.steps = 1000 (all
+  // other settings default), which keeps the soak near one minute on 2 cores.
   const std::size_t n_full = static_cast<std::size_t>(n_mutated) * 3 / 10;
   Config short_swim = c;
   short_swim.evaluation.steps = 1000;
-  soak(std::vector<Genome>(mutated.begin(), mutated.begin() + static_cast<std::ptrdiff_t>(n_full)), c, mutated_stats);
+  soak(std::vector<Genome>(mutated.begin(), mutated.begin() + static_cast<std::ptrdiff_t>(n_full)),
+       c, mutated_stats);
   if (HasFatalFailure()) return;
-  soak(std::vector<Genome>(mutated.begin() + static_cast<std::ptrdiff_t>(n_full), mutated.end()), short_swim, short_stats);
+  soak(std::vector<Genome>(mutated.begin() + static_cast<std::ptrdiff_t>(n_full), mutated.end()),
+       short_swim, short_stats);
   if (HasFatalFailure()) return;
 
   auto report = [&](const char* name, const SoakStats& s, const Config& used) {
-    std::cout << "[soak] " << name << ": " << s.genomes << " genomes, " << s.viable << " viable, " << s.unstable
-              << " unstable (" << 100.0 * s.unstable / std::max(1, s.genomes) << "%), max fitness " << s.max_fitness
-              << " (config bound " << fitness_bound(used) << "), max cell speed " << s.max_speed
-              << ", max fitness/(max_speed*T) " << s.max_ratio_to_speed_bound << ", max cells " << s.max_cells << ", "
-              << s.seconds << " s on 2 threads\n";
-    for (const auto& [reason, n] : s.reasons) std::cout << "[soak]   unstable x" << n << ": " << reason << "\n";
+    std::cout << "[soak] " << name << ": " << s.genomes << " genomes, " << s.viable << " viable, "
+              << s.unstable << " unstable (" << 100.0 * s.unstable / std::max(1, s.genomes)
+              << "%), max fitness " << s.max_fitness << " (config bound " << fitness_bound(used)
+              << "), max cell speed " << s.max_speed << ", max fitness/(max_speed*T) "
+              << s.max_ratio_to_speed_bound << ", max cells " << s.max_cells << ", " << s.seconds
+              << " s on 2 threads\n";
+    for (const auto& [reason, n] : s.reasons)
+      std::cout << "[soak]   unstable x" << n << ": " << reason << "\n";
   };
   report("random, 4000 steps ", random_stats, c);
   report("mutated, 4000 steps", mutated_stats, c);
@@ -715,7 +768,8 @@ TEST(Soak, RandomAndMutatedGenomesNeverCrashNeverNaNNeverExceedTheSpeedBound) {
   RecordProperty("unstable", unstable);
   RecordProperty("viable", random_stats.viable + mutated_stats.viable + short_stats.viable);
   EXPECT_EQ(unstable, 0) << "fraction flagged unstable must be 0 at default settings";
-  EXPECT_GT(mutated_stats.viable + short_stats.viable, n_mutated / 10) << "mutants should mostly swim (else the soak tests little)";
+  EXPECT_GT(mutated_stats.viable + short_stats.viable, n_mutated / 10)
+      << "mutants should mostly swim (else the soak tests little)";
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -732,13 +786,23 @@ TEST(ExtremeConfigs, NeverANaNNeverACrash) {
     if (evaluate(g, base).viable) viable.push_back(std::move(g));
   }
   ASSERT_FALSE(viable.empty());
-  std::vector<std::string> overrides = {
-      "scene.drag_normal=1000000", "scene.drag_normal=0",        "scene.pressure=1000000",
-      "scene.spring_stiffness=1e9", "scene.spring_stiffness=0",   "scene.spring_damping=1e9",
-      "scene.cell_mass=1e-9",       "scene.cell_mass=1e9",        "physics.dt=1",
-      "physics.drag_scheme=explicit", "physics.max_step_displacement=1e-9", "development.amplitude_max=0.45",
-      "development.frequency_max=1e6", "scene.collision_stiffness=1e12", "physics.substeps=7",
-      "scene.effects=[]",           "development.effects=[]"};
+  std::vector<std::string> overrides = {"scene.drag_normal=1000000",
+                                        "scene.drag_normal=0",
+                                        "scene.pressure=1000000",
+                                        "scene.spring_stiffness=1e9",
+                                        "scene.spring_stiffness=0",
+                                        "scene.spring_damping=1e9",
+                                        "scene.cell_mass=1e-9",
+                                        "scene.cell_mass=1e9",
+                                        "physics.dt=1",
+                                        "physics.drag_scheme=explicit",
+                                        "physics.max_step_displacement=1e-9",
+                                        "development.amplitude_max=0.45",
+                                        "development.frequency_max=1e6",
+                                        "scene.collision_stiffness=1e12",
+                                        "physics.substeps=7",
+                                        "scene.effects=[]",
+                                        "development.effects=[]"};
   for (const auto& o : overrides) {
     Config c = base;
     apply_override(c, o);
@@ -825,21 +889,26 @@ TEST(ParallelEvaluation, StdThreadsWithTheirOwnWorldsMatchSerial) {
       for (std::size_t i = t; i < genomes.size(); i += 2) threaded[i] = f(genomes[i]);
     });
   for (auto& th : pool) th.join();
-  for (std::size_t i = 0; i < genomes.size(); ++i) EXPECT_EQ(serial[i], threaded[i]) << "genome " << i;
+  for (std::size_t i = 0; i < genomes.size(); ++i)
+    EXPECT_EQ(serial[i], threaded[i]) << "genome " << i;
 }
 
 TEST(TsanCanary, APlantedRaceInAFitnessFunctionIsReported) {
   // Run only by scripts/reliability.sh in the ThreadSanitizer build (ANIMAT_TSAN_CANARY=1), which
   // expects this process to die with a data-race report: proof that the TSan run sees races in code
   // called from evaluate_all's OpenMP region (a setup that silently saw nothing would also "pass").
-  if (std::getenv("ANIMAT_TSAN_CANARY") == nullptr) GTEST_SKIP() << "set ANIMAT_TSAN_CANARY=1 (ThreadSanitizer build only)";
+  if (std::getenv("ANIMAT_TSAN_CANARY") == nullptr)
+    GTEST_SKIP() << "set ANIMAT_TSAN_CANARY=1 (ThreadSanitizer build only)";
   int counter = 0;  // deliberately unsynchronised
   const std::vector<Genome> genomes(64);
-  const auto results = evaluate_all(genomes, [&](const Genome&) {
-    ++counter;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    return Fitness{};
-  }, 2);
+  const auto results = evaluate_all(
+      genomes,
+      [&](const Genome&) {
+        ++counter;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        return Fitness{};
+      },
+      2);
   EXPECT_EQ(results.size(), 64u);
 }
 
@@ -872,7 +941,9 @@ TEST(DiskFaults, OutputUnderARegularFileIsAClearError) {
     (void)run_evolution(c, run_options(dir / "file" / "run"), stub_fitness);
     FAIL() << "no error";
   } catch (const IoError& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot create run directory: Not a directory"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot create run directory: Not a directory"),
+              std::string::npos)
+        << e.what();
   }
   fs::remove_all(dir);
 }
@@ -880,7 +951,8 @@ TEST(DiskFaults, OutputUnderARegularFileIsAClearError) {
 TEST(DiskFaults, OutputInsideProcIsAClearError) {
   Config c = stub_config();
   c.evolution.generations = 2;
-  EXPECT_THROW((void)run_evolution(c, run_options("/proc/animat_no_such_dir/run"), stub_fitness), IoError);
+  EXPECT_THROW((void)run_evolution(c, run_options("/proc/animat_no_such_dir/run"), stub_fitness),
+               IoError);
 }
 
 TEST(DiskFaults, ExistingRunIsNeverOverwritten) {
@@ -906,14 +978,16 @@ TEST(DiskFaults, ResumeDirectoryWithoutCheckpointIsAClearError) {
     (void)run_evolution(stub_config(), run_options(dir, true), stub_fitness);
     FAIL();
   } catch (const CheckpointError& e) {
-    EXPECT_NE(std::string(e.what()).find("no checkpoint.json to resume from"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no checkpoint.json to resume from"), std::string::npos)
+        << e.what();
   }
   fs::remove_all(dir);
 }
 
 /// Runs `generations` generations; at generation `fault_at`, `inject(dir)` sabotages the next
 /// checkpoint write. Returns the error message of the failed run.
-std::string run_with_fault(const fs::path& dir, const Config& c, int fault_at, const std::function<void(const fs::path&)>& inject) {
+std::string run_with_fault(const fs::path& dir, const Config& c, int fault_at,
+                           const std::function<void(const fs::path&)>& inject) {
   RunOptions o = run_options(dir);
   o.callback = [&](const GenerationStats& s, const Evolution&) {
     if (s.generation == fault_at) inject(dir);
@@ -944,17 +1018,23 @@ void expect_resume_matches_uninterrupted(const fs::path& dir, const Config& c) {
 }
 
 /// The temporary file this process writes a checkpoint through.
-std::string checkpoint_temporary() { return "checkpoint.json." + std::to_string(::getpid()) + ".tmp"; }
+std::string checkpoint_temporary() {
+  return "checkpoint.json." + std::to_string(::getpid()) + ".tmp";
+}
 
 TEST(DiskFaults, FullDiskDuringACheckpointKeepsThePreviousOne) {
-  // checkpoint.json.PID.tmp (this process writes it) is a symlink to /dev/full: the next checkpoint write fails with ENOSPC.
+  // checkpoint.json.PID.tmp (this process writes it) is a symlink to /dev/full: the next checkpoint
+  // write fails with ENOSPC.
   const fs::path dir = fresh_dir("full");
   Config c = stub_config();
   c.evolution.generations = 8;
-  const std::string err = run_with_fault(dir, c, 3, [](const fs::path& d) { fs::create_symlink("/dev/full", d / checkpoint_temporary()); });
+  const std::string err = run_with_fault(dir, c, 3, [](const fs::path& d) {
+    fs::create_symlink("/dev/full", d / checkpoint_temporary());
+  });
   EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
   expect_checkpoint_at(dir, c, 3);
-  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / checkpoint_temporary()))) << "the failed temporary file is removed";
+  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / checkpoint_temporary())))
+      << "the failed temporary file is removed";
   expect_resume_matches_uninterrupted(dir, c);
   fs::remove_all(dir);
 }
@@ -964,7 +1044,8 @@ TEST(DiskFaults, UnwritableCheckpointKeepsThePreviousOne) {
   const fs::path dir = fresh_dir("blocked");
   Config c = stub_config();
   c.evolution.generations = 6;
-  const std::string err = run_with_fault(dir, c, 2, [](const fs::path& d) { fs::create_directory(d / checkpoint_temporary()); });
+  const std::string err = run_with_fault(
+      dir, c, 2, [](const fs::path& d) { fs::create_directory(d / checkpoint_temporary()); });
   EXPECT_NE(err.find("cannot write"), std::string::npos) << err;
   expect_checkpoint_at(dir, c, 2);
   fs::remove(dir / checkpoint_temporary());
@@ -976,8 +1057,9 @@ TEST(DiskFaults, CliFileSizeLimitIsAClearError) {
   // ulimit -f 8 (KiB) with SIGXFSZ ignored: writes fail with EFBIG, the binary reports and exits 2.
   const fs::path dir = fresh_dir("ulimit");
   std::string err;
-  const int rc = shell("ulimit -f 8; trap \"\" XFSZ; exec " + std::string(ANIMAT_EVOLVE_EXE) + kSmallRun +
-                           "--generations 3 --out " + dir.string(), &err);
+  const int rc = shell("ulimit -f 8; trap \"\" XFSZ; exec " + std::string(ANIMAT_EVOLVE_EXE) +
+                           kSmallRun + "--generations 3 --out " + dir.string(),
+                       &err);
   EXPECT_EQ(rc, 2) << err;
   EXPECT_NE(err.find("animat_evolve: error: "), std::string::npos) << err;
   EXPECT_NE(err.find("File too large"), std::string::npos) << err;
@@ -988,16 +1070,19 @@ TEST(DiskFaults, CliMissingResumeDirectoryIsAClearError) {
   std::string err;
   const int rc = shell(std::string(ANIMAT_EVOLVE_EXE) + " --resume /nonexistent/animat_run", &err);
   EXPECT_EQ(rc, 2) << err;
-  EXPECT_EQ(err, "animat_evolve: error: /nonexistent/animat_run: resume directory does not exist\n");
+  EXPECT_EQ(err,
+            "animat_evolve: error: /nonexistent/animat_run: resume directory does not exist\n");
 }
 
 TEST(DiskFaults, CliTinyAndReadOnlyTmpfs) {
-  // A 64 KiB tmpfs fills up mid-run; a read-only one refuses the run directory. Needs mount(2) rights.
+  // A 64 KiB tmpfs fills up mid-run; a read-only one refuses the run directory. Needs mount(2)
+  // rights.
   const fs::path mnt = fresh_dir("tmpfs");
   fs::create_directories(mnt);
   if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=64k") != 0) {
     fs::remove_all(mnt);
-    GTEST_SKIP() << "cannot mount a tmpfs here (" << std::strerror(errno) << "); the /dev/full and ulimit tests cover a full disk";
+    GTEST_SKIP() << "cannot mount a tmpfs here (" << std::strerror(errno)
+                 << "); the /dev/full and ulimit tests cover a full disk";
   }
   struct Unmount {
     fs::path dir;
@@ -1008,16 +1093,21 @@ TEST(DiskFaults, CliTinyAndReadOnlyTmpfs) {
     }
   } unmount{mnt};
   std::string err;
-  int rc = shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--set evolution.population=100 --generations 50 --out " +
-                     (mnt / "run").string(), &err);
+  int rc =
+      shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun +
+                "--set evolution.population=100 --generations 50 --out " + (mnt / "run").string(),
+            &err);
   EXPECT_EQ(rc, 2) << err;
   EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
   if (fs::exists(mnt / "run" / "checkpoint.json")) {
     const json left = json::parse(slurp(mnt / "run" / "checkpoint.json"), nullptr, false);
     EXPECT_FALSE(left.is_discarded()) << "a checkpoint left on a full disk is whole";
   }
-  ASSERT_EQ(::mount("tmpfs", mnt.c_str(), "tmpfs", MS_REMOUNT | MS_RDONLY, "size=64k"), 0) << std::strerror(errno);
-  rc = shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " + (mnt / "run2").string(), &err);
+  ASSERT_EQ(::mount("tmpfs", mnt.c_str(), "tmpfs", MS_REMOUNT | MS_RDONLY, "size=64k"), 0)
+      << std::strerror(errno);
+  rc = shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " +
+                 (mnt / "run2").string(),
+             &err);
   EXPECT_EQ(rc, 2) << err;
   EXPECT_NE(err.find("Read-only file system"), std::string::npos) << err;
 }
@@ -1025,7 +1115,8 @@ TEST(DiskFaults, CliTinyAndReadOnlyTmpfs) {
 // ---------------------------------------------------------------------------------------------------
 // The run directory: one writer, no run silently replaced, refusals that change nothing
 
-/// Every file and folder under `dir` with its content: equal snapshots = a byte-identical directory.
+/// Every file and folder under `dir` with its content: equal snapshots = a byte-identical
+/// directory.
 std::map<std::string, std::string> snapshot(const fs::path& dir) {
   std::map<std::string, std::string> out;
   if (!fs::exists(dir)) return out;
@@ -1038,15 +1129,17 @@ std::map<std::string, std::string> snapshot(const fs::path& dir) {
 
 std::string listing(const std::map<std::string, std::string>& snap) {
   std::string s;
-  for (const auto& [name, content] : snap) s += name + " (" + std::to_string(content.size()) + " bytes) ";
+  for (const auto& [name, content] : snap)
+    s += name + " (" + std::to_string(content.size()) + " bytes) ";
   return s;
 }
 
-#define EXPECT_SAME_DIRECTORY(before, dir, what)                                                              \
-  do {                                                                                                        \
-    const auto after_ = snapshot(dir);                                                                        \
-    EXPECT_TRUE(after_ == (before)) << (what) << " changed the run directory:\n before: " << listing(before) \
-                                    << "\n after:  " << listing(after_);                                     \
+#define EXPECT_SAME_DIRECTORY(before, dir, what)                                 \
+  do {                                                                           \
+    const auto after_ = snapshot(dir);                                           \
+    EXPECT_TRUE(after_ == (before))                                              \
+        << (what) << " changed the run directory:\n before: " << listing(before) \
+        << "\n after:  " << listing(after_);                                     \
   } while (0)
 
 /// A stub-fitness config whose real swims are short too (a CLI run on the same directory swims).
@@ -1080,12 +1173,14 @@ TEST(RunDirectory, SecondWriterIsRefusedNamingTheHolderAndChangesNothing) {
     checked = true;
     EXPECT_TRUE(fs::exists(dir / ".lock")) << "the run holds RUN/.lock";
     const auto before = snapshot(dir);
-    for (const std::string& args : {std::string(" --quiet --resume ") + dir.string() + " --generations 9",
-                                    kSmallRun + "--generations 9 --out " + dir.string()}) {
+    for (const std::string& args :
+         {std::string(" --quiet --resume ") + dir.string() + " --generations 9",
+          kSmallRun + "--generations 9 --out " + dir.string()}) {
       std::string err;
       const int rc = shell(std::string(ANIMAT_EVOLVE_EXE) + args, &err);
       EXPECT_EQ(rc, 2) << args << ": " << err;
-      EXPECT_NE(err.find("in use by another animat process (" + me), std::string::npos) << args << ": " << err;
+      EXPECT_NE(err.find("in use by another animat process (" + me), std::string::npos)
+          << args << ": " << err;
       EXPECT_NE(err.find("Nothing was written"), std::string::npos) << err;
       EXPECT_SAME_DIRECTORY(before, dir, args);
     }
@@ -1102,10 +1197,12 @@ TEST(RunDirectory, SecondWriterIsRefusedNamingTheHolderAndChangesNothing) {
   const RunSummary r = run_evolution(c, o, stub_fitness);
   ASSERT_TRUE(checked);
   EXPECT_EQ(r.history.back().generation, 5);
-  EXPECT_EQ(history_generations(dir), (std::vector<int>{0, 1, 2, 3, 4, 5})) << "one writer, generations in order";
+  EXPECT_EQ(history_generations(dir), (std::vector<int>{0, 1, 2, 3, 4, 5}))
+      << "one writer, generations in order";
   EXPECT_FALSE(fs::exists(dir / ".lock")) << "a run that ends removes its lock file";
   for (const auto& e : fs::recursive_directory_iterator(dir))
-    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos)
+        << "temporary file left: " << e.path();
   fs::remove_all(dir);
 }
 
@@ -1127,7 +1224,8 @@ TEST(RunDirectory, LockFileOfAKilledRunIsTakenOver) {
   const RunSummary r = run_evolution(c, run_options(dir, true), stub_fitness);
   EXPECT_EQ(r.history.back().generation, 4);
   EXPECT_FALSE(fs::exists(dir / ".lock"));
-  EXPECT_FALSE(fs::exists(dir / "checkpoint.json.4242.tmp")) << "temporary files of dead writers are removed";
+  EXPECT_FALSE(fs::exists(dir / "checkpoint.json.4242.tmp"))
+      << "temporary files of dead writers are removed";
   fs::remove_all(dir);
 }
 
@@ -1156,14 +1254,16 @@ TEST(RunDirectory, TemporaryFilesAreNamedAfterTheirProcess) {
 }
 
 TEST(RunDirectory, RunFilesWithoutACheckpointAreNeverOverwritten) {
-  // config.toml, history.csv and best/ of a run whose checkpoint.json is gone: a new run there would
-  // shrink the history and mix two lineages. Refused, naming what is there; overwrite replaces it.
+  // config.toml, history.csv and best/ of a run whose checkpoint.json is gone: a new run there
+  // would shrink the history and mix two lineages. Refused, naming what is there; overwrite
+  // replaces it.
   const fs::path dir = fresh_dir("no_ckpt_files");
   Config c = small_run_config(4);
   (void)run_evolution(c, run_options(dir), stub_fitness);
   fs::remove(dir / "checkpoint.json");
   const auto before = snapshot(dir);
-  for (const std::int64_t seed : {std::int64_t{3}, std::int64_t{4}}) {  // the same config, and another
+  for (const std::int64_t seed : {std::int64_t{3}, std::int64_t{4}}) {
+    // the same config, and another
     Config again = small_run_config(2);
     again.evolution.seed = seed;
     try {
@@ -1175,14 +1275,19 @@ TEST(RunDirectory, RunFilesWithoutACheckpointAreNeverOverwritten) {
       EXPECT_NE(m.find("history.csv (5 generations)"), std::string::npos) << m;
       EXPECT_NE(m.find("best/ ("), std::string::npos) << m;
       EXPECT_NE(m.find("overwrite"), std::string::npos) << m;
-      EXPECT_NE(m.find("config.toml (a different config: "), std::string::npos) << m;  // generations differs
+      // generations differs
+      EXPECT_NE(m.find("config.toml (a different config: "), std::string::npos) << m;
       EXPECT_EQ(m.find("evolution.seed") != std::string::npos, seed == 4) << m;
     }
     EXPECT_SAME_DIRECTORY(before, dir, "a refused new run");
   }
   // The CLI says the same and exits 2.
   std::string err;
-  EXPECT_EQ(shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " + dir.string(), &err), 2) << err;
+  EXPECT_EQ(
+      shell(std::string(ANIMAT_EVOLVE_EXE) + kSmallRun + "--generations 2 --out " + dir.string(),
+            &err),
+      2)
+      << err;
   EXPECT_NE(err.find("holds the files of a run but no checkpoint.json"), std::string::npos) << err;
   EXPECT_SAME_DIRECTORY(before, dir, "the CLI's refused new run");
   // Asked for explicitly, the old run is replaced entirely.
@@ -1202,7 +1307,8 @@ TEST(RunDirectory, TheSameCommandStoppedBeforeItsFirstCheckpointStartsOver) {
   const Config c = small_run_config(3);
   (void)run_evolution(c, run_options(ref), stub_fitness);
   RunOptions o = run_options(dir);
-  o.callback = [](const GenerationStats&, const Evolution&) { return false; };  // stop after generation 0
+  // stop after generation 0
+  o.callback = [](const GenerationStats&, const Evolution&) { return false; };
   (void)run_evolution(c, o, stub_fitness);
   fs::remove(dir / "checkpoint.json");
   (void)run_evolution(c, run_options(dir), stub_fitness);
@@ -1228,16 +1334,18 @@ TEST(RunDirectory, EveryRefusalOfTheCliLeavesTheDirectoryByteIdentical) {
   ckpt[ckpt.size() / 2] = ckpt[ckpt.size() / 2] == 'x' ? 'y' : 'x';
   spit(corrupt / "checkpoint.json", ckpt);
   const std::vector<std::pair<fs::path, std::string>> refused = {
-      {dir, "--resume " + dir.string() + " --set evolution.population=9"},  // a change that defines the run
+      // a change that defines the run
+      {dir, "--resume " + dir.string() + " --set evolution.population=9"},
       {dir, "--resume " + dir.string() + " --set evolution.seed=5"},
-      {dir, "--resume " + dir.string() + " --generations -1"},                // a bad flag value
+      {dir, "--resume " + dir.string() + " --generations -1"},  // a bad flag value
       {dir, "--resume " + dir.string() + " --set evolution.elites=nine"},
       {dir, "--resume " + dir.string() + " --config " + (dir / "config.toml").string()},
       {dir, "--resume " + dir.string() + " --overwrite"},
       {dir, "--resume " + dir.string() + " --out " + no_ckpt.string()},
-      {dir, kSmallRun + "--generations 2 --out " + dir.string()},            // an existing run
-      {no_ckpt, "--resume " + no_ckpt.string()},                              // no checkpoint
-      {corrupt, "--resume " + corrupt.string()},                              // a corrupt checkpoint
+      {dir, kSmallRun + "--generations 2 --out " + dir.string()},  // an existing run
+      {no_ckpt, "--resume " + no_ckpt.string()},                   // no checkpoint
+      // a corrupt checkpoint
+      {corrupt, "--resume " + corrupt.string()},
   };
   for (const auto& [target, args] : refused) {
     const auto before = snapshot(target);
@@ -1245,15 +1353,18 @@ TEST(RunDirectory, EveryRefusalOfTheCliLeavesTheDirectoryByteIdentical) {
     EXPECT_NE(rc, 0) << args << ": accepted";
     EXPECT_SAME_DIRECTORY(before, target, args);
   }
-  EXPECT_EQ(shell(exe + " --resume " + dir.string() + " --generations 3 1>&2", &err), 0) << err;  // the log too
-  EXPECT_NE(err.find("rank 1 lost"), std::string::npos) << "the accepted resume shows stopped.txt: " << err;
+  // the log too
+  EXPECT_EQ(shell(exe + " --resume " + dir.string() + " --generations 3 1>&2", &err), 0) << err;
+  EXPECT_NE(err.find("rank 1 lost"), std::string::npos)
+      << "the accepted resume shows stopped.txt: " << err;
   EXPECT_FALSE(fs::exists(dir / "stopped.txt"));
   for (const auto& d : {dir, no_ckpt, corrupt}) fs::remove_all(d);
 }
 
 // ---------------------------------------------------------------------------------------------------
 // Fuzz regressions: every input a fuzzer crashed on is kept as fuzz/corpus/<target>/regression-*
-// (so each fuzz run replays it first) and replayed here through the same entry point, without clang.
+// (so each fuzz run replays it first) and replayed here through the same entry point, without
+// clang.
 
 std::vector<fs::path> regressions(const std::string& target) {
   std::vector<fs::path> out;
@@ -1300,7 +1411,9 @@ TEST(FuzzRegressions, CheckpointInputsRaiseOnlyAnimatErrors) {
     switch (static_cast<unsigned char>(data[0]) % 3) {
       case 0: text = rest; break;
       case 1: {
-        const std::string body = json::parse(json(rest).dump(-1, ' ', false, json::error_handler_t::replace)).get<std::string>();
+        const std::string body =
+            json::parse(json(rest).dump(-1, ' ', false, json::error_handler_t::replace))
+                .get<std::string>();
         text = json{{"checksum", fnv_hex(body)}, {"payload", body}}.dump();
         break;
       }

@@ -1,12 +1,12 @@
-// Scale-out building blocks (issue 20): the evaluator interface, islands and ring migration, and the
-// wire codec of the MPI messages. The MPI runs themselves are checked end to end in
+// Scale-out building blocks (issue 20): the evaluator interface, islands and ring migration, and
+// the wire codec of the MPI messages. The MPI runs themselves are checked end to end in
 // tests/python/test_mpi.py (mpirun on localhost).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -14,8 +14,8 @@
 #include "animat/errors.hpp"
 #include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
-#include "animat/run_identity.hpp"
 #include "animat/islands.hpp"
+#include "animat/run_identity.hpp"
 #include "animat/wire.hpp"
 #include "test_support.hpp"
 
@@ -47,7 +47,8 @@ void expect_same_population(const std::vector<Individual>& a, const std::vector<
 // Counts calls and answers like the stub: an evaluator that is not the OpenMP one.
 class CountingEvaluator final : public Evaluator {
  public:
-  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes, const StopRequest&) override {
+  std::vector<Fitness> evaluate(std::span<const Genome* const> genomes,
+                                const StopRequest&) override {
     ++calls;
     evaluated += genomes.size();
     std::vector<Fitness> out;
@@ -80,8 +81,10 @@ TEST(Evaluator, AnyEvaluatorGivesTheSameRunAsTheOpenMpThreads) {
   }
   expect_same_population(local.population(), other.population());
   EXPECT_EQ(local.evaluations(), other.evaluations());
-  EXPECT_EQ(counting->calls - seeding_calls, 5);  // one call per generation: the whole generation is handed out at once
-  EXPECT_EQ(seeding + static_cast<std::int64_t>(counting->evaluated - seeding_evaluated), other.evaluations());
+  // one call per generation: the whole generation is handed out at once
+  EXPECT_EQ(counting->calls - seeding_calls, 5);
+  EXPECT_EQ(seeding + static_cast<std::int64_t>(counting->evaluated - seeding_evaluated),
+            other.evaluations());
 }
 
 TEST(Evaluator, LocalEvaluatorRethrowsTheFirstErrorByIndex) {
@@ -132,12 +135,14 @@ TEST(Islands, ConfigErrorsNameTheKeys) {
   c = island_config(3, 12);
   c.evolution.elites = 4;
   EXPECT_THROW(validate(c), ConfigError);
-  c = island_config(1, 12, 1, 100);  // without islands the island keys are not checked against sizes
+  // without islands the island keys are not checked against sizes
+  c = island_config(1, 12, 1, 100);
   EXPECT_NO_THROW(validate(c));
 }
 
 TEST(Islands, RingMigrationCopiesTheBestOverTheWorstOfTheNextIsland) {
-  // 3 islands of 4; fitness = 10 * island + position, so the best of island k is its last individual.
+  // 3 islands of 4; fitness = 10 * island + position, so the best of island k is its last
+  // individual.
   std::vector<Individual> pop(12);
   for (std::size_t i = 0; i < 12; ++i) {
     pop[i].genome.dimensions = static_cast<int>(i);  // a label
@@ -147,7 +152,8 @@ TEST(Islands, RingMigrationCopiesTheBestOverTheWorstOfTheNextIsland) {
   const IslandLayout layout = island_layout(12, 3);
   const auto moves = migrate(pop, layout, 2, 7);
   ASSERT_EQ(moves.size(), 6u);
-  // island 0 -> 1: the best two of island 0 (3, 2) replace the worst two of island 1 (5 non-viable, then 4)
+  // island 0 -> 1: the best two of island 0 (3, 2) replace the worst two of island 1 (5 non-viable,
+  // then 4)
   EXPECT_EQ(moves[0], (Migration{7, 0, 1, 3, 5}));
   EXPECT_EQ(moves[1], (Migration{7, 0, 1, 2, 4}));
   EXPECT_EQ(moves[2], (Migration{7, 1, 2, 7, 8}));
@@ -155,7 +161,8 @@ TEST(Islands, RingMigrationCopiesTheBestOverTheWorstOfTheNextIsland) {
   EXPECT_EQ(moves[4], (Migration{7, 2, 0, 11, 0}));  // the ring closes
   EXPECT_EQ(moves[5], (Migration{7, 2, 0, 10, 1}));
   for (const Migration& m : moves) {
-    EXPECT_EQ(pop[m.to].genome.dimensions, static_cast<int>(m.from));  // a copy, from before any replacement
+    // a copy, from before any replacement
+    EXPECT_EQ(pop[m.to].genome.dimensions, static_cast<int>(m.from));
     EXPECT_EQ(pop[m.to].result, pop[m.from].result);
   }
 }
@@ -180,7 +187,8 @@ TEST(Islands, MigrantsArriveExactlyAtTheScheduledGenerations) {
       EXPECT_EQ(m.to_island, (k + 1) % 3);
       EXPECT_EQ(layout.island_of(m.from), k);
       EXPECT_EQ(layout.island_of(m.to), (k + 1) % 3);
-      EXPECT_TRUE(evo.population()[m.to].genome == evo.population()[m.from].genome) << "generation " << g;
+      EXPECT_TRUE(evo.population()[m.to].genome == evo.population()[m.from].genome)
+          << "generation " << g;
     }
   }
 }
@@ -192,9 +200,11 @@ TEST(Islands, SelectionStaysWithinAnIslandBetweenMigrations) {
   Evolution evo(c, stub_fitness);
   evo.initialize();
   const IslandLayout layout = island_layout(12, 3);
-  std::vector<std::set<std::vector<double>>> initial(3);  // coordinates of the initial elements, per island
+  // coordinates of the initial elements, per island
+  std::vector<std::set<std::vector<double>>> initial(3);
   for (std::size_t i = 0; i < 12; ++i)
-    for (const auto& e : evo.population()[i].genome.elements) initial[layout.island_of(i)].insert(e.coords);
+    for (const auto& e : evo.population()[i].genome.elements)
+      initial[layout.island_of(i)].insert(e.coords);
   for (int g = 0; g < 6; ++g) evo.step();
   // Crossover and duplication copy elements; only point moves create new coordinates. An element
   // of island 0 found unchanged in island 1 would mean material crossed.
@@ -221,11 +231,13 @@ TEST(Islands, DeterministicForAnyThreadCountAndAcrossCheckpointResume) {
   for (int g = 0; g < 4; ++g) resumed.step();
   expect_same_population(straight.population(), resumed.population());
   ASSERT_EQ(straight.history().size(), resumed.history().size());
-  for (std::size_t i = 0; i < straight.history().size(); ++i) EXPECT_EQ(straight.history()[i].best, resumed.history()[i].best);
+  for (std::size_t i = 0; i < straight.history().size(); ++i)
+    EXPECT_EQ(straight.history()[i].best, resumed.history()[i].best);
 }
 
 TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
-  // Without islands the island keys neither change the run nor its identity (old checkpoints resume).
+  // Without islands the island keys neither change the run nor its identity (old checkpoints
+  // resume).
   Config a = island_config(1, 12);
   Config b = a;
   b.evolution.migration_interval = 77;
@@ -243,18 +255,45 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   std::string text = to_toml(plain);
   const auto begin = text.find("# sub-populations evolving apart");
   const auto end = text.find('\n', text.find("\nmigrants = ") + 1) + 1;
-  ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin), text.begin() + static_cast<std::ptrdiff_t>(end), '\n'), 6);
+  ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin),
+                       text.begin() + static_cast<std::ptrdiff_t>(end), '\n'),
+            6);
   text.erase(begin, end - begin);
   // So are the late keys at their defaults, each with its comment line.
-  for (const char* key : {"\nobjective = ", "\ndirection = ", "\nintegrator = ", "\ngravity = ", "\nground_height = ",
-                          "\nground_friction_static = ", "\nground_friction_kinetic = ", "\nsettle_steps = ",
-                          "\nenergy_weight = ", "\nenergy_offset = ", "\nextra_inputs = ", "\nextra_outputs = ",
-                          "\ngraph = ", "\ndistance_threshold = ", "\nalpha = ",
-                          "\nstiffness_min = ", "\nstiffness_max = ",
-                          "\nchemical = ", "\nchemical_source = ", "\nchemical_decay_length = ", "\nmode = ", "\nactuation = ",
-                          "\nupdate_interval = ", "\ngrn_rate = ", "\nsignal_rate = ", "\nsignal_decay = ",
-                          "\nstart_ramp = ", "\nsource_directions = ", "\nsource_seed = ", "\npush_step = ",
-                          "\npush_impulse = ", "\npush_cells = ", "\nmorphogen_cutoff = ", "\nenergy_accounting = ",
+  for (const char* key : {"\nobjective = ",
+                          "\ndirection = ",
+                          "\nintegrator = ",
+                          "\ngravity = ",
+                          "\nground_height = ",
+                          "\nground_friction_static = ",
+                          "\nground_friction_kinetic = ",
+                          "\nsettle_steps = ",
+                          "\nenergy_weight = ",
+                          "\nenergy_offset = ",
+                          "\nextra_inputs = ",
+                          "\nextra_outputs = ",
+                          "\ngraph = ",
+                          "\ndistance_threshold = ",
+                          "\nalpha = ",
+                          "\nstiffness_min = ",
+                          "\nstiffness_max = ",
+                          "\nchemical = ",
+                          "\nchemical_source = ",
+                          "\nchemical_decay_length = ",
+                          "\nmode = ",
+                          "\nactuation = ",
+                          "\nupdate_interval = ",
+                          "\ngrn_rate = ",
+                          "\nsignal_rate = ",
+                          "\nsignal_decay = ",
+                          "\nstart_ramp = ",
+                          "\nsource_directions = ",
+                          "\nsource_seed = ",
+                          "\npush_step = ",
+                          "\npush_impulse = ",
+                          "\npush_cells = ",
+                          "\nmorphogen_cutoff = ",
+                          "\nenergy_accounting = ",
                           "\ndivision_axis = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
@@ -275,8 +314,8 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
 
 TEST(RunIdentity, RunsCheckpointedBeforeTheLateKeysStillResume) {
   // data/paper_100_generations was checkpointed (scheme 1) before evaluation.objective,
-  // evaluation.direction and physics.integrator existed; its checkpoints carry these identities (the
-  // checkpoint field "identity"), which the config it was run with must still give.
+  // evaluation.direction and physics.integrator existed; its checkpoints carry these identities
+  // (the checkpoint field "identity"), which the config it was run with must still give.
   const std::filesystem::path run =
       std::filesystem::path(ANIMAT_SOURCE_DIR) / "data" / "paper_100_generations" / "dn2" / "run_1";
   const Config config = load_config(run / "config.toml");
@@ -306,7 +345,8 @@ TEST(RunIdentity, SchemeTwoIsPinnedAndReadsValuesNotDocumentation) {
   std::string text;
   for (const auto& key : config_keys()) {
     if (config_identity(key) == Identity::resumable) continue;
-    if (config_identity(key) == Identity::late && get_value(c, key) == get_value(Config{}, key)) continue;
+    if (config_identity(key) == Identity::late && get_value(c, key) == get_value(Config{}, key))
+      continue;
     text += key + " = " + format_config_value(get_value(c, key)) + "\n";
   }
   EXPECT_EQ(text.find('#'), std::string::npos);
@@ -323,16 +363,20 @@ TEST(RunIdentity, SchemeTwoIsPinnedAndReadsValuesNotDocumentation) {
   Evolution resumed(c, stub_fitness);
   EXPECT_NO_THROW(resumed.restore(saved, "scheme 2"));
   // One of an unknown scheme (an intact checkpoint: its checksum recomputed) is refused by name.
-  nlohmann::json payload = nlohmann::json::parse(nlohmann::json::parse(saved).at("payload").get<std::string>());
+  nlohmann::json payload =
+      nlohmann::json::parse(nlohmann::json::parse(saved).at("payload").get<std::string>());
   EXPECT_EQ(payload.at("identity_scheme"), kRunIdentityScheme);
   payload["identity_scheme"] = 7;
   const std::string body = payload.dump();
-  const std::string unknown = nlohmann::json{{"checksum", fmt::format("{:016x}", fnv1a(body))}, {"payload", body}}.dump();
+  const std::string unknown =
+      nlohmann::json{{"checksum", fmt::format("{:016x}", fnv1a(body))}, {"payload", body}}.dump();
   try {
     Evolution(c, stub_fitness).restore(unknown, "unknown.json");
     FAIL();
   } catch (const CheckpointError& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown.json: identity scheme 7 is not supported"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unknown.json: identity scheme 7 is not supported"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -351,7 +395,8 @@ TEST(Wire, GenomesAndFitnessTravelBitForBit) {
   EXPECT_TRUE(back == g);
   for (std::size_t i = 0; i < g.elements.size(); ++i)
     for (std::size_t d = 0; d < g.elements[i].coords.size(); ++d)
-      EXPECT_EQ(std::memcmp(&back.elements[i].coords[d], &g.elements[i].coords[d], sizeof(double)), 0);
+      EXPECT_EQ(std::memcmp(&back.elements[i].coords[d], &g.elements[i].coords[d], sizeof(double)),
+                0);
   EXPECT_EQ(r.fitness(), f);
   EXPECT_EQ(r.get<std::uint32_t>(), 7u);
   EXPECT_EQ(r.string(), "done");
@@ -364,7 +409,8 @@ TEST(Wire, TruncatedOrMalformedMessagesAreErrorsNotReadsPastTheEnd) {
   wire::Writer w;
   w.genome(random_genome(GenomeParams{}, rng));
   const auto bytes = w.bytes();
-  for (std::size_t cut : {std::size_t{0}, std::size_t{3}, std::size_t{9}, bytes.size() / 2, bytes.size() - 1}) {
+  for (std::size_t cut :
+       {std::size_t{0}, std::size_t{3}, std::size_t{9}, bytes.size() / 2, bytes.size() - 1}) {
     wire::Reader r(bytes.data(), cut);
     EXPECT_THROW((void)r.genome(), Error) << "cut at " << cut;
   }

@@ -11,7 +11,8 @@
 #include "animat/errors.hpp"
 #include "animat/physics.hpp"
 #include "animat/scene.hpp"
-#pragma GCC diagnostic ignored "-Wunused-function"  // physics_support.hpp: helpers this file does not use
+// physics_support.hpp: helpers this file does not use
+#pragma GCC diagnostic ignored "-Wunused-function"
 #include "physics_support.hpp"
 
 namespace animat {
@@ -42,7 +43,8 @@ TEST(EvolvedStiffness, UniformFactorsReproduceTheDefaultBodyBitwise) {
 
   Body ones = plain;
   ones.stiffness = Vector::Ones(plain.node_count());
-  EXPECT_EQ(run_positions(ones, scene, steps), reference) << "factors 1 must be the uniform body, bit for bit";
+  EXPECT_EQ(run_positions(ones, scene, steps), reference)
+      << "factors 1 must be the uniform body, bit for bit";
 
   // Factors 2 with half the scene stiffness: k/2 · 2 = k exactly (powers of two).
   Body twos = plain;
@@ -63,11 +65,14 @@ double measured_period(const Body& body, const SceneParams& scene, int steps) {
   Simulation sim(body, scene, physics);
   const double rest = body.rest_lengths(0);
   std::vector<double> crossings;
-  double prev = std::hypot(sim.state().x[1] - sim.state().x[0], sim.state().y[1] - sim.state().y[0]) - rest;
+  double prev =
+      std::hypot(sim.state().x[1] - sim.state().x[0], sim.state().y[1] - sim.state().y[0]) - rest;
   for (int k = 1; k <= steps; ++k) {
     sim.step(1);
-    const double u = std::hypot(sim.state().x[1] - sim.state().x[0], sim.state().y[1] - sim.state().y[0]) - rest;
-    if (prev < 0.0 && u >= 0.0) crossings.push_back((k - 1 + prev / (prev - u)) * physics.dt);  // linear interpolation
+    const double u =
+        std::hypot(sim.state().x[1] - sim.state().x[0], sim.state().y[1] - sim.state().y[0]) - rest;
+    // linear interpolation
+    if (prev < 0.0 && u >= 0.0) crossings.push_back((k - 1 + prev / (prev - u)) * physics.dt);
     prev = u;
   }
   EXPECT_GE(crossings.size(), 5U);
@@ -81,7 +86,8 @@ TEST(EvolvedStiffness, TwoCellPeriodFollowsTheEvolvedStiffness) {
   scene.spring_damping = 0.0;
   const double k = scene.spring_stiffness, m = scene.cell_mass;
   const PhysicsParams physics;
-  for (const auto& [f0, f1] : std::vector<std::pair<double, double>>{{1.0, 1.0}, {0.3, 0.3}, {0.5, 2.0}, {1.0, 4.0}, {0.2, 3.0}}) {
+  for (const auto& [f0, f1] : std::vector<std::pair<double, double>>{
+           {1.0, 1.0}, {0.3, 0.3}, {0.5, 2.0}, {1.0, 4.0}, {0.2, 3.0}}) {
     Body b = two_nodes(1.05, 1.0);  // stretched by 5 %
     b.stiffness = (Vector(2) << f0, f1).finished();
     const double k_eff = k * 2.0 * f0 * f1 / (f0 + f1);
@@ -89,8 +95,10 @@ TEST(EvolvedStiffness, TwoCellPeriodFollowsTheEvolvedStiffness) {
     const double period = 2.0 * std::numbers::pi / omega;
     const int steps = static_cast<int>(8.0 * period / physics.dt);
     const double measured = measured_period(b, scene, steps);
-    // A second-order integrator at ω·dt <= 0.4 is within ~(ω dt)²/24 < 1 % of the continuous period.
-    EXPECT_NEAR(measured, period, 0.01 * period) << "f0=" << f0 << " f1=" << f1 << " omega*dt=" << omega * physics.dt;
+    // A second-order integrator at ω·dt <= 0.4 is within ~(ω dt)²/24 < 1 % of the continuous
+    // period.
+    EXPECT_NEAR(measured, period, 0.01 * period)
+        << "f0=" << f0 << " f1=" << f1 << " omega*dt=" << omega * physics.dt;
   }
 }
 

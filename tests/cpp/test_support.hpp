@@ -39,7 +39,8 @@ inline void spit(const std::filesystem::path& p, std::string_view text) {
 
 /// An empty (removed) path under the temp directory, unique per process and prefix.
 inline std::filesystem::path fresh_dir(const std::string& prefix, const std::string& name) {
-  auto p = std::filesystem::temp_directory_path() / (prefix + name + "_" + std::to_string(::getpid()));
+  auto p =
+      std::filesystem::temp_directory_path() / (prefix + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(p);
   return p;
 }

@@ -63,7 +63,8 @@ TEST(ActuationWork, UndampedPeriodicResponseDoesNoNetWorkPerPeriod) {
     const double net = after.actuation_work - before.actuation_work;
     const double abs = after.actuation_work_absolute - before.actuation_work_absolute;
     const double pos = after.actuation_work_positive - before.actuation_work_positive;
-    EXPECT_LT(std::abs(net), 1e-6 * k * sum_abs_dr) << "period " << period << " net " << net << " abs " << abs;
+    EXPECT_LT(std::abs(net), 1e-6 * k * sum_abs_dr)
+        << "period " << period << " net " << net << " abs " << abs;
     EXPECT_GT(abs, 0.1 * k * c * std::abs(c - A));  // the test is not vacuous: work flows both ways
     EXPECT_NEAR(pos, 0.5 * abs, 1e-6 * k * sum_abs_dr);
   }
@@ -97,7 +98,8 @@ TEST(ActuationWork, DampedSteadyStateWorkEqualsDissipation) {
   }
   const double work = sim.counters().actuation_work - before.actuation_work;
   ASSERT_GT(dissipated, 0.0);
-  EXPECT_NEAR(work, dissipated, 0.01 * dissipated) << "work " << work << " dissipated " << dissipated;
+  EXPECT_NEAR(work, dissipated, 0.01 * dissipated)
+      << "work " << work << " dissipated " << dissipated;
 }
 
 TEST(ActuationWork, NoActuationNoWorkAndPerCellSplitSumsToTotals) {
@@ -118,8 +120,10 @@ TEST(ActuationWork, NoActuationNoWorkAndPerCellSplitSumsToTotals) {
   EXPECT_NEAR(r.actuation_work, 2.0 * r.actuation_work_positive - r.actuation_work_absolute,
               1e-9 * r.actuation_work_absolute);
   ASSERT_EQ(r.cell_work_positive.size(), b.node_count());
-  EXPECT_NEAR(r.cell_work_positive.sum(), r.actuation_work_positive, 1e-9 * r.actuation_work_positive);
-  EXPECT_NEAR(r.cell_work_absolute.sum(), r.actuation_work_absolute, 1e-9 * r.actuation_work_absolute);
+  EXPECT_NEAR(r.cell_work_positive.sum(), r.actuation_work_positive,
+              1e-9 * r.actuation_work_positive);
+  EXPECT_NEAR(r.cell_work_absolute.sum(), r.actuation_work_absolute,
+              1e-9 * r.actuation_work_absolute);
   EXPECT_GE(r.cell_work_positive.minCoeff(), 0.0);
   // Without actuation rest lengths never change: a still square does no work at all.
   Simulation sq(square(), scene_with({"springs", "pressure"}));

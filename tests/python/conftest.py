@@ -4,6 +4,7 @@ Study code lives under studies/ and is not part of the installed package (python
 of those modules import them as the study scripts do, from their own folders: ``replication_store``
 and ``replication_stats`` (studies/replication), ``known_swimmers`` (studies/locomotion).
 """
+
 import sys
 from pathlib import Path
 

@@ -1,5 +1,6 @@
 """`import animat` for analysis: Run (run directories, also in progress or malformed), replay and
 its eq. 2 actuation state, typed stubs and docstrings."""
+
 import json
 import math
 import os
@@ -46,6 +47,7 @@ def evolve_exe():
 
 # --- Run ------------------------------------------------------------------------------------------
 
+
 def test_run_reads_config_history_and_lineage(run, run_dir):
     assert run.config == animat.load_config(str(run_dir / "config.toml"))
     assert run.config["evaluation.steps"] == 300
@@ -70,8 +72,22 @@ def test_run_reads_a_directory_written_by_the_animat_evolve_cli(tmp_path):
     if exe is None:
         pytest.skip("animat_evolve not found (set ANIMAT_EVOLVE_EXE)")
     out = tmp_path / "cli_run"
-    subprocess.run([str(exe), "--generations", "2", "--set", "evolution.population=10", "--set",
-                    "evaluation.steps=200", "--quiet", "--out", str(out)], check=True, capture_output=True)
+    subprocess.run(
+        [
+            str(exe),
+            "--generations",
+            "2",
+            "--set",
+            "evolution.population=10",
+            "--set",
+            "evaluation.steps=200",
+            "--quiet",
+            "--out",
+            str(out),
+        ],
+        check=True,
+        capture_output=True,
+    )
     run = animat.Run(out)
     assert run.history["generation"].tolist() == [0, 1, 2]
     assert run.config["evolution.population"] == 10
@@ -132,7 +148,9 @@ def test_malformed_run_directories_give_clear_errors(run_dir, tmp_path):
     with pytest.raises(ValueError, match=r"history\.csv:2: expected 11"):
         run.history
     # A run written before the exploit guard's columns still reads, with NaN and 0 there.
-    old = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 8, 9)) + "\n" for line in lines]
+    old = [
+        ",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 8, 9)) + "\n" for line in lines
+    ]
     (bad / "history.csv").write_text("".join(old))
     h = run.history
     assert np.isnan(h["best_reference"]).all() and (h["invalid"] == 0).all() and (h["drag_limited"] == 0).all()
@@ -143,7 +161,9 @@ def test_malformed_run_directories_give_clear_errors(run_dir, tmp_path):
     h = run.history
     assert (h["drag_limited"] == 0).all() and not np.isnan(h["best_reference"]).any()
     # The exploit guard's columns without drag_limited but in another order is no format of ours.
-    (bad / "history.csv").write_text(guard[0].replace("best_reference,invalid", "invalid,best_reference") + "".join(guard[1:]))
+    (bad / "history.csv").write_text(
+        guard[0].replace("best_reference,invalid", "invalid,best_reference") + "".join(guard[1:])
+    )
     with pytest.raises(ValueError, match="unexpected header"):
         run.history
 
@@ -170,6 +190,7 @@ def test_morphology_changes_and_distance(run):
 
 
 # --- replay and eq. 2 -------------------------------------------------------------------------------
+
 
 def test_replay_shapes_dtypes_and_fitness(run):
     best = run.best()
@@ -220,7 +241,9 @@ def synthetic_body(amplitude=0.1, frequency=2 * np.pi, phase_gradient=2.0):
     xs, ys = np.meshgrid(np.arange(6.0), np.arange(3.0))
     pos = np.column_stack([xs.ravel() + 0.5 * (ys.ravel() % 2), ys.ravel() * 0.87])
     n = len(pos)
-    return animat.build_body(pos, np.full(n, amplitude), np.full(n, frequency), phase_gradient * pos[:, 0] % (2 * np.pi))
+    return animat.build_body(
+        pos, np.full(n, amplitude), np.full(n, frequency), phase_gradient * pos[:, 0] % (2 * np.pi)
+    )
 
 
 def test_actuation_state_is_the_sign_of_the_rest_length_rate():
@@ -297,6 +320,7 @@ def test_cycle_frames_span_one_period():
 
 # --- typing and docs -----------------------------------------------------------------------------------
 
+
 def test_stubs_and_py_typed_ship_with_the_module():
     here = Path(animat._core.__file__).parent
     stub = here / "_core.pyi"
@@ -307,19 +331,47 @@ def test_stubs_and_py_typed_ship_with_the_module():
 
 
 def test_help_shows_docstrings():
-    out = subprocess.run([sys.executable, "-c", "import animat; help(animat.evaluate)"], capture_output=True,
-                         text=True, check=True, env={**os.environ, "PAGER": "cat", "TERM": "dumb"}).stdout
+    out = subprocess.run(
+        [sys.executable, "-c", "import animat; help(animat.evaluate)"],
+        capture_output=True,
+        text=True,
+        check=True,
+        env={**os.environ, "PAGER": "cat", "TERM": "dumb"},
+    ).stdout
     assert "genome -> development -> body -> swim" in out
-    public = [animat.Run, animat.replay, animat.animate, animat.Trajectory, animat.read_history,
-              animat.morphology_distance, animat.actuation_terms, animat.actuation_rates, animat.LineageEntry,
-              animat.Run.best, animat.Run.morphology_changes, animat.Trajectory.cycle_frames]
+    public = [
+        animat.Run,
+        animat.replay,
+        animat.animate,
+        animat.Trajectory,
+        animat.read_history,
+        animat.morphology_distance,
+        animat.actuation_terms,
+        animat.actuation_rates,
+        animat.LineageEntry,
+        animat.Run.best,
+        animat.Run.morphology_changes,
+        animat.Trajectory.cycle_frames,
+    ]
     from animat import plot
-    public += [plot.development, plot.construction, plot.motion_cycle, plot.phase_map, plot.fitness_history,
-               plot.draw_body]
+
+    public += [
+        plot.development,
+        plot.construction,
+        plot.motion_cycle,
+        plot.phase_map,
+        plot.fitness_history,
+        plot.draw_body,
+    ]
     for obj in public:
         assert obj.__doc__ and len(obj.__doc__.strip()) > 30, obj
-    missing = [name for name in dir(animat._core) if not name.startswith("_")
-               and callable(getattr(animat._core, name)) and not (getattr(animat._core, name).__doc__ or "").strip()]
+    missing = [
+        name
+        for name in dir(animat._core)
+        if not name.startswith("_")
+        and callable(getattr(animat._core, name))
+        and not (getattr(animat._core, name).__doc__ or "").strip()
+    ]
     assert not missing, f"core functions without a docstring: {missing}"
 
 
@@ -339,8 +391,8 @@ def test_docs_walkthrough_code_runs(tmp_path, monkeypatch, capsys):
         exec(compile(block, f"{doc.name} block {k + 1}", "exec"), namespace)
     figures = tmp_path / "runs" / "walkthrough" / "figures"
     assert sorted(p.name for p in figures.iterdir()) == sorted(
-        ["development.png", "construction.png", "motion_cycle.png", "phase_map.png", "fitness_history.png",
-         "best.gif"])
+        ["development.png", "construction.png", "motion_cycle.png", "phase_map.png", "fitness_history.png", "best.gif"]
+    )
     import matplotlib.pyplot as plt
 
     plt.close("all")

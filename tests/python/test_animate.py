@@ -43,8 +43,8 @@ def test_gif_has_the_expected_frames_and_size(trajectory, tmp_path):
     assert stack.shape[:3] == (len(frames), 120, 200)
     # the nodes are drawn in the paper's colours: some red and some blue pixels somewhere
     rgb = stack[..., :3].reshape(-1, 3).astype(int)
-    red = np.sum((np.abs(rgb - [214, 39, 40]).sum(axis=1) < 40))
-    blue = np.sum((np.abs(rgb - [31, 119, 180]).sum(axis=1) < 40))
+    red = np.sum(np.abs(rgb - [214, 39, 40]).sum(axis=1) < 40)
+    blue = np.sum(np.abs(rgb - [31, 119, 180]).sum(axis=1) < 40)
     assert red > 50 and blue > 50
 
 

@@ -1,5 +1,6 @@
 """Body stage through Python: Gabriel graph against its O(n^3) definition, Body shapes and dtypes,
 and the documented errors (issue 4)."""
+
 import re
 
 import numpy as np
@@ -159,11 +160,15 @@ def test_collinear_is_a_chain():
         ([[0, 0], [1, np.nan], [2, 5]], "gabriel_graph: point 1 has a non-finite coordinate y = nan"),
         ([[0, 0], [np.inf, 1]], "gabriel_graph: point 1 has a non-finite coordinate x = inf"),
         ([[0, 0], [1, 2e7]], "gabriel_graph: point 1 has coordinate y = 20000000, beyond max_coordinate = 1000000"),
-        ([[0, 0], [1, 1], [0, 0]],
-         "gabriel_graph: points 0 and 2 coincide at (0, 0) (distance 0); duplicate cell centres are rejected"),
-        ([[0, 0], [1, 1], [2.5e-7, 0]],
-         "gabriel_graph: points 0 and 2 are 2.5e-07 apart, closer than merge_distance = 1e-06; "
-         "near-coincident cell centres are rejected"),
+        (
+            [[0, 0], [1, 1], [0, 0]],
+            "gabriel_graph: points 0 and 2 coincide at (0, 0) (distance 0); duplicate cell centres are rejected",
+        ),
+        (
+            [[0, 0], [1, 1], [2.5e-7, 0]],
+            "gabriel_graph: points 0 and 2 are 2.5e-07 apart, closer than merge_distance = 1e-06; "
+            "near-coincident cell centres are rejected",
+        ),
     ],
 )
 def test_bad_points_raise_value_error(points, message):

@@ -1,6 +1,7 @@
 """animat_evolve command line through Python (issue 2): --print-config output parses back to the same
 config; --set/--config/--seed change it; bad options exit non-zero with a message on stderr.
 Skipped when ANIMAT_EVOLVE_EXE is not set (scripts/test.sh sets it)."""
+
 import os
 import pathlib
 import subprocess
@@ -28,12 +29,25 @@ def test_print_config_parses_back_to_default(tmp_path):
 
 
 def test_set_and_options_are_reflected(tmp_path):
-    r = run("--print-config", "--set", "evolution.population=50", "--set", "grn.dt=0.025", "--seed", "99",
-            "--generations", "3", "--threads", "1", cwd=tmp_path)
+    r = run(
+        "--print-config",
+        "--set",
+        "evolution.population=50",
+        "--set",
+        "grn.dt=0.025",
+        "--seed",
+        "99",
+        "--generations",
+        "3",
+        "--threads",
+        "1",
+        cwd=tmp_path,
+    )
     assert r.returncode == 0, r.stderr
     c = animat.Config.from_toml(r.stdout)
-    expected = animat.Config({"evolution": {"population": 50, "seed": 99, "generations": 3, "threads": 1},
-                              "grn": {"dt": 0.025}})
+    expected = animat.Config(
+        {"evolution": {"population": 50, "seed": 99, "generations": 3, "threads": 1}, "grn": {"dt": 0.025}}
+    )
     assert c == expected
 
 
@@ -62,8 +76,10 @@ def test_config_file_then_set(tmp_path):
         (["--seed", "-1"], ["--seed"]),
         (["--threads", "5000"], ["evolution.threads"]),
         (["--config", "/nonexistent/animat.toml"], ["/nonexistent/animat.toml"]),
-        (["--config", str(BAD / "config_unknown_key.toml")],
-         [f"{BAD / 'config_unknown_key.toml'}:6", "evolution.populaton", "did you mean 'population'"]),
+        (
+            ["--config", str(BAD / "config_unknown_key.toml")],
+            [f"{BAD / 'config_unknown_key.toml'}:6", "evolution.populaton", "did you mean 'population'"],
+        ),
         (["--config", str(BAD / "config_dt_zero.toml")], [f"{BAD / 'config_dt_zero.toml'}:6", "grn.dt", "(0, 1]"]),
     ],
 )
@@ -75,8 +91,11 @@ def test_bad_options_exit_nonzero_with_message(tmp_path, args, fragments):
     assert "[grn]" not in r.stdout
 
 
-@pytest.mark.parametrize("pair", [("evolution.elites=150", "evolution.population=200"),
-                                  ("evolution.elites=30", "evolution.population=20")], ids=["valid", "invalid"])
+@pytest.mark.parametrize(
+    "pair",
+    [("evolution.elites=150", "evolution.population=200"), ("evolution.elites=30", "evolution.population=20")],
+    ids=["valid", "invalid"],
+)
 def test_set_cross_key_checks_do_not_depend_on_the_flag_order(pair, tmp_path):
     a = run("--print-config", "--set", pair[0], "--set", pair[1], cwd=tmp_path)
     b = run("--print-config", "--set", pair[1], "--set", pair[0], cwd=tmp_path)

@@ -1,4 +1,5 @@
 """python -m animat show|animate|info RUN_DIR: files written, paths printed, clear errors."""
+
 import os
 import subprocess
 import sys

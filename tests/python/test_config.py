@@ -1,5 +1,6 @@
 """animat.Config through Python (issue 2): defaults, the dict view, attribute sections, TOML round
 trips, and bad values / bad TOML as ValueError with messages naming file, line, key and expectation."""
+
 import copy
 import math
 import pathlib
@@ -111,8 +112,18 @@ def test_attribute_section_missing_attribute_follows_python_protocol():
 
 def test_to_dict_nested_and_typed():
     d = animat.Config().to_dict()
-    assert list(d) == ["genome", "mutation", "grn", "development", "body", "scene", "physics", "evaluation", "evolution",
-                       "control"]
+    assert list(d) == [
+        "genome",
+        "mutation",
+        "grn",
+        "development",
+        "body",
+        "scene",
+        "physics",
+        "evaluation",
+        "evolution",
+        "control",
+    ]
     assert d["grn"]["dt"] == 0.05 and isinstance(d["grn"]["dt"], float)
     assert isinstance(d["evolution"]["population"], int)
     assert isinstance(d["physics"]["drag_scheme"], str)

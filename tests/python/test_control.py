@@ -1,4 +1,5 @@
 """animat.SwimEnv: the Gymnasium API on a developed body, actions driving the rest lengths."""
+
 import numpy as np
 import pytest
 
@@ -34,8 +35,8 @@ def test_observations_are_relative_to_the_centre_of_mass_and_start_at_rest(body_
     rel = obs[: 2 * n].reshape(n, 2)
     np.testing.assert_allclose(rel.mean(axis=0), 0.0, atol=1e-9)
     np.testing.assert_allclose(rel + info["com"], np.asarray(body.positions), atol=1e-5)  # float32 Box2D positions
-    np.testing.assert_array_equal(obs[2 * n:4 * n], 0.0)  # at rest
-    np.testing.assert_allclose(obs[4 * n:], 0.0, atol=1e-6)  # springs at their rest length
+    np.testing.assert_array_equal(obs[2 * n : 4 * n], 0.0)  # at rest
+    np.testing.assert_allclose(obs[4 * n :], 0.0, atol=1e-6)  # springs at their rest length
     obs2, reward, terminated, truncated, _ = env.step(np.zeros(n))  # no actuation: nothing moves
     assert reward == 0.0 and not terminated and not truncated
     np.testing.assert_array_equal(obs2, obs)

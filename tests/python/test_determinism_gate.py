@@ -31,6 +31,7 @@ change, rewrite the whole file and review its diff::
 current values (in the file's format) whether or not they match. A commit that changes a pin
 changes results: its message says which pins and why.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -149,8 +150,9 @@ GENOMES: Dict[str, Callable[[], animat.Genome]] = {
     "exploit_old_physics_dn10": lambda: _evolved("exploit_old_physics_dn10"),
     "replication_dn2_best": lambda: _replication_best("dn2_run_0"),
     "replication_dn10_best": lambda: _replication_best("dn10_run_0"),
-    "chemotaxis_amplitude_best": lambda: animat.Genome.load(REPO / "tests" / "data" / "determinism"
-                                                            / "chemotaxis_amplitude_best.json"),
+    "chemotaxis_amplitude_best": lambda: animat.Genome.load(
+        REPO / "tests" / "data" / "determinism" / "chemotaxis_amplitude_best.json"
+    ),
     "random_seed0_no_grn_path": lambda: animat.Genome.random(0),
     "random_seed1_no_division": lambda: animat.Genome.random(1),
     "random_viable_seed3": lambda: animat.Genome.random_viable(3)[0],
@@ -195,44 +197,116 @@ SCENES: Dict[str, Tuple[Optional[str], Dict[str, Any], Tuple[str, ...]]] = {
     "replication_dn2_run": ("tests/data/replication/dn2_run_0/config.toml", {}, ALL),
     "replication_dn10_run": ("tests/data/replication/dn10_run_0/config.toml", {}, ALL),
     # the scene the colliding genomes were evolved in: fast oscillators, many collisions
-    "collisions_f12_dn0.5": (None, {"scene.drag_normal": 0.5, "development.frequency_max": 12.0,
-                                    "scene.pressure": 100.0, "scene.pressure_area_floor": 0.1}, ALL),
+    "collisions_f12_dn0.5": (
+        None,
+        {
+            "scene.drag_normal": 0.5,
+            "development.frequency_max": 12.0,
+            "scene.pressure": 100.0,
+            "scene.pressure_area_floor": 0.1,
+        },
+        ALL,
+    ),
     "integrator_box2d": (None, {"physics.integrator": "box2d"}, SWIMMERS),
     "drag_stable": ("configs/paper_dn10.toml", {"physics.drag_scheme": "stable"}, SWIMMERS),
-    "drag_implicit_forces_start": (None, {"physics.drag_scheme": "implicit", "physics.velocity_forces": "start"},
-                                   SWIMMERS),
-    "drag_explicit_substeps4": ("configs/paper_dn0.5.toml", {"physics.drag_scheme": "explicit",
-                                                             "physics.substeps": 4}, SWIMMERS),
-    "graph_alpha_shape_skin_collisions": (None, {"body.graph": "alpha_shape", "scene.collision_edges": "skin",
-                                                 "development.frequency_max": 12.0}, SWIMMERS),
+    "drag_implicit_forces_start": (
+        None,
+        {"physics.drag_scheme": "implicit", "physics.velocity_forces": "start"},
+        SWIMMERS,
+    ),
+    "drag_explicit_substeps4": (
+        "configs/paper_dn0.5.toml",
+        {"physics.drag_scheme": "explicit", "physics.substeps": 4},
+        SWIMMERS,
+    ),
+    "graph_alpha_shape_skin_collisions": (
+        None,
+        {"body.graph": "alpha_shape", "scene.collision_edges": "skin", "development.frequency_max": 12.0},
+        SWIMMERS,
+    ),
     "graph_distance": (None, {"body.graph": "distance"}, SWIMMERS),
     "objective_distance_per_size": (None, {"evaluation.objective": "distance_per_size"}, SWIMMERS),
-    "objective_speed_toward": (None, {"evaluation.objective": "speed_toward", "evaluation.direction": [0.6, -0.8]},
-                               SWIMMERS),
+    "objective_speed_toward": (
+        None,
+        {"evaluation.objective": "speed_toward", "evaluation.direction": [0.6, -0.8]},
+        SWIMMERS,
+    ),
     "objective_distance_minus_energy": (None, {"evaluation.objective": "distance_minus_energy"}, SWIMMERS),
-    "objective_distance_per_energy": ("configs/paper_dn0.5.toml", {"evaluation.objective": "distance_per_energy"},
-                                      SWIMMERS),
-    "chemotaxis_direct": ("configs/chemotaxis.toml", {**_CHEMOTAXIS_SHORT, "control.actuation": "direct"},
-                          CONTROLLED),
-    "chemotaxis_plane_no_signal_push": ("configs/chemotaxis.toml", {
-        **_CHEMOTAXIS_SHORT, "scene.chemical": "plane", "control.signal_rate": 0.0, "evaluation.push_step": 500,
-        "evaluation.push_impulse": [1.0, 0.5], "evaluation.push_cells": "front"}, CONTROLLED),
+    "objective_distance_per_energy": (
+        "configs/paper_dn0.5.toml",
+        {"evaluation.objective": "distance_per_energy"},
+        SWIMMERS,
+    ),
+    "chemotaxis_direct": ("configs/chemotaxis.toml", {**_CHEMOTAXIS_SHORT, "control.actuation": "direct"}, CONTROLLED),
+    "chemotaxis_plane_no_signal_push": (
+        "configs/chemotaxis.toml",
+        {
+            **_CHEMOTAXIS_SHORT,
+            "scene.chemical": "plane",
+            "control.signal_rate": 0.0,
+            "evaluation.push_step": 500,
+            "evaluation.push_impulse": [1.0, 0.5],
+            "evaluation.push_cells": "front",
+        },
+        CONTROLLED,
+    ),
     "grn_direct": (None, {**_ACTIVE, "control.actuation": "direct"}, CONTROLLED),
 }
 
 # Every diagnostic of an evaluation (pinned through one digest), and those pinned one by one.
 EVALUATION_FIELDS = (
-    "fitness", "source_progress", "viable", "stable", "valid", "cell_count", "displacement",
-    "spring_count", "region_count", "skin_edge_count", "development_steps", "swim_steps", "simulated_time",
-    "max_speed", "max_step_displacement", "max_stretch", "min_stretch", "max_kinetic_energy",
-    "final_kinetic_energy", "max_kinetic_energy_per_cell", "min_area_ratio", "inverted_region_steps",
-    "skin_crossing_steps", "first_invalid_step", "collisions", "collisions_inelastic", "collisions_unresolved",
-    "drag_limited", "settle_steps", "ground_contacts", "ground_slips", "actuation_work",
-    "actuation_work_positive", "actuation_work_absolute", "cell_work_positive", "cell_work_absolute",
-    "grn_updates", "displacement_at_push",
+    "fitness",
+    "source_progress",
+    "viable",
+    "stable",
+    "valid",
+    "cell_count",
+    "displacement",
+    "spring_count",
+    "region_count",
+    "skin_edge_count",
+    "development_steps",
+    "swim_steps",
+    "simulated_time",
+    "max_speed",
+    "max_step_displacement",
+    "max_stretch",
+    "min_stretch",
+    "max_kinetic_energy",
+    "final_kinetic_energy",
+    "max_kinetic_energy_per_cell",
+    "min_area_ratio",
+    "inverted_region_steps",
+    "skin_crossing_steps",
+    "first_invalid_step",
+    "collisions",
+    "collisions_inelastic",
+    "collisions_unresolved",
+    "drag_limited",
+    "settle_steps",
+    "ground_contacts",
+    "ground_slips",
+    "actuation_work",
+    "actuation_work_positive",
+    "actuation_work_absolute",
+    "cell_work_positive",
+    "cell_work_absolute",
+    "grn_updates",
+    "displacement_at_push",
 )
-EVALUATION_PINNED = ("fitness", "viable", "displacement", "max_speed", "min_area_ratio", "actuation_work",
-                     "source_progress", "collisions", "drag_limited", "ground_contacts", "grn_updates")
+EVALUATION_PINNED = (
+    "fitness",
+    "viable",
+    "displacement",
+    "max_speed",
+    "min_area_ratio",
+    "actuation_work",
+    "source_progress",
+    "collisions",
+    "drag_limited",
+    "ground_contacts",
+    "grn_updates",
+)
 
 # the full diagnostics of the last computation of each case, for the failure message
 _diagnostics: Dict[str, Dict[str, Any]] = {}
@@ -252,18 +326,31 @@ def evaluation_case(scene: str) -> Dict[str, Any]:
 
 
 # --- development and body -----------------------------------------------------------------------
-EMBRYO_FIELDS = ("cell_count", "viable", "steps_run", "division_steps", "positions", "radii",
-                 "orientations", "outputs", "amplitude", "frequency", "phase", "stiffness")
+EMBRYO_FIELDS = (
+    "cell_count",
+    "viable",
+    "steps_run",
+    "division_steps",
+    "positions",
+    "radii",
+    "orientations",
+    "outputs",
+    "amplitude",
+    "frequency",
+    "phase",
+    "stiffness",
+)
 # (the positions and oscillators of a body are the embryo's, pinned by the development cases)
-BODY_FIELDS = ("spring_count", "region_count", "springs", "rest_lengths", "regions", "rest_areas", "skin",
-               "skin_loops")
+BODY_FIELDS = ("spring_count", "region_count", "springs", "rest_lengths", "regions", "rest_areas", "skin", "skin_loops")
 
 
 def development_case(name: str) -> Dict[str, Any]:
     config = _chemotaxis_config() if name.endswith("_control") else animat.Config()
     embryo = animat.develop(genome(name), config)
-    return {field: canon(np.asarray(getattr(embryo, field)) if field == "division_steps"
-                         else getattr(embryo, field)) for field in EMBRYO_FIELDS}
+    return {
+        field: canon(np.asarray(getattr(embryo, field)) if field == "division_steps" else getattr(embryo, field))
+        for field in EMBRYO_FIELDS
+    }
 
 
 def body_case(graph: str) -> Dict[str, Any]:
@@ -281,13 +368,25 @@ def body_case(graph: str) -> Dict[str, Any]:
 
 # --- short GA runs ------------------------------------------------------------------------------
 GA_RUNS: Dict[str, Tuple[Optional[str], Dict[str, Any]]] = {
-    "default": (None, {"evolution.population": 10, "evolution.generations": 3, "evaluation.steps": 1000,
-                       "evolution.seed": 11}),
-    "islands_dn0.5": ("configs/paper_dn0.5.toml", {"evolution.population": 12, "evolution.generations": 3,
-                                                   "evaluation.steps": 1000, "evolution.seed": 5,
-                                                   "evolution.islands": 2, "evolution.migration_interval": 1}),
-    "chemotaxis": ("configs/chemotaxis.toml", {"evolution.population": 8, "evolution.generations": 2,
-                                               "evaluation.steps": 1000, "evolution.seed": 4}),
+    "default": (
+        None,
+        {"evolution.population": 10, "evolution.generations": 3, "evaluation.steps": 1000, "evolution.seed": 11},
+    ),
+    "islands_dn0.5": (
+        "configs/paper_dn0.5.toml",
+        {
+            "evolution.population": 12,
+            "evolution.generations": 3,
+            "evaluation.steps": 1000,
+            "evolution.seed": 5,
+            "evolution.islands": 2,
+            "evolution.migration_interval": 1,
+        },
+    ),
+    "chemotaxis": (
+        "configs/chemotaxis.toml",
+        {"evolution.population": 8, "evolution.generations": 2, "evaluation.steps": 1000, "evolution.seed": 4},
+    ),
 }
 
 
@@ -347,17 +446,25 @@ def test_fingerprint(case: str) -> None:
         print(_dump({case: current}))
     pins = _load_pins()
     if case not in pins:
-        pytest.fail(f"determinism gate: {case} has no pin in {PINS.relative_to(REPO)}; its current values:\n"
-                    f"{_dump({case: current})}", pytrace=False)
+        pytest.fail(
+            f"determinism gate: {case} has no pin in {PINS.relative_to(REPO)}; its current values:\n"
+            f"{_dump({case: current})}",
+            pytrace=False,
+        )
     lines = differences(pins[case], current, "")
     for name, values in current.items():
         every = _diagnostics.get(f"{case}/{name}")
         if every is not None and pins[case].get(name) != values:  # the digest hides which one changed
-            lines.append(f"  {name}, every diagnostic now: "
-                         + ", ".join(f"{key}={_readable(value)}" for key, value in every.items()))
+            lines.append(
+                f"  {name}, every diagnostic now: "
+                + ", ".join(f"{key}={_readable(value)}" for key, value in every.items())
+            )
     if lines:
-        pytest.fail(f"determinism gate: the results of {case} changed. A pin changes only with a deliberate change "
-                    "of results, explained in the commit (module docstring).\n" + "\n".join(lines), pytrace=False)
+        pytest.fail(
+            f"determinism gate: the results of {case} changed. A pin changes only with a deliberate change "
+            "of results, explained in the commit (module docstring).\n" + "\n".join(lines),
+            pytrace=False,
+        )
 
 
 def test_every_pin_has_a_case() -> None:
@@ -370,8 +477,10 @@ def test_ga_is_identical_with_two_threads(run: str) -> None:
     one, two = ga_case(run, 1), ga_case(run, 2)
     lines = differences(one, two, "")
     if lines:
-        pytest.fail(f"ga/{run}: 2 threads differ from 1 thread (pinned: 1 thread; now: 2 threads):\n"
-                    + "\n".join(lines), pytrace=False)
+        pytest.fail(
+            f"ga/{run}: 2 threads differ from 1 thread (pinned: 1 thread; now: 2 threads):\n" + "\n".join(lines),
+            pytrace=False,
+        )
 
 
 def test_the_gate_exercises_the_model() -> None:
@@ -395,8 +504,10 @@ def test_the_pins_agree_with_the_committed_runs() -> None:
     # The replication runs stored their bests' fitness when they were evolved: the pins of those
     # genomes in their own runs' configs are those very numbers.
     pins = _load_pins()
-    for run, scene, name in (("dn2_run_0", "replication_dn2_run", "replication_dn2_best"),
-                             ("dn10_run_0", "replication_dn10_run", "replication_dn10_best")):
+    for run, scene, name in (
+        ("dn2_run_0", "replication_dn2_run", "replication_dn2_best"),
+        ("dn10_run_0", "replication_dn10_run", "replication_dn10_best"),
+    ):
         stored = float(_replication_record(run)["fitness"])
         assert pins[f"evaluation/{scene}"][name]["fitness"] == stored.hex(), (run, stored)
 

@@ -1,4 +1,5 @@
 """Development (issue 3) through the Python surface: animat.develop(genome, config) -> Embryo."""
+
 import math
 
 import numpy as np
@@ -16,8 +17,9 @@ def bias_genome(divide_at=(0.0, 0.0), rotate_at=(5.0, 5.0)):
     channels = [BIAS, DIVIDE, AMPLITUDE, FREQUENCY, PHASE, ROTATE, GROW]
     coords = [(0, 0), divide_at, (0, 0), (0, 0), (0, 0), rotate_at, (5, 5)]
     types = [INPUT] + [OUTPUT] * 6
-    return animat.Genome.from_arrays(np.array(types), np.ones(7, dtype=np.int64), np.array(channels),
-                                     np.array(coords, dtype=float))
+    return animat.Genome.from_arrays(
+        np.array(types), np.ones(7, dtype=np.int64), np.array(channels), np.array(coords, dtype=float)
+    )
 
 
 def config(**development):
@@ -42,7 +44,9 @@ def test_bias_genome_divides_to_the_cap_and_is_viable():
     dev = animat.Config().development
     np.testing.assert_array_equal(e.amplitude, dev.amplitude_max * e.outputs[:, AMPLITUDE])
     np.testing.assert_array_equal(e.phase, 2 * math.pi * e.outputs[:, PHASE])
-    np.testing.assert_allclose(e.frequency, dev.frequency_min + (dev.frequency_max - dev.frequency_min) * e.outputs[:, FREQUENCY])
+    np.testing.assert_allclose(
+        e.frequency, dev.frequency_min + (dev.frequency_max - dev.frequency_min) * e.outputs[:, FREQUENCY]
+    )
     assert np.all(e.amplitude > 0.19) and np.all(e.amplitude < 0.2)
     assert "32 cells" in repr(e) and "viable" in repr(e)
 
@@ -108,8 +112,10 @@ def test_gradient_division_axis_is_a_config_value():
     assert np.ptp(along_x.positions[:, 1]) == 0.0
     assert np.ptp(along_y.positions[:, 0]) == 0.0
     assert np.ptp(along_y.positions[:, 1]) > 5.0
-    np.testing.assert_array_equal(animat.develop(bias_genome(), config(division_axis="orientation")).positions,
-                                  animat.develop(bias_genome()).positions)
+    np.testing.assert_array_equal(
+        animat.develop(bias_genome(), config(division_axis="orientation")).positions,
+        animat.develop(bias_genome()).positions,
+    )
     with pytest.raises(ValueError, match="division_axis.*sideways"):
         animat.develop(bias_genome(), config(division_axis="sideways"))
 

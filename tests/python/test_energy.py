@@ -1,5 +1,6 @@
 """Energy accounting from Python: evaluation.energy_accounting fills EvaluationResult.energy, the
 books close on an evolved swimmer, the record pickles, and the figure draws what it says."""
+
 import json
 import pickle
 from pathlib import Path
@@ -68,7 +69,7 @@ def test_simulation_books_a_free_edge_in_the_fluid():
     sim.step(600)
     e = sim.energy
     u_end = 1.5 / (1.0 + 1.0 * 1.5 * sim.time)
-    assert e.drag_normal == pytest.approx(1.5 ** 2 - u_end ** 2, rel=1e-5)
+    assert e.drag_normal == pytest.approx(1.5**2 - u_end**2, rel=1e-5)
     assert e.drag_tangential == 0.0
 
 

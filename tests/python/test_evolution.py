@@ -1,4 +1,5 @@
 """The GA through `import animat`: evolve, callbacks, run directories, parallel evaluation."""
+
 import csv
 import json
 
@@ -25,13 +26,13 @@ def test_tournament_probability_ramps_from_0_8_to_1():
 
 def test_reference_disagrees_needs_both_tolerances_exceeded():
     # Defaults: 1 % of the reference and 0.05 length units; both must be exceeded, on either side.
-    assert animat.reference_disagrees(10.0, 10.2)          # 0.2 > 0.05 and 2 % > 1 %
+    assert animat.reference_disagrees(10.0, 10.2)  # 0.2 > 0.05 and 2 % > 1 %
     assert animat.reference_disagrees(10.2, 10.0)
-    assert not animat.reference_disagrees(100.0, 100.9)    # 0.9 > 0.05 but 0.9 % < 1 %
-    assert not animat.reference_disagrees(1.0, 1.04)       # 4 % > 1 % but 0.04 < 0.05
+    assert not animat.reference_disagrees(100.0, 100.9)  # 0.9 > 0.05 but 0.9 % < 1 %
+    assert not animat.reference_disagrees(1.0, 1.04)  # 4 % > 1 % but 0.04 < 0.05
     cfg = animat.Config()
     cfg["evaluation.reference_tolerance"] = 0.001
-    assert animat.reference_disagrees(100.0, 100.9, cfg)   # 0.9 % > 0.1 % with the config's tolerance
+    assert animat.reference_disagrees(100.0, 100.9, cfg)  # 0.9 % > 0.1 % with the config's tolerance
     cfg["evaluation.reference_abs_tolerance"] = 1.0
     assert not animat.reference_disagrees(100.0, 100.9, cfg)
 
@@ -65,7 +66,19 @@ def test_run_directory_layout_and_resume(tmp_path):
     animat.evolve(c, out=str(out))
     assert (out / "config.toml").exists() and (out / "checkpoint.json").exists()
     rows = list(csv.reader(open(out / "history.csv")))
-    assert rows[0] == ["generation", "best", "mean", "median", "viable_fraction", "best_cells", "evaluations", "best_reference", "invalid", "drag_limited", "wall_seconds"]
+    assert rows[0] == [
+        "generation",
+        "best",
+        "mean",
+        "median",
+        "viable_fraction",
+        "best_cells",
+        "evaluations",
+        "best_reference",
+        "invalid",
+        "drag_limited",
+        "wall_seconds",
+    ]
     assert [r[0] for r in rows[1:]] == ["0", "1", "2"]
     lineage = sorted((out / "best").glob("gen_*.json"))
     assert lineage and lineage[0].name == "gen_000000.json"
@@ -138,9 +151,22 @@ def test_generation_stats_fields_pickling_and_history_columns_follow_one_descrip
     header = (tmp_path / "run" / "history.csv").read_text().splitlines()[0].split(",")
     assert list(animat.HISTORY_DTYPE.names) == header == [n for n, _ in animat.GenerationStats.HISTORY_COLUMNS]
     assert run.history.dtype == animat.HISTORY_DTYPE
-    d = {"generation": 3, "best": 1.5, "mean": 0.5, "median": 0.25, "viable_fraction": 0.75, "best_cells": 9,
-         "evaluations": 120, "best_reference": float("nan"), "invalid": 2, "drag_limited": 0, "wall_seconds": 1.25,
-         "best_changed": True, "evaluations_per_second": 40.0, "crossovers": 1}
+    d = {
+        "generation": 3,
+        "best": 1.5,
+        "mean": 0.5,
+        "median": 0.25,
+        "viable_fraction": 0.75,
+        "best_cells": 9,
+        "evaluations": 120,
+        "best_reference": float("nan"),
+        "invalid": 2,
+        "drag_limited": 0,
+        "wall_seconds": 1.25,
+        "best_changed": True,
+        "evaluations_per_second": 40.0,
+        "crossovers": 1,
+    }
     s = animat.GenerationStats(d)
     back = s.to_dict()
     assert set(back) == set(d)

@@ -1,4 +1,5 @@
 """The experiment runner and the paper's environment configs (issue 10)."""
+
 import json
 import subprocess
 import sys
@@ -19,8 +20,10 @@ generations = 2
 """
 
 
-@pytest.mark.parametrize("name,dn,cells", [("paper_dn0.5", 0.5, 32), ("paper_dn2", 2.0, 32),
-                                           ("paper_dn10", 10.0, 32), ("paper_dn0.2_64cells", 0.2, 64)])
+@pytest.mark.parametrize(
+    "name,dn,cells",
+    [("paper_dn0.5", 0.5, 32), ("paper_dn2", 2.0, 32), ("paper_dn10", 10.0, 32), ("paper_dn0.2_64cells", 0.2, 64)],
+)
 def test_paper_configs_hold_the_paper_settings(name, dn, cells):
     c = animat.load_config(str(ROOT / "configs" / f"{name}.toml"))
     assert c["scene.drag_normal"] == dn
@@ -61,12 +64,43 @@ def test_experiment_command_line(tmp_path):
     cfg = tmp_path / "tiny.toml"
     cfg.write_text(TINY)
     out = tmp_path / "cli"
-    r = subprocess.run([sys.executable, "-m", "animat", "experiment", str(cfg), "--runs", "1", "--out", str(out),
-                        "--set", "scene.drag_normal=3", "--quiet"], capture_output=True, text=True)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "animat",
+            "experiment",
+            str(cfg),
+            "--runs",
+            "1",
+            "--out",
+            str(out),
+            "--set",
+            "scene.drag_normal=3",
+            "--quiet",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 0, r.stderr
     assert "median best fitness" in r.stdout
     assert animat.load_config(str(out / "run_0" / "config.toml"))["scene.drag_normal"] == 3.0
-    bad = subprocess.run([sys.executable, "-m", "animat", "experiment", str(cfg), "--runs", "1", "--out", str(out),
-                          "--set", "scene.drag_nromal=3"], capture_output=True, text=True)
+    bad = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "animat",
+            "experiment",
+            str(cfg),
+            "--runs",
+            "1",
+            "--out",
+            str(out),
+            "--set",
+            "scene.drag_nromal=3",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert bad.returncode == 1
     assert "unknown key 'scene.drag_nromal'" in bad.stderr

@@ -1,5 +1,6 @@
 """animat.Genome / animat.Rng / animat.affinity through Python (issue 2): arrays and dtypes, parsing,
 JSON round trips and bad JSON, operators and their determinism with int seeds and with animat.Rng."""
+
 import json
 import math
 import pathlib
@@ -323,8 +324,15 @@ def test_mutate_keeps_valid_and_respects_max_elements():
     c = animat.Config(
         {
             "genome": {"max_elements": 40},
-            "mutation": {"type_rate": 0.1, "sign_rate": 0.1, "move_rate": 0.5, "move_sigma": 2.0,
-                         "duplicate_rate": 1.0, "delete_rate": 0.0, "max_series_length": 8},
+            "mutation": {
+                "type_rate": 0.1,
+                "sign_rate": 0.1,
+                "move_rate": 0.5,
+                "move_sigma": 2.0,
+                "duplicate_rate": 1.0,
+                "delete_rate": 0.0,
+                "max_series_length": 8,
+            },
         }
     )
     for seed in range(20):

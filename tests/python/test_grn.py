@@ -1,5 +1,6 @@
 """animat.Grn through Python (issue 2): eq. 1 relaxation against its closed form, levels in [0, 1),
 maternal and sensed-morphogen inputs, edges, reachability (viability criterion 1) and DOT export."""
+
 import math
 
 import numpy as np
@@ -44,7 +45,9 @@ def test_unit_relaxes_along_closed_form():
         assert abs(L[k, 0] - l) < 1e-12
 
 
-@pytest.mark.parametrize("x, s_in, s_p", [(0.0, 1, 1), (0.0, -1, -1), (0.5, 1, 1), (1.7, 1, 1), (0.0, -1, 1), (1.0, 1, -1)])
+@pytest.mark.parametrize(
+    "x, s_in, s_p", [(0.0, 1, 1), (0.0, -1, -1), (0.5, 1, 1), (1.7, 1, 1), (0.0, -1, 1), (1.0, 1, -1)]
+)
 def test_closed_form_for_several_activations(x, s_in, s_p):
     grn = animat.Grn(genome([(I, BIAS, 0, 0, s_in), (P, 0, x, 0, s_p), (G, 0, 9, 9)]))
     A = s_in * s_p * animat.affinity(x)
@@ -114,8 +117,19 @@ def test_sensed_morphogens_replace_own_level():
 
 def test_edges_arrays():
     grn = animat.Grn(
-        genome([(I, BIAS, 0, 0), (I, MAT0, 20, 0.5, -1), (P, 0, 0, 0), (P, 0, 1, 0), (G, 0, 10, 10), (P, 0, 20, 0),
-                (G, 0, 30, 30), (O, DIVIDE, 10, 11.5), (O, ROTATE, 30, 30, -1)])
+        genome(
+            [
+                (I, BIAS, 0, 0),
+                (I, MAT0, 20, 0.5, -1),
+                (P, 0, 0, 0),
+                (P, 0, 1, 0),
+                (G, 0, 10, 10),
+                (P, 0, 20, 0),
+                (G, 0, 30, 30),
+                (O, DIVIDE, 10, 11.5),
+                (O, ROTATE, 30, 30, -1),
+            ]
+        )
     )
     src, dst, w = grn.edges()
     assert src.dtype == np.int64 and dst.dtype == np.int64 and w.dtype == np.float64
@@ -139,8 +153,12 @@ def test_levels_stay_in_unit_interval_under_extreme_weights_for_long_runs():
     g = animat.Genome.random(5, c)
     grn = animat.Grn(g, c)
     rng = np.random.default_rng(0)
-    L = grn.run(100_000, maternal=list(rng.uniform(size=3)), morphogens=list(rng.uniform(size=len(grn.morphogen_units))),
-                config=c)
+    L = grn.run(
+        100_000,
+        maternal=list(rng.uniform(size=3)),
+        morphogens=list(rng.uniform(size=len(grn.morphogen_units))),
+        config=c,
+    )
     assert L.min() >= 0.0 and L.max() < 1.0
 
 
@@ -159,7 +177,9 @@ def test_has_required_paths():
     assert direct.reaches(animat.OutputChannel.divide)
     assert not direct.reaches(animat.OutputChannel.rotate)
     for missing in (DIVIDE, AMPLITUDE, FREQUENCY, PHASE):
-        els = [(I, MAT0, 0, 0)] + [(O, c, *((50, 50) if c == missing else (0, 0))) for c in (DIVIDE, AMPLITUDE, FREQUENCY, PHASE)]
+        els = [(I, MAT0, 0, 0)] + [
+            (O, c, *((50, 50) if c == missing else (0, 0))) for c in (DIVIDE, AMPLITUDE, FREQUENCY, PHASE)
+        ]
         g = animat.Grn(genome(els))
         assert not g.has_required_paths()
         assert not g.reaches(animat.OutputChannel(missing))
@@ -180,12 +200,19 @@ def test_path_through_intermediate_unit():
 
 
 def test_to_dot():
-    grn = animat.Grn(genome([(I, BIAS, 0, 0), (P, 0, 0, 0), (M, 0, 5, 5), (P, 0, 5, 5, -1), (G, 0, 10, 10), (O, DIVIDE, 10, 10)]))
+    grn = animat.Grn(
+        genome([(I, BIAS, 0, 0), (P, 0, 0, 0), (M, 0, 5, 5), (P, 0, 5, 5, -1), (G, 0, 10, 10), (O, DIVIDE, 10, 10)])
+    )
     dot = grn.to_dot()
     assert dot.startswith("digraph")
-    for s in ('in0 [label="bias"', 'u0 [label="unit 0 (morphogen)"]', 'out0 [label="divide"',
-              'in0 -> u0 [label="10", color=black]', 'u0 -> u1 [label="-10", color=red, style=dashed]',
-              'u1 -> out0 [label="10", color=black]'):
+    for s in (
+        'in0 [label="bias"',
+        'u0 [label="unit 0 (morphogen)"]',
+        'out0 [label="divide"',
+        'in0 -> u0 [label="10", color=black]',
+        'u0 -> u1 [label="-10", color=red, style=dashed]',
+        'u1 -> out0 [label="10", color=black]',
+    ):
         assert s in dot, dot
     assert dot.count("->") == len(grn.edges()[0]) == 3
 

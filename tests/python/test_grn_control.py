@@ -1,5 +1,6 @@
 """Active control (issue 18, docs/control.md) through the Python surface: the extension channels,
 the [control] keys, GRN-mode evaluations, objective chemotaxis and Simulation.push."""
+
 import math
 
 import numpy as np

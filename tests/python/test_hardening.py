@@ -8,6 +8,7 @@ Anything that could kill the interpreter runs in a child interpreter, so a crash
 
 docs/reliability.md lists every attack with its count and the test that covers it.
 """
+
 from __future__ import annotations
 
 import json
@@ -29,13 +30,14 @@ import animat
 
 ROOT = Path(__file__).resolve().parents[2]
 PY = sys.executable
-INT64_MIN, INT64_MAX = -2**63, 2**63 - 1
+INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 
 
 def run_python(code: str, timeout: float = 60, **kw) -> subprocess.CompletedProcess:
     """Run `code` in a fresh interpreter with this test's environment."""
-    return subprocess.run([PY, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout,
-                          env=os.environ.copy(), **kw)
+    return subprocess.run(
+        [PY, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout, env=os.environ.copy(), **kw
+    )
 
 
 def small_config(**extra) -> animat.Config:
@@ -55,6 +57,7 @@ def snapshot(d: Path) -> dict:
 
 # --------------------------------------------------------------------------------------------------
 # Rng.integer
+
 
 def test_rng_integer_over_the_whole_int64_range_does_not_kill_the_interpreter():
     # Was SIGFPE (a division by zero in below(0)).
@@ -82,7 +85,7 @@ def test_rng_integer_argument_errors_are_clear():
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.integers(min_value=-2**70, max_value=2**70), st.integers(min_value=-2**70, max_value=2**70))
+@given(st.integers(min_value=-(2**70), max_value=2**70), st.integers(min_value=-(2**70), max_value=2**70))
 def test_rng_integer_property(a, b):
     rng = animat.Rng(abs(a) % 1000)
     if not (INT64_MIN <= a <= INT64_MAX and INT64_MIN <= b <= INT64_MAX):
@@ -98,6 +101,7 @@ def test_rng_integer_property(a, b):
 # --------------------------------------------------------------------------------------------------
 # Objects that are not thread-safe
 
+
 def test_one_simulation_stepped_from_two_threads_is_a_clear_error_not_an_abort():
     # Was SIGABRT (b2StackAllocator assertion): step() releases the GIL. A worker steps the simulation
     # in calls of 2,000 steps, each holding it without the GIL, until the main thread has been refused;
@@ -105,7 +109,8 @@ def test_one_simulation_stepped_from_two_threads_is_a_clear_error_not_an_abort()
     # waits a set time, so the outcome does not depend on the machine's speed or load: the only way out
     # of the main loop is a refusal (or the worker failing otherwise, reported). A build without the
     # lease aborts or never refuses: then the child's timeout, a hang guard only, fails the test.
-    r = run_python("""
+    r = run_python(
+        """
         import threading, animat
         config = animat.Config()
         for seed in range(5000):
@@ -139,12 +144,15 @@ def test_one_simulation_stepped_from_two_threads_is_a_clear_error_not_an_abort()
         assert message is not None and "in use by another thread" in message, message
         sim.step(1)  # usable again once the other thread is done
         print("ok")
-    """, timeout=600)
+    """,
+        timeout=600,
+    )
     assert r.returncode == 0 and "ok" in r.stdout, (r.returncode, r.stderr[-2000:])
 
 
 # --------------------------------------------------------------------------------------------------
 # load_config
+
 
 def test_load_config_of_a_directory_or_unreadable_file_is_an_error(tmp_path):
     with pytest.raises(OSError, match="Is a directory"):  # was the default config, silently
@@ -162,6 +170,7 @@ def test_load_config_of_a_directory_or_unreadable_file_is_an_error(tmp_path):
 # --------------------------------------------------------------------------------------------------
 # animat.evolve: callback result, Ctrl-C, stop event, resume
 
+
 def test_evolve_callback_returning_a_non_bool_is_a_type_error_with_a_resumable_checkpoint(tmp_path):
     out = tmp_path / "run"
     config = small_config(evolution__generations=5, evolution__checkpoint_every=3)
@@ -173,14 +182,17 @@ def test_evolve_callback_returning_a_non_bool_is_a_type_error_with_a_resumable_c
     resumed = animat.evolve(config, out=str(out), resume=True, callback=lambda s: None)
     assert resumed.history[-1].generation == 5
     np = pytest.importorskip("numpy")
-    assert animat.evolve(small_config(evolution__generations=3), callback=lambda s: np.bool_(s.generation < 2)
-                         ).stop_reason == "stopped by callback"
+    assert (
+        animat.evolve(small_config(evolution__generations=3), callback=lambda s: np.bool_(s.generation < 2)).stop_reason
+        == "stopped by callback"
+    )
 
 
 def test_evolve_exception_in_the_callback_is_raised_with_the_partial_result(tmp_path):
     def boom(stats):
         if stats.generation == 2:
             raise ZeroDivisionError("from the callback")
+
     config = small_config(evolution__generations=6, evolution__checkpoint_every=4)
     with pytest.raises(ZeroDivisionError) as e:
         animat.evolve(config, out=str(tmp_path / "run"), callback=boom)
@@ -204,8 +216,9 @@ def _calls_at_the_end_of_each_generation(config):
     def mark(stats):
         marks[stats.generation] = calls[0]
 
-    result = animat.evolve(config, objective=animat.Objective(counting, every=0, name="counting"), callback=mark,
-                           quiet=True)
+    result = animat.evolve(
+        config, objective=animat.Objective(counting, every=0, name="counting"), callback=mark, quiet=True
+    )
     return marks, result
 
 
@@ -224,15 +237,25 @@ def test_evolve_stop_event_returns_an_interrupted_result(tmp_path):
             stop.set()
         return _counting_objective(record)
 
-    result = animat.evolve(config, out=str(tmp_path / "run"), stop=stop, quiet=True,
-                           objective=animat.Objective(counting, every=0, name="counting"))
+    result = animat.evolve(
+        config,
+        out=str(tmp_path / "run"),
+        stop=stop,
+        quiet=True,
+        objective=animat.Objective(counting, every=0, name="counting"),
+    )
     assert result.stop_reason == "interrupted"
     last = int(result.history["generation"][-1])
     assert last in (1, 2), last
     assert at <= calls[0] <= marks[2], (at, calls[0], marks)  # nothing of generation 3 was evaluated
     assert animat.Run(tmp_path / "run").history["generation"][-1] == last  # checkpointed
-    resumed = animat.evolve(config, out=str(tmp_path / "run"), resume=True, quiet=True,
-                            objective=animat.Objective(_counting_objective, every=0, name="counting"))
+    resumed = animat.evolve(
+        config,
+        out=str(tmp_path / "run"),
+        resume=True,
+        quiet=True,
+        objective=animat.Objective(_counting_objective, every=0, name="counting"),
+    )
     assert list(resumed.history["best"]) == list(straight.history["best"])
     assert list(resumed.history["mean"]) == list(straight.history["mean"])
 
@@ -288,8 +311,13 @@ def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_ch
     marks, straight = _calls_at_the_end_of_each_generation(config)
     out = tmp_path / "run"
     at = marks[1] + 1  # the first evaluation of generation 2
-    r = subprocess.run([PY, "-c", textwrap.dedent(_CTRL_C_CHILD), where, str(threads), str(out), str(at)],
-                       capture_output=True, text=True, timeout=600, preexec_fn=_ctrl_c_as_in_a_terminal)
+    r = subprocess.run(
+        [PY, "-c", textwrap.dedent(_CTRL_C_CHILD), where, str(threads), str(out), str(at)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        preexec_fn=_ctrl_c_as_in_a_terminal,
+    )
     assert r.returncode == 0, (r.stdout, r.stderr[-2000:])
     got = json.loads(r.stdout)
     assert got["stop"] == "interrupted", got
@@ -301,8 +329,13 @@ def test_ctrl_c_during_evolve_raises_keyboard_interrupt_with_the_result_and_a_ch
         assert got["last"] in ([1], [2]), got
     # The checkpoint is the last complete generation, and it resumes into the uninterrupted run.
     assert animat.Run(out).history["generation"][-1] == got["last"][0]
-    resumed = animat.evolve(config, out=str(out), resume=True, quiet=True,
-                            objective=animat.Objective(_counting_objective, every=0, name="counting"))
+    resumed = animat.evolve(
+        config,
+        out=str(out),
+        resume=True,
+        quiet=True,
+        objective=animat.Objective(_counting_objective, every=0, name="counting"),
+    )
     assert list(resumed.history["best"]) == list(straight.history["best"])
 
 
@@ -313,9 +346,28 @@ def test_experiment_stops_every_run_on_one_ctrl_c(tmp_path):
     cfg = tmp_path / "exp.toml"
     cfg.write_text("[evolution]\npopulation = 30\nelites = 1\n")
     out = tmp_path / "exp"
-    p = subprocess.Popen([PY, "-m", "animat", "experiment", str(cfg), "--runs", "3", "--parallel", "2", "--threads", "2",
-                          "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         cwd=str(tmp_path), preexec_fn=_ctrl_c_as_in_a_terminal)
+    p = subprocess.Popen(
+        [
+            PY,
+            "-m",
+            "animat",
+            "experiment",
+            str(cfg),
+            "--runs",
+            "3",
+            "--parallel",
+            "2",
+            "--threads",
+            "2",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=str(tmp_path),
+        preexec_fn=_ctrl_c_as_in_a_terminal,
+    )
     try:
         hang_guard = time.monotonic() + 900  # only keeps a broken build from hanging the suite
         while p.poll() is None and not all((out / f"run_{i}" / "checkpoint.json").exists() for i in (0, 1)):
@@ -358,9 +410,9 @@ def test_hand_edited_checkpoint_is_refused(tmp_path):
     payload = json.loads(outer["payload"])
     payload["history"].reverse()
     body = json.dumps(payload, separators=(",", ":"))
-    h = 0xcbf29ce484222325
+    h = 0xCBF29CE484222325
     for ch in body.encode():
-        h = ((h ^ ch) * 0x100000001b3) & 0xFFFFFFFFFFFFFFFF
+        h = ((h ^ ch) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
     (out / "checkpoint.json").write_text(json.dumps({"checksum": f"{h:016x}", "payload": body}))
     before = snapshot(out)
     with pytest.raises(ValueError, match="checkpoint"):
@@ -375,7 +427,7 @@ KEYS = animat.Config().keys()
 VALUES = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.floats(min_value=-1e7, max_value=1e7),
-    st.integers(min_value=-2**70, max_value=2**70),
+    st.integers(min_value=-(2**70), max_value=2**70),
     st.integers(min_value=-10, max_value=5000),
     st.booleans(),
     st.text(max_size=12),
@@ -412,8 +464,9 @@ def test_config_set_any_key_to_any_value(key, value):
     assert back == c
 
 
-SCENE_FLOATS = [k for k in KEYS if k.split(".")[0] in ("scene", "physics", "development")
-                and isinstance(animat.Config()[k], float)]
+SCENE_FLOATS = [
+    k for k in KEYS if k.split(".")[0] in ("scene", "physics", "development") and isinstance(animat.Config()[k], float)
+]
 
 
 @pytest.fixture(scope="module")
@@ -452,6 +505,7 @@ def test_evaluate_at_any_in_range_value_is_finite(viable_genome, key, fraction):
 def _range_of(doc: str):
     """(lo, hi) from a key's doc '... (in [a, b])' or '(in (a, b])'; None for other forms."""
     import re
+
     m = re.search(r"\(in [\[(]([-0-9.e+]+), ([-0-9.e+]+)[\])]\)$", doc)
     if not m:
         return None, None
@@ -460,8 +514,11 @@ def _range_of(doc: str):
 
 
 @settings(max_examples=150, deadline=None)
-@given(st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6)), min_size=1, max_size=12),
-       st.floats(-1e3, 1e3), st.floats(0, 1e12))
+@given(
+    st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6)), min_size=1, max_size=12),
+    st.floats(-1e3, 1e3),
+    st.floats(0, 1e12),
+)
 def test_simulation_of_any_point_set_never_crashes(points, frequency, drag):
     # Built from any points the body stage accepts, a swim either runs or raises a clear error.
     np = pytest.importorskip("numpy")

@@ -1,13 +1,14 @@
 """Hand-built swimmers of known locomotion mode (studies/locomotion/known_swimmers.py) are classified as built."""
+
 import math
 
 import numpy as np
 import pytest
 
-import known_swimmers as K  # studies/locomotion (conftest.py)
-
 import animat
 from animat import locomotion as L
+
+import known_swimmers as K  # studies/locomotion (conftest.py)
 
 
 def swim(s, drag=2.0, steps=2000):
@@ -19,13 +20,17 @@ def swim(s, drag=2.0, steps=2000):
     return L.classify_locomotion(tr)
 
 
-@pytest.mark.parametrize("swimmer,drag", [
-    (K.undulator("contraction"), 2.0),
-    (K.synchronous_contractor(), 0.5),
-    (K.protrusion_swimmer(length=1), 0.5),
-    (K.protrusion_swimmer(length=3, wide=True), 2.0),
-    (K.tail_swimmer(), 0.5),
-], ids=lambda v: getattr(v, "name", str(v)))
+@pytest.mark.parametrize(
+    "swimmer,drag",
+    [
+        (K.undulator("contraction"), 2.0),
+        (K.synchronous_contractor(), 0.5),
+        (K.protrusion_swimmer(length=1), 0.5),
+        (K.protrusion_swimmer(length=3, wide=True), 2.0),
+        (K.tail_swimmer(), 0.5),
+    ],
+    ids=lambda v: getattr(v, "name", str(v)),
+)
 def test_known_swimmer_is_classified_as_built(swimmer, drag):
     m = swim(swimmer, drag)
     assert m.mode == swimmer.expected, m.reason
@@ -33,7 +38,7 @@ def test_known_swimmer_is_classified_as_built(swimmer, drag):
         assert m.groups >= 2 and m.contrast >= L.LOCAL_CONTRAST
         # the most strained fifth of the cells are mostly actuated ones (appendages and their anchors)
         actuated = set(np.flatnonzero(swimmer.amplitude > 0).tolist())
-        strained = set(np.argsort(-m.amplitudes)[:int(math.ceil(0.2 * swimmer.cells))].tolist())
+        strained = set(np.argsort(-m.amplitudes)[: int(math.ceil(0.2 * swimmer.cells))].tolist())
         assert len(strained & actuated) >= 0.75 * len(strained)
     if swimmer.expected == "tail":
         assert m.groups == 1
@@ -72,6 +77,7 @@ def test_appendage_stroke_is_measured_for_appendage_swimmers_only():
 
 # --- the paper's stroke (animat.locomotion.paddling) ------------------------------------------------------
 
+
 def _paddler_frames(sweep: float, extension: float, base: float = 2.0, frames: int = 200, periods: float = 4.0):
     """A rigid 4 × 2 block of cells with one paddle cell above and one below its middle (the skin walks
     around both, CCW). Each paddle sits `base` from the axis ± `extension`·cos(ωt) and at x = `sweep`·sin(ωt)
@@ -80,7 +86,7 @@ def _paddler_frames(sweep: float, extension: float, base: float = 2.0, frames: i
     block = [(-2, -1), (-1, -1), (0, -1), (1, -1), (2, -1), (2, 1), (1, 1), (0, 1), (-1, 1), (-2, 1)]
     t = np.linspace(0.0, periods * 2 * math.pi, frames, endpoint=False)
     P = np.zeros((frames, len(block) + 2, 2))
-    P[:, :len(block)] = np.array(block, dtype=float)
+    P[:, : len(block)] = np.array(block, dtype=float)
     for k, sgn in ((10, 1.0), (11, -1.0)):
         P[:, k, 0] = sweep * np.sin(t)
         P[:, k, 1] = sgn * (base + extension * np.cos(t))
@@ -120,9 +126,16 @@ def test_paddling_rejects_a_bad_loop():
         L.paddling_motion(P, [0, 1], 1.0, (1.0, 0.0))
 
 
-@pytest.mark.parametrize("swimmer", [K.undulator("contraction"), K.undulator("across", length=6.0, width=5.0),
-                                     K.synchronous_contractor(), K.synchronous_contractor(lag=1.0)],
-                         ids=lambda s: s.name)
+@pytest.mark.parametrize(
+    "swimmer",
+    [
+        K.undulator("contraction"),
+        K.undulator("across", length=6.0, width=5.0),
+        K.synchronous_contractor(),
+        K.synchronous_contractor(lag=1.0),
+    ],
+    ids=lambda s: s.name,
+)
 def test_whole_body_swimmers_do_not_paddle(swimmer):
     c = animat.Config()
     c["scene.drag_normal"] = 2.0

@@ -5,6 +5,7 @@ deterministic on 1 and 3 ranks, and their migrants arrive at the scheduled gener
 
 Needs ANIMAT_EVOLVE_EXE and mpirun. scripts/test.sh sets ANIMAT_TEST_MPI=1: then a missing mpirun
 or a build without MPI fails instead of skipping."""
+
 import csv
 import json
 import os
@@ -24,12 +25,18 @@ REQUIRED = os.environ.get("ANIMAT_TEST_MPI") == "1"
 if REQUIRED:
     assert EXE and os.path.exists(EXE), "ANIMAT_TEST_MPI=1 but ANIMAT_EVOLVE_EXE is not set"
     assert MPIRUN, "ANIMAT_TEST_MPI=1 but mpirun is not installed (scripts/setup.sh installs openmpi-bin)"
-pytestmark = pytest.mark.skipif(not EXE or not os.path.exists(EXE) or not MPIRUN,
-                                reason="needs ANIMAT_EVOLVE_EXE and mpirun")
+pytestmark = pytest.mark.skipif(
+    not EXE or not os.path.exists(EXE) or not MPIRUN, reason="needs ANIMAT_EVOLVE_EXE and mpirun"
+)
 
 # mpirun refuses root without these (CI and containers run as root); localhost only.
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader",
-           OMPI_MCA_btl_vader_single_copy_mechanism="none")  # no CMA: containers may forbid ptrace
+ENV = dict(
+    os.environ,
+    OMPI_ALLOW_RUN_AS_ROOT="1",
+    OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+    OMPI_MCA_btl="self,vader",
+    OMPI_MCA_btl_vader_single_copy_mechanism="none",
+)  # no CMA: containers may forbid ptrace
 SMALL = ["--set", "evolution.population=10", "--set", "evaluation.steps=200", "--generations", "4", "--seed", "3"]
 
 
@@ -62,8 +69,13 @@ def assert_same_run(a, b):
 
 
 def test_built_with_mpi(tmp_path):
-    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", EXE, "--print-config"], capture_output=True, text=True,
-                       env=ENV, timeout=60)
+    r = subprocess.run(
+        [MPIRUN, "--oversubscribe", "-np", "2", EXE, "--print-config"],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        timeout=60,
+    )
     assert r.returncode == 0, r.stderr
     assert "built without MPI" not in r.stderr
     assert r.stdout.count("[evolution]") == 1  # rank 0 prints; rank 1 is released without a run
@@ -114,8 +126,25 @@ def test_killed_rank_stops_the_job_and_a_resume_on_other_ranks_finishes_identica
     # limits only keep a broken build from hanging.
     args = ["--set", "evolution.population=16", "--set", "evaluation.steps=1000", "--seed", "5"]
     run = tmp_path / "killed"
-    cmd = [MPIRUN, "--oversubscribe", "--bind-to", "none", "-np", "3", EXE, *args, "--generations", "0", "--set",
-           "evolution.stall_generations=0", "--threads", "1", "--out", str(run), "--quiet"]
+    cmd = [
+        MPIRUN,
+        "--oversubscribe",
+        "--bind-to",
+        "none",
+        "-np",
+        "3",
+        EXE,
+        *args,
+        "--generations",
+        "0",
+        "--set",
+        "evolution.stall_generations=0",
+        "--threads",
+        "1",
+        "--out",
+        str(run),
+        "--quiet",
+    ]
     job = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=ENV)
     try:
         hang_guard = time.monotonic() + 900
@@ -145,16 +174,50 @@ def test_killed_rank_stops_the_job_and_a_resume_on_other_ranks_finishes_identica
     straight = tmp_path / "straight"
     r = evolve(straight, *args, "--generations", final, timeout=900)
     assert r.returncode == 0, r.stderr
-    r = subprocess.run([MPIRUN, "--oversubscribe", "--bind-to", "none", "-np", "2", EXE, "--resume", str(run),
-                        "--generations", final, "--threads", "2"], capture_output=True, text=True, env=ENV, timeout=900)
+    r = subprocess.run(
+        [
+            MPIRUN,
+            "--oversubscribe",
+            "--bind-to",
+            "none",
+            "-np",
+            "2",
+            EXE,
+            "--resume",
+            str(run),
+            "--generations",
+            final,
+            "--threads",
+            "2",
+        ],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        timeout=900,
+    )
     assert r.returncode == 0, r.stdout + r.stderr
     assert not stopped.exists()
     assert_same_run(straight, run)
 
 
-ISLANDS = ["--set", "evolution.population=12", "--set", "evolution.islands=3", "--set", "evolution.migration_interval=2",
-           "--set", "evolution.migrants=1", "--set", "evolution.elites=1", "--set", "evaluation.steps=200",
-           "--generations", "6", "--seed", "4"]
+ISLANDS = [
+    "--set",
+    "evolution.population=12",
+    "--set",
+    "evolution.islands=3",
+    "--set",
+    "evolution.migration_interval=2",
+    "--set",
+    "evolution.migrants=1",
+    "--set",
+    "evolution.elites=1",
+    "--set",
+    "evaluation.steps=200",
+    "--generations",
+    "6",
+    "--seed",
+    "4",
+]
 
 
 def test_islands_are_deterministic_on_one_and_three_ranks_and_migrate_on_schedule(tmp_path):
@@ -202,22 +265,37 @@ def test_study_on_mpi_ranks_equals_the_same_study_run_task_by_task(tmp_path):
     py = [sys.executable, "-m", "animat", "experiment"]
     study = [f"a={cfg}", f"b={cfg}", "--runs", "2", "--set", "evolution.threads=1", "--quiet"]
     env = dict(ENV, PYTHONPATH=os.environ.get("PYTHONPATH", ""))
-    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "mpi"), "--mpi"],
-                       capture_output=True, text=True, env=env, timeout=180)
+    r = subprocess.run(
+        [MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "mpi"), "--mpi"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=180,
+    )
     assert r.returncode == 0, r.stdout + r.stderr
     assert (tmp_path / "mpi" / "a" / "summary.md").exists() and (tmp_path / "mpi" / "b" / "summary.json").exists()
     # The four runs as four array tasks, one process each: the same runs wherever they ran.
     for task in range(4):
-        r = subprocess.run([*py, *study, "--out", str(tmp_path / "array"), "--index", str(task)], capture_output=True,
-                           text=True, env=env, timeout=180)
+        r = subprocess.run(
+            [*py, *study, "--out", str(tmp_path / "array"), "--index", str(task)],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=180,
+        )
         assert r.returncode == 0, r.stderr
     assert not (tmp_path / "array" / "a" / "summary.md").exists()  # tasks write no summary
     for env_name in "ab":
         for i in range(2):
             assert_same_run(tmp_path / "mpi" / env_name / f"run_{i}", tmp_path / "array" / env_name / f"run_{i}")
     # Under mpirun without --mpi every rank would run everything: refused.
-    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "x")],
-                       capture_output=True, text=True, env=env, timeout=180)
+    r = subprocess.run(
+        [MPIRUN, "--oversubscribe", "-np", "2", *py, *study, "--out", str(tmp_path / "x")],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=180,
+    )
     assert r.returncode != 0 and "without --mpi" in r.stderr + r.stdout
 
 
@@ -232,14 +310,26 @@ def test_errors_on_any_rank_reach_rank_0_and_release_the_others(tmp_path):
     assert message.split("error: ")[-1] in mpi.stderr, mpi.stderr
     # Rank 0 fails before the ranks got a run (no such directory), and after (a corrupt checkpoint):
     # both end at once with rank 0's message, no rank left waiting (the timeout would fail the test).
-    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "none")],
-                       capture_output=True, text=True, env=ENV, timeout=60)
+    r = subprocess.run(
+        [MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "none")],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        timeout=60,
+    )
     assert r.returncode != 0 and "resume directory does not exist" in r.stderr
-    ok = evolve(tmp_path / "run", "--set", "evolution.population=8", "--set", "evaluation.steps=100", "--generations", "1")
+    ok = evolve(
+        tmp_path / "run", "--set", "evolution.population=8", "--set", "evaluation.steps=100", "--generations", "1"
+    )
     assert ok.returncode == 0, ok.stderr
     (tmp_path / "run" / "checkpoint.json").write_text("garbage")
-    r = subprocess.run([MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "run")],
-                       capture_output=True, text=True, env=ENV, timeout=60)
+    r = subprocess.run(
+        [MPIRUN, "--oversubscribe", "-np", "2", EXE, "--resume", str(tmp_path / "run")],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        timeout=60,
+    )
     assert r.returncode != 0 and "corrupt checkpoint" in r.stderr
 
 
@@ -251,22 +341,67 @@ def test_paper_study_submits_an_array_and_a_report_and_a_task_runs_its_run(tmp_p
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()
     log = tmp_path / "sbatch.log"
-    (bin_dir / "sbatch").write_text(f"#!/bin/sh\necho \"$@\" >> {log}\necho 4242\n")
+    (bin_dir / "sbatch").write_text(f'#!/bin/sh\necho "$@" >> {log}\necho 4242\n')
     (bin_dir / "sbatch").chmod(0o755)
-    env = dict(ENV, PATH=f"{bin_dir}:{os.environ['PATH']}", ANIMAT_PYTHONPATH=os.environ.get("PYTHONPATH", ""),
-               ANIMAT_PYTHON=sys.executable)
+    env = dict(
+        ENV,
+        PATH=f"{bin_dir}:{os.environ['PATH']}",
+        ANIMAT_PYTHONPATH=os.environ.get("PYTHONPATH", ""),
+        ANIMAT_PYTHON=sys.executable,
+    )
     out = tmp_path / "study"
-    r = subprocess.run([str(ROOT / "scripts" / "paper_study.sh"), "--slurm", "--runs", "2", "--out", str(out), "--",
-                        "--generations", "1"], capture_output=True, text=True, env=env, timeout=60)
+    r = subprocess.run(
+        [
+            str(ROOT / "scripts" / "paper_study.sh"),
+            "--slurm",
+            "--runs",
+            "2",
+            "--out",
+            str(out),
+            "--",
+            "--generations",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
     assert r.returncode == 0, r.stderr
     array, report = log.read_text().splitlines()
-    assert "--array=0-7" in array and "scripts/cluster/paper_study.sbatch --runs 2" in array and "-- --generations 1" in array
+    assert (
+        "--array=0-7" in array
+        and "scripts/cluster/paper_study.sbatch --runs 2" in array
+        and "-- --generations 1" in array
+    )
     assert "--dependency=afterok:4242" in report and "scripts/cluster/paper_report.sbatch" in report
     # Array task 5 is run 1 of the third environment (d_N = 10); it writes that run and no summary.
-    r = subprocess.run([str(ROOT / "scripts" / "paper_study.sh"), "--task", "5", "--runs", "2", "--out", str(out), "--",
-                        "--generations", "1", "--set", "evolution.population=8", "--set", "evaluation.steps=100",
-                        "--quiet"], capture_output=True, text=True, env=env, timeout=120)
+    r = subprocess.run(
+        [
+            str(ROOT / "scripts" / "paper_study.sh"),
+            "--task",
+            "5",
+            "--runs",
+            "2",
+            "--out",
+            str(out),
+            "--",
+            "--generations",
+            "1",
+            "--set",
+            "evolution.population=8",
+            "--set",
+            "evaluation.steps=100",
+            "--quiet",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     assert r.returncode == 0, r.stderr
     assert (out / "dn10" / "run_1" / "checkpoint.json").exists()
     assert [p.name for p in out.iterdir() if p.is_dir()] == ["dn10"]
-    assert json.loads(json.loads((out / "dn10" / "run_1" / "checkpoint.json").read_text())["payload"])["generation"] == 1
+    assert (
+        json.loads(json.loads((out / "dn10" / "run_1" / "checkpoint.json").read_text())["payload"])["generation"] == 1
+    )

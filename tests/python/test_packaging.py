@@ -5,6 +5,7 @@ build/python/animat mirrors it (CMake target ``animat_python_stage``, which also
 the source no longer has). A new module in the package must be added to LIBRARY_MODULES on purpose:
 study code (scripts, reports, reference data for checks) goes to studies/<study>/ instead.
 """
+
 import importlib.util
 import tomllib
 from pathlib import Path
@@ -16,8 +17,20 @@ SOURCE = ROOT / "python" / "animat"
 
 #: Every Python module the package ships.
 LIBRARY_MODULES = {
-    "__init__", "__main__", "animation", "cli", "control", "evolution", "experiment", "locomotion", "pipeline",
-    "plot", "protrusion", "run", "shape", "trajectory",
+    "__init__",
+    "__main__",
+    "animation",
+    "cli",
+    "control",
+    "evolution",
+    "experiment",
+    "locomotion",
+    "pipeline",
+    "plot",
+    "protrusion",
+    "run",
+    "shape",
+    "trajectory",
 }
 #: Study modules that live under studies/ (and must stay out of the package).
 STUDY_MODULES = {

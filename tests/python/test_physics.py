@@ -1,5 +1,6 @@
 """Swimming physics (issue 5) through the Python surface: animat.Scene, animat.Simulation,
 animat.swim and animat.evaluate."""
+
 import math
 
 import numpy as np
@@ -36,6 +37,7 @@ def viable_genomes(count, seed=5, tries=50000):
 
 
 # --- Scene -------------------------------------------------------------------------------------
+
 
 def test_default_scene_has_every_effect_and_paper_drag():
     s = animat.Scene()
@@ -84,6 +86,7 @@ def test_config_scene_section_drives_the_simulation():
 
 
 # --- Simulation ----------------------------------------------------------------------------------
+
 
 def test_simulation_surface_shapes_and_time():
     b = wave_body()
@@ -184,6 +187,7 @@ def test_phase_delay_rule():
 
 
 # --- evaluate --------------------------------------------------------------------------------------
+
 
 def test_evaluate_is_deterministic_and_reports_diagnostics():
     genomes = viable_genomes(2)

@@ -1,14 +1,15 @@
 """The paper's protrusion stroke (animat.protrusion) and its place in the classifier."""
+
 import math
 
 import numpy as np
 import pytest
 
-import known_swimmers as K  # studies/locomotion (conftest.py)
-
 import animat
 from animat import locomotion as L
 from animat import protrusion as P
+
+import known_swimmers as K  # studies/locomotion (conftest.py)
 
 OMEGA = 2 * math.pi
 
@@ -37,8 +38,9 @@ def test_a_paddling_pair_scores_one_and_its_reverse_minus_one():
     assert st.score == pytest.approx(1.0, abs=2e-3)  # the outward direction is off y by the lattice jitter
     # loop area per cell: pi * 0.3 * 0.2 (the anchors do not move), in spacings^2 (spacing ~1)
     assert st.area == pytest.approx(math.pi * 0.06, rel=0.05)
-    back = P.stroke_motion(*_frames(s, sweep=+0.3, extension=0.2)[:2], OMEGA, (1.0, 0.0), body.skin_loops[0],
-                           body.springs, rest)
+    back = P.stroke_motion(
+        *_frames(s, sweep=+0.3, extension=0.2)[:2], OMEGA, (1.0, 0.0), body.skin_loops[0], body.springs, rest
+    )
     assert back.score == pytest.approx(-1.0, abs=2e-3) and not back.strokes
     # the same stroke seen against a motion along -x is the reverse loop
     other_way = P.stroke_motion(Q, t, OMEGA, (-1.0, 0.0), body.skin_loops[0], body.springs, rest)
@@ -57,8 +59,9 @@ def test_a_sweep_or_an_extension_alone_does_not_row():
 def test_a_body_without_protrusions_has_no_pair():
     s = K.protrusion_swimmer(length=1)  # its round core alone: cut the appendages off
     core = int(s.description.split("(")[1].split()[0])
-    disc = K.KnownSwimmer("disc", "other", s.positions[:core], s.amplitude[:core], s.frequency[:core],
-                          s.phase[:core], "the core")
+    disc = K.KnownSwimmer(
+        "disc", "other", s.positions[:core], s.amplitude[:core], s.frequency[:core], s.phase[:core], "the core"
+    )
     body = disc.body()
     rest = np.asarray(body.positions) - np.asarray(body.positions).mean(axis=0)
     t = np.arange(160) / 40
@@ -114,10 +117,18 @@ def test_paper_protrusion_swimmers_swim_and_stroke(name):
     assert m.stroke.score >= P.STROKE_SCORE and m.stroke.area >= P.STROKE_AREA
 
 
-@pytest.mark.parametrize("name,expected", [
-    ("undulator_contraction", "undulation"), ("undulator_across", "undulation"),
-    ("synchronous_teardrop", "synchronous contraction"), ("synchronous_lag1.0", "synchronous contraction"),
-    ("tail4", "tail"), ("standing_halves", "other"), ("standing_random", "other")])
+@pytest.mark.parametrize(
+    "name,expected",
+    [
+        ("undulator_contraction", "undulation"),
+        ("undulator_across", "undulation"),
+        ("synchronous_teardrop", "synchronous contraction"),
+        ("synchronous_lag1.0", "synchronous contraction"),
+        ("tail4", "tail"),
+        ("standing_halves", "other"),
+        ("standing_random", "other"),
+    ],
+)
 def test_other_classes_do_not_stroke(name, expected):
     _, m = _classify(CAL[name], 0.5)
     assert m.mode == expected, m.reason

@@ -9,6 +9,7 @@
 
 docs/reliability.md lists every guarantee with the test that checks it.
 """
+
 from __future__ import annotations
 
 import csv
@@ -38,6 +39,7 @@ EXCEPTIONS = {"ValueError": ValueError, "OSError": OSError, "RuntimeError": Runt
 # --------------------------------------------------------------------------------------------------
 # The catalogue
 
+
 def read_expected(path: Path) -> dict:
     """error/python/message (exact) or contains (substrings), as in the catalogue's README."""
     want = {"contains": []}
@@ -53,8 +55,9 @@ def read_expected(path: Path) -> dict:
 
 
 def catalogue(*kinds: str) -> list:
-    return sorted(p.name for p in CATALOGUE.iterdir()
-                  if p.suffix in (".toml", ".json", ".txt") and p.name.split("_")[0] in kinds)
+    return sorted(
+        p.name for p in CATALOGUE.iterdir() if p.suffix in (".toml", ".json", ".txt") and p.name.split("_")[0] in kinds
+    )
 
 
 def catalogue_config():
@@ -108,14 +111,15 @@ def test_catalogue_override_is_a_clear_cli_error(case):
     assert r.returncode == 2, r.stderr
     prefix = "animat_evolve: error: "
     assert r.stderr.startswith(prefix) and r.stderr.endswith("\n"), r.stderr
-    check_message(r.stderr[len(prefix):-1], want, "")
+    check_message(r.stderr[len(prefix) : -1], want, "")
 
 
 def run_isolated(code: str, timeout=300) -> subprocess.CompletedProcess:
     """Runs Python code in a fresh interpreter with the same animat on the path."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
-    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True,
-                          timeout=timeout, env=env)
+    return subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout, env=env
+    )
 
 
 def test_no_catalogue_case_aborts_the_interpreter():
@@ -152,7 +156,9 @@ def test_no_catalogue_case_aborts_the_interpreter():
 
 
 def test_ten_million_element_genome_is_a_value_error():
-    text = '{"format": "animat.genome", "version": 1, "dimensions": 2, "elements": [' + ",".join(["0"] * 10_000_000) + "]}"
+    text = (
+        '{"format": "animat.genome", "version": 1, "dimensions": 2, "elements": [' + ",".join(["0"] * 10_000_000) + "]}"
+    )
     with pytest.raises(ValueError, match=r"^<string>: 10000000 elements exceed genome.max_elements = 1000000$"):
         animat.Genome.from_json(text)
 
@@ -181,8 +187,19 @@ def test_deeply_nested_genome_is_a_value_error_not_a_crash():
 # Kill-and-resume of the real binary
 
 FINAL_GENERATION = 20
-RUN_ARGS = ["--quiet", "--threads", "2", "--seed", "5", "--set", "evolution.population=12",
-            "--set", "evaluation.steps=300", "--generations", str(FINAL_GENERATION)]
+RUN_ARGS = [
+    "--quiet",
+    "--threads",
+    "2",
+    "--seed",
+    "5",
+    "--set",
+    "evolution.population=12",
+    "--set",
+    "evaluation.steps=300",
+    "--generations",
+    str(FINAL_GENERATION),
+]
 # The runs that are killed or signalled: the same run with no generation cap and no stall limit (both
 # may change on resume and are not part of the run), so that it can never end before the kill or the
 # signal, however fast or slow the machine; a resume with --generations FINAL_GENERATION finishes it.
@@ -254,16 +271,23 @@ def finish_and_compare(run: Path, reference: dict):
     last kill or signal landed after FINAL_GENERATION (possible only when this process was held up for
     several generations), the run holds more generations: then its first FINAL_GENERATION + 1 must be
     the uninterrupted run's."""
-    r = subprocess.run([EXE, "--resume", str(run), "--generations", str(FINAL_GENERATION), "--quiet"],
-                       capture_output=True, text=True, timeout=HANG_GUARD_SECONDS)
+    r = subprocess.run(
+        [EXE, "--resume", str(run), "--generations", str(FINAL_GENERATION), "--quiet"],
+        capture_output=True,
+        text=True,
+        timeout=HANG_GUARD_SECONDS,
+    )
     assert r.returncode == 0, r.stderr
     generation = read_checkpoint(run)["generation"]
     assert generation >= FINAL_GENERATION
     rows = history(run)
     assert len(rows) == len(reference["history"]) + generation - FINAL_GENERATION
-    assert rows[:len(reference["history"])] == reference["history"]
-    assert {name: genome for name, genome in lineage(run).items()
-            if int(name[len("gen_"):-len(".json")]) <= FINAL_GENERATION} == reference["lineage"]
+    assert rows[: len(reference["history"])] == reference["history"]
+    assert {
+        name: genome
+        for name, genome in lineage(run).items()
+        if int(name[len("gen_") : -len(".json")]) <= FINAL_GENERATION
+    } == reference["lineage"]
 
 
 @pytest.fixture(scope="module")
@@ -290,13 +314,14 @@ def test_sigkill_at_random_moments_then_resume_equals_an_uninterrupted_run(refer
     mid_run, checked = [], 0
     for kill in range(6):
         resumed_from = checkpoint_generation(run)
-        proc = start(["--resume", str(run), "--threads", "2", "--quiet"] if resumed_from >= 0
-                     else [*UNCAPPED, "--out", str(run)])
+        proc = start(
+            ["--resume", str(run), "--threads", "2", "--quiet"] if resumed_from >= 0 else [*UNCAPPED, "--out", str(run)]
+        )
         if kill < 2:
             delay = rng.uniform(0.0, 0.5)  # from the start: often during initialization
         else:
             target = resumed_from + rng.randint(1, 3)
-            wait_until(proc, lambda: checkpoint_generation(run) >= target, f"checkpoint of generation {target}")
+            wait_until(proc, lambda: checkpoint_generation(run) >= target, f"checkpoint of generation {target}")  # noqa: B023
             delay = rng.uniform(0.0, 0.05)  # within the next generation or so
         try:
             proc.wait(timeout=delay)  # only where the kill lands; the run cannot end meanwhile
@@ -344,10 +369,16 @@ SMALL = ["--quiet", "--threads", "1", "--seed", "3", "--set", "evolution.populat
 @needs_exe
 def test_cli_unwritable_output_directory(tmp_path):
     (tmp_path / "file").write_text("x")
-    r = subprocess.run([EXE, *SMALL, "--generations", "1", "--out", str(tmp_path / "file" / "run")],
-                       capture_output=True, text=True, timeout=60)
+    r = subprocess.run(
+        [EXE, *SMALL, "--generations", "1", "--out", str(tmp_path / "file" / "run")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert r.returncode == 2
-    assert r.stderr == f"animat_evolve: error: {tmp_path / 'file' / 'run'}: cannot create run directory: Not a directory\n"
+    assert (
+        r.stderr == f"animat_evolve: error: {tmp_path / 'file' / 'run'}: cannot create run directory: Not a directory\n"
+    )
 
 
 @needs_exe
@@ -363,8 +394,13 @@ def test_cli_full_disk_via_file_size_limit(tmp_path):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
 
-    r = subprocess.run([EXE, *SMALL, "--generations", "3", "--out", str(tmp_path / "run")], capture_output=True,
-                       text=True, timeout=120, preexec_fn=limit)
+    r = subprocess.run(
+        [EXE, *SMALL, "--generations", "3", "--out", str(tmp_path / "run")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        preexec_fn=limit,
+    )
     assert r.returncode == 2, r.stderr
     assert r.stderr.startswith("animat_evolve: error: ") and "File too large" in r.stderr, r.stderr
 
@@ -379,6 +415,7 @@ def test_evolve_into_an_unwritable_directory_is_an_os_error(tmp_path):
 
 # --------------------------------------------------------------------------------------------------
 # The run directory: one writer (RUN/.lock), no run silently replaced, refusals that change nothing
+
 
 def small_run_config(generations: int):
     c = animat.Config()
@@ -412,8 +449,12 @@ def test_evolve_refuses_a_second_writer_naming_the_holder(tmp_path):
         with pytest.raises(BlockingIOError, match=f"pid {os.getpid()}"):
             animat.evolve(small_run_config(6), out=str(out), overwrite=True, quiet=True)
         if EXE and Path(EXE).exists():
-            r = subprocess.run([EXE, "--quiet", "--resume", str(out), "--generations", "6"], capture_output=True,
-                               text=True, timeout=300)
+            r = subprocess.run(
+                [EXE, "--quiet", "--resume", str(out), "--generations", "6"],
+                capture_output=True,
+                text=True,
+                timeout=300,
+            )
             seen["cli"] = (r.returncode, r.stderr)
         seen["same"] = snapshot(out) == before
         return None
@@ -440,21 +481,26 @@ def test_evolve_never_replaces_run_files_without_a_checkpoint(tmp_path):
     r = animat.evolve(small_run_config(1), out=str(out), quiet=True, overwrite=True)
     assert [int(row[0]) for row in history(out)[1:]] == [0, 1] == [int(g) for g in r.history["generation"]]
     assert sorted(p.name for p in (out / "best").iterdir()) == sorted(
-        f"gen_{e.generation:06d}.json" for e in animat.Run(out).best_genomes)
+        f"gen_{e.generation:06d}.json" for e in animat.Run(out).best_genomes
+    )
 
 
 @needs_exe
 def test_cli_refused_resume_keeps_stopped_txt(tmp_path):
     run = tmp_path / "run"
-    r = subprocess.run([EXE, *SMALL, "--generations", "2", "--out", str(run)], capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [EXE, *SMALL, "--generations", "2", "--out", str(run)], capture_output=True, text=True, timeout=300
+    )
     assert r.returncode == 0, r.stderr
     (run / "stopped.txt").write_text("animat_evolve: error: MPI job stopped: rank 1 lost\n")
     empty = tmp_path / "empty"
     shutil.copytree(run, empty)
     (empty / "checkpoint.json").unlink()
-    for folder, args in [(run, ["--resume", str(run), "--set", "evolution.population=9"]),
-                         (run, ["--resume", str(run), "--threads", "-2"]),
-                         (empty, ["--resume", str(empty)])]:
+    for folder, args in [
+        (run, ["--resume", str(run), "--set", "evolution.population=9"]),
+        (run, ["--resume", str(run), "--threads", "-2"]),
+        (empty, ["--resume", str(empty)]),
+    ]:
         before = snapshot(folder)
         r = subprocess.run([EXE, "--quiet", *args], capture_output=True, text=True, timeout=300)
         assert r.returncode != 0, args

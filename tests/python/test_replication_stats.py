@@ -1,4 +1,5 @@
 """replication_stats (studies/replication): Fisher's exact test against hand-computed tables, the bootstrap."""
+
 import math
 
 import numpy as np

@@ -1,5 +1,6 @@
 """replication_store (studies/replication): packed runs unpack into run directories and pack back to the
 same bytes; pack refuses runs that would not restore or are behind, unpack verifies every checksum and size."""
+
 import gzip
 import hashlib
 import json
@@ -14,6 +15,7 @@ from pathlib import Path
 import pytest
 
 import animat
+
 import replication_store as R  # studies/replication (conftest.py)
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -36,7 +38,8 @@ def test_unpack_then_pack_gives_the_same_bytes(tmp_path):
     manifest = (again / R.MANIFEST).read_bytes()
     assert json.loads(manifest)["unpacked"]["checkpoint.json"] == {
         "sha256": hashlib.sha256((work / "checkpoint.json").read_bytes()).hexdigest(),
-        "size": (work / "checkpoint.json").stat().st_size}
+        "size": (work / "checkpoint.json").stat().st_size,
+    }
     R.pack_run(work, again)
     assert (again / R.MANIFEST).read_bytes() == manifest  # the manifest is deterministic too
     with pytest.raises(FileExistsError):
@@ -73,14 +76,17 @@ def test_next_round_cap_grows_the_least_advanced_open_run(tmp_path):
     work = tmp_path / "work"
     _run(work, "a", 0, [1.0 + g for g in range(301)])  # at 300, improving
     _run(work, "a", 1, [1.0 + g for g in range(151)])  # at 150: the least advanced
-    _run(work, "b", 0, [5.0] * 700)                    # 699 generations without improvement: stalled
+    _run(work, "b", 0, [5.0] * 700)  # 699 generations without improvement: stalled
     _run(work, "b", 1, [1.0 + g for g in range(1001)])  # at the cap
     assert R.next_round_cap(work, ["a", "b"], 2, 1000, 150) == 300
     assert R.next_round_cap(work, ["a", "b"], 2, 1000, 1000) == 1000  # never past the cap
     assert R.next_round_cap(work, ["a", "b", "c"], 2, 1000, 150) == 150  # runs of "c" not started: generation 0
     assert R.next_round_cap(work, ["a", "b"], 3, 1000, 150) == 150  # nor is run 2 of each
     assert R.next_round_cap(work, ["b"], 2, 1000, 150) == -1  # stalled or at the cap: finished
-    assert R.main(["next-cap", str(work), "--envs", "a", "b", "--runs", "2", "--generations", "1000", "--round", "150"]) == 0
+    assert (
+        R.main(["next-cap", str(work), "--envs", "a", "b", "--runs", "2", "--generations", "1000", "--round", "150"])
+        == 0
+    )
     with pytest.raises(ValueError):
         R.next_round_cap(work, ["a"], 2, 1000, 0)
 
@@ -91,8 +97,20 @@ def _two_packed_runs_and_report_command(tmp_path):
     shutil.copytree(PACKED, data / "dn2" / "run_0")
     shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
     doc = tmp_path / "docs" / "replication.md"
-    cmd = [sys.executable, str(STUDY / "replication_report.py"), "--data", str(data), "--doc", str(doc),
-           "--no-gif", "--no-calibration", "--target-runs", "3", "--discussion", str(tmp_path / "none.md")]
+    cmd = [
+        sys.executable,
+        str(STUDY / "replication_report.py"),
+        "--data",
+        str(data),
+        "--doc",
+        str(doc),
+        "--no-gif",
+        "--no-calibration",
+        "--target-runs",
+        "3",
+        "--discussion",
+        str(tmp_path / "none.md"),
+    ]
     return data, doc, cmd
 
 
@@ -115,8 +133,10 @@ def test_report_rebuilds_from_packed_data_alone(tmp_path):
 def test_report_states_the_guard_tolerances_per_environment_when_they_differ(tmp_path):
     data, doc, cmd = _two_packed_runs_and_report_command(tmp_path)
     subprocess.run(cmd, capture_output=True, text=True, check=True)
-    same = ("Within the guard's tolerance (it warns where the two differ by more than both "
-            "`evaluation.reference_tolerance` = 1 % and `evaluation.reference_abs_tolerance` = 0.05): 2 of 2 bests.")
+    same = (
+        "Within the guard's tolerance (it warns where the two differ by more than both "
+        "`evaluation.reference_tolerance` = 1 % and `evaluation.reference_abs_tolerance` = 0.05): 2 of 2 bests."
+    )
     assert same in doc.read_text()
     config = data / "dn10" / "run_0" / "config.toml"
     text = config.read_text()
@@ -125,8 +145,7 @@ def test_report_states_the_guard_tolerances_per_environment_when_they_differ(tmp
     subprocess.run(cmd, capture_output=True, text=True, check=True)
     page = doc.read_text()
     assert same not in page
-    assert ("`evaluation.reference_abs_tolerance`: `dn2` 1 % and 0.05, `dn10` 2 % and 0.05): 2 of 2 bests."
-            in page)
+    assert "`evaluation.reference_abs_tolerance`: `dn2` 1 % and 0.05, `dn10` 2 % and 0.05): 2 of 2 bests." in page
 
 
 def _tree(root: Path) -> dict:
@@ -174,17 +193,24 @@ def _edit_payload(ckpt: Path) -> None:
 
 
 DAMAGES = {  # what is damaged, and the file and the words the refusal names
-    "truncated checkpoint": (lambda run: _cut(run / "checkpoint.json", (run / "checkpoint.json").stat().st_size // 2),
-                             "checkpoint.json: not valid JSON"),
-    "edited checkpoint": (lambda run: _edit_payload(run / "checkpoint.json"),
-                          "checkpoint.json: checksum"),
-    "best file not JSON": (lambda run: _cut(run / "best" / "gen_000000.json", 100),
-                           "best/gen_000000.json: not a JSON genome record"),
+    "truncated checkpoint": (
+        lambda run: _cut(run / "checkpoint.json", (run / "checkpoint.json").stat().st_size // 2),
+        "checkpoint.json: not valid JSON",
+    ),
+    "edited checkpoint": (lambda run: _edit_payload(run / "checkpoint.json"), "checkpoint.json: checksum"),
+    "best file not JSON": (
+        lambda run: _cut(run / "best" / "gen_000000.json", 100),
+        "best/gen_000000.json: not a JSON genome record",
+    ),
     "history missing": (lambda run: (run / "history.csv").unlink(), "history.csv: missing"),
-    "history cut mid-row": (lambda run: _cut(run / "history.csv", (run / "history.csv").stat().st_size - 5),
-                            "history.csv: the last line is incomplete"),
-    "config not TOML": (lambda run: (run / "config.toml").write_text((run / "config.toml").read_text() + "[[[\n"),
-                        "config.toml: not a TOML config"),
+    "history cut mid-row": (
+        lambda run: _cut(run / "history.csv", (run / "history.csv").stat().st_size - 5),
+        "history.csv: the last line is incomplete",
+    ),
+    "config not TOML": (
+        lambda run: (run / "config.toml").write_text((run / "config.toml").read_text() + "[[[\n"),
+        "config.toml: not a TOML config",
+    ),
 }
 
 
@@ -217,8 +243,10 @@ def test_pack_never_replaces_a_packed_run_with_one_behind_it(tmp_path, capsys):
     before = _tree(data)
     assert R.main(["pack", str(work), str(data)]) == 1
     err = capsys.readouterr().err
-    assert (f"{run}: at generation 50 (checkpoint.json), behind the run packed in {packed} at generation 100 "
-            f"(checkpoint.json.gz); refusing to replace it") in err
+    assert (
+        f"{run}: at generation 50 (checkpoint.json), behind the run packed in {packed} at generation 100 "
+        f"(checkpoint.json.gz); refusing to replace it"
+    ) in err
     assert _tree(data) == before
     with pytest.raises(R.StoreError):
         R.pack_run(run, packed)
@@ -284,8 +312,9 @@ def test_unpack_keeps_a_work_run_further_on_and_refuses_one_behind(tmp_path):
     assert f"{ckpt}: not valid JSON" in str(e.value) and f"move {target} away" in str(e.value)
 
 
-@pytest.mark.parametrize("name", ["checkpoint.json.gz", "best.tar.gz", "history.csv.gz", "config.toml", "status.json",
-                                  "manifest.json"])
+@pytest.mark.parametrize(
+    "name", ["checkpoint.json.gz", "best.tar.gz", "history.csv.gz", "config.toml", "status.json", "manifest.json"]
+)
 def test_one_flipped_bit_in_a_packed_file_is_an_error_naming_it_and_writes_nothing(tmp_path, name):
     data, packed = _packed_with_manifest(tmp_path)
     f = packed / name
@@ -311,7 +340,7 @@ def test_a_packed_run_without_manifest_is_checked_by_its_gzip_crc(tmp_path):
     original = (packed / "best.tar.gz").read_bytes()
     tar = gzip.decompress(original)
     i = tar.index(b'"fitness": 4.9') + len(b'"fitness": 4.9')
-    altered = gzip.compress(tar[:i] + b"8" + tar[i + 1:], compresslevel=9, mtime=0)
+    altered = gzip.compress(tar[:i] + b"8" + tar[i + 1 :], compresslevel=9, mtime=0)
     (packed / "best.tar.gz").write_bytes(altered[:-8] + original[-8:])  # the original CRC-32 and length
     with pytest.raises(R.StoreError) as e:
         R.unpack_tree(data, tmp_path / "work")

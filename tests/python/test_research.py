@@ -1,4 +1,5 @@
 """The research API (issue 16): objectives, ask/tell, pickling, process pools, the quickstart, packaging."""
+
 import copy
 import math
 import multiprocessing
@@ -7,7 +8,6 @@ import pickle
 import re
 import subprocess
 import sys
-import warnings
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -44,6 +44,7 @@ def rightward(record):
 
 # --- 1. objectives --------------------------------------------------------------------------------------
 
+
 def test_builtin_objectives_by_name_and_config_key(viable):
     c, g = viable
     r = animat.evaluate(g, c)
@@ -56,10 +57,20 @@ def test_builtin_objectives_by_name_and_config_key(viable):
     c2.apply_override("evaluation.direction=[0.0, 1.0]")
     speed = animat.evaluate(g, c2).fitness
     assert speed == pytest.approx(r.displacement[1] / r.simulated_time, rel=1e-12)
-    assert set(animat.OBJECTIVES) == {"distance", "distance_per_size", "speed_toward", "distance_x",
-                                      "distance_minus_energy", "distance_per_energy", "chemotaxis"}
-    with pytest.raises(ValueError, match="expected one of distance, distance_per_size, speed_toward, distance_x, "
-                                         "distance_minus_energy, distance_per_energy, chemotaxis, python:"):
+    assert set(animat.OBJECTIVES) == {
+        "distance",
+        "distance_per_size",
+        "speed_toward",
+        "distance_x",
+        "distance_minus_energy",
+        "distance_per_energy",
+        "chemotaxis",
+    }
+    with pytest.raises(
+        ValueError,
+        match="expected one of distance, distance_per_size, speed_toward, distance_x, "
+        "distance_minus_energy, distance_per_energy, chemotaxis, python:",
+    ):
         c2["evaluation.objective"] = "fastest"
 
 
@@ -81,9 +92,16 @@ def test_the_objective_table_scores_an_evaluation_exactly_as_the_engine(viable):
         c2["evaluation.direction"] = [1.0, -2.0]
         c2["evaluation.energy_weight"] = 0.5
         engine = animat.evaluate(g, c2).fitness
-        table_value = animat.objective_value(spec.name, distance=r.fitness, dx=r.displacement[0], dy=r.displacement[1],
-                                             duration=r.simulated_time, body_length=length,
-                                             actuation_work_positive=r.actuation_work_positive, config=c2)
+        table_value = animat.objective_value(
+            spec.name,
+            distance=r.fitness,
+            dx=r.displacement[0],
+            dy=r.displacement[1],
+            duration=r.simulated_time,
+            body_length=length,
+            actuation_work_positive=r.actuation_work_positive,
+            config=c2,
+        )
         assert table_value == engine, spec.name
         assert spec.meaning and (not spec.nonnegative or engine >= 0.0), spec.name
     with pytest.raises(ValueError, match='"fastest" is not a built-in objective'):
@@ -152,6 +170,7 @@ def test_python_objective_errors_are_clear(viable):
 
 
 # --- 2. ask / tell --------------------------------------------------------------------------------------
+
 
 def test_ga_loop_gives_exactly_the_evolve_run():
     c = small_config(population=10, steps=400, seed=5)
@@ -228,6 +247,7 @@ def test_tell_refuses_what_it_cannot_use():
 
 # --- 2b. tell is held to the engine's rules; what save() writes, load() reads ---------------------------
 
+
 def _answer_everything(ga, value):
     """Tells `value` for every asked genome until generation 0 exists (every draw viable)."""
     while ga.generation < 0:
@@ -263,9 +283,26 @@ def test_every_checkpoint_saved_after_an_accepted_tell_loads(tmp_path):
     rng = np.random.default_rng(20240601)
     tiny = float(np.nextafter(0.0, 1.0))
     top = 1.7976931348623157e308
-    special = [0.0, -0.0, tiny, -tiny, 1e-300, -1e-300, 1.0, -1.0, 1e300, -1e300, top, -top, top / 2, -top / 2,
-               math.nan, math.inf, -math.inf]
-    cells = [0, 1, 7, 2**31 - 1, -1, -2**31]
+    special = [
+        0.0,
+        -0.0,
+        tiny,
+        -tiny,
+        1e-300,
+        -1e-300,
+        1.0,
+        -1.0,
+        1e300,
+        -1e300,
+        top,
+        -top,
+        top / 2,
+        -top / 2,
+        math.nan,
+        math.inf,
+        -math.inf,
+    ]
+    cells = [0, 1, 7, 2**31 - 1, -1, -(2**31)]
 
     def adversarial():
         pick = rng.integers(0, 5)
@@ -276,8 +313,13 @@ def test_every_checkpoint_saved_after_an_accepted_tell_loads(tmp_path):
         if pick == 2:
             return float(rng.normal() * 10.0 ** int(rng.integers(-320, 309)))  # may overflow to inf: refused
         fit = float(special[rng.integers(0, len(special))]) if pick == 3 else float(rng.normal())
-        return animat.Fitness(fit, bool(rng.integers(0, 2)), bool(rng.integers(0, 2)),
-                              int(cells[rng.integers(0, len(cells))]), bool(rng.integers(0, 2)))
+        return animat.Fitness(
+            fit,
+            bool(rng.integers(0, 2)),
+            bool(rng.integers(0, 2)),
+            int(cells[rng.integers(0, len(cells))]),
+            bool(rng.integers(0, 2)),
+        )
 
     def acceptable(v, objective):
         if v is None:
@@ -314,7 +356,9 @@ def test_every_checkpoint_saved_after_an_accepted_tell_loads(tmp_path):
                 accepted += 1
                 if ga.generation >= 0:
                     for row in ga.history:
-                        assert math.isfinite(row["best"]) and math.isfinite(row["mean"]) and math.isfinite(row["median"])
+                        assert (
+                            math.isfinite(row["best"]) and math.isfinite(row["mean"]) and math.isfinite(row["median"])
+                        )
                     back = animat.GA.load(ga.save(tmp_path / f"{objective}_{trial}.json"), c)
                     saved += 1
                     assert back.history.tobytes() == ga.history.tobytes()
@@ -383,6 +427,7 @@ def test_ga_with_a_python_objective_needs_it_for_the_exploit_guard():
 
 # --- 3. pickle and copy ----------------------------------------------------------------------------------
 
+
 def _same(a, b):
     if isinstance(a, np.ndarray):
         return np.array_equal(a, b)
@@ -409,9 +454,20 @@ def test_every_value_type_pickles_and_copies(viable, tmp_path):
     evo = animat.evolve(small_config(population=6, steps=200), out=out, generations=1, quiet=True)
     run = animat.Run(out)
     trajectory = animat.replay(g, c, steps=100, every=10)
-    values = [c, g, animat.Scene(drag_normal=5.0), body, embryo, embryo.trace, result, animat.Fitness(1.5, True, False, 7),
-              animat.record_evaluation(g, c, every=100),
-              evo.population[0], animat.GenerationStats(_core_stats(evo)), animat.Rng(9)]
+    values = [
+        c,
+        g,
+        animat.Scene(drag_normal=5.0),
+        body,
+        embryo,
+        embryo.trace,
+        result,
+        animat.Fitness(1.5, True, False, 7),
+        animat.record_evaluation(g, c, every=100),
+        evo.population[0],
+        animat.GenerationStats(_core_stats(evo)),
+        animat.Rng(9),
+    ]
     for v in values:
         for twin in (pickle.loads(pickle.dumps(v)), copy.copy(v), copy.deepcopy(v)):
             assert type(twin) is type(v)
@@ -436,8 +492,10 @@ def test_every_value_type_pickles_and_copies(viable, tmp_path):
 
 
 def _core_stats(evo):
-    return {name: float(evo.history[-1][name]) if evo.history.dtype[name].kind == "f" else int(evo.history[-1][name])
-            for name in evo.history.dtype.names} | {"evaluations_per_second": 1.0, "best_changed": True, "crossovers": 2}
+    return {
+        name: float(evo.history[-1][name]) if evo.history.dtype[name].kind == "f" else int(evo.history[-1][name])
+        for name in evo.history.dtype.names
+    } | {"evaluations_per_second": 1.0, "best_changed": True, "crossovers": 2}
 
 
 def test_unpickling_a_foreign_state_is_a_clear_error():
@@ -460,6 +518,7 @@ def test_multiprocessing_pool_and_process_pool_executor_evaluate_a_population(vi
 
 
 # --- 5. the quickstart ----------------------------------------------------------------------------------
+
 
 def test_random_genome_takes_a_seed_keyword_and_random_viable_reports_tries():
     assert animat.Genome.random(seed=42) == animat.Genome.random(42)
@@ -533,8 +592,23 @@ def test_log_reports_eval_per_second_of_the_last_generation_and_an_eta(tmp_path)
     exe = os.environ.get("ANIMAT_EVOLVE_EXE")
     if not exe:
         pytest.skip("ANIMAT_EVOLVE_EXE not set")
-    p = subprocess.run([exe, "--set", "evolution.population=6", "--set", "evaluation.steps=200", "--generations", "3",
-                        "--out", str(tmp_path / "r"), "--set", "evolution.threads=1"], capture_output=True, text=True)
+    p = subprocess.run(
+        [
+            exe,
+            "--set",
+            "evolution.population=6",
+            "--set",
+            "evaluation.steps=200",
+            "--generations",
+            "3",
+            "--out",
+            str(tmp_path / "r"),
+            "--set",
+            "evolution.threads=1",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert p.returncode == 0, p.stderr
     lines = [l for l in p.stdout.splitlines() if "| gen " in l or "gen     3" in l]
     assert lines and "ETA" in lines[-1], p.stdout
@@ -555,6 +629,7 @@ def test_readme_quickstart_runs(tmp_path, monkeypatch):
 
 # --- 6. packaging ---------------------------------------------------------------------------------------
 
+
 def test_paper_configs_are_package_data():
     names = animat.paper_configs()
     assert {"paper_dn10", "paper_dn2", "paper_dn0.5", "paper_dn0.2_64cells"} <= set(names)
@@ -571,16 +646,18 @@ def test_animat_evolve_subcommand_is_animat_evolve(tmp_path):
         pytest.skip("ANIMAT_EVOLVE_EXE not set")
     flags = ["--set", "evolution.population=6", "--set", "evaluation.steps=200", "--generations", "2", "--quiet"]
     a = subprocess.run([exe, *flags, "--out", str(tmp_path / "a")], capture_output=True, text=True)
-    b = subprocess.run([sys.executable, "-m", "animat", "evolve", *flags, "--out", str(tmp_path / "b")],
-                       capture_output=True, text=True)
+    b = subprocess.run(
+        [sys.executable, "-m", "animat", "evolve", *flags, "--out", str(tmp_path / "b")], capture_output=True, text=True
+    )
     assert a.returncode == b.returncode == 0, b.stderr
     strip = lambda p: [row.rsplit(",", 1)[0] for row in (p / "history.csv").read_text().splitlines()]  # noqa: E731
     assert strip(tmp_path / "a") == strip(tmp_path / "b")
     help_a = subprocess.run([exe, "--help"], capture_output=True, text=True).stdout
     help_b = subprocess.run([sys.executable, "-m", "animat", "evolve", "--help"], capture_output=True, text=True).stdout
     assert set(re.findall(r"--[a-z-]+", help_a)) == set(re.findall(r"--[a-z-]+", help_b))
-    bad = subprocess.run([sys.executable, "-m", "animat", "evolve", "--set", "evaluation.objective=fast"],
-                         capture_output=True, text=True)
+    bad = subprocess.run(
+        [sys.executable, "-m", "animat", "evolve", "--set", "evaluation.objective=fast"], capture_output=True, text=True
+    )
     assert bad.returncode == 2 and "expected one of distance, distance_per_size, speed_toward" in bad.stderr
 
 
@@ -600,23 +677,54 @@ def test_public_exports_and_docstrings():
     for name in animat.__all__:
         assert hasattr(animat, name), name
     core_public = {n for n in dir(animat._core) if not n.startswith("_")}
-    internal = {"Evolution", "EvolutionSummary", "evolve_cli", "load_config", "develop", "build_body", "swim",
-                "evaluate", "evaluate_population", "record_evaluation", "evolve", "start_state"}
+    internal = {
+        "Evolution",
+        "EvolutionSummary",
+        "evolve_cli",
+        "load_config",
+        "develop",
+        "build_body",
+        "swim",
+        "evaluate",
+        "evaluate_population",
+        "record_evaluation",
+        "evolve",
+        "start_state",
+    }
     assert core_public - internal <= set(animat.__all__), core_public - internal - set(animat.__all__)
-    functions = [getattr(animat, n) for n in animat.__all__ if callable(getattr(animat, n))
-                 and not isinstance(getattr(animat, n), type)]
+    functions = [
+        getattr(animat, n)
+        for n in animat.__all__
+        if callable(getattr(animat, n)) and not isinstance(getattr(animat, n), type)
+    ]
     assert len(functions) > 30
     for fn in functions:
         assert "nb_func" not in type(fn).__name__, fn
         assert fn.__doc__ and len(fn.__doc__.strip()) > 30, fn
     assert pickle.loads(pickle.dumps(animat.gabriel_graph)) is animat.gabriel_graph
-    for fn in (animat.evaluate, animat.evolve, animat.develop, animat.build_body, animat.swim,
-               animat.evaluate_population, animat.record_evaluation, animat.load_config, animat.gabriel_graph):
-        out = subprocess.run([sys.executable, "-c", f"import animat; help(animat.{fn.__name__})"], capture_output=True,
-                             text=True, check=True, env={**os.environ, "PAGER": "cat", "TERM": "dumb"}).stdout
+    for fn in (
+        animat.evaluate,
+        animat.evolve,
+        animat.develop,
+        animat.build_body,
+        animat.swim,
+        animat.evaluate_population,
+        animat.record_evaluation,
+        animat.load_config,
+        animat.gabriel_graph,
+    ):
+        out = subprocess.run(
+            [sys.executable, "-c", f"import animat; help(animat.{fn.__name__})"],
+            capture_output=True,
+            text=True,
+            check=True,
+            env={**os.environ, "PAGER": "cat", "TERM": "dumb"},
+        ).stdout
         assert "nanobind" not in out.splitlines()[2] and fn.__doc__.split("\n")[0].strip() in out, fn
-    from animat import plot
     import inspect
+
+    from animat import plot
+
     for fn in (plot.development, plot.construction, plot.motion_cycle, plot.phase_map, plot.fitness_history):
         assert inspect.signature(fn).return_annotation in ("Figure", "matplotlib.figure.Figure"), fn
 
@@ -629,14 +737,28 @@ def test_pyright_reports_no_error_on_the_examples_and_the_package():
 
     stage = Path(animat.__file__).resolve().parent.parent  # build/python: the package as installed, with stubs
     config = stage.parent / "pyrightconfig.json"  # pyright reads "include" relative to its config file
-    config.write_text(json.dumps({
-        "include": [os.path.relpath(ROOT / "examples", config.parent), os.path.relpath(stage / "animat", config.parent)],
-        # examples/push_recovery.py imports the packed-run store from its study folder, as it runs
-        "extraPaths": [str(stage), str(ROOT / "examples"), str(ROOT / "studies" / "replication")],
-        "pythonVersion": f"{sys.version_info.major}.{sys.version_info.minor}",
-        "typeCheckingMode": "standard",
-        "exclude": [os.path.relpath(stage / "animat" / "_core.pyi", config.parent)],  # nanobind's generated stub
-    }))
-    p = subprocess.run([str(pyright), "--pythonpath", sys.executable, "-p", str(config)], capture_output=True,
-                       text=True, cwd=ROOT, timeout=600)
+    config.write_text(
+        json.dumps(
+            {
+                "include": [
+                    os.path.relpath(ROOT / "examples", config.parent),
+                    os.path.relpath(stage / "animat", config.parent),
+                ],
+                # examples/push_recovery.py imports the packed-run store from its study folder, as it runs
+                "extraPaths": [str(stage), str(ROOT / "examples"), str(ROOT / "studies" / "replication")],
+                "pythonVersion": f"{sys.version_info.major}.{sys.version_info.minor}",
+                "typeCheckingMode": "standard",
+                "exclude": [
+                    os.path.relpath(stage / "animat" / "_core.pyi", config.parent)
+                ],  # nanobind's generated stub
+            }
+        )
+    )
+    p = subprocess.run(
+        [str(pyright), "--pythonpath", sys.executable, "-p", str(config)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=600,
+    )
     assert p.returncode == 0 and "0 errors" in p.stdout, p.stdout[-4000:] + p.stderr[-2000:]

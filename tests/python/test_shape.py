@@ -1,4 +1,5 @@
 """Shape descriptors (animat.shape) on hand-built bodies with known answers."""
+
 import math
 
 import numpy as np
@@ -35,7 +36,7 @@ def test_hexagon_is_a_round_convex_body_without_protrusions():
     assert sh.spacing == pytest.approx(1.0)
     assert sh.elongation == pytest.approx(1.0, abs=1e-12)
     assert sh.concavity == pytest.approx(0.0, abs=1e-12)
-    assert sh.outline_area == pytest.approx(6 * SQ3, rel=1e-12)   # hexagon of circumradius 2
+    assert sh.outline_area == pytest.approx(6 * SQ3, rel=1e-12)  # hexagon of circumradius 2
     assert sh.protrusion_count == 0 and sh.core_cells == 19
     # the six 120° corners: ρ (1/sin 60° − 1); every other cell is in the core
     corner = RHO * (2 / SQ3 - 1)
@@ -195,8 +196,9 @@ def test_genome_shape_develops_and_builds_the_body():
     genome, _ = animat.Genome.random_viable(3, config)
     body = animat.build_body(animat.develop(genome, config), config=config)
     assert S.genome_shape(genome, config) == S.body_shape(body)
-    nonviable = next(g for g in (animat.Genome.random(k, config) for k in range(100))
-                     if not animat.develop(g, config).viable)
+    nonviable = next(
+        g for g in (animat.Genome.random(k, config) for k in range(100)) if not animat.develop(g, config).viable
+    )
     assert S.genome_shape(nonviable, config) is None
 
 

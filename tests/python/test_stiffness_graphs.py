@@ -1,6 +1,7 @@
 """Issue 17 parts 3 and 4 from Python: evolved stiffness reaches the body (genome.extra_outputs =
 "stiffness"), the stiffness map renders (the phase map's sibling), old genomes still develop, and
 body.graph selects the distance / alpha-shape bodies."""
+
 import matplotlib
 
 matplotlib.use("Agg")

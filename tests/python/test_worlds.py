@@ -1,4 +1,5 @@
 """The crawl world and the cost of actuation (issue 17, docs/worlds.md) through the Python surface."""
+
 import math
 from pathlib import Path
 
@@ -49,8 +50,13 @@ def test_simulation_counters_include_floor_and_work():
     sim = animat.Simulation(body, config=cfg)
     sim.step(200)
     c = sim.counters
-    for key in ("ground_contacts", "ground_slips", "actuation_work", "actuation_work_positive",
-                "actuation_work_absolute"):
+    for key in (
+        "ground_contacts",
+        "ground_slips",
+        "actuation_work",
+        "actuation_work_positive",
+        "actuation_work_absolute",
+    ):
         assert key in c
     assert c["actuation_work_absolute"] > 0
 
