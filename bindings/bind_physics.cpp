@@ -302,91 +302,35 @@ void bind_physics(nb::module_& m) {
   nb::class_<SwimResult> swim_result(m, "SwimResult", "What one swim did (see ``animat.swim``).");
   nb::class_<EvaluationResult> evaluation_result(
       m, "EvaluationResult", "Fitness and diagnostics of one genome (see ``animat.evaluate``).");
-  // EvaluationResult: every field from its one descriptor (visit_fields in animat/evaluate.hpp).
-  {
-    const EvaluationResult probe;
+  // SwimResult and EvaluationResult: every field from its one descriptor (animat/evaluate.hpp).
+  auto def_properties = [](auto& cls, const auto& probe) {
+    using Record = std::decay_t<decltype(probe)>;
     visit_fields(probe, [&](const char* name, const char* doc, const auto& field) {
       using T = std::decay_t<decltype(field)>;
       if constexpr (std::is_same_v<T, Eigen::VectorXd>) {  // a numpy array that owns its copy
         const std::ptrdiff_t offset =
             reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&probe);
-        evaluation_result.def_prop_ro(
+        cls.def_prop_ro(
             name,
-            [offset](const EvaluationResult& r) {
+            [offset](const Record& r) {
               return owned_vector(
                   *reinterpret_cast<const T*>(reinterpret_cast<const char*>(&r) + offset));
             },
             nb::rv_policy::move, doc);
       } else {
-        def_field_property(evaluation_result, probe, field, name, doc);
+        def_field_property(cls, probe, field, name, doc);
       }
     });
-  }
-  // SwimResult shares the invariants and counted deviations, documented once (EvaluationResult's).
-  auto doc_of = [](std::string_view name) {
-    const EvaluationResult probe;
-    const char* out = nullptr;
-    visit_fields(probe, [&](const char* n, const char* doc, auto&) {
-      if (name == n) out = doc;
-    });
-    if (!out) throw std::logic_error("no EvaluationResult field " + std::string(name));
-    return out;
   };
-  {
-    using R = SwimResult;
-    swim_result.def_ro("valid", &R::valid, doc_of("valid"))
-        .def_ro("max_kinetic_energy_per_cell", &R::max_kinetic_energy_per_cell,
-                doc_of("max_kinetic_energy_per_cell"))
-        .def_ro("min_area_ratio", &R::min_area_ratio, doc_of("min_area_ratio"))
-        .def_ro("inverted_region_steps", &R::inverted_region_steps, doc_of("inverted_region_steps"))
-        .def_ro("skin_crossing_steps", &R::skin_crossing_steps, doc_of("skin_crossing_steps"))
-        .def_ro("first_invalid_step", &R::first_invalid_step, doc_of("first_invalid_step"))
-        .def_ro("collisions", &R::collisions, doc_of("collisions"))
-        .def_ro("collisions_inelastic", &R::collisions_inelastic, doc_of("collisions_inelastic"))
-        .def_ro("collisions_unresolved", &R::collisions_unresolved, doc_of("collisions_unresolved"))
-        .def_ro("drag_limited", &R::drag_limited, doc_of("drag_limited"))
-        .def_ro("settle_steps", &R::settle_steps, doc_of("settle_steps"))
-        .def_ro("ground_contacts", &R::ground_contacts, doc_of("ground_contacts"))
-        .def_ro("ground_slips", &R::ground_slips, doc_of("ground_slips"))
-        .def_ro("actuation_work", &R::actuation_work, doc_of("actuation_work"))
-        .def_ro("actuation_work_positive", &R::actuation_work_positive,
-                doc_of("actuation_work_positive"))
-        .def_ro("actuation_work_absolute", &R::actuation_work_absolute,
-                doc_of("actuation_work_absolute"))
-        .def_prop_ro(
-            "cell_work_positive", [](const R& r) { return owned_vector(r.cell_work_positive); },
-            nb::rv_policy::move, doc_of("cell_work_positive"))
-        .def_prop_ro(
-            "cell_work_absolute", [](const R& r) { return owned_vector(r.cell_work_absolute); },
-            nb::rv_policy::move, doc_of("cell_work_absolute"))
-        .def_ro("grn_updates", &R::grn_updates, doc_of("grn_updates"))
-        .def_prop_ro(
-            "displacement_at_push",
-            [](const R& r) -> Eigen::Vector2d { return r.displacement_at_push; },
-            doc_of("displacement_at_push"))
-        .def_ro("energy", &R::energy, doc_of("energy"));
-  }
-  swim_result.def_ro("distance", &SwimResult::distance, "|COM(end) - COM(start)|; 0 when unstable.")
-      .def_prop_ro(
-          "displacement", [](const SwimResult& r) -> Eigen::Vector2d { return r.displacement; },
-          doc_of("displacement"))
-      .def_ro("stable", &SwimResult::stable, "False if a step left the valid domain.")
-      .def_ro("failure", &SwimResult::failure, "The instability message ('' when stable).")
-      .def_ro("steps", &SwimResult::steps, "Control steps completed.")
-      .def_ro("simulated_time", &SwimResult::simulated_time, doc_of("simulated_time"))
-      .def_ro("max_speed", &SwimResult::max_speed, doc_of("max_speed"))
-      .def_ro("max_step_displacement", &SwimResult::max_step_displacement,
-              doc_of("max_step_displacement"))
-      .def_ro("max_stretch", &SwimResult::max_stretch, doc_of("max_stretch"))
-      .def_ro("min_stretch", &SwimResult::min_stretch, doc_of("min_stretch"))
-      .def_ro("final_kinetic_energy", &SwimResult::final_kinetic_energy,
-              doc_of("final_kinetic_energy"))
-      .def_ro("max_kinetic_energy", &SwimResult::max_kinetic_energy, doc_of("max_kinetic_energy"))
-      .def("__repr__", [](const SwimResult& r) {
-        return fmt::format("<animat.SwimResult distance={:.6g} stable={} valid={} steps={}>",
-                           r.distance, r.stable ? "True" : "False", r.valid ? "True" : "False",
-                           r.steps);
-      });
+  const SwimResult swim_probe;
+  def_properties(swim_result, swim_probe);
+  const EvaluationResult evaluation_probe;
+  def_properties(evaluation_result, evaluation_probe);
+  swim_result.def("__repr__", [](const SwimResult& r) {
+    return fmt::format("<animat.SwimResult distance={:.6g} stable={} valid={} steps={}>",
+                       r.distance, r.stable ? "True" : "False", r.valid ? "True" : "False",
+                       r.steps);
+  });
 
   evaluation_result.def("__repr__", [](const EvaluationResult& r) {
     return fmt::format(

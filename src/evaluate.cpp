@@ -349,40 +349,14 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
     }
   }
   out.source_progress = chemotaxis && s.valid ? progress / trials : 0.0;
-  out.grn_updates = s.grn_updates;
-  out.displacement_at_push = s.displacement_at_push;
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
-  out.valid = s.valid;
   if (!s.valid) out.reasons.push_back(s.failure);
   out.fitness = s.distance;
-  out.displacement = s.displacement;
   out.swim_steps = s.steps;
-  out.simulated_time = s.simulated_time;
-  out.max_speed = s.max_speed;
-  out.max_step_displacement = s.max_step_displacement;
-  out.max_stretch = s.max_stretch;
-  out.min_stretch = s.min_stretch;
-  out.max_kinetic_energy = s.max_kinetic_energy;
-  out.final_kinetic_energy = s.final_kinetic_energy;
-  out.max_kinetic_energy_per_cell = s.max_kinetic_energy_per_cell;
-  out.min_area_ratio = s.min_area_ratio;
-  out.inverted_region_steps = s.inverted_region_steps;
-  out.skin_crossing_steps = s.skin_crossing_steps;
-  out.first_invalid_step = s.first_invalid_step;
-  out.collisions = s.collisions;
-  out.collisions_inelastic = s.collisions_inelastic;
-  out.collisions_unresolved = s.collisions_unresolved;
-  out.drag_limited = s.drag_limited;
-  out.settle_steps = s.settle_steps;
-  out.ground_contacts = s.ground_contacts;
-  out.ground_slips = s.ground_slips;
-  out.actuation_work = s.actuation_work;
-  out.actuation_work_positive = s.actuation_work_positive;
-  out.actuation_work_absolute = s.actuation_work_absolute;
-  out.cell_work_positive = s.cell_work_positive;
-  out.cell_work_absolute = s.cell_work_absolute;
-  out.energy = s.energy;
+  // Every field both records have (valid, the counters, the work, ...): visit_swim_fields.
+  visit_swim_fields([](const char*, const char*, const auto& from, auto& to) { to = from; }, s,
+                    out);
   return out;
 }
 

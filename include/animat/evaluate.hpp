@@ -61,21 +61,21 @@ struct SwimResult {
   long collisions_unresolved = 0;
   long drag_limited = 0;  ///< edge-component steps where drag_scheme "stable" scaled eq. 5 down
   // Crawl world and cost of actuation (docs/worlds.md).
-  long settle_steps =
-      0;  ///< control steps settled (actuation off) before the fitness clock started
-  long ground_contacts =
-      0;  ///< (cell, Box2D step) contacts with the floor (effect ground; SwimCounters)
+  /// control steps settled (actuation off) before the fitness clock started
+  long settle_steps = 0;
+  /// (cell, Box2D step) contacts with the floor (effect ground; SwimCounters)
+  long ground_contacts = 0;
   long ground_slips = 0;  ///< of those, sliding ones (kinetic friction)
-  double actuation_work =
-      0.0;  ///< net mechanical work of actuation on the springs (measured phase)
-  double actuation_work_positive =
-      0.0;  ///< positive work, per spring and Box2D step (what an actuator spends)
+  /// net mechanical work of actuation on the springs (measured phase)
+  double actuation_work = 0.0;
+  /// positive work, per spring and Box2D step (what an actuator spends)
+  double actuation_work_positive = 0.0;
   double actuation_work_absolute = 0.0;  ///< absolute work, per spring and Box2D step
-  Eigen::VectorXd
-      cell_work_positive;  ///< per cell: half the positive work of each spring it ends (n)
-  Eigen::VectorXd
-      cell_work_absolute;  ///< per cell: half the absolute work of each spring it ends (n)
-  long grn_updates = 0;    ///< GRN updates while swimming (control.mode = "grn")
+  /// per cell: half the positive work of each spring it ends (n)
+  Eigen::VectorXd cell_work_positive;
+  /// per cell: half the absolute work of each spring it ends (n)
+  Eigen::VectorXd cell_work_absolute;
+  long grn_updates = 0;  ///< GRN updates while swimming (control.mode = "grn")
   Eigen::Vector2d displacement_at_push{0.0, 0.0};  ///< COM(push) − COM(start) (push_step >= 0)
   EnergyAccount energy;  ///< where the energy went (SwimOptions::account_energy)
 };
@@ -91,14 +91,14 @@ struct SwimOptions {
   bool stop_when_invalid = true;  ///< stop at the first broken invariant (the fitness is 0 anyway)
   /// Keep the energy books of the measured swim (SwimResult::energy; settling is not included).
   bool account_energy = false;
-  EvaluationObserver* observer =
-      nullptr;  ///< sees the simulation every observer->sample_every() steps
+  /// sees the simulation every observer->sample_every() steps
+  EvaluationObserver* observer = nullptr;
   /// control.mode = "grn": where every cell's GRN starts (nullptr: open loop, the scene's own
   /// actuation). With it, "actuation" is dropped from the scene and a GrnControl effect drives
   /// eq. 2.
   const GrnControlStart* control_start = nullptr;
-  const ControlParams* control =
-      nullptr;  ///< the controller's params (required with control_start)
+  /// the controller's params (required with control_start)
+  const ControlParams* control = nullptr;
   /// A disruption (evaluation.push_step, push_impulse, push_cells): at the start of control step
   /// push_step (counted from the fitness clock's start; -1 = never) every pushed cell gets
   /// push_impulse (per cell; velocity change impulse/m). push_cells: "all", or "front" (the cells
@@ -189,6 +189,82 @@ struct EvaluationResult {
   double seconds_swim = 0.0;
 };
 
+/// What a swim measured, the same fields in SwimResult and EvaluationResult, with their
+/// documentation: v(name, doc, field of each record...). One record: the descriptors below; two:
+/// evaluate() copies a SwimResult into its EvaluationResult field by field.
+template <class V, class... R>
+void visit_swim_fields(V&& v, R&... r) {
+  v("displacement", "COM(end) - COM(start) as a (2,) array.", r.displacement...);
+  v("simulated_time", "Simulated swim time.", r.simulated_time...);
+  v("max_speed", "Largest cell speed seen.", r.max_speed...);
+  v("max_step_displacement", "Largest |v|*h of one Box2D step seen.", r.max_step_displacement...);
+  v("max_stretch", "Largest spring length / L0 (sampled every 16 steps).", r.max_stretch...);
+  v("min_stretch", "Smallest spring length / L0 (same samples).", r.min_stretch...);
+  v("max_kinetic_energy", "Largest kinetic energy (same samples).", r.max_kinetic_energy...);
+  v("final_kinetic_energy", "Kinetic energy at the end.", r.final_kinetic_energy...);
+  v("max_kinetic_energy_per_cell", "Largest kinetic energy / cells.",
+    r.max_kinetic_energy_per_cell...);
+  v("valid",
+    "False if the swim broke an invariant: unstable, a region inverted, the skin crossed itself, "
+    "or a collision could not be resolved. An invalid swim has fitness/distance 0.",
+    r.valid...);
+  v("min_area_ratio", "Smallest S/S0 of any region over the swim (must stay > 0).",
+    r.min_area_ratio...);
+  v("inverted_region_steps", "(region, step) pairs with S/S0 <= 0 (must be 0).",
+    r.inverted_region_steps...);
+  v("skin_crossing_steps", "Steps in which two skin edges intersected (must be 0).",
+    r.skin_crossing_steps...);
+  v("first_invalid_step", "Step at whose end an invariant first broke (-1: never).",
+    r.first_invalid_step...);
+  v("collisions", "Cell-edge collisions resolved by an impulse.", r.collisions...);
+  v("collisions_inelastic", "Collisions resolved by the inelastic fallback.",
+    r.collisions_inelastic...);
+  v("collisions_unresolved", "Steps with a crossing no impulse prevented (must be 0).",
+    r.collisions_unresolved...);
+  v("drag_limited", "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.",
+    r.drag_limited...);
+  v("settle_steps", "Control steps settled (actuation off) before the fitness clock started.",
+    r.settle_steps...);
+  v("ground_contacts", "(cell, Box2D step) contacts with the floor (effect ground).",
+    r.ground_contacts...);
+  v("ground_slips", "Of the floor contacts, those that slid (kinetic friction).",
+    r.ground_slips...);
+  v("actuation_work", "Net mechanical work of actuation on the springs (docs/worlds.md).",
+    r.actuation_work...);
+  v("actuation_work_positive",
+    "Positive actuation work, summed per spring and Box2D step (what the actuators spend).",
+    r.actuation_work_positive...);
+  v("actuation_work_absolute", "Absolute actuation work, summed per spring and Box2D step.",
+    r.actuation_work_absolute...);
+  v("cell_work_positive", "Per cell (n,): half the positive actuation work of each spring it ends.",
+    r.cell_work_positive...);
+  v("cell_work_absolute", "Per cell (n,): half the absolute actuation work of each spring it ends.",
+    r.cell_work_absolute...);
+  v("grn_updates", "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).",
+    r.grn_updates...);
+  v("displacement_at_push",
+    "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).",
+    r.displacement_at_push...);
+  v("energy",
+    "Where the energy went (an EnergyAccount; measured only with evaluation.energy_accounting).",
+    r.energy...);
+}
+
+/// SwimResult's fields with their documentation, in one list from which the Python class's
+/// properties follow (a new field: one line here, or in visit_swim_fields if both records have it).
+template <class R, class V>
+void visit_fields(R& r, V&& v)
+  requires std::is_same_v<std::remove_const_t<R>, SwimResult>
+{
+  v("distance", "|COM(end) - COM(start)|; 0 when unstable.", r.distance);
+  v("stable", "False if a step left the valid domain.", r.stable);
+  v("failure", "The instability message ('' when stable).", r.failure);
+  v("steps", "Control steps completed.", r.steps);
+  v("embedding_checked", "Whether the planar embedding was checked after every step.",
+    r.embedding_checked);
+  visit_swim_fields(v, r);
+}
+
 /// EvaluationResult's fields with their documentation, in one list from which the Python class's
 /// properties, its pickling and its dict follow (a new field: one line here).
 template <class R, class V>
@@ -197,79 +273,25 @@ void visit_fields(R& r, V&& v)
 {
   v("fitness",
     "The objective's value (default: the paper's straight-line distance of the centre of mass, "
-    "start "
-    "to end); 0 if not viable, unstable or invalid.",
+    "start to end); 0 if not viable, unstable or invalid.",
     r.fitness);
   v("viable", "Development verdict; non-viable genomes are never swum.", r.viable);
   v("stable", "False if the development or the swim left the valid domain.", r.stable);
-  v("valid",
-    "False if the swim broke an invariant: unstable, a region inverted, the skin crossed itself, "
-    "or a\n"
-    "collision could not be resolved. An invalid swim has fitness/distance 0.",
-    r.valid);
   v("cell_count", "Cells of the embryo.", r.cell_count);
   v("reasons", "Non-viability reasons, or the instability description.", r.reasons);
-  v("displacement", "COM(end) - COM(start) as a (2,) array.", r.displacement);
   v("spring_count", "Springs of the body.", r.spring_count);
   v("region_count", "Regions of the body.", r.region_count);
   v("skin_edge_count", "Skin edges of the body.", r.skin_edge_count);
   v("development_steps", "Development steps actually run.", r.development_steps);
   v("swim_steps", "Control steps swum.", r.swim_steps);
-  v("simulated_time", "Simulated swim time.", r.simulated_time);
-  v("max_speed", "Largest cell speed seen.", r.max_speed);
-  v("max_step_displacement", "Largest |v|*h of one Box2D step seen.", r.max_step_displacement);
-  v("max_stretch", "Largest spring length / L0 (sampled every 16 steps).", r.max_stretch);
-  v("min_stretch", "Smallest spring length / L0 (same samples).", r.min_stretch);
-  v("max_kinetic_energy", "Largest kinetic energy (same samples).", r.max_kinetic_energy);
-  v("final_kinetic_energy", "Kinetic energy at the end.", r.final_kinetic_energy);
-  v("max_kinetic_energy_per_cell", "Largest kinetic energy / cells.",
-    r.max_kinetic_energy_per_cell);
-  v("min_area_ratio", "Smallest S/S0 of any region over the swim (must stay > 0).",
-    r.min_area_ratio);
-  v("inverted_region_steps", "(region, step) pairs with S/S0 <= 0 (must be 0).",
-    r.inverted_region_steps);
-  v("skin_crossing_steps", "Steps in which two skin edges intersected (must be 0).",
-    r.skin_crossing_steps);
-  v("first_invalid_step", "Step at whose end an invariant first broke (-1: never).",
-    r.first_invalid_step);
-  v("collisions", "Cell-edge collisions resolved by an impulse.", r.collisions);
-  v("collisions_inelastic", "Collisions resolved by the inelastic fallback.",
-    r.collisions_inelastic);
-  v("collisions_unresolved", "Steps with a crossing no impulse prevented (must be 0).",
-    r.collisions_unresolved);
-  v("drag_limited", "Edge-component steps where drag_scheme 'stable' scaled eq. 5 down.",
-    r.drag_limited);
-  v("settle_steps", "Control steps settled (actuation off) before the fitness clock started.",
-    r.settle_steps);
-  v("ground_contacts", "(cell, Box2D step) contacts with the floor (effect ground).",
-    r.ground_contacts);
-  v("ground_slips", "Of the floor contacts, those that slid (kinetic friction).", r.ground_slips);
-  v("actuation_work", "Net mechanical work of actuation on the springs (docs/worlds.md).",
-    r.actuation_work);
-  v("actuation_work_positive",
-    "Positive actuation work, summed per spring and Box2D step (what the actuators spend).",
-    r.actuation_work_positive);
-  v("actuation_work_absolute", "Absolute actuation work, summed per spring and Box2D step.",
-    r.actuation_work_absolute);
-  v("cell_work_positive", "Per cell (n,): half the positive actuation work of each spring it ends.",
-    r.cell_work_positive);
-  v("cell_work_absolute", "Per cell (n,): half the absolute actuation work of each spring it ends.",
-    r.cell_work_absolute);
   v("source_progress",
     "Objective chemotaxis: mean progress toward the chemical source over "
     "evaluation.source_directions swims (|x_s| - |x_s - displacement|; 0 otherwise).",
     r.source_progress);
-  v("grn_updates", "GRN updates while swimming (control.mode = 'grn'; 0 in open loop).",
-    r.grn_updates);
-  v("displacement_at_push",
-    "COM(push) - COM(start), (2,), when evaluation.push_step >= 0 (docs/control.md).",
-    r.displacement_at_push);
-  v("energy",
-    "Where the energy went (an EnergyAccount; measured only with evaluation.energy_accounting).",
-    r.energy);
   v("seconds_development", "Wall time of development (diagnostic).", r.seconds_development);
   v("seconds_body", "Wall time of body construction (diagnostic).", r.seconds_body);
   v("seconds_swim", "Wall time of the swim (diagnostic).", r.seconds_swim);
+  visit_swim_fields(v, r);
 }
 
 /// Where control.mode = "grn" starts: the genome's GRN and every cell's state at the end of
