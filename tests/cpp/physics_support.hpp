@@ -18,13 +18,15 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// --- hand-made bodies -----------------------------------------------------------------------------
+// --- hand-made bodies
+// -----------------------------------------------------------------------------
 
 double dist(const Points& p, int i, int j) { return (p.row(i) - p.row(j)).norm(); }
 
 /// A body from explicit parts; rest lengths and areas measured from the positions unless given.
 Body make_body(const Points& p, const std::vector<std::pair<int, int>>& springs,
-               const std::vector<std::vector<int>>& regions, const std::vector<std::pair<int, int>>& skin) {
+               const std::vector<std::vector<int>>& regions,
+               const std::vector<std::pair<int, int>>& skin) {
   Body b;
   b.positions = p;
   b.springs.resize(static_cast<Eigen::Index>(springs.size()), 2);
@@ -37,7 +39,8 @@ Body make_body(const Points& p, const std::vector<std::pair<int, int>>& springs,
   }
   b.regions = regions;
   b.rest_areas.resize(static_cast<Eigen::Index>(regions.size()));
-  for (std::size_t r = 0; r < regions.size(); ++r) b.rest_areas(static_cast<Eigen::Index>(r)) = polygon_area(p, regions[r]);
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    b.rest_areas(static_cast<Eigen::Index>(r)) = polygon_area(p, regions[r]);
   b.skin.resize(static_cast<Eigen::Index>(skin.size()), 2);
   for (std::size_t e = 0; e < skin.size(); ++e) {
     b.skin(static_cast<Eigen::Index>(e), 0) = skin[e].first;
@@ -56,20 +59,21 @@ Points points(const std::vector<std::pair<double, double>>& xy) {
 }
 
 /// Two nodes on the x axis at distance d joined by one spring of rest length l0 (also a skin edge).
-Body two_nodes(double d, double l0) {
+[[maybe_unused]] Body two_nodes(double d, double l0) {
   Body b = make_body(points({{0.0, 0.0}, {d, 0.0}}), {{0, 1}}, {}, {{0, 1}});
   b.rest_lengths(0) = l0;
   return b;
 }
 
 /// Unit square, CCW, one region, four edge springs, all skin.
-Body square() {
-  return make_body(points({{0, 0}, {1, 0}, {1, 1}, {0, 1}}), {{0, 1}, {1, 2}, {2, 3}, {0, 3}}, {{0, 1, 2, 3}},
-                   {{0, 1}, {1, 2}, {2, 3}, {0, 3}});
+[[maybe_unused]] Body square() {
+  return make_body(points({{0, 0}, {1, 0}, {1, 1}, {0, 1}}), {{0, 1}, {1, 2}, {2, 3}, {0, 3}},
+                   {{0, 1, 2, 3}}, {{0, 1}, {1, 2}, {2, 3}, {0, 3}});
 }
 
 /// Triangular lattice of nx × ny cells (spacing 1) through build_body, with oscillators.
-[[maybe_unused]] Points lattice_points(int nx, int ny, double jitter = 0.0, std::uint64_t seed = 1) {
+[[maybe_unused]] Points lattice_points(int nx, int ny, double jitter = 0.0,
+                                       std::uint64_t seed = 1) {
   Rng rng(seed);
   Points p(nx * ny, 2);
   for (int j = 0; j < ny; ++j)
@@ -82,7 +86,8 @@ Body square() {
 
 enum class Drive { none, wave, random };
 
-[[maybe_unused]] Body swimmer(const Points& p, Drive drive, double amplitude = 0.2, double frequency = 4.0, std::uint64_t seed = 7) {
+[[maybe_unused]] Body swimmer(const Points& p, Drive drive, double amplitude = 0.2,
+                              double frequency = 4.0, std::uint64_t seed = 7) {
   const int n = static_cast<int>(p.rows());
   Vector a = Vector::Constant(n, drive == Drive::none ? 0.0 : amplitude);
   Vector f = Vector::Constant(n, frequency);
@@ -109,7 +114,8 @@ SceneParams scene_with(std::vector<std::string> effects) {
 /// gravity). Without weights every cell gets (fx, fy).
 class ConstantForce final : public Effect {
  public:
-  ConstantForce(double fx, double fy, std::vector<double> weights = {}) : fx_(fx), fy_(fy), w_(std::move(weights)) {}
+  ConstantForce(double fx, double fy, std::vector<double> weights = {})
+      : fx_(fx), fy_(fy), w_(std::move(weights)) {}
   std::string_view name() const override { return "constant_force"; }
   void apply(SwimState& s) override {
     ++calls_;
