@@ -7,7 +7,7 @@ organised by task:
   :func:`build_body`, :class:`Simulation`, :func:`evaluate`;
 - evolution: :func:`evolve` (the engine of ``animat_evolve``), :class:`GA` (ask/tell), your own
   :class:`Objective`, :class:`History`;
-- control: :class:`SwimEnv` (Gymnasium API; ``pip install animat[control]``);
+- control: :class:`SwimEnv` (Gymnasium API, registered as ``"animat/Swim-v0"``; ``pip install animat[control]``);
 - analysis: :class:`Run` reads a run directory; :func:`replay` returns a :class:`Trajectory`;
   :mod:`animat.plot` draws the paper's figures; :mod:`animat.locomotion` classifies how a swimmer
   moves; :func:`animate` renders GIF/MP4;
@@ -15,6 +15,7 @@ organised by task:
 
 Every value type pickles and copies. ``animat.plot`` imports matplotlib on first use only.
 """
+
 from typing import TYPE_CHECKING
 
 from . import _core
@@ -46,7 +47,7 @@ from ._core import (
     SwimResult,
 )
 from .animation import animate, mp4_available
-from .control import SWIM_ENV_OBJECTIVES, SwimEnv, gymnasium_available
+from .control import SWIM_ENV_ID, SWIM_ENV_OBJECTIVES, SwimEnv, gymnasium_available
 from .evolution import (
     GA,
     EvolutionResult,
@@ -107,24 +108,96 @@ if TYPE_CHECKING:  # animat.plot is imported lazily at run time (it pulls in mat
 
 __all__ = [
     # the pipeline
-    "Config", "ConfigSection", "Genome", "Rng", "ElementType", "InputChannel", "OutputChannel", "Grn", "affinity",
-    "develop", "Embryo", "DevelopmentTrace", "build_body", "Body", "gabriel_graph", "delaunay_edges", "polygon_area",
-    "body_length", "Scene", "Simulation", "ExternalActuation", "GrnControl", "swim", "SwimResult", "evaluate", "EvaluationResult",
+    "Config",
+    "ConfigSection",
+    "Genome",
+    "Rng",
+    "ElementType",
+    "InputChannel",
+    "OutputChannel",
+    "Grn",
+    "affinity",
+    "develop",
+    "Embryo",
+    "DevelopmentTrace",
+    "build_body",
+    "Body",
+    "gabriel_graph",
+    "delaunay_edges",
+    "polygon_area",
+    "body_length",
+    "Scene",
+    "Simulation",
+    "ExternalActuation",
+    "GrnControl",
+    "swim",
+    "SwimResult",
+    "evaluate",
+    "EvaluationResult",
     "EnergyAccount",
-    "EvaluationRecord", "record_evaluation", "actuation_start_time", "actuation_term", "warm_up_box2d",
-    "load_config", "config_path", "paper_configs", "set_log_level", "__version__",
+    "EvaluationRecord",
+    "record_evaluation",
+    "actuation_start_time",
+    "actuation_term",
+    "warm_up_box2d",
+    "load_config",
+    "config_path",
+    "paper_configs",
+    "set_log_level",
+    "__version__",
     # evolution
-    "evolve", "EvolutionResult", "GA", "Objective", "OBJECTIVES", "ObjectiveSpec", "objectives", "objective_value", "Fitness", "Individual", "GenerationStats",
-    "History", "evaluate_population", "to_fitness", "tournament_probability", "reference_disagrees", "run_experiment",
+    "evolve",
+    "EvolutionResult",
+    "GA",
+    "Objective",
+    "OBJECTIVES",
+    "ObjectiveSpec",
+    "objectives",
+    "objective_value",
+    "Fitness",
+    "Individual",
+    "GenerationStats",
+    "History",
+    "evaluate_population",
+    "to_fitness",
+    "tournament_probability",
+    "reference_disagrees",
+    "run_experiment",
     "run_study",
     # control
-    "SwimEnv", "SWIM_ENV_OBJECTIVES", "gymnasium_available", "grn_swim",
+    "SwimEnv",
+    "SWIM_ENV_ID",
+    "SWIM_ENV_OBJECTIVES",
+    "gymnasium_available",
+    "grn_swim",
     # analysis
-    "Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE",
-    "Trajectory", "replay", "actuation_terms", "actuation_rates", "EXPANDING", "CONTRACTING", "NEUTRAL",
-    "STATE_NAMES", "DEFAULT_NEUTRAL", "animate", "mp4_available", "LocomotionMode", "classify_locomotion",
-    "best_statistics", "grow_output", "last_morphology_change", "morphology_changes", "oscillator_spread",
-    "phase_spread", "tries_per_viable", "plot",
+    "Run",
+    "LineageEntry",
+    "HISTORY_DTYPE",
+    "read_history",
+    "morphology_distance",
+    "MORPHOLOGY_TOLERANCE",
+    "Trajectory",
+    "replay",
+    "actuation_terms",
+    "actuation_rates",
+    "EXPANDING",
+    "CONTRACTING",
+    "NEUTRAL",
+    "STATE_NAMES",
+    "DEFAULT_NEUTRAL",
+    "animate",
+    "mp4_available",
+    "LocomotionMode",
+    "classify_locomotion",
+    "best_statistics",
+    "grow_output",
+    "last_morphology_change",
+    "morphology_changes",
+    "oscillator_spread",
+    "phase_spread",
+    "tries_per_viable",
+    "plot",
 ]
 
 
