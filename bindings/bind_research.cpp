@@ -496,7 +496,12 @@ void bind_research(nb::module_& m) {
       "Actuation set from outside the simulation (see ``Simulation.add_external_actuation``):\n"
       "rest length of spring (i, j) = (1 + u_i + u_j) L0, with the cell terms u_i set directly\n"
       "(mode 'rest_length') or u_i = a_i sin(f_i t + phase_i) with amplitudes and phases set\n"
-      "(mode 'oscillator'; f_i: the body's frequencies unless set). |u_i| < 0.5.")
+      "(mode 'oscillator'; f_i: the body's frequencies unless set). |u_i| < 0.5. The oscillators\n"
+      "step exactly as the body's own (effect 'actuation'); with ``delayed_start`` each cell "
+      "starts at\n"
+      "a zero of its sine as the paper's cells do, so the body's amplitudes, frequencies and "
+      "phases\n"
+      "swim the body as an evaluation does, bit for bit.")
       .def_prop_ro(
           "mode",
           [](const ExternalActuation& a) {
@@ -504,6 +509,18 @@ void bind_research(nb::module_& m) {
                                                                                 : "oscillator");
           },
           "'rest_length' or 'oscillator'.")
+      .def_prop_ro("delayed_start", &ExternalActuation::delayed_start,
+                   "Mode 'oscillator': each cell starts at the first zero of its sine (the paper's "
+                   "delayed start).")
+      .def_prop_ro(
+          "start_steps",
+          [](const ExternalActuation& a) {
+            const std::vector<long> v = a.start_steps();
+            return owned_int(std::vector<std::int64_t>(v.begin(), v.end()), {v.size()});
+          },
+          nb::rv_policy::move,
+          "(n,) int64: each cell's start step as of the last step (mode 'oscillator'; -1 = not yet "
+          "decided or never).")
       .def_prop_ro("node_count", &ExternalActuation::node_count, "Cells.")
       .def(
           "set_terms", [](ExternalActuation& a, nb::handle u) { a.set_terms(to_doubles(u)); },
@@ -528,7 +545,7 @@ void bind_research(nb::module_& m) {
           nb::rv_policy::move, "(n,) cell terms u_i of the last step.");
   add_method(
       nb::type<Simulation>(), "add_external_actuation",
-      [](Simulation& sim, const Body& body, const std::string& mode) {
+      [](Simulation& sim, const Body& body, const std::string& mode, bool delayed_start) {
         for (const Effect* e : sim.effects())
           if (e->name() == "actuation" || e->name() == "external_actuation")
             throw ConfigError(fmt::format(
@@ -539,16 +556,19 @@ void bind_research(nb::module_& m) {
           throw GeometryError(fmt::format(
               "Simulation.add_external_actuation: the body has {} cells, the simulation {}",
               body.node_count(), sim.node_count()));
-        auto effect = std::make_unique<ExternalActuation>(body, actuation_mode(mode));
+        auto effect =
+            std::make_unique<ExternalActuation>(body, actuation_mode(mode), delayed_start);
         ExternalActuation* raw = effect.get();
         sim.add_effect(std::move(effect));
         return raw;
       },
-      "body"_a, "mode"_a = "rest_length", nb::rv_policy::reference_internal,
+      "body"_a, "mode"_a = "rest_length", "delayed_start"_a = false,
+      nb::rv_policy::reference_internal,
       "Drive the rest lengths from outside (returns the ExternalActuation to set): `body` is the "
       "body this\n"
-      "simulation swims; mode 'rest_length' (set u_i) or 'oscillator' (set amplitudes and phases). "
-      "The\n"
+      "simulation swims; mode 'rest_length' (set u_i) or 'oscillator' (set amplitudes and phases;\n"
+      "`delayed_start`: each cell starts at a zero of its sine, as the body's own actuation starts "
+      "it). The\n"
       "scene must not list 'actuation'.");
 
   // --- GRN control added to a Python-built simulation (issue 18, docs/control.md)

@@ -15,17 +15,16 @@ Controller = Callable[[np.ndarray, float], np.ndarray]
 
 
 def random_controller(env: animat.SwimEnv, seed: int = 0) -> Controller:
-    """Uniform random rest-length terms every step (the action space's own sampler)."""
+    """Uniform random rest-length terms every step (the action space's own sampler, in [-1, 1])."""
     env.action_space.seed(seed)
     return lambda obs, t: np.asarray(env.action_space.sample())
 
 
 def travelling_wave(env: animat.SwimEnv, frequency: float = 4.0, wavelength: float = 6.0) -> Controller:
     """u_i(t) = a sin(f t - 2 pi x_i / wavelength): a wave running along the body's x axis (amplitude a
-    = development.amplitude_max, the paper's 0.2)."""
+    = development.amplitude_max, the paper's 0.2: the normalised action sin(...) in [-1, 1])."""
     x = np.asarray(env.body.positions)[:, 0]
-    a = env.amplitude_max
-    return lambda obs, t: a * np.sin(frequency * t - 2 * np.pi * x / wavelength)
+    return lambda obs, t: np.sin(frequency * t - 2 * np.pi * x / wavelength)
 
 
 def episode(env: animat.SwimEnv, controller: Controller, seed: int = 0) -> float:

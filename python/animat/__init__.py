@@ -7,7 +7,7 @@ organised by task:
   :func:`build_body`, :class:`Simulation`, :func:`evaluate`;
 - evolution: :func:`evolve` (the engine of ``animat_evolve``), :class:`GA` (ask/tell), your own
   :class:`Objective`, :class:`History`;
-- control: :class:`SwimEnv` (Gymnasium API; ``pip install animat[control]``);
+- control: :class:`SwimEnv` (Gymnasium API, registered as ``"animat/Swim-v0"``; ``pip install animat[control]``);
 - analysis: :class:`Run` reads a run directory; :func:`replay` returns a :class:`Trajectory`;
   :mod:`animat.plot` draws the paper's figures; :mod:`animat.locomotion` classifies how a swimmer
   moves; :func:`animate` renders GIF/MP4;
@@ -46,7 +46,7 @@ from ._core import (
     SwimResult,
 )
 from .animation import animate, mp4_available
-from .control import SWIM_ENV_OBJECTIVES, SwimEnv, gymnasium_available
+from .control import SWIM_ENV_ID, SWIM_ENV_OBJECTIVES, SwimEnv, gymnasium_available
 from .evolution import (
     GA,
     EvolutionResult,
@@ -166,6 +166,7 @@ __all__ = [
     "run_study",
     # control
     "SwimEnv",
+    "SWIM_ENV_ID",
     "SWIM_ENV_OBJECTIVES",
     "gymnasium_available",
     "grn_swim",

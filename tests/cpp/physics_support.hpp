@@ -59,14 +59,14 @@ Points points(const std::vector<std::pair<double, double>>& xy) {
 }
 
 /// Two nodes on the x axis at distance d joined by one spring of rest length l0 (also a skin edge).
-Body two_nodes(double d, double l0) {
+[[maybe_unused]] Body two_nodes(double d, double l0) {
   Body b = make_body(points({{0.0, 0.0}, {d, 0.0}}), {{0, 1}}, {}, {{0, 1}});
   b.rest_lengths(0) = l0;
   return b;
 }
 
 /// Unit square, CCW, one region, four edge springs, all skin.
-Body square() {
+[[maybe_unused]] Body square() {
   return make_body(points({{0, 0}, {1, 0}, {1, 1}, {0, 1}}), {{0, 1}, {1, 2}, {2, 3}, {0, 3}},
                    {{0, 1, 2, 3}}, {{0, 1}, {1, 2}, {2, 3}, {0, 3}});
 }

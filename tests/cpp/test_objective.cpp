@@ -14,6 +14,8 @@
 #include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "animat/run.hpp"
+#include "counting_allocator.hpp"
+#include "physics_support.hpp"
 #include "test_support.hpp"
 
 using namespace animat;
@@ -90,8 +92,8 @@ TEST(AskTell, DrivenFromOutsideEqualsTheEngineRunningItself) {
       driven.tell(f);
       ++rounds;
     }
-    // the initial slots needed more than one round (1 genome in 4 is non-viable)
-    EXPECT_GT(rounds, 15);
+    EXPECT_GT(rounds,
+              15);  // the initial slots needed more than one round (1 genome in 4 is non-viable)
     expect_same_history(itself.history(), driven.history());
     expect_same_population(itself, driven);
   }
@@ -266,8 +268,8 @@ TEST(Objective, DistanceIsEvaluateBitForBitAndObservingChangesNothing) {
 }
 
 TEST(Objective, DistancePerSizeAndSpeedTowardFollowTheirFormulas) {
-  // the 3-4-5 triangle's hypotenuse + a cell
-  EXPECT_DOUBLE_EQ(body_length(triangle_body()), 5.0 + 1.0);
+  EXPECT_DOUBLE_EQ(body_length(triangle_body()),
+                   5.0 + 1.0);  // the 3-4-5 triangle's hypotenuse + a cell
   Config c = small_config();
   const Genome g = viable_genome(c, 5);
   const EvaluationRecord rec = record_evaluation(g, c, true, 0);
@@ -435,5 +437,158 @@ TEST(ExternalActuation, OscillatorModeIsEq2WithoutTheDelayedStart) {
       ASSERT_NEAR(sim.rest_lengths_now()[static_cast<std::size_t>(s)], expected, 1e-12)
           << "step " << k;
     }
+  }
+}
+
+namespace {
+
+std::vector<double> values(const Vector& v) { return {v.data(), v.data() + v.size()}; }
+
+}  // namespace
+
+TEST(ExternalActuation, DelayedStartReplaysTheBodysOwnActuationBitForBit) {
+  // Random amplitudes, frequencies and phases: every cell has its own start step. The same values,
+  // set again every 7 steps (a controller holding its action), write the rest lengths the effect
+  // "actuation" writes, bit for bit, across a resynchronisation of the oscillators (step 1024).
+  const Body b = swimmer(lattice_points(5, 4, 0.1, 3), Drive::random, 0.2, 4.0, 11);
+  const std::vector<double> a = values(b.amplitude), phase = values(b.phase);
+  Simulation own(b, scene_with({"springs", "actuation", "pressure", "drag"}));
+  Simulation driven(b, scene_with({"springs", "pressure", "drag"}));
+  auto effect = std::make_unique<ExternalActuation>(b, ExternalActuation::Mode::oscillator, true);
+  ExternalActuation* act = effect.get();
+  driven.add_effect(std::move(effect));
+  EXPECT_TRUE(act->delayed_start());
+  const double h = PhysicsParams{}.dt;
+  long latest = 0;
+  for (long k = 0; k < 1300; ++k) {
+    if (k % 7 == 0) act->set_oscillators(a, phase);
+    own.step();
+    driven.step();
+    ASSERT_EQ(
+        std::vector<double>(driven.rest_lengths_now().begin(), driven.rest_lengths_now().end()),
+        std::vector<double>(own.rest_lengths_now().begin(), own.rest_lengths_now().end()))
+        << "step " << k;
+    if (k == 0) {
+      const std::vector<long> start = act->start_steps();
+      for (int i = 0; i < b.node_count(); ++i) {
+        const auto u = static_cast<std::size_t>(i);
+        EXPECT_EQ(start[u], static_cast<long>(
+                                std::ceil(actuation_start_time(b.frequency(i), b.phase(i)) / h)))
+            << i;
+        latest = std::max(latest, start[u]);
+      }
+    }
+  }
+  EXPECT_GT(latest, 10);  // the starts really are delayed
+  EXPECT_EQ(driven.positions(), own.positions());
+  EXPECT_EQ(driven.velocities(), own.velocities());
+}
+
+TEST(ExternalActuation, EvaluateEqualsTheBodysOscillatorsDrivenFromOutside) {
+  // evaluate()'s distance is the distance of a swim whose actuation is external, set once to the
+  // body's amplitudes and phases with delayed_start: the same number, not just a close one.
+  Config c = small_config();
+  c.evaluation.steps = 1100;
+  // The first viable genome (from seed 5 on) with a cell whose start is delayed by 10 steps or more
+  // (a saturated phase output, φ = 0 or 2π, starts at once).
+  Genome g;
+  Body body;
+  for (std::uint64_t seed = 5;; ++seed) {
+    ASSERT_LT(seed, 100u);
+    g = viable_genome(c, seed);
+    body = build_body(develop(g, c.genome, c.grn, c.development), c.body);
+    double latest = 0.0;
+    for (int i = 0; i < body.node_count(); ++i)
+      latest = std::max(latest, actuation_start_time(body.frequency(i), body.phase(i)));
+    if (latest >= 10 * c.physics.dt) break;
+  }
+  const EvaluationResult r = evaluate(g, c);
+  ASSERT_TRUE(r.valid);
+  ASSERT_GT(r.fitness, 0.0);
+  SceneParams scene = c.scene;
+  std::erase(scene.effects, std::string("actuation"));
+  auto distance = [&](bool delayed_start) {
+    Simulation sim(body, scene, c.physics);
+    auto effect = std::make_unique<ExternalActuation>(body, ExternalActuation::Mode::oscillator,
+                                                      delayed_start);
+    effect->set_oscillators(values(body.amplitude), values(body.phase));
+    sim.add_effect(std::move(effect));
+    const Eigen::Vector2d start = sim.center_of_mass();
+    sim.step(c.evaluation.steps);
+    return (sim.center_of_mass() - start).norm();
+  };
+  EXPECT_EQ(distance(true), r.fitness);
+  EXPECT_GT(std::abs(distance(false) - r.fitness),
+            1e-6 * r.fitness);  // every cell started at once: another swim
+}
+
+TEST(ExternalActuation, ANewPhaseRestartsTheOscillatorAndRecountsAPendingStart) {
+  Points p(3, 2);
+  p << 0, 0, 1, 0, 0.5, 0.9;
+  Vector f(3);
+  f << 2.0, 0.1, 4.0;
+  const Body b = build_body(p, Vector::Zero(3), f, Vector::Zero(3));
+  const double h = PhysicsParams{}.dt;
+  Simulation sim(b, scene_with({"springs"}));
+  auto effect = std::make_unique<ExternalActuation>(b, ExternalActuation::Mode::oscillator, true);
+  ExternalActuation* act = effect.get();
+  sim.add_effect(std::move(effect));
+  std::vector<double> a = {0.1, 0.2, 0.15}, phase = {0.3, 1.0, 2.0};
+  act->set_oscillators(a, phase);
+  sim.step(40);
+  // cell 0 starts at (π − 0.3)/2 = 1.42 (step 86), cell 1 at (π − 1)/0.1 = 21.4, cell 2 at
+  // (π − 2)/4 = 0.29 (step 18)
+  const std::vector<long> start = act->start_steps();
+  EXPECT_EQ(start[0], static_cast<long>(std::ceil((kPi - 0.3) / 2.0 / h)));
+  EXPECT_EQ(start[2], static_cast<long>(std::ceil((kPi - 2.0) / 4.0 / h)));
+  EXPECT_EQ(act->terms()[0], 0.0);
+  EXPECT_NE(act->terms()[2], 0.0);
+  // New phases at step 40 (t = 40 h): cell 1 has not started, so its start is recounted from now;
+  // cell 2 has, and its oscillator is recomputed from its formula at once.
+  phase = {0.3, 3.0, 0.5};
+  act->set_oscillators(a, phase);
+  sim.step();
+  const double t = 40 * h;
+  const std::vector<long> restart = act->start_steps();
+  EXPECT_EQ(restart[0], start[0]);
+  EXPECT_EQ(restart[1],
+            40 + static_cast<long>(std::ceil(actuation_start_time(0.1, 0.1 * t + 3.0) / h)));
+  EXPECT_EQ(restart[2], start[2]);
+  EXPECT_EQ(act->terms()[2], 0.15 * std::sin(4.0 * t + 0.5));
+  EXPECT_EQ(act->terms()[1], 0.0);
+  sim.step(restart[1] - 41);
+  EXPECT_EQ(act->terms()[1], 0.0);  // the step before its start
+  sim.step();
+  EXPECT_NEAR(act->terms()[1], 0.2 * std::sin(0.1 * static_cast<double>(restart[1]) * h + 3.0),
+              1e-15);
+  EXPECT_LT(std::abs(act->terms()[1]), 0.2 * 0.1 * h);  // it starts at a zero of its sine
+  // Without delayed_start every cell oscillates from the first step on.
+  ExternalActuation plain(b, ExternalActuation::Mode::oscillator);
+  EXPECT_FALSE(plain.delayed_start());
+  EXPECT_EQ(plain.start_steps(), (std::vector<long>{-1, -1, -1}));  // not decided before a step
+  EXPECT_THROW(ExternalActuation(b, ExternalActuation::Mode::rest_length, true), ConfigError);
+}
+
+TEST(ExternalActuation, ControlLoopAllocatesNothing) {
+  const Body b = swimmer(lattice_points(6, 4, 0.1, 2), Drive::random, 0.2, 4.0, 5);
+  for (const bool delayed : {false, true}) {
+    Simulation sim(b, scene_with({"springs", "pressure", "drag", "collisions"}));
+    auto effect =
+        std::make_unique<ExternalActuation>(b, ExternalActuation::Mode::oscillator, delayed);
+    ExternalActuation* act = effect.get();
+    sim.add_effect(std::move(effect));
+    const std::vector<double> a = values(b.amplitude), phase = values(b.phase);
+    std::vector<double> shifted = phase;
+    for (double& v : shifted) v += 0.5;
+    act->set_oscillators(a, phase);
+    sim.step(10);
+    g_allocations = 0;
+    g_counting = true;
+    for (int k = 0; k < 200; ++k) {
+      act->set_oscillators(a, k % 50 < 25 ? phase : shifted);
+      sim.step(4);
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0) << "delayed_start " << delayed;
   }
 }

@@ -1,5 +1,8 @@
 """animat.SwimEnv: the Gymnasium API on a developed body, actions driving the rest lengths."""
 
+import math
+import warnings
+
 import numpy as np
 import pytest
 
@@ -10,21 +13,63 @@ from gymnasium.utils.env_checker import check_env  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def body_and_config():
+def genome_and_config():
     c = animat.Config()
     c["evaluation.steps"] = 400
     genome, _ = animat.Genome.random_viable(seed=3, config=c)
+    return genome, c
+
+
+@pytest.fixture(scope="module")
+def body_and_config(genome_and_config):
+    genome, c = genome_and_config
     return animat.build_body(animat.develop(genome, c)), c
 
 
-@pytest.mark.parametrize("mode", ["rest_length", "oscillator"])
-def test_passes_gymnasium_env_checker(body_and_config, mode):
+def test_import_animat_registers_the_environment_with_gymnasium(body_and_config):
     body, c = body_and_config
-    env = animat.SwimEnv(body, c, mode=mode, frame_skip=4, max_episode_steps=20)
-    check_env(env, skip_render_check=True)
+    assert animat.SWIM_ENV_ID == "animat/Swim-v0" and animat.SWIM_ENV_ID in gymnasium.envs.registry
+    assert animat.control.register_envs()  # again: a no-op, no re-registration warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert animat.control.register_envs()
+        env = gymnasium.make("animat/Swim-v0", body=body, config=c, mode="oscillator", frame_skip=2, episode_steps=7)
+        assert isinstance(env.unwrapped, animat.SwimEnv)
+        assert env.unwrapped.max_episode_steps == 7 and env.unwrapped.frame_skip == 2
+        env.reset(seed=0)
+        for k in range(7):
+            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+            assert not terminated and truncated == (k == 6)
+        env.close()
+
+
+@pytest.mark.parametrize("mode", ["rest_length", "oscillator"])
+def test_passes_gymnasium_env_checker_without_a_warning(body_and_config, mode):
+    """check_env with every check on (render modes and close included: the env is made through
+    gymnasium.make, so it has a spec), warnings turned into errors."""
+    body, c = body_and_config
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env = gymnasium.make(
+            "animat/Swim-v0",
+            body=body,
+            config=c,
+            mode=mode,
+            frame_skip=4,
+            episode_steps=20,
+            render_mode="rgb_array",
+            render_size=(64, 48),
+        )
+        check_env(env.unwrapped)
+        env.reset(seed=1)  # the PassiveEnvChecker wrapper's own checks
+        env.step(env.action_space.sample())
+        assert env.render().shape == (48, 64, 3)
+        env.close()
     n, m = body.node_count, body.spring_count
     assert env.observation_space.shape == (4 * n + m,)
     assert env.action_space.shape == ((n,) if mode == "rest_length" else (2 * n,))
+    assert np.all(env.action_space.low == -1.0) and np.all(env.action_space.high == 1.0)
+    assert np.all(np.isfinite(env.observation_space.low)) and np.all(np.isfinite(env.observation_space.high))
 
 
 def test_observations_are_relative_to_the_centre_of_mass_and_start_at_rest(body_and_config):
@@ -32,11 +77,13 @@ def test_observations_are_relative_to_the_centre_of_mass_and_start_at_rest(body_
     env = animat.SwimEnv(body, c)
     obs, info = env.reset(seed=1)
     n = body.node_count
-    rel = obs[: 2 * n].reshape(n, 2)
+    length = animat._core.body_length(body)
+    rel = obs[: 2 * n].reshape(n, 2) * length  # in body lengths
     np.testing.assert_allclose(rel.mean(axis=0), 0.0, atol=1e-9)
     np.testing.assert_allclose(rel + info["com"], np.asarray(body.positions), atol=1e-5)  # float32 Box2D positions
     np.testing.assert_array_equal(obs[2 * n : 4 * n], 0.0)  # at rest
     np.testing.assert_allclose(obs[4 * n :], 0.0, atol=1e-6)  # springs at their rest length
+    np.testing.assert_array_equal(obs, env.physical_observation() / env.obs_scale)
     obs2, reward, terminated, truncated, _ = env.step(np.zeros(n))  # no actuation: nothing moves
     assert reward == 0.0 and not terminated and not truncated
     np.testing.assert_array_equal(obs2, obs)
@@ -49,7 +96,7 @@ def test_rewards_add_up_to_the_objective_and_an_episode_truncates(body_and_confi
         env.reset(seed=0)
         total, t = 0.0, 0.0
         for k in range(30):
-            action = 0.15 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0])
+            action = 0.75 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0])  # u = 0.15 sin(...)
             _, reward, terminated, truncated, info = env.step(action)
             total += reward
             t = info["time"]
@@ -67,8 +114,12 @@ def test_actions_outside_the_space_are_refused(body_and_config):
     env = animat.SwimEnv(body, c)
     env.reset()
     n = body.node_count
+    with pytest.raises(ValueError, match=r"action\[0\] = 1.5 is outside the action space \[-1.0, 1.0\]"):
+        env.step(np.full(n, 1.5))
+    physical = animat.SwimEnv(body, c, normalize_actions=False)
+    physical.reset()
     with pytest.raises(ValueError, match=r"action\[0\] = 0.3 is outside the action space \[-0.2, 0.2\]"):
-        env.step(np.full(n, 0.3))
+        physical.step(np.full(n, 0.3))
     with pytest.raises(ValueError, match="action has shape"):
         env.step(np.zeros(n + 1))
 
@@ -76,7 +127,7 @@ def test_actions_outside_the_space_are_refused(body_and_config):
 def test_oscillator_mode_equals_the_body_oscillating_by_itself_once_started(body_and_config):
     """Amplitudes and phases set to the body's own reproduce eq. 2 (without the paper's delayed start)."""
     body, c = body_and_config
-    env = animat.SwimEnv(body, c, mode="oscillator", frame_skip=1)
+    env = animat.SwimEnv(body, c, mode="oscillator", frame_skip=1, normalize_actions=False)
     env.reset()
     action = np.concatenate([np.asarray(body.amplitude), np.mod(np.asarray(body.phase), 2 * np.pi)])
     env.step(action)
@@ -112,7 +163,7 @@ def test_energy_and_horizontal_objectives_are_rewarded_as_the_metered_work_says(
         env.reset(seed=0)
         total, t = 0.0, 0.0
         for _ in range(30):
-            _, reward, terminated, _, info = env.step(0.15 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0]))
+            _, reward, terminated, _, info = env.step(0.75 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0]))
             total += reward
             t = info["time"]
             assert not terminated
@@ -146,7 +197,7 @@ def test_crawl_episodes_start_on_the_floor_settled_as_an_evaluation_does(body_an
     assert np.asarray(start_body.positions)[:, 1].min() >= floor - 1e-6
     t = 0.0
     for _ in range(50):
-        _, _, terminated, _, info = env.step(0.15 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0]))
+        _, _, terminated, _, info = env.step(0.75 * np.sin(4.0 * t - np.asarray(body.positions)[:, 0]))
         t = info["time"]
         assert not terminated
         assert np.asarray(env._sim.positions)[:, 1].min() >= floor - 1e-6  # never below the floor
@@ -156,10 +207,181 @@ def test_crawl_episodes_start_on_the_floor_settled_as_an_evaluation_does(body_an
 def test_external_actuation_terms_and_frequencies_can_be_read(body_and_config):
     """The ExternalActuation's array properties (they raised a nanobind ownership error before)."""
     body, c = body_and_config
-    env = animat.SwimEnv(body, c, mode="oscillator", frame_skip=1)
+    env = animat.SwimEnv(body, c, mode="oscillator", frame_skip=1, normalize_actions=False)
     env.reset()
     np.testing.assert_array_equal(env._actuation.frequency, np.asarray(body.frequency))
     n = body.node_count
     amplitude, phase = np.full(n, 0.1), np.linspace(0.0, 1.0, n)
     env.step(np.concatenate([amplitude, phase]))
     np.testing.assert_allclose(env._actuation.terms, amplitude * np.sin(phase), rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("mode", ["rest_length", "oscillator"])
+def test_normalised_actions_map_to_the_physical_ranges(body_and_config, mode):
+    """[-1, 1] → u in ±a_max (rest_length), amplitude in [0, a_max] and phase in [0, 2π] (oscillator);
+    a normalised action swims as its physical action does in an env that takes physical actions."""
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c, mode=mode)
+    physical_env = animat.SwimEnv(body, c, mode=mode, normalize_actions=False)
+    n, a_max = body.node_count, c["development.amplitude_max"]
+    assert physical_env.action_space == env.physical_action_space == physical_env.physical_action_space
+    lo, hi = env.physical_action(env.action_space.low), env.physical_action(env.action_space.high)
+    np.testing.assert_array_equal(lo, env.physical_action_space.low)
+    np.testing.assert_array_equal(hi, env.physical_action_space.high)
+    if mode == "rest_length":
+        assert hi[0] == a_max and env.physical_action(np.zeros(n))[0] == 0.0
+    else:
+        np.testing.assert_array_equal(hi, np.concatenate([np.full(n, a_max), np.full(n, 2 * math.pi)]))
+        np.testing.assert_allclose(env.physical_action(np.zeros(2 * n)), np.repeat([a_max / 2, math.pi], n))
+    rng = np.random.default_rng(4)
+    actions = [rng.uniform(-1, 1, env.action_space.shape) for _ in range(10)]
+    for a in actions:
+        np.testing.assert_allclose(env.normalized_action(env.physical_action(a)), a, rtol=0, atol=1e-15)
+    env.reset(seed=0)
+    physical_env.reset(seed=0)
+    for a in actions:
+        obs, reward, *_ = env.step(a)
+        obs_p, reward_p, *_ = physical_env.step(env.physical_action(a))
+        np.testing.assert_array_equal(obs, obs_p)
+        assert reward == reward_p
+    assert env.objective_value() > 0
+
+
+def test_observations_stay_in_their_box_and_clipping_is_counted(body_and_config):
+    body, c = body_and_config
+    env = animat.SwimEnv(body, c, max_episode_steps=40)
+    env.action_space.seed(0)
+    obs, info = env.reset(seed=0)
+    assert env.observation_space.contains(obs) and info["obs_clipped"] == 0
+    worst = 0.0
+    for _ in range(40):
+        obs, _, terminated, _, info = env.step(env.action_space.sample())  # random, the roughest control
+        assert env.observation_space.contains(obs) and not terminated
+        worst = max(worst, np.abs(env.physical_observation() / env.obs_scale).max())
+    assert env.obs_clipped == 0 and worst < 1.0  # the default limit, 10, is far from the values of a swim
+    # A limit the swim exceeds: the observation is clipped into the Box and every clipped value counted.
+    tight = animat.SwimEnv(body, c, max_episode_steps=40, obs_limit=0.05)
+    tight.action_space.seed(0)
+    _, info = tight.reset(seed=0)
+    total = info["obs_clipped"]  # the positions of the start already exceed 0.05 body lengths
+    assert total > 0
+    for _ in range(40):
+        obs, _, _, _, info = tight.step(tight.action_space.sample())
+        scaled = tight.physical_observation() / tight.obs_scale
+        beyond = np.abs(scaled) > 0.05
+        assert info["obs_clipped"] == beyond.sum()
+        np.testing.assert_array_equal(obs, np.clip(scaled, -0.05, 0.05))
+        assert tight.observation_space.contains(obs)
+        total += info["obs_clipped"]
+    assert tight.obs_clipped == total > 0
+    _, info = tight.reset(seed=0)  # counted afresh from the reset observation on
+    assert tight.obs_clipped == info["obs_clipped"] > 0
+
+
+def test_rgb_array_rendering_draws_the_body_as_it_moves(body_and_config):
+    body, c = body_and_config
+    assert animat.SwimEnv(body, c).render() is None  # render_mode None
+    env = animat.SwimEnv(body, c, render_mode="rgb_array", max_episode_steps=30)
+    assert env.metadata["render_fps"] == pytest.approx(15.0)  # real time: 1 / (dt · frame_skip)
+    with pytest.raises(RuntimeError, match="reset"):
+        env.render()
+    env.reset(seed=0)
+    first = env.render()
+    assert first.shape == (240, 320, 3) and first.dtype == np.uint8
+    assert (first < 200).any(axis=2).mean() > 0.01  # the body is drawn (dark skin and springs on white)
+    for k in range(30):
+        env.step(0.75 * np.sin(4.0 * k * env.dt - np.asarray(body.positions)[:, 0]))
+    last = env.render()
+    assert last.shape == first.shape and not np.array_equal(last, first)
+    reds = (last[..., 0] > 150) & (last[..., 2] < 120)
+    blues = (last[..., 2] > 150) & (last[..., 0] < 120)
+    assert reds.any() and blues.any()  # cells coloured by their term: lengthening and shortening
+    # Gymnasium's frame collector takes the frames of every step.
+    wrapped = gymnasium.wrappers.RenderCollection(
+        gymnasium.make("animat/Swim-v0", body=body, config=c, render_mode="rgb_array", episode_steps=5)
+    )
+    wrapped.reset(seed=0)
+    for _ in range(5):
+        wrapped.step(wrapped.action_space.sample())
+    frames = wrapped.render()
+    assert len(frames) == 6 and all(f.shape == (240, 320, 3) for f in frames)
+
+
+def test_record_video_writes_an_episode(body_and_config, tmp_path):
+    pytest.importorskip("moviepy")
+    body, c = body_and_config
+    env = gymnasium.wrappers.RecordVideo(
+        gymnasium.make("animat/Swim-v0", body=body, config=c, render_mode="rgb_array", episode_steps=10),
+        str(tmp_path / "videos"),
+        episode_trigger=lambda k: True,
+        disable_logger=True,
+    )
+    env.reset(seed=0)
+    for _ in range(10):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+    assert truncated and not terminated
+    env.close()
+    videos = list((tmp_path / "videos").glob("*.mp4"))
+    assert len(videos) == 1 and videos[0].stat().st_size > 0
+
+
+def test_delayed_start_replays_evaluate_exactly(genome_and_config):
+    """The body's own amplitudes and phases, held for an episode with the paper's delayed start, swim
+    the body exactly as animat.evaluate() does (steps across the oscillators' resynchronisation at
+    step 1024); without the delayed start the swim differs."""
+    genome, c = genome_and_config
+    c = c.copy()
+    c["evaluation.steps"] = 1200
+    result = animat.evaluate(genome, c)
+    assert result.valid and result.fitness > 0
+
+    def swim(**kwargs):
+        env = animat.SwimEnv(genome, c, mode="oscillator", **kwargs)
+        assert env.max_episode_steps == 300
+        env.reset(seed=0)
+        action, total = env.own_action(), 0.0
+        while True:
+            _, reward, terminated, truncated, _ = env.step(action)
+            total += reward
+            assert not terminated
+            if truncated:
+                return env, total
+
+    env, total = swim(delayed_start=True, normalize_actions=False)
+    assert env.objective_value() == result.fitness  # bit for bit
+    assert env.valid()  # as evaluate() judged it
+    assert total == pytest.approx(result.fitness, rel=1e-12)
+    assert env._sim.steps_done == result.swim_steps == 1200
+    h = c["physics.dt"]
+    start = np.ceil(
+        np.mod(np.pi - np.mod(np.asarray(env.body.phase), np.pi), np.pi) / np.asarray(env.body.frequency) / h
+    )
+    np.testing.assert_array_equal(env._actuation.start_steps, start)  # the paper's start of each cell
+    assert start.max() > 0
+    undelayed, _ = swim(normalize_actions=False)
+    assert abs(undelayed.objective_value() - result.fitness) > 1e-6 * result.fitness
+    normalised, _ = swim(delayed_start=True)  # the same controller through [-1, 1]: rounding only
+    assert normalised.objective_value() == pytest.approx(result.fitness, rel=1e-6)
+    with pytest.raises(ValueError, match="delayed_start needs mode='oscillator'"):
+        animat.SwimEnv(genome, c, delayed_start=True)
+    with pytest.raises(ValueError, match="own_action"):
+        animat.SwimEnv(genome, c).own_action()
+
+
+def test_the_cem_example_trains_through_gymnasium_make(body_and_config):
+    """examples/swim_env_cem.py, in miniature: the best return so far never falls and beats the start."""
+    import importlib.util
+    from pathlib import Path
+
+    body, c = body_and_config
+    path = Path(__file__).resolve().parents[2] / "examples" / "swim_env_cem.py"
+    spec = importlib.util.spec_from_file_location("swim_env_cem", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    env = gymnasium.make("animat/Swim-v0", body=body, config=c, mode="oscillator", episode_steps=25)
+    start = module.episode_return(env, lambda obs: np.zeros(env.action_space.shape))
+    action, value, history = module.cem(env, iterations=3, population=6, seed=1, log=lambda line: None)
+    assert len(history) == 3 and all(np.isfinite(h).all() for h in history)
+    best_so_far = [h[2] for h in history]
+    assert best_so_far == sorted(best_so_far) and value == best_so_far[-1] >= start
+    assert module.episode_return(env, lambda obs: action) == value  # deterministic episodes
