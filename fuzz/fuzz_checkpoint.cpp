@@ -3,7 +3,7 @@
 // The first byte picks how the rest reaches restore():
 //   0 (mod 3)  as is: the whole checkpoint file (checksum and all);
 //   1          as the payload, wrapped with its correct checksum (reaches the content checks);
-//   2          as a payload JSON object whose identity, format and version are set to this config's,
+//   2          as a payload JSON object whose identity (scheme 2), format and version are set to this config's,
 //              then wrapped with its checksum (reaches population, genomes and history).
 // Failure = a crash, a sanitizer report, an exception other than animat::Error, or a broken oracle:
 // an accepted checkpoint is one run_evolution can continue (a non-empty history ending at the
@@ -22,6 +22,7 @@
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
 #include "animat/run.hpp"
+#include "animat/run_identity.hpp"
 #include "fuzz_util.hpp"
 
 namespace {
@@ -80,6 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       json p = json::parse(rest, nullptr, false);
       if (p.is_discarded() || !p.is_object()) return 0;
       p["identity"] = fmt::format("{:016x}", run_identity(config));
+      p["identity_scheme"] = kRunIdentityScheme;
       p["format"] = "animat.checkpoint";
       p["version"] = 1;
       text = wrap(p.dump(-1, ' ', false, json::error_handler_t::replace));
