@@ -50,9 +50,12 @@ void validate(const DevelopmentParams& p) {
            fmt::format("unknown effect '{}' (known: repulsion, adhesion, morphogens)", e));
   if (std::find(std::begin(kDivisionAxisNames), std::end(kDivisionAxisNames), p.division_axis) ==
       std::end(kDivisionAxisNames))
-    fail("division_axis",
-         fmt::format("unknown value '{}' (expected one of orientation, morphogen_gradient)",
-                     p.division_axis));
+    fail(
+        "division_axis",
+        fmt::format("unknown value '{}' (expected one of orientation, morphogen_gradient, outward)",
+                    p.division_axis));
+  if (p.division_max_contacts < 0)
+    fail("division_max_contacts", fmt::format("must be >= 0, got {}", p.division_max_contacts));
   if (p.steps < 1) fail("steps", fmt::format("must be >= 1, got {}", p.steps));
   if (p.max_cells < 1) fail("max_cells", fmt::format("must be >= 1, got {}", p.max_cells));
   if (!(p.time_step > 0.0 && p.time_step <= 1.0))
@@ -95,6 +98,7 @@ struct DevelopmentWorld::Impl {
   DevelopmentParams params;
   bool repulsion = false, adhesion = false, morphogens = false;
   bool gradient_axis = false;  ///< division_axis == "morphogen_gradient"
+  bool outward_axis = false;   ///< division_axis == "outward"
   std::array<Vec2, 3> sources{};
 
   CellIntegrator motion;  ///< the cells' Box2D state (position, velocity), index = cell
@@ -119,6 +123,32 @@ struct DevelopmentWorld::Impl {
   /// less
   std::size_t grid_from = 64;
 
+  /// Whether cells i and j touch: surfaces closer than adhesion_range (the adhesion's reach, a
+  /// geometric definition whether or not adhesion is on).
+  [[nodiscard]] bool touching(std::size_t i, std::size_t j) const {
+    const double reach = cells[i].radius + cells[j].radius + params.adhesion_range;
+    return (cells[j].position - cells[i].position).squaredNorm() < reach * reach;
+  }
+  /// How many other cells cell i touches (division_max_contacts). Only asked for cells about to
+  /// divide, so a scan of every cell costs less than keeping a contact list.
+  [[nodiscard]] int contact_count(std::size_t i) const {
+    int count = 0;
+    for (std::size_t j = 0; j < cells.size(); ++j)
+      if (j != i && touching(i, j)) ++count;
+    return count;
+  }
+  /// Σ of the unit vectors from cell i to the cells it touches (division_axis = "outward").
+  [[nodiscard]] Vec2 contact_direction_sum(std::size_t i) const {
+    Vec2 sum = Vec2::Zero();
+    for (std::size_t j = 0; j < cells.size(); ++j) {
+      if (j == i || !touching(i, j)) continue;
+      const Vec2 d = cells[j].position - cells[i].position;
+      const double norm = d.norm();
+      if (norm > 1e-12) sum += d / norm;
+    }
+    return sum;
+  }
+
   Impl(Grn g, const GrnParams& gp, const DevelopmentParams& p)
       : grn(std::move(g)), grn_params(gp), params(p) {
     validate(params);
@@ -126,6 +156,7 @@ struct DevelopmentWorld::Impl {
     adhesion = has_effect(params.effects, "adhesion");
     morphogens = has_effect(params.effects, "morphogens");
     gradient_axis = params.division_axis == "morphogen_gradient";
+    outward_axis = params.division_axis == "outward";
     for (std::size_t k = 0; k < 3; ++k)
       sources[k] = Vec2(params.maternal_sources[2 * k], params.maternal_sources[2 * k + 1]);
     morph_count = static_cast<int>(grn.morphogen_units().size());
@@ -381,7 +412,11 @@ int DevelopmentWorld::divide(int cell) {
   // axis that the GRN can turn, instead of one carried down the lineage. At the source itself (no
   // gradient) the orientation is used.
   Vec2 direction = mother.orientation;
-  if (w.gradient_axis) {
+  if (w.outward_axis) {
+    const Vec2 away = -w.contact_direction_sum(mi);
+    const double norm = away.norm();
+    if (norm > 1e-9) direction = away / norm;
+  } else if (w.gradient_axis) {
     const Vec2 up = w.sources[0] - mother.position;
     const double norm = up.norm();
     if (norm > 0.0) {
@@ -425,6 +460,9 @@ int DevelopmentWorld::divide_ready() {
     if (output(i, OutputChannel::divide) < w.params.divide_threshold) continue;
     if (static_cast<long long>(step_) - w.cells[static_cast<std::size_t>(i)].last_division <=
         w.params.refractory_steps)
+      continue;
+    if (w.params.division_max_contacts > 0 &&
+        w.contact_count(static_cast<std::size_t>(i)) > w.params.division_max_contacts)
       continue;
     divide(i);
     w.division_steps.push_back(step_);

@@ -27,9 +27,11 @@ namespace animat {
 inline constexpr std::string_view kDevelopmentEffectNames[] = {"repulsion", "adhesion",
                                                                "morphogens"};
 /// Where a daughter is placed (DevelopmentParams::division_axis): "orientation" (the paper's: along
-/// the mother's orientation vector) or "morphogen_gradient" (along the gradient of maternal
-/// morphogen 0 at the mother's position, turned by 2π × the mother's rotate output).
-inline constexpr std::string_view kDivisionAxisNames[] = {"orientation", "morphogen_gradient"};
+/// the mother's orientation vector), "morphogen_gradient" (along the gradient of maternal
+/// morphogen 0 at the mother's position, turned by 2π × the mother's rotate output) or "outward"
+/// (away from the cells the mother touches).
+inline constexpr std::string_view kDivisionAxisNames[] = {"orientation", "morphogen_gradient",
+                                                          "outward"};
 
 struct DevelopmentParams {
   int steps = 400;                ///< development steps [paper: 400]
@@ -50,8 +52,14 @@ struct DevelopmentParams {
   double division_offset = 0.2;
   /// Placement direction of a daughter: "orientation" (the mother's orientation vector) [paper] or
   /// "morphogen_gradient" (the unit gradient of maternal morphogen 0 at the mother's position, i.e.
-  /// toward source 0, rotated by 2π·rotate of the mother) [choose]; the jitter applies to either.
+  /// toward source 0, rotated by 2π·rotate of the mother) or "outward" (opposite to the sum of the
+  /// unit vectors to the cells the mother touches; the orientation when it touches none) [choose];
+  /// the jitter applies to every axis.
   std::string division_axis = "orientation";
+  /// A cell divides only while it touches at most this many cells (surfaces closer than
+  /// adhesion_range): 1 grows from the ends of a line only, 2 also lets branches start from a line;
+  /// 0 = any cell may divide [paper]. With division_axis = "outward" it grows from the tips.
+  int division_max_contacts = 0;
   double frequency_min = 0.5;  ///< oscillator frequency at output 0, rad per unit time [choose]
   double frequency_max = 6.0;  ///< oscillator frequency at output 1 [choose: docs/model.md]
   double amplitude_max = 0.2;  ///< amplitude scale [paper: 0.2]
@@ -125,9 +133,18 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"division_axis",
               "direction in which a daughter is placed: orientation (the mother's orientation "
               "vector) [paper] or morphogen_gradient (gradient of maternal morphogen 0 at the "
-              "mother, i.e. toward source 0, rotated by 2*pi*rotate of the mother) [choose]",
+              "mother, i.e. toward source 0, rotated by 2*pi*rotate of the mother) or outward "
+              "(away from the cells the mother touches) [choose]",
               Bounds::any(), kDivisionAxisNames, Identity::late},
     p.division_axis);
+  v(FieldInfo{"division_max_contacts",
+              "a cell divides only while it touches at most this many cells (surfaces closer "
+              "than adhesion_range); 0 = any cell [paper]; with division_axis = outward the "
+              "body grows from its tips [choose]",
+              Bounds::closed(0, 4096),
+              {},
+              Identity::late},
+    p.division_max_contacts);
   v(FieldInfo{"frequency_min",
               "oscillator frequency (rad per time unit) at frequency output 0 [choose]",
               Bounds::upto(kMaxCoefficient)},

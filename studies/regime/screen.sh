@@ -7,12 +7,16 @@
 #   studies/regime/screen.sh            # every point, one run at a time
 #   SCREEN_JOBS=2 studies/regime/screen.sh
 #
-# Grid (environment variables, space-separated): SCREEN_ENVS, SCREEN_DAMPING, SCREEN_STIFFNESS,
-# SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS.
+# Grid (environment variables, space-separated): SCREEN_ENVS, SCREEN_GROWTH, SCREEN_DAMPING,
+# SCREEN_STIFFNESS, SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS.
+# Growth: "paper" (any cell divides along its orientation), "tipsN" (a cell divides only while it
+# touches at most N cells, its daughter placed outward: development.division_max_contacts = N,
+# development.division_axis = "outward"). Run names carry the growth unless it is "paper".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 EXE=${ANIMAT_EVOLVE_EXE:-build/animat_evolve}
 ENVS=${SCREEN_ENVS:-"dn0.5 dn10"}
+GROWTH=${SCREEN_GROWTH:-"paper"}
 DAMPING=${SCREEN_DAMPING:-"4 1 0.25"}
 STIFFNESS=${SCREEN_STIFFNESS:-"100 30"}
 SEEDS=${SCREEN_SEEDS:-"1 2"}
@@ -23,15 +27,23 @@ KEEP=studies/regime/screen
 WORK=runs/screen
 mkdir -p "$KEEP" "$WORK"
 
-one() {  # env damping stiffness seed
+one() {  # env growth damping stiffness seed
   set -euo pipefail
-  local env=$1 c=$2 k=$3 seed=$4
-  local name="${env}_c${c}_k${k}_seed${seed}"
+  local env=$1 growth=$2 c=$3 k=$4 seed=$5
+  local name="${env}_c${c}_k${k}_seed${seed}" grow=()
+  if [[ "$growth" =~ ^tips([0-9]+)$ ]]; then
+    name="${env}_${growth}_c${c}_k${k}_seed${seed}"
+    grow=(--set "development.division_max_contacts=${BASH_REMATCH[1]}"
+          --set "development.division_axis=outward")
+  elif [[ "$growth" != paper ]]; then
+    echo "screen: unknown growth '$growth' (expected paper or tipsN)" >&2
+    return 1
+  fi
   local keep="$KEEP/$name" work="$WORK/$name"
   [[ -f "$keep/best_genome.json" ]] && return 0
   local args=(--config "configs/paper_${env}.toml" --set "evolution.population=$POP"
-              --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" --generations "$GENS"
-              --threads 1 --seed "$seed" --quiet)
+              --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" "${grow[@]}"
+              --generations "$GENS" --threads 1 --seed "$seed" --quiet)
   if [[ -f "$work/checkpoint.json" ]]; then
     "$EXE" --resume "$work" --generations "$GENS" --threads 1 --quiet >/dev/null
   else
@@ -53,7 +65,7 @@ one() {  # env damping stiffness seed
 export -f one
 export EXE POP GENS KEEP WORK
 points=()
-for env in $ENVS; do for c in $DAMPING; do for k in $STIFFNESS; do for s in $SEEDS; do
-  points+=("$env $c $k $s")
+for env in $ENVS; do for g in $GROWTH; do for c in $DAMPING; do for k in $STIFFNESS; do
+  for s in $SEEDS; do points+=("$env $g $c $k $s"); done
 done; done; done; done
 printf '%s\n' "${points[@]}" | xargs -P "$JOBS" -L 1 bash -c 'one "$@"' _

@@ -28,8 +28,11 @@ OUT_MD = ROOT / "studies" / "regime" / "screen.md"
 
 
 def point_of(name: str):
-    env, c, k, seed = name.split("_")
-    return env, float(c[1:]), float(k[1:]), int(seed[4:])
+    """(environment, growth, damping, stiffness, seed) of a run folder named by screen.sh."""
+    parts = name.split("_")
+    growth = parts.pop(1) if len(parts) == 5 else "paper"
+    env, c, k, seed = parts
+    return env, growth, float(c[1:]), float(k[1:]), int(seed[4:])
 
 
 def summarise_run(folder: Path) -> dict:
@@ -38,9 +41,10 @@ def summarise_run(folder: Path) -> dict:
     genome = animat.Genome.from_json(json.dumps(entry["genome"]))
     with open(folder / "history.csv") as fh:
         last = list(csv.DictReader(fh))[-1]
-    env, c, k, seed = point_of(folder.name)
+    env, growth, c, k, seed = point_of(folder.name)
     row = {
         "environment": env,
+        "growth": growth,
         "spring_damping": c,
         "spring_stiffness": k,
         "seed": seed,
@@ -82,20 +86,18 @@ def main() -> int:
         "`studies/regime/results/screen.csv`. Medians over the seeds of each point; the criteria are those",
         "of `docs/regime.md`.",
         "",
-        "| environment | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
+        "| environment | growth | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
         "at frequency bound | median frequency | elongation | protrusions | symmetric pair | modes |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    points = sorted(
-        {(r["environment"], r["spring_damping"], r["spring_stiffness"]) for r in rows},
-        key=lambda p: (p[0], -p[1], -p[2]),
-    )
-    for env, c, k in points:
-        sel = [r for r in rows if (r["environment"], r["spring_damping"], r["spring_stiffness"]) == (env, c, k)]
+    point = lambda r: (r["environment"], r["growth"], r["spring_damping"], r["spring_stiffness"])  # noqa: E731
+    points = sorted({point(r) for r in rows}, key=lambda p: (float(p[0][2:]), p[1], -p[2], -p[3]))
+    for env, growth, c, k in points:
+        sel = [r for r in rows if point(r) == (env, growth, c, k)]
         med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731, B023 (used in this iteration)
         modes = ", ".join(f"{m} {sum(r['mode'] == m for r in sel)}" for m in sorted({r["mode"] for r in sel}))
         lines.append(
-            f"| {env} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
+            f"| {env} | {growth} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
             f"{max(abs(r['reference_error']) for r in sel):.2%} | {med('fluid_share'):.2f} | "
             f"{sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | {med('frequency_median'):.2f} | "
             f"{med('elongation'):.2f} | {med('protrusions'):.0f} | {sum(r['symmetric_pair'] for r in sel)} of {len(sel)} | "

@@ -282,6 +282,70 @@ TEST(Development, GradientDivisionAxisFollowsMaternalMorphogenZeroTurnedByRotate
   EXPECT_GT(along_y.positions.col(1).maxCoeff() - along_y.positions.col(1).minCoeff(), 5.0);
 }
 
+TEST(Development, OutwardAxisPlacesTheDaughterAwayFromTheCellsTheMotherTouches) {
+  const Genome g = bias_divide_genome();
+  const Grn grn(g, GenomeParams{});
+  DevelopmentParams p = with_effects({});
+  p.placement_jitter = 0.0;
+  p.division_axis = "outward";
+  // A mother at the origin touching cells at (+1, 0) and (0, +1) (radii 0.5, gap 0 < range), and
+  // one at (−3, 0) that it does not touch: the daughter goes along −(1, 1)/√2.
+  DevelopmentWorld w(grn, GrnParams{}, p);
+  const int m = w.add_cell(Vec2::Zero(), 0.5, Vec2(1.0, 0.0));
+  w.add_cell(Vec2(1.0, 0.0), 0.5, Vec2(1.0, 0.0));
+  w.add_cell(Vec2(0.0, 1.0), 0.5, Vec2(1.0, 0.0));
+  w.add_cell(Vec2(-3.0, 0.0), 0.5, Vec2(1.0, 0.0));
+  const Vec2 along = w.position(w.divide(m)) / (p.division_offset * 0.5);
+  EXPECT_NEAR(along.x(), -std::sqrt(0.5), 1e-6);
+  EXPECT_NEAR(along.y(), -std::sqrt(0.5), 1e-6);
+  // A lone cell touches nothing: its orientation is used, as in the paper.
+  DevelopmentWorld lone(grn, GrnParams{}, p);
+  const int c = lone.add_cell(Vec2::Zero(), 0.5, Vec2(0.0, 1.0));
+  const Vec2 up = lone.position(lone.divide(c));
+  EXPECT_NEAR(up.x(), 0.0, 1e-6);
+  EXPECT_NEAR(up.y(), p.division_offset * 0.5, 1e-6);
+}
+
+TEST(Development, MaxContactsLetsOnlyCellsTouchingFewOthersDivide) {
+  const Genome g = bias_divide_genome();
+  const Grn grn(g, GenomeParams{});
+  EXPECT_EQ(DevelopmentParams{}.division_max_contacts, 0);  // any cell divides by default [paper]
+  DevelopmentParams p = with_effects({});
+  p.refractory_steps = 0;
+  p.division_max_contacts = 1;
+  const auto divide_node = static_cast<std::size_t>(grn.output_node(OutputChannel::divide));
+  // A line of three touching cells: the middle one touches two, the ends one each. Only the ends
+  // divide; with no limit all three do.
+  for (const int limit : {1, 0}) {
+    p.division_max_contacts = limit;
+    DevelopmentWorld w(grn, GrnParams{}, p);
+    for (int i = 0; i < 3; ++i) w.add_cell(Vec2(i * 1.0, 0.0), 0.5, Vec2(0.0, 1.0));
+    for (int i = 0; i < 3; ++i) w.state(i).levels[divide_node] = 1.0;
+    w.advance_clock();
+    const int before = w.cell_count();
+    const int divided = w.divide_ready();
+    EXPECT_EQ(divided, limit == 1 ? 2 : 3) << limit;
+    EXPECT_EQ(w.cell_count(), before + divided);
+  }
+  // Through develop(): a genome whose daughters turn packs its cells into a cluster with the
+  // paper's placement; grown from the tips of a line, outward, the same genome makes a long body.
+  const Genome turning = bias_divide_rotate_genome();
+  auto extent = [](const Embryo& e) {
+    return (e.positions.colwise().maxCoeff() - e.positions.colwise().minCoeff()).maxCoeff();
+  };
+  DevelopmentParams tips;
+  tips.division_max_contacts = 1;
+  tips.division_axis = "outward";
+  const Embryo line = develop(turning, GenomeParams{}, GrnParams{}, tips);
+  const Embryo cluster = develop(turning, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  ASSERT_GE(line.cell_count(), 16);  // two tips grow at a time: 26 of 32 cells in 400 steps
+  ASSERT_EQ(cluster.cell_count(), tips.max_cells);
+  // A line that bends (the jitter) but spans over half its length: 14.6 for 26 cells; the cluster
+  // 5.8.
+  EXPECT_GT(extent(line), 0.5 * (line.cell_count() - 1) * 2.0 * tips.cell_radius);
+  EXPECT_LT(extent(cluster), 0.5 * extent(line));
+}
+
 TEST(Development, UnknownDivisionAxisIsRejectedNamingKeyAndValue) {
   DevelopmentParams p;
   p.division_axis = "gradient";
