@@ -8,7 +8,8 @@
 #   SCREEN_JOBS=2 studies/regime/screen.sh
 #
 # Grid (environment variables, space-separated): SCREEN_ENVS, SCREEN_GROWTH, SCREEN_DAMPING,
-# SCREEN_STIFFNESS, SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS.
+# SCREEN_STIFFNESS, SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS; SCREEN_GUARD (the exploit
+# guard, evaluation.reference_check: "record" by default; "select" adds "_select" to the names).
 # Growth: "paper" (any cell divides along its orientation), "tipsN" (a cell divides only while it
 # touches at most N cells, its daughter placed outward: development.division_max_contacts = N,
 # development.division_axis = "outward"). Run names carry the growth unless it is "paper".
@@ -17,6 +18,7 @@ cd "$(dirname "$0")/../.."
 EXE=${ANIMAT_EVOLVE_EXE:-build/animat_evolve}
 ENVS=${SCREEN_ENVS:-"dn0.5 dn10"}
 GROWTH=${SCREEN_GROWTH:-"paper"}
+GUARD=${SCREEN_GUARD:-record}
 DAMPING=${SCREEN_DAMPING:-"4 1 0.25"}
 STIFFNESS=${SCREEN_STIFFNESS:-"100 30"}
 SEEDS=${SCREEN_SEEDS:-"1 2"}
@@ -39,11 +41,13 @@ one() {  # env growth damping stiffness seed
     echo "screen: unknown growth '$growth' (expected paper or tipsN)" >&2
     return 1
   fi
+  local guard=(--set "evaluation.reference_check=$GUARD")
+  [[ "$GUARD" == record ]] || name="${name%_seed*}_${GUARD}_seed${seed}"
   local keep="$KEEP/$name" work="$WORK/$name"
   [[ -f "$keep/best_genome.json" ]] && return 0
   local args=(--config "configs/paper_${env}.toml" --set "evolution.population=$POP"
               --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" "${grow[@]}"
-              --generations "$GENS" --threads 1 --seed "$seed" --quiet)
+              "${guard[@]}" --generations "$GENS" --threads 1 --seed "$seed" --quiet)
   if [[ -f "$work/checkpoint.json" ]]; then
     "$EXE" --resume "$work" --generations "$GENS" --threads 1 --quiet >/dev/null
   else
@@ -63,7 +67,7 @@ one() {  # env growth damping stiffness seed
   echo "screen: $name done"
 }
 export -f one
-export EXE POP GENS KEEP WORK
+export EXE POP GENS KEEP WORK GUARD
 points=()
 for env in $ENVS; do for g in $GROWTH; do for c in $DAMPING; do for k in $STIFFNESS; do
   for s in $SEEDS; do points+=("$env $g $c $k $s"); done

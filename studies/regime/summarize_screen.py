@@ -27,12 +27,20 @@ OUT_CSV = ROOT / "studies" / "regime" / "results" / "screen.csv"
 OUT_MD = ROOT / "studies" / "regime" / "screen.md"
 
 
-def point_of(name: str):
-    """(environment, growth, damping, stiffness, seed) of a run folder named by screen.sh."""
-    parts = name.split("_")
-    growth = parts.pop(1) if len(parts) == 5 else "paper"
-    env, c, k, seed = parts
-    return env, growth, float(c[1:]), float(k[1:]), int(seed[4:])
+def point_of(folder: Path, config) -> tuple:
+    """(environment, growth, guard, damping, stiffness, seed) of a run kept by screen.sh: the
+    environment and seed from its name, the rest from its config."""
+    parts = folder.name.split("_")
+    contacts = config.development.division_max_contacts
+    growth = f"tips{contacts}" if contacts > 0 else "paper"
+    return (
+        parts[0],
+        growth,
+        config.evaluation.reference_check,
+        config.scene.spring_damping,
+        config.scene.spring_stiffness,
+        int(parts[-1][4:]),
+    )
 
 
 def summarise_run(folder: Path) -> dict:
@@ -41,10 +49,11 @@ def summarise_run(folder: Path) -> dict:
     genome = animat.Genome.from_json(json.dumps(entry["genome"]))
     with open(folder / "history.csv") as fh:
         last = list(csv.DictReader(fh))[-1]
-    env, growth, c, k, seed = point_of(folder.name)
+    env, growth, guard, c, k, seed = point_of(folder, config)
     row = {
         "environment": env,
         "growth": growth,
+        "reference_check": guard,
         "spring_damping": c,
         "spring_stiffness": k,
         "seed": seed,
@@ -86,18 +95,18 @@ def main() -> int:
         "`studies/regime/results/screen.csv`. Medians over the seeds of each point; the criteria are those",
         "of `docs/regime.md`.",
         "",
-        "| environment | growth | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
+        "| environment | growth | guard | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
         "at frequency bound | median frequency | elongation | protrusions | symmetric pair | modes |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    point = lambda r: (r["environment"], r["growth"], r["spring_damping"], r["spring_stiffness"])  # noqa: E731
-    points = sorted({point(r) for r in rows}, key=lambda p: (float(p[0][2:]), p[1], -p[2], -p[3]))
-    for env, growth, c, k in points:
-        sel = [r for r in rows if point(r) == (env, growth, c, k)]
+    point = lambda r: (r["environment"], r["growth"], r["reference_check"], r["spring_damping"], r["spring_stiffness"])  # noqa: E731
+    points = sorted({point(r) for r in rows}, key=lambda p: (float(p[0][2:]), p[1], p[2], -p[3], -p[4]))
+    for env, growth, guard, c, k in points:
+        sel = [r for r in rows if point(r) == (env, growth, guard, c, k)]
         med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731, B023 (used in this iteration)
         modes = ", ".join(f"{m} {sum(r['mode'] == m for r in sel)}" for m in sorted({r["mode"] for r in sel}))
         lines.append(
-            f"| {env} | {growth} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
+            f"| {env} | {growth} | {guard} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
             f"{max(abs(r['reference_error']) for r in sel):.2%} | {med('fluid_share'):.2f} | "
             f"{sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | {med('frequency_median'):.2f} | "
             f"{med('elongation'):.2f} | {med('protrusions'):.0f} | {sum(r['symmetric_pair'] for r in sel)} of {len(sel)} | "
