@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -20,6 +22,16 @@
 #include "animat/random.hpp"
 
 namespace animat {
+
+void copy_counters(const SwimCounters& from, SwimResult& to) {
+  visit_fields(from, [&](std::string_view name, const char*, const auto& value) {
+    visit_fields(to, [&](std::string_view field, const char*, auto& target) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(target)>, std::decay_t<decltype(value)>>)
+        if (field == name) target = value;
+    });
+  });
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -210,16 +222,7 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   }
   r.max_kinetic_energy_per_cell =
       body.node_count() > 0 ? r.max_kinetic_energy / body.node_count() : 0.0;
-  const SwimCounters& c = sim.counters();
-  r.collisions = c.collisions;
-  r.collisions_inelastic = c.collisions_inelastic;
-  r.collisions_unresolved = c.collisions_unresolved;
-  r.drag_limited = c.drag_limited;
-  r.ground_contacts = c.ground_contacts;
-  r.ground_slips = c.ground_slips;
-  r.actuation_work = c.actuation_work;
-  r.actuation_work_positive = c.actuation_work_positive;
-  r.actuation_work_absolute = c.actuation_work_absolute;
+  copy_counters(sim.counters(), r);
   r.energy = sim.energy_account();
   if (const Effect* springs = sim.effect("springs")) {
     std::vector<double> pos, abs;

@@ -294,6 +294,11 @@ void visit_fields(R& r, V&& v)
   visit_swim_fields(v, r);
 }
 
+/// The swim's counters (Simulation::counters) into the SwimResult fields of the same name and type:
+/// both records list their fields (visit_fields), so a counter that SwimResult also reports needs
+/// no line of its own.
+void copy_counters(const SwimCounters& from, SwimResult& to);
+
 /// Where control.mode = "grn" starts: the genome's GRN and every cell's state at the end of
 /// `embryo`.
 [[nodiscard]] GrnControlStart grn_control_start(const Genome& genome, const Embryo& embryo,

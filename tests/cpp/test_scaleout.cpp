@@ -294,7 +294,8 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\npush_cells = ",
                           "\nmorphogen_cutoff = ",
                           "\nenergy_accounting = ",
-                          "\ndivision_axis = "}) {
+                          "\ndivision_axis = ",
+                          "\ndivision_max_contacts = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;

@@ -5,6 +5,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "animat/body.hpp"
@@ -132,4 +135,41 @@ TEST(ActuationWork, NoActuationNoWorkAndPerCellSplitSumsToTotals) {
 }
 
 }  // namespace
+}  // namespace animat
+
+namespace animat {
+
+TEST(SwimCounters, EveryCounterThatSwimResultReportsIsCopiedByName) {
+  // Distinct values in every counter; each SwimResult field of the same name and type gets its
+  // counter's value, every other field keeps its default.
+  SwimCounters c;
+  double next = 1.0;
+  visit_fields(c, [&](const char*, const char*, auto& value) {
+    value = static_cast<std::decay_t<decltype(value)>>(next);
+    next += 1.0;
+  });
+  SwimResult r;
+  copy_counters(c, r);
+  std::vector<std::string> copied, not_reported;
+  visit_fields(c, [&](const char* name, const char*, const auto& value) {
+    bool found = false;
+    visit_fields(r, [&](const char* field, const char*, const auto& target) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(target)>, std::decay_t<decltype(value)>>) {
+        if (std::string_view(field) == name) {
+          EXPECT_EQ(target, value) << name;
+          found = true;
+        }
+      }
+    });
+    (found ? copied : not_reported).push_back(name);
+  });
+  EXPECT_EQ(copied, (std::vector<std::string>{
+                        "collisions", "collisions_inelastic", "collisions_unresolved",
+                        "drag_limited", "ground_contacts", "ground_slips", "actuation_work",
+                        "actuation_work_positive", "actuation_work_absolute"}));
+  // The one counter a swim's record does not report (Simulation.counters has it).
+  EXPECT_EQ(not_reported, (std::vector<std::string>{"collision_max_passes"}));
+  EXPECT_EQ(r.distance, SwimResult{}.distance);
+}
+
 }  // namespace animat
