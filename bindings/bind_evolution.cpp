@@ -86,6 +86,24 @@ void bind_evolution(nb::module_& m) {
           "swim kept every invariant, and how often the drag limiter altered it (drag_scheme "
           "\"stable\" only).")
       .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
+      // Float-like: `ind.fitness` is the record, and it formats, converts and orders as its value,
+      // as LineageEntry.fitness and the history's floats do.
+      .def("__float__", [](const Fitness& f) { return f.fitness; })
+      .def("__format__",
+           [](const Fitness& f, nb::str spec) {
+             const nb::float_ value(f.fitness);
+             nb::object out = nb::steal(PyObject_Format(value.ptr(), spec.ptr()));
+             if (!out.is_valid()) throw nb::python_error();
+             return out;
+           })
+      .def("__lt__", [](const Fitness& f, double x) { return f.fitness < x; })
+      .def("__le__", [](const Fitness& f, double x) { return f.fitness <= x; })
+      .def("__gt__", [](const Fitness& f, double x) { return f.fitness > x; })
+      .def("__ge__", [](const Fitness& f, double x) { return f.fitness >= x; })
+      .def("__lt__", [](const Fitness& a, const Fitness& b) { return a.fitness < b.fitness; })
+      .def("__le__", [](const Fitness& a, const Fitness& b) { return a.fitness <= b.fitness; })
+      .def("__gt__", [](const Fitness& a, const Fitness& b) { return a.fitness > b.fitness; })
+      .def("__ge__", [](const Fitness& a, const Fitness& b) { return a.fitness >= b.fitness; })
       // The pickled state is the tuple of the descriptor's fields; 5 entries: pickled before
       // drag_limited.
       .def("__getstate__",
@@ -166,11 +184,25 @@ void bind_evolution(nb::module_& m) {
       .def_ro("fitness", &Individual::result, "Its Fitness.")
       .def_ro("tries", &Individual::tries,
               "Random genomes drawn to find it (initial population only; else 0).")
+      .def_ro("id", &Individual::id,
+              "Its id in the run's genealogy: generation of birth x population + its index then "
+              "(genealogy.csv); an elite keeps its id.")
+      .def_ro("parent_a", &Individual::parent_a,
+              "Id of its first parent; -1 for an initial individual (or one restored from a "
+              "checkpoint without ids).")
+      .def_ro("parent_b", &Individual::parent_b,
+              "Id of its second parent (crossover only); -1 otherwise.")
       .def("__getstate__",
-           [](const Individual& i) { return nb::make_tuple(i.genome, i.result, i.tries); })
+           [](const Individual& i) {
+             return nb::make_tuple(i.genome, i.result, i.tries, i.id, i.parent_a, i.parent_b);
+           })
       .def("__setstate__",
-           [](Individual& i, const std::tuple<Genome, Fitness, int>& t) {
+           [](Individual& i,
+              const std::tuple<Genome, Fitness, int, std::int64_t, std::int64_t, std::int64_t>& t) {
              new (&i) Individual{std::get<0>(t), std::get<1>(t), std::get<2>(t)};
+             i.id = std::get<3>(t);
+             i.parent_a = std::get<4>(t);
+             i.parent_b = std::get<5>(t);
            })
       .def("__copy__", [](const Individual& i) { return i; })
       .def(
@@ -321,13 +353,14 @@ void bind_evolution(nb::module_& m) {
       "evolve",
       [](std::optional<Config> config, std::optional<std::filesystem::path> out, bool resume,
          std::optional<nb::callable> callback, bool quiet, nb::object stop, nb::handle objective,
-         bool overwrite) {
+         bool overwrite, std::string label) {
         const Config c = config.value_or(Config{});
         RunOptions opt;
         if (out) opt.out = *out;
         opt.resume = resume;
         opt.overwrite = overwrite;
         opt.quiet = quiet;
+        opt.label = std::move(label);
         // A Python exception raised while the run is in progress (Ctrl-C's KeyboardInterrupt, an
         // error in or about the callback) stops the run like a signal does: the last complete
         // generation is checkpointed, and the exception is raised afterwards with the partial
@@ -412,6 +445,7 @@ void bind_evolution(nb::module_& m) {
       },
       "config"_a = nb::none(), "out"_a = nb::none(), "resume"_a = false, "callback"_a = nb::none(),
       "quiet"_a = true, "stop"_a = nb::none(), "objective"_a = nb::none(), "overwrite"_a = false,
+      "label"_a = "",
       "Run the paper's genetic algorithm (the engine behind animat_evolve); animat.evolve wraps "
       "it.\n\n"
       "config: animat.Config (default: the embedded paper setting; set evolution.generations!).\n"
@@ -430,6 +464,7 @@ void bind_evolution(nb::module_& m) {
       "objective.\n"
       "overwrite: start afresh in `out` even if it holds a run (its run files are removed, under "
       "the lock).\n"
+      "label: prefix of every progress line, '[label] ' (several runs in one process).\n"
       "The run directory is locked (out/.lock) while it runs: a second writer gets BlockingIOError "
       "naming\n"
       "the holder's pid; a directory holding a run (with or without a checkpoint) gives "

@@ -4,7 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-scripts/build.sh
+# Only what the demo runs: the CLI and the Python module (the tests are scripts/test.sh's).
+ANIMAT_TARGETS="animat_evolve _core animat_python_stage" scripts/build.sh
 OUT=${ANIMAT_DEMO_OUT:-runs/demo}
 GENERATIONS=${ANIMAT_DEMO_GENERATIONS:-25}
 rm -rf "$OUT"

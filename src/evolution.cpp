@@ -352,12 +352,17 @@ bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
   for (const auto& slot : slots_)
     if (!slot.filled) return false;
   population_.clear();
-  for (auto& slot : slots_) population_.push_back(std::move(slot.individual));
+  for (auto& slot : slots_) {
+    slot.individual.id = static_cast<std::int64_t>(population_.size());
+    population_.push_back(std::move(slot.individual));
+  }
   slots_.clear();
   generation_ = 0;
   best_ever_ = best().result.fitness;
   stall_ = 0;
-  history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_));
+  // Every initial individual is a viable draw that was swum once.
+  history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_,
+                                static_cast<int>(population_.size())));
   check_reference();
   return true;
 }
@@ -413,14 +418,20 @@ std::vector<Genome> Evolution::ask_generation() {
     if (i < layout.begin(isl) + copied[isl]) continue;  // an elite
     Rng rng = Rng::derive(static_cast<std::uint64_t>(ep.seed), static_cast<std::uint64_t>(g), i);
     Individual& child = next[i];
+    child.id =
+        static_cast<std::int64_t>(g) * static_cast<std::int64_t>(n) + static_cast<std::int64_t>(i);
     if (rng.bernoulli(ep.crossover_fraction)) {
       const std::size_t a = tournament(population_, eligible[isl], p, rng);
       const std::size_t b = tournament(population_, eligible[isl], p, rng);
       ++crossovers;
       child.genome = crossover(population_[a].genome, population_[b].genome,
                                config_->mutation.crossover_points, rng);
+      child.parent_a = population_[a].id;
+      child.parent_b = population_[b].id;
     } else {
-      child.genome = population_[tournament(population_, eligible[isl], p, rng)].genome;
+      const std::size_t a = tournament(population_, eligible[isl], p, rng);
+      child.genome = population_[a].genome;
+      child.parent_a = population_[a].id;
     }
     mutate(child.genome, config_->mutation, config_->genome, rng);
     needs_eval[i] = true;
@@ -444,7 +455,11 @@ std::vector<Genome> Evolution::ask_generation() {
 }
 
 bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
-  for (std::size_t k = 0; k < fitness.size(); ++k) next_[asked_index_[k]].result = fitness[k];
+  int swims = 0;
+  for (std::size_t k = 0; k < fitness.size(); ++k) {
+    next_[asked_index_[k]].result = fitness[k];
+    if (fitness[k].viable) ++swims;
+  }
   evaluations_ += static_cast<std::int64_t>(fitness.size());
 
   const Genome previous_best = best().genome;
@@ -464,7 +479,7 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
     ++stall_;
   }
   history_.push_back(
-      statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_));
+      statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_, swims));
   history_.back().crossovers = next_crossovers_;
   check_reference();
   return true;
@@ -497,7 +512,7 @@ GenerationStats population_statistics(const std::vector<Individual>& population)
 }
 }  // namespace
 
-GenerationStats Evolution::statistics(bool best_changed, double wall) const {
+GenerationStats Evolution::statistics(bool best_changed, double wall, int swims) const {
   if (population_.empty()) throw Error("Evolution::statistics: the population is empty");
   GenerationStats s = population_statistics(population_);
   s.generation = generation_;
@@ -507,6 +522,8 @@ GenerationStats Evolution::statistics(bool best_changed, double wall) const {
   const double seconds = history_.empty() ? wall : wall - history_.back().wall_seconds;
   const auto evaluated = evaluations_ - (history_.empty() ? 0 : history_.back().evaluations);
   s.evaluations_per_second = seconds > 0 ? static_cast<double>(evaluated) / seconds : 0.0;
+  s.swims = swims;
+  s.swims_per_second = seconds > 0 ? swims / seconds : 0.0;
   s.best_changed = best_changed;
   return s;
 }
@@ -689,7 +706,10 @@ std::string Evolution::checkpoint() const {
             {"stable", ind.result.stable},
             {"valid", ind.result.valid},
             {"cell_count", ind.result.cell_count},
-            {"tries", ind.tries}};
+            {"tries", ind.tries},
+            {"id", ind.id}};
+    if (ind.parent_a != kNoParent) ji["parent_a"] = ind.parent_a;
+    if (ind.parent_b != kNoParent) ji["parent_b"] = ind.parent_b;
     if (!std::isnan(ind.reference)) ji["reference"] = ind.reference;
     if (ind.result.drag_limited > 0) ji["drag_limited"] = ind.result.drag_limited;
     individuals[static_cast<std::size_t>(i)] = std::move(ji);
@@ -752,6 +772,7 @@ void Evolution::restore(std::string_view text, std::string_view source) {
                       source, p.at("identity").get<std::string>(), expected,
                       fmt::join(resumable_keys(), ", ")));
     std::vector<Individual> pop;
+    bool ids_known = true;
     for (const json& ji : p.at("population")) {
       Individual ind;
       ind.genome = genome_from_json(ji.at("genome").dump(), config_->genome, source);
@@ -764,6 +785,12 @@ void Evolution::restore(std::string_view text, std::string_view source) {
         ind.result.drag_limited = static_cast<long>(int_field(ji, "drag_limited", 0, kInt64Max));
       ind.result.cell_count = static_cast<int>(int_field(ji, "cell_count", 0, kIntMax));
       ind.tries = static_cast<int>(int_field(ji, "tries", 0, kIntMax));
+      // Checkpoints written before the genealogy hold no ids: each individual is then taken as
+      // born at the checkpoint's generation, with unknown parents.
+      if (ji.contains("id")) ind.id = int_field(ji, "id", 0, kInt64Max);
+      if (ji.contains("parent_a")) ind.parent_a = int_field(ji, "parent_a", 0, kInt64Max);
+      if (ji.contains("parent_b")) ind.parent_b = int_field(ji, "parent_b", 0, kInt64Max);
+      ids_known = ids_known && ji.contains("id");
       pop.push_back(std::move(ind));
     }
     if (pop.size() != static_cast<std::size_t>(config_->evolution.population))
@@ -777,9 +804,14 @@ void Evolution::restore(std::string_view text, std::string_view source) {
           hist.empty() ? st.wall_seconds : st.wall_seconds - hist.back().wall_seconds;
       const auto evaluated = st.evaluations - (hist.empty() ? 0 : hist.back().evaluations);
       st.evaluations_per_second = seconds > 0 ? static_cast<double>(evaluated) / seconds : 0.0;
+      st.swims_per_second = seconds > 0 ? st.swims / seconds : 0.0;
       hist.push_back(st);
     }
     const int generation = static_cast<int>(int_field(p, "generation", 0, kIntMax));
+    if (!ids_known)
+      for (std::size_t i = 0; i < pop.size(); ++i)
+        pop[i].id = static_cast<std::int64_t>(generation) * static_cast<std::int64_t>(pop.size()) +
+                    static_cast<std::int64_t>(i);
     if (hist.empty())
       throw CheckpointError(fmt::format("{}: checkpoint has an empty history", source));
     if (hist.back().generation != generation)

@@ -126,10 +126,57 @@ void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
          {"fitness", b.result.fitness},
          {"reference_fitness", std::isnan(b.reference) ? json(nullptr) : json(b.reference)},
          {"cell_count", b.result.cell_count},
+         {"id", b.id},
          {"genome", json::parse(to_json(b.genome))}};
   write_atomically(dir / "best" / fmt::format("gen_{:06d}.json", evo.generation()),
                    j.dump(1) + "\n");
 }
+
+// genealogy.csv: one row per individual born (the initial population, then each generation's
+// offspring; an elite or migrant copy is not born again), so the family tree of any individual can
+// be traced through the parent ids. Rows after the checkpoint are dropped on resume, as
+// history.csv's.
+class GenealogyLog {
+ public:
+  static constexpr std::string_view kHeader = "generation,id,parent_a,parent_b,fitness,cells\n";
+  explicit GenealogyLog(std::filesystem::path path) : path_(std::move(path)) {}
+
+  void start(const Evolution& evo) const {
+    write_atomically(path_, std::string(kHeader) + rows(evo));
+  }
+  void resume(int generation) const {
+    std::string kept(kHeader);
+    std::ifstream in(path_, std::ios::binary);
+    std::string line;
+    for (bool header = true; std::getline(in, line); header = false) {
+      int g = -1;
+      if (!header && std::sscanf(line.c_str(), "%d,", &g) == 1 && g <= generation)
+        kept += line + "\n";
+    }
+    in.close();
+    write_atomically(path_, kept);
+  }
+  void append(const Evolution& evo) const { ::animat::append(path_, rows(evo)); }
+
+ private:
+  static std::string rows(const Evolution& evo) {
+    const auto& pop = evo.population();
+    const auto n = static_cast<std::int64_t>(pop.size());
+    const std::int64_t first = static_cast<std::int64_t>(evo.generation()) * n;
+    std::vector<bool> written(pop.size(), false);
+    std::string out;
+    for (const Individual& ind : pop) {
+      if (ind.id < first || ind.id >= first + n) continue;  // born earlier: an elite
+      const auto slot = static_cast<std::size_t>(ind.id - first);
+      if (written[slot]) continue;  // a migrant's second copy
+      written[slot] = true;
+      out += fmt::format("{},{},{},{},{},{}\n", evo.generation(), ind.id, ind.parent_a,
+                         ind.parent_b, ind.result.fitness, ind.result.cell_count);
+    }
+    return out;
+  }
+  std::filesystem::path path_;
+};
 
 std::string duration(double s) {
   const auto t = static_cast<long long>(std::max(0.0, s));
@@ -299,9 +346,9 @@ class RunLock {
 };
 
 // What a run writes into its directory (RunOptions::overwrite removes these and nothing else).
-const std::vector<std::string> kRunFiles = {"config.toml", "history.csv", "checkpoint.json",
-                                            "islands.csv", "resume.log",  "stopped.txt",
-                                            "best",        "figures"};
+const std::vector<std::string> kRunFiles = {"config.toml", "history.csv",   "checkpoint.json",
+                                            "islands.csv", "genealogy.csv", "resume.log",
+                                            "stopped.txt", "best",          "figures"};
 
 // NAME.PID.tmp or NAME.tmp next to a run file: left by a process killed while writing NAME.
 bool is_leftover_temporary(const std::string& name) {
@@ -390,9 +437,10 @@ void refuse_existing_run(const Config& config, const std::filesystem::path& dir)
     if (files > 0) found.push_back(fmt::format("best/ ({} file{})", files, files == 1 ? "" : "s"));
     if (beyond_zero) restartable = false;
   }
-  if (std::filesystem::exists(dir / "islands.csv", ec)) {
-    (void)history_rows(dir / "islands.csv", &zero_only);
-    found.push_back("islands.csv");
+  for (const char* log : {"islands.csv", "genealogy.csv"}) {
+    if (!std::filesystem::exists(dir / log, ec)) continue;
+    (void)history_rows(dir / log, &zero_only);
+    found.push_back(log);
     if (!zero_only) restartable = false;
   }
   if (std::filesystem::exists(dir / "resume.log", ec)) {
@@ -438,9 +486,11 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
   }
   Evolution evo(config, std::move(fitness), std::move(reference), opt.evaluator);
   evo.set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
+  const std::string tag = opt.label.empty() ? std::string() : "[" + opt.label + "] ";
   const bool writing = !opt.out.empty();
   // [islands] islands.csv
   IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);
+  const GenealogyLog genealogy(opt.out / "genealogy.csv");
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
   // 1. Everything that can refuse the command, before any file is written: checked once without the
@@ -500,7 +550,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
         note += fmt::format(" {} {} -> {};", key, format_config_value(get_value(stored, key)),
                             format_config_value(get_value(config, key)));
         if (!opt.quiet)
-          spdlog::info("resume: {} changed from {} to {}", key,
+          spdlog::info("{}resume: {} changed from {} to {}", tag, key,
                        format_config_value(get_value(stored, key)),
                        format_config_value(get_value(config, key)));
       }
@@ -515,6 +565,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
     for (const auto& s : evo.history()) rows += history_row(s);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
     island_log.resume(evo.generation());
+    genealogy.resume(evo.generation());
     // Lineage files of generations after the checkpoint belong to the lost future; they are
     // rewritten.
     for (const auto& entry : std::filesystem::directory_iterator(opt.out / "best")) {
@@ -523,16 +574,19 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
       if (std::sscanf(name.c_str(), "gen_%d.json", &g) == 1 && g > evo.generation())
         std::filesystem::remove(entry.path());
     }
-    if (!opt.quiet) spdlog::info("resumed {} at generation {}", opt.out.string(), evo.generation());
+    if (!opt.quiet)
+      spdlog::info("{}resumed {} at generation {}", tag, opt.out.string(), evo.generation());
   } else {
     if (!opt.quiet)
-      spdlog::info("drawing {} viable random individuals...", config.evolution.population);
+      spdlog::info("{}drawing {} viable random individuals...", tag, config.evolution.population);
     try {
       evo.initialize();
     } catch (const Interrupted&) {
       if (!opt.quiet)
         spdlog::info(
-            "stopped: interrupted before the initial population was complete (nothing to resume)");
+            "{}stopped: interrupted before the initial population was complete (nothing to "
+            "resume)",
+            tag);
       RunSummary summary;
       summary.stop_reason = "interrupted";
       return summary;
@@ -542,13 +596,14 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
         std::accumulate(tries.begin(), tries.end(), 0.0) / static_cast<double>(tries.size());
     if (!opt.quiet)
       spdlog::info(
-          "initial population: {:.0f} random genomes per viable individual on average (paper: \"a "
-          "few hundred\")",
-          mean_tries);
+          "{}initial population: {} random genomes drawn, {:.0f} per viable individual on average "
+          "(paper: \"a few hundred\"); they are developed, only the viable ones swim",
+          tag, evo.evaluations(), mean_tries);
     if (writing) {
       write_atomically(hist, history_header() + history_row(evo.history().back()));
       write_lineage(opt.out, evo);
       island_log.start(evo);
+      genealogy.start(evo);
       write_atomically(ckpt, evo.checkpoint());
     }
   }
@@ -578,10 +633,12 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
       left = fmt::format(", {} left of budget",
                          duration(config.evolution.wall_seconds - s.wall_seconds));
     }
+    // The rate counts swims: a non-viable offspring is only developed, and generation 0's thousands
+    // of random draws are not a pace.
     spdlog::info(
-        "gen {:5d} | best {:8.4f} mean {:8.4f} median {:8.4f} | viable {:5.1f}% | {:6.1f} eval/s | "
-        "{} elapsed{}",
-        s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.evaluations_per_second,
+        "{}gen {:5d} | best {:8.4f} mean {:8.4f} median {:8.4f} | viable {:5.1f}% | {:6.1f} "
+        "swims/s | {} elapsed{}",
+        tag, s.generation, s.best, s.mean, s.median, 100.0 * s.viable_fraction, s.swims_per_second,
         duration(s.wall_seconds), left);
   };
   // Exploit guard: a best whose fitness the reference step does not confirm is reported.
@@ -590,9 +647,9 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
     if (opt.quiet || !s.best_changed || std::isnan(s.best_reference)) return;
     if (reference_disagrees(s.best, s.best_reference, ev))
       spdlog::warn(
-          "gen {}: the new best's fitness {:.4f} is not confirmed at the reference step "
+          "{}gen {}: the new best's fitness {:.4f} is not confirmed at the reference step "
           "(physics.substeps x {}: {:.4f}, {:+.1f}%): its swim depends on the step size",
-          s.generation, s.best, ev.reference_substeps, s.best_reference,
+          tag, s.generation, s.best, ev.reference_substeps, s.best_reference,
           100.0 * (s.best - s.best_reference) / std::max(std::abs(s.best_reference), 1e-12));
   };
   report(evo.history().back(), true);
@@ -622,6 +679,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
     if (writing) {
       append(hist, history_row(s));
       island_log.append(evo);
+      genealogy.append(evo);
       if (s.best_changed) write_lineage(opt.out, evo);
       dirty = true;
       if (++since_checkpoint >= config.evolution.checkpoint_every) {
@@ -637,7 +695,16 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
   }
   if (writing && dirty) write_atomically(ckpt, evo.checkpoint());
   report(evo.history().back(), true);
-  if (!opt.quiet) spdlog::info("stopped: {}", summary.stop_reason);
+  if (!opt.quiet) {
+    // The best's own generation: the last in which the best changed (the lineage's last file).
+    const auto& h = evo.history();
+    int found = 0;
+    for (const auto& row : h)
+      if (row.best_changed) found = row.generation;
+    spdlog::info("{}stopped at generation {}: {}; best {:.4f} ({} cells), found at generation {}",
+                 tag, h.back().generation, summary.stop_reason, evo.best().result.fitness,
+                 evo.best().result.cell_count, found);
+  }
   summary.history = evo.history();
   summary.best = evo.best();
   summary.population = evo.population();

@@ -87,10 +87,19 @@ class Objective;
 [[nodiscard]] FitnessFunction objective_fitness(const Config& config,
                                                 std::shared_ptr<const Objective> objective);
 
+/// No parent (an initial individual; the second parent of a mutant); Individual::parent_a, _b.
+inline constexpr std::int64_t kNoParent = -1;
+
 struct Individual {
   Genome genome;
   Fitness result;
   int tries = 0;  ///< random genomes drawn to find this one (initial population only)
+  /// Who it is, for the genealogy: generation of birth × population + its index then (initial
+  /// individuals 0 … population − 1). An elite or migrant copy keeps its id.
+  std::int64_t id = 0;
+  /// Its parents' ids: both for a crossover, parent_a only for a mutant of one parent, neither
+  /// (kNoParent) for an initial individual or one restored from a checkpoint without ids.
+  std::int64_t parent_a = kNoParent, parent_b = kNoParent;
   /// Fitness at the reference step (the exploit guard, evaluation.reference_check); NaN = not
   /// evaluated.
   double reference = std::numeric_limits<double>::quiet_NaN();
@@ -112,6 +121,11 @@ struct GenerationStats {
   double wall_seconds = 0.0;
   /// of this generation alone (its evaluations / its wall time)
   double evaluations_per_second = 0.0;
+  /// Swims of this generation: its evaluations of viable genomes (a non-viable one is only
+  /// developed, hundreds of times cheaper); generation 0: the initial population's.
+  int swims = 0;
+  /// of this generation alone (its swims / its wall time): the rate the progress line shows
+  double swims_per_second = 0.0;
   bool best_changed = false;  ///< the best genome differs from the previous generation's
   int crossovers = 0;         ///< offspring made by crossover in this generation
   /// The best's fitness at the reference step (evaluation.reference_check); NaN when off.
@@ -159,6 +173,12 @@ void visit_fields(S& s, V&& v)
   v(StatsField{"evaluations", "Cumulative fitness evaluations (swims and non-viable developments).",
                true, C::required},
     s.evaluations);
+  v(StatsField{"swims",
+               "Swims of this generation: evaluations of viable genomes (a non-viable genome is "
+               "only developed); generation 0: the initial population. 0 in rows written before "
+               "this column existed.",
+               true, C::later},
+    s.swims);
   v(
       StatsField{
           "best_reference",
@@ -183,6 +203,8 @@ void visit_fields(S& s, V&& v)
   v(StatsField{"evaluations_per_second", "Evaluations per second of this generation alone.", false,
                C::none},
     s.evaluations_per_second);
+  v(StatsField{"swims_per_second", "Swims per second of this generation alone.", false, C::none},
+    s.swims_per_second);
   v(StatsField{"crossovers", "Offspring made by crossover in this generation.", false, C::none},
     s.crossovers);
 }
@@ -293,7 +315,7 @@ class Evolution {
   [[nodiscard]] const std::vector<Migration>& migrations() const { return migrations_; }
 
  private:
-  GenerationStats statistics(bool best_changed, double wall_seconds) const;
+  GenerationStats statistics(bool best_changed, double wall_seconds, int swims) const;
   /// Exploit guard, after a generation is complete: the best's reference fitness (evaluated once
   /// per genome), recorded in the last history row.
   void check_reference();

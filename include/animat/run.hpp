@@ -22,7 +22,9 @@ struct RunOptions {
   /// once the directory is locked. Contradicts `resume`.
   bool overwrite = false;
   bool quiet = false;
-  double progress_interval = 1.0;                ///< seconds between progress lines
+  double progress_interval = 1.0;  ///< seconds between progress lines
+  /// Prefix of every progress line, "[label] " (several runs in one process); "" = none.
+  std::string label;
   const std::atomic<bool>* stop_flag = nullptr;  ///< set by a signal handler: checkpoint and stop
   /// Polled like StopRequest::poll (on the calling thread, about every 20 ms): true = checkpoint
   /// and stop.

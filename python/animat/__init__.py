@@ -71,7 +71,16 @@ from .locomotion import (
     tries_per_viable,
 )
 from .pipeline import build_body, config_path, develop, documented, load_config, paper_configs, swim
-from .run import HISTORY_DTYPE, MORPHOLOGY_TOLERANCE, LineageEntry, Run, morphology_distance, read_history
+from .run import (
+    GENEALOGY_DTYPE,
+    HISTORY_DTYPE,
+    MORPHOLOGY_TOLERANCE,
+    LineageEntry,
+    Run,
+    morphology_distance,
+    read_genealogy,
+    read_history,
+)
 from .trajectory import (
     CONTRACTING,
     DEFAULT_NEUTRAL,
@@ -175,6 +184,8 @@ __all__ = [
     "LineageEntry",
     "HISTORY_DTYPE",
     "read_history",
+    "read_genealogy",
+    "GENEALOGY_DTYPE",
     "morphology_distance",
     "MORPHOLOGY_TOLERANCE",
     "Trajectory",

@@ -525,7 +525,7 @@ def evolve(
             bar.set_postfix(
                 best=f"{stats.best:.4g}",
                 viable=f"{100 * stats.viable_fraction:.0f}%",
-                evals_per_s=f"{stats.evaluations_per_second:.0f}",
+                swims_per_s=f"{stats.swims_per_second:.1f}",
                 refresh=False,
             )
             bar.refresh()

@@ -21,11 +21,13 @@ import json
 import os
 import statistics
 import threading
+import warnings
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from . import _core
+from .pipeline import load_config
 
 
 @dataclass
@@ -43,10 +45,15 @@ class RunRecord:
 
 
 def _run_one(
-    config: _core.Config, out: Path, index: int, quiet: bool, stop: Optional[threading.Event] = None
+    config: _core.Config,
+    out: Path,
+    index: int,
+    quiet: bool,
+    stop: Optional[threading.Event] = None,
+    label: str = "",
 ) -> Optional[RunRecord]:
     resume = (out / "checkpoint.json").exists()
-    result = _core.evolve(config, out=str(out), resume=resume, quiet=quiet, stop=stop)
+    result = _core.evolve(config, out=str(out), resume=resume, quiet=quiet, stop=stop, label=label)
     if not result.history:  # stopped before its initial population was complete: nothing to record
         return None
     last = result.history[-1]
@@ -248,7 +255,7 @@ def run_study(
 
     bases = {}
     for name, path in envs:
-        base = _core.load_config(path)
+        base = load_config(path)  # a file, or a packaged config by name
         base.apply_overrides(list(overrides))  # checked together: their order does not matter
         if generations is not None:
             base["evolution.generations"] = int(generations)
@@ -256,6 +263,14 @@ def run_study(
             base["evolution.wall_seconds"] = float(wall_seconds)
         base["evolution.threads"] = per_run
         bases[name] = base
+        if rank == 0 and int(base["evolution.generations"]) == 0 and float(base["evolution.wall_seconds"]) == 0:
+            warnings.warn(
+                f"experiment: {name}: no generation cap (--generations) and no wall-clock budget (--wall-seconds): "
+                f"each run stops only after {int(base['evolution.stall_generations'])} generations without "
+                "improvement (hours)",
+                UserWarning,
+                stacklevel=2,
+            )
     chosen = list(index) if index is not None else list(range(len(tasks)))
     mine = chosen[rank::size]
 
@@ -282,7 +297,8 @@ def run_study(
             cfg["evolution.seed"] = int(bases[task.env]["evolution.seed"]) + task.index
             task.out.parent.mkdir(parents=True, exist_ok=True)
             try:
-                rec = _run_one(cfg, task.out, task.index, quiet, stop)
+                # Runs share the process's output: every line names its run.
+                rec = _run_one(cfg, task.out, task.index, quiet, stop, label=f"{task.env} run {task.index}")
                 if rec is None:
                     if stop.is_set():  # stopped while drawing its initial population: nothing to record
                         return

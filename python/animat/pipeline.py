@@ -71,13 +71,22 @@ def swim(
 
 
 def load_config(path: Union[str, os.PathLike[str]]) -> Any:
-    """Load a TOML config file into an :class:`animat.Config`; ValueError naming the file, line and key
-    for a bad one (see also :func:`config_path` for the paper's)."""
-    return _core.load_config(str(path))
+    """Load a TOML config file into an :class:`animat.Config`, or a config shipped with the package by
+    name (``"paper_dn10"``, :func:`paper_configs`; a file of that name wins). ValueError naming the
+    file, line and key for a bad one."""
+    text = str(path)
+    if not os.path.exists(text) and os.sep not in text:
+        name = text[: -len(".toml")] if text.endswith(".toml") else text
+        if name in paper_configs():
+            return _core.load_config(str(config_path(name)))
+        raise FileNotFoundError(
+            f"{text}: no such file, and no packaged config of that name (packaged: {', '.join(paper_configs())})"
+        )
+    return _core.load_config(text)
 
 
 def paper_configs() -> List[str]:
-    """Names of the paper's configs shipped with the package (``paper_dn10`` ...)."""
+    """Names of the configs shipped with the package (``paper_dn10`` ..., ``crawl``, ``chemotaxis``)."""
     return sorted(p.stem for p in _CONFIG_DIR.glob("*.toml"))
 
 

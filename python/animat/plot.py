@@ -1006,6 +1006,59 @@ def fitness_history(
     return fig
 
 
+def genealogy(run: Any, id: Optional[int] = None, *, title: Optional[str] = None) -> Figure:
+    """The family tree of the best (or of individual ``id``): every ancestor recorded in the run's
+    ``genealogy.csv`` (:meth:`animat.Run.ancestry`) at its generation of birth and fitness, joined to
+    its parents (solid: the first parent, dashed: the second of a crossover); the line of first
+    parents back to generation 0 is drawn bold, over the run's best fitness per generation (grey).
+
+    Returns:
+        The Figure; its Axes is labelled ``"genealogy"``. Raises ValueError for a run without a
+        genealogy (made before it was recorded).
+    """
+    run = run if isinstance(run, Run) else Run(run)
+    tree = run.ancestry(id)
+    by_id = {int(r["id"]): r for r in tree}
+    fig, ax = plt.subplots(figsize=(9, 4.6))
+    ax.set_label("genealogy")
+    hist = run.history
+    if len(hist):
+        ax.plot(hist["generation"], hist["best"], drawstyle="steps-post", color="0.75", lw=1.0, label="best fitness")
+    solid, dashed = [], []
+    for r in tree:
+        child = (float(r["generation"]), float(r["fitness"]))
+        for parent, segments in ((int(r["parent_a"]), solid), (int(r["parent_b"]), dashed)):
+            if parent in by_id:
+                p = by_id[parent]
+                segments.append([(float(p["generation"]), float(p["fitness"])), child])
+    ax.add_collection(LineCollection(solid, colors="#7f9fbf", linewidths=0.8))
+    ax.add_collection(LineCollection(dashed, colors="#bf9f7f", linewidths=0.8, linestyles="dashed"))
+    line, current = [], tree[0]
+    while True:
+        line.append((float(current["generation"]), float(current["fitness"])))
+        parent = int(current["parent_a"])
+        if parent not in by_id:
+            break
+        current = by_id[parent]
+    line_arr = np.array(line)
+    ax.plot(line_arr[:, 0], line_arr[:, 1], color="#1f4e79", lw=1.8, label="first parents")
+    ax.scatter(tree["generation"], tree["fitness"], s=8, color="#1f4e79", zorder=3, label="ancestors")
+    ax.scatter([line[0][0]], [line[0][1]], s=40, color="#c0392b", zorder=4, label=f"individual {int(tree[0]['id'])}")
+    name, _, _ = objective_info(run.config)
+    ax.set_xlabel("generation of birth")
+    ax.set_ylabel(f"fitness: {name}")
+    crossovers = int(np.sum(tree["parent_b"] >= 0))
+    ax.set_title(
+        title
+        or f"{run.path.name}: {len(tree)} ancestors over {int(tree[0]['generation'])} generations, {crossovers} by crossover",
+        fontsize=10,
+    )
+    ax.legend(fontsize=8, loc="lower right")
+    ax.autoscale_view()
+    fig.tight_layout()
+    return fig
+
+
 def energy_split(
     accounts: Any,
     labels: Optional[Sequence[str]] = None,

@@ -18,7 +18,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, List, Optional, Union
+from typing import Any, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -31,9 +31,10 @@ __all__ = ["Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_d
 HISTORY_DTYPE = np.dtype([(name, np.dtype(kind)) for name, kind in _core.GenerationStats.HISTORY_COLUMNS])
 
 #: Columns that older runs do not have, and the value they read as.
-_LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0, "drag_limited": 0}
-#: The headers of earlier releases: before the exploit guard, and before the drag limiter's column.
-_OLDER_HEADERS = ({"best_reference", "invalid", "drag_limited"}, {"drag_limited"})
+_LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0, "drag_limited": 0, "swims": 0}
+#: The headers of earlier releases: before the exploit guard, before the drag limiter's column, and
+#: before the swims column.
+_OLDER_HEADERS = ({"best_reference", "invalid", "drag_limited", "swims"}, {"drag_limited", "swims"}, {"swims"})
 
 _LINEAGE_NAME = re.compile(r"^gen_(\d+)\.json$")
 
@@ -52,6 +53,7 @@ class LineageEntry:
         path: the JSON file it was read from.
         reference_fitness: its fitness at the exploit guard's reference step (float; NaN when the
             run did not check it).
+        id: its id in the run's genealogy (:meth:`Run.genealogy`); -1 in runs made before ids.
     """
 
     generation: int
@@ -60,6 +62,7 @@ class LineageEntry:
     genome: Any
     path: Path
     reference_fitness: float = float("nan")
+    id: int = -1
 
     def develop(self, config: Optional[Any] = None):
         """Develop the genome (``animat.develop``) with ``config`` (default: the animat defaults)."""
@@ -86,11 +89,13 @@ def read_history(path: PathLike) -> np.ndarray:
         :class:`animat.History` (a numpy structured array with ``.to_pandas()``), shape (rows,), one
         row per completed generation; fields
         ``generation`` (int64), ``best``, ``mean``, ``median``, ``viable_fraction`` (float64),
-        ``best_cells``, ``evaluations`` (int64), ``best_reference`` (float64: the best's fitness at
+        ``best_cells``, ``evaluations`` (int64, cumulative, developments included), ``swims`` (int64: this
+        generation's evaluations that swam), ``best_reference`` (float64: the best's fitness at
         the exploit guard's reference step, NaN when not evaluated), ``invalid`` (int64: viable
         individuals whose swim was unstable or broke an invariant), ``wall_seconds`` (float64, the
         only machine-dependent column, always last). Runs written before ``best_reference`` and
-        ``invalid`` existed read with NaN and 0 there, and those before ``drag_limited`` with 0 there.
+        ``invalid`` existed read with NaN and 0 there, and those before ``drag_limited`` and ``swims``
+        with 0 there.
     """
     path = Path(path)
     if not path.is_file():
@@ -156,7 +161,46 @@ def _read_lineage_file(path: Path) -> LineageEntry:
         genome,
         path,
         float("nan") if reference is None else float(reference),
+        int(data.get("id", -1)),
     )
+
+
+#: One row of ``genealogy.csv``: an individual's birth.
+GENEALOGY_DTYPE = np.dtype(
+    [
+        ("generation", np.int64),
+        ("id", np.int64),
+        ("parent_a", np.int64),
+        ("parent_b", np.int64),
+        ("fitness", np.float64),
+        ("cells", np.int64),
+    ]
+)
+
+
+def read_genealogy(path: PathLike) -> np.ndarray:
+    """``genealogy.csv`` as a structured array (:data:`GENEALOGY_DTYPE`), one row per individual born.
+
+    Raises ValueError naming the file and line for a malformed file.
+    """
+    path = Path(path)
+    names: Tuple[str, ...] = GENEALOGY_DTYPE.names or ()
+    with open(path, encoding="utf-8") as fh:
+        header = fh.readline().strip()
+        if header.split(",") != list(names):
+            raise ValueError(f"{path}:1: expected the header {','.join(names)}, got {header!r}")
+        rows = []
+        for number, line in enumerate(fh, start=2):
+            fields = line.strip().split(",")
+            if fields == [""]:
+                continue
+            if len(fields) != len(names):
+                raise ValueError(f"{path}:{number}: expected {len(names)} fields, got {len(fields)} in {line!r}")
+            try:
+                rows.append(tuple(float(v) if k == "fitness" else int(v) for k, v in zip(names, fields)))
+            except ValueError:
+                raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
+    return np.array(rows, dtype=GENEALOGY_DTYPE)
 
 
 def morphology_distance(a, b) -> float:
@@ -293,6 +337,41 @@ class Run:
                 f"({len(lineage)} improvement(s))"
             )
         return "\n".join(lines)
+
+    def genealogy(self) -> np.ndarray:
+        """Every individual born in the run, from ``genealogy.csv`` (:func:`read_genealogy`): generation,
+        id, parent_a, parent_b (-1: none), fitness, cells. Empty for a run made before the genealogy
+        was recorded."""
+        path = self.path / "genealogy.csv"
+        if not path.is_file():
+            return np.zeros(0, dtype=GENEALOGY_DTYPE)
+        return read_genealogy(path)
+
+    def ancestry(self, id: Optional[int] = None) -> np.ndarray:
+        """The family tree of individual ``id`` (default: the current best): its genealogy row and
+        those of all its ancestors recorded in ``genealogy.csv``, newest first (each id once).
+
+        Raises ValueError when the run has no genealogy or ``id`` is not in it.
+        """
+        rows = self.genealogy()
+        if id is None:
+            id = self.best().id
+        if not len(rows):
+            raise ValueError(f"{self.path / 'genealogy.csv'}: no genealogy (a run made before it was recorded)")
+        index = {int(i): k for k, i in enumerate(rows["id"])}
+        if int(id) not in index:
+            raise ValueError(f"{self.path / 'genealogy.csv'}: no individual with id {id}")
+        seen, todo, out = set(), [int(id)], []
+        while todo:
+            current = todo.pop()
+            if current in seen or current not in index:
+                continue
+            seen.add(current)
+            row = rows[index[current]]
+            out.append(index[current])
+            todo.extend(int(p) for p in (row["parent_a"], row["parent_b"]) if p >= 0)
+        out.sort(key=lambda k: (-int(rows[k]["generation"]), int(rows[k]["id"])))
+        return rows[out]
 
     def morphology_changes(self, tolerance: float = MORPHOLOGY_TOLERANCE, config=None) -> List[LineageEntry]:
         """The lineage entries at which the best's *morphology* changed (paper Figs. 8-9).

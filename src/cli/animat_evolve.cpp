@@ -2,6 +2,7 @@
 // animat_evolve_main() is the whole command line; src/cli/main.cpp calls it, and so does the Python
 // module (animat._core.evolve_cli, `animat evolve`), which links the same library (animat_cli).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <charconv>
@@ -63,6 +64,33 @@ std::string default_run_dir(std::int64_t seed) {
   return "runs/" + std::string(stamp) + "-seed" + std::to_string(seed);
 }
 
+// The configs of the source's configs/ folder, compiled in (cmake/embed_configs.cmake).
+struct PackagedConfig {
+  std::string_view name, text;
+};
+constexpr PackagedConfig kPackagedConfigs[] = {
+#include "packaged_configs.inc"
+};
+
+// --config: a file, else a packaged config by name ("paper_dn10" or "paper_dn10.toml"). A file of
+// that name wins, so a user's own paper_dn10 in the working directory is never shadowed.
+animat::Config load_named_config(const std::string& given) {
+  std::error_code ec;
+  if (std::filesystem::exists(given, ec) || given.find('/') != std::string::npos)
+    return animat::load_config(given);
+  std::string_view name(given);
+  if (name.ends_with(".toml")) name.remove_suffix(5);
+  std::string names;
+  for (const auto& c : kPackagedConfigs) {
+    if (c.name == name)
+      return animat::config_from_toml(c.text, fmt::format("packaged config {}", c.name));
+    names += (names.empty() ? "" : ", ") + std::string(c.name);
+  }
+  throw animat::IoError(
+      fmt::format("--config {}: no such file, and no packaged config of that name (packaged: {})",
+                  given, names));
+}
+
 // The seed as given: digits only, within int64 (an error, never a clamp).
 std::int64_t parse_seed(const std::string& text) {
   std::int64_t value = 0;
@@ -89,8 +117,8 @@ int animat_evolve_main(int argc, char** argv) {
   int generations = -1, threads = -1;
   bool print_config = false, quiet = false, use_mpi = false, overwrite = false;
   app.add_option("--config", config_path,
-                 "TOML config file (default: the embedded paper d_N = 2, 32-cell setting)")
-      ->check(CLI::ExistingFile);
+                 "TOML config file, or the name of a packaged one (paper_dn10, crawl, ...: "
+                 "configs/ of the source; default: the embedded paper d_N = 2, 32-cell setting)");
   app.add_option("--set", overrides, "override one value: section.key=value (repeatable)");
   // Read as text: CLI11 would clamp a seed beyond int64 to 2^63-1 silently.
   app.add_option("--seed", seed_text, "run seed (evolution.seed), an integer in [0, 2^63-1]");
@@ -161,7 +189,7 @@ int animat_evolve_main(int argc, char** argv) {
             (ec && ec != std::errc::no_such_file_or_directory ? " (" + ec.message() + ")" : ""));
       config = animat::load_config(base);
     } else if (!config_path.empty()) {
-      config = animat::load_config(config_path);
+      config = load_named_config(config_path);
     }
     // validated together: the order of the --set flags does not matter
     animat::apply_overrides(config, overrides);
@@ -184,13 +212,26 @@ int animat_evolve_main(int argc, char** argv) {
     options.stop_flag = &g_stop;
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    if (!quiet)
+    if (!quiet) {
+      // The world as it is: d_N only where the scene has drag.
+      const std::string world =
+          animat::has_effect(config.scene.effects, "drag")
+              ? fmt::format("d_N = {}", config.scene.drag_normal)
+              : fmt::format("no drag ({})", fmt::join(config.scene.effects, ", "));
       spdlog::info(
-          "animat {} | population {} | {} cells max | d_N = {} | {} swim steps | seed {} | run dir "
-          "{}",
-          ANIMAT_VERSION, config.evolution.population, config.development.max_cells,
-          config.scene.drag_normal, config.evaluation.steps, config.evolution.seed,
+          "animat {} | population {} | {} cells max | {} | objective {} | {} swim steps | seed {} "
+          "| run dir {}",
+          ANIMAT_VERSION, config.evolution.population, config.development.max_cells, world,
+          config.evaluation.objective, config.evaluation.steps, config.evolution.seed,
           options.out.string());
+      if (config.evolution.generations == 0 && config.evolution.wall_seconds == 0)
+        spdlog::warn(
+            "no generation cap (--generations, evolution.generations) and no wall-clock budget "
+            "(evolution.wall_seconds): the run stops only after evolution.stall_generations = {} "
+            "generations without improvement, hours at the paper's setting (Ctrl-C stops it with "
+            "a checkpoint)",
+            config.evolution.stall_generations);
+    }
     if (mpi_job) {  // [mpi]
       // mpirun closes our output when a rank dies: a hang-up (output on a pty) or a broken pipe
       // must not kill rank 0 before it has said what is on disk.
@@ -232,12 +273,16 @@ int animat_evolve_main(int argc, char** argv) {
     const animat::ObjectiveSpec* spec = animat::find_objective(objective);
     const std::string meaning =
         spec ? std::string(spec->meaning) : "evaluation.objective = " + objective;
-    std::printf("\nBest swimmer: fitness %.4f (%s), %d cells, generation %d\n", best.result.fitness,
-                meaning.c_str(), best.result.cell_count, summary.history.back().generation);
+    int found = 0;  // the generation that found the best: the last in which the best changed
+    for (const auto& row : summary.history)
+      if (row.best_changed) found = row.generation;
+    std::printf("\nBest swimmer: fitness %.4f (%s), %d cells, found at generation %d of %d\n",
+                best.result.fitness, meaning.c_str(), best.result.cell_count, found,
+                summary.history.back().generation);
     std::printf("Stopped: %s\n", summary.stop_reason.c_str());
     std::printf(
         "Results in %s: config.toml, history.csv, best/ (lineage of best genomes), "
-        "checkpoint.json\n",
+        "genealogy.csv, checkpoint.json\n",
         options.out.c_str());
     std::printf(
         "View them:  animat show %s   (in a source tree: PYTHONPATH=build/python .venv/bin/python "

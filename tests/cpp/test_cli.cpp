@@ -164,6 +164,65 @@ TEST(Cli, ConfigFileThenSetOverridesIt) {
   EXPECT_TRUE(config_from_toml(r.out, "stdout") == expected);
 }
 
+TEST(Cli, PackagedConfigsResolveByNameAndAFileOfThatNameWins) {
+  const Config dn10 = load_config(fs::path(ANIMAT_SOURCE_DIR) / "configs" / "paper_dn10.toml");
+  for (const char* name : {"paper_dn10", "paper_dn10.toml"}) {
+    const Result r = run(std::string("--print-config --config ") + name);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(config_from_toml(r.out, "stdout") == dn10) << name;
+  }
+  // The scratch directory is the working directory: its own paper_dn10.toml is read instead.
+  Config own;
+  own.evolution.population = 42;
+  write_file("paper_dn10.toml", to_toml(own));
+  const Result r = run("--print-config --config paper_dn10.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(config_from_toml(r.out, "stdout").evolution.population, 42);
+  fs::remove(scratch_dir() / "paper_dn10.toml");
+}
+
+TEST(Cli, ProgressCountsSwimsAndTheClosingLineNamesTheBestsGeneration) {
+  const fs::path out = scratch_dir() / "progress_run";
+  const Result r =
+      run("--set evolution.population=6 --set evolution.elites=1 --set evaluation.steps=40 "
+          "--generations 3 --threads 1 --seed 5 --out '" +
+          out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string log = r.out + r.err;
+  EXPECT_CONTAINS(log, "| d_N = 2 | objective distance |");
+  EXPECT_CONTAINS(log, "random genomes drawn");
+  EXPECT_CONTAINS(log, "swims/s");
+  EXPECT_TRUE(log.find("eval/s") == std::string::npos) << log;
+  EXPECT_TRUE(log.find("no generation cap") == std::string::npos) << log;
+  // The generation that found the best: the last lineage file.
+  int found = -1;
+  for (const auto& e : fs::directory_iterator(out / "best"))
+    found = std::max(found, std::stoi(e.path().stem().string().substr(4)));
+  EXPECT_CONTAINS(log, "stopped at generation 3: generation cap");
+  EXPECT_CONTAINS(log, ", found at generation " + std::to_string(found));
+  fs::remove_all(out);
+}
+
+TEST(Cli, AnUncappedRunIsWarnedAboutAndADriftlessSceneHasNoDN) {
+  // The warning comes before the run starts; the run itself is refused (no such directory).
+  const Result r = run("--config crawl --generations 0 --out /dev/null/run");
+  EXPECT_NE(r.exit_code, 0);
+  const std::string log = r.out + r.err;
+  EXPECT_CONTAINS(log, "no generation cap");
+  EXPECT_CONTAINS(log, "evolution.stall_generations = 500");
+  EXPECT_CONTAINS(log, "| no drag (");
+  EXPECT_TRUE(log.find("d_N =") == std::string::npos) << log;
+}
+
+TEST(CliErrors, UnknownConfigNameListsThePackagedOnes) {
+  const Result r = run("--print-config --config paper_dn11");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_CONTAINS(r.err, "--config paper_dn11: no such file, and no packaged config of that name");
+  EXPECT_CONTAINS(r.err, "paper_dn10");
+  EXPECT_CONTAINS(r.err, "crawl");
+  EXPECT_EQ(r.out, "");
+}
+
 TEST(CliErrors, UnknownOption) {
   const Result r = run("--print-config --bogus-option");
   EXPECT_NE(r.exit_code, 0);

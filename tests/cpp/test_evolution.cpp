@@ -1,11 +1,14 @@
 // The GA engine, checked in milliseconds with a cheap deterministic stub fitness.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "animat/config.hpp"
@@ -226,6 +229,81 @@ TEST(Evolution, CheckpointResumeReproducesTheUninterruptedRun) {
   }
 }
 
+TEST(Evolution, IdsAndParentsTraceEveryIndividualToThePreviousGeneration) {
+  Config c = small_config(20);
+  c.evolution.crossover_fraction = 0.5;  // many of both kinds
+  Evolution evo(c, stub_fitness);
+  evo.initialize();
+  const auto n = static_cast<std::int64_t>(c.evolution.population);
+  for (std::int64_t i = 0; i < n; ++i) {
+    EXPECT_EQ(evo.population()[static_cast<std::size_t>(i)].id, i);
+    EXPECT_EQ(evo.population()[static_cast<std::size_t>(i)].parent_a, kNoParent);
+    EXPECT_EQ(evo.population()[static_cast<std::size_t>(i)].parent_b, kNoParent);
+  }
+  int crossovers_seen = 0, mutants_seen = 0;
+  for (int g = 1; g <= 8; ++g) {
+    const std::vector<Individual> before = evo.population();
+    std::set<std::int64_t> previous;
+    for (const auto& ind : before) previous.insert(ind.id);
+    const GenerationStats s = evo.step();
+    int crossovers = 0;
+    for (std::size_t i = 0; i < evo.population().size(); ++i) {
+      const Individual& ind = evo.population()[i];
+      if (ind.id < g * n) {  // an elite: the same individual as before, parents and all
+        const auto it = std::find_if(before.begin(), before.end(),
+                                     [&](const Individual& b) { return b.id == ind.id; });
+        ASSERT_NE(it, before.end()) << "generation " << g << " id " << ind.id;
+        EXPECT_TRUE(it->genome == ind.genome);
+        EXPECT_EQ(it->parent_a, ind.parent_a);
+        continue;
+      }
+      EXPECT_EQ(ind.id, g * n + static_cast<std::int64_t>(i)) << "generation " << g;
+      EXPECT_TRUE(previous.count(ind.parent_a)) << "generation " << g << " index " << i;
+      if (ind.parent_b != kNoParent) {
+        EXPECT_TRUE(previous.count(ind.parent_b)) << "generation " << g << " index " << i;
+        ++crossovers;
+      } else {
+        ++mutants_seen;
+      }
+    }
+    EXPECT_EQ(crossovers, s.crossovers) << "generation " << g;
+    crossovers_seen += crossovers;
+  }
+  EXPECT_GT(crossovers_seen, 0);
+  EXPECT_GT(mutants_seen, 0);
+
+  // Ids survive a checkpoint; one written before ids existed restores with each individual born at
+  // its generation and parents unknown, and the run goes on identically.
+  const std::string ckpt = evo.checkpoint();
+  Evolution same(c, stub_fitness);
+  same.restore(ckpt);
+  for (std::size_t i = 0; i < evo.population().size(); ++i) {
+    EXPECT_EQ(same.population()[i].id, evo.population()[i].id);
+    EXPECT_EQ(same.population()[i].parent_a, evo.population()[i].parent_a);
+    EXPECT_EQ(same.population()[i].parent_b, evo.population()[i].parent_b);
+  }
+  nlohmann::json payload =
+      nlohmann::json::parse(nlohmann::json::parse(ckpt)["payload"].get<std::string>());
+  for (auto& ind : payload["population"]) {
+    ind.erase("id");
+    ind.erase("parent_a");
+    ind.erase("parent_b");
+  }
+  const std::string body = payload.dump();
+  Evolution old(c, stub_fitness);
+  old.restore(
+      nlohmann::json{{"checksum", fmt::format("{:016x}", fnv1a(body))}, {"payload", body}}.dump());
+  for (std::size_t i = 0; i < old.population().size(); ++i) {
+    EXPECT_EQ(old.population()[i].id, 8 * n + static_cast<std::int64_t>(i));
+    EXPECT_EQ(old.population()[i].parent_a, kNoParent);
+  }
+  old.step();
+  same.step();
+  expect_same_history(old.history(), same.history());
+  for (std::size_t i = 0; i < old.population().size(); ++i)
+    EXPECT_TRUE(old.population()[i].genome == same.population()[i].genome);
+}
+
 TEST(Evolution, CorruptOrMismatchedCheckpointIsRefused) {
   const Config c = small_config();
   Evolution evo(c, stub_fitness);
@@ -271,12 +349,19 @@ TEST(RunDirectory, WritesConfigHistoryLineageAndCheckpointThenResumes) {
   EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.json"));
   EXPECT_EQ(load_config(dir / "config.toml"), c);
   const std::string hist = slurp(dir / "history.csv");
-  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,best_"
-                       "reference,invalid,drag_limited,wall_seconds\n",
+  EXPECT_EQ(hist.rfind("generation,best,mean,median,viable_fraction,best_cells,evaluations,swims,"
+                       "best_reference,invalid,drag_limited,wall_seconds\n",
                        0),
             0u);
   EXPECT_EQ(std::count(hist.begin(), hist.end(), '\n'), 1 + 7);  // header + generations 0..6
   EXPECT_TRUE(std::filesystem::exists(dir / "best" / "gen_000000.json"));
+  // genealogy.csv: the initial population, then every generation's offspring (the elites are not
+  // born again): 20 + 6 x 18 rows.
+  const std::string family = slurp(dir / "genealogy.csv");
+  EXPECT_EQ(family.rfind("generation,id,parent_a,parent_b,fitness,cells\n", 0), 0u);
+  EXPECT_EQ(std::count(family.begin(), family.end(), '\n'), 1 + 20 + 6 * 18);
+  EXPECT_NE(family.find("\n0,0,-1,-1,"), std::string::npos);
+  EXPECT_NE(family.find("\n6,139,"), std::string::npos);  // the last offspring: 6 x 20 + 19
 
   // A second run into the same directory is refused; a resume with a higher cap continues it.
   EXPECT_THROW(run_evolution(c, opt, stub_fitness), IoError);
@@ -293,6 +378,7 @@ TEST(RunDirectory, WritesConfigHistoryLineageAndCheckpointThenResumes) {
   straight_opt.quiet = true;
   const RunSummary straight = run_evolution(straight_cfg, straight_opt, stub_fitness);
   expect_same_history(straight.history, r.history);
+  EXPECT_EQ(slurp(dir / "genealogy.csv"), slurp(straight_opt.out / "genealogy.csv"));
   std::filesystem::remove_all(dir);
   std::filesystem::remove_all(straight_opt.out);
 }

@@ -141,25 +141,33 @@ def test_malformed_run_directories_give_clear_errors(run_dir, tmp_path):
     (bad / "history.csv").write_text("gen,best\n" + "".join(lines[1:]))
     with pytest.raises(ValueError, match=r"history\.csv:1: unexpected header"):
         run.history
-    (bad / "history.csv").write_text(lines[0] + lines[1] + "1,oops,0,0,1,32,10,nan,0,0,1.0\n" + "".join(lines[3:]))
+    (bad / "history.csv").write_text(lines[0] + lines[1] + "1,oops,0,0,1,32,10,10,nan,0,0,1.0\n" + "".join(lines[3:]))
     with pytest.raises(ValueError, match=r"history\.csv:3: not a number"):
         run.history
     (bad / "history.csv").write_text(lines[0] + "1,2,3\n")
-    with pytest.raises(ValueError, match=r"history\.csv:2: expected 11"):
+    with pytest.raises(ValueError, match=r"history\.csv:2: expected 12"):
         run.history
     # A run written before the exploit guard's columns still reads, with NaN and 0 there.
     old = [
-        ",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 8, 9)) + "\n" for line in lines
+        ",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 8, 9, 10)) + "\n"
+        for line in lines
     ]
     (bad / "history.csv").write_text("".join(old))
     h = run.history
     assert np.isnan(h["best_reference"]).all() and (h["invalid"] == 0).all() and (h["drag_limited"] == 0).all()
     assert h["wall_seconds"][-1] == float(lines[-1].rstrip("\n").split(",")[-1])
     # One written with the exploit guard but before the drag limiter's column (data/paper_100_generations).
-    guard = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k != 9) + "\n" for line in lines]
+    guard = [
+        ",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k not in (7, 10)) + "\n" for line in lines
+    ]
     (bad / "history.csv").write_text("".join(guard))
     h = run.history
     assert (h["drag_limited"] == 0).all() and not np.isnan(h["best_reference"]).any()
+    # One written before the swims column (data/replication): 0 there, everything else read.
+    unswum = [",".join(c for k, c in enumerate(line.rstrip("\n").split(",")) if k != 7) + "\n" for line in lines]
+    (bad / "history.csv").write_text("".join(unswum))
+    h = run.history
+    assert (h["swims"] == 0).all() and not np.isnan(h["best_reference"]).any()
     # The exploit guard's columns without drag_limited but in another order is no format of ours.
     (bad / "history.csv").write_text(
         guard[0].replace("best_reference,invalid", "invalid,best_reference") + "".join(guard[1:])
@@ -396,3 +404,89 @@ def test_docs_walkthrough_code_runs(tmp_path, monkeypatch, capsys):
     import matplotlib.pyplot as plt
 
     plt.close("all")
+
+
+# --- genealogy ------------------------------------------------------------------------------------
+
+
+def test_genealogy_records_every_birth_and_traces_the_best_to_generation_zero(run, run_dir):
+    g = run.genealogy()
+    assert g.dtype == animat.GENEALOGY_DTYPE
+    n = 12
+    elites = int(run.config["evolution.elites"])
+    # the initial population, then each generation's offspring (the elites are not born again)
+    assert len(g) == n + 3 * (n - elites)
+    assert g["id"][:n].tolist() == list(range(n))
+    assert np.all(g["parent_a"][:n] == -1) and np.all(g["parent_b"][:n] == -1)
+    later = g[n:]
+    assert np.all(later["id"] == later["generation"] * n + later["id"] % n)
+    assert np.all(later["parent_a"] >= 0)
+    assert np.all(later["parent_a"] < later["generation"] * n)  # parents were born earlier
+    # the population's fitness is the swims' (the history's best is the best of the recorded births)
+    assert run.history["best"][-1] == pytest.approx(g["fitness"].max())
+    best = run.best()
+    assert best.id >= 0 and best.id in set(g["id"].tolist())
+    tree = run.ancestry()
+    assert tree[0]["id"] == best.id
+    assert tree[-1]["generation"] == 0  # back to an initial individual
+    ids = set(tree["id"].tolist())
+    for row in tree:
+        for parent in (row["parent_a"], row["parent_b"]):
+            assert parent < 0 or parent in ids  # closed under parents
+    with pytest.raises(ValueError, match="no individual with id 99999"):
+        run.ancestry(99999)
+
+
+def test_individuals_carry_their_ids_and_fitness_reads_as_a_float(run):
+    result = animat.evolve(small_config(), quiet=True)
+    ids = [ind.id for ind in result.population]
+    assert len(set(ids)) == len(ids)
+    assert all(ind.parent_a >= 0 for ind in result.population if ind.id >= 12)
+    ind = max(result.population, key=lambda i: float(i.fitness))
+    assert float(ind.fitness) == ind.fitness.fitness
+    assert f"{ind.fitness:.3f}" == f"{ind.fitness.fitness:.3f}"
+    assert ind.fitness >= 0.0 and not ind.fitness < 0.0
+    assert sorted(result.population, key=lambda i: i.fitness)[-1].fitness.fitness == ind.fitness.fitness
+    import pickle
+
+    back = pickle.loads(pickle.dumps(ind))
+    assert (back.id, back.parent_a, back.parent_b) == (ind.id, ind.parent_a, ind.parent_b)
+
+
+def test_genealogy_figure_draws_the_family_tree(run):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    fig = animat.plot.genealogy(run)
+    ax = next(a for a in fig.axes if a.get_label() == "genealogy")
+    assert ax.get_xlabel() == "generation of birth"
+    assert ax.get_ylabel() == "fitness: distance"
+    assert "ancestors" in ax.get_title()
+    assert len(ax.collections) >= 3  # parent links (solid, dashed) and the ancestors' points
+
+
+def test_a_run_without_genealogy_reads_empty_and_says_so(run_dir, tmp_path):
+    old = tmp_path / "old"
+    shutil.copytree(run_dir, old)
+    (old / "genealogy.csv").unlink()
+    r = animat.Run(old)
+    assert len(r.genealogy()) == 0
+    with pytest.raises(ValueError, match="no genealogy"):
+        r.ancestry(0)
+
+
+def test_a_malformed_genealogy_names_file_and_line(run_dir, tmp_path):
+    bad = tmp_path / "bad"
+    shutil.copytree(run_dir, bad)
+    text = (bad / "genealogy.csv").read_text().splitlines()
+    text[3] = "1,2,x,3,4.5,6"
+    (bad / "genealogy.csv").write_text("\n".join(text) + "\n")
+    with pytest.raises(ValueError, match=r"genealogy.csv:4: not a number"):
+        animat.Run(bad).genealogy()
+
+
+def test_packaged_configs_load_by_name():
+    assert animat.load_config("paper_dn10") == animat.load_config(animat.config_path("paper_dn10"))
+    assert animat.load_config("crawl.toml") == animat.load_config(animat.config_path("crawl"))
+    with pytest.raises(FileNotFoundError, match="paper_dn11: no such file, and no packaged config"):
+        animat.load_config("paper_dn11")

@@ -74,6 +74,7 @@ def test_run_directory_layout_and_resume(tmp_path):
         "viable_fraction",
         "best_cells",
         "evaluations",
+        "swims",
         "best_reference",
         "invalid",
         "drag_limited",
@@ -159,12 +160,14 @@ def test_generation_stats_fields_pickling_and_history_columns_follow_one_descrip
         "viable_fraction": 0.75,
         "best_cells": 9,
         "evaluations": 120,
+        "swims": 30,
         "best_reference": float("nan"),
         "invalid": 2,
         "drag_limited": 0,
         "wall_seconds": 1.25,
         "best_changed": True,
         "evaluations_per_second": 40.0,
+        "swims_per_second": 10.0,
         "crossovers": 1,
     }
     s = animat.GenerationStats(d)

@@ -495,7 +495,7 @@ def _core_stats(evo):
     return {
         name: float(evo.history[-1][name]) if evo.history.dtype[name].kind == "f" else int(evo.history[-1][name])
         for name in evo.history.dtype.names
-    } | {"evaluations_per_second": 1.0, "best_changed": True, "crossovers": 2}
+    } | {"evaluations_per_second": 1.0, "swims_per_second": 0.5, "best_changed": True, "crossovers": 2}
 
 
 def test_unpickling_a_foreign_state_is_a_clear_error():
