@@ -165,23 +165,23 @@ def _b64(array: np.ndarray) -> str:
     return base64.b64encode(np.ascontiguousarray(array).tobytes()).decode("ascii")
 
 
-def downsample_indices(n: int, max_points: int, keep: Sequence[int] = ()) -> np.ndarray:
+def downsample_indices(n: int, max_points: int, keep: Any = ()) -> np.ndarray:
     """At most ``max_points`` sorted row indices of ``n`` rows: all of them when they fit, else the
     first and last, as many of ``keep`` (e.g. the rows where the best changed) as three quarters of
     the budget allow (evenly chosen), and an even grid for the rest."""
     if n <= max_points:
         return np.arange(n)
     max_points = max(int(max_points), 2)
-    keep = np.unique(np.asarray(keep, dtype=np.int64))
-    keep = keep[(keep >= 0) & (keep < n)]
+    kept = np.unique(np.asarray(keep, dtype=np.int64))
+    kept = kept[(kept >= 0) & (kept < n)]
     budget = (3 * max_points) // 4
-    if len(keep) > budget:
-        keep = keep[np.unique(np.linspace(0, len(keep) - 1, budget).round().astype(np.int64))]
-    grid = np.linspace(0, n - 1, max(max_points - len(keep), 2)).round().astype(np.int64)
-    picked = np.unique(np.concatenate([grid, keep, [0, n - 1]]))
+    if len(kept) > budget:
+        kept = kept[np.unique(np.linspace(0, len(kept) - 1, budget).round().astype(np.int64))]
+    grid = np.linspace(0, n - 1, max(max_points - len(kept), 2)).round().astype(np.int64)
+    picked = np.unique(np.concatenate([grid, kept, [0, n - 1]]))
     if len(picked) > max_points:  # grid and keep overlap rarely: trim the grid points in between
         extra = len(picked) - max_points
-        inner = np.setdiff1d(picked, np.concatenate([keep, [0, n - 1]]))
+        inner = np.setdiff1d(picked, np.concatenate([kept, [0, n - 1]]))
         drop = inner[np.unique(np.linspace(0, len(inner) - 1, extra).round().astype(np.int64))]
         picked = np.setdiff1d(picked, drop)
     return picked
@@ -235,6 +235,25 @@ def _entry_id(entry: Any) -> Optional[int]:
     except (OSError, ValueError, AttributeError):
         return None
     return int(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def _summary(history: np.ndarray, path: Path) -> Dict[str, Any]:
+    """The runs table's row: the last generation's numbers, and why the run stopped (stopped.txt)."""
+    out: Dict[str, Any] = {"generations": len(history)}
+    if len(history):
+        last = history[-1]
+        out.update(
+            last_generation=int(last["generation"]),
+            best=_num(last["best"]),
+            reference=_num(last["best_reference"]),
+            cells=int(last["best_cells"]),
+            evaluations=int(last["evaluations"]),
+            invalid=int(np.sum(history["invalid"])),
+            wall_seconds=_num(last["wall_seconds"], 4),
+        )
+    stopped = path / "stopped.txt"
+    out["stopped"] = stopped.read_text(errors="replace").strip()[:200] if stopped.is_file() else ""
+    return out
 
 
 def _lineage_payload(lineage: Sequence[Any]) -> List[dict]:
@@ -392,7 +411,7 @@ def _swim_payload(entry: Any, config: Any, frames: int) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # an unstable swim: said on the page
         tr = replay(entry, config)
-    scene = _core.Scene.from_config(config)
+    scene: Any = _core.Scene.from_config(config)
     effects = list(scene.effects)
     idx = np.asarray(default_frames(tr, max_frames=max(2, frames)), dtype=np.int64)
     align = "gravity" not in effects and "ground" not in effects
@@ -535,22 +554,7 @@ def run_data(ref: RunRef, *, frames: int = 200, max_points: int = 500, modes: bo
         "mode": None,
         "_config": config,
     }
-    if len(history):
-        last = history[-1]
-        data["summary"] = {
-            "generations": len(history),
-            "last_generation": int(last["generation"]),
-            "best": _num(last["best"]),
-            "reference": _num(last["best_reference"]),
-            "cells": int(last["best_cells"]),
-            "evaluations": int(last["evaluations"]),
-            "invalid": int(np.sum(history["invalid"])),
-            "wall_seconds": _num(last["wall_seconds"], 4),
-        }
-    else:
-        data["summary"] = {"generations": 0}
-    stopped = ref.path / "stopped.txt"
-    data["summary"]["stopped"] = stopped.read_text(errors="replace").strip()[:200] if stopped.is_file() else ""
+    data["summary"] = _summary(history, ref.path)
     if not lineage_entries:
         data["swim_note"] = "no best yet (best/ is empty)"
         return data
@@ -596,18 +600,7 @@ def live_data(refs: Sequence[RunRef], max_points: int = 500) -> dict:
             curves, flags = _history_payload(history, config, max_points)
             entry = {"label": ref.label, "history": curves, "flags": flags}
             entry["lineage"] = _lineage_payload(run.best_genomes)
-            if len(history):
-                last = history[-1]
-                entry["summary"] = {
-                    "generations": len(history),
-                    "last_generation": int(last["generation"]),
-                    "best": _num(last["best"]),
-                    "reference": _num(last["best_reference"]),
-                    "cells": int(last["best_cells"]),
-                    "evaluations": int(last["evaluations"]),
-                    "invalid": int(np.sum(history["invalid"])),
-                    "wall_seconds": _num(last["wall_seconds"], 4),
-                }
+            entry["summary"] = _summary(history, ref.path)
         except (OSError, ValueError) as e:  # a file being rewritten: said, and tried again next poll
             entry = {"label": ref.label, "error": str(e)}
         runs.append(entry)
