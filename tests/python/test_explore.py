@@ -449,3 +449,33 @@ def test_the_live_page_redraws_as_the_history_grows(browser, runs, tmp_path):
     finally:
         server.shutdown()
         server.server_close()
+
+
+def test_cli_serves_the_page_on_localhost_until_interrupted(runs):
+    import signal
+
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    args = ["explore", runs / "study" / "run_1", "--serve", "--port", "0", "--live", "--frames", "10"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "animat", *map(str, args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+/", line)
+        assert url, line + (proc.stderr.read() if proc.stderr else "")
+        page = urllib.request.urlopen(url.group(0)).read().decode()
+        assert '"live":{"poll":2.0' in page and "animat-data" in page
+        live = json.loads(urllib.request.urlopen(url.group(0) + "live.json").read())
+        rows = len(animat.Run(runs / "study" / "run_1").history)
+        assert live["runs"][0]["label"] == "run_1" and live["runs"][0]["history"]["total"] == rows
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
