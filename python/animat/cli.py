@@ -279,8 +279,8 @@ def cmd_explore(args) -> int:
                 live=args.live,
                 poll=args.poll,
                 page=page,
-                max_points=args.max_points,
                 log=lambda m: print(m, flush=True),
+                **options,
             )
         except KeyboardInterrupt:
             print("(stopped serving)", file=sys.stderr)

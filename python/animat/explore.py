@@ -447,6 +447,7 @@ def _swim_payload(entry: Any, config: Any, frames: int) -> dict:
             "decay": _num(scene.chemical_decay_length),
         }
     return {
+        "generation": int(entry.generation),
         "n": int(tr.node_count),
         "frames": len(idx),
         "recorded": int(tr.frame_count),
@@ -686,19 +687,31 @@ def make_server(
     """A :class:`http.server.ThreadingHTTPServer` on 127.0.0.1:``port`` (0: any free port) serving the
     page at ``/`` and, with ``live``, the runs' current curves at ``/live.json`` (:func:`live_data`;
     ``?since=VERSION`` answers ``{"changed": false}`` while nothing changed). The page polls every
-    ``poll`` seconds (backing off to 30 s while nothing changes; at most ``max_polls`` times).
-    ``server.url`` is its address; call ``serve_forever()`` (or run it in a thread) and ``shutdown()``.
+    ``poll`` seconds (backing off to 30 s while nothing changes; at most ``max_polls`` times); a live
+    page is built again when it is loaded after the runs changed, so a reload shows the newest best's
+    swim and genealogy. ``page`` is the page already built (``kwargs`` are :func:`build_data`'s, for
+    building it). ``server.url`` is its address; call ``serve_forever()`` (or run it in a thread) and
+    ``shutdown()``.
     """
     from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
     from urllib.parse import parse_qs, urlparse
 
     refs = find_runs(paths)
     max_points = int(kwargs.get("max_points", 500))
+    liveinfo = {"poll": float(poll), "max_polls": int(max_polls)} if live else None
+    built = {"version": _live_version(refs), "body": b""}
     if page is None:
-        liveinfo = {"poll": float(poll), "max_polls": int(max_polls)} if live else None
         page = render_html(build_data(paths, live=liveinfo, refs=refs, **kwargs))
-    body = page.encode("utf-8")
+    built["body"] = page.encode("utf-8")
     lock = threading.Lock()
+
+    def current_page() -> bytes:
+        with lock:
+            version = _live_version(refs)
+            if live and version != built["version"]:  # the runs grew since it was built: build it again
+                built["body"] = render_html(build_data(paths, live=liveinfo, refs=refs, **kwargs)).encode("utf-8")
+                built["version"] = version
+            return built["body"]
 
     class Handler(BaseHTTPRequestHandler):
         def _send(self, status: int, payload: bytes, kind: str) -> None:
@@ -712,7 +725,7 @@ def make_server(
         def do_GET(self) -> None:  # noqa: N802 - the http.server API
             url = urlparse(self.path)
             if url.path in ("/", "/index.html", "/explore.html"):
-                self._send(200, body, "text/html; charset=utf-8")
+                self._send(200, current_page(), "text/html; charset=utf-8")
             elif url.path == "/live.json" and live:
                 since = parse_qs(url.query).get("since", [""])[0]
                 with lock:

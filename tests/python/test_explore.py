@@ -441,6 +441,15 @@ def test_the_live_page_redraws_as_the_history_grows(browser, runs, tmp_path):
         page.wait_for_function(f"animatExplore.data.runs[0].history.total === {total + 3}", timeout=15_000)
         assert page.evaluate("animatExplore.live.updates") >= 1
         assert page.text_content("#summary tbody tr td:nth-child(3)") == str(total + 3)
+        newest = sorted((run / "best").glob("gen_*.json"))[-1]
+        entry = {**json.loads(newest.read_text()), "generation": int(last[0]) + 3}
+        (run / "best" / f"gen_{int(last[0]) + 3:06d}.json").write_text(json.dumps(entry))  # a new best
+        page.wait_for_function("animatExplore.live.note.includes('reload to replay it')", timeout=15_000)
+        assert page.eval_on_selector_all("#lineage tbody tr", "(rs) => rs.length") == len(
+            list((run / "best").iterdir())
+        )
+        reloaded = urllib.request.urlopen(server.url).read().decode()  # a reload is built again
+        assert f'"generations":{total + 3},' in reloaded and f'"generation":{int(last[0]) + 3},"n":' in reloaded
         version = json.loads(urllib.request.urlopen(server.url + "live.json").read())["version"]
         again = urllib.request.urlopen(server.url + "live.json?since=" + urllib.parse.quote(version)).read()
         assert json.loads(again) == {"changed": False, "version": version}
