@@ -319,12 +319,13 @@ def ancestry(genealogy: Dict[int, Tuple[int, int, int, float, int]], start: int)
             if parent >= 0 and parent not in seen:
                 seen.add(parent)
                 stack.append(parent)
-    primary = [start]
+    primary, on_line = [start], {start}
     while True:
         row = genealogy.get(primary[-1])
-        if row is None or row[1] < 0 or row[1] in primary:
+        if row is None or row[1] < 0 or row[1] in on_line:
             break
         primary.append(row[1])
+        on_line.add(row[1])
     ordered = sorted(seen, key=lambda i: (-genealogy[i][0] if i in genealogy else 1, i))
     return ordered, primary
 
@@ -357,6 +358,8 @@ def _genealogy_payload(run_path: Path, lineage: List[dict], max_nodes: int) -> d
             return {"note": f"{path.name}: the best (generation {best['generation']}) is not in it (no id, no match)"}
         start = max(candidates, key=lambda i: (table[i][0], i))
     ancestors, primary = ancestry(table, start)
+    ancestors = [i for i in ancestors if i in table]  # a parent without its row ends the branch: not drawn
+    primary = [i for i in primary if i in table]
     total = len(ancestors)
     keep = set(primary)
     for i in ancestors:  # youngest first, after the primary line
@@ -368,9 +371,9 @@ def _genealogy_payload(run_path: Path, lineage: List[dict], max_nodes: int) -> d
     lineage_ids = {e["id"] for e in lineage if e.get("id") is not None}
     rows = []
     for i in nodes:
-        g, a, b, f, c = table.get(i, (-1, -1, -1, float("nan"), 0))
+        g, a, b, f, c = table[i]
         rows.append([i, g, index.get(a, -1), index.get(b, -1), _num(f), c, 1 if i in lineage_ids else 0])
-    founders = sum(1 for i in ancestors if i in table and table[i][1] < 0 and table[i][2] < 0)
+    founders = sum(1 for i in ancestors if table[i][1] < 0 and table[i][2] < 0)
     return {
         "nodes": rows,  # [id, generation, parent_a index, parent_b index, fitness, cells, in lineage]
         "primary": [index[i] for i in primary if i in index],
