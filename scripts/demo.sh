@@ -15,4 +15,6 @@ if [[ -f python/animat/__main__.py ]]; then
   echo "== Drawing the best swimmer of $OUT =="
   PYTHONPATH=build/python .venv/bin/python -m animat show "$OUT"
   PYTHONPATH=build/python .venv/bin/python -m animat animate "$OUT"
+  PYTHONPATH=build/python .venv/bin/python -m animat explore "$OUT"
+  echo "Open $OUT/explore.html in a browser (offline): the curves, lineage, genealogy and the best's swim."
 fi

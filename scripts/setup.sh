@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 APT_PACKAGES=(build-essential cmake ninja-build pkg-config python3-venv
   libbox2d-dev libcgal-dev libeigen3-dev libspdlog-dev libfmt-dev googletest libgtest-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libbenchmark-dev
-  libopenmpi-dev openmpi-bin)
+  libopenmpi-dev openmpi-bin
+  chromium)  # the headless browser of tests/python/test_explore.py (driven by playwright)
 if [[ "${ANIMAT_EXTRA_APT:-}" != "" ]]; then read -r -a extra <<<"$ANIMAT_EXTRA_APT"; APT_PACKAGES+=("${extra[@]}"); fi
 
 missing=()

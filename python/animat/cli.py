@@ -5,6 +5,7 @@
                                         #   (+ stiffness_map for a body with evolved stiffness)
     python -m animat animate RUN_DIR    # figures/best.gif
     python -m animat info RUN_DIR       # a short summary of the run
+    python -m animat explore RUN_DIR... # one HTML page: curves, lineage, genealogy, the best's swim (--serve --live)
     python -m animat experiment CONFIG --runs N --out DIR   # N independent seeds, resumable, with a summary
     mpirun -np R python -m animat experiment NAME=CONFIG ... --runs N --out DIR --mpi   # a study over MPI ranks
 
@@ -34,7 +35,7 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="animat", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    sub = p.add_subparsers(dest="command", required=True, metavar="{evolve,show,animate,info,experiment}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="{evolve,show,animate,info,explore,experiment}")
 
     sub.add_parser(
         "evolve",
@@ -69,6 +70,25 @@ def _parser() -> argparse.ArgumentParser:
 
     i = sub.add_parser("info", help="print a summary of a run directory")
     i.add_argument("run", metavar="RUN_DIR")
+
+    x = sub.add_parser(
+        "explore",
+        help="write one self-contained HTML page for runs or a study (curves, lineage, genealogy, swims)",
+        description="One HTML page for one or several run directories, or an experiment directory of "
+        "`animat experiment`: fitness curves overlaid, the lineage and genealogy of each best, its swim "
+        "animated, the phase map, config differences. It works offline from a file (docs/python.md).",
+    )
+    x.add_argument("runs", metavar="RUN_DIR", nargs="+", help="run directories or experiment directories")
+    x.add_argument(
+        "--out", type=Path, help="the page to write (default RUN_DIR/explore.html for one RUN_DIR; needed for several)"
+    )
+    x.add_argument("--modes", action="store_true", help="classify every best's locomotion (a few seconds per run)")
+    x.add_argument("--frames", type=int, default=200, help="frames of each best's swim at most (default 200)")
+    x.add_argument("--max-points", type=int, default=500, help="generations per curve at most (default 500)")
+    x.add_argument("--serve", action="store_true", help="serve the page on http://127.0.0.1:PORT/ until Ctrl-C")
+    x.add_argument("--port", type=int, default=8765, help="port of --serve (default 8765; 0: any free port)")
+    x.add_argument("--live", action="store_true", help="with --serve: the page polls the runs and redraws as they grow")
+    x.add_argument("--poll", type=float, default=2.0, help="seconds between live polls (default 2)")
 
     e = sub.add_parser("experiment", help="run (or resume) N independent seeds of a config and summarise them")
     e.add_argument(
@@ -220,6 +240,53 @@ def cmd_info(args) -> int:
     return 0
 
 
+def cmd_explore(args) -> int:
+    from . import explore
+
+    if args.frames < 2:
+        raise ValueError(f"--frames must be at least 2, got {args.frames}")
+    if args.max_points < 10:
+        raise ValueError(f"--max-points must be at least 10, got {args.max_points}")
+    if args.poll <= 0:
+        raise ValueError(f"--poll must be positive, got {args.poll}")
+    if args.live and not args.serve:
+        raise ValueError("--live needs --serve (a page opened from a file cannot poll)")
+    if not 0 <= args.port <= 65535:
+        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+    refs = explore.find_runs(args.runs)  # every path checked before anything runs
+    out = args.out
+    if out is None and not args.serve:
+        if len(args.runs) > 1:
+            raise ValueError(f"{len(args.runs)} RUN_DIRs: name the page with --out FILE.html")
+        out = Path(args.runs[0]) / "explore.html"
+    options = dict(frames=args.frames, max_points=args.max_points, modes=args.modes)
+    t0 = time.perf_counter()
+    live = {"poll": args.poll, "max_polls": 20000} if args.live else None
+    page = explore.render_html(explore.build_data(args.runs, live=live, refs=refs, **options))
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(page, encoding="utf-8")
+        print(out)
+    print(
+        f"({len(refs)} run(s), {len(page.encode('utf-8')) / 1e3:.0f} kB; {time.perf_counter() - t0:.1f} s)",
+        file=sys.stderr,
+    )
+    if args.serve:
+        try:
+            explore.serve(
+                args.runs,
+                port=args.port,
+                live=args.live,
+                poll=args.poll,
+                page=page,
+                log=lambda m: print(m, flush=True),
+                **options,
+            )
+        except KeyboardInterrupt:
+            print("(stopped serving)", file=sys.stderr)
+    return 0
+
+
 def cmd_experiment(args) -> int:
     from .experiment import run_study, summarize
 
@@ -262,7 +329,13 @@ def main(argv: Optional[List[str]] = None) -> int:
 
         return _core.evolve_cli(argv[1:])
     args = _parser().parse_args(argv)
-    command = {"show": cmd_show, "animate": cmd_animate, "info": cmd_info, "experiment": cmd_experiment}[args.command]
+    command = {
+        "show": cmd_show,
+        "animate": cmd_animate,
+        "info": cmd_info,
+        "explore": cmd_explore,
+        "experiment": cmd_experiment,
+    }[args.command]
     try:
         return command(args)
     except KeyboardInterrupt as e:

@@ -24,6 +24,7 @@ LIBRARY_MODULES = {
     "control",
     "evolution",
     "experiment",
+    "explore",
     "locomotion",
     "pipeline",
     "plot",
@@ -32,6 +33,8 @@ LIBRARY_MODULES = {
     "shape",
     "trajectory",
 }
+#: Data files the package ships next to its modules (read through ``Path(__file__).with_name``).
+PACKAGE_DATA = {"explore_template.html"}  # the page of `animat explore` (animat/explore.py)
 #: Study modules that live under studies/ (and must stay out of the package).
 STUDY_MODULES = {
     "replication_store": ROOT / "studies" / "replication" / "replication_store.py",
@@ -46,9 +49,21 @@ def _modules(package_dir: Path) -> set:
 
 def test_the_package_source_holds_exactly_the_library_modules():
     assert _modules(SOURCE) == LIBRARY_MODULES
-    # Besides the modules: the typing marker, and the compiled extension (ignored by git) where linked.
+    # Besides the modules: the typing marker, the data files of PACKAGE_DATA, and the compiled extension
+    # (ignored by git) where linked.
     others = {p.name for p in SOURCE.iterdir() if p.suffix != ".py" and p.name != "__pycache__"}
-    assert {n for n in others if not n.startswith("_core")} == {"py.typed"}
+    assert {n for n in others if not n.startswith("_core")} == {"py.typed"} | PACKAGE_DATA
+
+
+def test_the_package_data_is_staged_and_read_from_the_package():
+    # The wheel packs every file of python/animat; the development stage copies python/animat/* (not
+    # subfolders): so the data files sit next to the modules, and the modules find them there.
+    staged = Path(animat.__file__).resolve().parent
+    for name in PACKAGE_DATA:
+        assert (staged / name).is_file(), f"{name} is not staged next to the modules in {staged}"
+    from animat import explore
+
+    assert explore.TEMPLATE.parent == staged and explore.TEMPLATE.name in PACKAGE_DATA
 
 
 def test_the_imported_package_holds_exactly_the_library_modules():

@@ -1,0 +1,490 @@
+"""``animat explore``: the page's data (curves downsampled, flags, lineage, genealogy, swim, config
+differences), the command line, and the page itself in a real headless Chromium (playwright driving
+Debian's ``/usr/bin/chromium``): it loads without a console error, its canvases draw, play, pause and
+the scrubber move the swim, the genealogy of a hand-written genealogy.csv is drawn, and a served live
+page redraws after rows are appended to history.csv.
+
+The browser tests skip, saying why, only when Chromium or playwright is missing and ``CI`` is unset;
+under ``CI=true`` they fail instead (scripts/setup.sh installs both). The load time of a 1,000-generation
+study is measured by ``bench/explore_load.py``, not asserted here: a test holds the page's size and its
+downsampling, which decide it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import urllib.parse
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import animat
+from animat import explore
+
+ROOT = Path(__file__).resolve().parents[2]
+CHROMIUM = os.environ.get("ANIMAT_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
+IN_CI = os.environ.get("CI", "").strip().lower() not in ("", "0", "false", "no")
+
+
+def tiny_config(base=None, **keys):
+    c = animat.Config() if base is None else animat.load_config(str(base))
+    c["evolution.population"] = 8
+    c["evaluation.steps"] = 300
+    for k, v in keys.items():
+        c[k.replace("__", ".")] = v
+    return c
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Three tiny runs: seed 1 and seed 2 of the default world (an experiment directory), and a copy of
+    the first with a hand-written genealogy.csv."""
+    root = tmp_path_factory.mktemp("explore")
+    for seed in (1, 2):
+        animat.evolve(
+            tiny_config(evolution__seed=seed), out=str(root / "study" / f"run_{seed}"), generations=3, quiet=True
+        )
+    shutil.copytree(root / "study" / "run_1", root / "genealogy" / "run")
+    write_genealogy_fixture(root / "genealogy" / "run")
+    return root
+
+
+#: The fixture's individuals: (generation, id, parent_a, parent_b, fitness). Ids 0-5 are generation 0;
+#: 6 and 8 are mutants, 7, 9, 12 and 13 children of a crossover. The best (13, generation 4) descends
+#: from 13 individuals (itself included): 13, 11, 12, 9, 10, 4, 6, 7, 8 and the founders 0, 1, 2, 3;
+#: 5, 14 and 15 are not its ancestors. Its primary line (parent_a) is 13, 11, 9, 6, 0.
+GENEALOGY = [
+    (0, 0, -1, -1, 0.01),
+    (0, 1, -1, -1, 0.002),
+    (0, 2, -1, -1, 0.003),
+    (0, 3, -1, -1, 0.004),
+    (0, 4, -1, -1, 0.005),
+    (0, 5, -1, -1, 0.006),
+    (1, 6, 0, -1, 0.02),
+    (1, 7, 1, 2, 0.002),
+    (1, 8, 3, -1, 0.003),
+    (2, 9, 6, 7, 0.03),
+    (2, 10, 8, -1, 0.004),
+    (3, 11, 9, -1, 0.025),
+    (3, 12, 10, 4, 0.02),
+    (4, 13, 11, 12, 0.04),
+    (4, 14, 5, -1, 0.01),
+    (5, 15, 13, -1, 0.05),
+]
+FIXTURE_LINEAGE = {0: 0, 1: 6, 2: 9, 4: 13}  # generation of each best -> its id
+FIXTURE_ANCESTORS = {13, 11, 12, 9, 10, 4, 6, 7, 8, 0, 1, 2, 3}
+FIXTURE_PRIMARY = [13, 11, 9, 6, 0]
+
+
+def write_genealogy_fixture(run: Path, ids: bool = True) -> None:
+    """genealogy.csv from GENEALOGY, and best/gen_*.json for the bests of FIXTURE_LINEAGE (the run's own
+    best genome in each, with the fixture's fitness and, when ``ids``, the fixture's id)."""
+    files = sorted((run / "best").glob("gen_*.json"))
+    data = json.loads(files[-1].read_text())
+    data.pop("id", None)
+    for f in files:
+        f.unlink()
+    fitness = {i: f for _, i, _, _, f in GENEALOGY}
+    for generation, i in FIXTURE_LINEAGE.items():
+        entry = {**data, "generation": generation, "fitness": fitness[i]}
+        if ids:
+            entry["id"] = i
+        (run / "best" / f"gen_{generation:06d}.json").write_text(json.dumps(entry))
+    rows = "".join(f"{g},{i},{a},{b},{f!r},32\n" for g, i, a, b, f in GENEALOGY)
+    (run / "genealogy.csv").write_text("generation,id,parent_a,parent_b,fitness,cells\n" + rows)
+
+
+def cli(*args):
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    return subprocess.run([sys.executable, "-m", "animat", *map(str, args)], capture_output=True, text=True, env=env)
+
+
+# --- finding runs, downsampling, genealogy ---------------------------------------------------------------
+
+
+def test_find_runs_reads_run_and_experiment_directories(runs, tmp_path):
+    one = explore.find_runs([runs / "study" / "run_1"])
+    assert [(r.label, r.group) for r in one] == [("run_1", "")]
+    study = explore.find_runs([runs / "study"])
+    assert [r.label for r in study] == ["run_1", "run_2"]
+    nested = tmp_path / "exp"
+    for env in ("dn2", "dn10"):
+        for i in (0, 1):
+            shutil.copytree(runs / "study" / "run_1", nested / env / f"run_{i}")
+    refs = explore.find_runs([nested])
+    assert [(r.label, r.group) for r in refs] == [  # natural order: dn2 before dn10
+        ("dn2/run_0", "dn2"),
+        ("dn2/run_1", "dn2"),
+        ("dn10/run_0", "dn10"),
+        ("dn10/run_1", "dn10"),
+    ]
+    both = explore.find_runs([runs / "study" / "run_1", runs / "genealogy" / "run", runs / "study" / "run_1"])
+    assert len({r.label for r in both}) == 3
+
+
+def test_find_runs_names_the_bad_path(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nope"):
+        explore.find_runs([tmp_path / "nope"])
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(FileNotFoundError, match="empty.*neither a run directory"):
+        explore.find_runs([tmp_path / "empty"])
+    (tmp_path / "file.txt").write_text("x")
+    with pytest.raises(NotADirectoryError, match="file.txt"):
+        explore.find_runs([tmp_path / "file.txt"])
+
+
+def test_downsampling_keeps_the_ends_and_the_changes_within_the_budget():
+    assert list(explore.downsample_indices(10, 500)) == list(range(10))
+    keep = [3, 77, 78, 401, 998]
+    idx = explore.downsample_indices(1000, 100, keep)
+    assert len(idx) <= 100 and idx[0] == 0 and idx[-1] == 999
+    assert set(keep) <= set(idx.tolist())
+    assert np.all(np.diff(idx) > 0)
+    many = explore.downsample_indices(1000, 50, range(0, 1000, 2))  # more changes than half the budget
+    assert len(many) <= 50
+
+
+def test_read_genealogy_and_the_ancestry_of_the_best(runs, tmp_path):
+    table = explore.read_genealogy(runs / "genealogy" / "run" / "genealogy.csv")
+    assert len(table) == len(GENEALOGY) and table[9] == (2, 6, 7, 0.03, 32)
+    ancestors, primary = explore.ancestry(table, 13)
+    assert set(ancestors) == FIXTURE_ANCESTORS and primary == FIXTURE_PRIMARY
+    generations = [table[i][0] for i in ancestors]
+    assert generations == sorted(generations, reverse=True)  # youngest first
+    partial = tmp_path / "genealogy.csv"
+    partial.write_text((runs / "genealogy" / "run" / "genealogy.csv").read_text() + "6,16,15,-")
+    assert len(explore.read_genealogy(partial)) == len(GENEALOGY)  # a row being written is ignored
+    partial.write_text("generation,id,parent_a,parent_b,fitness,cells\n0,0,-1,-1,0.1,32\n1,x,0,-1,0.2,32\n")
+    with pytest.raises(ValueError, match=r"genealogy.csv:3: not a number"):
+        explore.read_genealogy(partial)
+    partial.write_text("gen,id\n")
+    with pytest.raises(ValueError, match=r"genealogy.csv:1: unexpected header"):
+        explore.read_genealogy(partial)
+
+
+def test_the_genealogy_payload_traces_the_fixture_and_degrades_without_it(runs, tmp_path):
+    data = explore.build_data([runs / "genealogy" / "run"], frames=20)
+    g = data["runs"][0]["genealogy"]
+    ids = [n[0] for n in g["nodes"]]
+    assert set(ids) == FIXTURE_ANCESTORS and g["total"] == g["shown"] == 13 and g["founders"] == 4 + 1
+    assert [ids[k] for k in g["primary"]] == FIXTURE_PRIMARY and ids[g["best"]] == 13
+    assert g["matched_by"] == "id"
+    node = {n[0]: n for n in g["nodes"]}
+    assert ids[node[12][2]] == 10 and ids[node[12][3]] == 4  # parent_a, parent_b as indices
+    assert {n[0] for n in g["nodes"] if n[6]} == set(FIXTURE_LINEAGE.values())  # the bests of the lineage
+    assert [e["id"] for e in data["runs"][0]["lineage"]] == [0, 6, 9, 13]
+    # lineage files without an id (a run written before them): the best is found by generation and fitness
+    no_ids = tmp_path / "no_ids"
+    shutil.copytree(runs / "genealogy" / "run", no_ids)
+    write_genealogy_fixture(no_ids, ids=False)
+    g2 = explore.build_data([no_ids], frames=20)["runs"][0]["genealogy"]
+    assert g2["matched_by"] == "match" and {n[0] for n in g2["nodes"]} == FIXTURE_ANCESTORS
+    # a capped drawing keeps the primary line
+    capped = explore.build_data([runs / "genealogy" / "run"], frames=20, max_nodes=6)["runs"][0]["genealogy"]
+    assert capped["shown"] == 6 and capped["total"] == 13
+    assert [capped["nodes"][k][0] for k in capped["primary"]] == FIXTURE_PRIMARY
+    # no genealogy.csv: a note
+    plain = explore.build_data([runs / "study" / "run_1"], frames=20)["runs"][0]["genealogy"]
+    assert "nodes" not in plain and "no genealogy.csv" in plain["note"]
+
+
+def test_the_data_hold_curves_flags_lineage_swim_and_config_differences(runs):
+    data = explore.build_data([runs / "study"], frames=30, modes=True)
+    assert [r["label"] for r in data["runs"]] == ["run_1", "run_2"]
+    run = animat.Run(runs / "study" / "run_1")
+    r = data["runs"][0]
+    h = run.history
+    assert r["history"]["generation"] == h["generation"].tolist() and r["history"]["total"] == len(h)
+    assert r["history"]["best"] == pytest.approx(h["best"].tolist(), rel=1e-5)
+    assert [e["generation"] for e in r["lineage"]] == [e.generation for e in run.best_genomes]
+    s = r["swim"]
+    assert s["frames"] <= 30 and s["n"] == run.best().cell_count
+    assert len(explore.base64.b64decode(s["pos"])) == s["frames"] * s["n"] * 2 * 2  # int16 x, y
+    assert len(explore.base64.b64decode(s["state"])) == s["frames"] * s["n"]
+    assert s["world"]["floor"] is None and s["world"]["source"] is None and s["stiffness"] is None
+    assert s["graph"] == "Gabriel graph" and "fluid d_N = 2" in r["world"]
+    assert len(s["phase"]) == s["n"] and len(s["rest"]) == 2 * s["n"]
+    assert r["mode"] and isinstance(r["mode"], str)
+    assert data["config_diff"] == {"against": "runs", "keys": [["evolution.seed", [1, 2]]]}
+    single = explore.build_data([runs / "study" / "run_1"], frames=10)["config_diff"]
+    assert single["against"] == "defaults" and ["evaluation.steps", [4000, 300]] in single["keys"]
+
+
+def test_the_flags_mark_invalid_swims_the_drag_limiter_and_unconfirmed_bests(runs, tmp_path):
+    run = tmp_path / "flags"
+    shutil.copytree(runs / "study" / "run_1", run)
+    lines = (run / "history.csv").read_text().splitlines()
+    rows = [line.split(",") for line in lines[1:]]
+    rows[1][8] = "3"  # invalid
+    rows[2][9] = "2"  # drag_limited
+    rows[3][7] = str(float(rows[3][1]) * 0.5 - 1.0)  # best_reference far below best: not confirmed
+    (run / "history.csv").write_text("\n".join([lines[0]] + [",".join(r) for r in rows]) + "\n")
+    flags = explore.build_data([run], frames=10)["runs"][0]["flags"]
+    assert flags["invalid"] == [[1, 3]] and flags["drag_limited"] == [[2, 2]]
+    assert [f[0] for f in flags["guard"]] == [3]
+
+
+def test_the_worlds_are_drawn_as_they_are(tmp_path):
+    crawl = tmp_path / "crawl"
+    animat.evolve(tiny_config(ROOT / "configs" / "crawl.toml"), out=str(crawl), generations=1, quiet=True)
+    chem = tmp_path / "chemotaxis"
+    animat.evolve(tiny_config(ROOT / "configs" / "chemotaxis.toml"), out=str(chem), generations=1, quiet=True)
+    data = explore.build_data([crawl, chem], frames=20)
+    floor, source = data["runs"][0]["swim"], data["runs"][1]["swim"]
+    assert floor["world"]["floor"] == 0.0 and not floor["aligned"] and floor["world"]["source"] is None
+    assert source["world"]["source"] is not None and source["world"]["chemical"]["kind"] == "point"
+    assert source["progress_label"] == "to source" and source["control"] == "grn"
+    assert "floor at y = 0" in data["runs"][0]["world"] and "source" in data["runs"][1]["world"]
+
+
+def test_a_long_study_is_downsampled_and_the_page_stays_small(runs, tmp_path):
+    study = long_study(runs, tmp_path, runs_count=3, generations=1000)
+    data = explore.build_data([study], frames=200)
+    for r in data["runs"]:
+        h = r["history"]
+        assert h["total"] == 1000 and len(h["generation"]) <= 500
+        assert h["changes_kept"] and len(set(h["best"])) == 200  # every step of the best is drawn
+        assert len(r["flags"]["invalid"]) == 100  # flags are never downsampled
+    page = explore.render_html(data)
+    assert len(page.encode()) < 600_000, len(page)
+    assert not re.search(r"""<(script|link|img)[^>]+(src|href)=["']?(https?:|//)""", page)  # nothing fetched
+
+
+def long_study(runs: Path, tmp_path: Path, runs_count: int, generations: int) -> Path:
+    """An experiment directory of copies of a tiny run whose history.csv has ``generations`` rows: a
+    best that rises in 200 steps, invalid swims every tenth generation."""
+    study = tmp_path / "long"
+    header = (runs / "study" / "run_1" / "history.csv").read_text().splitlines()[0]
+    for k in range(runs_count):
+        run = study / f"run_{k}"
+        shutil.copytree(runs / "study" / "run_1", run)
+        rows = [
+            f"{g},{(g // 5) * 0.01 + k},{g * 0.001},{g * 0.001},0.9,32,{100 * g},{(g // 5) * 0.01 + k},"
+            f"{int(g % 10 == 0)},0,{g * 0.5}"
+            for g in range(generations)
+        ]
+        (run / "history.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
+    return study
+
+
+# --- the command line -----------------------------------------------------------------------------------------
+
+
+def test_cli_writes_the_page_of_one_run_and_of_a_study(runs, tmp_path):
+    r = cli("explore", runs / "study" / "run_1", "--frames", 20)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == str(runs / "study" / "run_1" / "explore.html")
+    out = tmp_path / "study.html"
+    r = cli("explore", runs / "study", runs / "genealogy" / "run", "--out", out, "--frames", 20)
+    assert r.returncode == 0, r.stderr
+    text = out.read_text()
+    assert "__ANIMAT_DATA__" not in text and '"label":"study/run_1"' in text and '"label":"run"' in text
+
+
+def test_cli_errors_are_one_line_naming_the_path(runs, tmp_path):
+    for args, expected in (
+        ([tmp_path / "nope"], "nope"),
+        ([tmp_path], str(tmp_path)),
+        ([runs / "study" / "run_1", runs / "study" / "run_2"], "--out"),
+        ([runs / "study" / "run_1", "--live"], "--serve"),
+        ([runs / "study" / "run_1", "--frames", "1"], "--frames"),
+    ):
+        r = cli("explore", *args)
+        assert r.returncode == 1, (args, r.stderr)
+        assert r.stderr.startswith("animat explore: error:") and expected in r.stderr, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+
+
+# --- in Chromium --------------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def browser():
+    missing = []
+    if CHROMIUM is None:
+        missing.append("Chromium (apt-get install chromium; scripts/setup.sh installs it)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        sync_playwright = None
+        missing.append("playwright (.venv/bin/pip install -r requirements-dev.txt)")
+    if missing:
+        message = f"the browser tests need {' and '.join(missing)}"
+        if IN_CI:
+            pytest.fail(f"CI is set: {message}")
+        pytest.skip(message)
+    assert sync_playwright is not None
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM)
+        yield b
+        b.close()
+
+
+def open_page(browser, url: str):
+    """The page, loaded and ready, with the list its console errors and uncaught exceptions go to."""
+    page = browser.new_page(viewport={"width": 1200, "height": 900})
+    problems: list = []
+    page.on("console", lambda m: problems.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda e: problems.append(str(e)))
+    page.goto(url)
+    page.wait_for_function("window.animatExplore && window.animatExplore.ready", timeout=20_000)
+    return page, problems
+
+
+INKED = """(id) => { const c = document.getElementById(id); const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+  let k = 0; for (let i = 0; i < d.length; i += 4) if (d[i] < 235 || d[i + 1] < 235 || d[i + 2] < 235) k++; return k; }"""
+PIXELS = "(id) => document.getElementById(id).toDataURL()"
+
+
+def test_the_page_draws_plays_pauses_and_scrubs(browser, runs, tmp_path):
+    path = explore.write_page([runs / "genealogy" / "run"], tmp_path / "page.html", frames=60)
+    page, problems = open_page(browser, path.as_uri())
+    for canvas in ("curves", "viable", "swim", "phase", "genealogy"):
+        assert page.evaluate(INKED, canvas) > 500, canvas
+    assert page.evaluate("animatExplore.frame") == 0 and not page.evaluate("animatExplore.playing")
+    first = page.evaluate(PIXELS, "swim")
+    page.click("#play")
+    page.wait_for_function("animatExplore.frame >= 3", timeout=10_000)
+    page.click("#play")  # pause
+    assert not page.evaluate("animatExplore.playing")
+    paused = page.evaluate("animatExplore.frame")
+    page.wait_for_timeout(300)
+    assert page.evaluate("animatExplore.frame") == paused  # paused: no frame moves
+    assert page.evaluate(PIXELS, "swim") != first
+    page.eval_on_selector("#scrub", "(e) => { e.value = '40'; e.dispatchEvent(new Event('input')); }")
+    assert page.evaluate("animatExplore.frame") == 40
+    frames = page.evaluate("animatExplore.data.runs[0].swim.frames")
+    assert 40 < frames <= 60 and page.text_content("#frame-label") == f"frame 41 / {frames}"
+    scrubbed = page.evaluate(PIXELS, "swim")
+    modes = page.eval_on_selector_all("#color-by option", "(os) => os.map((o) => o.value)")
+    assert modes == ["state", "term", "phase"]
+    page.select_option("#color-by", "phase")
+    assert page.evaluate(PIXELS, "swim") != scrubbed
+    page.select_option("#color-by", "term")
+    assert page.evaluate("animatExplore.genealogy.drawn") == 13
+    assert page.evaluate("animatExplore.genealogy.primary") == 5
+    assert page.evaluate("animatExplore.genealogy.edges") == 12  # 4 mutants (1 parent) and 4 crossovers (2)
+    assert "13 ancestors" in page.text_content("#genealogy-note")
+    assert page.eval_on_selector_all("#lineage tbody tr", "(rs) => rs.length") == 4
+    page.hover("#curves", position={"x": 600, "y": 150})
+    assert "generation" in page.text_content("#readout")
+    assert not problems and not page.evaluate("animatExplore.errors")
+    page.close()
+
+
+def test_a_study_page_overlays_runs_and_shows_modes_and_worlds(browser, runs, tmp_path):
+    crawl = tmp_path / "crawl"
+    animat.evolve(tiny_config(ROOT / "configs" / "crawl.toml"), out=str(crawl), generations=1, quiet=True)
+    chem = tmp_path / "chem"
+    animat.evolve(tiny_config(ROOT / "configs" / "chemotaxis.toml"), out=str(chem), generations=1, quiet=True)
+    path = explore.write_page([runs / "study", crawl, chem], tmp_path / "study.html", frames=30, modes=True)
+    page, problems = open_page(browser, path.as_uri())
+    assert page.eval_on_selector_all("#curves-legend .legend-run", "(e) => e.length") == 4
+    assert page.eval_on_selector_all("#summary tbody tr", "(e) => e.length") == 4
+    assert not page.is_hidden("#modes-section")
+    assert page.eval_on_selector_all("#modes tbody tr", "(e) => e.length") == 4
+    assert "keys differ between the runs" in page.text_content("#config-note")
+    assert "no genealogy.csv" in page.text_content("#genealogy-note") and page.is_hidden("#genealogy")
+    before = page.evaluate(PIXELS, "curves")
+    page.click("#curves-legend .legend-run >> nth=0")  # hide a run
+    assert page.evaluate("animatExplore.curves.runs") == 3 and page.evaluate(PIXELS, "curves") != before
+    page.evaluate("animatExplore.selectRun(2)")  # the crawl: a floor
+    assert page.evaluate(INKED, "swim") > 500 and "floor" in page.text_content("#run-world")
+    page.evaluate("animatExplore.selectRun(3)")  # chemotaxis: the source, and the chemical sensed
+    assert "chemical" in page.eval_on_selector_all("#color-by option", "(os) => os.map((o) => o.value)")
+    page.select_option("#color-by", "chemical")
+    page.evaluate("animatExplore.setFrame(10)")
+    assert page.evaluate(INKED, "swim") > 500
+    assert not problems and not page.evaluate("animatExplore.errors")
+    page.close()
+
+
+def test_a_long_study_loads(browser, runs, tmp_path):
+    study = long_study(runs, tmp_path, runs_count=3, generations=1000)
+    path = explore.write_page([study], tmp_path / "long.html")
+    page, problems = open_page(browser, path.as_uri())
+    curves = page.evaluate("animatExplore.curves")
+    assert curves["total"] == 3000 and curves["points"] <= 1500
+    assert "Downsampled" in page.text_content("#curves-note")
+    assert page.evaluate(INKED, "curves") > 2000
+    assert not problems
+    page.close()
+
+
+def test_the_live_page_redraws_as_the_history_grows(browser, runs, tmp_path):
+    run = tmp_path / "growing"
+    shutil.copytree(runs / "study" / "run_1", run)
+    server = explore.make_server([run], port=0, live=True, poll=0.2, frames=20)
+    assert server.server_address[0] == "127.0.0.1"
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        page, problems = open_page(browser, server.url)
+        rows = (run / "history.csv").read_text().splitlines()
+        total = len(rows) - 1
+        assert page.evaluate("animatExplore.data.runs[0].history.total") == total
+        last = rows[-1].split(",")
+        with open(run / "history.csv", "a") as f:
+            for k in (1, 2, 3):
+                row = list(last)
+                row[0], row[1] = str(int(last[0]) + k), repr(float(last[1]) + k)
+                f.write(",".join(row) + "\n")
+            f.write("99,1.0,")  # a row being written: not read
+        page.wait_for_function(f"animatExplore.data.runs[0].history.total === {total + 3}", timeout=15_000)
+        assert page.evaluate("animatExplore.live.updates") >= 1
+        assert page.text_content("#summary tbody tr td:nth-child(3)") == str(total + 3)
+        newest = sorted((run / "best").glob("gen_*.json"))[-1]
+        entry = {**json.loads(newest.read_text()), "generation": int(last[0]) + 3}
+        (run / "best" / f"gen_{int(last[0]) + 3:06d}.json").write_text(json.dumps(entry))  # a new best
+        page.wait_for_function("animatExplore.live.note.includes('reload to replay it')", timeout=15_000)
+        assert page.eval_on_selector_all("#lineage tbody tr", "(rs) => rs.length") == len(
+            list((run / "best").iterdir())
+        )
+        reloaded = urllib.request.urlopen(server.url).read().decode()  # a reload is built again
+        assert f'"generations":{total + 3},' in reloaded and f'"generation":{int(last[0]) + 3},"n":' in reloaded
+        version = json.loads(urllib.request.urlopen(server.url + "live.json").read())["version"]
+        again = urllib.request.urlopen(server.url + "live.json?since=" + urllib.parse.quote(version)).read()
+        assert json.loads(again) == {"changed": False, "version": version}
+        assert not problems
+        page.close()
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def test_cli_serves_the_page_on_localhost_until_interrupted(runs):
+    import signal
+
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    args = ["explore", runs / "study" / "run_1", "--serve", "--port", "0", "--live", "--frames", "10"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "animat", *map(str, args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+/", line)
+        assert url, line + (proc.stderr.read() if proc.stderr else "")
+        page = urllib.request.urlopen(url.group(0)).read().decode()
+        assert '"live":{"poll":2.0' in page and "animat-data" in page
+        live = json.loads(urllib.request.urlopen(url.group(0) + "live.json").read())
+        rows = len(animat.Run(runs / "study" / "run_1").history)
+        assert live["runs"][0]["label"] == "run_1" and live["runs"][0]["history"]["total"] == rows
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
