@@ -32,7 +32,7 @@ import numpy as np
 import animat
 from animat import explore
 
-HEADER = "generation,best,mean,median,viable_fraction,best_cells,evaluations,best_reference,invalid,drag_limited,wall_seconds"
+HEADER = ",".join(animat.HISTORY_DTYPE.names or ())
 
 
 def synthetic_study(root: Path, runs: int, generations: int, population: int = 100) -> Path:
@@ -56,11 +56,23 @@ def synthetic_study(root: Path, runs: int, generations: int, population: int = 1
         best_f = np.maximum.accumulate(np.cumsum(rng.exponential(0.05, generations) * (rng.random(generations) < 0.08)))
         reference = best_f * np.where(rng.random(generations) < 0.02, 0.9, 1.0)
         mean = best_f * rng.uniform(0.2, 0.4, generations)
-        rows = [
-            f"{i},{float(best_f[i])!r},{float(mean[i])!r},{float(mean[i])!r},{rng.uniform(0.6, 1):.3f},32,{(i + 1) * 100},"
-            f"{float(reference[i])!r},{int(rng.random() < 0.05)},0,{i * 3.1:.1f}"
-            for i in g
-        ]
+        rows = []
+        for i in g:
+            values = {
+                "generation": i,
+                "best": repr(float(best_f[i])),
+                "mean": repr(float(mean[i])),
+                "median": repr(float(mean[i])),
+                "viable_fraction": f"{rng.uniform(0.6, 1):.3f}",
+                "best_cells": 32,
+                "evaluations": (i + 1) * 100,
+                "swims": population,
+                "best_reference": repr(float(reference[i])),
+                "invalid": int(rng.random() < 0.05),
+                "drag_limited": 0,
+                "wall_seconds": f"{i * 3.1:.1f}",
+            }
+            rows.append(",".join(str(values[name]) for name in HEADER.split(",")))
         (run / "history.csv").write_text(HEADER + "\n" + "\n".join(rows) + "\n")
         changes = np.unique(np.linspace(0, generations - 1, 80).astype(int))
         ids = {}

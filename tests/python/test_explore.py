@@ -191,9 +191,15 @@ def test_the_genealogy_payload_traces_the_fixture_and_degrades_without_it(runs, 
     capped = explore.build_data([runs / "genealogy" / "run"], frames=20, max_nodes=6)["runs"][0]["genealogy"]
     assert capped["shown"] == 6 and capped["total"] == 13
     assert [capped["nodes"][k][0] for k in capped["primary"]] == FIXTURE_PRIMARY
-    # no genealogy.csv: a note
-    plain = explore.build_data([runs / "study" / "run_1"], frames=20)["runs"][0]["genealogy"]
+    # no genealogy.csv (a run made before it was recorded): a note
+    old = tmp_path / "old"
+    shutil.copytree(runs / "study" / "run_1", old)
+    (old / "genealogy.csv").unlink()
+    plain = explore.build_data([old], frames=20)["runs"][0]["genealogy"]
     assert "nodes" not in plain and "no genealogy.csv" in plain["note"]
+    # a real run's genealogy: the best traced back to generation 0
+    real = explore.build_data([runs / "study" / "run_1"], frames=20)["runs"][0]["genealogy"]
+    assert real["matched_by"] == "id" and real["total"] >= 1
 
 
 def test_the_data_hold_curves_flags_lineage_swim_and_config_differences(runs):
@@ -222,10 +228,12 @@ def test_the_flags_mark_invalid_swims_the_drag_limiter_and_unconfirmed_bests(run
     run = tmp_path / "flags"
     shutil.copytree(runs / "study" / "run_1", run)
     lines = (run / "history.csv").read_text().splitlines()
+    col = {name: k for k, name in enumerate(lines[0].split(","))}
     rows = [line.split(",") for line in lines[1:]]
-    rows[1][8] = "3"  # invalid
-    rows[2][9] = "2"  # drag_limited
-    rows[3][7] = str(float(rows[3][1]) * 0.5 - 1.0)  # best_reference far below best: not confirmed
+    rows[1][col["invalid"]] = "3"
+    rows[2][col["drag_limited"]] = "2"
+    # best_reference far below best: not confirmed
+    rows[3][col["best_reference"]] = str(float(rows[3][col["best"]]) * 0.5 - 1.0)
     (run / "history.csv").write_text("\n".join([lines[0]] + [",".join(r) for r in rows]) + "\n")
     flags = explore.build_data([run], frames=10)["runs"][0]["flags"]
     assert flags["invalid"] == [[1, 3]] and flags["drag_limited"] == [[2, 2]]
@@ -266,11 +274,21 @@ def long_study(runs: Path, tmp_path: Path, runs_count: int, generations: int) ->
     for k in range(runs_count):
         run = study / f"run_{k}"
         shutil.copytree(runs / "study" / "run_1", run)
-        rows = [
-            f"{g},{(g // 5) * 0.01 + k},{g * 0.001},{g * 0.001},0.9,32,{100 * g},{(g // 5) * 0.01 + k},"
-            f"{int(g % 10 == 0)},0,{g * 0.5}"
-            for g in range(generations)
-        ]
+        values = lambda g, k=k: {  # noqa: E731
+            "generation": g,
+            "best": (g // 5) * 0.01 + k,
+            "mean": g * 0.001,
+            "median": g * 0.001,
+            "viable_fraction": 0.9,
+            "best_cells": 32,
+            "evaluations": 100 * g,
+            "swims": 90,
+            "best_reference": (g // 5) * 0.01 + k,
+            "invalid": int(g % 10 == 0),
+            "drag_limited": 0,
+            "wall_seconds": g * 0.5,
+        }
+        rows = [",".join(str(values(g)[name]) for name in header.split(",")) for g in range(generations)]
         (run / "history.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
     return study
 
@@ -392,7 +410,9 @@ def test_a_study_page_overlays_runs_and_shows_modes_and_worlds(browser, runs, tm
     assert not page.is_hidden("#modes-section")
     assert page.eval_on_selector_all("#modes tbody tr", "(e) => e.length") == 4
     assert "keys differ between the runs" in page.text_content("#config-note")
-    assert "no genealogy.csv" in page.text_content("#genealogy-note") and page.is_hidden("#genealogy")
+    # every run here records its genealogy: the first run's is drawn
+    assert "traced through the parent ids" in page.text_content("#genealogy-note")
+    assert not page.is_hidden("#genealogy")
     before = page.evaluate(PIXELS, "curves")
     page.click("#curves-legend .legend-run >> nth=0")  # hide a run
     assert page.evaluate("animatExplore.curves.runs") == 3 and page.evaluate(PIXELS, "curves") != before
