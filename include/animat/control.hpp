@@ -36,6 +36,10 @@ struct ControlParams {
   /// k: Box2D steps between two GRN updates (sensors, signalling and eq. 1 advance together)
   /// [choose: the bench of docs/control.md]
   int update_interval = 10;
+  /// Time between two GRN updates, in time units; 0 = every update_interval Box2D steps. When set,
+  /// the controller's schedule is the same at every physics step (k = update_period / h, which must
+  /// be a whole number), so refining the step refines the physics only [choose]
+  double update_period = 0.0;
   /// Rate of eq. 1 in swim time: one update advances eq. 1 by dt = grn_rate·k·h (h the Box2D step),
   /// so a level relaxes with time constant 1/grn_rate whatever k. k·h·grn_rate must be <= 1
   /// [choose]
@@ -73,6 +77,16 @@ void visit_fields(ControlParams& p, V&& v) {
               {},
               Identity::late},
     p.update_interval);
+  v(
+      FieldInfo{
+          "update_period",
+          "time between GRN updates in mode grn, time units; 0 = every update_interval Box2D "
+          "steps. Set, the update schedule does not change with the physics step (update_period "
+          "/ (physics.dt/substeps) must be a whole number) [choose]",
+          Bounds::upto(1e6),
+          {},
+          Identity::late},
+      p.update_period);
   v(FieldInfo{"grn_rate",
               "rate of eq. 1 while swimming, per time unit: an update advances eq. 1 by "
               "grn_rate*k*h (h = physics.dt/substeps, must be <= 1) [choose]",
@@ -103,9 +117,14 @@ void visit_fields(ControlParams& p, V&& v) {
     p.start_ramp);
 }
 
-/// Checks what bounds cannot: the eq. 1 step grn_rate·k·h <= 1 (signalling stays stable by taking
-/// substeps, GrnControl::signal_substeps()). Throws ConfigError naming the keys.
+/// Checks what bounds cannot: update_period a whole number of Box2D steps, and the eq. 1 step
+/// grn_rate·k·h <= 1 (signalling stays stable by taking substeps, GrnControl::signal_substeps()).
+/// Throws ConfigError naming the keys.
 void validate(const ControlParams& control, const PhysicsParams& physics);
+
+/// k, the Box2D steps between two GRN updates: update_period / h when update_period is set (h =
+/// physics.dt / physics.substeps), else update_interval.
+[[nodiscard]] int grn_update_steps(const ControlParams& control, const PhysicsParams& physics);
 
 /// The scene's chemical field at a point (scene.chemical): "point": exp(−|x − x_s|/ℓ); "plane":
 /// exp(−max(0, (x_s − x)·n)/ℓ), n the unit vector from the body's start centre towards x_s, so 1 on
@@ -171,6 +190,7 @@ class GrnControl final : public Effect {
   GrnControlStart start_;
   ControlParams control_;
   int n_ = 0, nodes_ = 0, morph_ = 0;
+  int update_steps_ = 1;    ///< k, Box2D steps between updates (grn_update_steps)
   double update_dt_ = 0.0;  ///< simulated time between updates, k·h
   GrnParams step_params_;   ///< dt = grn_rate·k·h
   std::vector<int> a_, b_;

@@ -1,7 +1,8 @@
 // Effect "grn_control" (control.mode = "grn", issue 18): the GRN keeps running while the animat
 // swims and its actuation output drives eq. 2 (control.hpp, docs/control.md).
 //
-// Every k = control.update_interval Box2D steps (at steps 0, k, 2k, ...) one update:
+// Every k = control.update_interval Box2D steps (or k = control.update_period / h; at steps 0, k,
+// 2k, ...) one update:
 //   1. sensors from the positions at the start of that step: strain (mean of ℓ/L0 − 1 over the
 //      cell's springs), pressure (mean S/S0 over the cell's regions; 1 for a cell in no region, the
 //      value at rest) and the scene's chemical field at the cell;
@@ -27,15 +28,34 @@
 
 namespace animat {
 
-void validate(const ControlParams& c, const PhysicsParams& physics) {
+int grn_update_steps(const ControlParams& c, const PhysicsParams& physics) {
+  if (!(c.update_period > 0.0)) return c.update_interval;
   const double h = physics.dt / physics.substeps;
-  const double step = c.grn_rate * c.update_interval * h;
-  if (c.mode == "grn" && !(step <= 1.0))
-    throw ConfigError(
-        fmt::format("control.grn_rate = {} x control.update_interval = {} x h = {} (physics.dt / "
-                    "physics.substeps) is {}: one GRN update would advance eq. 1 by more than 1 "
-                    "(levels would overshoot); lower grn_rate or update_interval",
-                    c.grn_rate, c.update_interval, h, step));
+  return static_cast<int>(std::lround(c.update_period / h));
+}
+
+void validate(const ControlParams& c, const PhysicsParams& physics) {
+  if (c.mode != "grn") return;
+  const double h = physics.dt / physics.substeps;
+  if (c.update_period > 0.0) {
+    const double k = c.update_period / h;
+    if (!(k >= 0.5) || std::abs(k - std::round(k)) > 1e-9 * std::max(1.0, k))
+      throw ConfigError(fmt::format(
+          "control.update_period = {} is not a whole number of Box2D steps h = physics.dt / "
+          "physics.substeps = {} (it is {} steps); choose a multiple of h",
+          c.update_period, h, k));
+  }
+  const int k = grn_update_steps(c, physics);
+  const double step = c.grn_rate * k * h;
+  if (!(step <= 1.0))
+    throw ConfigError(fmt::format(
+        "control.grn_rate = {} x {} x h = {} (physics.dt / physics.substeps) is {}: one GRN update "
+        "would advance eq. 1 by more than 1 (levels would overshoot); lower grn_rate or the update "
+        "interval",
+        c.grn_rate,
+        c.update_period > 0.0 ? fmt::format("control.update_period / h = {} steps", k)
+                              : fmt::format("control.update_interval = {}", c.update_interval),
+        h, step));
 }
 
 double chemical_field(std::string_view kind, double sx, double sy, double nx, double ny,
@@ -70,7 +90,8 @@ GrnControl::GrnControl(const Body& body_in, GrnControlStart start, const Control
   nodes_ = start_.grn.node_count();
   morph_ = static_cast<int>(start_.grn.morphogen_units().size());
   const double h = physics.dt / physics.substeps;
-  update_dt_ = control_.update_interval * h;
+  update_steps_ = grn_update_steps(control_, physics);
+  update_dt_ = update_steps_ * h;
   step_params_ = start_.grn_params;
   step_params_.dt = control_.grn_rate * update_dt_;
   const auto n = static_cast<std::size_t>(n_);
@@ -246,7 +267,7 @@ void GrnControl::update(const SwimState& s) {
 
 void GrnControl::apply(SwimState& s) {
   ++calls_;
-  if (s.step != last_update_step_ && s.step % control_.update_interval == 0) {
+  if (s.step != last_update_step_ && s.step % update_steps_ == 0) {
     update(s);
     last_update_step_ = s.step;
   }

@@ -365,6 +365,53 @@ TEST(ControlEvaluation, OpenLoopIsTheEngineAndGrnModeSwims) {
   EXPECT_TRUE(r.stable) << (r.reasons.empty() ? "" : r.reasons[0]);
 }
 
+TEST(ControlEvaluation, AnUpdatePeriodKeepsTheControllerScheduleAtEveryPhysicsStep) {
+  // The GRN's updates every update_interval Box2D steps happen more often per time unit at a finer
+  // step; with update_period they happen at the same times at any step, and a period of k steps at
+  // the default step is the update_interval k, bit for bit.
+  Config config;
+  config.evaluation.steps = 240;
+  config.control.mode = "grn";
+  Rng rng(11);
+  Genome active;
+  for (int tries = 0; tries < 5000 && active.elements.empty(); ++tries) {
+    Genome g = random_genome(config.genome, rng);
+    if (!evaluate(g, Config{}).viable) continue;
+    for (const Element& e : g.elements)
+      if (e.type == ElementType::promoter) {
+        g.elements.push_back(
+            Element{ElementType::output, 1, static_cast<int>(OutputChannel::actuation), e.coords});
+        break;
+      }
+    active = g;
+  }
+  ASSERT_FALSE(active.elements.empty());
+  const EvaluationResult steps = evaluate(active, config);
+  Config period = config;
+  period.control.update_period = config.control.update_interval * config.physics.dt;
+  const EvaluationResult same = evaluate(active, period);
+  EXPECT_EQ(same.fitness, steps.fitness);
+  EXPECT_EQ(same.grn_updates, steps.grn_updates);
+  for (const int substeps : {2, 4}) {
+    Config finer = config;
+    finer.physics.substeps = substeps;
+    EXPECT_EQ(evaluate(active, finer).grn_updates, substeps * steps.grn_updates) << substeps;
+    Config finer_period = period;
+    finer_period.physics.substeps = substeps;
+    EXPECT_EQ(evaluate(active, finer_period).grn_updates, steps.grn_updates) << substeps;
+  }
+  // A period that is not a whole number of steps is refused, naming the key and the step.
+  period.control.update_period = 1.5 * config.physics.dt;
+  try {
+    validate(period);
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("control.update_period = 0.025 is not a whole number"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ControlEvaluation, ChemotaxisAveragesProgressOverSeededDirections) {
   Config config;
   config.evaluation.objective = "chemotaxis";
