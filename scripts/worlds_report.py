@@ -117,8 +117,10 @@ def crawl(args) -> int:
                 floor = cfg["scene.ground_height"]
                 airborne = float(np.mean(y.min(axis=1) > floor + 1e-3))
                 print(
-                    f"  floor contacts {r.ground_contacts}, slips {r.ground_slips}; frames with no cell within 1e-3 "
-                    f"of the floor: {airborne:.0%}; lowest centre {y.min() - floor:.2e} above the floor"
+                    f"  floor contacts {r.ground_contacts}, slips {r.ground_slips}; airborne share (Box2D steps in "
+                    f"which the floor pushed no cell) {r.airborne_steps / (cfg['evaluation.steps'] * cfg['physics.substeps']):.0%}; "
+                    f"frames with no cell within 1e-3 of the floor: {airborne:.0%}; lowest centre "
+                    f"{y.min() - floor:.2e} above the floor"
                 )
                 print(
                     f"  actuation work: positive {r.actuation_work_positive:.3g}, absolute {r.actuation_work_absolute:.3g}"

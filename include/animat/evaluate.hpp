@@ -66,6 +66,8 @@ struct SwimResult {
   /// (cell, Box2D step) contacts with the floor (effect ground; SwimCounters)
   long ground_contacts = 0;
   long ground_slips = 0;  ///< of those, sliding ones (kinetic friction)
+  /// Box2D steps in which the floor pushed no cell (effect ground; SwimCounters)
+  long airborne_steps = 0;
   /// net mechanical work of actuation on the springs (measured phase)
   double actuation_work = 0.0;
   /// positive work, per spring and Box2D step (what an actuator spends)
@@ -168,6 +170,7 @@ struct EvaluationResult {
   long settle_steps = 0;           ///< control steps settled before the fitness clock started
   long ground_contacts = 0;        ///< (cell, Box2D step) contacts with the floor (effect ground)
   long ground_slips = 0;           ///< of those, sliding ones
+  long airborne_steps = 0;         ///< Box2D steps in which the floor pushed no cell
   double actuation_work = 0.0;     ///< net mechanical work of actuation (docs/worlds.md)
   double actuation_work_positive = 0.0;  ///< positive actuation work (per spring and Box2D step)
   double actuation_work_absolute = 0.0;  ///< absolute actuation work (per spring and Box2D step)
@@ -229,6 +232,10 @@ void visit_swim_fields(V&& v, R&... r) {
     r.ground_contacts...);
   v("ground_slips", "Of the floor contacts, those that slid (kinetic friction).",
     r.ground_slips...);
+  v("airborne_steps",
+    "Box2D steps in which the floor pushed no cell (effect ground); airborne share = "
+    "airborne_steps / Box2D steps of the measured phase.",
+    r.airborne_steps...);
   v("actuation_work", "Net mechanical work of actuation on the springs (docs/worlds.md).",
     r.actuation_work...);
   v("actuation_work_positive",

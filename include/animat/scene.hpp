@@ -216,6 +216,9 @@ struct SwimCounters {
   /// (cell, Box2D step) pairs in which the floor pushed a cell (effect ground)
   long ground_contacts = 0;
   long ground_slips = 0;  ///< of those, contacts that slid (kinetic friction)
+  /// Box2D steps in which the floor pushed no cell (effect ground): airborne share = airborne_steps
+  /// / Box2D steps
+  long airborne_steps = 0;
   /// Mechanical work of actuation (effect springs, while actuation changes the rest lengths): per
   /// spring and Box2D step ΔW = k·(r_k − r_{k−1})·((r_k + r_{k−1})/2 − (ℓ_k + ℓ_{k−1})/2), the
   /// midpoint rule of ∫ k·(r − ℓ)·dr/dt dt (r rest length, ℓ length; docs/worlds.md).
@@ -240,6 +243,10 @@ void visit_fields(C& c, V&& v)
   v("ground_contacts", "(cell, Box2D step) pairs in which the floor pushed a cell (effect ground)",
     c.ground_contacts);
   v("ground_slips", "of those, contacts that slid (kinetic friction)", c.ground_slips);
+  v("airborne_steps",
+    "Box2D steps in which the floor pushed no cell (effect ground); airborne share = "
+    "airborne_steps / Box2D steps",
+    c.airborne_steps);
   v("actuation_work", "net mechanical work of actuation", c.actuation_work);
   v("actuation_work_positive", "positive work, per spring and Box2D step",
     c.actuation_work_positive);

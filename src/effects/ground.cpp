@@ -34,8 +34,8 @@ namespace {
 /// loop (src/effects/collisions.cpp, the same law), so that no floor impulse can undo a collision
 /// guarantee; this effect then only adds the floor impulses that loop computed
 /// (SwimState::ground_fx, ground_fy), booked as the floor's. Without collisions it resolves each
-/// cell's contact itself. Counted: contacts (cell-steps in which the floor pushed) and slips (of
-/// those, sliding ones). Nothing is allocated.
+/// cell's contact itself. Counted: contacts (cell-steps in which the floor pushed), slips (of
+/// those, sliding ones) and airborne steps (no cell pushed). Nothing is allocated.
 class Ground final : public Effect {
  public:
   explicit Ground(const SceneParams& p)
@@ -48,10 +48,13 @@ class Ground final : public Effect {
   void apply(SwimState& s) override {
     ++calls_;
     if (in_collisions_) {  // resolved (and counted) by effect collisions
+      bool pushed = false;
       for (int i = 0; i < s.n; ++i) {
         s.fx[at(i)] += s.ground_fx[at(i)];
         s.fy[at(i)] += s.ground_fy[at(i)];
+        pushed = pushed || s.ground_fy[at(i)] != 0.0;
       }
+      if (!pushed) ++s.counters.airborne_steps;
       return;
     }
     const double h = s.h, inv_h = 1.0 / s.h, m = s.mass, kv = s.h * s.inv_mass;
@@ -88,6 +91,7 @@ class Ground final : public Effect {
     }
     s.counters.ground_contacts += contacts;
     s.counters.ground_slips += slips;
+    if (contacts == 0) ++s.counters.airborne_steps;
   }
 
  private:

@@ -513,5 +513,20 @@ TEST(Objective, DistanceXAndEnergyObjectives) {
   EXPECT_DOUBLE_EQ(make_objective(p)->value(rec), 5.0 / 250.0);
 }
 
+TEST(Ground, AirborneStepsCountTheFallUntilTheFirstContact) {
+  // One cell from rest at y = 30 over the floor at 0, g = 2: at step k the floor is met when
+  // y_start − g·h²·k(k+1)/2 < 0 (the free fall of FreeFallIsAnalytic, then the crossing within the
+  // step), first at k = 329 for h = 1/60; from then on it rests and the floor pushes it every step.
+  // The same count whether the floor is resolved by itself or inside effect collisions.
+  for (const auto& effects : {std::vector<std::string>{"gravity", "ground"},
+                              std::vector<std::string>{"gravity", "ground", "collisions"}}) {
+    Simulation sim(make_body(points({{0.0, 30.0}}), {}, {}, {}), floor_scene(effects, 2.0));
+    ASSERT_DOUBLE_EQ(sim.physics().dt, 1.0 / 60.0);
+    sim.step(600);
+    EXPECT_EQ(sim.counters().airborne_steps, 328) << effects.size();
+    EXPECT_EQ(sim.counters().ground_contacts, 600 - 328) << effects.size();
+  }
+}
+
 }  // namespace
 }  // namespace animat

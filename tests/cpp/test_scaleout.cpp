@@ -295,7 +295,8 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nmorphogen_cutoff = ",
                           "\nenergy_accounting = ",
                           "\ndivision_axis = ",
-                          "\ndivision_max_contacts = "}) {
+                          "\ndivision_max_contacts = ",
+                          "\nupdate_period = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;

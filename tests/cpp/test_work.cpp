@@ -165,9 +165,9 @@ TEST(SwimCounters, EveryCounterThatSwimResultReportsIsCopiedByName) {
   });
   EXPECT_EQ(copied, (std::vector<std::string>{
                         "collisions", "collisions_inelastic", "collisions_unresolved",
-                        "drag_limited", "ground_contacts", "ground_slips", "actuation_work",
-                        "actuation_work_positive", "actuation_work_absolute"}));
-  // The one counter a swim's record does not report (Simulation.counters has it).
+                        "drag_limited", "ground_contacts", "ground_slips", "airborne_steps",
+                        "actuation_work", "actuation_work_positive", "actuation_work_absolute"}));
+  // The counters a swim's record does not report (Simulation.counters has them).
   EXPECT_EQ(not_reported, (std::vector<std::string>{"collision_max_passes"}));
   EXPECT_EQ(r.distance, SwimResult{}.distance);
 }

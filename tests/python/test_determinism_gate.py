@@ -286,6 +286,7 @@ EVALUATION_FIELDS = (
     "settle_steps",
     "ground_contacts",
     "ground_slips",
+    "airborne_steps",
     "actuation_work",
     "actuation_work_positive",
     "actuation_work_absolute",

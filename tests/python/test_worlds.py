@@ -53,6 +53,7 @@ def test_simulation_counters_include_floor_and_work():
     for key in (
         "ground_contacts",
         "ground_slips",
+        "airborne_steps",
         "actuation_work",
         "actuation_work_positive",
         "actuation_work_absolute",
