@@ -7,6 +7,8 @@ organised by task:
   :func:`build_body`, :class:`Simulation`, :func:`evaluate`;
 - evolution: :func:`evolve` (the engine of ``animat_evolve``), :class:`GA` (ask/tell), your own
   :class:`Objective`, :class:`History`;
+- quality diversity: :class:`MapElites` (ask/tell) over a :class:`GridArchive` or :class:`CVTArchive`
+  of :data:`DESCRIPTORS` (body and motion), :func:`run_map_elites` (a run directory); :mod:`animat.qd`;
 - control: :class:`SwimEnv` (Gymnasium API, registered as ``"animat/Swim-v0"``; ``pip install animat[control]``);
 - analysis: :class:`Run` reads a run directory; :func:`replay` returns a :class:`Trajectory`;
   :mod:`animat.plot` draws the paper's figures; :mod:`animat.locomotion` classifies how a swimmer
@@ -18,7 +20,7 @@ Every value type pickles and copies. ``animat.plot`` imports matplotlib on first
 
 from typing import TYPE_CHECKING
 
-from . import _core
+from . import _core, qd
 from ._core import (
     OBJECTIVES,
     Body,
@@ -71,6 +73,16 @@ from .locomotion import (
     tries_per_viable,
 )
 from .pipeline import build_body, config_path, develop, documented, load_config, paper_configs, swim
+from .qd import (
+    DESCRIPTORS,
+    QD_HISTORY_DTYPE,
+    CVTArchive,
+    Descriptor,
+    Elite,
+    GridArchive,
+    MapElites,
+    run_map_elites,
+)
 from .run import (
     GENEALOGY_DTYPE,
     HISTORY_DTYPE,
@@ -173,6 +185,16 @@ __all__ = [
     "reference_disagrees",
     "run_experiment",
     "run_study",
+    # quality diversity
+    "qd",
+    "MapElites",
+    "GridArchive",
+    "CVTArchive",
+    "Descriptor",
+    "DESCRIPTORS",
+    "Elite",
+    "QD_HISTORY_DTYPE",
+    "run_map_elites",
     # control
     "SwimEnv",
     "SWIM_ENV_ID",

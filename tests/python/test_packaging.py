@@ -29,6 +29,7 @@ LIBRARY_MODULES = {
     "pipeline",
     "plot",
     "protrusion",
+    "qd",
     "run",
     "shape",
     "trajectory",

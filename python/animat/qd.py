@@ -1,0 +1,1212 @@
+"""Quality diversity: MAP-Elites over descriptors of body and motion (issue 35).
+
+The paper ends (§7) by suggesting niching: protect novel morphologies until evolution has had the time
+to adjust their control. MAP-Elites (Mouret & Clune 2015) does this by construction: an **archive**
+keeps one elite per cell of a space of **descriptors** (how many cells, how elongated, how many
+protrusions, the oscillators' frequency, the locomotion mode ...), and a candidate competes only with
+the elite of its own cell. Every generation, elites chosen uniformly at random are varied by the
+genome's own operators (the GA's crossover with probability ``crossover_fraction``, then its mutation)
+and evaluated by the same evaluators as the GA (:func:`animat.evaluate_population`).
+
+- :data:`DESCRIPTORS`: the table of named descriptors; :class:`Descriptor` also wraps your own
+  ``f(genome, config, evaluation) -> float``. :func:`measure` computes them for one genome.
+- :class:`GridArchive` (a regular grid) and :class:`CVTArchive` (a centroidal Voronoi tessellation).
+- :class:`MapElites`: ask/tell, ``step()``, ``history``, ``checkpoint()`` / :meth:`MapElites.restore`.
+- :func:`run_map_elites`: a run directory (``config.toml``, ``history.csv``, ``archive/gen_*.csv``,
+  ``checkpoint.json``) that resumes.
+
+**Determinism.** Every random number of generation g, offspring i is drawn from
+``animat.Rng.derive(seed, g, i)`` and the parents are picked from the elites in cell order, so a run is
+a function of (config, archive definition, seed, batch, crossover_fraction) alone: identical for any
+thread count, and across checkpoint and resume.
+
+**What is archived.** A candidate enters the archive only when its genome is viable, its swim stable
+and valid (no simulator exploit: the engine scores those 0) and every descriptor is a number (not
+NaN). It enters its cell when the cell is empty or when its **objective** is strictly greater than the
+elite's (a tie keeps the elite); candidates are added in the order of ``ask()``.
+
+**The exploit guard** (``evaluation.reference_check``, as for the GA): ``"off"``: nothing more.
+``"record"`` (the default): every genome that is an elite at the end of a ``tell()`` and entered
+during it is evaluated again at the reference step (``physics.substeps ×
+evaluation.reference_substeps``, the engine's ``reference_config``) with the run's objective; its
+``reference`` fitness is stored with the elite and ``history["disagreements"]`` counts the elites
+whose fitness and reference disagree (:func:`animat.reference_disagrees`). ``"select"``: every
+archivable candidate is evaluated at the reference step *before* it is added, and the archive
+compares, scores and reports the **reference** fitness (the elite's ``objective``), so a candidate
+that exploits the coarse step never displaces an honest one. Under ``"record"`` and ``"off"`` the
+objective is the fitness. The reference costs about ``reference_substeps`` ordinary evaluations
+each: per new elite under ``"record"``, per archivable candidate under ``"select"``.
+
+Example::
+
+    archive = animat.GridArchive(["elongation", "protrusions"], bins=(8, 8))
+    me = animat.MapElites(config, archive, batch=32, seed=1)
+    for _ in range(10):
+        me.step()                                   # ask, evaluate_population, tell
+    print(me.history["coverage"], archive.qd_score())
+    frame = archive.to_pandas()                     # index, objective, measures_0.., solution (pyribs)
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import shutil
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from pathlib import Path
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, cast
+
+import numpy as np
+
+from . import _core
+from .evolution import Objective, ObjectiveLike, _config_for, _objective, evaluate_population, to_fitness
+
+__all__ = [
+    "Descriptor",
+    "DESCRIPTORS",
+    "descriptor_table",
+    "measure",
+    "Elite",
+    "GridArchive",
+    "CVTArchive",
+    "MapElites",
+    "QD_HISTORY_DTYPE",
+    "run_map_elites",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+#: Version tag of :meth:`MapElites.checkpoint`.
+CHECKPOINT_FORMAT = "animat.map_elites/1"
+
+# --- descriptors ----------------------------------------------------------------------------------
+
+
+class _Subject:
+    """One genome under a config, with the expensive intermediate results shared by the descriptors
+    (development once, the body and its shape once, the locomotion replay once)."""
+
+    def __init__(self, genome: Any, config: Any, evaluation: Any) -> None:
+        self.genome = genome
+        self.config = config
+        self.evaluation = evaluation
+
+    @cached_property
+    def embryo(self) -> Any:
+        return _core.develop(self.genome, self.config)
+
+    @cached_property
+    def shape(self) -> Any:
+        from . import pipeline
+        from .shape import body_shape
+
+        return body_shape(pipeline.build_body(self.embryo, config=self.config))
+
+    @cached_property
+    def locomotion(self) -> str:
+        from .locomotion import classify_locomotion
+
+        return classify_locomotion(self.genome, self.config).mode
+
+    @cached_property
+    def fitness(self) -> float:
+        if self.evaluation is None:
+            from .evolution import evaluate
+
+            self.evaluation = evaluate(self.genome, self.config)
+        return float(self.evaluation.fitness)
+
+
+def _locomotion_index(s: _Subject) -> float:
+    from .locomotion import MODES
+
+    return float(MODES.index(s.locomotion))
+
+
+@dataclass(frozen=True)
+class Descriptor:
+    """One descriptor: a number computed from a genome, its config and its evaluation, and the range
+    ``[lo, hi]`` the archives divide (values outside are clipped to it, see :class:`GridArchive`).
+
+    ``function(genome, config, evaluation) -> float``: ``evaluation`` is what was told for the genome
+    (an :class:`animat.EvaluationResult` from :func:`animat.evaluate`, an :class:`animat.Fitness` from
+    :meth:`MapElites.step`), or None when :func:`measure` is called without one. It must be a pure
+    function of its arguments (the run's determinism rests on it); NaN means "no descriptor" (the
+    genome is not archived). ``computed`` says in words how it is computed.
+
+    Your own: ``Descriptor("width", "body width in cells", 0, 10, my_function)``, or the tuple
+    ``(my_function, 0, 10)`` wherever descriptors are given. A table entry with another range:
+    ``DESCRIPTORS["elongation"].with_range(1, 3)`` or the tuple ``("elongation", 1, 3)``.
+    """
+
+    name: str
+    meaning: str
+    lo: float
+    hi: float
+    function: Callable[[Any, Any, Any], float] = field(repr=False, compare=False)
+    computed: str = ""
+    # Table entries compute from a shared _Subject (one development per genome for all of them).
+    _of_subject: Optional[Callable[[_Subject], float]] = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self.name or not isinstance(self.name, str):
+            raise ValueError(f"Descriptor: a name is required, got {self.name!r}")
+        lo, hi = float(self.lo), float(self.hi)
+        if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+            raise ValueError(f"Descriptor {self.name!r}: the range must be finite with hi > lo, got [{lo}, {hi}]")
+        object.__setattr__(self, "lo", lo)
+        object.__setattr__(self, "hi", hi)
+        if not callable(self.function):
+            raise TypeError(f"Descriptor {self.name!r}: function must be callable")
+
+    def with_range(self, lo: float, hi: float) -> Descriptor:
+        """The same descriptor over another range."""
+        return replace(self, lo=lo, hi=hi)
+
+    def __call__(self, genome: Any, config: Any = None, evaluation: Any = None) -> float:
+        return float(self.function(genome, config, evaluation))
+
+    def _value(self, subject: _Subject) -> float:
+        if self._of_subject is not None:
+            return float(self._of_subject(subject))
+        return float(self.function(subject.genome, subject.config, subject.evaluation))
+
+
+def _table_entry(
+    name: str, meaning: str, lo: float, hi: float, of_subject: Callable[[_Subject], float], computed: str
+) -> Descriptor:
+    def function(genome: Any, config: Any = None, evaluation: Any = None) -> float:
+        return float(of_subject(_Subject(genome, config, evaluation)))
+
+    function.__name__ = name
+    return Descriptor(name, meaning, lo, hi, function, computed, of_subject)
+
+
+#: The named descriptors, in table order: name -> :class:`Descriptor`. Integer descriptors have a
+#: range one wider than their values (``[0, 8]`` for 0..7 protrusions) so that a grid of ``hi - lo``
+#: bins gives each value its own bin. The ranges are those of the paper's settings; change them with
+#: :meth:`Descriptor.with_range` (or a ``(name, lo, hi)`` tuple) for others.
+DESCRIPTORS: Dict[str, Descriptor] = {
+    d.name: d
+    for d in (
+        _table_entry(
+            "cells",
+            "number of cells of the developed embryo",
+            1,
+            65,
+            lambda s: len(s.embryo.positions),
+            "`animat.develop(genome, config)`: the number of cell centres",
+        ),
+        _table_entry(
+            "elongation",
+            "sqrt(λ1/λ2) of the cells' second moments: 1 for a round body",
+            1,
+            4,
+            lambda s: s.shape.elongation,
+            "`animat.shape.body_shape(body).elongation` of the body at rest",
+        ),
+        _table_entry(
+            "protrusions",
+            "number of protrusions: parts sticking out of the body's core",
+            0,
+            8,
+            lambda s: s.shape.protrusion_count,
+            "`animat.shape.body_shape(body).protrusion_count`",
+        ),
+        _table_entry(
+            "symmetric_pair",
+            "1 when two protrusions mirror each other about a principal axis, else 0",
+            0,
+            2,
+            lambda s: 1.0 if s.shape.symmetric_pair else 0.0,
+            "`animat.shape.body_shape(body).symmetric_pair`",
+        ),
+        _table_entry(
+            "concavity",
+            "1 − outline area / convex hull area: 0 for a convex body",
+            0,
+            0.5,
+            lambda s: s.shape.concavity,
+            "`animat.shape.body_shape(body).concavity`",
+        ),
+        _table_entry(
+            "frequency",
+            "median oscillator frequency of the cells (rad per time unit)",
+            0.5,
+            6,
+            lambda s: float(np.median(s.embryo.frequency)),
+            "`numpy.median(animat.develop(genome, config).frequency)`",
+        ),
+        _table_entry(
+            "locomotion",
+            "locomotion mode: the index in animat.locomotion.MODES (0 undulation ... 5 none)",
+            0,
+            6,
+            _locomotion_index,
+            "`animat.classify_locomotion(genome, config).mode` (replays the swim: one more evaluation)",
+        ),
+        _table_entry(
+            "fitness",
+            "the objective's own value (the paper's distance: up to about 44 in 4000 steps)",
+            0,
+            50,
+            lambda s: s.fitness,
+            "`evaluation.fitness` (evaluated again when no evaluation is given)",
+        ),
+    )
+}
+
+
+def descriptor_table() -> str:
+    """:data:`DESCRIPTORS` as a Markdown table (the one in docs/python.md)."""
+
+    def number(x: float) -> str:
+        return f"{x:g}"
+
+    lines = ["| name | meaning | range | computed by |", "| --- | --- | --- | --- |"]
+    for d in DESCRIPTORS.values():
+        lines.append(f"| `{d.name}` | {d.meaning} | [{number(d.lo)}, {number(d.hi)}] | {d.computed} |")
+    return "\n".join(lines)
+
+
+#: Descriptor values: a sequence of floats or a 1-D array.
+Values = Union[Sequence[float], np.ndarray]
+
+DescriptorLike = Union[str, Descriptor, Callable[[Any, Any, Any], float], Tuple[Any, float, float]]
+
+
+def _descriptor(spec: DescriptorLike) -> Descriptor:
+    if isinstance(spec, Descriptor):
+        return spec
+    if isinstance(spec, str):
+        if spec not in DESCRIPTORS:
+            raise ValueError(f"no descriptor named {spec!r}; the table has {', '.join(DESCRIPTORS)}")
+        return DESCRIPTORS[spec]
+    if isinstance(spec, tuple) and len(spec) == 3:
+        what: Any = spec[0]
+        lo, hi = spec[1], spec[2]
+        if isinstance(what, str):
+            return _descriptor(what).with_range(lo, hi)
+        if callable(what):
+            name = getattr(what, "__name__", None) or type(what).__name__
+            function = cast(Callable[[Any, Any, Any], float], what)
+            return Descriptor(name, f"{name} (a Python function)", lo, hi, function, "your function")
+    if callable(spec):
+        raise ValueError("a descriptor function needs a range: pass (function, lo, hi) or a Descriptor")
+    raise TypeError(f"a descriptor is a name, a Descriptor or a (name or function, lo, hi) tuple, got {spec!r:.80}")
+
+
+def _descriptors(specs: Iterable[DescriptorLike]) -> Tuple[Descriptor, ...]:
+    out = tuple(_descriptor(s) for s in specs)
+    if not out:
+        raise ValueError("an archive needs at least one descriptor")
+    names = [d.name for d in out]
+    if len(set(names)) != len(names):
+        raise ValueError(f"descriptor names must be distinct, got {names}")
+    return out
+
+
+def measure(
+    genome: Any, config: Any = None, descriptors: Iterable[DescriptorLike] = ("cells",), evaluation: Any = None
+) -> Optional[np.ndarray]:
+    """The values of ``descriptors`` for ``genome`` under ``config`` (float64 array, in order), or None
+    when the genome is not viable (its embryo, or ``evaluation.viable`` when an evaluation is given):
+    a non-viable genome has no descriptor. Deterministic (a function of genome and config; ``fitness``
+    and your own functions also read ``evaluation``). The table's descriptors share one development
+    per call."""
+    cfg = _core.Config() if config is None else config
+    if evaluation is not None and not bool(getattr(evaluation, "viable", True)):
+        return None
+    subject = _Subject(genome, cfg, evaluation)
+    if not subject.embryo.viable:
+        return None
+    return np.array([d._value(subject) for d in _descriptors(descriptors)], dtype=np.float64)
+
+
+# --- archives -------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Elite:
+    """The elite of one cell.
+
+    Attributes:
+        index: the cell.
+        genome: its :class:`animat.Genome`.
+        fitness: the objective's value at the run's step.
+        objective: what the archive compares and sums: the fitness, or the reference under
+            ``evaluation.reference_check = "select"``.
+        descriptors: its descriptor values (float, in the archive's order).
+        reference: the fitness at the exploit guard's reference step; NaN when not checked.
+        generation: the generation that found it (-1 when added by hand).
+    """
+
+    index: int
+    genome: Any = field(repr=False)
+    fitness: float
+    objective: float
+    descriptors: Tuple[float, ...]
+    reference: float = float("nan")
+    generation: int = -1
+
+
+class _Archive:
+    """What both archives share: the elites by cell, add, QD-score, coverage, the data frame."""
+
+    kind = ""
+
+    def __init__(self, descriptors: Iterable[DescriptorLike], qd_offset: float = 0.0) -> None:
+        self.descriptors: Tuple[Descriptor, ...] = _descriptors(descriptors)
+        self.qd_offset = float(qd_offset)
+        if not math.isfinite(self.qd_offset):
+            raise ValueError(f"qd_offset must be finite, got {qd_offset}")
+        self._elites: Dict[int, Elite] = {}
+
+    # --- to override ------------------------------------------------------------------------------
+    @property
+    def cells(self) -> int:
+        """Number of cells."""
+        raise NotImplementedError
+
+    def _index(self, values: np.ndarray) -> int:
+        raise NotImplementedError
+
+    def _geometry(self) -> Dict[str, Any]:
+        raise NotImplementedError
+
+    # --- shared -----------------------------------------------------------------------------------
+    @property
+    def dims(self) -> int:
+        """Number of descriptors."""
+        return len(self.descriptors)
+
+    @property
+    def names(self) -> Tuple[str, ...]:
+        """The descriptors' names, in order."""
+        return tuple(d.name for d in self.descriptors)
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.array([d.lo for d in self.descriptors])
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.array([d.hi for d in self.descriptors])
+
+    def index_of(self, descriptors: Values) -> Optional[int]:
+        """The cell of these descriptor values; None when one of them is NaN (never archived)."""
+        v = np.asarray(descriptors, dtype=np.float64).reshape(-1)
+        if len(v) != self.dims:
+            raise ValueError(f"{len(v)} descriptor values for an archive of {self.dims} descriptors {self.names}")
+        if np.isnan(v).any():
+            return None
+        return self._index(v)
+
+    def add(
+        self,
+        genome: Any,
+        fitness: float,
+        descriptors: Values,
+        *,
+        objective: Optional[float] = None,
+        reference: float = float("nan"),
+        generation: int = -1,
+    ) -> bool:
+        """Offer a candidate; returns whether it entered (its cell was empty, or its ``objective``,
+        default the fitness, is strictly greater than the elite's: a tie keeps the elite). A NaN
+        descriptor is never archived (False); a fitness or objective that is not finite is a ValueError."""
+        fitness = float(fitness)
+        obj = fitness if objective is None else float(objective)
+        if not (math.isfinite(fitness) and math.isfinite(obj)):
+            raise ValueError(f"add: the fitness and the objective must be finite, got {fitness}, {obj}")
+        index = self.index_of(descriptors)
+        if index is None:
+            return False
+        old = self._elites.get(index)
+        if old is not None and not obj > old.objective:
+            return False
+        values = tuple(float(x) for x in np.asarray(descriptors, dtype=np.float64).reshape(-1))
+        self._elites[index] = Elite(index, genome, fitness, obj, values, float(reference), int(generation))
+        return True
+
+    def _set_reference(self, index: int, reference: float) -> None:
+        self._elites[index] = replace(self._elites[index], reference=float(reference))
+
+    def __len__(self) -> int:
+        return len(self._elites)
+
+    def __contains__(self, index: object) -> bool:
+        return index in self._elites
+
+    def __getitem__(self, index: int) -> Elite:
+        return self._elites[index]
+
+    def elites(self) -> List[Elite]:
+        """The elites, in cell order."""
+        return [self._elites[i] for i in sorted(self._elites)]
+
+    def best(self) -> Optional[Elite]:
+        """The elite with the greatest objective (the lowest cell among equals); None when empty."""
+        best = None
+        for e in self.elites():
+            if best is None or e.objective > best.objective:
+                best = e
+        return best
+
+    def qd_score(self) -> float:
+        """Σ (objective − qd_offset) over the elites (exactly rounded: ``math.fsum``). With a signed
+        objective, give the archive a ``qd_offset`` below any objective value, so that every elite adds
+        to the score (pyribs's ``qd_score_offset``)."""
+        return math.fsum(e.objective - self.qd_offset for e in self._elites.values())
+
+    def coverage(self) -> float:
+        """Occupied cells / cells."""
+        return len(self._elites) / self.cells
+
+    def clear(self) -> None:
+        self._elites.clear()
+
+    # --- export -----------------------------------------------------------------------------------
+    def data(self) -> Dict[str, np.ndarray]:
+        """The elites as columns (numpy arrays, one row per elite in cell order) with pyribs's names
+        (its ``ArchiveDataFrame``): ``index`` (the cell), ``objective``, ``measures_0`` ..
+        ``measures_{d-1}`` (the descriptors, in order), ``solution`` (the genome's JSON text: a genome
+        is not a vector), and ``fitness``, ``reference``, ``generation``."""
+        es = self.elites()
+        cols: Dict[str, np.ndarray] = {
+            "index": np.array([e.index for e in es], dtype=np.int64),
+            "objective": np.array([e.objective for e in es], dtype=np.float64),
+        }
+        for j in range(self.dims):
+            cols[f"measures_{j}"] = np.array([e.descriptors[j] for e in es], dtype=np.float64)
+        cols["solution"] = np.array([e.genome.to_json() for e in es], dtype=object)
+        cols["fitness"] = np.array([e.fitness for e in es], dtype=np.float64)
+        cols["reference"] = np.array([e.reference for e in es], dtype=np.float64)
+        cols["generation"] = np.array([e.generation for e in es], dtype=np.int64)
+        return cols
+
+    def to_pandas(self) -> Any:
+        """:meth:`data` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing);
+        ``ribs.archives.ArchiveDataFrame(frame)`` reads it."""
+        try:
+            import pandas as pd  # type: ignore[import-not-found]
+        except ImportError:
+            raise ImportError("to_pandas needs pandas: pip install pandas") from None
+        return pd.DataFrame(self.data())
+
+    def as_data_frame(self) -> Any:
+        """:meth:`to_pandas` when pandas is installed, else :meth:`data` (a dict of numpy arrays)."""
+        try:
+            return self.to_pandas()
+        except ImportError:
+            return self.data()
+
+    def write_csv(self, path: PathLike) -> Path:
+        """One row per elite: ``index, objective, fitness, reference, generation``, the descriptors by
+        name, ``genome`` (JSON). Written atomically."""
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["index", "objective", "fitness", "reference", "generation", *self.names, "genome"])
+        for e in self.elites():
+            w.writerow(
+                [e.index, repr(e.objective), repr(e.fitness), repr(e.reference), e.generation]
+                + [repr(x) for x in e.descriptors]
+                + [e.genome.to_json()]
+            )
+        return _write_atomic(Path(path), buf.getvalue())
+
+    # --- state ------------------------------------------------------------------------------------
+    def state(self) -> Dict[str, Any]:
+        """The archive as a JSON-able dict (:meth:`from_state` reads it back exactly)."""
+        return {
+            "kind": self.kind,
+            "descriptors": [{"name": d.name, "lo": d.lo, "hi": d.hi} for d in self.descriptors],
+            "qd_offset": self.qd_offset,
+            **self._geometry(),
+            "elites": [
+                {
+                    "index": e.index,
+                    "genome": e.genome.to_json(),
+                    "fitness": e.fitness,
+                    "objective": e.objective,
+                    "reference": _json_float(e.reference),
+                    "descriptors": list(e.descriptors),
+                    "generation": e.generation,
+                }
+                for e in self.elites()
+            ],
+        }
+
+    @staticmethod
+    def from_state(state: Mapping[str, Any], descriptors: Iterable[DescriptorLike] = ()) -> Any:
+        """An archive from :meth:`state`. Descriptors are found by name: first in ``descriptors`` (your
+        own functions must be given again: a function is not saved), then in :data:`DESCRIPTORS`; the
+        saved range is used."""
+        given = {d.name: d for d in (_descriptor(s) for s in descriptors)}
+        ds = []
+        for saved in state["descriptors"]:
+            name = saved["name"]
+            if name in given:
+                base = given[name]
+            elif name in DESCRIPTORS:
+                base = DESCRIPTORS[name]
+            else:
+                raise ValueError(
+                    f"the archive's descriptor {name!r} is not in the table: pass it again "
+                    "(descriptors=[Descriptor(...)] or (function, lo, hi))"
+                )
+            ds.append(base.with_range(saved["lo"], saved["hi"]))
+        archive: _Archive
+        if state["kind"] == "grid":
+            archive = GridArchive(ds, state["bins"], qd_offset=state["qd_offset"])
+        elif state["kind"] == "cvt":
+            archive = CVTArchive._with_centroids(
+                ds, np.array(state["centroids"], dtype=np.float64), state["seed"], state["samples"], state["qd_offset"]
+            )
+        else:
+            raise ValueError(f"unknown archive kind {state['kind']!r}")
+        for e in state["elites"]:
+            elite = Elite(
+                int(e["index"]),
+                _core.Genome.from_json(e["genome"]),
+                float(e["fitness"]),
+                float(e["objective"]),
+                tuple(float(x) for x in e["descriptors"]),
+                _from_json_float(e["reference"]),
+                int(e["generation"]),
+            )
+            archive._elites[elite.index] = elite
+        return archive
+
+    def _own_descriptors(self) -> Tuple[Descriptor, ...]:
+        # Descriptors that are not table entries (your functions): saved by pickle, not in the state.
+        return tuple(d for d in self.descriptors if d._of_subject is None)
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        # Pickles as its state (the table's functions are found by name) and your own descriptors.
+        return (_Archive.from_state, (self.state(), self._own_descriptors()))
+
+    def __repr__(self) -> str:
+        return (
+            f"<animat.{type(self).__name__} {', '.join(self.names)}: {len(self)}/{self.cells} cells, "
+            f"QD-score {self.qd_score():.6g}>"
+        )
+
+
+class GridArchive(_Archive):
+    """An archive on a regular grid: descriptor j is divided into ``bins[j]`` equal bins over its range.
+
+    Bin k of a descriptor holds the values v with ``edges[k] <= v < edges[k + 1]``, ``edges =
+    numpy.linspace(lo, hi, bins + 1)`` (:attr:`edges`): a value on an interior edge belongs to the bin
+    above it. Values outside the range are **clipped**: v < lo (and -inf) go to the first bin, v >= hi
+    (``hi`` itself and +inf included) to the last. A NaN is never archived. The cell index is the
+    row-major (C order) index of the bins, ``numpy.ravel_multi_index`` (pyribs's grid order).
+
+    Args:
+        descriptors: names from :data:`DESCRIPTORS`, :class:`Descriptor` objects, or ``(name or
+            function, lo, hi)`` tuples.
+        bins: one int for every descriptor, or one per descriptor.
+        qd_offset: subtracted from every objective in :meth:`qd_score`.
+    """
+
+    kind = "grid"
+
+    def __init__(
+        self, descriptors: Iterable[DescriptorLike], bins: Union[int, Sequence[int]], *, qd_offset: float = 0.0
+    ) -> None:
+        super().__init__(descriptors, qd_offset)
+        b = [int(bins)] * self.dims if isinstance(bins, (int, np.integer)) else [int(x) for x in bins]
+        if len(b) != self.dims or min(b) < 1:
+            raise ValueError(f"bins: one count >= 1 per descriptor ({self.dims}), got {bins}")
+        self.bins: Tuple[int, ...] = tuple(b)
+        #: Bin edges per descriptor (``bins[j] + 1`` values, from lo to hi).
+        self.edges: Tuple[np.ndarray, ...] = tuple(
+            np.linspace(d.lo, d.hi, n + 1) for d, n in zip(self.descriptors, self.bins)
+        )
+
+    @property
+    def cells(self) -> int:
+        return int(np.prod(self.bins))
+
+    def bin_of(self, descriptors: Values) -> Optional[Tuple[int, ...]]:
+        """The bin of every descriptor (clipped as described above); None for a NaN."""
+        v = np.asarray(descriptors, dtype=np.float64).reshape(-1)
+        if len(v) != self.dims:
+            raise ValueError(f"{len(v)} descriptor values for an archive of {self.dims} descriptors {self.names}")
+        if np.isnan(v).any():
+            return None
+        return tuple(
+            int(min(max(np.searchsorted(e, x, side="right") - 1, 0), n - 1))
+            for e, x, n in zip(self.edges, v, self.bins)
+        )
+
+    def _index(self, values: np.ndarray) -> int:
+        b = self.bin_of(values)
+        assert b is not None
+        return int(np.ravel_multi_index(b, self.bins))
+
+    def _geometry(self) -> Dict[str, Any]:
+        return {"bins": list(self.bins)}
+
+
+class CVTArchive(_Archive):
+    """An archive on a centroidal Voronoi tessellation (Vassiliades et al. 2018): ``cells`` centroids
+    in the descriptor box; a value belongs to the cell of its nearest centroid.
+
+    The centroids are computed once, deterministically, in the box scaled to the unit cube (each
+    descriptor's ``(v - lo) / (hi - lo)``, so every descriptor weighs the same): ``samples`` points are
+    drawn uniformly with ``numpy.random.default_rng(seed).random((samples, d))``, the first ``cells`` of
+    them start Lloyd's k-means, and each iteration assigns every sample to its nearest centroid (the
+    lowest index among equals) and moves each centroid to the mean of its samples (a centroid with
+    none stays), until the assignment no longer changes or after ``iterations``. Checkpoints store the
+    centroids, so a restored archive does not depend on numpy's generator.
+
+    A value is scaled the same way and clipped to the unit cube, then put in the cell of its nearest
+    centroid (the lowest index among equals); a NaN is never archived.
+
+    Args:
+        descriptors: as for :class:`GridArchive`.
+        cells: number of centroids.
+        seed: seed of the samples.
+        samples: sample count (default ``max(1000, 20 * cells)``).
+        iterations: the most Lloyd iterations (default 100).
+        qd_offset: as for :class:`GridArchive`.
+    """
+
+    kind = "cvt"
+
+    def __init__(
+        self,
+        descriptors: Iterable[DescriptorLike],
+        cells: int,
+        seed: int = 0,
+        *,
+        samples: Optional[int] = None,
+        iterations: int = 100,
+        qd_offset: float = 0.0,
+    ) -> None:
+        super().__init__(descriptors, qd_offset)
+        cells = int(cells)
+        n = max(1000, 20 * cells) if samples is None else int(samples)
+        if cells < 1 or n < cells:
+            raise ValueError(f"CVTArchive: need 1 <= cells <= samples, got cells={cells}, samples={n}")
+        self.seed = int(seed)
+        self.samples = n
+        self._unit = _kmeans(np.random.default_rng(self.seed).random((n, self.dims)), cells, int(iterations))
+
+    @classmethod
+    def _with_centroids(
+        cls, descriptors: Sequence[Descriptor], unit: np.ndarray, seed: int, samples: int, qd_offset: float
+    ) -> CVTArchive:
+        archive = cls.__new__(cls)
+        _Archive.__init__(archive, descriptors, qd_offset)
+        archive.seed, archive.samples = int(seed), int(samples)
+        archive._unit = unit.reshape(-1, archive.dims).copy()
+        return archive
+
+    @property
+    def cells(self) -> int:
+        return len(self._unit)
+
+    @property
+    def centroids(self) -> np.ndarray:
+        """(cells, d) centroids in descriptor units."""
+        return self.lower + self._unit * (self.upper - self.lower)
+
+    def _index(self, values: np.ndarray) -> int:
+        u = np.clip((values - self.lower) / (self.upper - self.lower), 0.0, 1.0)
+        return int(_nearest(u[None, :], self._unit)[0])
+
+    def _geometry(self) -> Dict[str, Any]:
+        return {"seed": self.seed, "samples": self.samples, "centroids": self._unit.tolist()}
+
+
+def _nearest(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
+    """Index of the nearest centroid of every point (the first among equals), in chunks of bounded memory."""
+    out = np.empty(len(points), dtype=np.int64)
+    step = max(1, 2_000_000 // max(1, centroids.size))
+    for a in range(0, len(points), step):
+        d = ((points[a : a + step, None, :] - centroids[None, :, :]) ** 2).sum(axis=2)
+        out[a : a + step] = np.argmin(d, axis=1)
+    return out
+
+
+def _kmeans(samples: np.ndarray, k: int, iterations: int) -> np.ndarray:
+    centroids = samples[:k].copy()
+    previous: Optional[np.ndarray] = None
+    for _ in range(max(0, iterations)):
+        labels = _nearest(samples, centroids)
+        if previous is not None and np.array_equal(labels, previous):
+            break
+        counts = np.bincount(labels, minlength=k)
+        filled = counts > 0
+        for j in range(samples.shape[1]):
+            sums = np.bincount(labels, weights=samples[:, j], minlength=k)
+            centroids[filled, j] = sums[filled] / counts[filled]
+        previous = labels
+    return centroids
+
+
+# --- MAP-Elites -----------------------------------------------------------------------------------
+
+#: The columns of :attr:`MapElites.history` and ``history.csv``, one row per generation.
+QD_HISTORY_DTYPE = np.dtype(
+    [
+        ("generation", np.int64),
+        ("evaluations", np.int64),  # swims told so far (the batches; reference swims not counted)
+        ("qd_score", np.float64),
+        ("coverage", np.float64),
+        ("best", np.float64),  # the greatest objective in the archive (NaN when empty)
+        ("elites", np.int64),
+        ("added", np.int64),  # candidates of this generation that entered the archive
+        ("discarded", np.int64),  # candidates never archivable: non-viable, unstable, invalid, NaN descriptor
+        ("reference_evaluations", np.int64),  # the exploit guard's swims so far
+        ("disagreements", np.int64),  # elites whose fitness and reference disagree (reference_disagrees)
+    ]
+)
+
+
+def _json_float(x: float) -> Optional[float]:
+    return None if math.isnan(x) else float(x)
+
+
+def _from_json_float(x: Any) -> float:
+    return float("nan") if x is None else float(x)
+
+
+def _write_atomic(path: Path, text: str) -> Path:
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+    return path
+
+
+def _reference_config(config: Any) -> Any:
+    """The engine's reference_config: physics.substeps × evaluation.reference_substeps, all else equal."""
+    ref = config.copy()
+    ref["physics.substeps"] = int(config["physics.substeps"]) * int(config["evaluation.reference_substeps"])
+    return ref
+
+
+def _comparable(config: Any) -> Dict[str, Any]:
+    d = config.to_dict()
+    d.get("evolution", {}).pop("threads", None)
+    return d
+
+
+class MapElites:
+    """MAP-Elites driven by ``ask``/``tell`` (or :meth:`step`), over a :class:`GridArchive` or a
+    :class:`CVTArchive` (see the module docstring for what is archived and the exploit guard).
+
+    ``ask()`` returns the batch of generation g = ``generation + 1``: for generation 0 (and whenever
+    the archive is empty), ``initial`` random viable genomes, genome i drawn by
+    ``animat.Genome.random_viable(seed=animat.Rng.derive(seed, g, i), config)``; afterwards ``batch``
+    offspring, offspring i varied with the stream ``rng = animat.Rng.derive(seed, g, i)``: a parent
+    ``elites[rng.integer(0, n - 1)]`` (the n elites in cell order); with probability
+    ``crossover_fraction`` (``rng.uniform() < crossover_fraction``) a second one drawn the same way and
+    ``parent.crossover(other, rng, mutation.crossover_points)``; then ``.mutate(rng, config)``, as the
+    GA varies its offspring. Asking again before ``tell`` returns the same genomes.
+
+    ``tell(results)`` takes one result per asked genome, in order: :class:`animat.EvaluationResult`
+    (``animat.evaluate``), :class:`animat.Fitness`, a number or None (non-viable); ``descriptors=``
+    gives their descriptor values instead of computing them (a row of None: not archived).
+
+    Example::
+
+        me = animat.MapElites(config, animat.GridArchive(["elongation", "frequency"], 10), batch=20)
+        while me.generation < 5:
+            genomes = me.ask()
+            me.tell([animat.evaluate(g, config) for g in genomes])     # or me.step()
+
+    Args:
+        config: the run's :class:`animat.Config` (default: the embedded paper setting).
+        archive: the archive, filled in place (it may hold elites already: a run continues from them).
+        batch: offspring per generation (default ``evolution.population``).
+        initial: random genomes of generation 0 (default ``batch``).
+        seed: the run's seed (default ``evolution.seed``; it is written into the config).
+        objective: as for :class:`animat.GA`: a built-in name, a callable of an
+            :class:`animat.EvaluationRecord` or an :class:`animat.Objective`.
+        crossover_fraction: share of offspring made by crossover (default ``evolution.crossover_fraction``).
+        threads: evaluation threads of :meth:`step` and the exploit guard (default ``evolution.threads``;
+            0 = all cores). The run does not depend on it.
+    """
+
+    def __init__(
+        self,
+        config: Any,
+        archive: Union[GridArchive, CVTArchive],
+        *,
+        batch: Optional[int] = None,
+        initial: Optional[int] = None,
+        seed: Optional[int] = None,
+        objective: ObjectiveLike = None,
+        crossover_fraction: Optional[float] = None,
+        threads: Optional[int] = None,
+    ) -> None:
+        if not isinstance(archive, _Archive):
+            raise TypeError(f"MapElites: archive must be a GridArchive or a CVTArchive, got {type(archive).__name__}")
+        obj = _objective(objective)
+        self._config = _config_for(config, obj)
+        self._objective: Optional[Objective] = obj if isinstance(obj, Objective) else None
+        name = str(self._config["evaluation.objective"])
+        if name.startswith("python:") and self._objective is None:
+            raise ValueError(
+                f"MapElites: evaluation.objective = {name!r} is a Python objective: pass "
+                "objective=animat.Objective(...) with that name"
+            )
+        if seed is not None:
+            self._config["evolution.seed"] = int(seed)
+        if threads is not None:
+            self._config["evolution.threads"] = int(threads)
+        self.seed = int(self._config["evolution.seed"])
+        self.batch = int(self._config["evolution.population"]) if batch is None else int(batch)
+        self.initial = self.batch if initial is None else int(initial)
+        cf = float(self._config["evolution.crossover_fraction"]) if crossover_fraction is None else crossover_fraction
+        self.crossover_fraction = float(cf)
+        if self.batch < 1 or self.initial < 1:
+            raise ValueError(f"MapElites: batch and initial must be >= 1, got {self.batch}, {self.initial}")
+        if not 0.0 <= self.crossover_fraction <= 1.0:
+            raise ValueError(f"MapElites: crossover_fraction must be in [0, 1], got {self.crossover_fraction}")
+        self.archive = archive
+        self._guard = str(self._config["evaluation.reference_check"])
+        self._generation = -1
+        self._evaluations = 0
+        self._reference_evaluations = 0
+        self._history: List[Tuple[Any, ...]] = []
+        self._asked: Optional[List[Any]] = None
+
+    # --- the loop ---------------------------------------------------------------------------------
+    def ask(self) -> List[Any]:
+        """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
+        if self._asked is None:
+            self._asked = self._draw(self._generation + 1)
+        return list(self._asked)
+
+    def _draw(self, g: int) -> List[Any]:
+        cfg = self._config
+        elites = self.archive.elites()
+        if not elites:
+            return [_core.Genome.random_viable(_core.Rng.derive(self.seed, g, i), cfg)[0] for i in range(self.initial)]
+        points = int(cfg["mutation.crossover_points"])
+        top = len(elites) - 1
+        out = []
+        for i in range(self.batch):
+            rng = _core.Rng.derive(self.seed, g, i)
+            child = elites[rng.integer(0, top)].genome
+            if rng.uniform() < self.crossover_fraction:
+                other = elites[rng.integer(0, top)].genome
+                child = child.crossover(other, rng, points)
+            out.append(child.mutate(rng, cfg))
+        return out
+
+    def tell(self, results: Sequence[Any], descriptors: Optional[Sequence[Optional[Values]]] = None) -> Any:
+        """The result of every genome of the last ``ask()``, in order (see the class docstring);
+        completes the generation and returns its history row (a numpy record)."""
+        if self._asked is None:
+            raise RuntimeError("MapElites.tell: nothing was asked (call ask() first)")
+        genomes = self._asked
+        if len(results) != len(genomes):
+            raise ValueError(f"MapElites.tell: {len(results)} results for the {len(genomes)} genomes asked")
+        if descriptors is not None and len(descriptors) != len(genomes):
+            raise ValueError(f"MapElites.tell: {len(descriptors)} descriptor rows for {len(genomes)} genomes")
+        fits = []
+        for i, r in enumerate(results):
+            try:
+                fits.append(to_fitness(r))
+            except (TypeError, ValueError) as e:
+                raise type(e)(f"MapElites.tell: value {i} ({r!r:.60}): {e}") from None
+        g = self._generation + 1
+        cfg = self._config
+        # The candidates that may enter: viable, stable, valid, with every descriptor a number.
+        candidates: List[Tuple[Any, float, np.ndarray]] = []
+        for i, (genome, fit, raw) in enumerate(zip(genomes, fits, results)):
+            if not (fit.viable and fit.stable and fit.valid):
+                continue
+            if descriptors is not None:
+                row = descriptors[i]
+                values = None if row is None else np.asarray(row, dtype=np.float64).reshape(-1)
+            else:
+                evaluation = raw if isinstance(raw, _core.EvaluationResult) else fit
+                values = measure(genome, cfg, self.archive.descriptors, evaluation)
+            if values is None or np.isnan(values).any():
+                continue
+            candidates.append((genome, float(fit.fitness), values))
+        references: List[float] = [float("nan")] * len(candidates)
+        if self._guard == "select" and candidates:
+            references = self._references([c[0] for c in candidates])
+        added = 0
+        entered: Dict[int, bool] = {}
+        for (genome, fitness, values), ref in zip(candidates, references):
+            objective = ref if self._guard == "select" else fitness
+            if self.archive.add(genome, fitness, values, objective=objective, reference=ref, generation=g):
+                added += 1
+                index = self.archive.index_of(values)
+                assert index is not None
+                entered[index] = True
+        if self._guard == "record" and entered:
+            cells = sorted(entered)
+            for index, ref in zip(cells, self._references([self.archive[i].genome for i in cells])):
+                self.archive._set_reference(index, ref)
+        self._evaluations += len(genomes)
+        self._generation = g
+        self._asked = None
+        best = self.archive.best()
+        disagreements = sum(
+            1
+            for e in self.archive.elites()
+            if not math.isnan(e.reference) and _core.reference_disagrees(e.fitness, e.reference, cfg)
+        )
+        self._history.append(
+            (
+                g,
+                self._evaluations,
+                self.archive.qd_score(),
+                self.archive.coverage(),
+                float("nan") if best is None else best.objective,
+                len(self.archive),
+                added,
+                len(genomes) - len(candidates),
+                self._reference_evaluations,
+                disagreements,
+            )
+        )
+        return self.history[-1]
+
+    def _references(self, genomes: List[Any]) -> List[float]:
+        ref = _reference_config(self._config)
+        fits = evaluate_population(genomes, ref, int(self._config["evolution.threads"]), objective=self._objective)
+        self._reference_evaluations += len(genomes)
+        return [float(f.fitness) for f in fits]
+
+    def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
+        """Ask, evaluate (default: :func:`animat.evaluate_population` with the config's threads and the
+        objective) and tell one generation; returns its history row."""
+        genomes = self.ask()
+        if evaluate is None:
+            results: Sequence[Any] = evaluate_population(
+                genomes, self._config, int(self._config["evolution.threads"]), objective=self._objective
+            )
+        else:
+            results = evaluate(genomes)
+        return self.tell(list(results))
+
+    # --- state ------------------------------------------------------------------------------------
+    @property
+    def config(self) -> Any:
+        """The run's :class:`animat.Config` (a copy)."""
+        return self._config.copy()
+
+    @property
+    def generation(self) -> int:
+        """The last completed generation (-1 before the first ``tell``)."""
+        return self._generation
+
+    @property
+    def evaluations(self) -> int:
+        """Swims told so far."""
+        return self._evaluations
+
+    @property
+    def history(self) -> np.recarray:
+        """One row per generation (:data:`QD_HISTORY_DTYPE`): ``h["qd_score"]``, ``h[-1].coverage`` ..."""
+        return np.array(self._history, dtype=QD_HISTORY_DTYPE).view(np.recarray)
+
+    def history_frame(self) -> Any:
+        """:attr:`history` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
+        try:
+            import pandas as pd  # type: ignore[import-not-found]
+        except ImportError:
+            raise ImportError("history_frame needs pandas: pip install pandas") from None
+
+        return pd.DataFrame.from_records(np.asarray(self.history).view(np.ndarray))
+
+    def checkpoint(self) -> Dict[str, Any]:
+        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back). A
+        pending ``ask()`` is not saved: asking again after a restore gives the same genomes."""
+        return {
+            "format": CHECKPOINT_FORMAT,
+            "config": self._config.to_toml(),
+            "seed": self.seed,
+            "batch": self.batch,
+            "initial": self.initial,
+            "crossover_fraction": self.crossover_fraction,
+            "generation": self._generation,
+            "evaluations": self._evaluations,
+            "reference_evaluations": self._reference_evaluations,
+            "history": [[_json_float(x) if isinstance(x, float) else x for x in row] for row in self._history],
+            "archive": self.archive.state(),
+        }
+
+    def save(self, path: PathLike) -> Path:
+        """Write :meth:`checkpoint` as JSON to ``path`` atomically."""
+        return _write_atomic(Path(path), json.dumps(self.checkpoint(), allow_nan=False))
+
+    @classmethod
+    def restore(
+        cls,
+        state: Union[Mapping[str, Any], str, bytes],
+        config: Any = None,
+        *,
+        objective: ObjectiveLike = None,
+        descriptors: Iterable[DescriptorLike] = (),
+        threads: Optional[int] = None,
+    ) -> MapElites:
+        """A MapElites from :meth:`checkpoint` (a dict, or its JSON text). ``config``: default the saved
+        one; another must equal it but for ``evolution.threads`` (ValueError). ``descriptors``: your own
+        descriptor functions, by name (see :meth:`GridArchive.from_state`); ``objective``: a Python
+        objective must be passed again."""
+        if isinstance(state, (str, bytes)):
+            state = json.loads(state)
+        assert isinstance(state, Mapping)
+        if state.get("format") != CHECKPOINT_FORMAT:
+            raise ValueError(
+                f"not a MapElites checkpoint (format {state.get('format')!r}, expected {CHECKPOINT_FORMAT})"
+            )
+        saved = _core.Config.from_toml(state["config"], "checkpoint")
+        if config is None:
+            config = saved
+        else:
+            mine = _config_for(config, _objective(objective))
+            mine["evolution.seed"] = int(state["seed"])
+            if _comparable(mine) != _comparable(saved):
+                raise ValueError(
+                    "MapElites.restore: the config differs from the checkpoint's (only evolution.threads may)"
+                )
+        archive = _Archive.from_state(state["archive"], descriptors)
+        me = cls(
+            config,
+            archive,
+            batch=state["batch"],
+            initial=state["initial"],
+            seed=state["seed"],
+            objective=objective,
+            crossover_fraction=state["crossover_fraction"],
+            threads=threads,
+        )
+        me._generation = int(state["generation"])
+        me._evaluations = int(state["evaluations"])
+        me._reference_evaluations = int(state["reference_evaluations"])
+        me._history = [
+            tuple(_from_json_float(x) if QD_HISTORY_DTYPE[j].kind == "f" else int(x) for j, x in enumerate(row))
+            for row in state["history"]
+        ]
+        return me
+
+    @classmethod
+    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> MapElites:
+        """:meth:`restore` from a file written by :meth:`save` (or a run directory of :func:`run_map_elites`)."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "checkpoint.json"
+        return cls.restore(path.read_text(encoding="utf-8"), config, **kwargs)
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        # Pickles as its checkpoint, with the Python objective and your own descriptor functions.
+        return (_restore, (self.checkpoint(), self._objective, self.archive._own_descriptors()))
+
+    def __repr__(self) -> str:
+        return f"<animat.MapElites generation {self._generation}, batch {self.batch}, {self.archive!r}>"
+
+
+def _restore(
+    state: Mapping[str, Any], objective: Optional[Objective], descriptors: Tuple[Descriptor, ...]
+) -> MapElites:
+    return MapElites.restore(state, objective=objective, descriptors=descriptors)
+
+
+# --- the run directory ----------------------------------------------------------------------------
+
+_RUN_FILES = ("config.toml", "history.csv", "checkpoint.json")
+
+
+def _history_csv(history: np.ndarray) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    names = list(QD_HISTORY_DTYPE.names or ())
+    w.writerow(names)
+    for row in history:
+        w.writerow([repr(float(row[n])) if QD_HISTORY_DTYPE[n].kind == "f" else int(row[n]) for n in names])
+    return buf.getvalue()
+
+
+def run_map_elites(
+    config: Any,
+    out: PathLike,
+    generations: int,
+    archive: Optional[Union[GridArchive, CVTArchive]] = None,
+    *,
+    batch: Optional[int] = None,
+    initial: Optional[int] = None,
+    seed: Optional[int] = None,
+    objective: ObjectiveLike = None,
+    crossover_fraction: Optional[float] = None,
+    threads: Optional[int] = None,
+    archive_every: int = 10,
+    resume: bool = False,
+    overwrite: bool = False,
+    descriptors: Iterable[DescriptorLike] = (),
+    callback: Optional[Callable[[Any], Optional[bool]]] = None,
+) -> MapElites:
+    """Run MAP-Elites up to generation ``generations`` (generation 0 is the initial batch, as
+    ``evolution.generations`` counts) in the run directory ``out``:
+
+    - ``config.toml``: the run's config (its ``evolution.seed`` is the run's seed);
+    - ``history.csv``: :data:`QD_HISTORY_DTYPE`'s columns (``generation, evaluations, qd_score,
+      coverage, best, ...``), one row per generation;
+    - ``archive/gen_NNNNNN.csv``: the archive after every ``archive_every``-th generation and the last
+      (:meth:`GridArchive.write_csv`: one row per elite);
+    - ``checkpoint.json``: written after every generation (:meth:`MapElites.checkpoint`); ``resume=True``
+      continues from it (then ``archive`` may be None; your own descriptor functions go in
+      ``descriptors``) and gives the very run an uninterrupted one gives.
+
+    ``callback(row)`` is called after every generation; returning False stops (checkpointed). Returns
+    the :class:`MapElites`. A directory that holds a run is refused (FileExistsError) unless ``resume``
+    or ``overwrite`` (which removes the files above and ``archive/``, nothing else).
+    """
+    if resume and overwrite:
+        raise ValueError("run_map_elites: resume=True and overwrite=True contradict each other")
+    if archive_every < 1:
+        raise ValueError(f"run_map_elites: archive_every must be >= 1, got {archive_every}")
+    out = Path(out)
+    has_run = any((out / f).exists() for f in _RUN_FILES) or (out / "archive").exists()
+    if resume:
+        if not (out / "checkpoint.json").is_file():
+            raise FileNotFoundError(f"{out / 'checkpoint.json'}: no checkpoint to resume")
+        extra = tuple(descriptors) + (tuple(archive.descriptors) if archive is not None else ())
+        me = MapElites.load(out, config, objective=objective, descriptors=extra, threads=threads)
+    else:
+        if has_run and not overwrite:
+            raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
+        if archive is None:
+            raise ValueError("run_map_elites: an archive is required for a new run")
+        if overwrite:
+            for f in _RUN_FILES:
+                (out / f).unlink(missing_ok=True)
+            shutil.rmtree(out / "archive", ignore_errors=True)
+        me = MapElites(
+            config,
+            archive,
+            batch=batch,
+            initial=initial,
+            seed=seed,
+            objective=objective,
+            crossover_fraction=crossover_fraction,
+            threads=threads,
+        )
+    (out / "archive").mkdir(parents=True, exist_ok=True)
+    _write_atomic(out / "config.toml", me.config.to_toml())
+    while me.generation < generations:
+        row = me.step()
+        g = me.generation
+        if g % archive_every == 0 or g == generations:
+            me.archive.write_csv(out / "archive" / f"gen_{g:06d}.csv")
+        _write_atomic(out / "history.csv", _history_csv(me.history))
+        me.save(out / "checkpoint.json")
+        if callback is not None and callback(row) is False:
+            me.archive.write_csv(out / "archive" / f"gen_{g:06d}.csv")
+            break
+    return me
