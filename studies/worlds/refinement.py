@@ -1,0 +1,132 @@
+"""Does the crawl ranking survive refinement? Re-swims every lineage best of the crawl screen.
+
+For each run kept by ``crawl_screen.sh`` (``studies/worlds/crawl_screen/<name>/``), every genome
+that became the run's best is evaluated again, independently of the run's own monitor, with the
+run's config at its step dt and at dt/16 (``physics.dt`` / 16 with 16 times the swim and settle
+steps: the same simulated time). One row per lineage best goes to ``results/crawl_refinement.csv``;
+the summary printed per grid point is what ``docs/worlds.md`` quotes.
+
+    PYTHONPATH=build/python .venv/bin/python studies/worlds/refinement.py
+
+Columns: run, gravity, guard, seed, generation (at which the genome became the best), cells,
+recorded (the fitness the run recorded), fitness (re-evaluated at dt), fitness_fine (at dt/16),
+error (fitness / fitness_fine - 1), valid, valid_fine (the body's invariants held for the whole
+swim), airborne_share (Box2D steps in which the floor pushed no cell / Box2D steps, at dt), final
+(1 for the run's last lineage best).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import animat
+
+HERE = Path(__file__).resolve().parent
+FIELDS = (
+    "run",
+    "gravity",
+    "guard",
+    "seed",
+    "generation",
+    "cells",
+    "recorded",
+    "fitness",
+    "fitness_fine",
+    "error",
+    "valid",
+    "valid_fine",
+    "airborne_share",
+    "final",
+)
+
+
+def refined(config, factor: int):
+    """The same swim at dt / factor: factor times the swim and settle steps."""
+    fine = config.copy()
+    fine["physics.dt"] = config["physics.dt"] / factor
+    fine["evaluation.steps"] = config["evaluation.steps"] * factor
+    fine["evaluation.settle_steps"] = config["evaluation.settle_steps"] * factor
+    return fine
+
+
+def rows_of(run_dir: Path):
+    run = animat.Run(run_dir)
+    cfg = run.config
+    fine = refined(cfg, 16)
+    lineage = run.best_genomes
+    box2d_steps = cfg["evaluation.steps"] * cfg["physics.substeps"]
+    for i, entry in enumerate(lineage):
+        coarse = animat.evaluate(entry.genome, cfg)
+        refined_result = animat.evaluate(entry.genome, fine)
+        yield {
+            "run": run_dir.name,
+            "gravity": cfg["scene.gravity"],
+            "guard": cfg["evaluation.reference_check"],
+            "seed": run_dir.name.rsplit("seed", 1)[1],
+            "generation": entry.generation,
+            "cells": coarse.cell_count,
+            "recorded": entry.fitness,
+            "fitness": coarse.fitness,
+            "fitness_fine": refined_result.fitness,
+            "error": coarse.fitness / refined_result.fitness - 1.0 if refined_result.fitness else float("nan"),
+            "valid": int(coarse.valid),
+            "valid_fine": int(refined_result.valid),
+            "airborne_share": coarse.airborne_steps / box2d_steps,
+            "final": int(i == len(lineage) - 1),
+        }
+
+
+def summarize(rows) -> None:
+    points = sorted({(float(r["gravity"]), r["guard"]) for r in rows})
+    print(
+        "| gravity | guard | runs | lineage bests | invalid (dt, dt/16) | abs error p50 / p90 / max "
+        "(all) | final bests: abs error max | final bests: fitness | final bests: airborne share |"
+    )
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for g, guard in points:
+        sel = [r for r in rows if float(r["gravity"]) == g and r["guard"] == guard]
+        fin = [r for r in sel if int(r["final"])]
+        err = np.abs([float(r["error"]) for r in sel])
+        ferr = np.abs([float(r["error"]) for r in fin])
+        inv = sum(1 - int(r["valid"]) for r in sel), sum(1 - int(r["valid_fine"]) for r in sel)
+        fit = ", ".join(f"{float(r['fitness']):.1f}" for r in fin)
+        air = ", ".join(f"{float(r['airborne_share']):.0%}" for r in fin)
+        print(
+            f"| {g:g} | {guard} | {len(fin)} | {len(sel)} | {inv[0]}, {inv[1]} | "
+            f"{np.percentile(err, 50):.2%} / {np.percentile(err, 90):.2%} / {err.max():.2%} | "
+            f"{ferr.max():.2%} | {fit} | {air} |"
+        )
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--runs", default=str(HERE / "crawl_screen"), help="folder of kept runs")
+    p.add_argument("--out", default=str(HERE / "results" / "crawl_refinement.csv"))
+    p.add_argument("--summary-only", action="store_true", help="summarize --out without re-swimming")
+    args = p.parse_args(argv)
+    out = Path(args.out)
+    if not args.summary_only:
+        runs = sorted(d for d in Path(args.runs).iterdir() if (d / "history.csv").is_file())
+        if not runs:
+            print(f"{args.runs}: no kept runs (run studies/worlds/crawl_screen.sh first)", file=sys.stderr)
+            return 1
+        rows = [row for d in runs for row in rows_of(d)]
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with open(out, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=FIELDS, lineterminator="\n")
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in r.items()})
+    with open(out, newline="") as f:
+        rows = list(csv.DictReader(f))
+    summarize(rows)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
