@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Does an evolved fitness survive refinement? (issue 14, docs/accuracy.md "Evolved swimmers")
+"""Does an evolved fitness survive refinement? (docs/accuracy.md "Evolved swimmers")
 
 Takes the best genome of each run directory given (the last entry of its lineage, developed and
 swum with the run's own config.toml) and swims it over the evaluation horizon (4000 steps of the

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""What accuracy costs in time (issue 5): sweep the Box2D step, substeps and drag scheme over a fixed
-set of bodies and measure, against a fine reference (the default dt / 16):
+"""What accuracy costs in time (docs/accuracy.md): sweep the Box2D step, substeps and drag scheme
+over a fixed set of bodies and measure, against a fine reference (the default dt / 16):
 
 - the error of the final centre-of-mass displacement (a vector, so it includes the heading),
 - the fitness error (|displacement|, what the GA ranks),

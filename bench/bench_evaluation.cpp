@@ -1,7 +1,7 @@
-// Evaluation benchmarks (issue 8): the cost of one fitness evaluation at the paper setting (the
-// embedded default config: 400 development steps, up to 32 cells, 4000 swim steps), split into its
-// stages, on random viable genomes drawn at fixed seeds; and the cost of a random try (development
-// of a random genome, viable or not), which is what seeding generation 0 costs.
+// Evaluation benchmarks (docs/performance.md): the cost of one fitness evaluation at the paper
+// setting (the embedded default config: 400 development steps, up to 32 cells, 4000 swim steps),
+// split into its stages, on random viable genomes drawn at fixed seeds; and the cost of a random
+// try (development of a random genome, viable or not), which is what seeding generation 0 costs.
 //
 //   build/bench_evaluation --benchmark_out=bench_evaluation.csv --benchmark_out_format=csv
 //
@@ -142,10 +142,11 @@ void BM_RandomTry(benchmark::State& state) {
 }
 BENCHMARK(BM_RandomTry)->Unit(benchmark::kMicrosecond);
 
-/// One development step with n cells (issue 21's size exponent): the GRN of the first sample genome
-/// that has morphogen products, n cells placed on a triangular lattice of spacing 1 (as grown cells
-/// pack), max_cells = n so that none divides; stepped 50 times before timing. Second argument:
-/// development.morphogen_cutoff in tenths (0 = none, the paper's every-pair field).
+/// One development step with n cells (the size exponent of docs/performance.md): the GRN of the
+/// first sample genome that has morphogen products, n cells placed on a triangular lattice of
+/// spacing 1 (as grown cells pack), max_cells = n so that none divides; stepped 50 times before
+/// timing. Second argument: development.morphogen_cutoff in tenths (0 = none, the paper's
+/// every-pair field).
 void BM_DevelopStep(benchmark::State& state) {
   const Sample& s = sample();
   const int n = static_cast<int>(state.range(0));

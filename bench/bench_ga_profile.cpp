@@ -1,4 +1,4 @@
-// Where the time of a GA generation goes, and what that means on many cores (issue 20).
+// Where the time of a GA generation goes, and what that means on many cores (docs/performance.md).
 //
 //   build/bench_ga_profile POPULATION GENERATIONS [SEED]      (embedded default config, 1 thread)
 //
@@ -192,8 +192,8 @@ int main(int argc, char** argv) {
   }
   // Projected speedup over one worker of the whole run (seeding + generations), serial part
   // included, with a checkpoint every generation (the default) or every 10th
-  // (evolution.checkpoint_every = 10). spread = 0: the checkpoint as before issue 20 (all on one
-  // thread); 1: its per-individual part on rank 0's threads (now).
+  // (evolution.checkpoint_every = 10). spread = 0: the whole checkpoint on one thread
+  // (as it once was); 1: its per-individual part on rank 0's threads (as now).
   for (int spread : {0, 1})
     for (int every : {1, 10})
       for (const char* path : {"threads", "mpi"}) {

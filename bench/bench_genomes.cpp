@@ -1,5 +1,5 @@
-// Evaluation cost of given genomes (issue 14's speed budget): develop + build_body + swim at the
-// build's default config (plus --set overrides), as animat_evolve evaluates them.
+// Evaluation cost of given genomes (the speed budget of docs/performance.md): develop + build_body
+// + swim at the build's default config (plus --set overrides), as animat_evolve evaluates them.
 //
 //   build/bench_genomes [--set section.key=value]... [--repeat N] GENOME.json...
 //

@@ -1,5 +1,5 @@
-// Swim-step benchmarks (issues 5 and 8): the swim step against a bare Box2D Step of the same number
-// of fixture-less bodies, the cost of each effect alone, and of each drag scheme.
+// Swim-step benchmarks (docs/performance.md): the swim step against a bare Box2D Step of the same
+// number of fixture-less bodies, the cost of each effect alone, and of each drag scheme.
 //
 //   build-phys/bench_physics --benchmark_out=bench_physics.csv --benchmark_out_format=csv
 //
@@ -167,7 +167,7 @@ void BM_VelocityForces(benchmark::State& state) {
 }
 BENCHMARK(BM_VelocityForces)->DenseRange(0, 1);
 
-/// Issue 18 (docs/control.md): the swim step under control.mode = "grn" at update interval k
+/// Active control (docs/control.md): the swim step under control.mode = "grn" at update interval k
 /// (Arg = k) against open loop (Arg = 0: the default scene with its oscillators), 32 cells. The
 /// controller's GRN is a random genome with every extension channel (10 units, the paper's size),
 /// signalling on (D = 1, one diffusible product or more), a point chemical source.

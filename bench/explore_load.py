@@ -12,7 +12,7 @@ Chromium (Debian's ``/usr/bin/chromium`` driven by playwright, as tests/python/t
 Prints the machine, the page size, the build time and the load time: from the start of the navigation
 to the page's ``animatExplore.ready`` (``performance.now()`` when the script has drawn everything: the
 curves, the first swim frame, the phase map, the lineage and the genealogy), median and maximum. The
-target (issue 34) is under 2 s.
+target is under 2 s.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What `development.morphogen_cutoff` changes (docs/performance.md, issue 21).
+"""What `development.morphogen_cutoff` changes (docs/performance.md).
 
 For each cut-off, every genome is evaluated with the paper's every-pair morphogen field and with the
 cut-off: how many develop to a different number of cells, how many fitnesses differ at all (bit for

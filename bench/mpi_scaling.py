@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""MPI scaling of animat_evolve (issue 20): strong scaling (population 100 and 400 fixed) and weak
+"""MPI scaling of animat_evolve: strong scaling (population 100 and 400 fixed) and weak
 scaling (population 50 x ranks) over 1, 2, 4 ranks of one thread each on this machine, plus the GA
 profile and the projection to many workers (build/bench_ga_profile). Writes bench/results/mpi_scaling.csv,
 bench/results/ga_profile_<P>.jsonl and the Markdown tables printed at the end (docs/performance.md,

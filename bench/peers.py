@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Issue 21's peers' row: the same 32-cell body, time step and spring constants in pymunk (Chipmunk2D),
-as its users would write it, beside our own swim step, measured in one run.
+"""The peers' row of docs/performance.md: the same 32-cell body, time step and spring constants in
+pymunk (Chipmunk2D), as its users would write it, beside our own swim step, measured in one run.
 
     .venv/bin/python bench/peers.py            # installs pymunk into bench/.venv-peers on first use
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The performance benchmarks of issue 8, run and tabulated in one go.
+"""The performance benchmarks (docs/performance.md), run and tabulated in one go.
 
     .venv/bin/python bench/run_benchmarks.py            # everything (about 10 min on 2 cores)
     .venv/bin/python bench/run_benchmarks.py --no-callgrind --generations 3   # quicker
@@ -374,7 +374,7 @@ def main() -> int:
         "",
     ]
 
-    # Development step against cells (issue 21's exponent target).
+    # Development step against cells (the exponent target of docs/performance.md).
     dev_cells = [32, 64, 128, 256, 512, 1024]
     cutoffs = [0, 40, 80]  # development.morphogen_cutoff in tenths (0 = none, the paper's field)
     us = {(n, c): dev[f"BM_DevelopStep/{n}/{c}"]["cpu_us"] for n in dev_cells for c in cutoffs}

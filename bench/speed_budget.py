@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Issue 14's speed budget: one paper-setting evaluation at the new defaults against the previous
-release at its defaults, side by side in one run, on the same genomes.
+"""The speed budget of trustworthy physics (docs/performance.md): one paper-setting evaluation at
+the new defaults against the previous release at its defaults, side by side in one run, on the same
+genomes.
 
     git worktree add --detach ../baseline aaac293      # the previous release
     cmake -S ../baseline -B ../baseline/build -G Ninja -DCMAKE_BUILD_TYPE=Release \\

@@ -93,7 +93,7 @@ void bind_development(nb::module_& m) {
           "stiffness", [](const Embryo& e) -> Vector { return e.stiffness; },
           "Spring stiffness factor per cell, "
           "development.stiffness_min·(stiffness_max/stiffness_min)^output\n"
-          "(issue 17); empty unless genome.extra_outputs enables the stiffness output.")
+          "(evolvable stiffness); empty unless genome.extra_outputs enables the stiffness output.")
       .def_prop_ro(
           "division_steps", [](const Embryo& e) { return e.division_steps; },
           "Step (1-based) of every division, in order (list of int); len == cell_count - 1.")

@@ -124,7 +124,7 @@ Body body_from_state(nb::handle state) {
   b.frequency = nb::cast<Vector>(t[8]);
   b.phase = nb::cast<Vector>(t[9]);
   if (t.size() > 10)
-    b.stiffness = nb::cast<Vector>(t[10]);  // absent in states pickled before issue 17 part 3
+    b.stiffness = nb::cast<Vector>(t[10]);  // absent in states pickled before evolvable stiffness
   return b;
 }
 
@@ -164,7 +164,7 @@ Embryo embryo_from_state(nb::handle state) {
   e.reasons = nb::cast<std::vector<std::string>>(t[10]);
   e.trace = trace_from_state(t[11]);
   if (t.size() > 12)
-    e.stiffness = nb::cast<Vector>(t[12]);  // absent in states pickled before issue 17 part 3
+    e.stiffness = nb::cast<Vector>(t[12]);  // absent in states pickled before evolvable stiffness
   return e;
 }
 
@@ -571,8 +571,7 @@ void bind_research(nb::module_& m) {
       "it). The\n"
       "scene must not list 'actuation'.");
 
-  // --- GRN control added to a Python-built simulation (issue 18, docs/control.md)
-  // ---------------------
+  // --- GRN control added to a Python-built simulation (docs/control.md) ------------------------
   nb::class_<GrnControl>(
       m, "GrnControl",
       "The GRN running while the body swims (control.mode = 'grn'; see "
@@ -633,8 +632,8 @@ void bind_research(nb::module_& m) {
         return raw;
       },
       "body"_a, "genome"_a, "config"_a = nb::none(), nb::rv_policy::reference_internal,
-      "Run `genome`'s GRN while this simulation swims (issue 18): `body` is the body it swims "
-      "(developed\n"
+      "Run `genome`'s GRN while this simulation swims (docs/control.md): `body` is the body it "
+      "swims (developed\n"
       "from `genome` with `config`), whose cells start from their end-of-development GRN states; "
       "the\n"
       "control keys (control.*, scene.chemical*) come from `config`. The scene must not list "

@@ -1,6 +1,6 @@
-"""Issue 17 part 4: one embryo's centres turned into a body by each body.graph (Gabriel, distance,
-alpha shape at two radii). Regions are filled; holes of the alpha shape are left white and their
-boundary is drawn as skin (thick).
+"""Other body graphs (docs/model.md): one embryo's centres turned into a body by each body.graph
+(Gabriel, distance, alpha shape at two radii). Regions are filled; holes of the alpha shape are left
+white and their boundary is drawn as skin (thick).
 
     PYTHONPATH=build/python .venv/bin/python examples/body_graphs.py [--run DIR] [--out PNG]
 """

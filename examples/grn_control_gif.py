@@ -1,4 +1,4 @@
-"""Issue 18 (docs/control.md): a GRN-controlled swimmer turning toward a chemical source, as a GIF.
+"""Active control (docs/control.md): a GRN-controlled swimmer turning toward a chemical source, as a GIF.
 
 Swims the best of the amplitude-mode chemotaxis run (data/control/chemotaxis_amplitude_seed2_*)
 toward sources in several directions with ``animat.grn_swim`` and writes one panel per source into

@@ -1,4 +1,4 @@
-"""Issue 18 (docs/control.md): what an evolved GRN controller does while it swims.
+"""Active control (docs/control.md): what an evolved GRN controller does while it swims.
 
 Reads the best genome of a short chemotaxis run (data/control/<run>_*) and writes
   docs/images/control_<run>_terms.png  the actuation term u_i of every cell over time,

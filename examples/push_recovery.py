@@ -1,4 +1,4 @@
-"""Issue 18 (docs/control.md): do GRN-controlled swimmers recover from a push better than open-loop ones?
+"""Active control (docs/control.md): do GRN-controlled swimmers recover from a push better than open-loop ones?
 
 For every best given (packed runs, as data/control/push/<name>/run_<i> or data/replication/dn2/run_<i>),
 at the paper's d_N = 2 setting, 4000 steps:

@@ -1,5 +1,6 @@
-"""Issue 17 part 3: the best swimmer of a run with evolvable stiffness (genome.extra_outputs =
-"stiffness"), phase map beside stiffness map (nodes and springs coloured by their factors).
+"""Evolvable stiffness (docs/model.md): the best swimmer of a run with evolvable stiffness
+(genome.extra_outputs = "stiffness"), phase map beside stiffness map (nodes and springs coloured by
+their factors).
 
     PYTHONPATH=build/python .venv/bin/python examples/stiffness_map.py --run DIR [--out PNG]
 """

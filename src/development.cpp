@@ -732,7 +732,7 @@ Embryo develop(const Genome& genome, const GenomeParams& genome_params, const Gr
                      e.outputs.col(static_cast<int>(OutputChannel::frequency)).array())
                     .matrix();
   e.phase = 2.0 * std::numbers::pi * e.outputs.col(static_cast<int>(OutputChannel::phase));
-  // Evolvable stiffness (issue 17 part 3): only when the config enables the output; a genome
+  // Evolvable stiffness (docs/model.md): only when the config enables the output; a genome
   // without a stiffness element has level 0 there (stiffness_min), as a missing amplitude element
   // gives 0.
   const auto enabled = enabled_output_channels(genome_params);

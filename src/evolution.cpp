@@ -695,7 +695,7 @@ std::string Evolution::checkpoint() const {
   payload["wall_seconds"] = history_.empty() ? 0.0 : history_.back().wall_seconds;
   // The individuals are serialised on the evaluation threads: on many cores the checkpoint is most
   // of the serial part of a generation, and two thirds of it is this loop (docs/performance.md,
-  // issue 20).
+  // "Scale-out with MPI").
   std::vector<json> individuals(population_.size());
 #pragma omp parallel for schedule(static) num_threads(resolve_threads(config_->evolution.threads))
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(population_.size()); ++i) {

@@ -11,13 +11,13 @@ namespace animat {
 
 struct Embryo;
 
-/// The body graphs (issue 17 part 4, docs/model.md "Other body graphs").
+/// The body graphs (docs/model.md "Other body graphs").
 inline constexpr std::string_view kBodyGraphNames[] = {"gabriel", "distance", "alpha_shape"};
 
 struct BodyParams {
   double merge_distance = 1e-6;   ///< points closer than this are duplicates (rejected) [choose]
   double max_coordinate = 1e6;    ///< |x| or |y| above this is rejected as absurd [choose]
-  std::string graph = "gabriel";  ///< gabriel [paper] | distance | alpha_shape [issue 17]
+  std::string graph = "gabriel";  ///< gabriel [paper] | distance | alpha_shape [choose]
   /// distance graph: Delaunay-tessellation edges up to this length, in mean nearest-neighbour
   /// distances
   double distance_threshold = 1.5;
@@ -38,12 +38,12 @@ void visit_fields(BodyParams& p, V&& v) {
               "(Delaunay-tessellation edges not longer than distance_threshold, plus the "
               "relative-neighbourhood edges that keep the body in one piece); alpha_shape "
               "(regularized alpha complex of radius alpha, same connecting edges; bounded faces "
-              "outside the complex are holes: no pressure, skin) [issue 17]",
+              "outside the complex are holes: no pressure, skin) [choose]",
               Bounds::any(), kBodyGraphNames, Identity::late},
     p.graph);
   v(FieldInfo{"distance_threshold",
               "graph = distance: longest spring, in units of the mean nearest-neighbour distance "
-              "of the cell centres (1 = a packed cell diameter), (0, 1e6] [issue 17]",
+              "of the cell centres (1 = a packed cell diameter), (0, 1e6] [choose]",
               Bounds::positive_upto(kMaxLength),
               {},
               Identity::late},
@@ -51,7 +51,7 @@ void visit_fields(BodyParams& p, V&& v) {
   v(FieldInfo{"alpha",
               "graph = alpha_shape: largest circumradius of a filled triangle, in units of the "
               "mean nearest-neighbour distance of the cell centres (CGAL's alpha is its square), "
-              "(0, 1e6] [issue 17]",
+              "(0, 1e6] [choose]",
               Bounds::positive_upto(kMaxLength),
               {},
               Identity::late},
@@ -82,9 +82,9 @@ struct Body {
   std::vector<std::vector<int>> skin_loops;
   /// per-node oscillator parameters (zeros if none given)
   Vector amplitude, frequency, phase;
-  /// Per-node stiffness factor f (issue 17 part 3, GRN output `stiffness`); empty = every spring
-  /// has scene.spring_stiffness (the paper's uniform stiffness). Spring (i, j) then has stiffness
-  /// k·spring_stiffness_factor(f_i, f_j).
+  /// Per-node stiffness factor f (evolvable stiffness: GRN output `stiffness`); empty = every
+  /// spring has scene.spring_stiffness (the paper's uniform stiffness). Spring (i, j) then has
+  /// stiffness k·spring_stiffness_factor(f_i, f_j).
   Vector stiffness;
 
   [[nodiscard]] int node_count() const { return static_cast<int>(positions.rows()); }

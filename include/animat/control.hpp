@@ -1,5 +1,5 @@
 #pragma once
-// Active control beyond the paper (issue 18, docs/control.md): the GRN keeps running while the
+// Active control beyond the paper (docs/control.md): the GRN keeps running while the
 // animat swims. With control.mode = "grn" every cell's network (its state at the end of development
 // carried over) is stepped every control.update_interval Box2D steps; its `actuation` output sets
 // the cell's term u_i of eq. 2, its inputs read sensors (strain, pressure, the scene's chemical

@@ -63,9 +63,9 @@ struct DevelopmentParams {
   double frequency_min = 0.5;  ///< oscillator frequency at output 0, rad per unit time [choose]
   double frequency_max = 6.0;  ///< oscillator frequency at output 1 [choose: docs/model.md]
   double amplitude_max = 0.2;  ///< amplitude scale [paper: 0.2]
-  /// Stiffness factor at stiffness output 0 and 1 (issue 17 part 3; only when genome.extra_outputs
-  /// enables `stiffness`): f = stiffness_min·(stiffness_max/stiffness_min)^level, geometric
-  /// [choose]
+  /// Stiffness factor at stiffness output 0 and 1 (evolvable stiffness; only when
+  /// genome.extra_outputs enables `stiffness`):
+  /// f = stiffness_min·(stiffness_max/stiffness_min)^level, geometric [choose]
   double stiffness_min = 0.25;
   double stiffness_max = 4.0;
   // Physics of the development world [choose].
@@ -88,7 +88,7 @@ struct DevelopmentParams {
   /// longest delay d/v kept in the history (steps); longer delays read the oldest sample
   int morphogen_max_delay = 64;
   /// Cells farther apart than this do not sense each other's morphogens; 0 = no cut-off, every pair
-  /// (the paper's field). A cut-off makes development linear in cells (issue 21) [choose]
+  /// (the paper's field). A cut-off makes development linear in cells [choose]
   double morphogen_cutoff = 0.0;
   std::vector<std::string> effects = {"repulsion", "adhesion", "morphogens"};
   int trace_every = 0;  ///< record a trace snapshot every k steps; 0 = off
@@ -159,7 +159,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"stiffness_min",
               "spring stiffness factor of a cell at stiffness output 0 (used only when "
               "genome.extra_outputs has stiffness), dimensionless multiple of "
-              "scene.spring_stiffness, [1e-6, 1e6] [issue 17]",
+              "scene.spring_stiffness, [1e-6, 1e6] [choose]",
               Bounds::closed(1e-6, 1e6),
               {},
               Identity::late},
@@ -167,7 +167,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"stiffness_max",
               "stiffness factor at stiffness output 1; the factor is "
               "stiffness_min*(stiffness_max/stiffness_min)^output (geometric), [1e-6, 1e6], >= "
-              "stiffness_min [issue 17]",
+              "stiffness_min [choose]",
               Bounds::closed(1e-6, 1e6),
               {},
               Identity::late},
@@ -215,7 +215,7 @@ void visit_fields(DevelopmentParams& p, V&& v) {
   v(FieldInfo{"morphogen_cutoff",
               "distance beyond which cells do not sense each other's morphogens; 0 = no cut-off, "
               "every pair (the paper's field); a cut-off makes development linear in cells "
-              "[choose, issue 21]",
+              "[choose]",
               Bounds::upto(kMaxLength),
               {},
               Identity::late},
@@ -259,7 +259,7 @@ struct Embryo {
   /// when the genome has extension outputs)
   OutputLevels outputs;
   Vector amplitude, frequency, phase;  ///< oscillator parameters derived from the outputs
-  /// Stiffness factor per cell from the `stiffness` output (issue 17 part 3); empty unless the
+  /// Stiffness factor per cell from the `stiffness` output (evolvable stiffness); empty unless the
   /// config enables that output channel (genome.extra_outputs has `stiffness`).
   Vector stiffness;
   std::vector<int> division_steps;  ///< step (1-based) of every division, in order

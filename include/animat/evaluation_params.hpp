@@ -39,7 +39,7 @@ struct EvaluationParams {
   /// W₀ of distance_per_energy: distance / (positive actuation work + W₀) [choose: docs/worlds.md;
   /// of the order of a swimmer's W⁺, so that barely moving bodies do not win on the ratio]
   double energy_offset = 1e4;
-  // Directional tasks and disruption (issue 18, docs/control.md).
+  // Directional tasks and disruption (docs/control.md).
   /// objective chemotaxis: swims per evaluation, one per source direction [choose]
   int source_directions = 4;
   /// objective chemotaxis: seed of the source directions (the same for every genome) [choose]

@@ -49,7 +49,7 @@ enum class OutputChannel : int {
   amplitude = 3,
   frequency = 4,
   phase = 5,
-  /// per-cell spring stiffness factor (issue 17 part 3; development.stiffness_min/max)
+  /// per-cell spring stiffness factor (evolvable stiffness; development.stiffness_min/max)
   stiffness = 6,
   actuation = 7,  ///< the cell's actuation term u_i under control.mode = "grn"
 };

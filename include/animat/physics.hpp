@@ -137,7 +137,7 @@ class Simulation {
   /// Sets every cell's velocity (n × 2), e.g. to launch a body; throws GeometryError for a wrong
   /// shape or non-finite values.
   void set_velocities(const Points& velocities);
-  /// A disruption (issue 18, docs/control.md): adds impulse/m (impulse = [Jx, Jy], per cell) to the
+  /// A disruption (docs/control.md): adds impulse/m (impulse = [Jx, Jy], per cell) to the
   /// velocity of every listed cell, now. Throws GeometryError for a cell index out of range or a
   /// non-finite impulse. Momentum grows by |cells|·impulse.
   void push(std::span<const int> cells, const Eigen::Vector2d& impulse);

@@ -1,4 +1,5 @@
-"""Independent evolutionary runs of one configuration: the replication workhorse (issue 10).
+"""Independent evolutionary runs of one configuration: the replication workhorse
+(docs/replication.md).
 
     python -m animat experiment configs/paper_dn2.toml --runs 3 --out runs/replication/dn2
 
@@ -8,7 +9,7 @@ Run ``i`` uses seed ``evolution.seed + i`` and lives in ``OUT/run_<i>``. Runs go
 that holds a checkpoint is continued, and a finished run stops at once. ``OUT/summary.json`` and
 ``OUT/summary.md`` hold the best fitness per run and the median with its spread.
 
-A study (issue 20) is several environments at once, ``NAME=CONFIG`` each, in ``OUT/NAME/run_<i>``, and
+A study is several environments at once, ``NAME=CONFIG`` each, in ``OUT/NAME/run_<i>``, and
 can be spread over many machines (docs/cluster.md): ``--mpi`` places the runs on the ranks of an MPI
 job (``mpirun -np R python -m animat experiment ... --mpi``, needs mpi4py), ``--index I`` runs only
 run I of the study (one task of a Slurm array). Every run depends only on its config and seed, never
@@ -144,7 +145,7 @@ def write_summary(root: Path, config_path: str, records: Sequence[RunRecord]) ->
     (root / "summary.md").write_text("\n".join(lines) + "\n")
 
 
-# --- Studies: several environments, on MPI ranks or as array tasks (issue 20) ------------------------
+# --- Studies: several environments, on MPI ranks or as array tasks ---------------------------------
 
 
 @dataclass

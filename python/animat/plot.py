@@ -11,7 +11,7 @@ function               paper        shows
 :func:`construction`   Fig. 3       centres → Delaunay → body graph (regions, skin)
 :func:`motion_cycle`   Figs. 4–6    snapshots of one motion cycle, nodes red / blue / green
 :func:`phase_map`      Fig. 7       nodes coloured by phase shift, maximum indicated
-:func:`stiffness_map`  (Fig. 7)     nodes and springs coloured by evolved stiffness (issue 17)
+:func:`stiffness_map`  (Fig. 7)     nodes and springs coloured by evolved stiffness
 :func:`fitness_history` Figs. 8–9   best fitness per generation, morphology changes marked
 :func:`energy_split`   (§4)         where the actuation work went: fluid, dampers, collisions...
 =====================  ===========  ==========================================================
@@ -792,7 +792,7 @@ def phase_map(
     return fig
 
 
-# --- stiffness map (issue 17 part 3), the phase map's sibling ---------------------------------------------
+# --- stiffness map, the phase map's sibling ---------------------------------------------------------------
 
 
 def stiffness_map(

@@ -1,4 +1,4 @@
-"""Quality diversity: MAP-Elites over descriptors of body and motion (issue 35).
+"""Quality diversity: MAP-Elites over descriptors of body and motion.
 
 The paper ends (§7) by suggesting niching: protect novel morphologies until evolution has had the time
 to adjust their control. MAP-Elites (Mouret & Clune 2015) does this by construction: an **archive**

@@ -1,4 +1,4 @@
-// Effect "grn_control" (control.mode = "grn", issue 18): the GRN keeps running while the animat
+// Effect "grn_control" (control.mode = "grn"): the GRN keeps running while the animat
 // swims and its actuation output drives eq. 2 (control.hpp, docs/control.md).
 //
 // Every k = control.update_interval Box2D steps (or k = control.update_period / h; at steps 0, k,

@@ -1,5 +1,5 @@
 // Effect "springs": damped Hooke springs, the same stiffness and damping for all [paper §4], or a
-// stiffness per spring from the cells' evolved stiffness factors (issue 17 part 3).
+// stiffness per spring from the cells' evolved stiffness factors (docs/model.md).
 #include <cmath>
 #include <cstddef>
 #include <memory>

@@ -1,4 +1,4 @@
-// Other body graphs (issue 17 part 4): body.graph = distance | alpha_shape against brute-force
+// Other body graphs (docs/model.md): body.graph = distance | alpha_shape against brute-force
 // definitions (O(n^3) / O(n^4)) on random clouds, lattices (cocircular points), circles,
 // near-collinear and nearly duplicate points, and the body invariants for graphs with holes.
 #include <gtest/gtest.h>

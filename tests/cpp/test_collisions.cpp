@@ -1,4 +1,4 @@
-// Trustworthy swimmers (issue 14): cell-edge collisions as the paper states them (elastic,
+// Trustworthy swimmers: cell-edge collisions as the paper states them (elastic,
 // momentum-conserving, never crossed), the planar-embedding invariant, eqs. 4–5 integrated without
 // a limiter, and the diagnostics every swim reports. Analytic wherever the physics allows.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Active control (issue 18, include/animat/control.hpp, docs/control.md): the GRN keeps running
+// Active control (include/animat/control.hpp, docs/control.md): the GRN keeps running
 // while the animat swims. Analytic checks of the sensors, of eq. 1 driving the actuation, of
 // signalling (the discrete heat equation on a chain), the push, the config keys, and that open loop
 // is the paper's engine.

@@ -625,8 +625,7 @@ TEST(Development, DeterministicBitIdentical) {
                            sizeof(double) * static_cast<std::size_t>(a.positions.size())));
 }
 
-// --- the pair grid (issue 21)
-// ---------------------------------------------------------------------
+// --- the pair grid ---------------------------------------------------------------------------
 
 /// The grid must hand out, in the all-pairs order, a superset of the pairs closer than the reach:
 /// uniform, clustered, collinear, coincident and widely spread points.

@@ -1,4 +1,4 @@
-// The crawl world (issue 17, part 1): effects "gravity" and "ground" (a floor with Coulomb
+// The crawl world (docs/worlds.md): effects "gravity" and "ground" (a floor with Coulomb
 // friction), the settling phase before the fitness clock, and the horizontal-distance objective.
 // Values are asserted against the analytic solutions of the discrete scheme (symplectic Euler, as
 // Box2D integrates) and of the continuous equations.

@@ -1,6 +1,6 @@
-// Reliability, round 2 (issue 15): no refused command may damage a run, no accepted value may
-// crash, every stop signal is honoured. docs/reliability.md lists each attack with its count and
-// test.
+// Hostile input, refused commands and stop requests: no refused command may damage a run, no
+// accepted value may crash, every stop signal is honoured. docs/reliability.md lists each attack
+// with its count and test.
 //
 //   ConfigSweep.*      every config key (iterated through visit_fields, so new keys are covered)
 //                      at its bounds and just beyond: refused values name the key (set_value,
@@ -12,7 +12,7 @@
 //                      evaluation, the CLI
 //   CheckpointMeaning.* checkpoints with a valid checksum but a content the engine cannot have
 //                      written
-//   Rows.*             the other rows of the issue's table
+//   Rows.*             the other attacks of docs/reliability.md
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -595,7 +595,7 @@ TEST(ConfigSweep, ResumableKeysAreExactlyTheKeysOutsideTheRunIdentity) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Rows of the issue's table
+// The other attacks of docs/reliability.md
 
 TEST(Rows, Box2DAssertValuesAreRefused) {
   // Both were accepted and then aborted in b2Body's constructor (exit 134).

@@ -975,7 +975,7 @@ long development_steps_without_allocation(const Config& config, std::size_t grid
   return quiet_steps;
 }
 
-/// Issue 21: development allocates only when a cell is born (its GRN state, history rows and
+/// Development allocates only when a cell is born (its GRN state, history rows and
 /// slots); a step without a division allocates nothing, whatever the genome.
 TEST(Performance, DevelopmentAllocatesOnlyWhenACellIsBorn) {
   EXPECT_GT(development_steps_without_allocation(Config{}, 64), 900);

@@ -1,4 +1,5 @@
-// Reliability (issue 9): bad input never crashes, long runs survive faults, resources stay bounded.
+// Reliability (docs/reliability.md): bad input never crashes, long runs survive faults, resources
+// stay bounded.
 //
 //   Catalogue.*        every file in tests/bad_inputs/catalogue/ raises the exact animat error its
 //                      <case>.expected sidecar names (configs, --set overrides, genomes,
@@ -240,7 +241,7 @@ TEST(CatalogueIndex, CoversEveryRequiredCaseAndEveryFileHasASidecar) {
     });
     EXPECT_TRUE(has_input) << entry.path().filename() << " has no input file";
   }
-  // The issue's list: configs, genomes and checkpoints.
+  // The cases the catalogue must hold: configs, genomes and checkpoints.
   for (const char* required :
        {"config_unknown_key.toml", "config_wrong_type_string.toml",
         "config_population_negative.toml", "config_cells_zero.toml", "config_physics_dt_zero.toml",

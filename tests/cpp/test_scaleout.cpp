@@ -1,5 +1,5 @@
-// Scale-out building blocks (issue 20): the evaluator interface, islands and ring migration, and
-// the wire codec of the MPI messages. The MPI runs themselves are checked end to end in
+// Scale-out building blocks (docs/cluster.md): the evaluator interface, islands and ring migration,
+// and the wire codec of the MPI messages. The MPI runs themselves are checked end to end in
 // tests/python/test_mpi.py (mpirun on localhost).
 #include <gtest/gtest.h>
 

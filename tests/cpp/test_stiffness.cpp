@@ -1,4 +1,4 @@
-// Evolvable stiffness (issue 17 part 3): a per-cell stiffness factor f sets each spring's stiffness
+// Evolvable stiffness (docs/model.md): a per-cell stiffness factor f sets each spring's stiffness
 // k·2·f_i·f_j/(f_i + f_j) (src/effects/springs.cpp, Body::stiffness). Uniform factors reproduce the
 // paper's uniform body bit for bit; a two-cell body oscillates at ω = sqrt(k_eff/μ).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The cost of actuation (issue 17, part 2): the mechanical work that the changing rest lengths put
+// The cost of actuation (docs/worlds.md): the mechanical work that the changing rest lengths put
 // into the springs, ΔW = k·(r − r₀)·((r + r₀)/2 − (ℓ + ℓ₀)/2) per spring and Box2D step
 // (src/effects/springs.cpp), checked on a single driven spring against the analytic energy balance.
 #include <gtest/gtest.h>

@@ -89,7 +89,7 @@ def test_animate_replays_a_body_first(tmp_path):
         assert im.n_frames == 5
 
 
-# --- the world in the GIF (issue "See a run", item 3) ---------------------------------------------------
+# --- the world in the GIF ------------------------------------------------------------------------------
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -1,5 +1,5 @@
 """Body stage through Python: Gabriel graph against its O(n^3) definition, Body shapes and dtypes,
-and the documented errors (issue 4)."""
+and the documented errors."""
 
 import re
 

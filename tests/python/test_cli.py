@@ -1,4 +1,4 @@
-"""animat_evolve command line through Python (issue 2): --print-config output parses back to the same
+"""animat_evolve command line through Python: --print-config output parses back to the same
 config; --set/--config/--seed change it; bad options exit non-zero with a message on stderr.
 Skipped when ANIMAT_EVOLVE_EXE is not set (scripts/test.sh sets it)."""
 

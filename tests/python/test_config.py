@@ -1,4 +1,4 @@
-"""animat.Config through Python (issue 2): defaults, the dict view, attribute sections, TOML round
+"""animat.Config through Python: defaults, the dict view, attribute sections, TOML round
 trips, and bad values / bad TOML as ValueError with messages naming file, line, key and expectation."""
 
 import copy

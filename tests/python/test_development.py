@@ -1,4 +1,4 @@
-"""Development (issue 3) through the Python surface: animat.develop(genome, config) -> Embryo."""
+"""Development through the Python surface: animat.develop(genome, config) -> Embryo."""
 
 import math
 

@@ -1,4 +1,4 @@
-"""The experiment runner and the paper's environment configs (issue 10)."""
+"""The experiment runner and the paper's environment configs."""
 
 import json
 import subprocess

@@ -1,4 +1,4 @@
-"""animat.Genome / animat.Rng / animat.affinity through Python (issue 2): arrays and dtypes, parsing,
+"""animat.Genome / animat.Rng / animat.affinity through Python: arrays and dtypes, parsing,
 JSON round trips and bad JSON, operators and their determinism with int seeds and with animat.Rng."""
 
 import json
@@ -181,7 +181,7 @@ def test_units_of_hand_built_genomes(types, expected):
 def test_from_arrays_validates():
     with pytest.raises(ValueError, match="sign"):
         make([P, G], signs=[1, 0])
-    # Channels 4-6 (inputs) and 6-7 (outputs) are the extensions of issue 18 (docs/model.md).
+    # Channels 4-6 (inputs) and 6-7 (outputs) are the channels beyond the paper (docs/model.md).
     with pytest.raises(ValueError, match=r"channel 7 out of range \[0, 7\)"):
         make([I], channels=[7])
     with pytest.raises(ValueError, match=r"channel 8 out of range \[0, 8\)"):

@@ -1,4 +1,4 @@
-"""animat.Grn through Python (issue 2): eq. 1 relaxation against its closed form, levels in [0, 1),
+"""animat.Grn through Python: eq. 1 relaxation against its closed form, levels in [0, 1),
 maternal and sensed-morphogen inputs, edges, reachability (viability criterion 1) and DOT export."""
 
 import math

@@ -1,4 +1,4 @@
-"""Active control (issue 18, docs/control.md) through the Python surface: the extension channels,
+"""Active control (docs/control.md) through the Python surface: the extension channels,
 the [control] keys, GRN-mode evaluations, objective chemotaxis and Simulation.push."""
 
 import math

@@ -1,4 +1,5 @@
-"""Reliability, round 2 (issue 15) through Python: the issue's rows and a Hypothesis sweep of the API.
+"""Hostile input, refused commands and stop requests through Python: the attacks of docs/reliability.md
+and a Hypothesis sweep of the API.
 
 Rows: Rng.integer over the whole int64 range and clear argument errors; a Simulation shared by two
 threads; load_config of a directory; an evolve callback returning a non-bool; Ctrl-C during

@@ -1,4 +1,4 @@
-"""One GA over MPI ranks (issue 20), end to end with mpirun on localhost: bit-identical to one
+"""One GA over MPI ranks, end to end with mpirun on localhost: bit-identical to one
 process with one thread for 1-3 ranks x 1-2 threads; a killed rank stops the job with a message and
 an intact checkpoint, and a resume on a different number of ranks finishes identically; islands are
 deterministic on 1 and 3 ranks, and their migrants arrive at the scheduled generations.

@@ -1,4 +1,4 @@
-"""Swimming physics (issue 5) through the Python surface: animat.Scene, animat.Simulation,
+"""Swimming physics through the Python surface: animat.Scene, animat.Simulation,
 animat.swim and animat.evaluate."""
 
 import math

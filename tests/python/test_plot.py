@@ -217,7 +217,7 @@ def test_construction_shows_delaunay_then_gabriel(run):
     assert isinstance(plot.construction(embryo.positions), Figure)
 
 
-# --- figures that fit every world (issue "See a run", item 3) ------------------------------------------
+# --- figures that fit every world -----------------------------------------------------------------------
 
 
 def small_config(config=None, **keys):

@@ -1,4 +1,4 @@
-"""Reliability (issue 9) through Python and the real binary.
+"""Reliability (docs/reliability.md) through Python and the real binary.
 
 - The bad-input catalogue (tests/bad_inputs/catalogue/): every case raises the Python exception and
   the exact message of its <case>.expected sidecar, and no case aborts the interpreter.

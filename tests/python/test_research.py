@@ -1,4 +1,5 @@
-"""The research API (issue 16): objectives, ask/tell, pickling, process pools, the quickstart, packaging."""
+"""The research API (docs/python.md): objectives, ask/tell, pickling, process pools, the quickstart,
+packaging."""
 
 import copy
 import math

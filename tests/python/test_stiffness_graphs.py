@@ -1,6 +1,6 @@
-"""Issue 17 parts 3 and 4 from Python: evolved stiffness reaches the body (genome.extra_outputs =
-"stiffness"), the stiffness map renders (the phase map's sibling), old genomes still develop, and
-body.graph selects the distance / alpha-shape bodies."""
+"""Evolvable stiffness and the other body graphs from Python: evolved stiffness reaches the body
+(genome.extra_outputs = "stiffness"), the stiffness map renders (the phase map's sibling), old
+genomes still develop, and body.graph selects the distance / alpha-shape bodies."""
 
 import matplotlib
 
@@ -97,7 +97,7 @@ def test_stiffness_map_colours_springs_by_their_harmonic_mean():
     body = animat.Body.__new__(animat.Body)
     body.__setstate__((kind, version, tuple(state[:10]) + (f,)))
     assert np.array_equal(body.stiffness, f)
-    old = animat.Body.__new__(animat.Body)  # a state pickled before issue 17 part 3 (10 fields) still loads
+    old = animat.Body.__new__(animat.Body)  # pickled before evolvable stiffness (10 fields): still loads
     old.__setstate__((kind, version, tuple(state[:10])))
     assert len(old.stiffness) == 0 and np.array_equal(old.springs, plain.springs)
     fig = plot.stiffness_map(body)

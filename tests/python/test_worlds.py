@@ -1,4 +1,4 @@
-"""The crawl world and the cost of actuation (issue 17, docs/worlds.md) through the Python surface."""
+"""The crawl world and the cost of actuation (docs/worlds.md) through the Python surface."""
 
 import math
 from pathlib import Path
