@@ -9,6 +9,8 @@ organised by task:
   :class:`Objective`, :class:`History`;
 - quality diversity: :class:`MapElites` (ask/tell) over a :class:`GridArchive` or :class:`CVTArchive`
   of :data:`DESCRIPTORS` (body and motion), :func:`run_map_elites` (a run directory); :mod:`animat.qd`;
+- several objectives: :class:`Nsga2` (NSGA-II, ask/tell) over :data:`CRITERIA` (distance against
+  actuation work, ...), the Pareto front, :func:`run_nsga2` (a run directory); :mod:`animat.moo`;
 - control: :class:`SwimEnv` (Gymnasium API, registered as ``"animat/Swim-v0"``; ``pip install animat[control]``);
 - analysis: :class:`Run` reads a run directory; :func:`replay` returns a :class:`Trajectory`;
   :mod:`animat.plot` draws the paper's figures; :mod:`animat.locomotion` classifies how a swimmer
@@ -20,7 +22,7 @@ Every value type pickles and copies. ``animat.plot`` imports matplotlib on first
 
 from typing import TYPE_CHECKING
 
-from . import _core, qd
+from . import _core, moo, qd
 from ._core import (
     OBJECTIVES,
     Body,
@@ -72,6 +74,7 @@ from .locomotion import (
     phase_spread,
     tries_per_viable,
 )
+from .moo import CRITERIA, Criterion, Nsga2, Solution, run_nsga2
 from .pipeline import build_body, config_path, develop, documented, load_config, paper_configs, swim
 from .qd import (
     DESCRIPTORS,
@@ -195,6 +198,13 @@ __all__ = [
     "Elite",
     "QD_HISTORY_DTYPE",
     "run_map_elites",
+    # several objectives
+    "moo",
+    "Nsga2",
+    "Criterion",
+    "CRITERIA",
+    "Solution",
+    "run_nsga2",
     # control
     "SwimEnv",
     "SWIM_ENV_ID",

@@ -26,6 +26,7 @@ LIBRARY_MODULES = {
     "experiment",
     "explore",
     "locomotion",
+    "moo",
     "pipeline",
     "plot",
     "protrusion",

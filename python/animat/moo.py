@@ -1,0 +1,1141 @@
+"""Several objectives: NSGA-II over a vector of objectives (distance against actuation work, ...).
+
+The GA and MAP-Elites rank a genome by one number. Here an objective is a **vector**: each genome is
+scored by several **criteria** (how far it swims, how much positive work its actuators spend, ...),
+each maximised or minimised, and the search keeps the genomes no other beats on every criterion at
+once, the **Pareto front**. NSGA-II (Deb, Pratap, Agarwal & Meyarivan 2002) does it with a fast
+non-dominated sort, a crowding distance, a binary tournament on (rank, crowding) and an elitist
+(mu + lambda) selection; the offspring are varied by the genome's own operators (the GA's crossover
+with probability ``crossover_fraction``, then its mutation).
+
+- :data:`CRITERIA`: the named criteria: ``fitness`` (the config's ``evaluation.objective``), every row
+  of the engine's objective table (:data:`animat.OBJECTIVES`: ``distance``, ``distance_per_size``, ...)
+  and the numeric fields of :class:`animat.EvaluationResult` (``actuation_work_positive``,
+  ``cell_count``, ``max_speed``, ...). :class:`Criterion` also wraps your own ``f(evaluation) -> float``.
+- :func:`non_dominated_sort`, :func:`crowding_distance`, :func:`hypervolume`, :func:`dominates`: the
+  pieces, on plain arrays.
+- :class:`Nsga2`: ask/tell, ``step()``, ``front()``, ``history``, ``checkpoint()`` / :meth:`Nsga2.restore`.
+- :func:`run_nsga2`: a run directory (``config.toml``, ``history.csv``, ``front/gen_*.csv``,
+  ``checkpoint.json``) that resumes.
+
+**Objectives.** A sequence of: a name (``"distance"``: the table's default sense), a ``(name,
+sense)`` or ``(function, sense)`` pair, or a :class:`Criterion`; a sense is ``"max"`` or ``"min"``
+(``"maximize"``, ``"minimize"`` too). Distance against positive actuation work::
+
+    animat.Nsga2(config, [("distance", "max"), ("actuation_work_positive", "min")])
+
+Every swim meters its actuation work (the effect ``springs`` does, in every scene: docs/worlds.md),
+so no setting is needed for the work criteria.
+
+**Determinism.** Every random number of generation g, offspring i is drawn from
+``animat.Rng.derive(seed, g, i)`` (the tournaments, the crossover draw, the crossover and the
+mutation), and the sort, the crowding distance and the selection are exact functions of the
+objective values with fixed tie rules, so a run is a function of (config, objectives, seed,
+population, crossover_fraction, reference_point) alone: identical for any thread count, and across
+checkpoint and resume.
+
+**Feasible.** A candidate is **feasible** when its genome is viable, its swim stable and valid (no
+simulator exploit: the engine scores those 0) and every criterion is a finite number. Only feasible
+candidates are sorted into fronts; the others share the worst rank (below every front, crowding 0):
+they are never on the front, and they stay in the population only when fewer than ``population``
+candidates are feasible. So do **copies**: a candidate whose genome equals one already in the
+population or earlier in its batch (mutation leaves some offspring unchanged) adds no point to the
+front and would only crowd it with duplicates (Deb et al. do not treat them; pymoo's NSGA-II drops
+duplicate offspring too, before it evaluates them).
+
+**The exploit guard** (``evaluation.reference_check``, as for the GA and MAP-Elites): ``"off"``:
+nothing more. ``"record"`` (the default): at the end of every ``tell()``, every genome on the front
+that has no reference yet is evaluated again at the reference step (``physics.substeps ×
+evaluation.reference_substeps``); its criteria there are stored with it (``Solution.reference``) and
+``history["disagreements"]`` counts the front's genomes for which one criterion and its reference
+disagree (:func:`animat.reference_disagrees`; a reference swim that is not valid disagrees).
+``"select"``: every feasible candidate is evaluated at the reference step *before* the selection (a
+copy takes its original's reference), and the selection compares the **reference** values
+(``Solution.objectives``; the step's own are ``Solution.measured``): a candidate whose swim exploits
+the coarse step, or is not valid at the reference step, never reaches the front. Under ``"record"``
+and ``"off"`` the objectives are the measured values.
+
+Example::
+
+    nsga = animat.Nsga2(config, [("distance", "max"), ("actuation_work_positive", "min")], population=20)
+    for _ in range(10):
+        nsga.step()                                     # ask, evaluate, tell
+    for s in nsga.front():
+        print(s.objectives)                             # (distance, work) of every Pareto-optimal genome
+    print(nsga.history["hypervolume"])
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import shutil
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, cast
+
+import numpy as np
+
+from . import _core
+from .qd import _comparable, _reference_config, _write_atomic
+
+__all__ = [
+    "Criterion",
+    "CRITERIA",
+    "Solution",
+    "Nsga2",
+    "dominates",
+    "non_dominated_sort",
+    "crowding_distance",
+    "hypervolume",
+    "history_dtype",
+    "run_nsga2",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+#: Version tag of :meth:`Nsga2.checkpoint`.
+CHECKPOINT_FORMAT = "animat.nsga2/1"
+
+_SENSES = {"max": "max", "maximize": "max", "maximise": "max", "min": "min", "minimize": "min", "minimise": "min"}
+
+
+def _sense(sense: Any, name: str) -> str:
+    s = _SENSES.get(sense) if isinstance(sense, str) else None
+    if s is None:
+        raise ValueError(f"objective {name!r}: the sense is 'max' or 'min' (or 'maximize', 'minimize'), got {sense!r}")
+    return s
+
+
+# --- criteria -------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """One objective of a multi-objective search: a number computed from a genome's evaluation, and
+    whether larger (``sense="max"``) or smaller (``"min"``) is better.
+
+    ``function(evaluation) -> float``: ``evaluation`` is the genome's :class:`animat.EvaluationResult`
+    (from :func:`animat.evaluate`), called for viable, stable and valid swims only. It must be a pure
+    function of it (the run's determinism rests on it); NaN or an infinity means "no value" (the
+    candidate is not feasible). ``name`` names its columns in ``history.csv`` and the front's CSV: an
+    identifier. (Not :class:`animat.Objective`, the GA's one objective, nor
+    :class:`animat.ObjectiveSpec`, a row of the engine's table.)
+
+    Your own: ``Criterion("speed", "max", lambda e: e.max_speed)``, or the pair ``(function, "max")``
+    (named by the function's ``__name__``) wherever objectives are given. A table entry with another
+    sense: ``CRITERIA["max_speed"].with_sense("min")`` or the pair ``("max_speed", "min")``.
+    """
+
+    name: str
+    sense: str
+    function: Callable[[Any], float] = field(repr=False, compare=False)
+    meaning: str = ""
+    # Table entries compute from (evaluation, genome, config): the engine's rows read the config's
+    # evaluation parameters and, for distance_per_size, the body.
+    _of: Optional[Callable[[Any, Any, Any], float]] = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(
+                f"Criterion: the name must be an identifier (it names CSV columns), got {self.name!r}: "
+                "name a function with Criterion('name', 'max', function)"
+            )
+        # "" only in the table: a field with no natural sense (say which: ("max_speed", "max")).
+        object.__setattr__(self, "sense", _sense(self.sense, self.name) if self.sense else "")
+        if not callable(self.function):
+            raise TypeError(f"Criterion {self.name!r}: function must be callable")
+
+    @property
+    def maximize(self) -> bool:
+        """True when larger is better."""
+        return self.sense == "max"
+
+    def with_sense(self, sense: str) -> Criterion:
+        """The same criterion with another sense."""
+        return replace(self, sense=_sense(sense, self.name))
+
+    def __call__(self, evaluation: Any, genome: Any = None, config: Any = None) -> float:
+        """Its value for an evaluation (``genome`` and ``config``: for the table's engine rows, see
+        :data:`CRITERIA`)."""
+        if self._of is not None:
+            return float(self._of(evaluation, genome, config))
+        return float(self.function(evaluation))
+
+
+def _engine_row(spec: Any) -> Criterion:
+    name = str(spec.name)
+
+    def of(evaluation: Any, genome: Any, config: Any) -> float:
+        cfg = _core.Config() if config is None else config
+        if str(cfg["evaluation.objective"]) == name:
+            return float(evaluation.fitness)  # the engine scored it: exactly its value
+        if not spec.one_swim:
+            raise ValueError(
+                f"objective {name!r} needs one swim per source direction: set evaluation.objective = {name!r}"
+            )
+        dx, dy = (float(v) for v in evaluation.displacement)
+        distance = math.sqrt(dx * dx + dy * dy) if evaluation.valid else 0.0  # the engine's SwimResult.distance
+        length = 0.0
+        if spec.needs_body:
+            if genome is None:
+                raise ValueError(f"objective {name!r} reads the body: pass the genome")
+            from .pipeline import build_body
+
+            length = float(_core.body_length(build_body(_core.develop(genome, cfg), config=cfg)))
+        return float(
+            _core.objective_value(
+                name,
+                distance,
+                dx,
+                dy,
+                float(evaluation.simulated_time),
+                length,
+                float(evaluation.actuation_work_positive),
+                float(evaluation.source_progress),
+                cfg,
+            )
+        )
+
+    def function(evaluation: Any) -> float:
+        return of(evaluation, None, None)
+
+    function.__name__ = name
+    return Criterion(name, "max", function, f"{spec.meaning} (the engine's objective {name!r})", of)
+
+
+# The numeric fields of EvaluationResult that are functions of the genome and the config (not the
+# wall-clock seconds), with the sense that is better where one is (the work an actuator spends).
+_FIELDS: Tuple[Tuple[str, str], ...] = (
+    ("actuation_work_positive", "min"),
+    ("actuation_work_absolute", "min"),
+    ("actuation_work", "min"),
+    ("cell_count", ""),
+    ("spring_count", ""),
+    ("region_count", ""),
+    ("skin_edge_count", ""),
+    ("development_steps", ""),
+    ("simulated_time", ""),
+    ("max_speed", ""),
+    ("max_step_displacement", ""),
+    ("max_stretch", ""),
+    ("min_stretch", ""),
+    ("max_kinetic_energy", ""),
+    ("final_kinetic_energy", ""),
+    ("max_kinetic_energy_per_cell", ""),
+    ("min_area_ratio", ""),
+    ("collisions", ""),
+    ("collisions_inelastic", ""),
+    ("drag_limited", ""),
+    ("ground_contacts", ""),
+    ("ground_slips", ""),
+    ("airborne_steps", ""),
+    ("source_progress", ""),
+    ("grn_updates", ""),
+)
+
+
+def _field(name: str, sense: str) -> Criterion:
+    def function(evaluation: Any) -> float:
+        return float(getattr(evaluation, name))
+
+    function.__name__ = name
+    doc = (getattr(_core.EvaluationResult, name).__doc__ or "").strip().split("\n")[0]
+    return Criterion(name, sense, function, f"{doc} (EvaluationResult.{name})")
+
+
+def _fitness(evaluation: Any) -> float:
+    return float(evaluation.fitness)
+
+
+#: The named criteria, name -> :class:`Criterion`: ``fitness`` (the config's ``evaluation.objective``,
+#: maximised), the engine's objective table (:data:`animat.OBJECTIVES`, maximised: scored from the
+#: evaluation with :func:`animat.objective_value`, exactly as the engine scores them; the config's own
+#: objective is ``evaluation.fitness``; ``chemotaxis`` only when it is the config's objective), and
+#: the numeric fields of :class:`animat.EvaluationResult` (the actuation work minimised; the others
+#: have no default sense: give one, ``("max_speed", "max")``).
+CRITERIA: Dict[str, Criterion] = {
+    "fitness": Criterion("fitness", "max", _fitness, "the config's evaluation.objective (EvaluationResult.fitness)"),
+    **{str(spec.name): _engine_row(spec) for spec in _core.objectives()},
+    **{name: _field(name, sense) for name, sense in _FIELDS},
+}
+
+#: The engine's objectives that one swim does not decide (chemotaxis): only as the config's own.
+_SEVERAL_SWIMS = frozenset(str(spec.name) for spec in _core.objectives() if not spec.one_swim)
+
+CriterionLike = Union[str, Criterion, Tuple[Any, str]]
+
+
+def _criterion(spec: CriterionLike) -> Criterion:
+    if isinstance(spec, Criterion):
+        return spec
+    if isinstance(spec, str):
+        if spec not in CRITERIA:
+            raise ValueError(f"no objective named {spec!r}; the names are {', '.join(CRITERIA)}")
+        return CRITERIA[spec]
+    if isinstance(spec, tuple) and len(spec) == 2:
+        what: Any = spec[0]
+        if isinstance(what, str):
+            return _criterion(what).with_sense(spec[1])
+        if callable(what):
+            name = getattr(what, "__name__", None) or type(what).__name__
+            function = cast(Callable[[Any], float], what)
+            return Criterion(name, _sense(spec[1], name), function, f"{name} (a Python function)")
+    if callable(spec):
+        raise ValueError("an objective function needs a sense: pass (function, 'max') or (function, 'min')")
+    raise TypeError(
+        f"an objective is a name, a Criterion or a (name or function, 'max' or 'min') pair, got {spec!r:.80}"
+    )
+
+
+def _criteria(specs: Iterable[CriterionLike]) -> Tuple[Criterion, ...]:
+    if isinstance(specs, (str, Criterion)):
+        specs = [specs]
+    out = tuple(_criterion(s) for s in specs)
+    if not out:
+        raise ValueError("NSGA-II needs at least one objective")
+    names = [c.name for c in out]
+    if len(set(names)) != len(names):
+        raise ValueError(f"objective names must be distinct, got {names}")
+    for c in out:
+        if not c.sense:
+            raise ValueError(
+                f"objective {c.name!r} has no default sense: pass ({c.name!r}, 'max') or ({c.name!r}, 'min')"
+            )
+    return out
+
+
+# --- the pieces: dominance, fronts, crowding, hypervolume -----------------------------------------
+
+
+def _points(points: Any) -> np.ndarray:
+    p = np.asarray(points, dtype=np.float64)
+    if p.ndim == 1:
+        p = p.reshape(-1, 1) if p.size else p.reshape(0, 0)
+    if p.ndim != 2:
+        raise ValueError(f"points: one row of objective values per point, got an array of shape {p.shape}")
+    return p
+
+
+def _minimized(points: Any, senses: Optional[Sequence[str]]) -> np.ndarray:
+    p = _points(points)
+    if senses is None:
+        return p
+    if len(senses) != p.shape[1]:
+        raise ValueError(f"{len(senses)} senses for {p.shape[1]} objectives")
+    signs = np.array([-1.0 if _sense(s, f"#{j}") == "max" else 1.0 for j, s in enumerate(senses)])
+    return p * signs
+
+
+def dominates(a: Sequence[float], b: Sequence[float], senses: Optional[Sequence[str]] = None) -> bool:
+    """Whether ``a`` Pareto-dominates ``b``: no worse in every objective and better in one. ``senses``:
+    ``"max"`` or ``"min"`` per objective (default: all minimised)."""
+    p = _minimized([list(a), list(b)], senses)
+    return bool((p[0] <= p[1]).all() and (p[0] < p[1]).any())
+
+
+def non_dominated_sort(points: Any, senses: Optional[Sequence[str]] = None) -> List[List[int]]:
+    """The fronts of ``points`` (one row of objective values per point; ``senses``: ``"max"`` or
+    ``"min"`` per objective, default all minimised), best first: front 0 holds the points no other
+    dominates, front k those dominated only by points of fronts < k (Deb et al.'s fast non-dominated
+    sort). Each front lists row indices in increasing order. Equal points are in the same front. A
+    row with a NaN is in no front (NSGA-II ranks such candidates last)."""
+    p = _minimized(points, senses)
+    rows = np.flatnonzero(~np.isnan(p).any(axis=1)) if p.size else np.arange(len(p))
+    q = p[rows]
+    if len(q) == 0:
+        return []
+    # better[i, j]: row i dominates row j.
+    better: np.ndarray = np.logical_and(
+        (q[:, None, :] <= q[None, :, :]).all(axis=2), (q[:, None, :] < q[None, :, :]).any(axis=2)
+    )
+    count = better.sum(axis=0)  # how many rows dominate each row
+    fronts: List[List[int]] = []
+    current = np.flatnonzero(count == 0)
+    while len(current):
+        fronts.append([int(rows[i]) for i in current])
+        count = count - better[current].sum(axis=0)
+        count[current] = -1
+        current = np.flatnonzero(count == 0)
+    return fronts
+
+
+def crowding_distance(points: Any) -> np.ndarray:
+    """Deb et al.'s crowding distance of every point of one front (rows of objective values): for
+    each objective, the points are ordered by their value (a stable sort: equal values in row order),
+    the first and the last get infinity and every other one adds ``(next − previous) / (max − min)``
+    (nothing when max = min); the objectives are added in order. Fronts of one or two points are all
+    infinity. The sense of an objective does not change it."""
+    p = _points(points)
+    n = len(p)
+    d = np.zeros(n)
+    if n <= 2:
+        d[:] = np.inf
+        return d
+    for j in range(p.shape[1]):
+        order = np.argsort(p[:, j], kind="stable")
+        v = p[order, j]
+        span = v[-1] - v[0]
+        if span > 0 and math.isfinite(span):
+            d[order[1:-1]] += (v[2:] - v[:-2]) / span
+        d[order[0]] = d[order[-1]] = np.inf
+    return d
+
+
+def hypervolume(points: Any, reference: Sequence[float], senses: Optional[Sequence[str]] = None) -> float:
+    """The hypervolume of ``points`` against ``reference`` (the volume they dominate and the reference
+    point bounds), for one or two objectives (``senses`` as for :func:`non_dominated_sort`). Only the
+    points better than the reference in every objective count (a point on its boundary adds nothing);
+    no such point: 0. Two objectives: the sum of the staircase's rectangles, ordered by the first
+    objective, taken with ``math.fsum``. ValueError for three or more objectives."""
+    p = _minimized(points, senses)
+    r = _minimized([list(reference)], senses)[0]
+    m = len(r)
+    if p.size and p.shape[1] != m:
+        raise ValueError(f"hypervolume: {p.shape[1]} objectives and a reference point of {m}")
+    if m not in (1, 2):
+        raise ValueError(f"hypervolume: one or two objectives, got {m}")
+    if not np.isfinite(r).all():
+        raise ValueError(f"hypervolume: the reference point must be finite, got {list(reference)}")
+    if not p.size:
+        return 0.0
+    p = p[np.isfinite(p).all(axis=1) & (p < r).all(axis=1)]
+    if not len(p):
+        return 0.0
+    if m == 1:
+        return float(r[0] - p[:, 0].min())
+    order = np.lexsort((p[:, 1], p[:, 0]))
+    terms = []
+    top = r[1]
+    for x, y in p[order]:
+        if y < top:
+            terms.append((r[0] - x) * (top - y))
+            top = y
+    return math.fsum(terms)
+
+
+# --- NSGA-II --------------------------------------------------------------------------------------
+
+Floats = Tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A genome of the population, with its objective values.
+
+    Attributes:
+        genome: the :class:`animat.Genome`.
+        objectives: the values the selection compares, one per criterion in order: the measured
+            values, or under ``reference_check = "select"`` the reference values.
+        measured: the criteria of its evaluation at the run's step (what was told).
+        reference: the criteria at the exploit guard's reference step (NaN where that swim was not
+            valid); None when it was not evaluated there.
+        generation: the generation that made it.
+        feasible: viable, stable, valid, every objective finite (see the module docstring).
+        rank: its front when it was selected (0 = the first; infeasible or a copy: one past the last
+            front).
+        crowding: its crowding distance in that front (infinity at the ends; 0 when infeasible or a copy).
+    """
+
+    genome: Any
+    objectives: Floats
+    measured: Floats
+    reference: Optional[Floats]
+    generation: int
+    feasible: bool
+    rank: int = -1
+    crowding: float = float("nan")
+
+
+def history_dtype(names: Sequence[str]) -> np.dtype:
+    """The columns of :attr:`Nsga2.history` and ``history.csv`` for objectives named ``names``:
+    ``generation``, ``evaluations`` (candidates told so far; reference swims not counted),
+    ``front_size``, ``hypervolume`` (NaN until the reference point is set, and for three or more
+    objectives), ``best_<name>`` for every objective (the best value on the front, in its sense;
+    NaN when the front is empty), ``feasible`` (in the population), ``discarded`` (infeasible
+    candidates of this generation), ``copies`` (candidates of this generation whose genome was in the
+    population or earlier in the batch), ``reference_evaluations`` (the exploit guard's swims so far),
+    ``disagreements`` (front genomes whose reference disagrees)."""
+    return np.dtype(
+        [
+            ("generation", np.int64),
+            ("evaluations", np.int64),
+            ("front_size", np.int64),
+            ("hypervolume", np.float64),
+            *[(f"best_{n}", np.float64) for n in names],
+            ("feasible", np.int64),
+            ("discarded", np.int64),
+            ("copies", np.int64),
+            ("reference_evaluations", np.int64),
+            ("disagreements", np.int64),
+        ]
+    )
+
+
+def _copies(pool: Sequence[Solution]) -> List[int]:
+    """The members of ``pool`` whose genome equals that of an earlier member."""
+    seen = set()
+    out = []
+    for i, s in enumerate(pool):
+        key = s.genome.to_json()
+        if key in seen:
+            out.append(i)
+        seen.add(key)
+    return out
+
+
+def _evaluate_results(genomes: Sequence[Any], config: Any, threads: int) -> List[Any]:
+    """An :class:`animat.EvaluationResult` per genome, in order: ``animat.evaluate`` (the GIL released
+    while it swims) on ``threads`` Python threads (0 = all cores). Each is a function of its genome and
+    the config alone, so the list is the same for any thread count."""
+    n = threads if threads > 0 else (os.cpu_count() or 1)
+    if n == 1 or len(genomes) <= 1:
+        return [_core.evaluate(g, config) for g in genomes]
+    _core.warm_up_box2d()
+    with ThreadPoolExecutor(max_workers=min(n, len(genomes))) as pool:
+        return list(pool.map(lambda g: _core.evaluate(g, config), genomes))
+
+
+def _enc(x: float) -> Any:
+    """A float for JSON (allow_nan=False): NaN as null, infinities as strings."""
+    if math.isnan(x):
+        return None
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return float(x)
+
+
+def _dec(x: Any) -> float:
+    return float("nan") if x is None else float(x)
+
+
+def _floats(values: Optional[Iterable[Any]]) -> Optional[Floats]:
+    return None if values is None else tuple(_dec(v) for v in values)
+
+
+class Nsga2:
+    """NSGA-II driven by ``ask``/``tell`` (or :meth:`step`) over several objectives (see the module
+    docstring for the objectives, what is feasible and the exploit guard).
+
+    ``ask()`` returns the candidates of generation g = ``generation + 1``: for generation 0,
+    ``population`` random viable genomes, genome i drawn by
+    ``animat.Genome.random_viable(animat.Rng.derive(seed, 0, i), config)``; afterwards
+    ``population`` offspring, offspring i varied with the stream ``rng = animat.Rng.derive(seed, g,
+    i)``: a parent by binary tournament (two members ``population[rng.integer(0, n - 1)]``, the one
+    of lower rank wins, then the one of larger crowding distance, then the first drawn); with
+    probability ``crossover_fraction`` (``rng.uniform() < crossover_fraction``) a second parent by
+    another tournament and ``parent.crossover(other, rng, mutation.crossover_points)``; then
+    ``.mutate(rng, config)``. Asking again before ``tell`` returns the same genomes.
+
+    ``tell(results)`` takes one result per asked genome, in order: an :class:`animat.EvaluationResult`
+    (``animat.evaluate``; its criteria are computed here), the objective values themselves (a
+    sequence of floats, one per objective; a NaN: not feasible) or None (not viable). It then selects
+    the next population from the current one and the candidates, parents first (Deb's (mu + lambda)
+    selection): whole fronts while they fit, then the rest of the front that does not fit by
+    decreasing crowding distance (equal distances: parents first, then in ``ask()`` order), then, if
+    fewer than ``population`` are feasible and distinct, copies and infeasible ones in that order. The new
+    population keeps that order, and each member the rank and crowding distance it had in the
+    selection (those of the fronts of parents and candidates together, as in Deb et al.).
+
+    Example::
+
+        nsga = animat.Nsga2(config, [("distance", "max"), ("actuation_work_positive", "min")], population=16)
+        while nsga.generation < 5:
+            genomes = nsga.ask()
+            nsga.tell([animat.evaluate(g, config) for g in genomes])     # or nsga.step()
+        front = nsga.front()
+
+    Args:
+        config: the run's :class:`animat.Config` (default: the embedded paper setting). Its
+            ``evaluation.objective`` must be a built-in (the ``fitness`` criterion).
+        objectives: the criteria (see the module docstring).
+        population: the population size N, also the offspring per generation (default
+            ``evolution.population``).
+        seed: the run's seed (default ``evolution.seed``; it is written into the config).
+        crossover_fraction: share of offspring made by crossover (default ``evolution.crossover_fraction``).
+        reference_point: the hypervolume's reference point, one value per objective, in the
+            objectives' units (e.g. ``(0.0, 1e5)``: no distance, a work of 1e5). Default: the worst
+            value of every objective over the feasible candidates of the first generation that has
+            any (normally generation 0), fixed then and saved with the run.
+        threads: evaluation threads of :meth:`step` and the exploit guard (default ``evolution.threads``;
+            0 = all cores). The run does not depend on it.
+    """
+
+    def __init__(
+        self,
+        config: Any,
+        objectives: Iterable[CriterionLike],
+        *,
+        population: Optional[int] = None,
+        seed: Optional[int] = None,
+        crossover_fraction: Optional[float] = None,
+        reference_point: Optional[Sequence[float]] = None,
+        threads: Optional[int] = None,
+    ) -> None:
+        self.criteria: Tuple[Criterion, ...] = _criteria(objectives)
+        self._config = _core.Config() if config is None else config.copy()
+        objective = str(self._config["evaluation.objective"])
+        if objective.startswith("python:"):
+            raise ValueError(
+                f"Nsga2: evaluation.objective = {objective!r} is a Python objective; NSGA-II evaluates with "
+                "animat.evaluate: make your function an objective, (function, 'max')"
+            )
+        for c in self.criteria:
+            if c._of is not None and c.name in _SEVERAL_SWIMS and c.name != objective:
+                raise ValueError(
+                    f"Nsga2: objective {c.name!r} needs one swim per source direction: set "
+                    f"evaluation.objective = {c.name!r} in the config"
+                )
+        if seed is not None:
+            self._config["evolution.seed"] = int(seed)
+        if threads is not None:
+            self._config["evolution.threads"] = int(threads)
+        self.seed = int(self._config["evolution.seed"])
+        self.population_size = int(self._config["evolution.population"]) if population is None else int(population)
+        cf = float(self._config["evolution.crossover_fraction"]) if crossover_fraction is None else crossover_fraction
+        self.crossover_fraction = float(cf)
+        if self.population_size < 1:
+            raise ValueError(f"Nsga2: population must be >= 1, got {self.population_size}")
+        if not 0.0 <= self.crossover_fraction <= 1.0:
+            raise ValueError(f"Nsga2: crossover_fraction must be in [0, 1], got {self.crossover_fraction}")
+        self._reference_point: Optional[Floats] = None
+        self._reference_point_given = reference_point is not None
+        if reference_point is not None:
+            point = tuple(float(x) for x in reference_point)
+            if len(point) != len(self.criteria) or not all(math.isfinite(x) for x in point):
+                raise ValueError(
+                    f"Nsga2: reference_point needs {len(self.criteria)} finite values (one per objective), "
+                    f"got {list(reference_point)}"
+                )
+            self._reference_point = point
+        self._guard = str(self._config["evaluation.reference_check"])
+        self._generation = -1
+        self._evaluations = 0
+        self._reference_evaluations = 0
+        self._history: List[Tuple[Any, ...]] = []
+        self._population: List[Solution] = []
+        self._asked: Optional[List[Any]] = None
+
+    # --- names ------------------------------------------------------------------------------------
+    @property
+    def names(self) -> Tuple[str, ...]:
+        """The objectives' names, in order."""
+        return tuple(c.name for c in self.criteria)
+
+    @property
+    def senses(self) -> Tuple[str, ...]:
+        """``"max"`` or ``"min"`` per objective."""
+        return tuple(c.sense for c in self.criteria)
+
+    @property
+    def reference_point(self) -> Optional[Floats]:
+        """The hypervolume's reference point (None until it is set; see the class docstring)."""
+        return self._reference_point
+
+    @property
+    def history_dtype(self) -> np.dtype:
+        """:func:`history_dtype` of this run's objectives."""
+        return history_dtype(self.names)
+
+    # --- the loop ---------------------------------------------------------------------------------
+    def ask(self) -> List[Any]:
+        """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
+        if self._asked is None:
+            self._asked = self._draw(self._generation + 1)
+        return list(self._asked)
+
+    def _draw(self, g: int) -> List[Any]:
+        cfg = self._config
+        n = self.population_size
+        if not self._population:
+            return [_core.Genome.random_viable(_core.Rng.derive(self.seed, g, i), cfg)[0] for i in range(n)]
+        points = int(cfg["mutation.crossover_points"])
+        out = []
+        for i in range(n):
+            rng = _core.Rng.derive(self.seed, g, i)
+            child = self._tournament(rng).genome
+            if rng.uniform() < self.crossover_fraction:
+                other = self._tournament(rng).genome
+                child = child.crossover(other, rng, points)
+            out.append(child.mutate(rng, cfg))
+        return out
+
+    def _tournament(self, rng: Any) -> Solution:
+        top = len(self._population) - 1
+        a = self._population[rng.integer(0, top)]
+        b = self._population[rng.integer(0, top)]
+        if b.rank < a.rank or (b.rank == a.rank and b.crowding > a.crowding):
+            return b
+        return a
+
+    def _measure(self, genome: Any, result: Any, config: Any) -> Tuple[Floats, bool]:
+        m = len(self.criteria)
+        if result is None:
+            return (float("nan"),) * m, False
+        if isinstance(result, _core.EvaluationResult):
+            if not (result.viable and result.stable and result.valid):
+                return (float("nan"),) * m, False
+            values = tuple(c(result, genome, config) for c in self.criteria)
+        elif isinstance(result, _core.Fitness):
+            raise TypeError(
+                "a Fitness holds one number: tell an animat.EvaluationResult (animat.evaluate) or the "
+                f"{m} objective values"
+            )
+        elif isinstance(result, (str, bytes)) or not hasattr(result, "__len__"):
+            raise TypeError(
+                "a result is an animat.EvaluationResult, a sequence of objective values or None, got "
+                f"{type(result).__name__}"
+            )
+        else:
+            values = tuple(float(x) for x in np.asarray(result, dtype=np.float64).reshape(-1))
+            if len(values) != m:
+                raise ValueError(f"{len(values)} values for the {m} objectives {self.names}")
+        return values, all(math.isfinite(x) for x in values)
+
+    def tell(self, results: Sequence[Any]) -> Any:
+        """The result of every genome of the last ``ask()``, in order (see the class docstring);
+        completes the generation and returns its history row (a numpy record)."""
+        if self._asked is None:
+            raise RuntimeError("Nsga2.tell: nothing was asked (call ask() first)")
+        genomes = self._asked
+        if len(results) != len(genomes):
+            raise ValueError(f"Nsga2.tell: {len(results)} results for the {len(genomes)} genomes asked")
+        measured: List[Tuple[Floats, bool]] = []
+        for i, (genome, r) in enumerate(zip(genomes, results)):
+            try:
+                measured.append(self._measure(genome, r, self._config))
+            except (TypeError, ValueError) as e:
+                raise type(e)(f"Nsga2.tell: value {i} ({r!r:.60}): {e}") from None
+        g = self._generation + 1
+        keys = [genome.to_json() for genome in genomes]
+        references: List[Optional[Floats]] = [None] * len(genomes)
+        if self._guard == "select":
+            # A copy of a genome seen before (a parent, an earlier candidate) has its reference: the same swim.
+            known: Dict[str, Optional[Floats]] = {}
+            for s in self._population:
+                known.setdefault(s.genome.to_json(), s.reference)
+            first: List[int] = []
+            for i, (key, (_, ok)) in enumerate(zip(keys, measured)):
+                if ok and key not in known:
+                    known[key] = None
+                    first.append(i)
+            for i, ref in zip(first, self._references([genomes[i] for i in first])):
+                known[keys[i]] = ref
+            references = [known.get(key) if ok else None for key, (_, ok) in zip(keys, measured)]
+        candidates = []
+        for genome, (values, ok), ref in zip(genomes, measured, references):
+            if self._guard == "select":
+                objectives = ref if ref is not None else values
+                ok = ok and ref is not None and all(math.isfinite(x) for x in ref)
+            else:
+                objectives = values
+            candidates.append(Solution(genome, objectives, values, ref, g, ok))
+        if self._reference_point is None:
+            feasible = [s.objectives for s in candidates if s.feasible]
+            if feasible:
+                worst = np.array(feasible)
+                self._reference_point = tuple(
+                    float(worst[:, j].min() if c.maximize else worst[:, j].max()) for j, c in enumerate(self.criteria)
+                )
+        pool = self._population + candidates
+        copies = _copies(pool)
+        population = self._select(pool, self.population_size, copies)
+        if self._guard == "record":
+            pending = [k for k, s in enumerate(population) if s.rank == 0 and s.feasible and s.reference is None]
+            for k, ref in zip(pending, self._references([population[k].genome for k in pending])):
+                population[k] = replace(population[k], reference=ref)
+        self._population = population
+        self._evaluations += len(genomes)
+        self._generation = g
+        self._asked = None
+        discarded = sum(1 for s in candidates if not s.feasible)
+        self._history.append(self._row(g, discarded, sum(1 for i in copies if i >= len(pool) - len(candidates))))
+        return self.history[-1]
+
+    def _select(self, pool: List[Solution], n: int, copies: Iterable[int] = ()) -> List[Solution]:
+        copied = set(copies)
+        feasible = [i for i, s in enumerate(pool) if s.feasible and i not in copied]
+        values = np.array([pool[i].objectives for i in feasible], dtype=np.float64).reshape(-1, len(self.criteria))
+        fronts = non_dominated_sort(values, self.senses)
+        rank: Dict[int, int] = {}
+        crowding: Dict[int, float] = {}
+        chosen: List[int] = []
+        for k, front in enumerate(fronts):
+            if len(chosen) >= n:
+                break
+            members = [feasible[i] for i in front]
+            d = crowding_distance(values[front])
+            for i, x in zip(members, d):
+                rank[i], crowding[i] = k, float(x)
+            if len(chosen) + len(members) <= n:
+                chosen += members
+            else:
+                order = sorted(range(len(members)), key=lambda j: (-d[j], members[j]))
+                chosen += [members[j] for j in order[: n - len(chosen)]]
+        for i, s in enumerate(pool):
+            if not s.feasible or i in copied:
+                rank[i], crowding[i] = len(fronts), 0.0
+                if len(chosen) < n:
+                    chosen.append(i)
+        return [replace(pool[i], rank=rank[i], crowding=crowding[i]) for i in sorted(chosen)]
+
+    def _references(self, genomes: List[Any]) -> List[Floats]:
+        if not genomes:
+            return []
+        ref = _reference_config(self._config)
+        results = _evaluate_results(genomes, ref, int(self._config["evolution.threads"]))
+        self._reference_evaluations += len(genomes)
+        return [self._measure(g, r, ref)[0] for g, r in zip(genomes, results)]
+
+    def _row(self, g: int, discarded: int, copies: int) -> Tuple[Any, ...]:
+        front = self.front()
+        hv = float("nan")
+        if self._reference_point is not None and len(self.criteria) <= 2:
+            hv = hypervolume([s.objectives for s in front], self._reference_point, self.senses)
+        best = []
+        for j, c in enumerate(self.criteria):
+            column = [s.objectives[j] for s in front]
+            best.append(float("nan") if not column else (max(column) if c.maximize else min(column)))
+        cfg = self._config
+        disagreements = sum(
+            1
+            for s in front
+            if s.reference is not None
+            and any(math.isnan(r) or _core.reference_disagrees(v, r, cfg) for v, r in zip(s.measured, s.reference))
+        )
+        return (
+            g,
+            self._evaluations,
+            len(front),
+            hv,
+            *best,
+            sum(1 for s in self._population if s.feasible),
+            discarded,
+            copies,
+            self._reference_evaluations,
+            disagreements,
+        )
+
+    def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
+        """Ask, evaluate (default: ``animat.evaluate`` on the config's threads: the GIL is released
+        while each genome swims) and tell one generation; returns its history row."""
+        genomes = self.ask()
+        if evaluate is None:
+            results: Sequence[Any] = _evaluate_results(genomes, self._config, int(self._config["evolution.threads"]))
+        else:
+            results = evaluate(genomes)
+        return self.tell(list(results))
+
+    # --- state ------------------------------------------------------------------------------------
+    def front(self) -> List[Solution]:
+        """The first front of the current population: its feasible members no other member dominates,
+        ordered by the first objective, best first (then the second ..., then population order)."""
+        members = [s for s in self._population if s.feasible and s.rank == 0]
+        signs = [-1.0 if c.maximize else 1.0 for c in self.criteria]
+        return sorted(members, key=lambda s: tuple(x * sign for x, sign in zip(s.objectives, signs)))
+
+    def front_values(self) -> np.ndarray:
+        """:meth:`front`'s objectives as a (k, objectives) float64 array."""
+        return np.array([s.objectives for s in self.front()], dtype=np.float64).reshape(-1, len(self.criteria))
+
+    @property
+    def population(self) -> List[Solution]:
+        """The current population (a list of :class:`Solution`, in selection order)."""
+        return list(self._population)
+
+    @property
+    def config(self) -> Any:
+        """The run's :class:`animat.Config` (a copy)."""
+        return self._config.copy()
+
+    @property
+    def generation(self) -> int:
+        """The last completed generation (-1 before the first ``tell``)."""
+        return self._generation
+
+    @property
+    def evaluations(self) -> int:
+        """Candidates told so far."""
+        return self._evaluations
+
+    @property
+    def history(self) -> np.recarray:
+        """One row per generation (:func:`history_dtype`): ``h["hypervolume"]``, ``h[-1].front_size`` ..."""
+        return np.array(self._history, dtype=self.history_dtype).view(np.recarray)
+
+    def history_frame(self) -> Any:
+        """:attr:`history` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
+        try:
+            import pandas as pd  # type: ignore[import-not-found]
+        except ImportError:
+            raise ImportError("history_frame needs pandas: pip install pandas") from None
+
+        return pd.DataFrame.from_records(np.asarray(self.history).view(np.ndarray))
+
+    def write_front(self, path: PathLike) -> Path:
+        """:meth:`front` as CSV, one row per genome: ``generation`` (that made it), ``crowding``, the
+        objectives by name (what the selection compares), ``measured_<name>`` and ``reference_<name>``
+        (NaN when not evaluated) for each, ``genome`` (JSON). Written atomically."""
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        names = self.names
+        w.writerow(
+            ["generation", "crowding", *names, *[f"measured_{n}" for n in names], *[f"reference_{n}" for n in names]]
+            + ["genome"]
+        )
+        nan = (float("nan"),) * len(names)
+        for s in self.front():
+            w.writerow(
+                [s.generation, repr(s.crowding)]
+                + [repr(x) for x in (*s.objectives, *s.measured, *(s.reference or nan))]
+                + [s.genome.to_json()]
+            )
+        return _write_atomic(Path(path), buf.getvalue())
+
+    def checkpoint(self) -> Dict[str, Any]:
+        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back). A
+        pending ``ask()`` is not saved: asking again after a restore gives the same genomes."""
+        return {
+            "format": CHECKPOINT_FORMAT,
+            "config": self._config.to_toml(),
+            "seed": self.seed,
+            "population_size": self.population_size,
+            "crossover_fraction": self.crossover_fraction,
+            "objectives": [{"name": c.name, "sense": c.sense} for c in self.criteria],
+            "reference_point": None if self._reference_point is None else [_enc(x) for x in self._reference_point],
+            "reference_point_given": self._reference_point_given,
+            "generation": self._generation,
+            "evaluations": self._evaluations,
+            "reference_evaluations": self._reference_evaluations,
+            "history": [[_enc(x) if isinstance(x, float) else int(x) for x in row] for row in self._history],
+            "population": [
+                {
+                    "genome": s.genome.to_json(),
+                    "objectives": [_enc(x) for x in s.objectives],
+                    "measured": [_enc(x) for x in s.measured],
+                    "reference": None if s.reference is None else [_enc(x) for x in s.reference],
+                    "generation": s.generation,
+                    "feasible": s.feasible,
+                    "rank": s.rank,
+                    "crowding": _enc(s.crowding),
+                }
+                for s in self._population
+            ],
+        }
+
+    def save(self, path: PathLike) -> Path:
+        """Write :meth:`checkpoint` as JSON to ``path`` atomically."""
+        return _write_atomic(Path(path), json.dumps(self.checkpoint(), allow_nan=False))
+
+    @classmethod
+    def restore(
+        cls,
+        state: Union[Mapping[str, Any], str, bytes],
+        config: Any = None,
+        *,
+        objectives: Iterable[CriterionLike] = (),
+        threads: Optional[int] = None,
+    ) -> Nsga2:
+        """An Nsga2 from :meth:`checkpoint` (a dict, or its JSON text). ``config``: default the saved
+        one; another must equal it but for ``evolution.threads`` (ValueError). ``objectives``: found by
+        name, first there (your own functions must be given again: a function is not saved), then in
+        :data:`CRITERIA`, with the saved sense; given ones must be the run's, in order (ValueError)."""
+        if isinstance(state, (str, bytes)):
+            state = json.loads(state)
+        assert isinstance(state, Mapping)
+        if state.get("format") != CHECKPOINT_FORMAT:
+            raise ValueError(f"not an Nsga2 checkpoint (format {state.get('format')!r}, expected {CHECKPOINT_FORMAT})")
+        saved = _core.Config.from_toml(state["config"], "checkpoint")
+        if config is None:
+            config = saved
+        else:
+            mine = config.copy()
+            mine["evolution.seed"] = int(state["seed"])
+            if _comparable(mine) != _comparable(saved):
+                raise ValueError("Nsga2.restore: the config differs from the checkpoint's (only evolution.threads may)")
+        given = list(objectives) if not isinstance(objectives, (str, Criterion)) else [objectives]
+        mine_criteria = _criteria(given) if given else ()
+        run = [(o["name"], o["sense"]) for o in state["objectives"]]
+        if mine_criteria and [(c.name, c.sense) for c in mine_criteria] != run:
+            raise ValueError(
+                f"Nsga2.restore: the objectives {[(c.name, c.sense) for c in mine_criteria]} are not the "
+                f"checkpoint's {run}"
+            )
+        by_name = {c.name: c for c in mine_criteria}
+        criteria = []
+        for name, sense in run:
+            if name in by_name:
+                criteria.append(by_name[name])
+            elif name in CRITERIA:
+                criteria.append(CRITERIA[name].with_sense(sense))
+            else:
+                raise ValueError(
+                    f"the run's objective {name!r} is not in the table: pass it again "
+                    "(objectives=[Criterion(...)] or (function, sense))"
+                )
+        point = state["reference_point"]
+        nsga = cls(
+            config,
+            criteria,
+            population=state["population_size"],
+            seed=state["seed"],
+            crossover_fraction=state["crossover_fraction"],
+            reference_point=_floats(point) if state["reference_point_given"] else None,
+            threads=threads,
+        )
+        nsga._reference_point = _floats(point)
+        nsga._generation = int(state["generation"])
+        nsga._evaluations = int(state["evaluations"])
+        nsga._reference_evaluations = int(state["reference_evaluations"])
+        dtype = nsga.history_dtype
+        nsga._history = [
+            tuple(_dec(x) if dtype[j].kind == "f" else int(x) for j, x in enumerate(row)) for row in state["history"]
+        ]
+        nsga._population = [
+            Solution(
+                _core.Genome.from_json(s["genome"]),
+                _floats(s["objectives"]) or (),
+                _floats(s["measured"]) or (),
+                _floats(s["reference"]),
+                int(s["generation"]),
+                bool(s["feasible"]),
+                int(s["rank"]),
+                _dec(s["crowding"]),
+            )
+            for s in state["population"]
+        ]
+        return nsga
+
+    @classmethod
+    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Nsga2:
+        """:meth:`restore` from a file written by :meth:`save` (or a run directory of :func:`run_nsga2`)."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "checkpoint.json"
+        return cls.restore(path.read_text(encoding="utf-8"), config, **kwargs)
+
+    def _own_criteria(self) -> Tuple[Criterion, ...]:
+        # Criteria that are not table entries (your functions): saved by pickle, not in the checkpoint.
+        return tuple(
+            c for c in self.criteria if CRITERIA.get(c.name) is None or c.function is not CRITERIA[c.name].function
+        )
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        # Pickles as its checkpoint, with your own criteria.
+        return (_restore, (self.checkpoint(), self._own_criteria()))
+
+    def __repr__(self) -> str:
+        objectives = ", ".join(f"{c.name} ({c.sense})" for c in self.criteria)
+        return (
+            f"<animat.Nsga2 generation {self._generation}, population {self.population_size}, {objectives}: "
+            f"front of {len(self.front())}>"
+        )
+
+
+def _restore(state: Mapping[str, Any], criteria: Tuple[Criterion, ...]) -> Nsga2:
+    return Nsga2.restore(state, objectives=_merge(state, criteria))
+
+
+def _merge(state: Mapping[str, Any], own: Tuple[Criterion, ...]) -> List[Criterion]:
+    by_name = {c.name: c for c in own}
+    out = []
+    for o in state["objectives"]:
+        c = by_name.get(o["name"])
+        out.append(c if c is not None else CRITERIA[o["name"]].with_sense(o["sense"]))
+    return out
+
+
+# --- the run directory ----------------------------------------------------------------------------
+
+_RUN_FILES = ("config.toml", "history.csv", "checkpoint.json")
+
+
+def _history_csv(history: np.ndarray) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    dtype = history.dtype
+    names = list(dtype.names or ())
+    w.writerow(names)
+    for row in history:
+        w.writerow([repr(float(row[n])) if dtype[n].kind == "f" else int(row[n]) for n in names])
+    return buf.getvalue()
+
+
+def run_nsga2(
+    config: Any,
+    objectives: Optional[Iterable[CriterionLike]],
+    out: PathLike,
+    generations: int,
+    *,
+    population: Optional[int] = None,
+    seed: Optional[int] = None,
+    crossover_fraction: Optional[float] = None,
+    reference_point: Optional[Sequence[float]] = None,
+    threads: Optional[int] = None,
+    front_every: int = 1,
+    resume: bool = False,
+    overwrite: bool = False,
+    callback: Optional[Callable[[Any], Optional[bool]]] = None,
+) -> Nsga2:
+    """Run NSGA-II up to generation ``generations`` (generation 0 is the initial population, as
+    ``evolution.generations`` counts) in the run directory ``out``:
+
+    - ``config.toml``: the run's config (its ``evolution.seed`` is the run's seed);
+    - ``history.csv``: :func:`history_dtype`'s columns (``generation, evaluations, front_size,
+      hypervolume, best_<name>..., feasible, discarded, reference_evaluations, disagreements``), one
+      row per generation;
+    - ``front/gen_NNNNNN.csv``: the front after every ``front_every``-th generation and the last
+      (:meth:`Nsga2.write_front`: one row per genome);
+    - ``checkpoint.json``: written after every generation (:meth:`Nsga2.checkpoint`); ``resume=True``
+      continues from it and gives the very run an uninterrupted one gives (``objectives`` may then
+      be None; your own functions must be passed again, and given objectives must be the run's).
+
+    ``callback(row)`` is called after every generation; returning False stops (checkpointed). Returns
+    the :class:`Nsga2`. A directory that holds a run is refused (FileExistsError) unless ``resume``
+    or ``overwrite`` (which removes the files above and ``front/``, nothing else).
+    """
+    if resume and overwrite:
+        raise ValueError("run_nsga2: resume=True and overwrite=True contradict each other")
+    if front_every < 1:
+        raise ValueError(f"run_nsga2: front_every must be >= 1, got {front_every}")
+    out = Path(out)
+    has_run = any((out / f).exists() for f in _RUN_FILES) or (out / "front").exists()
+    if resume:
+        if not (out / "checkpoint.json").is_file():
+            raise FileNotFoundError(f"{out / 'checkpoint.json'}: no checkpoint to resume")
+        nsga = Nsga2.load(out, config, objectives=() if objectives is None else objectives, threads=threads)
+    else:
+        if has_run and not overwrite:
+            raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
+        if objectives is None:
+            raise ValueError("run_nsga2: the objectives are required for a new run")
+        if overwrite:
+            for f in _RUN_FILES:
+                (out / f).unlink(missing_ok=True)
+            shutil.rmtree(out / "front", ignore_errors=True)
+        nsga = Nsga2(
+            config,
+            objectives,
+            population=population,
+            seed=seed,
+            crossover_fraction=crossover_fraction,
+            reference_point=reference_point,
+            threads=threads,
+        )
+    (out / "front").mkdir(parents=True, exist_ok=True)
+    _write_atomic(out / "config.toml", nsga.config.to_toml())
+    while nsga.generation < generations:
+        row = nsga.step()
+        g = nsga.generation
+        if g % front_every == 0 or g == generations:
+            nsga.write_front(out / "front" / f"gen_{g:06d}.csv")
+        _write_atomic(out / "history.csv", _history_csv(nsga.history))
+        nsga.save(out / "checkpoint.json")
+        if callback is not None and callback(row) is False:
+            nsga.write_front(out / "front" / f"gen_{g:06d}.csv")
+            break
+    return nsga
