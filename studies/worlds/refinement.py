@@ -7,10 +7,16 @@ steps: the same simulated time). One row per lineage best goes to ``results/craw
 the summary printed per grid point is what ``docs/worlds.md`` quotes.
 
     PYTHONPATH=build/python .venv/bin/python studies/worlds/refinement.py
+    PYTHONPATH=build/python .venv/bin/python studies/worlds/refinement.py --ladder g1_record_seed2:4
+
+``--ladder RUN:GENERATION ...`` prints, for those lineage bests, the fitness and the airborne share
+at dt, dt/2, dt/4, dt/8, dt/16 and dt/32 (does the fitness converge as the step shrinks?).
 
 Columns: run, gravity, guard, seed, generation (at which the genome became the best), cells,
 recorded (the fitness the run recorded), fitness (re-evaluated at dt), fitness_fine (at dt/16),
-error (fitness / fitness_fine - 1), valid, valid_fine (the body's invariants held for the whole
+error (fitness / fitness_fine - 1), fitness_finest (at dt/32), ranked_error (the error of the fitness
+the GA ranked by: fitness / fitness_fine - 1 under the guard's "record", and fitness_fine /
+fitness_finest - 1 under "select", where the GA ranks by the reference at dt/16), valid, valid_fine (the body's invariants held for the whole
 swim), airborne_share (Box2D steps in which the floor pushed no cell / Box2D steps, at dt), final
 (1 for the run's last lineage best).
 """
@@ -38,6 +44,8 @@ FIELDS = (
     "fitness",
     "fitness_fine",
     "error",
+    "fitness_finest",
+    "ranked_error",
     "valid",
     "valid_fine",
     "airborne_share",
@@ -58,11 +66,17 @@ def rows_of(run_dir: Path):
     run = animat.Run(run_dir)
     cfg = run.config
     fine = refined(cfg, 16)
+    finest = refined(cfg, 32)
+    select = cfg["evaluation.reference_check"] == "select"
     lineage = run.best_genomes
     box2d_steps = cfg["evaluation.steps"] * cfg["physics.substeps"]
     for i, entry in enumerate(lineage):
         coarse = animat.evaluate(entry.genome, cfg)
         refined_result = animat.evaluate(entry.genome, fine)
+        finest_result = animat.evaluate(entry.genome, finest)
+        ranked, truth = (
+            (refined_result.fitness, finest_result.fitness) if select else (coarse.fitness, refined_result.fitness)
+        )
         yield {
             "run": run_dir.name,
             "gravity": cfg["scene.gravity"],
@@ -74,6 +88,8 @@ def rows_of(run_dir: Path):
             "fitness": coarse.fitness,
             "fitness_fine": refined_result.fitness,
             "error": coarse.fitness / refined_result.fitness - 1.0 if refined_result.fitness else float("nan"),
+            "fitness_finest": finest_result.fitness,
+            "ranked_error": ranked / truth - 1.0 if truth else float("nan"),
             "valid": int(coarse.valid),
             "valid_fine": int(refined_result.valid),
             "airborne_share": coarse.airborne_steps / box2d_steps,
@@ -84,23 +100,45 @@ def rows_of(run_dir: Path):
 def summarize(rows) -> None:
     points = sorted({(float(r["gravity"]), r["guard"]) for r in rows})
     print(
-        "| gravity | guard | runs | lineage bests | invalid (dt, dt/16) | abs error p50 / p90 / max "
-        "(all) | final bests: abs error max | final bests: fitness | final bests: airborne share |"
+        "| gravity | guard | runs | lineage bests | invalid (dt, dt/16) | dt vs dt/16: abs error p50 / p90 / max "
+        "| ranked vs next finer: abs error p50 / p90 / max | final bests: ranked error | final bests: fitness "
+        "at dt | final bests: airborne share |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for g, guard in points:
         sel = [r for r in rows if float(r["gravity"]) == g and r["guard"] == guard]
         fin = [r for r in sel if int(r["final"])]
         err = np.abs([float(r["error"]) for r in sel])
-        ferr = np.abs([float(r["error"]) for r in fin])
+        rerr = np.abs([float(r["ranked_error"]) for r in sel])
+        ferr = ", ".join(f"{abs(float(r['ranked_error'])):.2%}" for r in fin)
         inv = sum(1 - int(r["valid"]) for r in sel), sum(1 - int(r["valid_fine"]) for r in sel)
         fit = ", ".join(f"{float(r['fitness']):.1f}" for r in fin)
         air = ", ".join(f"{float(r['airborne_share']):.0%}" for r in fin)
         print(
             f"| {g:g} | {guard} | {len(fin)} | {len(sel)} | {inv[0]}, {inv[1]} | "
             f"{np.percentile(err, 50):.2%} / {np.percentile(err, 90):.2%} / {err.max():.2%} | "
-            f"{ferr.max():.2%} | {fit} | {air} |"
+            f"{np.percentile(rerr, 50):.2%} / {np.percentile(rerr, 90):.2%} / {rerr.max():.2%} | "
+            f"{ferr} | {fit} | {air} |"
         )
+
+
+def ladder(runs: Path, specs) -> None:
+    factors = (1, 2, 4, 8, 16, 32)
+    print("| lineage best | " + " | ".join(f"dt/{f}" if f > 1 else "dt" for f in factors) + " |")
+    print("| --- |" + " --- |" * len(factors))
+    for spec in specs:
+        name, generation = spec.rsplit(":", 1)
+        run = animat.Run(runs / name)
+        entries = [e for e in run.best_genomes if e.generation == int(generation)]
+        if not entries:
+            raise SystemExit(f"{runs / name}: no lineage best of generation {generation}")
+        cfg = run.config
+        cells = []
+        for f in factors:
+            r = animat.evaluate(entries[0].genome, refined(cfg, f) if f > 1 else cfg)
+            share = r.airborne_steps / (cfg["evaluation.steps"] * cfg["physics.substeps"] * f)
+            cells.append(f"{r.fitness:.2f} ({share:.0%})")
+        print(f"| {spec} | " + " | ".join(cells) + " |", flush=True)
 
 
 def main(argv=None) -> int:
@@ -108,7 +146,11 @@ def main(argv=None) -> int:
     p.add_argument("--runs", default=str(HERE / "crawl_screen"), help="folder of kept runs")
     p.add_argument("--out", default=str(HERE / "results" / "crawl_refinement.csv"))
     p.add_argument("--summary-only", action="store_true", help="summarize --out without re-swimming")
+    p.add_argument("--ladder", nargs="+", metavar="RUN:GENERATION", help="refinement ladder of lineage bests")
     args = p.parse_args(argv)
+    if args.ladder:
+        ladder(Path(args.runs), args.ladder)
+        return 0
     out = Path(args.out)
     if not args.summary_only:
         runs = sorted(d for d in Path(args.runs).iterdir() if (d / "history.csv").is_file())
