@@ -104,6 +104,26 @@ bool fitter(const Individual& a, const Individual& b) {
   return a.result.fitness > b.result.fitness;
 }
 
+// The best individual: the first of the fittest by nominal fitness (ties resolve the same way on
+// every machine). Under the exploit guard's "select" the elites are ranked by their reference
+// fitness, so the best is the first of the best reference among the viable individuals that have
+// one (the elite candidates, referenced when their generation completed): a genome whose fitness
+// the reference step does not confirm is never reported as the run's best.
+std::size_t best_index(const std::vector<Individual>& pop, bool by_reference) {
+  std::size_t best =
+      static_cast<std::size_t>(std::min_element(pop.begin(), pop.end(), fitter) - pop.begin());
+  if (!by_reference) return best;
+  bool found = false;
+  for (std::size_t i = 0; i < pop.size(); ++i) {
+    if (!pop[i].result.viable || std::isnan(pop[i].reference)) continue;
+    if (!found || pop[i].reference > pop[best].reference) best = i;
+    found = true;
+  }
+  return best;
+}
+
+bool selects_by_reference(const Config& c) { return c.evaluation.reference_check == "select"; }
+
 }  // namespace
 
 double tournament_probability(const EvolutionParams& p, int generation) {
@@ -192,6 +212,17 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
   return cand;
 }
 
+void Evolution::reference_elite_candidates() {
+  if (!reference_ || !selects_by_reference(*config_)) return;
+  const IslandLayout layout = island_layout(population_.size(), config_->evolution.islands);
+  for (std::size_t isl = 0; isl < layout.count(); ++isl) {
+    const std::vector<std::size_t> order = island_ranking(population_, layout, isl);
+    (void)reference_ranked(
+        order,
+        std::min<std::size_t>(static_cast<std::size_t>(config_->evolution.elites), order.size()));
+  }
+}
+
 void Evolution::initialize() {
   if (!evaluator_)
     throw Error(
@@ -215,9 +246,7 @@ void Evolution::initialize() {
 const Individual& Evolution::best() const {
   if (generation_ < 0 || population_.empty())
     throw Error("Evolution::best: no generation yet (the initial population is not complete)");
-  // The first of the fittest, by index: ties resolve the same way on every machine.
-  return *std::min_element(population_.begin(), population_.end(),
-                           [](const Individual& a, const Individual& b) { return fitter(a, b); });
+  return population_[best_index(population_, selects_by_reference(*config_))];
 }
 
 std::vector<int> Evolution::initial_tries() const {
@@ -358,6 +387,7 @@ bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
   }
   slots_.clear();
   generation_ = 0;
+  reference_elite_candidates();
   best_ever_ = best().result.fitness;
   stall_ = 0;
   // Every initial individual is a viable draw that was swum once.
@@ -471,6 +501,7 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
   if (is_migration_generation(ep, generation_))
     migrations_ = migrate(population_, island_layout(population_.size(), ep.islands), ep.migrants,
                           generation_);
+  reference_elite_candidates();
   const Individual& b = best();
   if (b.result.fitness > best_ever_) {
     best_ever_ = b.result.fitness;
@@ -487,7 +518,8 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
 
 namespace {
 // The population columns of a history row: best, best_cells, viable_fraction, mean, median.
-GenerationStats population_statistics(const std::vector<Individual>& population) {
+GenerationStats population_statistics(const std::vector<Individual>& population,
+                                      bool by_reference) {
   GenerationStats s;
   std::vector<double> viable;
   for (const auto& ind : population) {
@@ -495,10 +527,7 @@ GenerationStats population_statistics(const std::vector<Individual>& population)
     if (ind.result.viable && (!ind.result.valid || !ind.result.stable)) ++s.invalid;
     if (ind.result.drag_limited > 0) ++s.drag_limited;
   }
-  // The first of the fittest, by index (as Evolution::best()).
-  const Individual& b =
-      *std::min_element(population.begin(), population.end(),
-                        [](const Individual& x, const Individual& y) { return fitter(x, y); });
+  const Individual& b = population[best_index(population, by_reference)];  // Evolution::best()
   s.best = b.result.fitness;
   s.best_cells = b.result.cell_count;
   s.viable_fraction = static_cast<double>(viable.size()) / static_cast<double>(population.size());
@@ -514,7 +543,7 @@ GenerationStats population_statistics(const std::vector<Individual>& population)
 
 GenerationStats Evolution::statistics(bool best_changed, double wall, int swims) const {
   if (population_.empty()) throw Error("Evolution::statistics: the population is empty");
-  GenerationStats s = population_statistics(population_);
+  GenerationStats s = population_statistics(population_, selects_by_reference(*config_));
   s.generation = generation_;
   s.evaluations = evaluations_;
   s.wall_seconds = wall;
@@ -613,7 +642,7 @@ GenerationStats stats_from_json(const json& j) {
 // history.
 void check_semantics(const std::vector<Individual>& pop, const std::vector<GenerationStats>& hist,
                      int stall, double best_ever, std::int64_t evaluations, double wall,
-                     bool nonnegative, std::string_view source) {
+                     bool nonnegative, bool by_reference, std::string_view source) {
   auto fail = [&](const std::string& what) {
     throw CheckpointError(fmt::format("{}: inconsistent checkpoint: {}", source, what));
   };
@@ -664,10 +693,16 @@ void check_semantics(const std::vector<Individual>& pop, const std::vector<Gener
   if (wall != last.wall_seconds)
     fail(fmt::format("wall_seconds is {}, but the last history row has {}", wall,
                      last.wall_seconds));
-  const GenerationStats now = population_statistics(pop);
-  if (now.best != last.best || now.best_cells != last.best_cells ||
-      now.viable_fraction != last.viable_fraction || now.mean != last.mean ||
-      now.median != last.median)
+  // Under "select", checkpoints written before the best was chosen by reference name the nominal
+  // best: either describes the population.
+  const GenerationStats now = population_statistics(pop, by_reference);
+  const GenerationStats nominal = population_statistics(pop, false);
+  const auto describes = [&](const GenerationStats& p) {
+    return p.best == last.best && p.best_cells == last.best_cells &&
+           p.viable_fraction == last.viable_fraction && p.mean == last.mean &&
+           p.median == last.median;
+  };
+  if (!describes(now) && !(by_reference && describes(nominal)))
     fail(fmt::format(
         "the last history row (generation {}: best {}, mean {}, median {}, viable {}, {} cells) "
         "does not "
@@ -823,7 +858,7 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     const std::int64_t evaluations = int_field(p, "evaluations", 0, kInt64Max);
     const double wall = number_field(p, "wall_seconds");
     check_semantics(pop, hist, stall, best_ever, evaluations, wall, nonnegative_objective(*config_),
-                    source);
+                    selects_by_reference(*config_), source);
     population_ = std::move(pop);
     slots_.clear();
     next_.clear();

@@ -293,6 +293,9 @@ class Evolution {
 
   [[nodiscard]] int generation() const { return generation_; }
   [[nodiscard]] const std::vector<Individual>& population() const { return population_; }
+  /// The first of the fittest by nominal fitness; under evaluation.reference_check = "select", the
+  /// first of the best reference fitness among the viable individuals that have one (what selection
+  /// trusts).
   [[nodiscard]] const Individual& best() const;
   [[nodiscard]] const std::vector<GenerationStats>& history() const { return history_; }
   [[nodiscard]] int generations_without_improvement() const { return stall_; }
@@ -326,6 +329,9 @@ class Evolution {
   /// "select": reference fitness of the elite candidates, which are then ranked by it.
   std::vector<std::size_t> reference_ranked(const std::vector<std::size_t>& order,
                                             std::size_t elites);
+  /// "select", when a generation is complete: the reference fitness of every island's elite
+  /// candidates, so that best() can be the best by reference (the next ask() finds them known).
+  void reference_elite_candidates();
 
   std::vector<Genome> ask_initial(int lookahead);
   std::vector<Genome> ask_generation();
