@@ -8,12 +8,14 @@
 #   studies/worlds/crawl_screen.sh
 #   SCREEN_GRAVITY="1 4" SCREEN_SEEDS="1 2 3" SCREEN_JOBS=2 studies/worlds/crawl_screen.sh
 #
-# Grid (environment variables, space-separated): SCREEN_GRAVITY (scene.gravity), SCREEN_GUARD
+# Grid (environment variables, space-separated): SCREEN_GRAVITY (scene.gravity), SCREEN_STIFFNESS
+# (scene.spring_stiffness; names carry it unless it is 100, the default), SCREEN_GUARD
 # (evaluation.reference_check), SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 EXE=${ANIMAT_EVOLVE_EXE:-build/animat_evolve}
 GRAVITY=${SCREEN_GRAVITY:-"1 4 10"}
+STIFFNESS=${SCREEN_STIFFNESS:-"100"}
 GUARD=${SCREEN_GUARD:-"record"}
 SEEDS=${SCREEN_SEEDS:-"1 2 3"}
 POP=${SCREEN_POPULATION:-100}
@@ -23,17 +25,19 @@ KEEP=studies/worlds/crawl_screen
 WORK=runs/crawl_screen
 mkdir -p "$KEEP" "$WORK"
 
-one() {  # gravity guard seed
+one() {  # gravity stiffness guard seed
   set -euo pipefail
-  local g=$1 guard=$2 seed=$3
+  local g=$1 k=$2 guard=$3 seed=$4
   local name="g${g}_${guard}_seed${seed}"
+  [[ "$k" == 100 ]] || name="g${g}_k${k}_${guard}_seed${seed}"
   local keep="$KEEP/$name" work="$WORK/$name"
   [[ -f "$keep/history.csv" ]] && return 0
   if [[ -f "$work/checkpoint.json" ]]; then
     "$EXE" --resume "$work" --generations "$GENS" --threads 1 --quiet >/dev/null
   else
     rm -rf "$work"
-    "$EXE" --config configs/crawl.toml --set "scene.gravity=$g" --set "evolution.population=$POP" \
+    "$EXE" --config configs/crawl.toml --set "scene.gravity=$g" --set "scene.spring_stiffness=$k" \
+      --set "evolution.population=$POP" \
       --set "evaluation.reference_check=$guard" --generations "$GENS" --threads 1 --seed "$seed" \
       --quiet --out "$work" >/dev/null
   fi
@@ -54,7 +58,7 @@ export -f one
 export EXE GENS POP KEEP WORK
 
 points=()
-for g in $GRAVITY; do for guard in $GUARD; do for seed in $SEEDS; do
-  points+=("$g $guard $seed")
-done; done; done
+for g in $GRAVITY; do for k in $STIFFNESS; do for guard in $GUARD; do for seed in $SEEDS; do
+  points+=("$g $k $guard $seed")
+done; done; done; done
 printf '%s\n' "${points[@]}" | xargs -P "$JOBS" -L 1 bash -c 'one "$@"' _
