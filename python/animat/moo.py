@@ -72,7 +72,6 @@ import io
 import json
 import math
 import os
-import shutil
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -81,7 +80,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 import numpy as np
 
 from . import _core
-from .qd import _comparable, _reference_config, _write_atomic
+from .qd import _comparable, _reference_config, _run_search, _write_atomic
 
 __all__ = [
     "Criterion",
@@ -1051,19 +1050,6 @@ def _merge(state: Mapping[str, Any], own: Tuple[Criterion, ...]) -> List[Criteri
 
 # --- the run directory ----------------------------------------------------------------------------
 
-_RUN_FILES = ("config.toml", "history.csv", "checkpoint.json")
-
-
-def _history_csv(history: np.ndarray) -> str:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    dtype = history.dtype
-    names = list(dtype.names or ())
-    w.writerow(names)
-    for row in history:
-        w.writerow([repr(float(row[n])) if dtype[n].kind == "f" else int(row[n]) for n in names])
-    return buf.getvalue()
-
 
 def run_nsga2(
     config: Any,
@@ -1098,44 +1084,38 @@ def run_nsga2(
     the :class:`Nsga2`. A directory that holds a run is refused (FileExistsError) unless ``resume``
     or ``overwrite`` (which removes the files above and ``front/``, nothing else).
     """
-    if resume and overwrite:
-        raise ValueError("run_nsga2: resume=True and overwrite=True contradict each other")
-    if front_every < 1:
-        raise ValueError(f"run_nsga2: front_every must be >= 1, got {front_every}")
-    out = Path(out)
-    has_run = any((out / f).exists() for f in _RUN_FILES) or (out / "front").exists()
-    if resume:
-        if not (out / "checkpoint.json").is_file():
-            raise FileNotFoundError(f"{out / 'checkpoint.json'}: no checkpoint to resume")
-        nsga = Nsga2.load(out, config, objectives=() if objectives is None else objectives, threads=threads)
-    else:
-        if has_run and not overwrite:
-            raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
+
+    def check_new() -> None:
         if objectives is None:
             raise ValueError("run_nsga2: the objectives are required for a new run")
-        if overwrite:
-            for f in _RUN_FILES:
-                (out / f).unlink(missing_ok=True)
-            shutil.rmtree(out / "front", ignore_errors=True)
-        nsga = Nsga2(
+
+    def new() -> Nsga2:
+        return Nsga2(
             config,
-            objectives,
+            cast(Any, objectives),
             population=population,
             seed=seed,
             crossover_fraction=crossover_fraction,
             reference_point=reference_point,
             threads=threads,
         )
-    (out / "front").mkdir(parents=True, exist_ok=True)
-    _write_atomic(out / "config.toml", nsga.config.to_toml())
-    while nsga.generation < generations:
-        row = nsga.step()
-        g = nsga.generation
-        if g % front_every == 0 or g == generations:
-            nsga.write_front(out / "front" / f"gen_{g:06d}.csv")
-        _write_atomic(out / "history.csv", _history_csv(nsga.history))
-        nsga.save(out / "checkpoint.json")
-        if callback is not None and callback(row) is False:
-            nsga.write_front(out / "front" / f"gen_{g:06d}.csv")
-            break
-    return nsga
+
+    return cast(
+        Nsga2,
+        _run_search(
+            "run_nsga2",
+            out,
+            "front",
+            front_every,
+            generations,
+            resume=resume,
+            overwrite=overwrite,
+            load=lambda path: Nsga2.load(
+                path, config, objectives=() if objectives is None else objectives, threads=threads
+            ),
+            new=new,
+            check_new=check_new,
+            write_snapshot=lambda nsga, path: nsga.write_front(path),
+            callback=callback,
+        ),
+    )

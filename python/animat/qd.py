@@ -1126,11 +1126,65 @@ _RUN_FILES = ("config.toml", "history.csv", "checkpoint.json")
 def _history_csv(history: np.ndarray) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    names = list(QD_HISTORY_DTYPE.names or ())
+    dtype = history.dtype
+    names = list(dtype.names or ())
     w.writerow(names)
     for row in history:
-        w.writerow([repr(float(row[n])) if QD_HISTORY_DTYPE[n].kind == "f" else int(row[n]) for n in names])
+        w.writerow([repr(float(row[n])) if dtype[n].kind == "f" else int(row[n]) for n in names])
     return buf.getvalue()
+
+
+def _run_search(
+    what: str,
+    out: PathLike,
+    snapshots: str,
+    every: int,
+    generations: int,
+    *,
+    resume: bool,
+    overwrite: bool,
+    load: Callable[[Path], Any],
+    new: Callable[[], Any],
+    check_new: Callable[[], None],
+    write_snapshot: Callable[[Any, Path], Any],
+    callback: Optional[Callable[[Any], Optional[bool]]],
+) -> Any:
+    """The run directory of a search (MAP-Elites, NSGA-II): ``config.toml``, ``history.csv``,
+    ``<snapshots>/gen_NNNNNN.csv`` every ``every`` generations and at the last, ``checkpoint.json``
+    after every generation. Every refusal comes before any file is touched."""
+    if resume and overwrite:
+        raise ValueError(f"{what}: resume=True and overwrite=True contradict each other")
+    if every < 1:
+        raise ValueError(f"{what}: {snapshots}_every must be >= 1, got {every}")
+    out = Path(out)
+    has_run = any((out / f).exists() for f in _RUN_FILES) or (out / snapshots).exists()
+    if resume:
+        if not (out / "checkpoint.json").is_file():
+            raise FileNotFoundError(f"{out / 'checkpoint.json'}: no checkpoint to resume")
+        search = load(out)
+    else:
+        if has_run and not overwrite:
+            raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
+        check_new()
+        if overwrite:
+            for f in _RUN_FILES:
+                (out / f).unlink(missing_ok=True)
+            shutil.rmtree(out / snapshots, ignore_errors=True)
+        search = new()
+    (out / snapshots).mkdir(parents=True, exist_ok=True)
+    _write_atomic(out / "config.toml", search.config.to_toml())
+    while search.generation < generations:
+        row = search.step()
+        g = search.generation
+        snapshot = out / snapshots / f"gen_{g:06d}.csv"
+        if g % every == 0 or g == generations:
+            write_snapshot(search, snapshot)
+        _write_atomic(out / "history.csv", _history_csv(search.history))
+        search.save(out / "checkpoint.json")
+        if callback is not None and callback(row) is False:
+            write_snapshot(search, snapshot)
+            break
+    return search
 
 
 def run_map_elites(
@@ -1167,29 +1221,19 @@ def run_map_elites(
     the :class:`MapElites`. A directory that holds a run is refused (FileExistsError) unless ``resume``
     or ``overwrite`` (which removes the files above and ``archive/``, nothing else).
     """
-    if resume and overwrite:
-        raise ValueError("run_map_elites: resume=True and overwrite=True contradict each other")
-    if archive_every < 1:
-        raise ValueError(f"run_map_elites: archive_every must be >= 1, got {archive_every}")
-    out = Path(out)
-    has_run = any((out / f).exists() for f in _RUN_FILES) or (out / "archive").exists()
-    if resume:
-        if not (out / "checkpoint.json").is_file():
-            raise FileNotFoundError(f"{out / 'checkpoint.json'}: no checkpoint to resume")
+
+    def load(path: Path) -> MapElites:
         extra = tuple(descriptors) + (tuple(archive.descriptors) if archive is not None else ())
-        me = MapElites.load(out, config, objective=objective, descriptors=extra, threads=threads)
-    else:
-        if has_run and not overwrite:
-            raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
+        return MapElites.load(path, config, objective=objective, descriptors=extra, threads=threads)
+
+    def check_new() -> None:
         if archive is None:
             raise ValueError("run_map_elites: an archive is required for a new run")
-        if overwrite:
-            for f in _RUN_FILES:
-                (out / f).unlink(missing_ok=True)
-            shutil.rmtree(out / "archive", ignore_errors=True)
-        me = MapElites(
+
+    def new() -> MapElites:
+        return MapElites(
             config,
-            archive,
+            cast(Any, archive),
             batch=batch,
             initial=initial,
             seed=seed,
@@ -1197,16 +1241,21 @@ def run_map_elites(
             crossover_fraction=crossover_fraction,
             threads=threads,
         )
-    (out / "archive").mkdir(parents=True, exist_ok=True)
-    _write_atomic(out / "config.toml", me.config.to_toml())
-    while me.generation < generations:
-        row = me.step()
-        g = me.generation
-        if g % archive_every == 0 or g == generations:
-            me.archive.write_csv(out / "archive" / f"gen_{g:06d}.csv")
-        _write_atomic(out / "history.csv", _history_csv(me.history))
-        me.save(out / "checkpoint.json")
-        if callback is not None and callback(row) is False:
-            me.archive.write_csv(out / "archive" / f"gen_{g:06d}.csv")
-            break
-    return me
+
+    return cast(
+        MapElites,
+        _run_search(
+            "run_map_elites",
+            out,
+            "archive",
+            archive_every,
+            generations,
+            resume=resume,
+            overwrite=overwrite,
+            load=load,
+            new=new,
+            check_new=check_new,
+            write_snapshot=lambda me, path: me.archive.write_csv(path),
+            callback=callback,
+        ),
+    )
