@@ -12,7 +12,7 @@ the summary printed per grid point is what ``docs/worlds.md`` quotes.
 ``--ladder RUN:GENERATION ...`` prints, for those lineage bests, the fitness and the airborne share
 at dt, dt/2, dt/4, dt/8, dt/16 and dt/32 (does the fitness converge as the step shrinks?).
 
-Columns: run, gravity, guard, seed, generation (at which the genome became the best), cells,
+Columns: run, gravity, stiffness (scene.spring_stiffness), guard, seed, generation (at which the genome became the best), cells,
 recorded (the fitness the run recorded), fitness (re-evaluated at dt), fitness_fine (at dt/16),
 error (fitness / fitness_fine - 1), fitness_finest (at dt/32), ranked_error (the error of the fitness
 the GA ranked by: fitness / fitness_fine - 1 under the guard's "record", and fitness_fine /
@@ -36,6 +36,7 @@ HERE = Path(__file__).resolve().parent
 FIELDS = (
     "run",
     "gravity",
+    "stiffness",
     "guard",
     "seed",
     "generation",
@@ -80,6 +81,7 @@ def rows_of(run_dir: Path):
         yield {
             "run": run_dir.name,
             "gravity": cfg["scene.gravity"],
+            "stiffness": cfg["scene.spring_stiffness"],
             "guard": cfg["evaluation.reference_check"],
             "seed": run_dir.name.rsplit("seed", 1)[1],
             "generation": entry.generation,
@@ -98,15 +100,15 @@ def rows_of(run_dir: Path):
 
 
 def summarize(rows) -> None:
-    points = sorted({(float(r["gravity"]), r["guard"]) for r in rows})
+    points = sorted({(float(r["gravity"]), float(r["stiffness"]), r["guard"]) for r in rows})
     print(
-        "| gravity | guard | runs | lineage bests | invalid (dt, dt/16) | dt vs dt/16: abs error p50 / p90 / max "
+        "| gravity | stiffness | guard | runs | lineage bests | invalid (dt, dt/16) | dt vs dt/16: abs error p50 / p90 / max "
         "| ranked vs next finer: abs error p50 / p90 / max | final bests: ranked error | final bests: fitness "
         "at dt | final bests: airborne share |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for g, guard in points:
-        sel = [r for r in rows if float(r["gravity"]) == g and r["guard"] == guard]
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for g, k, guard in points:
+        sel = [r for r in rows if (float(r["gravity"]), float(r["stiffness"]), r["guard"]) == (g, k, guard)]
         fin = [r for r in sel if int(r["final"])]
         err = np.abs([float(r["error"]) for r in sel])
         rerr = np.abs([float(r["ranked_error"]) for r in sel])
@@ -115,7 +117,7 @@ def summarize(rows) -> None:
         fit = ", ".join(f"{float(r['fitness']):.1f}" for r in fin)
         air = ", ".join(f"{float(r['airborne_share']):.0%}" for r in fin)
         print(
-            f"| {g:g} | {guard} | {len(fin)} | {len(sel)} | {inv[0]}, {inv[1]} | "
+            f"| {g:g} | {k:g} | {guard} | {len(fin)} | {len(sel)} | {inv[0]}, {inv[1]} | "
             f"{np.percentile(err, 50):.2%} / {np.percentile(err, 90):.2%} / {err.max():.2%} | "
             f"{np.percentile(rerr, 50):.2%} / {np.percentile(rerr, 90):.2%} / {rerr.max():.2%} | "
             f"{ferr} | {fit} | {air} |"
