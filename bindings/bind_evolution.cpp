@@ -282,7 +282,9 @@ void bind_evolution(nb::module_& m) {
             EngineLease l(e, "best");
             return e.best();
           },
-          "The best Individual (first of the fittest).")
+          "The best Individual (first of the fittest; under evaluation.reference_check = "
+          "\"select\", "
+          "of the best reference fitness).")
       .def_prop_ro(
           "history",
           [](const Evolution& e) {

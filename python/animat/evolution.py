@@ -340,7 +340,8 @@ class GA:
 
     @property
     def best(self) -> Any:
-        """The best :class:`animat.Individual` (the first of the fittest); ValueError before generation 0."""
+        """The best :class:`animat.Individual`: the first of the fittest (under ``evaluation.reference_check =
+        "select"``, of the best reference fitness); ValueError before generation 0."""
         return self._engine.best
 
     @property
