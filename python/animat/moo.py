@@ -80,7 +80,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 import numpy as np
 
 from . import _core
-from .qd import _comparable, _reference_config, _run_search, _write_atomic
+from .qd import _comparable, _reference_config, _run_search, _SearchState, _write_atomic
 
 __all__ = [
     "Criterion",
@@ -516,7 +516,7 @@ def _floats(values: Optional[Iterable[Any]]) -> Optional[Floats]:
     return None if values is None else tuple(_dec(v) for v in values)
 
 
-class Nsga2:
+class Nsga2(_SearchState):
     """NSGA-II driven by ``ask``/``tell`` (or :meth:`step`) over several objectives (see the module
     docstring for the objectives, what is feasible and the exploit guard).
 
@@ -847,33 +847,9 @@ class Nsga2:
         return list(self._population)
 
     @property
-    def config(self) -> Any:
-        """The run's :class:`animat.Config` (a copy)."""
-        return self._config.copy()
-
-    @property
-    def generation(self) -> int:
-        """The last completed generation (-1 before the first ``tell``)."""
-        return self._generation
-
-    @property
-    def evaluations(self) -> int:
-        """Candidates told so far."""
-        return self._evaluations
-
-    @property
     def history(self) -> np.recarray:
         """One row per generation (:func:`history_dtype`): ``h["hypervolume"]``, ``h[-1].front_size`` ..."""
         return np.array(self._history, dtype=self.history_dtype).view(np.recarray)
-
-    def history_frame(self) -> Any:
-        """:attr:`history` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
-        try:
-            import pandas as pd  # type: ignore[import-not-found]
-        except ImportError:
-            raise ImportError("history_frame needs pandas: pip install pandas") from None
-
-        return pd.DataFrame.from_records(np.asarray(self.history).view(np.ndarray))
 
     def write_front(self, path: PathLike) -> Path:
         """:meth:`front` as CSV, one row per genome: ``generation`` (that made it), ``crowding``, the
@@ -925,10 +901,6 @@ class Nsga2:
                 for s in self._population
             ],
         }
-
-    def save(self, path: PathLike) -> Path:
-        """Write :meth:`checkpoint` as JSON to ``path`` atomically."""
-        return _write_atomic(Path(path), json.dumps(self.checkpoint(), allow_nan=False))
 
     @classmethod
     def restore(
@@ -1008,14 +980,6 @@ class Nsga2:
             for s in state["population"]
         ]
         return nsga
-
-    @classmethod
-    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Nsga2:
-        """:meth:`restore` from a file written by :meth:`save` (or a run directory of :func:`run_nsga2`)."""
-        path = Path(path)
-        if path.is_dir():
-            path = path / "checkpoint.json"
-        return cls.restore(path.read_text(encoding="utf-8"), config, **kwargs)
 
     def _own_criteria(self) -> Tuple[Criterion, ...]:
         # Criteria that are not table entries (your functions): saved by pickle, not in the checkpoint.

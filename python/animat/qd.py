@@ -798,7 +798,53 @@ def _comparable(config: Any) -> Dict[str, Any]:
     return d
 
 
-class MapElites:
+class _SearchState:
+    """What MAP-Elites and NSGA-II share: the run's config, its counters, the history as a data frame,
+    and saving and loading the checkpoint (each class defines ``checkpoint()``, ``restore()`` and
+    ``history``)."""
+
+    _config: Any
+    _generation: int
+    _evaluations: int
+
+    @property
+    def config(self) -> Any:
+        """The run's :class:`animat.Config` (a copy)."""
+        return self._config.copy()
+
+    @property
+    def generation(self) -> int:
+        """The last completed generation (-1 before the first ``tell``)."""
+        return self._generation
+
+    @property
+    def evaluations(self) -> int:
+        """Candidates told so far."""
+        return self._evaluations
+
+    def history_frame(self) -> Any:
+        """:attr:`history` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
+        try:
+            import pandas as pd  # type: ignore[import-not-found]
+        except ImportError:
+            raise ImportError("history_frame needs pandas: pip install pandas") from None
+
+        return pd.DataFrame.from_records(np.asarray(cast(Any, self).history).view(np.ndarray))
+
+    def save(self, path: PathLike) -> Path:
+        """Write :meth:`checkpoint` as JSON to ``path`` atomically."""
+        return _write_atomic(Path(path), json.dumps(cast(Any, self).checkpoint(), allow_nan=False))
+
+    @classmethod
+    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Any:
+        """:meth:`restore` from a file written by :meth:`save` (or the run directory of a search)."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "checkpoint.json"
+        return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, **kwargs)
+
+
+class MapElites(_SearchState):
     """MAP-Elites driven by ``ask``/``tell`` (or :meth:`step`), over a :class:`GridArchive` or a
     :class:`CVTArchive` (see the module docstring for what is archived and the exploit guard).
 
@@ -996,33 +1042,9 @@ class MapElites:
 
     # --- state ------------------------------------------------------------------------------------
     @property
-    def config(self) -> Any:
-        """The run's :class:`animat.Config` (a copy)."""
-        return self._config.copy()
-
-    @property
-    def generation(self) -> int:
-        """The last completed generation (-1 before the first ``tell``)."""
-        return self._generation
-
-    @property
-    def evaluations(self) -> int:
-        """Swims told so far."""
-        return self._evaluations
-
-    @property
     def history(self) -> np.recarray:
         """One row per generation (:data:`QD_HISTORY_DTYPE`): ``h["qd_score"]``, ``h[-1].coverage`` ..."""
         return np.array(self._history, dtype=QD_HISTORY_DTYPE).view(np.recarray)
-
-    def history_frame(self) -> Any:
-        """:attr:`history` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
-        try:
-            import pandas as pd  # type: ignore[import-not-found]
-        except ImportError:
-            raise ImportError("history_frame needs pandas: pip install pandas") from None
-
-        return pd.DataFrame.from_records(np.asarray(self.history).view(np.ndarray))
 
     def checkpoint(self) -> Dict[str, Any]:
         """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back). A
@@ -1040,10 +1062,6 @@ class MapElites:
             "history": [[_json_float(x) if isinstance(x, float) else x for x in row] for row in self._history],
             "archive": self.archive.state(),
         }
-
-    def save(self, path: PathLike) -> Path:
-        """Write :meth:`checkpoint` as JSON to ``path`` atomically."""
-        return _write_atomic(Path(path), json.dumps(self.checkpoint(), allow_nan=False))
 
     @classmethod
     def restore(
@@ -1095,14 +1113,6 @@ class MapElites:
             for row in state["history"]
         ]
         return me
-
-    @classmethod
-    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> MapElites:
-        """:meth:`restore` from a file written by :meth:`save` (or a run directory of :func:`run_map_elites`)."""
-        path = Path(path)
-        if path.is_dir():
-            path = path / "checkpoint.json"
-        return cls.restore(path.read_text(encoding="utf-8"), config, **kwargs)
 
     def __reduce__(self) -> Tuple[Any, ...]:
         # Pickles as its checkpoint, with the Python objective and your own descriptor functions.
