@@ -15,6 +15,7 @@
 # development.division_axis = "outward"). Run names carry the growth unless it is "paper".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+source studies/evolve_kept.sh
 EXE=${ANIMAT_EVOLVE_EXE:-build/animat_evolve}
 ENVS=${SCREEN_ENVS:-"dn0.5 dn10"}
 GROWTH=${SCREEN_GROWTH:-"paper"}
@@ -43,30 +44,13 @@ one() {  # env growth damping stiffness seed
   fi
   local guard=(--set "evaluation.reference_check=$GUARD")
   [[ "$GUARD" == record ]] || name="${name%_seed*}_${GUARD}_seed${seed}"
-  local keep="$KEEP/$name" work="$WORK/$name"
-  [[ -f "$keep/best_genome.json" ]] && return 0
-  local args=(--config "configs/paper_${env}.toml" --set "evolution.population=$POP"
-              --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" "${grow[@]}"
-              "${guard[@]}" --generations "$GENS" --threads 1 --seed "$seed" --quiet)
-  if [[ -f "$work/checkpoint.json" ]]; then
-    "$EXE" --resume "$work" --generations "$GENS" --threads 1 --quiet >/dev/null
-  else
-    rm -rf "$work"
-    "$EXE" "${args[@]}" --out "$work" >/dev/null
-  fi
-  local last
-  last=$(tail -1 "$work/history.csv" | cut -d, -f1)
-  if [[ "$last" != "$GENS" && ! -f "$work/stopped.txt" ]]; then
-    echo "screen: $name stopped at generation $last, not kept" >&2
-    return 1
-  fi
-  mkdir -p "$keep.tmp"
-  cp "$work/config.toml" "$work/history.csv" "$keep.tmp/"
-  cp "$(ls "$work"/best/gen_*.json | sort | tail -1)" "$keep.tmp/best_genome.json"
-  rm -rf "$keep" && mv "$keep.tmp" "$keep"
-  echo "screen: $name done"
+  [[ -f "$KEEP/$name/best_genome.json" ]] && return 0
+  evolve_kept "$name" "$KEEP/$name" "$WORK/$name" "$GENS" final \
+    --config "configs/paper_${env}.toml" --set "evolution.population=$POP" \
+    --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" "${grow[@]}" "${guard[@]}" \
+    --seed "$seed"
 }
-export -f one
+export -f one evolve_kept
 export EXE POP GENS KEEP WORK GUARD
 points=()
 for env in $ENVS; do for g in $GROWTH; do for c in $DAMPING; do for k in $STIFFNESS; do

@@ -9,13 +9,18 @@
 #   SCREEN_GRAVITY="1 4" SCREEN_SEEDS="1 2 3" SCREEN_JOBS=2 studies/worlds/crawl_screen.sh
 #
 # Grid (environment variables, space-separated): SCREEN_GRAVITY (scene.gravity), SCREEN_STIFFNESS
-# (scene.spring_stiffness; names carry it unless it is 100, the default), SCREEN_GUARD
+# (scene.spring_stiffness; names carry it unless it is 100, the default), SCREEN_FREQUENCY_MAX
+# (development.frequency_max; names carry it unless it is 6), SCREEN_AMPLITUDE_MAX
+# (development.amplitude_max; names carry it unless it is 0.2), SCREEN_GUARD
 # (evaluation.reference_check), SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+source studies/evolve_kept.sh
 EXE=${ANIMAT_EVOLVE_EXE:-build/animat_evolve}
 GRAVITY=${SCREEN_GRAVITY:-"1 4 10"}
 STIFFNESS=${SCREEN_STIFFNESS:-"100"}
+FREQUENCY_MAX=${SCREEN_FREQUENCY_MAX:-"6"}
+AMPLITUDE_MAX=${SCREEN_AMPLITUDE_MAX:-"0.2"}
 GUARD=${SCREEN_GUARD:-"record"}
 SEEDS=${SCREEN_SEEDS:-"1 2 3"}
 POP=${SCREEN_POPULATION:-100}
@@ -25,40 +30,25 @@ KEEP=studies/worlds/crawl_screen
 WORK=runs/crawl_screen
 mkdir -p "$KEEP" "$WORK"
 
-one() {  # gravity stiffness guard seed
+one() {  # gravity stiffness frequency_max amplitude_max guard seed
   set -euo pipefail
-  local g=$1 k=$2 guard=$3 seed=$4
-  local name="g${g}_${guard}_seed${seed}"
-  [[ "$k" == 100 ]] || name="g${g}_k${k}_${guard}_seed${seed}"
-  local keep="$KEEP/$name" work="$WORK/$name"
-  [[ -f "$keep/history.csv" ]] && return 0
-  if [[ -f "$work/checkpoint.json" ]]; then
-    "$EXE" --resume "$work" --generations "$GENS" --threads 1 --quiet >/dev/null
-  else
-    rm -rf "$work"
-    "$EXE" --config configs/crawl.toml --set "scene.gravity=$g" --set "scene.spring_stiffness=$k" \
-      --set "evolution.population=$POP" \
-      --set "evaluation.reference_check=$guard" --generations "$GENS" --threads 1 --seed "$seed" \
-      --quiet --out "$work" >/dev/null
-  fi
-  local last
-  last=$(tail -1 "$work/history.csv" | cut -d, -f1)
-  if [[ "$last" != "$GENS" && ! -f "$work/stopped.txt" ]]; then
-    echo "crawl_screen: $name stopped at generation $last, not kept" >&2
-    return 1
-  fi
-  rm -rf "$keep.tmp"
-  mkdir -p "$keep.tmp"
-  cp "$work/config.toml" "$work/history.csv" "$keep.tmp/"
-  cp -r "$work/best" "$keep.tmp/best"
-  mv "$keep.tmp" "$keep"
-  echo "crawl_screen: kept $name"
+  local g=$1 k=$2 f=$3 a=$4 guard=$5 seed=$6
+  local name="g${g}"
+  [[ "$k" == 100 ]] || name+="_k${k}"
+  [[ "$f" == 6 ]] || name+="_f${f}"
+  [[ "$a" == 0.2 ]] || name+="_a${a}"
+  name+="_${guard}_seed${seed}"
+  [[ -f "$KEEP/$name/history.csv" ]] && return 0
+  evolve_kept "$name" "$KEEP/$name" "$WORK/$name" "$GENS" lineage \
+    --config configs/crawl.toml --set "scene.gravity=$g" --set "scene.spring_stiffness=$k" \
+    --set "development.frequency_max=$f" --set "development.amplitude_max=$a" \
+    --set "evolution.population=$POP" --set "evaluation.reference_check=$guard" --seed "$seed"
 }
-export -f one
+export -f one evolve_kept
 export EXE GENS POP KEEP WORK
 
 points=()
-for g in $GRAVITY; do for k in $STIFFNESS; do for guard in $GUARD; do for seed in $SEEDS; do
-  points+=("$g $k $guard $seed")
+for g in $GRAVITY; do for k in $STIFFNESS; do for f in $FREQUENCY_MAX; do for a in $AMPLITUDE_MAX; do
+  for guard in $GUARD; do for seed in $SEEDS; do points+=("$g $k $f $a $guard $seed"); done; done
 done; done; done; done
 printf '%s\n' "${points[@]}" | xargs -P "$JOBS" -L 1 bash -c 'one "$@"' _

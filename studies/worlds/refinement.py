@@ -1,6 +1,7 @@
-"""Does the crawl ranking survive refinement? Re-swims every lineage best of the crawl screen.
+"""Does the ranking survive refinement? Re-swims every lineage best of a screen's kept runs.
 
-For each run kept by ``crawl_screen.sh`` (``studies/worlds/crawl_screen/<name>/``), every genome
+For each run kept by ``crawl_screen.sh`` (``studies/worlds/crawl_screen/<name>/``, the default
+``--runs``) or by ``studies/control/screen.sh`` (``--runs studies/control/screen``), every genome
 that became the run's best is evaluated again, independently of the run's own monitor, with the
 run's config at its step dt and at dt/16 (``physics.dt`` / 16 with 16 times the swim and settle
 steps: the same simulated time). One row per lineage best goes to ``results/crawl_refinement.csv``;
@@ -8,6 +9,8 @@ the summary printed per grid point is what ``docs/worlds.md`` quotes.
 
     PYTHONPATH=build/python .venv/bin/python studies/worlds/refinement.py
     PYTHONPATH=build/python .venv/bin/python studies/worlds/refinement.py --ladder g1_record_seed2:4
+    PYTHONPATH=build/python .venv/bin/python studies/worlds/refinement.py --runs studies/control/screen \
+        --out studies/control/results/screen_refinement.csv
 
 ``--ladder RUN:GENERATION ...`` prints, for those lineage bests, the fitness and the airborne share
 at dt, dt/2, dt/4, dt/8, dt/16 and dt/32 (does the fitness converge as the step shrinks?).
@@ -17,14 +20,19 @@ recorded (the fitness the run recorded), fitness (re-evaluated at dt), fitness_f
 error (fitness / fitness_fine - 1), fitness_finest (at dt/32), ranked_error (the error of the fitness
 the GA ranked by: fitness / fitness_fine - 1 under the guard's "record", and fitness_fine /
 fitness_finest - 1 under "select", where the GA ranks by the reference at dt/16), valid, valid_fine (the body's invariants held for the whole
-swim), airborne_share (Box2D steps in which the floor pushed no cell / Box2D steps, at dt), final
-(1 for the run's last lineage best).
+swim), airborne_share (Box2D steps in which the floor pushed no cell / Box2D steps, at dt; empty
+without a floor), elongation, protrusions and symmetric_pair (``animat.shape`` of the developed body),
+final (1 for the run's last lineage best).
+
+Runs already in ``--out`` are not swum again (delete it to redo them). The summary groups the runs by
+their grid point (the run's name without its seed).
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import re
 import sys
 from pathlib import Path
 
@@ -50,6 +58,9 @@ FIELDS = (
     "valid",
     "valid_fine",
     "airborne_share",
+    "elongation",
+    "protrusions",
+    "symmetric_pair",
     "final",
 )
 
@@ -75,6 +86,7 @@ def rows_of(run_dir: Path):
         coarse = animat.evaluate(entry.genome, cfg)
         refined_result = animat.evaluate(entry.genome, fine)
         finest_result = animat.evaluate(entry.genome, finest)
+        shape = animat.shape.genome_shape(entry.genome, cfg)
         ranked, truth = (
             (refined_result.fitness, finest_result.fitness) if select else (coarse.fitness, refined_result.fitness)
         )
@@ -94,33 +106,42 @@ def rows_of(run_dir: Path):
             "ranked_error": ranked / truth - 1.0 if truth else float("nan"),
             "valid": int(coarse.valid),
             "valid_fine": int(refined_result.valid),
-            "airborne_share": coarse.airborne_steps / box2d_steps,
+            "airborne_share": coarse.airborne_steps / box2d_steps if "ground" in cfg["scene.effects"] else "",
+            "elongation": shape.elongation,
+            "protrusions": shape.protrusion_count,
+            "symmetric_pair": int(shape.symmetric_pair),
             "final": int(i == len(lineage) - 1),
         }
 
 
+def point_of(run: str) -> str:
+    """A run's grid point: its name without the seed."""
+    return re.sub(r"_seed\d+$", "", run)
+
+
 def summarize(rows) -> None:
-    points = sorted({(float(r["gravity"]), float(r["stiffness"]), r["guard"]) for r in rows})
+    points = list(dict.fromkeys(point_of(r["run"]) for r in rows))
     print(
-        "| gravity | stiffness | guard | runs | lineage bests | invalid (dt, dt/16) | dt vs dt/16: abs error p50 / p90 / max "
+        "| point | runs | lineage bests | invalid (dt, dt/16) | dt vs dt/16: abs error p50 / p90 / max "
         "| ranked vs next finer: abs error p50 / p90 / max | final bests: ranked error | final bests: fitness "
-        "at dt | final bests: airborne share |"
+        "at dt | final bests: airborne share | final bests: protrusions (symmetric pair) |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for g, k, guard in points:
-        sel = [r for r in rows if (float(r["gravity"]), float(r["stiffness"]), r["guard"]) == (g, k, guard)]
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for point in points:
+        sel = [r for r in rows if point_of(r["run"]) == point]
         fin = [r for r in sel if int(r["final"])]
         err = np.abs([float(r["error"]) for r in sel])
         rerr = np.abs([float(r["ranked_error"]) for r in sel])
         ferr = ", ".join(f"{abs(float(r['ranked_error'])):.2%}" for r in fin)
         inv = sum(1 - int(r["valid"]) for r in sel), sum(1 - int(r["valid_fine"]) for r in sel)
-        fit = ", ".join(f"{float(r['fitness']):.1f}" for r in fin)
-        air = ", ".join(f"{float(r['airborne_share']):.0%}" for r in fin)
+        fit = ", ".join(f"{float(r['fitness']):.{3 if float(r['fitness']) < 10 else 1}f}" for r in fin)
+        shapes = ", ".join(f"{r['protrusions']}{' (pair)' if int(r['symmetric_pair']) else ''}" for r in fin)
+        air = ", ".join("-" if r["airborne_share"] == "" else f"{float(r['airborne_share']):.0%}" for r in fin)
         print(
-            f"| {g:g} | {k:g} | {guard} | {len(fin)} | {len(sel)} | {inv[0]}, {inv[1]} | "
+            f"| {point} | {len(fin)} | {len(sel)} | {inv[0]}, {inv[1]} | "
             f"{np.percentile(err, 50):.2%} / {np.percentile(err, 90):.2%} / {err.max():.2%} | "
             f"{np.percentile(rerr, 50):.2%} / {np.percentile(rerr, 90):.2%} / {rerr.max():.2%} | "
-            f"{ferr} | {fit} | {air} |"
+            f"{ferr} | {fit} | {air} | {shapes} |"
         )
 
 
@@ -159,7 +180,14 @@ def main(argv=None) -> int:
         if not runs:
             print(f"{args.runs}: no kept runs (run studies/worlds/crawl_screen.sh first)", file=sys.stderr)
             return 1
-        rows = [row for d in runs for row in rows_of(d)]
+        # Runs already in --out are kept as they are (delete it to re-swim them).
+        rows = []
+        if out.is_file():
+            with open(out, newline="") as f:
+                rows = [r for r in csv.DictReader(f) if (Path(args.runs) / r["run"]).is_dir()]
+        done = {r["run"] for r in rows}
+        rows += [row for d in runs if d.name not in done for row in rows_of(d)]
+        rows.sort(key=lambda r: (r["run"], int(r["generation"])))
         out.parent.mkdir(parents=True, exist_ok=True)
         with open(out, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=FIELDS, lineterminator="\n")
