@@ -248,6 +248,31 @@ void bind_body(nb::module_& m) {
       "Signed shoelace area of the closed vertex loop `loop` (indices into the (n, 2) array "
       "`points`);\n"
       "positive when counter-clockwise.");
+  m.def(
+      "morphology_kind",
+      [](nb::handle points) { return morphology_kind(to_points(points, "morphology_kind")); },
+      "points"_a,
+      "The coarse class of a body plan that evolution.protection_generations compares: cell "
+      "count * 16 +\n"
+      "elongation band, the band floor(log_1.5 elongation) clamped to [0, 15] (elongation as\n"
+      "animat.shape.elongation of the cell centres `points`, an (n, 2) array: sqrt of the ratio "
+      "of the\n"
+      "principal second moments, each cell a disc of one cell spacing); 0 for no cell. "
+      "EvaluationResult\n"
+      "and Fitness carry it for an evaluated genome (its body's rest positions).");
+  // The C++ geometry behind morphology_kind, for the tests that hold it to animat.shape.
+  m.def(
+      "_elongation",
+      [](nb::handle points, double cell_diameter) {
+        return elongation(to_points(points, "_elongation"), cell_diameter);
+      },
+      "points"_a, "cell_diameter"_a = 1.0,
+      "The C++ elongation of morphology_kind (animat.shape.elongation computes the same).");
+  m.def(
+      "_cell_spacing",
+      [](nb::handle points) { return cell_spacing(to_points(points, "_cell_spacing")); },
+      "points"_a,
+      "The C++ cell spacing of morphology_kind (animat.shape.cell_spacing computes the same).");
 }
 
 }  // namespace animat::py

@@ -73,18 +73,23 @@ void bind_evolution(nb::module_& m) {
       .def(
           "__init__",
           [](Fitness* f, double fitness, bool viable, bool stable, int cell_count, bool valid,
-             long drag_limited) {
+             long drag_limited, int morphology_kind) {
             if (drag_limited < 0) throw nb::value_error("Fitness: drag_limited must be >= 0");
-            new (f) Fitness{fitness, viable, stable, cell_count, valid, drag_limited};
+            if (morphology_kind < 0) throw nb::value_error("Fitness: morphology_kind must be >= 0");
+            new (f)
+                Fitness{fitness, viable, stable, cell_count, valid, drag_limited, morphology_kind};
           },
           "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0,
-          "valid"_a = true, "drag_limited"_a = 0,
+          "valid"_a = true, "drag_limited"_a = 0, "morphology_kind"_a = 0,
           "A fitness to tell() the GA: the objective's value, whether the genome was viable "
           "(non-viable ones\n"
           "are never selected before viable ones), whether its swim was stable, its cell count, "
           "whether the\n"
-          "swim kept every invariant, and how often the drag limiter altered it (drag_scheme "
-          "\"stable\" only).")
+          "swim kept every invariant, how often the drag limiter altered it (drag_scheme "
+          "\"stable\" only), and\n"
+          "the body plan's coarse class (EvaluationResult.morphology_kind; what "
+          "evolution.protection_generations\n"
+          "compares; 0 = unknown).")
       .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
       // Float-like: `ind.fitness` is the record, and it formats, converts and orders as its value,
       // as LineageEntry.fitness and the history's floats do.
@@ -105,7 +110,7 @@ void bind_evolution(nb::module_& m) {
       .def("__gt__", [](const Fitness& a, const Fitness& b) { return a.fitness > b.fitness; })
       .def("__ge__", [](const Fitness& a, const Fitness& b) { return a.fitness >= b.fitness; })
       // The pickled state is the tuple of the descriptor's fields; 5 entries: pickled before
-      // drag_limited.
+      // drag_limited, 6: before morphology_kind.
       .def("__getstate__",
            [](const Fitness& f) {
              nb::list state;
@@ -118,9 +123,9 @@ void bind_evolution(nb::module_& m) {
              std::size_t fields = 0;
              const Fitness empty;
              visit_fields(empty, [&](const char*, const char*, const auto&) { ++fields; });
-             if (t.size() != 5 && t.size() != fields)
+             if (t.size() < 5 || t.size() > fields)
                throw nb::value_error(
-                   fmt::format("Fitness state: expected 5 or {} entries", fields).c_str());
+                   fmt::format("Fitness state: expected 5 to {} entries", fields).c_str());
              new (&f) Fitness{};
              std::size_t k = 0;
              visit_fields(f, [&](const char*, const char*, auto& value) {
@@ -143,14 +148,17 @@ void bind_evolution(nb::module_& m) {
                                     "Statistics of one generation (a row of history.csv).");
   {
     const GenerationStats probe;
-    nb::list columns;
+    nb::list columns, protected_columns;
     visit_fields(probe, [&](const StatsField& f, const auto& field) {
       using T = std::decay_t<decltype(field)>;
       def_field_property(stats, probe, field, f.name, f.doc);
-      if (f.csv)
-        columns.append(nb::make_tuple(f.name, std::is_floating_point_v<T> ? "float64" : "int64"));
+      const auto column = nb::make_tuple(f.name, std::is_floating_point_v<T> ? "float64" : "int64");
+      if (f.csv && !f.protection_only) columns.append(column);
+      if (f.csv) protected_columns.append(column);
     });
     stats.attr("HISTORY_COLUMNS") = nb::tuple(columns);
+    // a run with evolution.protection_generations > 0 has the protection's columns too
+    stats.attr("PROTECTED_HISTORY_COLUMNS") = nb::tuple(protected_columns);
   }
   stats
       .def(
@@ -192,17 +200,28 @@ void bind_evolution(nb::module_& m) {
               "checkpoint without ids).")
       .def_ro("parent_b", &Individual::parent_b,
               "Id of its second parent (crossover only); -1 otherwise.")
+      .def_ro("morphology_age", &Individual::morphology_age,
+              "Generations since its lineage's morphology kind (fitness.morphology_kind) "
+              "appeared: 0 for an\n"
+              "initial individual and an offspring of a new kind, else its parent's + 1 (elites "
+              "age by 1 per\n"
+              "generation). Younger than evolution.protection_generations: protected.")
+      // 6 entries: pickled before morphology_age.
       .def("__getstate__",
            [](const Individual& i) {
-             return nb::make_tuple(i.genome, i.result, i.tries, i.id, i.parent_a, i.parent_b);
+             return nb::make_tuple(i.genome, i.result, i.tries, i.id, i.parent_a, i.parent_b,
+                                   i.morphology_age);
            })
       .def("__setstate__",
-           [](Individual& i,
-              const std::tuple<Genome, Fitness, int, std::int64_t, std::int64_t, std::int64_t>& t) {
-             new (&i) Individual{std::get<0>(t), std::get<1>(t), std::get<2>(t)};
-             i.id = std::get<3>(t);
-             i.parent_a = std::get<4>(t);
-             i.parent_b = std::get<5>(t);
+           [](Individual& i, const nb::tuple& t) {
+             if (t.size() != 6 && t.size() != 7)
+               throw nb::value_error("Individual state: expected 6 or 7 entries");
+             new (&i)
+                 Individual{nb::cast<Genome>(t[0]), nb::cast<Fitness>(t[1]), nb::cast<int>(t[2])};
+             i.id = nb::cast<std::int64_t>(t[3]);
+             i.parent_a = nb::cast<std::int64_t>(t[4]);
+             i.parent_b = nb::cast<std::int64_t>(t[5]);
+             if (t.size() == 7) i.morphology_age = nb::cast<int>(t[6]);
            })
       .def("__copy__", [](const Individual& i) { return i; })
       .def(

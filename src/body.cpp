@@ -336,4 +336,60 @@ Body build_body(const Embryo& embryo, const BodyParams& params) {
   return body;
 }
 
+double cell_spacing(const Points& positions) {
+  const auto n = static_cast<std::size_t>(positions.rows());
+  if (n < 2) return 1.0;
+  std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const auto a = static_cast<Eigen::Index>(i), b = static_cast<Eigen::Index>(j);
+      const double dx = positions(a, 0) - positions(b, 0), dy = positions(a, 1) - positions(b, 1);
+      const double d = std::sqrt(dx * dx + dy * dy);
+      nearest[i] = std::min(nearest[i], d);
+      nearest[j] = std::min(nearest[j], d);
+    }
+  std::sort(nearest.begin(), nearest.end());
+  const double s =
+      n % 2 ? nearest[n / 2] : (nearest[n / 2 - 1] + nearest[n / 2]) / 2.0;  // numpy's median
+  return s > 0.0 ? s : 1.0;
+}
+
+double elongation(const Points& positions, double cell_diameter) {
+  const Eigen::Index n = positions.rows();
+  if (n == 0) return 1.0;
+  const double s = cell_spacing(positions);
+  const double count = static_cast<double>(n);
+  const double mx = positions.col(0).sum() / count, my = positions.col(1).sum() / count;
+  double xx = 0.0, yy = 0.0, xy = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double x = positions(i, 0) - mx, y = positions(i, 1) - my;
+    xx += x * x;
+    yy += y * y;
+    xy += x * y;
+  }
+  const double disc = (cell_diameter * s) * (cell_diameter * s) / 16.0;
+  xx = xx / count + disc;
+  yy = yy / count + disc;
+  xy /= count;
+  // The eigenvalues of the symmetric 2 × 2 matrix [[xx, xy], [xy, yy]].
+  const double mid = 0.5 * (xx + yy), radius = std::hypot(0.5 * (xx - yy), xy);
+  const double major = mid + radius, minor = mid - radius;
+  if (major <= 0.0) return 1.0;
+  if (minor <= 1e-12 * major) return std::numeric_limits<double>::infinity();
+  return std::sqrt(major / minor);
+}
+
+int morphology_kind(const Points& positions) {
+  const auto n = static_cast<int>(positions.rows());
+  if (n == 0) return 0;
+  const double e = elongation(positions);
+  int band = 0;
+  double threshold = 1.5;  // 1.5^(band + 1), exact: 3^16 < 2^53
+  while (band + 1 < kElongationBands && e >= threshold) {
+    ++band;
+    threshold *= 1.5;
+  }
+  return n * kElongationBands + band;
+}
+
 }  // namespace animat

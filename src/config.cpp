@@ -433,7 +433,9 @@ void set_value(Config& config, std::string_view dotted, const ConfigValue& cv) {
     if (!ok && std::is_same_v<T, int> && std::holds_alternative<std::int64_t>(cv))
       throw ConfigError(fmt::format("{} = {}: out of the integer range, expected {}", dotted,
                                     std::get<std::int64_t>(cv), info.bounds.describe()));
-    if (!ok) throw ConfigError(fmt::format("{}: wrong type, expected {}", dotted, type_name<T>()));
+    if (!ok)
+      throw ConfigError(fmt::format("{} = {}: wrong type, expected {}", dotted,
+                                    format_config_value(cv), type_name<T>()));
     if (auto e = check(info, parsed); !e.empty())
       throw ConfigError(fmt::format("{} = {}: {}", dotted, format_value(parsed), e));
     value = std::move(parsed);

@@ -305,6 +305,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
   out.spring_count = body.spring_count();
   out.region_count = body.region_count();
   out.skin_edge_count = static_cast<int>(body.skin.rows());
+  out.morphology_kind = morphology_kind(body.positions);
 
   t0 = Clock::now();
   SwimOptions options;

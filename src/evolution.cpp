@@ -55,10 +55,9 @@ bool nonnegative_objective(const Config& c) {
 }
 
 // A fitness the GA can rank and a checkpoint can hold (restore() refuses anything else): finite,
-// and
-// >= 0 under an objective that is never negative; cell_count and drag_limited >= 0. "" =
-// acceptable, else what is wrong. The one rule for every way a fitness reaches the engine: its own
-// evaluations, tell() (animat.GA) and the exploit guard's reference evaluations.
+// and >= 0 under an objective that is never negative; cell_count, drag_limited and morphology_kind
+// >= 0. "" = acceptable, else what is wrong. The one rule for every way a fitness reaches the
+// engine: its own evaluations, tell() (animat.GA) and the exploit guard's reference evaluations.
 std::string fitness_problem(const Fitness& f, bool nonnegative) {
   if (!std::isfinite(f.fitness) || (nonnegative && f.fitness < 0.0))
     return fmt::format(
@@ -67,6 +66,8 @@ std::string fitness_problem(const Fitness& f, bool nonnegative) {
                     : "");
   if (f.cell_count < 0) return fmt::format("cell_count {} (must be >= 0)", f.cell_count);
   if (f.drag_limited < 0) return fmt::format("drag_limited {} (must be >= 0)", f.drag_limited);
+  if (f.morphology_kind < 0)
+    return fmt::format("morphology_kind {} (must be >= 0)", f.morphology_kind);
   return {};
 }
 
@@ -134,7 +135,7 @@ double tournament_probability(const EvolutionParams& p, int generation) {
 }
 
 std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std::size_t>& eligible,
-                       double p_fitter, Rng& rng) {
+                       double p_fitter, Rng& rng, int protection) {
   if (eligible.empty()) throw Error("tournament: no eligible individual");
   if (eligible.size() == 1) return eligible[0];
   const std::size_t a = eligible[rng.below(eligible.size())];
@@ -142,6 +143,15 @@ std::size_t tournament(const std::vector<Individual>& pop, const std::vector<std
   if (b == a) b = eligible.back();  // two distinct individuals, uniformly
   const bool a_fitter = fitter(pop[a], pop[b]) || (!fitter(pop[b], pop[a]) && a < b);
   const std::size_t winner = a_fitter ? a : b, loser = a_fitter ? b : a;
+  // Morphological innovation protection: a new body plan usually swims worse than the established
+  // ones until evolution has tuned its control, so it does not compete with an older kind yet.
+  // One draw either way: the random stream does not depend on who is protected.
+  if (protection > 0) {
+    const Individual &f = pop[winner], &o = pop[loser];
+    if (o.morphology_age < protection && o.result.morphology_kind != f.result.morphology_kind &&
+        o.morphology_age < f.morphology_age)
+      return rng.bernoulli(0.5) ? winner : loser;
+  }
   return rng.bernoulli(p_fitter) ? winner : loser;
 }
 
@@ -408,6 +418,7 @@ std::vector<Genome> Evolution::ask_generation() {
   std::vector<std::size_t> copied(layout.count(), 0);
   std::vector<Individual>& next = next_;
   next.assign(n, Individual{});
+  next_origin_.assign(n, Origin{});
   std::vector<bool> needs_eval(n, false);
   const bool select_by_reference = reference_ && config_->evaluation.reference_check == "select";
   for (std::size_t isl = 0; isl < layout.count(); ++isl) {
@@ -424,6 +435,7 @@ std::vector<Genome> Evolution::ask_generation() {
     if (select_by_reference) {
       // exploit guard "select": the elites are the best at the reference step
       for (std::size_t i : reference_ranked(order, elites)) {
+        next_origin_[layout.begin(isl) + copied[isl]] = Origin{i, Origin::none, true};
         Individual& elite = next[layout.begin(isl) + copied[isl]++];
         elite = population_[i];
         elite.tries = 0;
@@ -432,12 +444,14 @@ std::vector<Genome> Evolution::ask_generation() {
     }
     for (std::size_t k = 0; k < order.size() && copied[isl] < elites; ++k) {
       if (!population_[order[k]].result.viable) break;
+      next_origin_[layout.begin(isl) + copied[isl]] = Origin{order[k], Origin::none, true};
       Individual& elite = next[layout.begin(isl) + copied[isl]++];
       elite = population_[order[k]];
       elite.tries = 0;
     }
   }
   const double p = tournament_probability(ep, g);
+  const int protection = ep.protection_generations;
   int crossovers = 0;
   // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated
   // twice).
@@ -451,15 +465,17 @@ std::vector<Genome> Evolution::ask_generation() {
     child.id =
         static_cast<std::int64_t>(g) * static_cast<std::int64_t>(n) + static_cast<std::int64_t>(i);
     if (rng.bernoulli(ep.crossover_fraction)) {
-      const std::size_t a = tournament(population_, eligible[isl], p, rng);
-      const std::size_t b = tournament(population_, eligible[isl], p, rng);
+      const std::size_t a = tournament(population_, eligible[isl], p, rng, protection);
+      const std::size_t b = tournament(population_, eligible[isl], p, rng, protection);
+      next_origin_[i] = Origin{a, b, false};
       ++crossovers;
       child.genome = crossover(population_[a].genome, population_[b].genome,
                                config_->mutation.crossover_points, rng);
       child.parent_a = population_[a].id;
       child.parent_b = population_[b].id;
     } else {
-      const std::size_t a = tournament(population_, eligible[isl], p, rng);
+      const std::size_t a = tournament(population_, eligible[isl], p, rng, protection);
+      next_origin_[i] = Origin{a, Origin::none, false};
       child.genome = population_[a].genome;
       child.parent_a = population_[a].id;
     }
@@ -491,6 +507,21 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
     if (fitness[k].viable) ++swims;
   }
   evaluations_ += static_cast<std::int64_t>(fitness.size());
+  // Morphology ages, now that every offspring's kind is known (next_origin_ is only read: a tell
+  // that the exploit guard undoes can be repeated).
+  for (std::size_t i = 0; i < next_.size(); ++i) {
+    const Origin& o = next_origin_[i];
+    Individual& child = next_[i];
+    child.morphology_age = 0;  // a kind neither parent had (or no parent)
+    for (const std::size_t parent : {o.a, o.b}) {
+      if (parent >= population_.size()) continue;
+      const Individual& p = population_[parent];
+      if (o.elite || p.result.morphology_kind == child.result.morphology_kind) {
+        const int age = p.morphology_age + 1;
+        child.morphology_age = child.morphology_age > 0 ? std::min(child.morphology_age, age) : age;
+      }
+    }
+  }
 
   const Genome previous_best = best().genome;
   population_ = std::move(next_);
@@ -554,6 +585,9 @@ GenerationStats Evolution::statistics(bool best_changed, double wall, int swims)
   s.swims = swims;
   s.swims_per_second = seconds > 0 ? swims / seconds : 0.0;
   s.best_changed = best_changed;
+  if (const int protection = config_->evolution.protection_generations; protection > 0)
+    for (const auto& ind : population_)
+      if (ind.result.viable && ind.morphology_age < protection) ++s.protected_count;
   return s;
 }
 
@@ -652,6 +686,9 @@ void check_semantics(const std::vector<Individual>& pop, const std::vector<Gener
       fail(fmt::format("individual {} has fitness {} (a fitness is >= 0)", i, f.fitness));
     if (f.viable && pop[i].genome.elements.empty())
       fail(fmt::format("individual {} is viable with an empty genome", i));
+    if (!hist.empty() && pop[i].morphology_age > hist.back().generation)
+      fail(fmt::format("individual {} has morphology_age {}, older than the run (generation {})", i,
+                       pop[i].morphology_age, hist.back().generation));
   }
   double best_so_far = -std::numeric_limits<double>::infinity();
   int expected_stall = 0;
@@ -747,6 +784,9 @@ std::string Evolution::checkpoint() const {
     if (ind.parent_b != kNoParent) ji["parent_b"] = ind.parent_b;
     if (!std::isnan(ind.reference)) ji["reference"] = ind.reference;
     if (ind.result.drag_limited > 0) ji["drag_limited"] = ind.result.drag_limited;
+    // Absent when 0 (also in checkpoints written before morphology kinds and ages existed).
+    if (ind.result.morphology_kind > 0) ji["morphology_kind"] = ind.result.morphology_kind;
+    if (ind.morphology_age > 0) ji["morphology_age"] = ind.morphology_age;
     individuals[static_cast<std::size_t>(i)] = std::move(ji);
   }
   json pop = json::array();
@@ -819,6 +859,10 @@ void Evolution::restore(std::string_view text, std::string_view source) {
       if (ji.contains("drag_limited"))
         ind.result.drag_limited = static_cast<long>(int_field(ji, "drag_limited", 0, kInt64Max));
       ind.result.cell_count = static_cast<int>(int_field(ji, "cell_count", 0, kIntMax));
+      if (ji.contains("morphology_kind"))
+        ind.result.morphology_kind = static_cast<int>(int_field(ji, "morphology_kind", 0, kIntMax));
+      if (ji.contains("morphology_age"))
+        ind.morphology_age = static_cast<int>(int_field(ji, "morphology_age", 0, kIntMax));
       ind.tries = static_cast<int>(int_field(ji, "tries", 0, kIntMax));
       // Checkpoints written before the genealogy hold no ids: each individual is then taken as
       // born at the checkpoint's generation, with unknown parents.
@@ -862,6 +906,7 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     population_ = std::move(pop);
     slots_.clear();
     next_.clear();
+    next_origin_.clear();
     pending_ = false;
     asked_.clear();
     asked_index_.clear();

@@ -21,7 +21,9 @@ FitnessFunction objective_fitness(const Config& config,
   auto shared = std::make_shared<const Config>(config);
   return [shared, objective = std::move(objective)](const Genome& genome) {
     const EvaluationResult r = evaluate(genome, *shared, *objective);
-    return Fitness{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
+    Fitness f{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
+    f.morphology_kind = r.morphology_kind;
+    return f;
   };
 }
 

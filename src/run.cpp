@@ -85,23 +85,26 @@ std::string read_file(const std::filesystem::path& path) {
   return ss.str();
 }
 
-// history.csv's columns and rows, from GenerationStats' descriptor.
-const std::string& history_header() {
-  static const std::string header = [] {
-    std::string out;
-    GenerationStats probe;
-    visit_fields(probe, [&](const StatsField& f, const auto&) {
-      if (f.csv) out += (out.empty() ? "" : ",") + std::string(f.name);
-    });
-    return out + "\n";
-  }();
-  return header;
+// history.csv's columns and rows, from GenerationStats' descriptor. `protecting`: the run has
+// morphological innovation protection (evolution.protection_generations > 0), whose columns only
+// its history.csv holds.
+bool history_column(const StatsField& f, bool protecting) {
+  return f.csv && (protecting || !f.protection_only);
 }
 
-std::string history_row(const GenerationStats& s) {
+std::string history_header(bool protecting) {
+  std::string out;
+  GenerationStats probe;
+  visit_fields(probe, [&](const StatsField& f, const auto&) {
+    if (history_column(f, protecting)) out += (out.empty() ? "" : ",") + std::string(f.name);
+  });
+  return out + "\n";
+}
+
+std::string history_row(const GenerationStats& s, bool protecting) {
   std::string out;
   visit_fields(s, [&](const StatsField& f, const auto& value) {
-    if (!f.csv) return;
+    if (!history_column(f, protecting)) return;
     if (!out.empty()) out += ',';
     if constexpr (std::is_floating_point_v<std::decay_t<decltype(value)>>) {
       if (f.decimals >= 0) {
@@ -120,7 +123,7 @@ void append(const std::filesystem::path& path, std::string_view text) {
     throw IoError(fmt::format("{}: cannot append", path.string()));
 }
 
-void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
+void write_lineage(const std::filesystem::path& dir, const Evolution& evo, bool protecting) {
   const Individual& b = evo.best();
   json j{{"generation", evo.generation()},
          {"fitness", b.result.fitness},
@@ -128,6 +131,10 @@ void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
          {"cell_count", b.result.cell_count},
          {"id", b.id},
          {"genome", json::parse(to_json(b.genome))}};
+  if (protecting) {  // other runs write the file as before
+    j["morphology_kind"] = b.result.morphology_kind;
+    j["morphology_age"] = b.morphology_age;
+  }
   write_atomically(dir / "best" / fmt::format("gen_{:06d}.json", evo.generation()),
                    j.dump(1) + "\n");
 }
@@ -135,17 +142,21 @@ void write_lineage(const std::filesystem::path& dir, const Evolution& evo) {
 // genealogy.csv: one row per individual born (the initial population, then each generation's
 // offspring; an elite or migrant copy is not born again), so the family tree of any individual can
 // be traced through the parent ids. Rows after the checkpoint are dropped on resume, as
-// history.csv's.
+// history.csv's. A run with morphological innovation protection adds each newborn's morphology kind
+// and age (0, or its parent's + 1); other runs write the file as before.
 class GenealogyLog {
  public:
   static constexpr std::string_view kHeader = "generation,id,parent_a,parent_b,fitness,cells\n";
-  explicit GenealogyLog(std::filesystem::path path) : path_(std::move(path)) {}
+  static constexpr std::string_view kProtectionHeader =
+      "generation,id,parent_a,parent_b,fitness,cells,morphology_kind,morphology_age\n";
+  GenealogyLog(std::filesystem::path path, bool protecting)
+      : path_(std::move(path)), protecting_(protecting) {}
 
   void start(const Evolution& evo) const {
-    write_atomically(path_, std::string(kHeader) + rows(evo));
+    write_atomically(path_, std::string(header()) + rows(evo));
   }
   void resume(int generation) const {
-    std::string kept(kHeader);
+    std::string kept(header());
     std::ifstream in(path_, std::ios::binary);
     std::string line;
     for (bool header = true; std::getline(in, line); header = false) {
@@ -159,7 +170,10 @@ class GenealogyLog {
   void append(const Evolution& evo) const { ::animat::append(path_, rows(evo)); }
 
  private:
-  static std::string rows(const Evolution& evo) {
+  [[nodiscard]] std::string_view header() const {
+    return protecting_ ? kProtectionHeader : kHeader;
+  }
+  std::string rows(const Evolution& evo) const {
     const auto& pop = evo.population();
     const auto n = static_cast<std::int64_t>(pop.size());
     const std::int64_t first = static_cast<std::int64_t>(evo.generation()) * n;
@@ -170,12 +184,15 @@ class GenealogyLog {
       const auto slot = static_cast<std::size_t>(ind.id - first);
       if (written[slot]) continue;  // a migrant's second copy
       written[slot] = true;
-      out += fmt::format("{},{},{},{},{},{}\n", evo.generation(), ind.id, ind.parent_a,
-                         ind.parent_b, ind.result.fitness, ind.result.cell_count);
+      out += fmt::format("{},{},{},{},{},{}", evo.generation(), ind.id, ind.parent_a, ind.parent_b,
+                         ind.result.fitness, ind.result.cell_count);
+      out += protecting_ ? fmt::format(",{},{}\n", ind.result.morphology_kind, ind.morphology_age)
+                         : std::string("\n");
     }
     return out;
   }
   std::filesystem::path path_;
+  bool protecting_;
 };
 
 std::string duration(double s) {
@@ -490,7 +507,9 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
   const bool writing = !opt.out.empty();
   // [islands] islands.csv
   IslandLog island_log(writing ? opt.out : std::filesystem::path{}, config.evolution);
-  const GenealogyLog genealogy(opt.out / "genealogy.csv");
+  // [protection] history.csv, genealogy.csv and the lineage carry the protection's columns
+  const bool protecting = config.evolution.protection_generations > 0;
+  const GenealogyLog genealogy(opt.out / "genealogy.csv", protecting);
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
 
   // 1. Everything that can refuse the command, before any file is written: checked once without the
@@ -561,8 +580,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
   }
 
   if (opt.resume) {
-    std::string rows(history_header());
-    for (const auto& s : evo.history()) rows += history_row(s);
+    std::string rows(history_header(protecting));
+    for (const auto& s : evo.history()) rows += history_row(s, protecting);
     write_atomically(hist, rows);  // drops rows written after the checkpoint
     island_log.resume(evo.generation());
     genealogy.resume(evo.generation());
@@ -600,8 +619,9 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
           "(paper: \"a few hundred\"); they are developed, only the viable ones swim",
           tag, evo.evaluations(), mean_tries);
     if (writing) {
-      write_atomically(hist, history_header() + history_row(evo.history().back()));
-      write_lineage(opt.out, evo);
+      write_atomically(hist,
+                       history_header(protecting) + history_row(evo.history().back(), protecting));
+      write_lineage(opt.out, evo, protecting);
       island_log.start(evo);
       genealogy.start(evo);
       write_atomically(ckpt, evo.checkpoint());
@@ -677,10 +697,10 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
     report(s, false);
     guard(s);
     if (writing) {
-      append(hist, history_row(s));
+      append(hist, history_row(s, protecting));
       island_log.append(evo);
       genealogy.append(evo);
-      if (s.best_changed) write_lineage(opt.out, evo);
+      if (s.best_changed) write_lineage(opt.out, evo, protecting);
       dirty = true;
       if (++since_checkpoint >= config.evolution.checkpoint_every) {
         write_atomically(ckpt, evo.checkpoint());

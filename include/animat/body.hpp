@@ -118,4 +118,27 @@ struct Body {
 /// than 3 vertices.
 [[nodiscard]] double polygon_area(const Points& positions, const std::vector<int>& loop);
 
+/// s: the median distance from a cell centre to its nearest neighbour (the mean of the two middle
+/// values for an even count); 1 for fewer than 2 cells or a median of 0. The length unit of the
+/// shape descriptors (animat.shape.cell_spacing computes the same).
+[[nodiscard]] double cell_spacing(const Points& positions);
+
+/// sqrt(λ1/λ2) of the cells' principal second moments about their centroid: the eigenvalues of the
+/// covariance of the cell centres plus (cell_diameter·s)²/16 on the diagonal (s = cell_spacing(),
+/// each cell a uniform disc), λ1 >= λ2. 1 for no cell; infinity when λ2 <= 1e-12 λ1 (possible only
+/// with cell_diameter = 0). Exactly animat.shape.elongation (to rounding).
+[[nodiscard]] double elongation(const Points& positions, double cell_diameter = 1.0);
+
+/// Elongation bands of morphology_kind(): band k holds the elongations in [1.5^k, 1.5^(k+1)), the
+/// last one everything from 1.5^15 (438) up.
+inline constexpr int kElongationBands = 16;
+
+/// A coarse class of a body plan: cell count × kElongationBands + elongation band, the band
+/// floor(log_1.5 elongation()) clamped to [0, 15] (computed against the exact powers 1.5^k, no
+/// logarithm, so every machine agrees); 0 for no cell. Coarse on purpose: the GA's morphological
+/// innovation protection (evolution.protection_generations) treats an offspring of another class
+/// than its parents as a new morphology, and an exact signature of the body would change with
+/// nearly every mutation.
+[[nodiscard]] int morphology_kind(const Points& positions);
+
 }  // namespace animat

@@ -143,6 +143,8 @@ struct EvaluationResult {
   /// collision left unresolved (fitness 0). True for non-viable genomes (never swum).
   bool valid = true;
   int cell_count = 0;
+  /// The body plan's coarse class (morphology_kind() in body.hpp); 0 without a body (not viable).
+  int morphology_kind = 0;
   std::vector<std::string> reasons;  ///< non-viability reasons or the instability description
   // Diagnostics.
   Eigen::Vector2d displacement{0.0, 0.0};  ///< COM(end) − COM(start)
@@ -285,6 +287,10 @@ void visit_fields(R& r, V&& v)
   v("viable", "Development verdict; non-viable genomes are never swum.", r.viable);
   v("stable", "False if the development or the swim left the valid domain.", r.stable);
   v("cell_count", "Cells of the embryo.", r.cell_count);
+  v("morphology_kind",
+    "Coarse class of the body plan: cell_count * 16 + elongation band (floor(log_1.5 "
+    "elongation), clamped to [0, 15]); 0 if not viable.",
+    r.morphology_kind);
   v("reasons", "Non-viability reasons, or the instability description.", r.reasons);
   v("spring_count", "Springs of the body.", r.spring_count);
   v("region_count", "Regions of the body.", r.region_count);

@@ -50,6 +50,9 @@ struct Fitness {
   /// Edge-component steps where drag_scheme "stable" scaled eq. 5 down (0 with every other scheme):
   /// the swim was not integrated as written there.
   long drag_limited = 0;
+  /// Coarse class of the body plan (morphology_kind() in body.hpp; 0 if not viable or unknown):
+  /// what the morphological innovation protection (evolution.protection_generations) compares.
+  int morphology_kind = 0;
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
@@ -72,6 +75,11 @@ void visit_fields(F& f, V&& v)
     "Edge-component steps where physics.drag_scheme = \"stable\" scaled eq. 5 down (0 with every "
     "other scheme).",
     f.drag_limited);
+  v("morphology_kind",
+    "Coarse class of the body plan: cell_count * 16 + elongation band (0 if not viable or not "
+    "given); evolution.protection_generations protects an offspring whose class differs from its "
+    "parents'.",
+    f.morphology_kind);
 }
 
 /// Deterministic, thread-safe fitness of a genome. The real one develops and swims (swim_fitness);
@@ -103,6 +111,12 @@ struct Individual {
   /// Fitness at the reference step (the exploit guard, evaluation.reference_check); NaN = not
   /// evaluated.
   double reference = std::numeric_limits<double>::quiet_NaN();
+  /// Generations since its lineage's morphology kind (Fitness::morphology_kind) appeared: 0 for an
+  /// initial individual and for an offspring of a kind neither parent had; else the age of the
+  /// parent of its kind (the younger, if both are) + 1; an elite or unchanged copy ages by 1 per
+  /// generation. Under evolution.protection_generations = P, an individual younger than P is
+  /// protected from older individuals of other kinds in tournaments.
+  int morphology_age = 0;
 };
 
 /// One row of history.csv.
@@ -135,6 +149,9 @@ struct GenerationStats {
   /// Individuals whose swim the drag limiter altered (drag_scheme "stable" only;
   /// Fitness::drag_limited > 0).
   int drag_limited = 0;
+  /// Viable individuals whose morphology is younger than evolution.protection_generations
+  /// (Individual::morphology_age < P); 0 without protection.
+  int protected_count = 0;
 };
 
 /// How a GenerationStats field is stored (its descriptor, visit_fields below).
@@ -152,6 +169,10 @@ struct StatsField {
   Checkpoint checkpoint;
   /// history.csv: fixed decimals (-1: the shortest form that reads back exactly)
   int decimals = -1;
+  /// A column of history.csv only in runs with morphological innovation protection
+  /// (evolution.protection_generations > 0), so that every other run writes the file as before
+  /// (and its Python history has the dtype it always had).
+  bool protection_only = false;
 };
 
 /// GenerationStats' fields with their documentation, in history.csv's column order: the one list
@@ -194,6 +215,12 @@ void visit_fields(S& s, V&& v)
                "only; 0 otherwise).",
                true, C::when_set},
     s.drag_limited);
+  v(StatsField{"protected",
+               "Viable individuals whose morphology is younger than "
+               "evolution.protection_generations generations (a column only in runs with "
+               "protection).",
+               true, C::when_set, -1, true},
+    s.protected_count);
   // Last column: the only machine-dependent one.
   v(StatsField{"wall_seconds", "Cumulative wall time of the run, seconds.", true, C::required, 3},
     s.wall_seconds);
@@ -212,10 +239,14 @@ void visit_fields(S& s, V&& v)
 /// Probability that the fitter of two wins a tournament at generation g (linear ramp, paper §5).
 [[nodiscard]] double tournament_probability(const EvolutionParams& p, int generation);
 
-/// Index of the tournament winner among two distinct random eligible individuals.
+/// Index of the tournament winner among two distinct random eligible individuals: the fitter wins
+/// with probability p_fitter. With `protection` = P > 0 (evolution.protection_generations), two
+/// individuals do not compete when the less fit is younger than P (Individual::morphology_age), of
+/// another morphology kind than the fitter and younger than it: the winner is then either, with
+/// probability 1/2. The same random numbers are drawn either way; P = 0 is the paper's tournament.
 [[nodiscard]] std::size_t tournament(const std::vector<Individual>& population,
                                      const std::vector<std::size_t>& eligible, double p_fitter,
-                                     Rng& rng);
+                                     Rng& rng, int protection = 0);
 
 /// A run (or its initial population, or one generation) stopped by a StopRequest before it
 /// finished; what was completed before it is kept (see Evolution::initialize and Evolution::step).
@@ -281,10 +312,11 @@ class Evolution {
   /// The fitness of every genome of the last ask(), in order. Returns true when this completed a
   /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a value
   /// that the engine's own evaluations refuse (naming its index: a fitness that is not finite, a
-  /// negative one under a distance objective, a negative cell_count or drag_limited), or an initial
-  /// slot that used up evolution.max_init_tries. With a reference fitness function (the exploit
-  /// guard), a tell that completes a generation with a new best evaluates its reference here, as
-  /// step() does; if that throws, the engine is left as before the tell (the ask still pending).
+  /// negative one under a distance objective, a negative cell_count, drag_limited or
+  /// morphology_kind), or an initial slot that used up evolution.max_init_tries. With a reference
+  /// fitness function (the exploit guard), a tell that completes a generation with a new best
+  /// evaluates its reference here, as step() does; if that throws, the engine is left as before the
+  /// tell (the ask still pending).
   bool tell(const std::vector<Fitness>& fitness);
   /// Whether an ask() awaits its tell().
   [[nodiscard]] bool asked() const { return pending_; }
@@ -361,6 +393,14 @@ class Evolution {
   std::vector<Genome> asked_;             ///< the genomes of that ask()
   std::vector<std::size_t> asked_index_;  ///< their initial slot, or their index in next_
   std::vector<Individual> next_;          ///< the generation being made
+  /// Where each of next_ comes from in population_ (the morphology ages, computed by tell()):
+  /// parents (Origin::none: none), and whether it is an elite copy.
+  struct Origin {
+    static constexpr std::size_t none = static_cast<std::size_t>(-1);
+    std::size_t a = none, b = none;
+    bool elite = false;
+  };
+  std::vector<Origin> next_origin_;
   int next_crossovers_ = 0;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()

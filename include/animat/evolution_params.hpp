@@ -15,7 +15,11 @@ struct EvolutionParams {
   double tournament_p_start = 0.8;         ///< p(fitter wins) at generation 0 [paper: 0.8]
   double tournament_p_end = 1.0;           ///< p(fitter wins) after the ramp [paper: 1]
   int tournament_ramp_generations = 1000;  ///< [paper: 1000]
-  int generations = 0;                     ///< generation cap; 0 = none
+  /// Morphological innovation protection: an individual whose morphology kind is younger than this
+  /// many generations is not beaten in a tournament by an older individual of another kind with
+  /// probability p, only 1/2 (evolution.hpp, tournament()) [not in the paper; 0 = off]
+  int protection_generations = 0;
+  int generations = 0;  ///< generation cap; 0 = none
   /// stop after this many generations without improvement [paper: 500]
   int stall_generations = 500;
   double wall_seconds = 0.0;  ///< wall-clock budget; 0 = none
@@ -51,6 +55,14 @@ void visit_fields(EvolutionParams& p, V&& v) {
   v(FieldInfo{"tournament_ramp_generations", "generations of the linear ramp [paper: 1000]",
               Bounds::closed(0, 100000000)},
     p.tournament_ramp_generations);
+  v(FieldInfo{"protection_generations",
+              "generations a new morphology (another cell count or elongation band than its "
+              "parents') is protected: against a fitter, older individual of another morphology it "
+              "wins a tournament with probability 1/2 [not in the paper: 0 = off]",
+              Bounds::closed(0, 100000000),
+              {},
+              Identity::late},
+    p.protection_generations);
   v(FieldInfo{"generations",
               "generation cap; 0 = no cap",
               Bounds::closed(0, 100000000),

@@ -90,6 +90,8 @@ from .run import (
     GENEALOGY_DTYPE,
     HISTORY_DTYPE,
     MORPHOLOGY_TOLERANCE,
+    PROTECTED_GENEALOGY_DTYPE,
+    PROTECTED_HISTORY_DTYPE,
     LineageEntry,
     Run,
     morphology_distance,
@@ -121,6 +123,7 @@ gabriel_graph = documented(_core.gabriel_graph)
 objectives = documented(_core.objectives)
 objective_value = documented(_core.objective_value)
 grn_swim = documented(_core.grn_swim)
+morphology_kind = documented(_core.morphology_kind)
 polygon_area = documented(_core.polygon_area)
 set_log_level = documented(_core.set_log_level)
 tournament_probability = documented(_core.tournament_probability)
@@ -150,6 +153,7 @@ __all__ = [
     "delaunay_edges",
     "polygon_area",
     "body_length",
+    "morphology_kind",
     "Scene",
     "Simulation",
     "ExternalActuation",
@@ -215,9 +219,11 @@ __all__ = [
     "Run",
     "LineageEntry",
     "HISTORY_DTYPE",
+    "PROTECTED_HISTORY_DTYPE",
     "read_history",
     "read_genealogy",
     "GENEALOGY_DTYPE",
+    "PROTECTED_GENEALOGY_DTYPE",
     "morphology_distance",
     "MORPHOLOGY_TOLERANCE",
     "Trajectory",

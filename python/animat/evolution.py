@@ -18,7 +18,7 @@ from typing import Any, Callable, Iterable, List, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from .run import HISTORY_DTYPE
+from .run import history_dtype
 
 __all__ = [
     "History",
@@ -39,7 +39,9 @@ class History(np.recarray):
     """Per-generation statistics: a numpy structured (record) array, one row per generation, with the
     columns of ``history.csv``: ``generation``, ``best``, ``mean``, ``median``, ``viable_fraction``,
     ``best_cells``, ``evaluations``, ``best_reference`` (the best at the exploit guard's finer step; NaN
-    when not checked), ``invalid`` (swims that broke the body's embedding), ``wall_seconds``. ``h["best"]`` is a column, ``h[-1]`` a row
+    when not checked), ``invalid`` (swims that broke the body's embedding), ``protected`` (only in runs with
+    ``evolution.protection_generations`` > 0: viable individuals of a protected new morphology),
+    ``wall_seconds``. ``h["best"]`` is a column, ``h[-1]`` a row
     (``h[-1]["best"]``, or ``h[-1].best``; use ``["mean"]`` for the mean column: ``.mean`` is numpy's
     method). :attr:`Run.history`, :attr:`EvolutionResult.history` and :attr:`GA.history` are all of
     this type.
@@ -56,13 +58,20 @@ class History(np.recarray):
             import pandas as pd  # type: ignore[import-not-found]
         except ImportError:
             raise ImportError("History.to_pandas needs pandas: pip install pandas") from None
-        return pd.DataFrame.from_records(np.asarray(self).view(np.ndarray), columns=list(HISTORY_DTYPE.names or ()))
+        return pd.DataFrame.from_records(np.asarray(self).view(np.ndarray), columns=list(self.dtype.names or ()))
 
     @staticmethod
-    def from_rows(rows: Iterable[Any]) -> History:
-        """A History from GenerationStats objects (or anything with those attributes)."""
-        records = [tuple(getattr(r, name) for name in HISTORY_DTYPE.names or ()) for r in rows]
-        return np.array(records, dtype=HISTORY_DTYPE).view(History)  # type: ignore[return-value]
+    def from_rows(rows: Iterable[Any], protected: bool = False) -> History:
+        """A History from GenerationStats objects (or anything with those attributes); ``protected``:
+        with the ``protected`` column of a run with ``evolution.protection_generations`` > 0."""
+        dtype = history_dtype(protected)
+        records = [tuple(getattr(r, name) for name in dtype.names or ()) for r in rows]
+        return np.array(records, dtype=dtype).view(History)  # type: ignore[return-value]
+
+
+def _protects(config: Any) -> bool:
+    """Whether a config has morphological innovation protection (its history has ``protected``)."""
+    return int(config["evolution.protection_generations"]) > 0
 
 
 @dataclass
@@ -198,13 +207,20 @@ def record_evaluation(genome: Any, config: Any = None, every: int = 20) -> Any:
 
 def to_fitness(value: Any) -> Any:
     """A :class:`animat.Fitness` from what an evaluator returns: a Fitness; an EvaluationResult
-    (its fitness, viable, stable, cell_count, valid, drag_limited); ``None`` (not viable); or a number (a viable
-    genome's fitness; it must be finite)."""
+    (its fitness, viable, stable, cell_count, valid, drag_limited, morphology_kind); ``None`` (not viable); or a
+    number (a viable genome's fitness; it must be finite; its morphology kind is unknown, 0, so that
+    ``evolution.protection_generations`` protects nothing)."""
     if isinstance(value, _core.Fitness):
         return value
     if isinstance(value, _core.EvaluationResult):
         return _core.Fitness(
-            value.fitness, value.viable, value.stable, value.cell_count, value.valid, value.drag_limited
+            value.fitness,
+            value.viable,
+            value.stable,
+            value.cell_count,
+            value.valid,
+            value.drag_limited,
+            value.morphology_kind,
         )
     if value is None:
         return _core.Fitness(0.0, False, True, 0)
@@ -347,7 +363,7 @@ class GA:
     @property
     def history(self) -> History:
         """Statistics of every completed generation (:class:`History`)."""
-        return History.from_rows(self._engine.history)
+        return History.from_rows(self._engine.history, _protects(self._config))
 
     @property
     def evaluations(self) -> int:
@@ -545,7 +561,7 @@ def evolve(
 
     def result_of(summary: Any) -> EvolutionResult:
         return EvolutionResult(
-            history=History.from_rows(summary.history),
+            history=History.from_rows(summary.history, _protects(cfg)),
             best=summary.best,
             population=list(summary.population),
             stop_reason=summary.stop_reason,

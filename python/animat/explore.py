@@ -21,7 +21,8 @@ embedded as JSON. It shows
 polls ``/live.json`` and redraws the curves and the lineage while runs grow.
 
 ``genealogy.csv``: header ``generation,id,parent_a,parent_b,fitness,cells``, one row per individual
-born (generation 0 individuals have ``parent_a = parent_b = -1``, a mutant ``parent_b = -1``); each
+born (generation 0 individuals have ``parent_a = parent_b = -1``, a mutant ``parent_b = -1``; a run
+with ``evolution.protection_generations`` > 0 adds ``morphology_kind,morphology_age``); each
 ``best/gen_*.json`` then names its individual with an integer ``"id"``.
 """
 
@@ -284,14 +285,19 @@ def read_genealogy(path: PathLike) -> Dict[int, Tuple[int, int, int, float, int]
     if not lines:
         return {}
     header = lines[0].strip().split(",")
+    # a run with morphological innovation protection adds morphology_kind and morphology_age
+    if header[len(GENEALOGY_COLUMNS) :] == ["morphology_kind", "morphology_age"]:
+        header = header[: len(GENEALOGY_COLUMNS)]
     if header != list(GENEALOGY_COLUMNS):
         raise ValueError(f"{path}:1: unexpected header {lines[0].strip()!r}; expected {','.join(GENEALOGY_COLUMNS)!r}")
     out: Dict[int, Tuple[int, int, int, float, int]] = {}
     for number, row in enumerate(csv.reader(lines[1:]), start=2):
         if not row:
             continue
-        if len(row) != len(GENEALOGY_COLUMNS):
-            raise ValueError(f"{path}:{number}: expected {len(GENEALOGY_COLUMNS)} comma-separated values, got {row}")
+        if len(row) != len(lines[0].strip().split(",")):
+            raise ValueError(
+                f"{path}:{number}: expected {len(lines[0].strip().split(','))} comma-separated values, got {row}"
+            )
         try:
             g, i, a, b, c = (int(row[k]) for k in (0, 1, 2, 3, 5))
             f = float(row[4])

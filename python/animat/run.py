@@ -24,11 +24,32 @@ import numpy as np
 
 from . import _core
 
-__all__ = ["Run", "LineageEntry", "HISTORY_DTYPE", "read_history", "morphology_distance", "MORPHOLOGY_TOLERANCE"]
+__all__ = [
+    "Run",
+    "LineageEntry",
+    "HISTORY_DTYPE",
+    "PROTECTED_HISTORY_DTYPE",
+    "read_history",
+    "morphology_distance",
+    "MORPHOLOGY_TOLERANCE",
+]
 
 #: Columns of ``history.csv`` and their numpy types (the dtype of :attr:`Run.history`), from the
 #: engine's descriptor of a generation's statistics (``GenerationStats.HISTORY_COLUMNS``).
 HISTORY_DTYPE = np.dtype([(name, np.dtype(kind)) for name, kind in _core.GenerationStats.HISTORY_COLUMNS])
+#: The history of a run with morphological innovation protection (``evolution.protection_generations``
+#: > 0): :data:`HISTORY_DTYPE` plus ``protected`` (int64: viable individuals whose morphology is younger
+#: than the protection), before ``wall_seconds``. Other runs write and read :data:`HISTORY_DTYPE` as
+#: before the protection existed.
+PROTECTED_HISTORY_DTYPE = np.dtype(
+    [(name, np.dtype(kind)) for name, kind in _core.GenerationStats.PROTECTED_HISTORY_COLUMNS]
+)
+
+
+def history_dtype(protected: bool = False) -> np.dtype:
+    """:data:`PROTECTED_HISTORY_DTYPE` for a run with protection, else :data:`HISTORY_DTYPE`."""
+    return PROTECTED_HISTORY_DTYPE if protected else HISTORY_DTYPE
+
 
 #: Columns that older runs do not have, and the value they read as.
 _LATER_COLUMNS = {"best_reference": float("nan"), "invalid": 0, "drag_limited": 0, "swims": 0}
@@ -79,7 +100,8 @@ def _history_type() -> type:
 
 
 def read_history(path: PathLike) -> np.ndarray:
-    """Read a ``history.csv`` into a structured array of dtype :data:`HISTORY_DTYPE`.
+    """Read a ``history.csv`` into a structured array of dtype :data:`HISTORY_DTYPE` (that of a run
+    with morphological innovation protection, which has a ``protected`` column: :data:`PROTECTED_HISTORY_DTYPE`).
 
     The file must start with the header ``generation,best,...``. A last line without its newline
     (a row being written by a run in progress) is ignored. Any other malformed line raises
@@ -111,7 +133,11 @@ def read_history(path: PathLike) -> np.ndarray:
         return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())  # empty or header being written
     header = complete[0].strip().split(",")
     olders = [[name for name in expected if name not in missing] for missing in _OLDER_HEADERS]
-    if header != expected and header not in olders:
+    dtype = HISTORY_DTYPE
+    if header == list(PROTECTED_HISTORY_DTYPE.names or ()):
+        dtype = PROTECTED_HISTORY_DTYPE
+        expected = header
+    elif header != expected and header not in olders:
         raise ValueError(f"{path}:1: unexpected header {complete[0].strip()!r}; expected {','.join(expected)!r}")
     column = {name: k for k, name in enumerate(header)}
     rows = []
@@ -129,14 +155,14 @@ def read_history(path: PathLike) -> np.ndarray:
                     _LATER_COLUMNS[name]
                     if name not in column
                     else int(fields[column[name]])
-                    if HISTORY_DTYPE[name].kind == "i"
+                    if dtype[name].kind == "i"
                     else float(fields[column[name]])
                     for name in expected
                 )
             )
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
-    return np.array(rows, dtype=HISTORY_DTYPE).view(_history_type())
+    return np.array(rows, dtype=dtype).view(_history_type())
 
 
 def _read_lineage_file(path: Path) -> LineageEntry:
@@ -176,18 +202,29 @@ GENEALOGY_DTYPE = np.dtype(
         ("cells", np.int64),
     ]
 )
+#: ``genealogy.csv`` of a run with morphological innovation protection (``evolution.protection_generations``
+#: > 0): :data:`GENEALOGY_DTYPE` plus each newborn's ``morphology_kind`` and ``morphology_age`` (0: a kind
+#: neither parent had; else its parent's age + 1).
+PROTECTED_GENEALOGY_DTYPE = np.dtype(
+    GENEALOGY_DTYPE.descr + [("morphology_kind", np.int64), ("morphology_age", np.int64)]
+)
 
 
 def read_genealogy(path: PathLike) -> np.ndarray:
-    """``genealogy.csv`` as a structured array (:data:`GENEALOGY_DTYPE`), one row per individual born.
+    """``genealogy.csv`` as a structured array (:data:`GENEALOGY_DTYPE`, or :data:`PROTECTED_GENEALOGY_DTYPE`
+    for a run with protection), one row per individual born.
 
     Raises ValueError naming the file and line for a malformed file.
     """
     path = Path(path)
+    dtype = GENEALOGY_DTYPE
     names: Tuple[str, ...] = GENEALOGY_DTYPE.names or ()
     with open(path, encoding="utf-8") as fh:
         header = fh.readline().strip()
-        if header.split(",") != list(names):
+        if header.split(",") == list(PROTECTED_GENEALOGY_DTYPE.names or ()):
+            dtype = PROTECTED_GENEALOGY_DTYPE
+            names = PROTECTED_GENEALOGY_DTYPE.names or ()
+        elif header.split(",") != list(names):
             raise ValueError(f"{path}:1: expected the header {','.join(names)}, got {header!r}")
         rows = []
         for number, line in enumerate(fh, start=2):
@@ -200,7 +237,7 @@ def read_genealogy(path: PathLike) -> np.ndarray:
                 rows.append(tuple(float(v) if k == "fitness" else int(v) for k, v in zip(names, fields)))
             except ValueError:
                 raise ValueError(f"{path}:{number}: not a number in {line!r}") from None
-    return np.array(rows, dtype=GENEALOGY_DTYPE)
+    return np.array(rows, dtype=dtype)
 
 
 def morphology_distance(a, b) -> float:

@@ -296,7 +296,8 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nenergy_accounting = ",
                           "\ndivision_axis = ",
                           "\ndivision_max_contacts = ",
-                          "\nupdate_period = "}) {
+                          "\nupdate_period = ",
+                          "\nprotection_generations = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;

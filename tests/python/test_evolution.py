@@ -164,6 +164,7 @@ def test_generation_stats_fields_pickling_and_history_columns_follow_one_descrip
         "best_reference": float("nan"),
         "invalid": 2,
         "drag_limited": 0,
+        "protected": 0,
         "wall_seconds": 1.25,
         "best_changed": True,
         "evaluations_per_second": 40.0,
