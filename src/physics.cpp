@@ -165,6 +165,7 @@ struct Simulation::Impl {
   static Sink sink_of(const Effect& e, bool velocity_pass) {
     if (velocity_pass) {
       if (e.name() == "drag") return Sink::drag;
+      if (e.name() == "ground") return Sink::ground;  // the compliant floor
       if (e.name() == "springs") return Sink::spring_damping;
       return Sink::other;
     }

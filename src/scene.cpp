@@ -140,7 +140,9 @@ std::unique_ptr<Effect> make_effect(std::string_view name, const Body& body,
   if (name == "collisions") return effects::make_collisions(body, scene);
   if (name == "skin_collision") return effects::make_skin_collision(body, scene);
   if (name == "gravity") return effects::make_gravity(scene);
-  if (name == "ground") return effects::make_ground(scene);
+  if (name == "ground")
+    return scene.ground_contact == "compliant" ? effects::make_compliant_ground(scene)
+                                               : effects::make_ground(scene);
   throw ConfigError(fmt::format("scene.effects: unknown effect '{}' (expected any of {})", name,
                                 fmt::join(kSceneEffectNames, ", ")));
 }

@@ -42,6 +42,7 @@ inline constexpr std::string_view kSceneEffectNames[] = {"springs", "actuation",
                                                          "gravity", "ground"};
 inline constexpr std::string_view kCollisionEdgeNames[] = {"all", "skin"};
 inline constexpr std::string_view kChemicalNames[] = {"none", "point", "plane"};
+inline constexpr std::string_view kGroundContactNames[] = {"impulse", "compliant"};
 
 /// Units (docs/notes/physics.md): length = the cell spacing at the end of development (cell
 /// radius 0.5, so neighbouring centres are about 1 apart); mass = one cell; time = the unit of the
@@ -79,6 +80,15 @@ struct SceneParams {
   double ground_friction_static = 0.8;  ///< Coulomb static coefficient μ_s of the floor [choose]
   /// Coulomb kinetic coefficient μ_k of the floor, <= μ_s [choose]
   double ground_friction_kinetic = 0.5;
+  /// How the floor pushes: "impulse" (contact events: inelastic touchdown, Coulomb stick/slip;
+  /// src/effects/ground.cpp) or "compliant" (a continuous force: a stiff Hunt–Crossley spring under
+  /// each cell below the floor and regularised friction; src/effects/compliant_ground.cpp) [choose]
+  std::string ground_contact = "impulse";
+  double ground_stiffness = 1000.0;  ///< k_g of the compliant floor (force per length) [choose]
+  /// λ of the compliant floor: F_n = k_g·d·(1 + λ·ḋ), d the penetration [choose]
+  double ground_damping = 2.0;
+  /// v_s of the compliant floor's friction μ_k·F_n·v/sqrt(v² + v_s²) [choose]
+  double ground_slip_speed = 0.05;
   // A chemical field the cells sense under control.mode = "grn" (docs/control.md).
   /// "none", "point" (exp(−|x − x_s|/ℓ)) or "plane" (exp(−max(0, (x_s − x)·n)/ℓ), n from the body's
   /// start centre towards x_s) [beyond the paper]
@@ -171,6 +181,38 @@ void visit_fields(SceneParams& p, V&& v) {
               {},
               Identity::late},
     p.ground_friction_kinetic);
+  v(
+      FieldInfo{
+          "ground_contact",
+          "how the floor of effect ground pushes: impulse (contact events: inelastic touchdown, "
+          "Coulomb stick/slip with mu_s and mu_k) or compliant (a continuous force: a stiff "
+          "Hunt-Crossley spring ground_stiffness under every cell below the floor, damping "
+          "ground_damping, friction mu_k*F_n*v/sqrt(v^2 + ground_slip_speed^2); mu_s unused) "
+          "(docs/worlds.md) [choose]",
+          Bounds::any(), kGroundContactNames, Identity::late},
+      p.ground_contact);
+  v(FieldInfo{"ground_stiffness",
+              "k_g of the compliant floor: normal force per unit penetration, force/length "
+              "(ground_contact = compliant) [choose]",
+              Bounds::positive_upto(kMaxCoefficient),
+              {},
+              Identity::late},
+    p.ground_stiffness);
+  v(FieldInfo{"ground_damping",
+              "lambda of the compliant floor, time/length: F_n = k_g*d*(1 + lambda*dd/dt), d the "
+              "penetration (ground_contact = compliant) [choose]",
+              Bounds::upto(kMaxCoefficient),
+              {},
+              Identity::late},
+    p.ground_damping);
+  v(FieldInfo{"ground_slip_speed",
+              "v_s of the compliant floor's regularised friction, length/time: below it the floor "
+              "grips viscously, above it the friction is mu_k*F_n (ground_contact = compliant) "
+              "[choose]",
+              Bounds::positive_upto(kMaxLength),
+              {},
+              Identity::late},
+    p.ground_slip_speed);
   v(FieldInfo{"chemical",
               "chemical field sensed by the GRN's chemical input under control.mode = grn: none, "
               "point (exp(-|x - x_s|/l)) or plane (exp(-max(0, (x_s - x).n)/l), n from the start "

@@ -104,7 +104,7 @@ class Collisions final : public Effect {
   Collisions(const Body& body, const SceneParams& p)
       : restitution_(p.collision_restitution),
         tol_(p.collision_tolerance),
-        floor_(has_effect(p.effects, "ground")),
+        floor_(has_effect(p.effects, "ground") && p.ground_contact == "impulse"),
         y0_(p.ground_height),
         mu_s_(p.ground_friction_static),
         mu_k_(p.ground_friction_kinetic) {

@@ -26,6 +26,7 @@ namespace animat::effects {
 [[nodiscard]] std::unique_ptr<Effect> make_collisions(const Body& body, const SceneParams& scene);
 [[nodiscard]] std::unique_ptr<Effect> make_gravity(const SceneParams& scene);
 [[nodiscard]] std::unique_ptr<Effect> make_ground(const SceneParams& scene);
+[[nodiscard]] std::unique_ptr<Effect> make_compliant_ground(const SceneParams& scene);
 
 inline int as_int(Eigen::Index i) { return static_cast<int>(i); }
 inline std::size_t at(int i) { return static_cast<std::size_t>(i); }

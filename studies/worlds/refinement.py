@@ -24,6 +24,9 @@ swim), airborne_share (Box2D steps in which the floor pushed no cell / Box2D ste
 without a floor), elongation, protrusions and symmetric_pair (``animat.shape`` of the developed body),
 final (1 for the run's last lineage best).
 
+``--only GLOB`` re-swims only the runs whose name matches; ``--set KEY=VALUE`` (repeatable) re-swims
+them with that config value instead of the run's (another contact law, say), into its own ``--out``.
+
 Runs already in ``--out`` are not swum again (delete it to redo them). The summary groups the runs by
 their grid point (the run's name without its seed).
 """
@@ -32,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import fnmatch
 import re
 import sys
 from pathlib import Path
@@ -39,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 import animat
+import animat.shape
 
 HERE = Path(__file__).resolve().parent
 FIELDS = (
@@ -74,9 +79,11 @@ def refined(config, factor: int):
     return fine
 
 
-def rows_of(run_dir: Path):
+def rows_of(run_dir: Path, overrides=()):
     run = animat.Run(run_dir)
-    cfg = run.config
+    cfg = run.config.copy()
+    for key, value in overrides:
+        cfg[key] = value
     fine = refined(cfg, 16)
     finest = refined(cfg, 32)
     select = cfg["evaluation.reference_check"] == "select"
@@ -112,6 +119,14 @@ def rows_of(run_dir: Path):
             "symmetric_pair": int(shape.symmetric_pair),
             "final": int(i == len(lineage) - 1),
         }
+
+
+def parse_value(text: str):
+    """A --set value: a number where it reads as one, else the text."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
 
 
 def point_of(run: str) -> str:
@@ -170,13 +185,33 @@ def main(argv=None) -> int:
     p.add_argument("--out", default=str(HERE / "results" / "crawl_refinement.csv"))
     p.add_argument("--summary-only", action="store_true", help="summarize --out without re-swimming")
     p.add_argument("--ladder", nargs="+", metavar="RUN:GENERATION", help="refinement ladder of lineage bests")
+    p.add_argument("--only", metavar="GLOB", help="re-swim only the runs whose name matches")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="re-swim with this config value instead of the run's (needs --out)",
+    )
     args = p.parse_args(argv)
     if args.ladder:
         ladder(Path(args.runs), args.ladder)
         return 0
+    overrides = []
+    for item in args.set:
+        key, sep, value = item.partition("=")
+        if not sep:
+            p.error(f"--set {item!r}: expected KEY=VALUE")
+        overrides.append((key, parse_value(value)))
+    if overrides and args.out == p.get_default("out"):
+        p.error("--set re-swims with other values: give its own --out")
     out = Path(args.out)
     if not args.summary_only:
-        runs = sorted(d for d in Path(args.runs).iterdir() if (d / "history.csv").is_file())
+        runs = sorted(
+            d
+            for d in Path(args.runs).iterdir()
+            if (d / "history.csv").is_file() and (args.only is None or fnmatch.fnmatch(d.name, args.only))
+        )
         if not runs:
             print(f"{args.runs}: no kept runs (run studies/worlds/crawl_screen.sh first)", file=sys.stderr)
             return 1
@@ -184,9 +219,9 @@ def main(argv=None) -> int:
         rows = []
         if out.is_file():
             with open(out, newline="") as f:
-                rows = [r for r in csv.DictReader(f) if (Path(args.runs) / r["run"]).is_dir()]
+                rows = [r for r in csv.DictReader(f) if r["run"] in {d.name for d in runs}]
         done = {r["run"] for r in rows}
-        rows += [row for d in runs if d.name not in done for row in rows_of(d)]
+        rows += [row for d in runs if d.name not in done for row in rows_of(d, overrides)]
         rows.sort(key=lambda r: (r["run"], int(r["generation"])))
         out.parent.mkdir(parents=True, exist_ok=True)
         with open(out, "w", newline="") as f:

@@ -138,6 +138,26 @@ TEST(EnergyAccount, BodyDroppedOnTheFloorBooksTheGroundAndGravity) {
   EXPECT_LT(std::abs(a.residual()), 0.01 * throughput(a));
 }
 
+TEST(EnergyAccount, CompliantFloorIsBookedAsTheGroundAndTheBooksClose) {
+  // The same drop onto the compliant floor: its forces act in the velocity pass and are booked as
+  // the floor's (what it still stores at the end, m·g·d/2 per resting cell, counts there too).
+  Body b = square();
+  for (int i = 0; i < 4; ++i) b.positions(i, 1) += 2.0;
+  SceneParams scene = scene_with({"springs", "pressure", "gravity", "ground"});
+  scene.gravity = 1.0;
+  scene.ground_contact = "compliant";
+  Simulation sim(b, scene);
+  sim.account_energy();
+  sim.step(3000);
+  const EnergyAccount a = sim.energy_account();
+  EXPECT_GT(sim.counters().ground_contacts, 0);
+  const double lost = a.gravity_start - a.gravity_end;
+  EXPECT_NEAR(lost, 4.0 * scene.cell_mass * scene.gravity * 2.0, 0.05 * lost);
+  EXPECT_GT(a.ground, 0.0);
+  EXPECT_EQ(a.other, 0.0);
+  EXPECT_LT(std::abs(a.residual()), 0.01 * throughput(a));
+}
+
 TEST(EnergyAccount, FloorEventsInTheCollisionLoopAreBookedAsTheGround) {
   // A lattice dropped hard (g = 20, from 4 up) with collisions and ground: the floor contacts are
   // events of the collision loop, their impulses are still booked as the floor's, and the books

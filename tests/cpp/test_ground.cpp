@@ -317,6 +317,7 @@ TEST(FloorAndCollisions, TriangleFallingFlatOntoTheFloorBouncesOffItsBase) {
 struct FloorRun {
   long inverted = 0, crossings = 0, unresolved = 0, contacts = 0, slips = 0;
   double lowest = 1e9, min_area_ratio = 1.0;
+  Points end;  ///< positions at the end
 };
 
 enum class FloorCase { pressed, dropped, rolled, dragged };
@@ -329,11 +330,12 @@ enum class FloorCase { pressed, dropped, rolled, dragged };
 ///  - rolled: from 2 units above, spinning at 4 rad per time unit and moving sideways at 3, g = 5;
 ///  - dragged: resting on the floor (g = 2), its top row pulled sideways with 8 per cell (above the
 ///    static limit of the whole body): it tilts, slides and sticks again.
-FloorRun run_floor_case(FloorCase c, int refine) {
+FloorRun run_floor_case(FloorCase c, int refine, const std::string& contact = "impulse") {
   const Body b = swimmer(lattice_points(5, 3, 0.05, 11), Drive::none);
   Body body = b;
   body.positions.col(1).array() -= body.positions.col(1).minCoeff();
   SceneParams scene = floor_scene({"springs", "pressure", "collisions", "gravity", "ground"}, 1.0);
+  scene.ground_contact = contact;
   const double top = body.positions.col(1).maxCoeff() - 0.1;
   std::vector<double> top_row;
   for (int i = 0; i < body.node_count(); ++i)
@@ -378,6 +380,7 @@ FloorRun run_floor_case(FloorCase c, int refine) {
   r.unresolved = sim.counters().collisions_unresolved;
   r.contacts = sim.counters().ground_contacts;
   r.slips = sim.counters().ground_slips;
+  r.end = sim.positions();
   return r;
 }
 
@@ -525,6 +528,142 @@ TEST(Ground, AirborneStepsCountTheFallUntilTheFirstContact) {
     sim.step(600);
     EXPECT_EQ(sim.counters().airborne_steps, 328) << effects.size();
     EXPECT_EQ(sim.counters().ground_contacts, 600 - 328) << effects.size();
+  }
+}
+
+}  // namespace
+}  // namespace animat
+
+// --- the compliant floor (scene.ground_contact = "compliant") ------------------------------------
+namespace animat {
+namespace {
+
+SceneParams compliant_scene(std::vector<std::string> effects, double g = 2.0, double mu = 0.5) {
+  SceneParams s = floor_scene(std::move(effects), g, 0.8, mu);
+  s.ground_contact = "compliant";
+  return s;
+}
+
+TEST(CompliantGround, RestingRowSinksToTheStaticPenetrationMgOverK) {
+  // Each cell of a row on the floor carries its own weight: at rest F_n = k_g·d = m·g, so every
+  // cell ends d = m·g/k_g below the floor, whatever the damping (the backward-Euler solve has the
+  // continuous law's equilibrium).
+  const double g = 2.0;
+  SceneParams scene = compliant_scene({"springs", "gravity", "ground"}, g);
+  Simulation sim(row_block(4), scene);
+  sim.step(1200);
+  const double d = scene.cell_mass * g / scene.ground_stiffness;
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(sim.positions()(i, 1), -d, 1e-9 * d + kFloatPosition);
+  EXPECT_LT(sim.velocities().cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_EQ(sim.counters().airborne_steps, 0);
+}
+
+TEST(CompliantGround, LaunchedRowDeceleratesAtMuGAndComesToRest) {
+  // Resting at its static penetration, launched at v0 >> v_s: the friction is μ·m·g·v/sqrt(v² +
+  // v_s²), so v(t) = v0 − μ·g·t to O(v_s²/v²) (backward Euler is exact for a constant force);
+  // below v_s the floor grips viscously and the row comes to rest.
+  const double g = 2.0, mu = 0.5, v0 = 3.0;
+  SceneParams scene = compliant_scene({"springs", "gravity", "ground"}, g, mu);
+  Body b = row_block(3, -scene.cell_mass * g / scene.ground_stiffness);
+  Simulation sim(b, scene);
+  sim.set_velocities(Points::Constant(3, 2, 0.0).rowwise() + Eigen::RowVector2d(v0, 0.0));
+  const double h = sim.physics().dt;
+  sim.step(60);
+  const double v = v0 - mu * g * 60 * h;
+  EXPECT_NEAR(sim.velocities()(1, 0), v, 1e-3 * v);
+  EXPECT_EQ(sim.counters().ground_slips, 60L * 3);
+  sim.step(900);
+  EXPECT_LT(sim.velocities().cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(CompliantGround, DroppedCellBouncesLessTheHarderItLands) {
+  // Hunt–Crossley damping dissipates in proportion to the impact speed: a lone cell dropped from
+  // higher leaves the floor with a smaller fraction of its landing speed (restitution falls with
+  // speed), and always with less than it landed with.
+  double previous = 2.0;
+  for (double height : {0.5, 2.0, 8.0}) {
+    SceneParams scene = compliant_scene({"gravity", "ground"}, 2.0);
+    PhysicsParams physics;
+    physics.dt /= 16;
+    Body b = make_body(points({{0.0, height}}), {}, {}, {});
+    Simulation sim(b, scene, physics);
+    double landing = 0.0, leaving = 0.0;
+    bool touched = false;
+    for (int k = 0; k < 16 * 600 && !(touched && leaving > 0.0); ++k) {
+      const double vy = sim.velocities()(0, 1);
+      sim.step();
+      if (sim.positions()(0, 1) < 0.0 && !touched) {
+        touched = true;
+        landing = -vy;
+      }
+      if (touched && sim.positions()(0, 1) >= 0.0) leaving = sim.velocities()(0, 1);
+    }
+    ASSERT_TRUE(touched) << height;
+    const double restitution = leaving / landing;
+    std::printf("dropped from %g: lands at %.4g, leaves at %.4g (restitution %.4g)\n", height,
+                landing, leaving, restitution);
+    EXPECT_GT(restitution, 0.0) << height;
+    EXPECT_LT(restitution, previous) << height;
+    previous = restitution;
+  }
+}
+
+TEST(CompliantGround, PressedDroppedRolledAndDraggedBodiesKeepTheirEmbeddingAtEveryStep) {
+  // The compliant floor adds forces before the collision pass, so the collisions' guarantees hold
+  // as they do without a floor; the cells sink into the floor by their load over k_g.
+  const char* names[] = {"pressed", "dropped", "rolled", "dragged"};
+  for (FloorCase c :
+       {FloorCase::pressed, FloorCase::dropped, FloorCase::rolled, FloorCase::dragged})
+    for (int refine : {1, 4, 16}) {
+      const FloorRun r = run_floor_case(c, refine, "compliant");
+      const std::string what =
+          std::string(names[static_cast<int>(c)]) + " at dt/" + std::to_string(refine);
+      EXPECT_EQ(r.inverted, 0) << what;
+      EXPECT_EQ(r.crossings, 0) << what;
+      EXPECT_GT(r.min_area_ratio, 0.0) << what;
+      EXPECT_EQ(r.unresolved, 0) << what;
+      EXPECT_GT(r.lowest, -0.5) << what;
+      EXPECT_GT(r.contacts, 0) << what;
+    }
+}
+
+TEST(CompliantGround, SwimsConvergeAsTheStepShrinks) {
+  // The force is a continuous function of the state, so a smaller step refines the same solution:
+  // the end positions of the rolled and dragged bodies (sliding, tilting, sticking again) approach
+  // those at dt/64, by at least half per fourfold refinement from dt/4 on (the scheme is first
+  // order).
+  for (FloorCase c : {FloorCase::rolled, FloorCase::dragged}) {
+    const Points fine = run_floor_case(c, 64, "compliant").end;
+    double previous = 1e9;
+    for (int refine : {4, 16}) {
+      const double error =
+          (run_floor_case(c, refine, "compliant").end - fine).cwiseAbs().maxCoeff();
+      std::printf("case %d, dt/%d: largest position error %.4g\n", static_cast<int>(c), refine,
+                  error);
+      EXPECT_LT(error, 0.5 * previous) << static_cast<int>(c) << " dt/" << refine;
+      previous = error;
+    }
+    EXPECT_LT(previous, 0.05) << static_cast<int>(c);
+  }
+}
+
+TEST(CompliantGround, ConfigErrorsNameKeyAndValue) {
+  SceneParams s;
+  s.ground_contact = "soft";
+  try {
+    validate(s);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.ground_contact"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("soft"), std::string::npos) << e.what();
+  }
+  SceneParams k;
+  k.ground_stiffness = 0.0;
+  try {
+    validate(k);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.ground_stiffness"), std::string::npos) << e.what();
   }
 }
 
