@@ -193,6 +193,7 @@ SCENES: Dict[str, Tuple[Optional[str], Dict[str, Any], Tuple[str, ...]]] = {
     "paper_dn10": ("configs/paper_dn10.toml", {}, ALL),
     "paper_dn0.2_64cells": ("configs/paper_dn0.2_64cells.toml", {}, ALL),
     "crawl": ("configs/crawl.toml", {}, ALL),
+    "walk": ("configs/walk.toml", {}, ALL),
     "chemotaxis": ("configs/chemotaxis.toml", _CHEMOTAXIS_SHORT, ALL),
     "replication_dn2_run": ("tests/data/replication/dn2_run_0/config.toml", {}, ALL),
     "replication_dn10_run": ("tests/data/replication/dn10_run_0/config.toml", {}, ALL),
