@@ -189,7 +189,7 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
       } else if (std::holds_alternative<std::string>(def)) {
         for (const char* word :
              {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",
-              "grn", "point", "distance", "front", "amplitude", "morphogen_gradient"})
+              "grn", "point", "distance", "front", "amplitude", "morphogen_gradient", "compliant"})
           candidates.push_back(std::string(word));
       }
       for (const auto& cand : candidates) {
