@@ -24,6 +24,9 @@ swim), airborne_share (Box2D steps in which the floor pushed no cell / Box2D ste
 without a floor), elongation, protrusions and symmetric_pair (``animat.shape`` of the developed body),
 final (1 for the run's last lineage best).
 
+``--cost POINT ...`` prints what the step costs for the final bests of those grid points: the fitness
+error at dt to dt/16 against dt/32 and the CPU time of one evaluation.
+
 ``--only GLOB`` re-swims only the runs whose name matches; ``--set KEY=VALUE`` (repeatable) re-swims
 them with that config value instead of the run's (another contact law, say), into its own ``--out``.
 
@@ -36,8 +39,11 @@ from __future__ import annotations
 import argparse
 import csv
 import fnmatch
+import os
+import platform
 import re
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -179,12 +185,47 @@ def ladder(runs: Path, specs) -> None:
         print(f"| {spec} | " + " | ".join(cells) + " |", flush=True)
 
 
+def cost(runs: Path, points) -> None:
+    """What the step costs in accuracy and time: for the final bests of each grid point, the fitness
+    error at dt/f against dt/32 (median and largest) and the CPU time of one evaluation relative to
+    dt's (median over the bests; each evaluation timed once, so the machine's load enters)."""
+    factors = (1, 2, 4, 8, 16)
+    print(f"machine: {platform.machine()}, {os.cpu_count()} cores; CPU time per evaluation, one thread")
+    print("| point | step | fitness error vs dt/32: median / max | CPU time per evaluation (× dt's) |")
+    print("| --- | --- | --- | --- |")
+    for point in points:
+        dirs = sorted(d for d in runs.iterdir() if point_of(d.name) == point and (d / "history.csv").is_file())
+        if not dirs:
+            raise SystemExit(f"{runs}: no kept run of point {point}")
+        errors = {f: [] for f in factors}
+        seconds = {f: [] for f in factors}
+        for d in dirs:
+            run = animat.Run(d)
+            genome, cfg = run.best_genomes[-1].genome, run.config
+            truth = animat.evaluate(genome, refined(cfg, 32)).fitness
+            for f in factors:
+                start = time.process_time()
+                r = animat.evaluate(genome, refined(cfg, f) if f > 1 else cfg)
+                seconds[f].append(time.process_time() - start)
+                errors[f].append(abs(r.fitness / truth - 1.0))
+        base = float(np.median(seconds[1]))
+        for f in factors:
+            e = np.array(errors[f])
+            label = "dt" if f == 1 else f"dt/{f}"
+            print(
+                f"| {point} | {label} | {np.median(e):.2%} / {e.max():.2%} | "
+                f"{np.median(seconds[f]) * 1e3:.0f} ms ({np.median(seconds[f]) / base:.1f}×) |",
+                flush=True,
+            )
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", default=str(HERE / "crawl_screen"), help="folder of kept runs")
     p.add_argument("--out", default=str(HERE / "results" / "crawl_refinement.csv"))
     p.add_argument("--summary-only", action="store_true", help="summarize --out without re-swimming")
     p.add_argument("--ladder", nargs="+", metavar="RUN:GENERATION", help="refinement ladder of lineage bests")
+    p.add_argument("--cost", nargs="+", metavar="POINT", help="accuracy and cost of the step for these points")
     p.add_argument("--only", metavar="GLOB", help="re-swim only the runs whose name matches")
     p.add_argument(
         "--set",
@@ -196,6 +237,9 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     if args.ladder:
         ladder(Path(args.runs), args.ladder)
+        return 0
+    if args.cost:
+        cost(Path(args.runs), args.cost)
         return 0
     overrides = []
     for item in args.set:
