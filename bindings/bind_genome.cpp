@@ -312,6 +312,9 @@ void bind_genome(nb::module_& m) {
           "(n, N) float64 affinity-space coordinates.")
       .def("__len__", &Genome::size)
       .def("__eq__", [](const Genome& a, const Genome& b) { return a == b; })
+      // By content, as __eq__: a Python genome never changes (every operator returns a new one),
+      // so equal genomes may share a set or a dict key.
+      .def("__hash__", [](const Genome& g) { return genome_hash(g); })
       .def("__copy__", [](const Genome& g) { return Genome(g); })
       .def(
           "__deepcopy__", [](const Genome& g, nb::handle) { return Genome(g); }, "memo"_a)

@@ -138,6 +138,17 @@ def test_random_genome_respects_config():
     assert not np.any(g.types == G)
 
 
+def test_equal_genomes_hash_equal_so_sets_and_dicts_merge_them():
+    a, b, c = animat.Genome.random(3), animat.Genome.random(3), animat.Genome.random(4)
+    assert a is not b and a == b and hash(a) == hash(b)
+    assert a != c and hash(a) != hash(c)
+    assert len({a, b, c}) == 2
+    assert {a: 1}[animat.Genome.from_json(b.to_json())] == 1
+    m = a.mutate(5)
+    assert hash(a) == hash(b)  # mutate returns a new genome; a is unchanged
+    assert (m == a) == (hash(m) == hash(a))
+
+
 def test_random_genome_determinism():
     assert animat.Genome.random(123) == animat.Genome.random(123)
     assert animat.Genome.random(123) != animat.Genome.random(124)
