@@ -532,6 +532,12 @@ void bind_evolution(nb::module_& m) {
       "than both\n"
       "evaluation.reference_tolerance (relative to the reference) and "
       "evaluation.reference_abs_tolerance.");
+
+  m.def(
+      "reference_config", [](const Config& config) { return reference_config(config); }, "config"_a,
+      "The exploit guard's reference config: a copy of config with physics.substeps "
+      "multiplied\nby evaluation.reference_substeps, everything else equal. The GA, "
+      "MAP-Elites and NSGA-II\nswim their reference evaluations with it.");
 }
 
 }  // namespace animat::py

@@ -1,4 +1,5 @@
-"""Shared by the example scripts: a small fresh run, and saving compact PNGs.
+"""Shared by the example scripts: a small fresh run, saving compact PNGs, and the command line of the
+examples that run a search (DEAP, pymoo, MAP-Elites, NSGA-II).
 
 Run the examples from the repository root with the built module on the path, e.g.
 
@@ -47,6 +48,34 @@ def fresh_run(args):
     print(f"evolving {args.generations} generations of {args.population} into {out} ...")
     animat.evolve(config, out=str(out))
     return animat.Run(out)
+
+
+def search_parser(description, size="population", generations=20):
+    """The command line of the examples that run a search (deap_ga.py, pymoo_nsga2.py, map_elites.py,
+    nsga2_distance_vs_work.py): --generations, --population (or --batch: ``size``), --steps, --seed,
+    --threads. Each adds its own options."""
+    p = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--generations", type=int, default=generations)
+    p.add_argument(f"--{size}", type=int, default=20)
+    p.add_argument("--steps", type=int, default=1000, help="swim steps per evaluation (the paper: 4000)")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--threads", type=int, default=0, help="0 = all cores; the run does not depend on it")
+    return p
+
+
+def search_config(args):
+    """The default config with the command line's --steps."""
+    config = animat.Config()
+    config["evaluation.steps"] = args.steps
+    return config
+
+
+def at_reference(genome, fitness, config):
+    """The exploit guard's check, which DEAP's and pymoo's loops do not make: the genome's fitness at the
+    reference step (``animat.reference_config``) and whether it agrees with ``fitness``, as words."""
+    reference = animat.evaluate(genome, animat.reference_config(config)).fitness
+    agrees = "disagrees" if animat.reference_disagrees(fitness, reference, config) else "agrees"
+    return f"{reference:.4g} at the reference step ({agrees})"
 
 
 def save_png(fig, path, dpi=100, colors=128):

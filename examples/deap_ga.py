@@ -19,7 +19,6 @@ the evaluations); the evaluation is deterministic. So a seed gives the same run 
 # DEAP's creator and toolbox make their attributes at run time (creator.create, toolbox.register).
 # pyright: reportAttributeAccessIssue=false
 
-import argparse
 import random
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -29,6 +28,8 @@ import numpy as np
 from deap import algorithms, base, creator, tools
 
 import animat
+
+from _common import at_reference, search_config, search_parser
 
 SEED_BITS = 63  # the genome's operators take a seed in [0, 2^63)
 
@@ -133,35 +134,18 @@ def run(
     return Result(pop, logbook, hall_of_fame, config, time.perf_counter() - start)
 
 
-def reference_config(config: Any) -> Any:
-    """The exploit guard's reference step: ``physics.substeps × evaluation.reference_substeps``."""
-    reference = config.copy()
-    reference["physics.substeps"] = int(config["physics.substeps"]) * int(config["evaluation.reference_substeps"])
-    return reference
-
-
 def main(argv: Optional[Sequence[str]] = None) -> Result:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--generations", type=int, default=20)
-    p.add_argument("--population", type=int, default=20)
-    p.add_argument("--steps", type=int, default=1000, help="swim steps per evaluation (the paper: 4000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--threads", type=int, default=0, help="0 = all cores; the run does not depend on it")
+    p = search_parser(__doc__)
     p.add_argument("--quiet", action="store_true", help="no table of generations")
     args = p.parse_args(argv)
-
-    config = animat.Config()
-    config["evaluation.steps"] = args.steps
+    config = search_config(args)
     result = run(config, args.population, args.generations, args.seed, args.threads, verbose=not args.quiet)
     best = result.hall_of_fame[0]
     distance = best.fitness.values[0]
     cells = animat.evaluate(best.genome, config).cell_count
-    # The exploit guard's check, which DEAP's loop does not make: the best swims as far at a finer step.
-    reference = animat.evaluate(best.genome, reference_config(config)).fitness
-    agrees = "disagrees" if animat.reference_disagrees(distance, reference, config) else "agrees"
     print(
         f"{sum(result.logbook.select('nevals'))} evaluations in {result.seconds:.1f} s; the best swims "
-        f"{distance:.4g} ({cells} cells), {reference:.4g} at the reference step ({agrees})"
+        f"{distance:.4g} ({cells} cells), {at_reference(best.genome, distance, config)}"
     )
     return result
 

@@ -7,14 +7,13 @@ With the defaults (1000 swim steps, batches of 20, 30 generations) it took 17 s 
 ``--resume`` continues the run in ``--out-dir`` up to ``--generations``.
 """
 
-import argparse
 from pathlib import Path
 
 import numpy as np
 
 import animat
 
-from _common import plt, save_png
+from _common import plt, save_png, search_config, search_parser
 
 
 def heatmap(archive: animat.GridArchive, title: str):
@@ -36,19 +35,13 @@ def heatmap(archive: animat.GridArchive, title: str):
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--generations", type=int, default=30)
-    p.add_argument("--batch", type=int, default=20)
-    p.add_argument("--steps", type=int, default=1000, help="swim steps per evaluation (the paper: 4000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--threads", type=int, default=0, help="0 = all cores; the run does not depend on it")
+    p = search_parser(__doc__, size="batch", generations=30)
     p.add_argument("--out-dir", type=Path, default=Path("runs/map_elites"))
     p.add_argument("--resume", action="store_true")
     p.add_argument("--out", type=Path, default=Path("runs/map_elites/archive.png"))
     args = p.parse_args()
 
-    config = animat.Config()
-    config["evaluation.steps"] = args.steps
+    config = search_config(args)
     # The exploit guard's reference for every new elite (16 x the step): "off" would be faster.
     config["evaluation.reference_check"] = "record"
     archive = animat.GridArchive(["elongation", "protrusions"], bins=(12, 8))  # 0..7 protrusions, one bin each

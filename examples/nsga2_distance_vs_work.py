@@ -8,14 +8,13 @@ are shortened to ``--steps`` (1000 by default; the paper: 4000). ``--resume`` co
 ``--out-dir`` up to ``--generations``.
 """
 
-import argparse
 import csv
 import time
 from pathlib import Path
 
 import animat
 
-from _common import plt, save_png
+from _common import plt, save_png, search_config, search_parser
 
 OBJECTIVES = [("distance", "max"), ("actuation_work_positive", "min")]
 
@@ -55,19 +54,13 @@ def plot_fronts(nsga: animat.Nsga2, out_dir: Path, title: str):
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--generations", type=int, default=20)
-    p.add_argument("--population", type=int, default=20)
-    p.add_argument("--steps", type=int, default=1000, help="swim steps per evaluation (the paper: 4000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--threads", type=int, default=0, help="0 = all cores; the run does not depend on it")
+    p = search_parser(__doc__)
     p.add_argument("--out-dir", type=Path, default=Path("runs/nsga2"))
     p.add_argument("--resume", action="store_true")
     p.add_argument("--out", type=Path, default=Path("runs/nsga2/front.png"))
     args = p.parse_args()
 
-    config = animat.Config()
-    config["evaluation.steps"] = args.steps
+    config = search_config(args)
     # The exploit guard's reference for every genome that reaches the front (16 x the step): "off" is faster.
     config["evaluation.reference_check"] = "record"
 

@@ -127,6 +127,7 @@ morphology_kind = documented(_core.morphology_kind)
 polygon_area = documented(_core.polygon_area)
 set_log_level = documented(_core.set_log_level)
 tournament_probability = documented(_core.tournament_probability)
+reference_config = documented(_core.reference_config)
 reference_disagrees = documented(_core.reference_disagrees)
 warm_up_box2d = documented(_core.warm_up_box2d)
 
@@ -189,6 +190,7 @@ __all__ = [
     "evaluate_population",
     "to_fitness",
     "tournament_probability",
+    "reference_config",
     "reference_disagrees",
     "run_experiment",
     "run_study",

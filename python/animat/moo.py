@@ -80,7 +80,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 import numpy as np
 
 from . import _core
-from .qd import _comparable, _reference_config, _run_search, _SearchState, _write_atomic
+from .qd import _comparable, _run_search, _SearchState, _write_atomic
 
 __all__ = [
     "Criterion",
@@ -785,7 +785,7 @@ class Nsga2(_SearchState):
     def _references(self, genomes: List[Any]) -> List[Floats]:
         if not genomes:
             return []
-        ref = _reference_config(self._config)
+        ref = _core.reference_config(self._config)
         results = _evaluate_results(genomes, ref, int(self._config["evolution.threads"]))
         self._reference_evaluations += len(genomes)
         return [self._measure(g, r, ref)[0] for g, r in zip(genomes, results)]

@@ -28,7 +28,7 @@ elite's (a tie keeps the elite); candidates are added in the order of ``ask()``.
 **The exploit guard** (``evaluation.reference_check``, as for the GA): ``"off"``: nothing more.
 ``"record"`` (the default): every genome that is an elite at the end of a ``tell()`` and entered
 during it is evaluated again at the reference step (``physics.substeps ×
-evaluation.reference_substeps``, the engine's ``reference_config``) with the run's objective; its
+evaluation.reference_substeps``, :func:`animat.reference_config`) with the run's objective; its
 ``reference`` fitness is stored with the elite and ``history["disagreements"]`` counts the elites
 whose fitness and reference disagree (:func:`animat.reference_disagrees`). ``"select"``: every
 archivable candidate is evaluated at the reference step *before* it is added, and the archive
@@ -785,13 +785,6 @@ def _write_atomic(path: Path, text: str) -> Path:
     return path
 
 
-def _reference_config(config: Any) -> Any:
-    """The engine's reference_config: physics.substeps × evaluation.reference_substeps, all else equal."""
-    ref = config.copy()
-    ref["physics.substeps"] = int(config["physics.substeps"]) * int(config["evaluation.reference_substeps"])
-    return ref
-
-
 def _comparable(config: Any) -> Dict[str, Any]:
     d = config.to_dict()
     d.get("evolution", {}).pop("threads", None)
@@ -1023,7 +1016,7 @@ class MapElites(_SearchState):
         return self.history[-1]
 
     def _references(self, genomes: List[Any]) -> List[float]:
-        ref = _reference_config(self._config)
+        ref = _core.reference_config(self._config)
         fits = evaluate_population(genomes, ref, int(self._config["evolution.threads"]), objective=self._objective)
         self._reference_evaluations += len(genomes)
         return [float(f.fitness) for f in fits]

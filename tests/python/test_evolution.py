@@ -37,6 +37,22 @@ def test_reference_disagrees_needs_both_tolerances_exceeded():
     assert not animat.reference_disagrees(100.0, 100.9, cfg)
 
 
+@pytest.mark.parametrize("substeps, factor", [(1, 4), (3, 2), (2, 1)])
+def test_reference_config_multiplies_the_substeps_and_keeps_everything_else(substeps, factor):
+    c = small_config()
+    c["physics.substeps"] = substeps
+    c["evaluation.reference_substeps"] = factor
+    c["scene.drag_normal"] = 7.5
+    ref = animat.reference_config(c)
+    assert ref["physics.substeps"] == c["physics.substeps"] * c["evaluation.reference_substeps"] == substeps * factor
+    mine, theirs = c.to_dict(), ref.to_dict()
+    mine["physics"].pop("substeps")
+    theirs["physics"].pop("substeps")
+    assert mine == theirs
+    assert c["physics.substeps"] == substeps  # a copy: the config itself is unchanged
+    assert animat.reference_config.__doc__ and "reference_substeps" in animat.reference_config.__doc__
+
+
 def test_evolve_returns_history_and_best_and_elitism_holds():
     r = animat.evolve(small_config(generations=4))
     assert [h.generation for h in r.history] == [0, 1, 2, 3, 4]

@@ -26,6 +26,8 @@ def load_example(name: str):
     """An example script as a module (imported once: deap_ga.py creates DEAP's creator types)."""
     if name in sys.modules:
         return sys.modules[name]
+    if str(EXAMPLES) not in sys.path:  # the examples import their shared module, _common
+        sys.path.insert(0, str(EXAMPLES))
     spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
