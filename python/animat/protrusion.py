@@ -15,9 +15,9 @@ in shape during motion". :func:`stroke_motion` asks exactly that of a window of 
    joined to it by springs.
 2. *Stroke of a protrusion.* In the body frame (Procrustes, as the classifier), with ``d`` the
    direction of motion: per protruding cell, its **sweep** ``x(t)`` = position along ``d`` (relative
-   to the body's centre: body deformation counts) and its **extension** ``e(t)`` = its offset from the
-   mean of its protrusion's anchors along the protrusion's outward direction (anchors' mean → the
-   protrusion's mean in the mean shape). Both are fitted at the analysed frequency ω (complex
+   to the body's centre: body deformation counts) and its **extension** ``e(t)`` = its distance from the
+   mean of its protrusion's anchors (radial: a projection on the protrusion's mean outward direction
+   mixed the large sweep of a swept-back appendage into its extension). Both are fitted at the analysed frequency ω (complex
    amplitudes ``X``, ``E``, the convention of :func:`animat.locomotion.harmonic_amplitudes`). The
    correlation of ``e`` with the backward velocity ``−dx/dt`` is ``−Im(E X̄) / (|E||X|)``: +1 for the
    loop out → back → in → forward (extended while it moves backwards fastest), −1 for the reverse loop,
@@ -72,25 +72,29 @@ def cell_strokes(
     Q: np.ndarray, times: np.ndarray, omega: float, direction: Any, cells: Sequence[int], base: np.ndarray, outward: Any
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Complex amplitudes at ``omega`` of the sweep ``X`` (position along ``direction``) and the
-    extension ``E`` (offset from ``base`` along ``outward``) of ``cells``.
+    extension ``E`` (offset from ``base`` along ``outward``, or the distance from ``base`` when
+    ``outward`` is None) of ``cells``.
 
     Args:
         Q: (F, n, 2) body-frame positions. times: (F,). omega: rad per time unit.
         direction: (2,) direction of motion (body frame). cells: (k,) cell indices.
         base: (F, 2) the reference point of the extension (the anchors' mean), or (2,) a fixed point.
-        outward: (2,) the direction in which the cells extend.
+        outward: (2,) the direction in which the cells extend, or None (radial extension).
     """
     from .locomotion import harmonic_amplitudes  # noqa: PLC0415 - locomotion imports this module
 
     d = np.asarray(direction, dtype=np.float64)
     d = d / np.linalg.norm(d)
-    u = np.asarray(outward, dtype=np.float64)
-    u = u / np.linalg.norm(u)
     c = np.asarray(cells, dtype=np.int64)
     b = np.asarray(base, dtype=np.float64)
     b = np.broadcast_to(b if b.ndim == 2 else b[None, :], (len(Q), 2))
     sweep = Q[:, c] @ d
-    ext = (Q[:, c] - b[:, None, :]) @ u
+    if outward is None:  # radial: the distance from the base
+        ext = np.linalg.norm(Q[:, c] - b[:, None, :], axis=2)
+    else:
+        u = np.asarray(outward, dtype=np.float64)
+        u = u / np.linalg.norm(u)
+        ext = (Q[:, c] - b[:, None, :]) @ u
     return np.atleast_1d(harmonic_amplitudes(sweep, times, omega)), np.atleast_1d(
         harmonic_amplitudes(ext, times, omega)
     )
@@ -219,7 +223,7 @@ def stroke_motion(
             areas.append(float("nan"))
             found.append(Protrusion(tuple(g), 0.0, tuple(mean[list(g)].mean(axis=0))))
             continue
-        X, E = cell_strokes(Q, t, omega, d, g, base, outward)
+        X, E = cell_strokes(Q, t, omega, d, g, base, None)
         scores.append(rowing(X, E))
         areas.append(float(np.mean(-math.pi * np.imag(E * np.conj(X)))) / s**2)
         cx, cy = mean[list(g)].mean(axis=0)

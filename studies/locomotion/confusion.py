@@ -4,8 +4,8 @@ and 2).
 
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out
 
-prints one line per swim (distance, expected and found mode, the stroke's pair score and area) and the
-matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
+prints one line per swim (distance, expected and found mode, the stroke's pair score and area, and for
+the appendage swimmers the ground truth of known_swimmers.stroke_truth) and the matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
 then none, unstable).
 """
 
@@ -30,9 +30,13 @@ def main(names):
                 if st is not None
                 else "-"
             )
+            truth = ""
+            if r.truth is not None:
+                truth = f"; ground truth {'strokes' if r.truth.strokes else 'does not stroke: ' + r.truth.why_not()}"
+                truth += f" (rowing {min(r.truth.rowing):+.2f})"
             print(
                 f"{name} {r.swimmer.name:28s} dN={r.drag_normal:g} distance={r.distance:6.2f} "
-                f"built={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}"
+                f"built={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}{truth}"
             )
         print(name)
         print(K.confusion_matrix(res, CLASSES, CLASSES + ["none", "unstable"]))

@@ -589,6 +589,7 @@ class KnownResult:
     stable: bool
     stroke: Optional[Stroke] = None
     paddling: Any = None  # animat.locomotion.Paddling of the swim (None when unstable)
+    truth: Optional[StrokeTruth] = None  # the ground truth of the stroke (appendage swimmers only)
 
     @property
     def found(self) -> str:
@@ -619,7 +620,10 @@ def classify_known(
             mode = classify_locomotion(tr, stroke=stroke_rule) if tr.stable else None
             stroke = appendage_stroke(s, tr, mode) if mode is not None else None
             paddle = paddling(tr, mode) if mode is not None else None
-            out.append(KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke, paddle))
+            truth = stroke_truth(s, tr) if tr.stable else None
+            out.append(
+                KnownResult(s, float(dn), int(steps), mode, float(tr.distance), bool(tr.stable), stroke, paddle, truth)
+            )
     return out
 
 
