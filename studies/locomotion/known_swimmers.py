@@ -31,7 +31,9 @@ amplitude, frequency and phase of eq. 2 of the paper, ``L = (1 + a_i sin(f_i t +
 :func:`calibration_set` and :func:`held_out_set` give the two sets of the calibration table (the held-
 out one uses other shapes, sizes, appendage lengths and frequencies; it was not used to choose any
 threshold), :func:`classify_known` swims and classifies them. :func:`paper_calibration_set` and
-:func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind.
+:func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind,
+each of which performs the stroke by :func:`stroke_truth` (measured from its appendage cells, known by
+construction, not by the classifier); :func:`rowing_phase` actuates a geometry so that it does.
 """
 
 from __future__ import annotations
