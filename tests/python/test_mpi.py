@@ -98,6 +98,32 @@ def test_any_ranks_and_threads_give_the_one_thread_run(tmp_path, reference, rank
     assert_same_run(reference, out)
 
 
+def test_protected_ga_on_two_ranks_and_resumed_on_three_is_the_one_process_run(tmp_path):
+    # Morphological innovation protection (evolution.protection_generations) decides tournaments on
+    # rank 0 from each individual's morphology kind and age, which the ranks send back with the
+    # fitness: the run must not depend on where the swims ran, nor on a resume on other ranks.
+    protected = [*SMALL, "--set", "evolution.protection_generations=3"]
+    one = tmp_path / "one"
+    r = evolve(one, *protected)
+    assert r.returncode == 0, r.stderr
+    rows = history(one)
+    assert rows[0]["protected"] == "10" and any(0 < int(row["protected"]) < 10 for row in rows[1:]), rows
+    two = tmp_path / "two"
+    r = evolve(two, *protected, ranks=2)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert_same_run(one, two)
+    split = tmp_path / "split"
+    first_half = list(protected)
+    first_half[first_half.index("--generations") + 1] = "2"
+    r = evolve(split, *first_half, ranks=2)
+    assert r.returncode == 0, r.stdout + r.stderr
+    cmd = [MPIRUN, "--oversubscribe", "--bind-to", "none", "-np", "3", EXE, "--resume", str(split)]
+    cmd += ["--generations", "4", "--threads", "1", "--quiet"]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert_same_run(one, split)
+
+
 def _rank_pids(mpirun_pid):
     """Children of mpirun by MPI rank (a local launch forks the ranks directly)."""
     ranks = {}
