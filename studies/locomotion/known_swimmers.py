@@ -33,7 +33,8 @@ out one uses other shapes, sizes, appendage lengths and frequencies; it was not 
 threshold), :func:`classify_known` swims and classifies them. :func:`paper_calibration_set` and
 :func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind,
 each of which performs the stroke by :func:`stroke_truth` (measured from its appendage cells, known by
-construction, not by the classifier); :func:`rowing_phase` actuates a geometry so that it does.
+construction, not by the classifier); :func:`rowing_phase` actuates a geometry so that it does. Both have
+been seen and are now calibration; :func:`paper_third_set` is the held-out set of the bending-wave rule.
 """
 
 from __future__ import annotations

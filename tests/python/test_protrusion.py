@@ -104,8 +104,8 @@ def _classify(swimmer, drag):
 
 
 # The calibration set at d_N = 0.5 (docs/locomotion.md): the paper's protrusion swimmers swim and are
-# found by the stroke rule; every whole-body, tail and "other" swimmer keeps its class but the bending
-# undulators (other, as before the rule).
+# found by the stroke rule; every whole-body, tail and "other" swimmer keeps its class, and the bending
+# undulators are undulation by the bending wave of the stroke path (test_locomotion_bending.py).
 CAL = {s.name: s for s in K.paper_calibration_set()}
 HELD = {s.name: s for s in K.paper_held_out_set()}
 
@@ -122,6 +122,7 @@ def test_paper_protrusion_swimmers_swim_and_stroke(name):
     "name,expected",
     [
         ("undulator_contraction", "undulation"),
+        ("undulator_bending", "undulation"),
         ("synchronous_teardrop", "synchronous contraction"),
         ("synchronous_lag1.0", "synchronous contraction"),
         ("tail4", "tail"),
