@@ -26,7 +26,8 @@ struct Config;
 [[nodiscard]] bool reference_disagrees(double fitness, double reference,
                                        const EvaluationParams& params);
 /// The config of the reference evaluation of the exploit guard: physics.substeps multiplied by
-/// evaluation.reference_substeps, everything else equal.
+/// evaluation.reference_substeps and evaluation.reference_check "off" (the reference swim has no
+/// reference of its own), everything else equal.
 [[nodiscard]] Config reference_config(const Config& config);
 
 class Evaluator;  // evaluator.hpp
