@@ -92,7 +92,8 @@ on the smooth-deformation bounds above and on a synthetic swimmer (two 3-cell ap
 blob that sweep and extend as the paper's Fig. 6 describes: 0.86). Hand-built swimmers of known mode
 (studies/locomotion/known_swimmers.py; the confusion matrices are in docs/replication.md) were swum: the
 contrast rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase)
-is still missed (wave fit 0.78–0.80, just under WAVE_FIT).
+is still missed by the contraction fit (0.78–0.80, just under WAVE_FIT); on the stroke path
+:func:`bending_wave` finds it (docs/locomotion.md).
 
 The paper's stroke, tested directly
 -----------------------------------
