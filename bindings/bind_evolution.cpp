@@ -535,9 +535,9 @@ void bind_evolution(nb::module_& m) {
 
   m.def(
       "reference_config", [](const Config& config) { return reference_config(config); }, "config"_a,
-      "The exploit guard's reference config: a copy of config with physics.substeps "
-      "multiplied\nby evaluation.reference_substeps, everything else equal. The GA, "
-      "MAP-Elites and NSGA-II\nswim their reference evaluations with it.");
+      "The config of the exploit guard's reference swim (the engine's): a copy of config with\n"
+      "physics.substeps multiplied by evaluation.reference_substeps. The GA, MAP-Elites and "
+      "NSGA-II\nswim their reference evaluations with it.");
 }
 
 }  // namespace animat::py
