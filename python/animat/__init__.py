@@ -15,7 +15,7 @@ organised by task:
 - analysis: :class:`Run` reads a run directory; :func:`replay` returns a :class:`Trajectory`;
   :mod:`animat.plot` draws the paper's figures; :mod:`animat.locomotion` classifies how a swimmer
   moves; :func:`animate` renders GIF/MP4;
-- ``animat evolve|show|animate|info|experiment`` (or ``python -m animat``) does it from the shell.
+- ``animat evolve|show|animate|info|experiment|map-elites|nsga2`` (or ``python -m animat``) does it from the shell.
 
 Every value type pickles and copies. ``animat.plot`` imports matplotlib on first use only.
 """

@@ -8,6 +8,8 @@
     python -m animat explore RUN_DIR... # one HTML page: curves, lineage, genealogy, the best's swim (--serve --live)
     python -m animat experiment CONFIG --runs N --out DIR   # N independent seeds, resumable, with a summary
     mpirun -np R python -m animat experiment NAME=CONFIG ... --runs N --out DIR --mpi   # a study over MPI ranks
+    python -m animat map-elites CONFIG --out DIR [--descriptors NAME,NAME] [--bins B,B] [--mpi]   # MAP-Elites
+    python -m animat nsga2 CONFIG --out DIR [--objectives NAME:max,NAME:min] [--mpi]   # NSGA-II
 
 Every command exits with status 1 and a one-line message for a missing or malformed run directory.
 """
@@ -19,6 +21,8 @@ import sys
 import time
 from pathlib import Path
 from typing import List, Optional
+
+from .pool import MpiAbort
 
 FIGURES = ("development", "construction", "motion_cycle", "phase_map", "stiffness_map", "fitness_history")
 
@@ -35,7 +39,9 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="animat", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    sub = p.add_subparsers(dest="command", required=True, metavar="{evolve,show,animate,info,explore,experiment}")
+    sub = p.add_subparsers(
+        dest="command", required=True, metavar="{evolve,show,animate,info,explore,experiment,map-elites,nsga2}"
+    )
 
     sub.add_parser(
         "evolve",
@@ -119,7 +125,82 @@ def _parser() -> argparse.ArgumentParser:
         help="run only run I of the study, numbered environment-major (one Slurm array task: "
         "--index $SLURM_ARRAY_TASK_ID); repeatable; writes no summary",
     )
+    _search_parsers(sub)
     return p
+
+
+#: What ``animat map-elites`` and ``animat nsga2`` search over when a new run names none.
+DEFAULT_DESCRIPTORS = "elongation,protrusions"
+DEFAULT_BINS = 10
+DEFAULT_OBJECTIVES = "distance:max,actuation_work_positive:min"
+
+
+def _search_parsers(sub) -> None:
+    from .moo import CRITERIA
+    from .qd import DESCRIPTORS
+
+    m = sub.add_parser(
+        "map-elites",
+        help="run (or resume) MAP-Elites from a config into a run directory",
+        description="MAP-Elites (docs/python.md, section 7b) from a config: animat.run_map_elites into OUT "
+        "(config.toml, history.csv, archive/gen_*.csv, checkpoint.json). OUT holding a MAP-Elites run: the "
+        "same command resumes it.",
+    )
+    n = sub.add_parser(
+        "nsga2",
+        help="run (or resume) NSGA-II from a config into a run directory",
+        description="NSGA-II (docs/python.md, section 7c) from a config: animat.run_nsga2 into OUT "
+        "(config.toml, history.csv, front/gen_*.csv, checkpoint.json). OUT holding an NSGA-II run: the "
+        "same command resumes it.",
+    )
+    for q in (m, n):
+        q.add_argument(
+            "config", metavar="CONFIG", help="TOML config file, or a packaged config by name (paper_dn2 ...)"
+        )
+        q.add_argument("--out", required=True, type=Path, help="the run directory (a run there is resumed)")
+    m.add_argument(
+        "--descriptors",
+        metavar="NAME,NAME",
+        help=f"the archive's descriptors, of {', '.join(DESCRIPTORS)} (new run default {DEFAULT_DESCRIPTORS})",
+    )
+    m.add_argument(
+        "--bins",
+        metavar="B[,B...]",
+        help=f"grid bins: one count for every descriptor, or one each (new run default {DEFAULT_BINS})",
+    )
+    n.add_argument(
+        "--objectives",
+        metavar="NAME[:SENSE],...",
+        help=f"the objectives, each max or min (default: the table's sense), of {', '.join(CRITERIA)} "
+        f"(new run default {DEFAULT_OBJECTIVES})",
+    )
+    m.add_argument("--batch", type=int, help="offspring per generation (default evolution.population)")
+    n.add_argument(
+        "--population", type=int, help="population and offspring per generation (default evolution.population)"
+    )
+    for q, snapshots in ((m, "archive"), (n, "front")):
+        q.add_argument(
+            "--generations", type=int, help="run up to this generation (default evolution.generations, when set)"
+        )
+        q.add_argument("--seed", type=int, help="the run's seed (default evolution.seed)")
+        q.add_argument(
+            "--threads", type=int, help="evaluation threads per rank (default evolution.threads; 0 = all cores)"
+        )
+        q.add_argument(
+            f"--{snapshots}-every",
+            type=int,
+            default=10 if snapshots == "archive" else 1,
+            help=f"write {snapshots}/gen_NNNNNN.csv every this many generations and at the last "
+            f"(default {10 if snapshots == 'archive' else 1})",
+        )
+        q.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a config value")
+        q.add_argument(
+            "--mpi",
+            action="store_true",
+            help="swim on the ranks of an MPI job: mpirun -np R python -m animat ... --mpi (needs mpi4py); "
+            "the same run as without",
+        )
+        q.add_argument("--quiet", action="store_true", help="no line per generation")
 
 
 def has_evolved_stiffness(run, entry=None) -> bool:
@@ -320,6 +401,152 @@ def cmd_experiment(args) -> int:
     return 0
 
 
+def _names(option: str, text: str, table) -> List[str]:
+    names = [t.strip() for t in text.split(",")]
+    for name in names:
+        if name not in table:
+            raise ValueError(f"{option} {text!r}: no name {name!r}; the names are {', '.join(table)}")
+    if len(set(names)) != len(names):
+        raise ValueError(f"{option} {text!r}: a name appears twice")
+    return names
+
+
+def _at_least(option: str, value: Optional[int], least: int) -> None:
+    if value is not None and value < least:
+        raise ValueError(f"{option} must be >= {least}, got {value}")
+
+
+def _search_setup(args, what: str):
+    """The config, the generations and whether ``args.out`` is resumed, for map-elites and nsga2;
+    every check before any file is written."""
+    from .experiment import launched_ranks
+    from .pipeline import load_config
+
+    ranks = launched_ranks()
+    if ranks > 1 and not args.mpi:
+        raise RuntimeError(
+            f"started as one of {ranks} MPI ranks without --mpi: every rank would run the whole search into "
+            f"{args.out}; add --mpi to swim on the ranks"
+        )
+    _at_least("--seed", args.seed, 0)
+    _at_least("--threads", args.threads, 0)
+    _at_least("--generations", args.generations, 0)
+    config = load_config(args.config)
+    config.apply_overrides(list(args.set))
+    generations = args.generations
+    if generations is None:
+        generations = int(config["evolution.generations"])
+        if generations == 0:
+            raise ValueError(
+                f"--generations is needed: the config's evolution.generations is 0, no cap, and {what} has no other stop"
+            )
+    checkpoint = args.out / "checkpoint.json"
+    return config, generations, checkpoint.is_file()
+
+
+def _search(args, run, what: str, snapshots: str, line, **options) -> int:
+    """``run`` (run_map_elites or run_nsga2) into ``args.out`` with ``options`` and those every search
+    command shares; ``line(row)`` is printed after every generation (unless --quiet), a summary at the
+    end (rank 0 only over MPI)."""
+    config, generations, resume = _search_setup(args, what)
+
+    def report(row) -> None:
+        if not args.quiet:
+            print(line(row), flush=True)
+
+    search = run(
+        config=config,
+        out=args.out,
+        generations=generations,
+        resume=resume,
+        seed=args.seed,
+        threads=args.threads,
+        callback=report,
+        mpi=args.mpi,
+        **options,
+    )
+    if args.mpi:
+        from .experiment import _mpi_world
+
+        if _mpi_world().Get_rank() != 0:
+            return 0
+    print(
+        f"{args.out}: generation {search.generation}, {search.evaluations} evaluations"
+        f"{' (resumed)' if resume else ''}; history.csv, {snapshots}/gen_*.csv, checkpoint.json"
+    )
+    return 0
+
+
+def cmd_map_elites(args) -> int:
+    from .qd import DESCRIPTORS, GridArchive, run_map_elites
+
+    _at_least("--batch", args.batch, 1)
+    _at_least("--archive-every", args.archive_every, 1)
+    given = args.descriptors is not None or args.bins is not None
+    names = _names("--descriptors", args.descriptors or DEFAULT_DESCRIPTORS, DESCRIPTORS)
+    bins_text = args.bins or str(DEFAULT_BINS)
+    try:
+        bins = [int(b) for b in bins_text.split(",")]
+    except ValueError:
+        raise ValueError(f"--bins {bins_text!r}: counts are integers, e.g. 10 or 12,8") from None
+    if len(bins) not in (1, len(names)) or min(bins) < 1:
+        raise ValueError(
+            f"--bins {bins_text!r}: one count >= 1 for every descriptor, or one each for the {len(names)} "
+            f"descriptors {','.join(names)}"
+        )
+    archive = None  # a resume's, unless given
+    if given or not (args.out / "checkpoint.json").is_file():
+        archive = GridArchive(names, bins if len(bins) > 1 else bins[0])
+
+    return _search(
+        args,
+        run_map_elites,
+        "MAP-Elites",
+        "archive",
+        lambda row: (
+            f"generation {row.generation:4d}: {row.elites} elites, coverage {row.coverage:.3f}, "
+            f"QD-score {row.qd_score:.6g}, best {row.best:.6g}"
+        ),
+        archive=archive,
+        batch=args.batch,
+        archive_every=args.archive_every,
+    )
+
+
+def cmd_nsga2(args) -> int:
+    from .moo import CRITERIA, run_nsga2
+
+    _at_least("--population", args.population, 1)
+    _at_least("--front-every", args.front_every, 1)
+    objectives = None
+    if args.objectives is not None or not (args.out / "checkpoint.json").is_file():
+        text = args.objectives or DEFAULT_OBJECTIVES
+        pairs = [item.strip().partition(":") for item in text.split(",")]
+        _names("--objectives", ",".join(name for name, _, _ in pairs), CRITERIA)
+        objectives = []
+        for name, _, sense in pairs:
+            sense = sense.strip() or CRITERIA[name].sense
+            if sense not in ("max", "min"):
+                what = f"sense {sense!r}" if sense else "no default sense"
+                raise ValueError(f"--objectives {text!r}: {name} has {what}: write {name}:max or {name}:min")
+            objectives.append((name, sense))
+
+    def line(row) -> str:
+        best = ", ".join(f"{name} {row[name]:.6g}" for name in row.dtype.names if name.startswith("best_"))
+        return f"generation {row.generation:4d}: front {row.front_size}, hypervolume {row.hypervolume:.6g}, {best}"
+
+    return _search(
+        args,
+        run_nsga2,
+        "NSGA-II",
+        "front",
+        line,
+        objectives=objectives,
+        population=args.population,
+        front_every=args.front_every,
+    )
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Entry point of ``animat`` and ``python -m animat``; returns the exit status (0 ok, 1 error, 2 usage;
     ``animat evolve`` returns animat_evolve's)."""
@@ -335,9 +562,13 @@ def main(argv: Optional[List[str]] = None) -> int:
         "info": cmd_info,
         "explore": cmd_explore,
         "experiment": cmd_experiment,
+        "map-elites": cmd_map_elites,
+        "nsga2": cmd_nsga2,
     }[args.command]
     try:
         return command(args)
+    except MpiAbort:  # a rank other than 0 of a run that rank 0 stopped: rank 0 says why
+        return 1
     except KeyboardInterrupt as e:
         print(f"animat {args.command}: {e or 'interrupted'}", file=sys.stderr)
         return 130

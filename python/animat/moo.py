@@ -72,7 +72,6 @@ import io
 import json
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, cast
@@ -80,7 +79,8 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 import numpy as np
 
 from . import _core
-from .qd import _comparable, _run_search, _SearchState, _write_atomic
+from .pool import Swim, evaluate_results
+from .qd import _comparable, _on_ranks, _run_search, _same_as_run, _SearchState, _write_atomic
 
 __all__ = [
     "Criterion",
@@ -487,18 +487,6 @@ def _copies(pool: Sequence[Solution]) -> List[int]:
     return out
 
 
-def _evaluate_results(genomes: Sequence[Any], config: Any, threads: int) -> List[Any]:
-    """An :class:`animat.EvaluationResult` per genome, in order: ``animat.evaluate`` (the GIL released
-    while it swims) on ``threads`` Python threads (0 = all cores). Each is a function of its genome and
-    the config alone, so the list is the same for any thread count."""
-    n = threads if threads > 0 else (os.cpu_count() or 1)
-    if n == 1 or len(genomes) <= 1:
-        return [_core.evaluate(g, config) for g in genomes]
-    _core.warm_up_box2d()
-    with ThreadPoolExecutor(max_workers=min(n, len(genomes))) as pool:
-        return list(pool.map(lambda g: _core.evaluate(g, config), genomes))
-
-
 def _enc(x: float) -> Any:
     """A float for JSON (allow_nan=False): NaN as null, infinities as strings."""
     if math.isnan(x):
@@ -612,6 +600,7 @@ class Nsga2(_SearchState):
                 )
             self._reference_point = point
         self._guard = str(self._config["evaluation.reference_check"])
+        self._swim = evaluate_results
         self._generation = -1
         self._evaluations = 0
         self._reference_evaluations = 0
@@ -786,7 +775,7 @@ class Nsga2(_SearchState):
         if not genomes:
             return []
         ref = _core.reference_config(self._config)
-        results = _evaluate_results(genomes, ref, int(self._config["evolution.threads"]))
+        results = self._evaluate(genomes, ref)
         self._reference_evaluations += len(genomes)
         return [self._measure(g, r, ref)[0] for g, r in zip(genomes, results)]
 
@@ -821,12 +810,10 @@ class Nsga2(_SearchState):
 
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: ``animat.evaluate`` on the config's threads: the GIL is released
-        while each genome swims) and tell one generation; returns its history row."""
+        while each genome swims; over the MPI ranks under ``run_nsga2(..., mpi=True)``) and tell one
+        generation; returns its history row."""
         genomes = self.ask()
-        if evaluate is None:
-            results: Sequence[Any] = _evaluate_results(genomes, self._config, int(self._config["evolution.threads"]))
-        else:
-            results = evaluate(genomes)
+        results = self._evaluate(genomes, self._config) if evaluate is None else evaluate(genomes)
         return self.tell(list(results))
 
     # --- state ------------------------------------------------------------------------------------
@@ -1030,6 +1017,7 @@ def run_nsga2(
     resume: bool = False,
     overwrite: bool = False,
     callback: Optional[Callable[[Any], Optional[bool]]] = None,
+    mpi: bool = False,
 ) -> Nsga2:
     """Run NSGA-II up to generation ``generations`` (generation 0 is the initial population, as
     ``evolution.generations`` counts) in the run directory ``out``:
@@ -1046,8 +1034,29 @@ def run_nsga2(
 
     ``callback(row)`` is called after every generation; returning False stops (checkpointed). Returns
     the :class:`Nsga2`. A directory that holds a run is refused (FileExistsError) unless ``resume``
-    or ``overwrite`` (which removes the files above and ``front/``, nothing else).
+    or ``overwrite`` (which removes the files above and ``front/``, nothing else). On a resume, a
+    ``population``, ``seed``, ``crossover_fraction`` or ``reference_point`` that is given must be the
+    run's (ValueError), as the config must (but for ``evolution.threads``).
+
+    ``mpi=True``: the swims run on the ranks of an MPI job, as for :func:`animat.run_map_elites`
+    (start every rank with the same call; rank 0 runs the search and writes ``out``; bit-identical
+    to the run without MPI for any number of ranks; every rank returns the final :class:`Nsga2`).
     """
+    given = () if objectives is None else objectives
+
+    def load(path: Path) -> Nsga2:
+        nsga = Nsga2.load(path, config, objectives=given, threads=threads)
+        _same_as_run(
+            "run_nsga2",
+            population=(population, nsga.population_size),
+            seed=(seed, nsga.seed),
+            crossover_fraction=(crossover_fraction, nsga.crossover_fraction),
+            reference_point=(
+                None if reference_point is None else tuple(float(x) for x in reference_point),
+                nsga.reference_point if nsga._reference_point_given else None,
+            ),
+        )
+        return nsga
 
     def check_new() -> None:
         if objectives is None:
@@ -1064,9 +1073,8 @@ def run_nsga2(
             threads=threads,
         )
 
-    return cast(
-        Nsga2,
-        _run_search(
+    def run(pool: Optional[Swim]) -> Nsga2:
+        return _run_search(
             "run_nsga2",
             out,
             "front",
@@ -1074,12 +1082,15 @@ def run_nsga2(
             generations,
             resume=resume,
             overwrite=overwrite,
-            load=lambda path: Nsga2.load(
-                path, config, objectives=() if objectives is None else objectives, threads=threads
-            ),
+            load=load,
             new=new,
             check_new=check_new,
             write_snapshot=lambda nsga, path: nsga.write_front(path),
             callback=callback,
-        ),
-    )
+            pool=pool,
+        )
+
+    def restore(state: Any) -> Nsga2:
+        return Nsga2.restore(state, objectives=given, threads=threads)
+
+    return cast(Nsga2, _on_ranks("run_nsga2", mpi, evaluate_results, restore, run))

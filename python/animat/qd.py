@@ -64,6 +64,7 @@ import numpy as np
 
 from . import _core
 from .evolution import Objective, ObjectiveLike, _config_for, _objective, evaluate_population, to_fitness
+from .pool import MpiPool, Swim, serve
 
 __all__ = [
     "Descriptor",
@@ -799,6 +800,12 @@ class _SearchState:
     _config: Any
     _generation: int
     _evaluations: int
+    # The swim function (animat.pool): this process's, and the MPI pool's while run_* runs one.
+    _swim: Swim
+    _pool: Optional[Swim] = None
+
+    def _evaluate(self, genomes: List[Any], config: Any) -> List[Any]:
+        return (self._pool or self._swim)(genomes, config)
 
     @property
     def config(self) -> Any:
@@ -835,6 +842,22 @@ class _SearchState:
         if path.is_dir():
             path = path / "checkpoint.json"
         return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, **kwargs)
+
+
+def _python_objective(objective: ObjectiveLike) -> Optional[Objective]:
+    """The Python objective of a search's ``objective`` argument (None for a name or None)."""
+    obj = _objective(objective)
+    return obj if isinstance(obj, Objective) else None
+
+
+def _fitnesses(objective: Optional[Objective]) -> Swim:
+    """MAP-Elites' swim function (:mod:`animat.pool`): :func:`animat.evaluate_population` on the
+    config's ``evolution.threads`` with ``objective`` (a Python objective, or None: the config's)."""
+
+    def swim(genomes: List[Any], config: Any) -> List[Any]:
+        return evaluate_population(genomes, config, int(config["evolution.threads"]), objective=objective)
+
+    return swim
 
 
 class MapElites(_SearchState):
@@ -888,9 +911,9 @@ class MapElites(_SearchState):
     ) -> None:
         if not isinstance(archive, _Archive):
             raise TypeError(f"MapElites: archive must be a GridArchive or a CVTArchive, got {type(archive).__name__}")
-        obj = _objective(objective)
-        self._config = _config_for(config, obj)
-        self._objective: Optional[Objective] = obj if isinstance(obj, Objective) else None
+        self._config = _config_for(config, _objective(objective))
+        self._objective = _python_objective(objective)
+        self._swim = _fitnesses(self._objective)
         name = str(self._config["evaluation.objective"])
         if name.startswith("python:") and self._objective is None:
             raise ValueError(
@@ -1016,21 +1039,16 @@ class MapElites(_SearchState):
         return self.history[-1]
 
     def _references(self, genomes: List[Any]) -> List[float]:
-        ref = _core.reference_config(self._config)
-        fits = evaluate_population(genomes, ref, int(self._config["evolution.threads"]), objective=self._objective)
+        fits = self._evaluate(genomes, _core.reference_config(self._config))
         self._reference_evaluations += len(genomes)
         return [float(f.fitness) for f in fits]
 
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: :func:`animat.evaluate_population` with the config's threads and the
-        objective) and tell one generation; returns its history row."""
+        objective; over the MPI ranks under ``run_map_elites(..., mpi=True)``) and tell one generation;
+        returns its history row."""
         genomes = self.ask()
-        if evaluate is None:
-            results: Sequence[Any] = evaluate_population(
-                genomes, self._config, int(self._config["evolution.threads"]), objective=self._objective
-            )
-        else:
-            results = evaluate(genomes)
+        results = self._evaluate(genomes, self._config) if evaluate is None else evaluate(genomes)
         return self.tell(list(results))
 
     # --- state ------------------------------------------------------------------------------------
@@ -1137,6 +1155,29 @@ def _history_csv(history: np.ndarray) -> str:
     return buf.getvalue()
 
 
+def _on_ranks(
+    what: str, mpi: bool, swim: Swim, restore: Callable[[Any], Any], run: Callable[[Optional[Swim]], Any]
+) -> Any:
+    """``run(None)``, or with ``mpi`` ``run(pool)`` on rank 0 of COMM_WORLD with an :class:`MpiPool`
+    that swims over every rank with ``swim`` (:mod:`animat.pool`), while the other ranks serve it and
+    return ``restore(checkpoint)`` of the final state. Every rank calls this."""
+    if not mpi:
+        return run(None)
+    from .experiment import _mpi_world
+
+    comm = _mpi_world()
+    if comm.Get_rank() != 0:
+        return restore(serve(comm, swim, what))
+    pool = MpiPool(comm, swim, what)
+    try:
+        search = run(pool)
+    except BaseException as e:
+        pool.abort(e)
+        raise
+    pool.stop(search.checkpoint())
+    return search
+
+
 def _run_search(
     what: str,
     out: PathLike,
@@ -1151,10 +1192,12 @@ def _run_search(
     check_new: Callable[[], None],
     write_snapshot: Callable[[Any, Path], Any],
     callback: Optional[Callable[[Any], Optional[bool]]],
+    pool: Optional[Swim] = None,
 ) -> Any:
     """The run directory of a search (MAP-Elites, NSGA-II): ``config.toml``, ``history.csv``,
     ``<snapshots>/gen_NNNNNN.csv`` every ``every`` generations and at the last, ``checkpoint.json``
-    after every generation. Every refusal comes before any file is touched."""
+    after every generation. Every refusal comes before any file is touched. ``pool``: where the
+    search swims meanwhile (default its own threads)."""
     if resume and overwrite:
         raise ValueError(f"{what}: resume=True and overwrite=True contradict each other")
     if every < 1:
@@ -1176,17 +1219,21 @@ def _run_search(
         search = new()
     (out / snapshots).mkdir(parents=True, exist_ok=True)
     _write_atomic(out / "config.toml", search.config.to_toml())
-    while search.generation < generations:
-        row = search.step()
-        g = search.generation
-        snapshot = out / snapshots / f"gen_{g:06d}.csv"
-        if g % every == 0 or g == generations:
-            write_snapshot(search, snapshot)
-        _write_atomic(out / "history.csv", _history_csv(search.history))
-        search.save(out / "checkpoint.json")
-        if callback is not None and callback(row) is False:
-            write_snapshot(search, snapshot)
-            break
+    search._pool = pool
+    try:
+        while search.generation < generations:
+            row = search.step()
+            g = search.generation
+            snapshot = out / snapshots / f"gen_{g:06d}.csv"
+            if g % every == 0 or g == generations:
+                write_snapshot(search, snapshot)
+            _write_atomic(out / "history.csv", _history_csv(search.history))
+            search.save(out / "checkpoint.json")
+            if callback is not None and callback(row) is False:
+                write_snapshot(search, snapshot)
+                break
+    finally:
+        search._pool = None
     return search
 
 
@@ -1207,6 +1254,7 @@ def run_map_elites(
     overwrite: bool = False,
     descriptors: Iterable[DescriptorLike] = (),
     callback: Optional[Callable[[Any], Optional[bool]]] = None,
+    mpi: bool = False,
 ) -> MapElites:
     """Run MAP-Elites up to generation ``generations`` (generation 0 is the initial batch, as
     ``evolution.generations`` counts) in the run directory ``out``:
@@ -1222,12 +1270,30 @@ def run_map_elites(
 
     ``callback(row)`` is called after every generation; returning False stops (checkpointed). Returns
     the :class:`MapElites`. A directory that holds a run is refused (FileExistsError) unless ``resume``
-    or ``overwrite`` (which removes the files above and ``archive/``, nothing else).
+    or ``overwrite`` (which removes the files above and ``archive/``, nothing else). On a resume, an
+    ``archive``, ``batch``, ``initial``, ``seed`` or ``crossover_fraction`` that is given must be the
+    run's (ValueError), as the config must (but for ``evolution.threads``).
+
+    ``mpi=True``: the swims run on the ranks of an MPI job (mpi4py; :mod:`animat.pool`): start every
+    rank with the same call (``mpirun -np R python script.py``). Rank 0 runs the search, writes ``out``
+    and calls ``callback``; every rank swims a share of each batch on ``threads`` threads. The run is
+    bit-identical to the one without MPI, for any number of ranks. Every rank returns the final
+    :class:`MapElites`; an error on any rank raises on rank 0 and stops all
+    (:class:`animat.pool.MpiAbort` on the others).
     """
+    extra = tuple(descriptors) + (tuple(archive.descriptors) if archive is not None else ())
 
     def load(path: Path) -> MapElites:
-        extra = tuple(descriptors) + (tuple(archive.descriptors) if archive is not None else ())
-        return MapElites.load(path, config, objective=objective, descriptors=extra, threads=threads)
+        me = MapElites.load(path, config, objective=objective, descriptors=extra, threads=threads)
+        _same_as_run(
+            "run_map_elites",
+            archive=(None if archive is None else _archive_definition(archive), _archive_definition(me.archive)),
+            batch=(batch, me.batch),
+            initial=(initial, me.initial),
+            seed=(seed, me.seed),
+            crossover_fraction=(crossover_fraction, me.crossover_fraction),
+        )
+        return me
 
     def check_new() -> None:
         if archive is None:
@@ -1245,9 +1311,8 @@ def run_map_elites(
             threads=threads,
         )
 
-    return cast(
-        MapElites,
-        _run_search(
+    def run(pool: Optional[Swim]) -> MapElites:
+        return _run_search(
             "run_map_elites",
             out,
             "archive",
@@ -1260,5 +1325,31 @@ def run_map_elites(
             check_new=check_new,
             write_snapshot=lambda me, path: me.archive.write_csv(path),
             callback=callback,
-        ),
-    )
+            pool=pool,
+        )
+
+    def restore(state: Any) -> MapElites:
+        return MapElites.restore(state, objective=objective, descriptors=extra, threads=threads)
+
+    return cast(MapElites, _on_ranks("run_map_elites", mpi, _fitnesses(_python_objective(objective)), restore, run))
+
+
+def _same_as_run(what: str, **given: Tuple[Any, Any]) -> None:
+    """Refuse a resume given an argument (``name=(given, the run's)``; None: not given) that is not the
+    run's: it would be ignored."""
+    for name, (mine, run) in given.items():
+        if mine is not None and mine != run:
+            raise ValueError(
+                f"{what}: {name} {mine!r} is not the run's {run!r}: a resume continues the run as it was started"
+            )
+
+
+def _archive_definition(archive: _Archive) -> str:
+    """An archive's cells in words (its kind, descriptors, ranges, bins or centroids), not its elites."""
+    ranges = ", ".join(f"{d.name} [{d.lo!r}, {d.hi!r}]" for d in archive.descriptors)
+    geometry = {k: v for k, v in archive._geometry().items() if k != "centroids"}
+    if isinstance(archive, CVTArchive):
+        geometry["cells"] = archive.cells
+    if archive.qd_offset:
+        geometry["qd_offset"] = archive.qd_offset
+    return f"{archive.kind} archive of {ranges}, " + ", ".join(f"{k} {v!r}" for k, v in geometry.items())
