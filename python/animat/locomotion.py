@@ -70,7 +70,8 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
      body"; the drag and inertia of synchronously driven bodies produce lags up to 0.74 rad. On the
      stroke rule's path (``classify_locomotion(..., stroke=True)``) a *bending wave* also counts
      (:func:`bending_wave`: the same fit, lag and TI on the strain of the springs along the body,
-     signed by the side they lie on, fit ``>= BEND_FIT`` 0.65): the two sides of a bending undulator
+     signed by the side they lie on, fit ``>= BEND_FIT`` 0.65 and significant against shuffled positions,
+     p ``<= BEND_P`` 0.01): the two sides of a bending undulator
      contract in antiphase, which the cells' contraction mixes into a poor ramp (fit 0.75-0.80).
    - ``coherence >= SYNC_COHERENCE`` (0.8): **synchronous contraction**; also listed as mixed with an
      undulation whose lag is short enough to keep R ≥ 0.8 (a uniform lag of π/2 gives R = 0.90, of
@@ -149,7 +150,11 @@ __all__ = [
     "BEND_FIT",
     "BEND_CONE",
     "BEND_BAND",
+    "BEND_P",
+    "BEND_PERMUTATIONS",
+    "BEND_SEED",
     "bending_wave",
+    "shuffled_fits",
     "SYNC_COHERENCE",
     "TOP_FRACTION",
     "LOCAL_CONTRAST",
@@ -211,6 +216,15 @@ WAVE_TI = 0.15
 #: the calibration swims of studies/locomotion/known_swimmers.py (paper_calibration_set and the second
 #: held-out set, both seen): bending undulators 0.78-0.93, every other non-tail swim at most 0.49.
 BEND_FIT = 0.65
+#: Largest permutation p-value of the bending fit (:func:`bending_wave`): the fit must beat the fits of the
+#: same springs with their positions along the axis shuffled (:func:`shuffled_fits`) at the 1 % level. A
+#: circular-linear fit with a free gradient reaches BEND_FIT by chance on 14-22 springs (docs/locomotion.md).
+BEND_P = 0.01
+#: Shuffles of the permutation test (p = (1 + #shuffled fits >= the fit) / (1 + BEND_PERMUTATIONS), so
+#: the smallest p is 0.001, ten times under BEND_P).
+BEND_PERMUTATIONS = 999
+#: Seed of the shuffles: fixed, so that the classifier is deterministic.
+BEND_SEED = 0
 #: Springs within this angle (degrees) of the body's long axis carry the bending wave.
 BEND_CONE = 30.0
 #: ... and lie at least this far (median rest lengths) off the axis, on one side.
@@ -328,7 +342,9 @@ class WaveFit:
         coherence: :func:`phase_coherence` of the contraction field (the fit with g = 0).
         angle: angle (degrees, 0..180) between the direction the wave travels (-g) and the
             direction of motion: ~0 the wave runs forward (back to front), ~180 backward, ~90 across.
-        is_wave: the wave criterion holds (fit, lag and travelling index above their thresholds).
+        is_wave: the wave criterion holds (fit, lag and travelling index above their thresholds; for
+            :func:`bending_wave` also ``p_value <= BEND_P``).
+        p_value: the permutation p-value of the fit (:func:`bending_wave`; nan where not tested).
     """
 
     gradient: np.ndarray
@@ -338,6 +354,7 @@ class WaveFit:
     coherence: float
     angle: float
     is_wave: bool
+    p_value: float = float("nan")
 
     @property
     def travel(self) -> str:
@@ -387,6 +404,48 @@ def circular_linear_fit(
         g, r = best_on(axes)
         step /= 10
     return (g[0] if one_d else g), r
+
+
+def shuffled_fits(
+    phases: ArrayLike,
+    weights: ArrayLike,
+    coords: ArrayLike,
+    permutations: int = 999,
+    seed: int = 0,
+    max_gradient: float = math.pi,
+    grid: int = 81,
+) -> np.ndarray:
+    """The 1-D :func:`circular_linear_fit` of ``phases`` with their ``coords`` shuffled: the null
+    distribution of the fit when the phases are unrelated to the positions (each shuffle a permutation of
+    the positions, the (phase, weight) pairs kept together; ``seed`` fixes them). Same search as
+    :func:`circular_linear_fit` (coarse grid, four local refinements), batched over the shuffles.
+
+    Returns:
+        (permutations,) the best resultant length of each shuffle.
+    """
+    phi = np.asarray(phases, dtype=np.float64).ravel()
+    w = np.asarray(weights, dtype=np.float64).ravel()
+    x = np.asarray(coords, dtype=np.float64).ravel()
+    total = w.sum()
+    if total <= 0 or len(phi) == 0 or permutations <= 0:
+        return np.zeros(max(permutations, 0))
+    zw = w * np.exp(1j * phi)
+    rng = np.random.default_rng(seed)
+    X = np.stack([rng.permutation(x) for _ in range(permutations)])  # (N, m)
+    rows = np.arange(permutations)
+
+    def best_on(axes: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:  # axes (N, G) or (G,)
+        A = np.broadcast_to(axes, (permutations, axes.shape[-1]))
+        vals = np.abs(np.exp(-1j * A[:, :, None] * X[:, None, :]) @ zw) / total  # (N, G)
+        k = np.argmax(vals, axis=1)
+        return A[rows, k], vals[rows, k]
+
+    step = 2 * max_gradient / (grid - 1)
+    g, r = best_on(np.linspace(-max_gradient, max_gradient, grid))
+    for _ in range(4):
+        g, r = best_on(g[:, None] + np.linspace(-step, step, 21)[None, :])
+        step /= 10
+    return r
 
 
 # --- classification --------------------------------------------------------------------------------------
@@ -527,7 +586,10 @@ def bending_wave(
     phase) two antiphase halves that do not fit. The circular-linear fit along the axis, the lag over the
     springs with at least 10 % of the largest amplitude and the travelling index of the signal give a
     :class:`WaveFit` whose criterion is fit ``>= BEND_FIT``, lag ``>= WAVE_LAG`` and travelling index
-    ``>= WAVE_TI``.
+    ``>= WAVE_TI``, and the fit significant: its permutation p-value (the share of ``BEND_PERMUTATIONS``
+    shuffles of the springs' positions along the axis, :func:`shuffled_fits`, that fit as well, counting
+    the fit itself) ``<= BEND_P``. With a free gradient, unrelated phases on 14-22 springs fit 0.5-0.65
+    (docs/locomotion.md).
 
     Args:
         Q: (F, n, 2) body-frame positions (:func:`procrustes_frames`). times: (F,). omega: rad per time unit.
@@ -568,8 +630,10 @@ def bending_wave(
     else:
         angle = float("nan")
     ti = travelling_index(z)
-    is_wave = fit >= BEND_FIT and lag >= WAVE_LAG and ti >= WAVE_TI
-    return WaveFit(gradient, float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave))
+    null = shuffled_fits(np.angle(z), a, u[keep], BEND_PERMUTATIONS, BEND_SEED)
+    p = (1 + int(np.sum(null >= fit))) / (1 + len(null))
+    is_wave = fit >= BEND_FIT and p <= BEND_P and lag >= WAVE_LAG and ti >= WAVE_TI
+    return WaveFit(gradient, float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave), float(p))
 
 
 def _groups(cells: np.ndarray, springs: np.ndarray) -> int:
@@ -584,6 +648,8 @@ def _no_wave(w: WaveFit, bend: Optional[WaveFit] = None) -> str:
         out = []
         if x.fit < fit:
             out.append(f"fit {x.fit:.2f} < {fit}")
+        if x.p_value > BEND_P:  # nan (not tested) compares false
+            out.append(f"p {x.p_value:.3f} > {BEND_P} against shuffled positions")
         if x.lag < WAVE_LAG:
             out.append(f"lag {x.lag:.2f} rad < pi/2")
         if x.travelling_index < WAVE_TI:
@@ -605,7 +671,7 @@ def _wave_reason(w: WaveFit, bend: Optional[WaveFit]) -> str:
         )
     return (
         f"a bending wave: the side-difference strain of the axial springs has a consistent gradient "
-        f"(fit {bend.fit:.2f} >= {BEND_FIT}) with a lag of {bend.lag:.2f} rad >= pi/2 and travelling "
+        f"(fit {bend.fit:.2f} >= {BEND_FIT}, p {bend.p_value:.3f} <= {BEND_P}) with a lag of {bend.lag:.2f} rad >= pi/2 and travelling "
         f"index {bend.travelling_index:.2f} >= {WAVE_TI} (contraction fit {w.fit:.2f})"
     )
 
