@@ -1,8 +1,8 @@
 """Confusion matrices of animat.classify_locomotion with the paper's stroke rule on the hand-built
-swimmers of known_swimmers.py (paper_calibration_set, paper_held_out_set, both now calibration, and the
-third held-out set paper_third_set; 2000 steps at d_N = 0.5 and 2).
+swimmers of known_swimmers.py (paper_calibration_set, paper_held_out_set and paper_third_set, all now
+calibration, and the fourth held-out set paper_fourth_set; 2000 steps at d_N = 0.5 and 2).
 
-    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out,third
+    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out,third,fourth
 
 prints one line per swim (distance, expected and found mode, the stroke's pair score and area, and for
 the appendage swimmers the ground truth of known_swimmers.stroke_truth) and the matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
@@ -15,7 +15,12 @@ import warnings
 import known_swimmers as K  # this folder (sys.path[0] when run as a script)
 
 CLASSES = ["undulation", "synchronous contraction", "protrusions", "tail", "other"]
-SETS = {"calibration": K.paper_calibration_set, "held-out": K.paper_held_out_set, "third": K.paper_third_set}
+SETS = {
+    "calibration": K.paper_calibration_set,
+    "held-out": K.paper_held_out_set,
+    "third": K.paper_third_set,
+    "fourth": K.paper_fourth_set,
+}
 
 
 def main(names):
