@@ -103,3 +103,58 @@ def test_third_held_out_swimmers(name, drag, expected):
 def test_third_held_out_random_phases_are_other():
     m = L.classify_locomotion(_swim(THIRD["h3_standing_random"], 0.5), stroke=True)
     assert m.mode == "other", m.reason
+
+
+def test_the_bending_fit_is_tested_against_shuffled_positions():
+    P, t = _frames("bending")
+    Q, _, _ = L.procrustes_frames(P)
+    b = L.bending_wave(Q, t, OMEGA, animat.gabriel_graph(P[0]))
+    assert b.p_value == pytest.approx(1 / (1 + L.BEND_PERMUTATIONS))  # no shuffle fits as well
+    rng = np.random.default_rng(5)  # unrelated phases on 14 positions: the free gradient still fits ~0.5
+    phases, weights, x = rng.uniform(0, 2 * math.pi, 14), rng.rayleigh(1.0, 14), np.linspace(0, 9, 14)
+    _, fit = L.circular_linear_fit(phases, weights, x)
+    null = L.shuffled_fits(phases, weights, x, 199, seed=1)
+    assert 0.3 < np.median(null) < 0.7 and np.mean(null >= fit) > L.BEND_P
+    assert np.array_equal(null, L.shuffled_fits(phases, weights, x, 199, seed=1))  # deterministic
+    assert L.shuffled_fits(phases, weights, x, 0).shape == (0,)
+
+
+def test_a_chance_bending_fit_of_random_phases_is_not_a_wave():
+    m = L.classify_locomotion(_swim(THIRD["h3_standing_random_slow"], 0.5), stroke=True)
+    assert m.bend.fit >= L.BEND_FIT and m.bend.p_value > L.BEND_P  # fits 0.70, but so do 5 % of the shuffles
+    assert m.mode == "other", m.reason
+
+
+FOURTH = {s.name: s for s in K.paper_fourth_set()}
+
+
+@pytest.mark.parametrize(
+    "name,drag,expected",
+    [
+        ("h4_und_bend_b", 0.5, "undulation"),
+        ("h4_single_2pairs_b", 2.0, "protrusions"),
+        ("h4_tail5_slow", 0.5, "tail"),
+        ("h4_standing_random_a", 2.0, "other"),
+        ("h4_sync_lag", 0.5, "synchronous contraction"),
+    ],
+)
+def test_fourth_held_out_swimmers(name, drag, expected):
+    tr = _swim(FOURTH[name], drag)
+    m = L.classify_locomotion(tr, stroke=True)
+    assert m.mode == expected, m.reason
+    if FOURTH[name].appendages:
+        assert K.stroke_truth(FOURTH[name], tr).strokes
+
+
+@pytest.mark.xfail(strict=True, reason="known miss of the fourth held-out set: random phases bend as a wave (p 0.001)")
+def test_fourth_held_out_random_phases_are_other():
+    m = L.classify_locomotion(_swim(FOURTH["h4_standing_random_e"], 0.5), stroke=True)
+    assert m.mode == "other", m.reason
+
+
+@pytest.mark.xfail(strict=True, reason="known miss of the fourth held-out set: a two-cell chain pair scores 0.30")
+def test_fourth_held_out_chain_pair_strokes():
+    tr = _swim(FOURTH["h4_chain2_b"], 0.5)
+    assert K.stroke_truth(FOURTH["h4_chain2_b"], tr).strokes  # rows by the ground truth ...
+    m = L.classify_locomotion(tr, stroke=True)
+    assert m.mode == "protrusions", m.reason  # ... but not by the classifier's pair score
