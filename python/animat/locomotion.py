@@ -833,10 +833,9 @@ def classify_motion(
 
     mixed: List[str] = []
     groups = 0
-    strokes = stroke is not None and stroke.strokes
     cells = c_top if local else top
     one_appendage = prot and (_groups(cells, sp) == 1 or (stroke is not None and len(stroke.protrusions) == 1))
-    if strokes and not is_wave:
+    if stroke is not None and stroke.strokes and not is_wave:
         mode = "protrusions"
         groups = len(stroke.protrusions)
         a, b = stroke.pair
@@ -845,7 +844,9 @@ def classify_motion(
             f"cells) rows: extended while moving backwards, pair score {stroke.score:.2f} >= {STROKE_SCORE}, "
             f"stroke area {stroke.area:.3f} >= {STROKE_AREA}"
         )
-    elif strokes:  # a travelling wave runs along the body: its corners row with it (docs/locomotion.md)
+    elif (
+        stroke is not None and stroke.strokes
+    ):  # a travelling wave runs along the body: its corners row with it (docs/locomotion.md)
         mode = "undulation"
         groups = len(stroke.protrusions)
         mixed.append("protrusions")
