@@ -71,8 +71,8 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
      stroke rule's path (``classify_locomotion(..., stroke=True)``) a *bending wave* also counts
      (:func:`bending_wave`: the same fit, lag and TI on the strain of the springs along the body,
      signed by the side they lie on, fit ``>= BEND_FIT`` 0.65 and significant against shuffled positions,
-     p ``<= BEND_P`` 0.01): the two sides of a bending undulator
-     contract in antiphase, which the cells' contraction mixes into a poor ramp (fit 0.75-0.80).
+     p ``<= BEND_P`` 0.01, running backward against the motion, ``BEND_BACKWARD``): the two sides of a
+     bending undulator contract in antiphase, which the cells' contraction mixes into a poor ramp (fit 0.75-0.80).
    - ``coherence >= SYNC_COHERENCE`` (0.8): **synchronous contraction**; also listed as mixed with an
      undulation whose lag is short enough to keep R ≥ 0.8 (a uniform lag of π/2 gives R = 0.90, of
      π 0.64): mostly synchronous with a visible wave.
@@ -153,6 +153,7 @@ __all__ = [
     "BEND_P",
     "BEND_PERMUTATIONS",
     "BEND_SEED",
+    "BEND_BACKWARD",
     "bending_wave",
     "shuffled_fits",
     "SYNC_COHERENCE",
@@ -225,6 +226,12 @@ BEND_P = 0.01
 BEND_PERMUTATIONS = 999
 #: Seed of the shuffles: fixed, so that the classifier is deterministic.
 BEND_SEED = 0
+#: Smallest angle (degrees) between the direction a bending wave travels and the direction of motion: the
+#: wave must run backward along the body ("backward" of :attr:`WaveFit.travel`). A lateral wave propels a
+#: body through a resistive medium whose tangential drag is lower than its normal drag (here d_T = d_N /
+#: 200) only when it travels backward, against the motion (Gray & Hancock 1955); a bend that runs forward
+#: or across the motion does not drive it, whatever it fits.
+BEND_BACKWARD = 135.0
 #: Springs within this angle (degrees) of the body's long axis carry the bending wave.
 BEND_CONE = 30.0
 #: ... and lie at least this far (median rest lengths) off the axis, on one side.
@@ -589,11 +596,14 @@ def bending_wave(
     ``>= WAVE_TI``, and the fit significant: its permutation p-value (the share of ``BEND_PERMUTATIONS``
     shuffles of the springs' positions along the axis, :func:`shuffled_fits`, that fit as well, counting
     the fit itself) ``<= BEND_P``. With a free gradient, unrelated phases on 14-22 springs fit 0.5-0.65
-    (docs/locomotion.md).
+    (docs/locomotion.md). Last, the wave must run backward along the body, at least ``BEND_BACKWARD``
+    degrees from the direction of motion: only then does a bend propel a body whose tangential drag is
+    below its normal drag; a bend that runs forward or across the motion is not undulatory swimming.
 
     Args:
         Q: (F, n, 2) body-frame positions (:func:`procrustes_frames`). times: (F,). omega: rad per time unit.
-        springs: (m, 2) springs. motion: (2,) direction of motion in the body frame (for ``angle``).
+        springs: (m, 2) springs. motion: (2,) direction of motion in the body frame (for ``angle``; without
+            it no bending wave is accepted).
     """
     sp = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
     none = WaveFit(np.zeros(2), 0.0, 0.0, 0.0, 0.0, float("nan"), False)
@@ -632,7 +642,8 @@ def bending_wave(
     ti = travelling_index(z)
     null = shuffled_fits(np.angle(z), a, u[keep], BEND_PERMUTATIONS, BEND_SEED)
     p = (1 + int(np.sum(null >= fit))) / (1 + len(null))
-    is_wave = fit >= BEND_FIT and p <= BEND_P and lag >= WAVE_LAG and ti >= WAVE_TI
+    backward = angle >= BEND_BACKWARD  # nan (no motion given) compares false
+    is_wave = fit >= BEND_FIT and p <= BEND_P and lag >= WAVE_LAG and ti >= WAVE_TI and backward
     return WaveFit(gradient, float(fit), float(lag), ti, phase_coherence(z), angle, bool(is_wave), float(p))
 
 
@@ -654,6 +665,8 @@ def _no_wave(w: WaveFit, bend: Optional[WaveFit] = None) -> str:
             out.append(f"lag {x.lag:.2f} rad < pi/2")
         if x.travelling_index < WAVE_TI:
             out.append(f"TI {x.travelling_index:.2f} < {WAVE_TI}")
+        if np.isfinite(x.p_value) and not x.angle >= BEND_BACKWARD:  # the bending wave only
+            out.append(f"travels {x.angle:.0f} deg from the motion < {BEND_BACKWARD:g} (not backward)")
         return ", ".join(out)
 
     text = "no travelling wave (" + failed(w, WAVE_FIT) + ")"
@@ -672,7 +685,8 @@ def _wave_reason(w: WaveFit, bend: Optional[WaveFit]) -> str:
     return (
         f"a bending wave: the side-difference strain of the axial springs has a consistent gradient "
         f"(fit {bend.fit:.2f} >= {BEND_FIT}, p {bend.p_value:.3f} <= {BEND_P}) with a lag of {bend.lag:.2f} rad >= pi/2 and travelling "
-        f"index {bend.travelling_index:.2f} >= {WAVE_TI} (contraction fit {w.fit:.2f})"
+        f"index {bend.travelling_index:.2f} >= {WAVE_TI}, running backward ({bend.angle:.0f} deg from the motion; "
+        f"contraction fit {w.fit:.2f})"
     )
 
 
