@@ -1,8 +1,10 @@
 """Confusion matrices of animat.classify_locomotion with the paper's stroke rule on the hand-built
-swimmers of known_swimmers.py (paper_calibration_set, paper_held_out_set and paper_third_set, all now
-calibration, and the fourth held-out set paper_fourth_set; 2000 steps at d_N = 0.5 and 2).
+swimmers of known_swimmers.py (paper_calibration_set, paper_held_out_set, paper_third_set and
+paper_fourth_set, all now calibration, and the fifth held-out set paper_fifth_set; 2000 steps at d_N = 0.5
+and 2), every label from the ground truths (stroke_truth, undulation_truth).
 
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out,third,fourth
+    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py fifth
 
 prints one line per swim (distance, expected and found mode, the stroke's pair score and area, and for
 the appendage swimmers the ground truth of known_swimmers.stroke_truth) and the matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
@@ -20,6 +22,7 @@ SETS = {
     "held-out": K.paper_held_out_set,
     "third": K.paper_third_set,
     "fourth": K.paper_fourth_set,
+    "fifth": K.paper_fifth_set,
 }
 
 
@@ -36,6 +39,9 @@ def main(names):
                 else "-"
             )
             truth = ""
+            u = r.undulation
+            if u is not None:
+                truth = f"; undulation truth {'undulates' if u.undulates else 'does not: ' + u.why_not()}"
             if r.truth is not None:
                 truth = f"; ground truth {'strokes' if r.truth.strokes else 'does not stroke: ' + r.truth.why_not()}"
                 truth += f" (rowing {min(r.truth.rowing):+.2f})"
