@@ -121,7 +121,7 @@ def test_paper_protrusion_swimmers_swim_and_stroke(name):
 @pytest.mark.parametrize(
     "name,expected",
     [
-        ("undulator_contraction", "undulation"),
+        ("undulator_long", "undulation"),
         ("undulator_bending", "undulation"),
         ("synchronous_teardrop", "synchronous contraction"),
         ("synchronous_lag1.0", "synchronous contraction"),
@@ -204,7 +204,7 @@ def test_strain_contrast_without_a_stroke_is_not_protrusions(name, expected):
     [
         ("ho_single_b", 0.5, "protrusions"),
         ("ho_block2x2_b", 2.0, "protrusions"),
-        ("ho_und_slow", 2.0, "undulation"),
+        ("ho_und_across", 2.0, "undulation"),
         ("ho_tail5", 0.5, "tail"),
         ("ho_standing_halves", 0.5, "other"),
     ],
@@ -214,3 +214,21 @@ def test_held_out_swimmers(name, drag, expected):
     assert m.mode == expected, m.reason
     if HELD[name].appendages:
         assert K.stroke_truth(HELD[name], tr).strokes
+
+
+def test_the_extension_runs_along_the_protrusions_own_axis():
+    # a two-cell chain on anchors at the origin: swinging it rigidly about them is sweep, not extension;
+    # stretching it along its axis is extension, for its tip as for its base
+    t = np.arange(160) / 40
+    swing = 0.4 * np.sin(OMEGA * t)
+    Q = np.zeros((len(t), 4, 2))
+    Q[:, 0] = (-0.5, 0.0)
+    Q[:, 1] = (0.5, 0.0)  # the anchors, mean at the origin
+    for k, r in ((2, 1.0), (3, 2.0)):
+        Q[:, k, 0] = r * np.sin(swing)
+        Q[:, k, 1] = r * np.cos(swing)
+    X, E = P.cell_strokes(Q, t, OMEGA, (1.0, 0.0), [2, 3], Q[:, :2].mean(axis=1), None)
+    assert np.all(np.abs(X) > 0.3) and np.all(np.abs(E) < 1e-3)
+    Q[:, 2:, 1] *= 1 + 0.2 * np.cos(OMEGA * t)[:, None]  # and now it also stretches
+    _, E = P.cell_strokes(Q, t, OMEGA, (1.0, 0.0), [2, 3], Q[:, :2].mean(axis=1), None)
+    assert np.abs(E[1]) == pytest.approx(2 * np.abs(E[0]), rel=0.1) and np.abs(E[0]) > 0.15
