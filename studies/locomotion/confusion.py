@@ -6,8 +6,8 @@ and 2), every label from the ground truths (stroke_truth, undulation_truth).
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out,third,fourth
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py fifth
 
-prints one line per swim (distance, expected and found mode, the stroke's pair score and area, and for
-the appendage swimmers the ground truth of known_swimmers.stroke_truth) and the matrix (rows: built as undulation, synchronous contraction, protrusions, tail, other; columns: the same,
+prints one line per swim (distance, label (by the ground truths) and found mode, the stroke's pair score and area, and for
+the appendage swimmers the ground truth of known_swimmers.stroke_truth) and the matrix (rows: labelled undulation, synchronous contraction, protrusions, tail, other; columns: the same,
 then none, unstable).
 """
 
@@ -47,7 +47,7 @@ def main(names):
                 truth += f" (rowing {min(r.truth.rowing):+.2f})"
             print(
                 f"{name} {r.swimmer.name:28s} dN={r.drag_normal:g} distance={r.distance:6.2f} "
-                f"built={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}{truth}"
+                f"label={r.swimmer.expected:24s} found={r.mode.label if r.mode else 'unstable':32s} {sc}{truth}"
             )
         print(name)
         print(K.confusion_matrix(res, CLASSES, CLASSES + ["none", "unstable"]))
