@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -142,6 +143,14 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
     return r;
   }
   r.settle_steps = begin.settled;
+  if (options.start_offset) {  // a perturbed repeat (evaluation.repeats): the start, not the rest
+    if (options.start_offset->rows() != begin.body.node_count() ||
+        !options.start_offset->allFinite())
+      throw ConfigError(fmt::format(
+          "swim: SwimOptions::start_offset must hold {} finite rows (one per cell), got {}",
+          begin.body.node_count(), options.start_offset->rows()));
+    begin.body.positions += *options.start_offset;
+  }
   const Body& body = begin.body;
   // control.mode = "grn": the GRN drives eq. 2 instead of the scene's oscillators.
   SceneParams swim_scene = scene;
@@ -263,9 +272,32 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   return r;
 }
 
-EvaluationResult evaluate(const Genome& genome, const Config& config,
-                          EvaluationObserver* observer) {
-  EvaluationResult out;
+namespace {
+
+/// evaluation.repeats and repeat_perturbation in range (the config's bounds, for a config that did
+/// not pass validate()).
+void check_repeats(const EvaluationParams& p) {
+  if (p.repeats < 1 || p.repeats > 64)
+    throw ConfigError(fmt::format(
+        "evaluation.repeats = {} is out of range (expected an integer in [1, 64])", p.repeats));
+  if (!(p.repeat_perturbation > 0.0 && p.repeat_perturbation <= 0.1))
+    throw ConfigError(
+        fmt::format("evaluation.repeat_perturbation = {} is out of range (expected a length in "
+                    "(0, 0.1], length units)",
+                    p.repeat_perturbation));
+}
+
+/// What every swim of one evaluation shares: the developed body and the swim options.
+struct Developed {
+  Body body;
+  GrnControlStart control_start;
+  SwimOptions options;
+};
+
+/// Develops the genome and builds its body into `d`, filling the development and body fields of
+/// `out`; false when there is nothing to swim (not viable, or development left the valid domain:
+/// `out` says why).
+bool develop_body(const Genome& genome, const Config& config, EvaluationResult& out, Developed& d) {
   // a genome no loader would accept is an error, not UB
   validate(genome, config.genome, "evaluate");
   validate(config.scene);
@@ -280,7 +312,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
     out.stable = false;
     out.valid = false;
     out.reasons.push_back(fmt::format("development: {}", e.what()));
-    return out;
+    return false;
   }
   out.seconds_development = seconds_since(t0);
   out.cell_count = embryo.cell_count();
@@ -288,18 +320,18 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
   out.viable = embryo.viable;
   if (!embryo.viable) {
     out.reasons = embryo.reasons;
-    return out;
+    return false;
   }
 
   t0 = Clock::now();
-  Body body;
+  Body& body = d.body;
   try {
     body = build_body(embryo, config.body);
   } catch (const GeometryError& e) {
     out.seconds_body = seconds_since(t0);
     out.viable = false;
     out.reasons.push_back(fmt::format("body: {}", e.what()));
-    return out;
+    return false;
   }
   out.seconds_body = seconds_since(t0);
   out.spring_count = body.spring_count();
@@ -307,11 +339,9 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
   out.skin_edge_count = static_cast<int>(body.skin.rows());
   out.morphology_kind = morphology_kind(body.positions);
 
-  t0 = Clock::now();
-  SwimOptions options;
+  SwimOptions& options = d.options;
   options.check_embedding = config.evaluation.check_embedding;
   options.account_energy = config.evaluation.energy_accounting;
-  options.observer = observer;
   options.settle_steps = config.evaluation.settle_steps;
   options.push_step = config.evaluation.push_step;
   if (config.evaluation.push_impulse.size() != 2)
@@ -320,16 +350,25 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
   options.push_impulse =
       Eigen::Vector2d(config.evaluation.push_impulse[0], config.evaluation.push_impulse[1]);
   options.push_front_only = config.evaluation.push_cells == "front";
-  GrnControlStart control_start;
   if (config.control.mode == "grn") {
-    control_start = grn_control_start(genome, embryo, config);
-    options.control_start = &control_start;
+    d.control_start = grn_control_start(genome, embryo, config);
+    options.control_start = &d.control_start;
     options.control = &config.control;
   }
-  if (observer) observer->on_body(body);
-  // An objective that one swim does not decide (chemotaxis): one swim per source direction (the
-  // first is observed and gives the diagnostics), the fitness their mean progress toward the
-  // source.
+  return true;
+}
+
+/// The swims of one start (one per source direction for objective chemotaxis; the first is
+/// observed and gives the diagnostics) into the swim fields of `out`: fitness = the paper's
+/// distance, source_progress their mean progress toward the source. Returns the failure ('' when
+/// valid).
+std::string swim_start(const Developed& d, const Config& config, SwimOptions options,
+                       EvaluationObserver* observer, EvaluationResult& out) {
+  const Clock::time_point t0 = Clock::now();
+  options.observer = observer;
+  if (observer) observer->on_body(d.body);
+  // An objective that one swim does not decide (chemotaxis): one swim per source direction, the
+  // fitness their mean progress toward the source.
   const ObjectiveSpec* spec = find_objective(config.evaluation.objective);
   const bool chemotaxis = spec != nullptr && !spec->one_swim;
   const int trials = chemotaxis ? config.evaluation.source_directions : 1;
@@ -338,7 +377,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
   for (int t = 0; t < trials; ++t) {
     SceneParams scene = config.scene;
     if (chemotaxis) scene.chemical_source = source_direction(config, t);
-    const SwimResult st = swim(body, scene, config.physics, config.evaluation.steps, options);
+    const SwimResult st = swim(d.body, scene, config.physics, config.evaluation.steps, options);
     if (chemotaxis) {
       const Eigen::Vector2d src(scene.chemical_source[0], scene.chemical_source[1]);
       progress += st.valid ? src.norm() - (src - st.displacement).norm() : 0.0;
@@ -355,12 +394,112 @@ EvaluationResult evaluate(const Genome& genome, const Config& config,
   out.source_progress = chemotaxis && s.valid ? progress / trials : 0.0;
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
-  if (!s.valid) out.reasons.push_back(s.failure);
   out.fitness = s.distance;
   out.swim_steps = s.steps;
   // Every field both records have (valid, the counters, the work, ...): visit_swim_fields.
   visit_swim_fields([](const char*, const char*, const auto& from, auto& to) { to = from; }, s,
                     out);
+  return s.valid ? std::string() : s.failure;
+}
+
+/// evaluate()'s scorer with repeats: the paper's distance, the observer on repeat 0.
+class DistanceScorer final : public RepeatScorer {
+ public:
+  explicit DistanceScorer(EvaluationObserver* observer) : observer_(observer) {}
+  EvaluationObserver* observer(int repeat) override { return repeat == 0 ? observer_ : nullptr; }
+  double value(int, const EvaluationResult& result) override { return result.fitness; }
+
+ private:
+  EvaluationObserver* observer_;
+};
+
+}  // namespace
+
+Points start_perturbation(int repeat, int cells, double magnitude) {
+  Points d = Points::Zero(std::max(cells, 0), 2);
+  if (repeat == 0) return d;
+  for (int i = 0; i < cells; ++i) {
+    // A uniform direction without trigonometry (the same bits with every libm): a point uniform in
+    // the unit disc, by rejection, scaled to length 1.
+    Rng rng = Rng::derive(static_cast<std::uint64_t>(repeat), static_cast<std::uint64_t>(i));
+    double u = 0.0, v = 0.0, r2 = 0.0;
+    do {
+      u = rng.uniform(-1.0, 1.0);
+      v = rng.uniform(-1.0, 1.0);
+      r2 = u * u + v * v;
+    } while (r2 > 1.0 || r2 < 1e-6);
+    const double r = std::sqrt(r2);
+    d(i, 0) = magnitude * (u / r);
+    d(i, 1) = magnitude * (v / r);
+  }
+  return d;
+}
+
+EvaluationResult evaluate(const Genome& genome, const Config& config,
+                          EvaluationObserver* observer) {
+  check_repeats(config.evaluation);
+  if (config.evaluation.repeats > 1) {
+    DistanceScorer scorer(observer);
+    return evaluate_repeats(genome, config, scorer);
+  }
+  EvaluationResult out;
+  Developed d;
+  if (!develop_body(genome, config, out, d)) return out;
+  if (std::string failure = swim_start(d, config, d.options, observer, out); !out.valid)
+    out.reasons.push_back(std::move(failure));
+  return out;
+}
+
+EvaluationResult evaluate_repeats(const Genome& genome, const Config& config,
+                                  RepeatScorer& scorer) {
+  check_repeats(config.evaluation);
+  const int repeats = config.evaluation.repeats;
+  EvaluationResult developed;
+  Developed d;
+  if (!develop_body(genome, config, developed, d)) return developed;
+  EvaluationResult out;
+  std::vector<double> values(static_cast<std::size_t>(repeats), 0.0);
+  double seconds_swim = 0.0;
+  for (int j = 0; j < repeats; ++j) {
+    EvaluationResult r = developed;
+    SwimOptions options = d.options;
+    Points offset;
+    if (j > 0) {
+      offset = start_perturbation(j, d.body.node_count(), config.evaluation.repeat_perturbation);
+      options.start_offset = &offset;
+    }
+    const std::string failure = swim_start(d, config, options, scorer.observer(j), r);
+    seconds_swim += r.seconds_swim;
+    if (j == 0) out = r;
+    if (!r.valid || !r.stable) {
+      // The evaluation is invalid, as one invalid swim makes it; the diagnostics stay repeat 0's.
+      out.valid = false;
+      out.stable = out.stable && r.stable;
+      out.fitness = 0.0;
+      out.fitness_spread = 0.0;
+      out.reasons.push_back(fmt::format(
+          "repeat {} of {}{}: {}", j, repeats,
+          j > 0 && r.first_invalid_step == 0
+              ? fmt::format(" (its start, displaced by {:g}, already broke the embedding)",
+                            config.evaluation.repeat_perturbation)
+              : std::string(),
+          failure));
+      out.seconds_swim = seconds_swim;
+      return out;
+    }
+    values[static_cast<std::size_t>(j)] = scorer.value(j, r);
+  }
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  const double mean = sum / repeats;
+  double squares = 0.0;
+  for (double v : values) squares += (v - mean) * (v - mean);
+  const double sd = repeats > 1 ? std::sqrt(squares / (repeats - 1)) : 0.0;
+  out.fitness = mean;
+  out.fitness_spread = sd == 0.0     ? 0.0
+                       : mean != 0.0 ? sd / std::abs(mean)
+                                     : std::numeric_limits<double>::infinity();
+  out.seconds_swim = seconds_swim;
   return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "animat/config.hpp"
@@ -176,7 +177,50 @@ EvaluationRecord record_evaluation(const Genome& genome, const Config& config, b
   return record;
 }
 
+namespace {
+
+/// The value of one viable, stable and valid evaluation record; throws Error if not finite.
+double finite_value(const Objective& objective, const EvaluationRecord& record) {
+  const double v = objective.value(record);
+  if (!std::isfinite(v))
+    throw Error(fmt::format("objective \"{}\" returned {} (objectives must be finite)",
+                            objective.name(), v));
+  return v;
+}
+
+/// evaluation.repeats > 1: each repeat recorded (its own body copy and trajectory) and scored.
+class ObjectiveScorer final : public RepeatScorer {
+ public:
+  explicit ObjectiveScorer(const Objective& objective)
+      : objective_(objective), keep_body_(objective.needs_body()) {}
+  EvaluationObserver* observer(int) override {
+    record_ = EvaluationRecord{};
+    record_.every = objective_.sample_every();
+    if (!keep_body_ && record_.every == 0) return nullptr;
+    recorder_.emplace(record_, keep_body_);
+    return &*recorder_;
+  }
+  double value(int, const EvaluationResult& result) override {
+    record_.result = result;
+    return finite_value(objective_, record_);
+  }
+
+ private:
+  const Objective& objective_;
+  bool keep_body_;
+  EvaluationRecord record_;
+  std::optional<Recorder> recorder_;
+};
+
+}  // namespace
+
 EvaluationResult evaluate(const Genome& genome, const Config& config, const Objective& objective) {
+  if (config.evaluation.repeats > 1) {
+    // Each repeat scored on its own record, the fitness their mean (evaluate_repeats()); a repeat
+    // that is unstable or invalid makes the evaluation so, and no objective scores it.
+    ObjectiveScorer scorer(objective);
+    return evaluate_repeats(genome, config, scorer);
+  }
   EvaluationRecord record =
       record_evaluation(genome, config, objective.needs_body(), objective.sample_every());
   // Non-viable genomes are never swum, and an unstable or invalid swim (one that broke the planar
@@ -185,11 +229,7 @@ EvaluationResult evaluate(const Genome& genome, const Config& config, const Obje
     record.result.fitness = 0.0;
     return std::move(record.result);
   }
-  const double v = objective.value(record);
-  if (!std::isfinite(v))
-    throw Error(fmt::format("objective \"{}\" returned {} (objectives must be finite)",
-                            objective.name(), v));
-  record.result.fitness = v;
+  record.result.fitness = finite_value(objective, record);
   return std::move(record.result);
 }
 

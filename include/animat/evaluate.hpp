@@ -109,6 +109,10 @@ struct SwimOptions {
   long push_step = -1;
   Eigen::Vector2d push_impulse{0.0, 0.0};
   bool push_front_only = false;
+  /// A perturbed start (evaluation.repeats): n × 2 displacements added to the cells' start
+  /// positions after the ground placement and settling (nullptr: none). The body's rest lengths
+  /// and areas stay as given; the embedding is checked on the displaced start (step 0).
+  const Points* start_offset = nullptr;
 };
 
 /// Where a swim starts (the crawl world, docs/worlds.md): the body and its velocities.
@@ -137,8 +141,12 @@ struct StartState {
 
 struct EvaluationResult {
   double fitness = 0.0;  ///< straight-line distance of the centre of mass, start -> end
-  bool viable = false;   ///< development verdict; non-viable genomes are never swum
-  bool stable = true;    ///< false if the swim (or development) left the valid domain
+  /// evaluation.repeats = K > 1: standard deviation (K − 1 in the denominator) of the K repeats'
+  /// objective values over |their mean| (the fitness); 0 for K = 1, or when the values are equal;
+  /// +inf when they differ and their mean is 0.
+  double fitness_spread = 0.0;
+  bool viable = false;  ///< development verdict; non-viable genomes are never swum
+  bool stable = true;   ///< false if the swim (or development) left the valid domain
   /// False if the swim broke an invariant: unstable, a region inverted, the skin not simple, or a
   /// collision left unresolved (fitness 0). True for non-viable genomes (never swum).
   bool valid = true;
@@ -284,6 +292,11 @@ void visit_fields(R& r, V&& v)
     "The objective's value (default: the paper's straight-line distance of the centre of mass, "
     "start to end); 0 if not viable, unstable or invalid.",
     r.fitness);
+  v("fitness_spread",
+    "evaluation.repeats = K > 1: standard deviation (K - 1 in the denominator) of the K repeats' "
+    "objective values over |their mean| (the fitness is the mean); 0 for K = 1 or equal values, "
+    "inf when they differ around a mean of 0. The other diagnostics are repeat 0's.",
+    r.fitness_spread);
   v("viable", "Development verdict; non-viable genomes are never swum.", r.viable);
   v("stable", "False if the development or the swim left the valid domain.", r.stable);
   v("cell_count", "Cells of the embryo.", r.cell_count);
@@ -321,13 +334,42 @@ void copy_counters(const SwimCounters& from, SwimResult& to);
 /// evaluation.source_seed (the same for every genome): an evenly spaced fan at a random angle.
 [[nodiscard]] std::vector<double> source_direction(const Config& config, int trial);
 
+/// evaluation.repeats: where repeat `repeat` starts relative to the unperturbed start, `cells` × 2:
+/// row i is `magnitude` times a unit vector drawn from Rng::derive(repeat, i) (uniform direction),
+/// the same for every genome, thread and rank. Zeros for repeat 0.
+[[nodiscard]] Points start_perturbation(int repeat, int cells, double magnitude);
+
+/// Scores the repeats of one evaluation (evaluation.repeats, evaluate_repeats()).
+class RepeatScorer {
+ public:
+  virtual ~RepeatScorer() = default;
+  /// The observer of repeat `repeat` (nullptr: none): it sees the body (on_body) and the repeat's
+  /// first swim.
+  virtual EvaluationObserver* observer(int repeat) = 0;
+  /// The value of repeat `repeat`, called in repeat order once its swims are done and only if they
+  /// were stable and valid; `result` is that repeat's own (fitness = its paper's distance).
+  virtual double value(int repeat, const EvaluationResult& result) = 0;
+};
+
 /// genome -> develop -> build_body -> swim(config.evaluation.steps). Deterministic (same genome and
 /// config give a bit-identical fitness), thread-safe. A non-viable genome is never swum (fitness 0,
 /// viable = false, reasons from development). A development or swim that leaves the valid domain
 /// gives fitness 0, stable = false and the reason; nothing is clamped silently. A body the body
 /// stage rejects (e.g. duplicate centres) is non-viable with the reason. Throws ConfigError for an
-/// invalid config.
+/// invalid config. With evaluation.repeats > 1 it is evaluate_repeats() scored by the distance (the
+/// observer sees repeat 0).
 [[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config,
                                         EvaluationObserver* observer = nullptr);
+
+/// evaluation.repeats = K: develops the genome and builds its body once, then swims it K times
+/// (each repeat swims every source direction of objective chemotaxis), repeat 0 from the
+/// unperturbed start and repeat j >= 1 with start_offset = start_perturbation(j, n,
+/// evaluation.repeat_perturbation). fitness = the mean of scorer.value() over the repeats (summed
+/// in repeat order, then divided by K), fitness_spread their relative spread; every other field
+/// is repeat 0's, except seconds_swim (all repeats). If a repeat is unstable or invalid the
+/// evaluation is (fitness 0, spread 0, the reason names the repeat) and no later repeat is swum.
+/// For K = 1 it is evaluate() with the scorer's value, which evaluate() itself does not call.
+[[nodiscard]] EvaluationResult evaluate_repeats(const Genome& genome, const Config& config,
+                                                RepeatScorer& scorer);
 
 }  // namespace animat

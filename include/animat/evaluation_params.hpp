@@ -50,6 +50,14 @@ struct EvaluationParams {
   std::string push_cells = "all";  ///< pushed cells: all, or front (x >= the centre of mass's x)
   /// Keep the energy books of every swim (EvaluationResult::energy): slower, results unchanged.
   bool energy_accounting = false;
+  /// Swims per evaluation of the one developed body (1 = the paper's one swim, bit for bit): repeat
+  /// 0 from the unperturbed start, repeat j >= 1 with every cell's start displaced by
+  /// repeat_perturbation (start_perturbation() in evaluate.hpp); the fitness is the mean of the
+  /// objective over the repeats [not in the paper: chaotic bodies, docs/regime.md]
+  int repeats = 1;
+  /// Length of every cell's start displacement in repeats j >= 1, length units (a cell diameter is
+  /// 1) [not in the paper]
+  double repeat_perturbation = 1e-6;
 };
 
 template <class V>
@@ -150,6 +158,22 @@ void visit_fields(EvaluationParams& p, V&& v) {
               {},
               Identity::resumable},
     p.energy_accounting);
+  v(FieldInfo{"repeats",
+              "swims per evaluation of the one developed body, each scored by the objective; "
+              "fitness = their mean. Repeat 0 starts unperturbed, repeat j >= 1 with every cell's "
+              "start displaced by repeat_perturbation (docs/model.md, section 5); 1 = the paper's "
+              "one swim [not in the paper]",
+              Bounds::closed(1, 64),
+              {},
+              Identity::late},
+    p.repeats);
+  v(FieldInfo{"repeat_perturbation",
+              "repeats > 1: length of every cell's start displacement in repeats j >= 1, in length "
+              "units (a cell diameter is 1), (0, 0.1] [not in the paper]",
+              Bounds::positive_upto(0.1),
+              {},
+              Identity::late},
+    p.repeat_perturbation);
 }
 
 }  // namespace animat

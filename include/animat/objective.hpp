@@ -24,7 +24,9 @@ struct EvaluationParams;
 /// Everything an objective may look at: the evaluation result (fitness = the paper's distance, and
 /// every diagnostic), the body that swam, and its trajectory sampled every `every` control steps
 /// (frame 0 is the start; empty when the objective asked for no samples or the genome was not
-/// viable).
+/// viable). With evaluation.repeats > 1 the objective sees one record per repeat: that repeat's
+/// result and trajectory (frame 0 is its displaced start) and the body as built (its rest
+/// geometry, the same for every repeat).
 struct EvaluationRecord {
   EvaluationResult result;
   Body body;                       ///< empty (0 nodes) when the genome was not viable
@@ -65,13 +67,15 @@ void validate(const EvaluationParams& params);
 
 /// genome -> development -> body -> swim (exactly evaluate()), keeping the body when `keep_body`
 /// and the trajectory every `every` control steps (0 = none). The result's fitness is still the
-/// paper's distance.
+/// paper's distance (with evaluation.repeats > 1 its mean over the repeats, and the trajectory is
+/// repeat 0's).
 [[nodiscard]] EvaluationRecord record_evaluation(const Genome& genome, const Config& config,
                                                  bool keep_body, long every);
 
 /// evaluate() scored by `objective`: result.fitness = objective.value(record) for a viable genome
-/// (0 otherwise). For the `distance` objective this is evaluate() itself, bit for bit. Throws Error
-/// if the objective returns a non-finite value.
+/// (0 otherwise). With evaluation.repeats > 1 the objective scores each repeat's record and the
+/// fitness is their mean (evaluate_repeats()). For the `distance` objective this is evaluate()
+/// itself, bit for bit. Throws Error if the objective returns a non-finite value.
 [[nodiscard]] EvaluationResult evaluate(const Genome& genome, const Config& config,
                                         const Objective& objective);
 

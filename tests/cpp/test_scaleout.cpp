@@ -298,6 +298,8 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\npush_cells = ",
                           "\nmorphogen_cutoff = ",
                           "\nenergy_accounting = ",
+                          "\nrepeats = ",
+                          "\nrepeat_perturbation = ",
                           "\ndivision_axis = ",
                           "\ndivision_max_contacts = ",
                           "\nupdate_period = ",
