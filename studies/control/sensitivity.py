@@ -64,12 +64,14 @@ def progress_per_direction(genome, config) -> list:
     return out
 
 
-def perturbed(genome, config, size: float, copies: int) -> np.ndarray:
-    drag = config["scene.drag_normal"]
+def perturbed(genome, config, size: float, copies: int, key: str = "scene.drag_normal") -> np.ndarray:
+    """The fitness of ``copies`` swims with ``key`` multiplied by 1 + k·size, k = 1 … copies (a world
+    without drag needs another key: the crawl world's scene.gravity)."""
+    value = config[key]
     out = []
     for k in range(1, copies + 1):
         c = config.copy()
-        c["scene.drag_normal"] = drag * (1.0 + k * size)
+        c[key] = value * (1.0 + k * size)
         out.append(animat.evaluate(genome, c).fitness)
     return np.array(out)
 
