@@ -34,8 +34,11 @@ threshold), :func:`classify_known` swims and classifies them. :func:`paper_calib
 :func:`paper_held_out_set` do the same for every class with protrusion swimmers of the paper's kind,
 each of which performs the stroke by :func:`stroke_truth` (measured from its appendage cells, known by
 construction, not by the classifier); :func:`rowing_phase` actuates a geometry so that it does. Both have
-been seen and are now calibration, as is :func:`paper_third_set` (the held-out set of the bending-wave rule,
-seen); :func:`paper_fourth_set` is the held-out set of the permutation test of the bending fit.
+been seen and are now calibration, as are :func:`paper_third_set` and :func:`paper_fourth_set` (seen).
+Every whole-body swimmer of these sets is labelled by :func:`undulation_truth` (from its motion on the
+lattice it was built on: :func:`truth_label`); bodies on which a truth disagrees between drags are in no
+set. :func:`paper_fifth_set` is the held-out set of the stroke measured along a protrusion's axis, the
+backward bending wave and the undulation truth (run once, docs/locomotion.md).
 """
 
 from __future__ import annotations
