@@ -23,6 +23,7 @@ SETS = {
     "third": K.paper_third_set,
     "fourth": K.paper_fourth_set,
     "fifth": K.paper_fifth_set,
+    "sixth": K.paper_sixth_set,
 }
 
 

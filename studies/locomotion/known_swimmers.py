@@ -1419,3 +1419,101 @@ def paper_fifth_set() -> List[KnownSwimmer]:
     block appendage pairs (the weak spots); fixed before the classifier was run on any of them, which is
     done once (docs/locomotion.md). Sets nothing."""
     return _by_truth(fifth_set_candidates(), FIFTH_RELABELLED, FIFTH_TRUTH_REJECTED)
+
+
+#: The sixth held-out set's appendage candidates that stroke at both drags by :func:`stroke_truth` (with
+#: :data:`SIXTH_PHASES`), weighted toward multi-cell appendages: two one-cell pairs, three two-cell and four
+#: three-cell chain pairs, two 2 × 2 block pairs; new cores, seeds and frequencies.
+SIXTH_APPENDAGES = {
+    "h6_single_a": dict(kind="single", core_length=9.5, core_width=4.6, at=(-2.0,), frequency=6.5, seed=401),
+    "h6_single_b": dict(kind="single", core_length=10.5, core_width=5.0, at=(-1.0,), frequency=4.0, seed=402),
+    "h6_chain2_b": dict(kind="chain2", core_length=10.0, core_width=4.8, at=(-1.5,), frequency=7.0, seed=404),
+    "h6_chain2_d": dict(kind="chain2", core_length=8.5, core_width=4.0, at=(-1.0,), frequency=6.0, seed=406),
+    "h6_chain2_e": dict(kind="chain2", core_length=12.0, core_width=5.0, at=(-3.0,), frequency=5.5, seed=407),
+    "h6_chain3_a": dict(kind="chain3", core_length=9.5, core_width=4.4, at=(-1.5,), frequency=5.0, seed=408),
+    "h6_chain3_b": dict(kind="chain3", core_length=11.0, core_width=4.6, at=(-2.5,), frequency=6.0, seed=409),
+    "h6_chain3_c": dict(kind="chain3", core_length=10.0, core_width=5.0, at=(-2.0,), frequency=4.0, seed=410),
+    "h6_chain3_g": dict(kind="chain3", core_length=11.5, core_width=5.0, at=(-2.5,), frequency=4.5, seed=422),
+    "h6_block2x2_a": dict(kind="block2x2", core_length=10.0, core_width=4.8, at=(-2.0,), frequency=4.5, seed=413),
+    "h6_block2x2_f": dict(kind="block2x2", core_length=11.0, core_width=5.4, at=(-2.0,), frequency=3.5, seed=418),
+}
+#: Their appendage phases (× π/4) by :func:`rowing_phase` (the ground truth; the classifier plays no part).
+SIXTH_PHASES = {
+    "h6_single_a": 7,
+    "h6_single_b": 1,
+    "h6_chain2_b": 2,
+    "h6_chain2_d": 1,
+    "h6_chain2_e": 2,
+    "h6_chain3_a": 2,
+    "h6_chain3_b": 2,
+    "h6_chain3_c": 2,
+    "h6_chain3_g": 3,
+    "h6_block2x2_a": 3,
+    "h6_block2x2_f": 1,
+}
+#: Candidates that do not stroke at both drags with any of the 8 phases (best phase's truth): in no set.
+SIXTH_REJECTED = {
+    "h6_chain2_a": "rowing 0.07 / 0.24, moves towards its appendages",
+    "h6_chain2_c": "rowing 0.50 / 0.48 < 0.5 at d_N = 2",
+    "h6_chain3_d": "rowing -0.11 / -0.22",
+    "h6_chain3_e": "rowing 0.09 < 0.5 at d_N = 0.5",
+    "h6_chain3_f": "swims 0.24 < 0.25 spacings",
+    "h6_block2x2_b": "moves towards its appendages; swims 0.22 spacings",
+    "h6_block2x2_c": "rowing -0.16 / -0.37",
+    "h6_block2x2_d": "rowing 0.11 / 0.02",
+    "h6_block2x2_e": "rowing 0.19 / -0.16, swims 0.06 spacings",
+    "h6_block2x2_g": "rowing 0.30 / 0.46, moves towards its appendages",
+    "h6_block2x2_h": "rowing -0.05 / -0.12, 45-67 deg off its axis",
+}
+#: Whole-body candidates the undulation truth rejects (:func:`label_by_truth`, d_N = 0.5 and 2).
+SIXTH_TRUTH_REJECTED = {
+    "h6_und_c": "built undulator: swims 0.20 / 0.05 spacings",
+    "h6_standing_random_e": "random phases: undulates at d_N = 2 (lag 3.15, coherence 0.68), not at d_N = 0.5",
+}
+#: ... and relabels.
+SIXTH_RELABELLED = {
+    "h6_sync_c": "undulation",  # no actuated lag; its displacement travels 2.25-2.68 rad, swims 1.04-1.35
+    "h6_standing_random_b": "undulation",  # lag 1.58-2.19, coherence 0.63-0.68, swims 0.36-0.39 along its axis
+}
+
+
+def sixth_set_candidates() -> List[KnownSwimmer]:
+    """Every candidate of the sixth set with its built label, before the truths (the protrusion candidates at
+    their :data:`SIXTH_PHASES` phase; the rejected ones of :data:`SIXTH_REJECTED` are not built)."""
+    pi = math.pi
+    prot = [
+        appendage_swimmer(**g, appendage_phase=SIXTH_PHASES[name] * pi / 4, anchor_shift=pi, name=name)
+        for name, g in SIXTH_APPENDAGES.items()
+    ]
+    return prot + [
+        undulator("contraction", length=10.5, width=2.4, frequency=7.5, wavelengths=1.25, seed=431, name="h6_und_a"),
+        undulator("contraction", length=12.5, width=2.6, frequency=4.5, wavelengths=1.5, seed=432, name="h6_und_b"),
+        undulator("contraction", length=9.0, width=2.2, frequency=8.0, wavelengths=1.0, seed=433, name="h6_und_c"),
+        undulator("bending", length=11.0, width=2.8, frequency=5.0, wavelengths=1.0, seed=434, name="h6_und_bend_a"),
+        undulator("bending", length=9.5, width=2.4, frequency=7.0, wavelengths=1.25, seed=435, name="h6_und_bend_b"),
+        undulator("bending", length=12.5, width=3.0, frequency=4.5, wavelengths=1.0, seed=436, name="h6_und_bend_c"),
+        synchronous_contractor(length=9.0, width=5.4, frequency=5.0, seed=437, name="h6_sync_a"),
+        synchronous_contractor(length=7.5, width=5.6, frequency=9.5, seed=438, name="h6_sync_b"),
+        synchronous_contractor(length=10.5, width=4.8, frequency=4.0, seed=439, name="h6_sync_c"),
+        tail_swimmer(length=4, core_radius=2.5, frequency=5.0, wavelengths=0.5, seed=440, name="h6_tail4"),
+        tail_swimmer(length=5, core_radius=2.2, frequency=7.5, wavelengths=0.6, seed=441, name="h6_tail5"),
+        tail_swimmer(length=3, core_radius=2.4, frequency=10.0, wavelengths=0.4, seed=442, name="h6_tail3_fast"),
+        standing_swimmer("random", length=9.0, width=4.2, frequency=5.0, seed=443, name="h6_standing_random_a"),
+        standing_swimmer("random", length=11.5, width=4.6, frequency=4.0, seed=444, name="h6_standing_random_b"),
+        standing_swimmer("random", length=8.0, width=3.6, frequency=8.5, seed=445, name="h6_standing_random_c"),
+        standing_swimmer("random", length=10.0, width=3.8, frequency=6.0, seed=446, name="h6_standing_random_d"),
+        standing_swimmer("random", length=12.5, width=5.0, frequency=3.0, seed=447, name="h6_standing_random_e"),
+        standing_swimmer("random", length=8.5, width=4.4, frequency=7.0, seed=448, name="h6_standing_random_f"),
+        standing_swimmer("random", length=10.5, width=4.0, frequency=9.5, seed=449, name="h6_standing_random_g"),
+        standing_swimmer("halves", length=9.5, width=4.2, frequency=6.0, seed=450, name="h6_standing_halves"),
+    ]
+
+
+def paper_sixth_set() -> List[KnownSwimmer]:
+    """The sixth held-out set: :func:`sixth_set_candidates` labelled by the ground truths (the protrusion
+    bodies stroke at both drags by :func:`stroke_truth`; the whole-body ones are labelled by
+    :func:`undulation_truth`, :data:`SIXTH_TRUTH_REJECTED` dropped, :data:`SIXTH_RELABELLED` relabelled), all
+    of new sizes, seeds and frequencies 3–10, weighted toward multi-cell appendages (nine of the eleven
+    protrusion bodies are chains or blocks) and random-phase bodies (seven candidates); fixed before the
+    classifier was run on any of them, which is done once (docs/locomotion.md). Sets nothing."""
+    return _by_truth(sixth_set_candidates(), SIXTH_RELABELLED, SIXTH_TRUTH_REJECTED)
