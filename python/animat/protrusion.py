@@ -26,9 +26,11 @@ in shape during motion". :func:`stroke_motion` asks exactly that of a window of 
    correlation of ``e`` with the backward velocity ``−dx/dt`` is ``−Im(E X̄) / (|E||X|)``: +1 for the
    loop out → back → in → forward (extended while it moves backwards fastest), −1 for the reverse loop,
    0 for a purely radial or a purely sweeping motion. The protrusion's **score** is this correlation
-   weighted by ``|E||X|`` over its cells, ``Σ −Im(E X̄) / Σ |E||X|``; its **area** is the mean signed
-   area of its cells' loops in the (sweep, extension) plane, ``−π Im(E X̄)``, in spacings² (how large
-   the stroke is).
+   weighted by ``|E||X|`` over its cells, ``Σ −Im(E X̄) / Σ |E||X|``; its **area** is the signed area of
+   its cells' loops in the (sweep, extension) plane, ``−π Im(E X̄)``, summed over its cells, in
+   spacings²: how large the stroke of the whole appendage is (for a one-cell protrusion, its one loop;
+   the inner cells of a chain make small loops, so that a mean per cell put three-cell chains that row
+   by the ground truth under :data:`STROKE_AREA`).
 3. *Symmetric pairs.* Two protrusions mirrored about a principal axis of the mean shape
    (:func:`animat.shape.describe`'s test, ``pair_tolerance`` 1 spacing). The **pair score** is the
    smaller score of the two, the swim's **score** the best pair score (nan without a pair), and the
@@ -65,8 +67,8 @@ __all__ = [
 #: strokes as the paper's protrusion swimmers do. Set between the calibration set's groups (see
 #: docs/locomotion.md).
 STROKE_SCORE = 0.4
-#: Smallest mean signed loop area (spacings²) of the weaker protrusion of the pair: a stroke, not a
-#: tremor.
+#: Smallest signed loop area (spacings², summed over the protrusion's cells) of the weaker protrusion of
+#: the pair: a stroke, not a tremor.
 STROKE_AREA = 0.1
 #: Frames over the last period in which dynamic protrusions are looked for.
 STROKE_SAMPLES = 8
@@ -124,7 +126,7 @@ class ProtrusionStroke:
         protrusions: cell groups (sorted tuples), at rest ones first.
         at_rest: per protrusion, whether any of its cells protrudes at rest (else only during motion).
         scores: (p,) weighted rowing correlation per protrusion (nan when it does not move).
-        areas: (p,) mean signed loop area per cell, spacings².
+        areas: (p,) signed loop area of each protrusion (summed over its cells), spacings².
         pairs: symmetric pairs (indices into ``protrusions``).
         pair_scores: (len(pairs),) the smaller score of each pair.
         pair: the best pair (by pair score), or ().
@@ -234,7 +236,7 @@ def stroke_motion(
             continue
         X, E = cell_strokes(Q, t, omega, d, g, base, None)
         scores.append(rowing(X, E))
-        areas.append(float(np.mean(-math.pi * np.imag(E * np.conj(X)))) / s**2)
+        areas.append(float(np.sum(-math.pi * np.imag(E * np.conj(X)))) / s**2)  # the whole appendage's
         cx, cy = mean[list(g)].mean(axis=0)
         found.append(Protrusion(tuple(g), 0.0, (float(cx), float(cy))))
     pairs = tuple(symmetric_pairs(mean, found, params, s))

@@ -41,6 +41,7 @@ def test_the_fifth_set_is_labelled_by_the_ground_truths():
     [
         ("h5_chain2_a", 0.5, "protrusions"),
         ("h5_chain3_b", 0.5, "protrusions"),
+        ("h5_chain3_a", 2.0, "protrusions"),  # a miss with the per-cell mean area (0.067), 0.200 summed
         ("h5_und_bend_d", 2.0, "undulation"),
         ("h5_sync_c", 0.5, "synchronous contraction"),
         ("h5_tail5", 2.0, "tail"),
@@ -66,7 +67,7 @@ def test_fifth_chain2_pair_without_a_symmetric_pair():
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
 
-@pytest.mark.xfail(strict=True, reason="fifth-set miss: a three-cell chain pair's loop area 0.049 < STROKE_AREA")
+@pytest.mark.xfail(strict=True, reason="fifth-set miss: a three-cell chain pair scores 0.35 < STROKE_SCORE")
 def test_fifth_chain3_pair_with_a_small_loop():
     tr = _swim(FIFTH["h5_chain3_d"], 0.5)
     assert K.stroke_truth(FIFTH["h5_chain3_d"], tr).strokes

@@ -47,6 +47,19 @@ def test_a_paddling_pair_scores_one_and_its_reverse_minus_one():
     assert other_way.score == pytest.approx(-1.0, abs=2e-3)
 
 
+def test_the_area_is_the_whole_appendage_loop():
+    # every cell of a three-cell chain makes the same loop: the appendage's area is their sum, so a chain
+    # whose cells each make a small loop is not judged by one cell's loop
+    s = K.appendage_swimmer("chain3", at=(-1.5,))
+    Q, t, body, rest = _frames(s, sweep=-0.3, extension=0.2)
+    st = P.stroke_motion(Q, t, OMEGA, (1.0, 0.0), body.skin_loops[0], body.springs, rest)
+    assert st.pair != () and st.strokes
+    a, b = st.pair
+    assert len(st.protrusions[a]) == len(st.protrusions[b]) == 3
+    assert st.score > 0.95  # a chain's axis is off y by the lattice offset of its cells
+    assert st.areas[a] == pytest.approx(3 * math.pi * 0.06, rel=0.1)
+
+
 def test_a_sweep_or_an_extension_alone_does_not_row():
     s = K.appendage_swimmer("single", at=(-1.5,))
     for sweep, ext in ((-0.3, 0.0), (0.0, 0.2)):
