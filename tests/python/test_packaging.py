@@ -29,6 +29,7 @@ LIBRARY_MODULES = {
     "moo",
     "pipeline",
     "plot",
+    "pool",
     "protrusion",
     "qd",
     "run",
