@@ -784,6 +784,15 @@ class KnownResult:
         return self.found == self.swimmer.expected
 
 
+def swim_known(swimmer: KnownSwimmer, drag: float, steps: int = 2000, config: Optional[Any] = None) -> Any:
+    """The recorded swim (:func:`animat.replay`) of a hand-built swimmer, ``steps`` steps at normal drag
+    ``drag`` (d_T = d_N / 200 via the config default), under ``config`` (default: the defaults)."""
+    cfg = config.copy() if config is not None else animat.Config()
+    cfg["scene.drag_normal"] = float(drag)
+    cfg["evaluation.steps"] = int(steps)
+    return replay(swimmer.body(cfg), cfg)
+
+
 def classify_known(
     swimmers: Sequence[KnownSwimmer],
     drags: Sequence[float] = (0.5, 2.0),
@@ -796,11 +805,8 @@ def classify_known(
     (``stroke_rule``: with the paper's stroke rule, its ``stroke`` argument)."""
     out = []
     for dn in drags:
-        cfg = config.copy() if config is not None else animat.Config()
-        cfg["scene.drag_normal"] = float(dn)
-        cfg["evaluation.steps"] = int(steps)
         for s in swimmers:
-            tr = replay(s.body(cfg), cfg)
+            tr = swim_known(s, dn, steps, config)
             mode = classify_locomotion(tr, stroke=stroke_rule) if tr.stable else None
             stroke = appendage_stroke(s, tr, mode) if mode is not None else None
             paddle = paddling(tr, mode) if mode is not None else None

@@ -73,10 +73,7 @@ def test_the_bending_wave_is_looked_for_only_on_the_stroke_path():
 
 
 def _swim(swimmer, drag):
-    c = animat.Config()
-    c["scene.drag_normal"] = drag
-    c["evaluation.steps"] = 2000
-    tr = animat.replay(swimmer.body(c), c)
+    tr = K.swim_known(swimmer, drag)
     assert tr.stable
     return tr
 

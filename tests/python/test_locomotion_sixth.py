@@ -4,7 +4,6 @@ that a change that fixes one must update the docs."""
 
 import pytest
 
-import animat
 from animat import locomotion as L
 
 import known_swimmers as K  # studies/locomotion (conftest.py)
@@ -13,10 +12,7 @@ SIXTH = {s.name: s for s in K.paper_sixth_set()}
 
 
 def _swim(swimmer, drag):
-    c = animat.Config()
-    c["scene.drag_normal"] = drag
-    c["evaluation.steps"] = 2000
-    tr = animat.replay(swimmer.body(c), c)
+    tr = K.swim_known(swimmer, drag)
     assert tr.stable
     return tr
 

@@ -108,10 +108,7 @@ def test_appendage_swimmer_actuates_every_cell_symmetrically():
 
 
 def _classify(swimmer, drag):
-    c = animat.Config()
-    c["scene.drag_normal"] = drag
-    c["evaluation.steps"] = 2000
-    tr = animat.replay(swimmer.body(c), c)
+    tr = K.swim_known(swimmer, drag)
     assert tr.stable
     return tr, L.classify_locomotion(tr, stroke=True)
 
