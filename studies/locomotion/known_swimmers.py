@@ -88,6 +88,8 @@ __all__ = [
     "paper_third_set",
     "paper_fourth_set",
     "paper_fifth_set",
+    "paper_sixth_set",
+    "paper_seventh_set",
 ]
 
 #: The paper's largest amplitude (development.amplitude_max): a cell changes its springs by ±20 %.
@@ -1523,3 +1525,186 @@ def paper_sixth_set() -> List[KnownSwimmer]:
     protrusion bodies are chains or blocks) and random-phase bodies (seven candidates); fixed before the
     classifier was run on any of them, which is done once (docs/locomotion.md). Sets nothing."""
     return _by_truth(sixth_set_candidates(), SIXTH_RELABELLED, SIXTH_TRUTH_REJECTED)
+
+
+#: The seventh held-out set's appendage candidates that stroke at both drags by :func:`stroke_truth` (with
+#: :data:`SEVENTH_PHASES`): built after the extension across the motion and the growth of protrusions by
+#: their loops (``animat.protrusion.grow_protrusions``) were fixed on the six sets above, weighted toward
+#: three-cell chains and 2 × 2 blocks (12 and 11 of the 28 candidates; seeds 501-560, reused only for other
+#: geometries); two one-cell pairs, three two-cell chain pairs, one three-cell chain pair and four block
+#: pairs stroke at both drags.
+SEVENTH_APPENDAGES = {
+    "h7_single_a": dict(kind="single", core_length=9.0, core_width=4.8, at=(-1.5,), frequency=5.0, seed=501),
+    "h7_single_b": dict(kind="single", core_length=10.0, core_width=4.4, at=(-2.0,), frequency=7.0, seed=502),
+    "h7_chain2_a": dict(kind="chain2", core_length=9.5, core_width=4.4, at=(-1.5,), frequency=5.0, seed=503),
+    "h7_chain2_b": dict(kind="chain2", core_length=11.0, core_width=5.2, at=(-2.5,), frequency=6.5, seed=504),
+    "h7_chain2_c": dict(kind="chain2", core_length=8.5, core_width=4.2, at=(-1.0,), frequency=4.0, seed=505),
+    "h7_chain3_f": dict(kind="chain3", core_length=9.5, core_width=4.8, at=(-2.0,), frequency=7.5, seed=511),
+    "h7_block2x2_a": dict(kind="block2x2", core_length=10.5, core_width=5.2, at=(-2.0,), frequency=4.0, seed=513),
+    "h7_block2x2_g": dict(kind="block2x2", core_length=12.5, core_width=5.2, at=(-3.0,), frequency=5.5, seed=519),
+    "h7_block2x2_h": dict(kind="block2x2", core_length=10.5, core_width=4.4, at=(-2.0,), frequency=5.0, seed=520),
+    "h7_block2x2_j": dict(kind="block2x2", core_length=13.0, core_width=5.4, at=(-3.0,), frequency=4.0, seed=549),
+}
+#: Their appendage phases (× π/4) by :func:`rowing_phase` (the ground truth; the classifier plays no part).
+SEVENTH_PHASES = {
+    "h7_single_a": 1,
+    "h7_single_b": 7,
+    "h7_chain2_a": 2,
+    "h7_chain2_b": 1,
+    "h7_chain2_c": 1,
+    "h7_chain3_f": 2,
+    "h7_block2x2_a": 7,
+    "h7_block2x2_g": 2,
+    "h7_block2x2_h": 1,
+    "h7_block2x2_j": 1,
+}
+#: Candidates that do not stroke at both drags with any of the 8 phases: their geometry and what fails at
+#: their best phase (d_N = 0.5 / 2). In no set.
+SEVENTH_REJECTED = {
+    "h7_chain3_a": (
+        dict(kind="chain3", core_length=10.5, core_width=4.6, at=(-2.0,), frequency=4.5, seed=506),
+        "rowing 0.49 < 0.5 / strokes",
+    ),
+    "h7_chain3_b": (
+        dict(kind="chain3", core_length=9.0, core_width=4.0, at=(-1.5,), frequency=5.5, seed=507),
+        "strokes / rowing 0.41",
+    ),
+    "h7_chain3_c": (
+        dict(kind="chain3", core_length=11.5, core_width=5.4, at=(-2.5,), frequency=6.5, seed=508),
+        "rowing 0.08, swims 0.11 spacings / rowing 0.15, moves towards its appendages",
+    ),
+    "h7_chain3_d": (
+        dict(kind="chain3", core_length=10.0, core_width=4.2, at=(-1.5,), frequency=3.5, seed=509),
+        "strokes / rowing 0.29",
+    ),
+    "h7_chain3_e": (
+        dict(kind="chain3", core_length=12.0, core_width=5.0, at=(-3.0,), frequency=5.0, seed=510),
+        "rowing 0.02 / strokes",
+    ),
+    "h7_chain3_g": (
+        dict(kind="chain3", core_length=11.0, core_width=4.4, at=(-2.0,), frequency=6.0, seed=512),
+        "strokes / rowing 0.13",
+    ),
+    "h7_chain3_h": (
+        dict(kind="chain3", core_length=12.5, core_width=5.6, at=(-2.5,), frequency=4.0, seed=547),
+        "strokes / rowing 0.00, swims 0.06 spacings",
+    ),
+    "h7_chain3_i": (
+        dict(kind="chain3", core_length=10.0, core_width=4.6, at=(-1.5,), frequency=5.0, seed=560),
+        "strokes / rowing 0.36",
+    ),
+    "h7_chain3_j": (
+        dict(kind="chain3", core_length=11.0, core_width=5.0, at=(-2.0,), frequency=4.0, seed=507),
+        "strokes / rowing -0.49, moves towards its appendages",
+    ),
+    "h7_chain3_k": (
+        dict(kind="chain3", core_length=9.5, core_width=4.4, at=(-1.0,), frequency=6.5, seed=509),
+        "rowing 0.19 / strokes",
+    ),
+    "h7_chain3_l": (
+        dict(kind="chain3", core_length=12.0, core_width=5.4, at=(-2.5,), frequency=5.5, seed=512),
+        "rowing 0.13 / rowing 0.11, swims 0.14 spacings",
+    ),
+    "h7_block2x2_b": (
+        dict(kind="block2x2", core_length=11.5, core_width=5.0, at=(-2.5,), frequency=5.0, seed=514),
+        "rowing 0.45, 39 deg off its axis / rowing 0.47, swims 0.17 spacings",
+    ),
+    "h7_block2x2_c": (
+        dict(kind="block2x2", core_length=9.5, core_width=4.6, at=(-1.5,), frequency=3.5, seed=515),
+        "moves towards its appendages at both drags",
+    ),
+    "h7_block2x2_d": (
+        dict(kind="block2x2", core_length=12.0, core_width=5.6, at=(-2.5,), frequency=4.5, seed=516),
+        "rowing -0.47 / strokes",
+    ),
+    "h7_block2x2_e": (
+        dict(kind="block2x2", core_length=10.0, core_width=5.4, at=(-2.0,), frequency=6.0, seed=517),
+        "rowing 0.29 / 0.26",
+    ),
+    "h7_block2x2_f": (
+        dict(kind="block2x2", core_length=11.0, core_width=4.8, at=(-1.5,), frequency=3.0, seed=518),
+        "moves towards its appendages at both drags",
+    ),
+    "h7_block2x2_i": (
+        dict(kind="block2x2", core_length=11.5, core_width=5.6, at=(-2.0,), frequency=3.5, seed=548),
+        "rowing -0.08 / -0.16, 59-62 deg off its axis",
+    ),
+    "h7_block2x2_k": (
+        dict(kind="block2x2", core_length=9.0, core_width=5.0, at=(-1.5,), frequency=4.5, seed=550),
+        "rowing 0.01 / 0.01, 46-62 deg off its axis",
+    ),
+}
+#: Whole-body candidates the undulation truth rejects (:func:`label_by_truth`, d_N = 0.5 and 2): built
+#: synchronous bodies that undulate at d_N = 0.5 only.
+SEVENTH_TRUTH_REJECTED = {
+    "h7_sync_e": "built synchronous: undulates at d_N = 0.5 (lag 1.79, coherence 0.85), not at d_N = 2 (lag 0.75)",
+    "h7_sync_lag_b": "built synchronous (lag 0.4 rad): undulates at d_N = 0.5 (lag 2.59), not at d_N = 2 (lag 1.19)",
+    "h7_sync_h": "built synchronous: undulates at d_N = 0.5 (lag 3.66), not at d_N = 2 (lag 1.36)",
+}
+#: ... and relabels: bodies actuated synchronously or with random phases whose displacement travels.
+SEVENTH_RELABELLED = {
+    "h7_sync_g": "undulation",  # no actuated lag; lag 2.76 / 2.04, coherence 0.82 / 0.87, swims 0.33 / 0.42
+    "h7_standing_random_a": "undulation",  # lag 2.94 / 3.85, coherence 0.57 / 0.52, swims 0.36 / 0.28
+    "h7_standing_random_d": "undulation",  # lag 1.70 / 1.72, coherence 0.70 / 0.66, swims 0.74 / 0.68
+    "h7_standing_random_e": "undulation",  # lag 6.22 / 7.16, coherence 0.45 / 0.45, swims 0.36 / 0.41
+    "h7_standing_random_j": "undulation",  # lag 6.51 / 7.05, coherence 0.51 / 0.49, swims 0.83 / 0.91
+}
+
+
+def seventh_set_candidates() -> List[KnownSwimmer]:
+    """Every candidate of the seventh set with its built label, before the truths (the protrusion candidates
+    at their :data:`SEVENTH_PHASES` phase; the rejected ones of :data:`SEVENTH_REJECTED` are not built)."""
+    pi = math.pi
+    prot = [
+        appendage_swimmer(**g, appendage_phase=SEVENTH_PHASES[name] * pi / 4, anchor_shift=pi, name=name)
+        for name, g in SEVENTH_APPENDAGES.items()
+    ]
+    U, S, T, W = undulator, synchronous_contractor, tail_swimmer, standing_swimmer
+    return prot + [
+        U("contraction", length=10.0, width=2.4, frequency=6.0, wavelengths=1.25, seed=521, name="h7_und_a"),
+        U("contraction", length=11.5, width=2.2, frequency=8.5, wavelengths=1.0, seed=522, name="h7_und_b"),
+        U("contraction", length=13.0, width=2.8, frequency=5.5, wavelengths=1.5, seed=523, name="h7_und_c"),
+        U("bending", length=10.5, width=2.6, frequency=6.5, wavelengths=1.0, seed=524, name="h7_und_bend_a"),
+        U("bending", length=12.0, width=2.8, frequency=4.0, wavelengths=1.25, seed=525, name="h7_und_bend_b"),
+        U("bending", length=9.0, width=2.2, frequency=8.0, wavelengths=1.0, seed=526, name="h7_und_bend_c"),
+        U("across", length=7.0, width=7.0, frequency=5.0, seed=546, name="h7_und_across"),
+        S(length=8.5, width=5.0, frequency=6.0, seed=527, name="h7_sync_a"),
+        S(length=9.5, width=5.2, frequency=3.5, seed=528, name="h7_sync_b"),
+        S(length=11.5, width=4.6, frequency=5.5, seed=529, name="h7_sync_c"),
+        S(length=10.0, width=4.4, frequency=8.5, seed=530, name="h7_sync_d"),
+        S(length=12.5, width=5.0, frequency=4.5, seed=551, name="h7_sync_e"),
+        S(length=11.0, width=4.2, frequency=9.5, seed=552, name="h7_sync_f"),
+        S(length=10.5, width=5.0, frequency=7.0, lag=0.2, seed=531, name="h7_sync_lag_a"),
+        S(length=12.0, width=4.8, frequency=4.5, lag=0.4, seed=532, name="h7_sync_lag_b"),
+        S(length=9.0, width=4.4, frequency=6.5, lag=0.3, seed=553, name="h7_sync_lag_c"),
+        S(length=11.5, width=4.8, frequency=10.0, lag=0.3, seed=554, name="h7_sync_lag_d"),
+        S(length=10.0, width=4.6, frequency=4.5, seed=555, name="h7_sync_g"),
+        S(length=12.0, width=5.2, frequency=3.5, seed=556, name="h7_sync_h"),
+        S(length=9.5, width=4.8, frequency=9.0, lag=0.2, seed=557, name="h7_sync_lag_e"),
+        T(length=4, core_radius=2.6, frequency=6.0, wavelengths=0.5, seed=533, name="h7_tail4"),
+        T(length=5, core_radius=2.1, frequency=8.5, wavelengths=0.55, seed=534, name="h7_tail5"),
+        T(length=3, core_radius=2.5, frequency=4.5, wavelengths=0.6, seed=535, name="h7_tail3"),
+        W("random", length=9.5, width=4.0, frequency=4.5, seed=536, name="h7_standing_random_a"),
+        W("random", length=11.0, width=4.8, frequency=6.5, seed=537, name="h7_standing_random_b"),
+        W("random", length=8.5, width=3.8, frequency=8.0, seed=538, name="h7_standing_random_c"),
+        W("random", length=12.0, width=4.4, frequency=3.5, seed=539, name="h7_standing_random_d"),
+        W("random", length=10.0, width=4.6, frequency=5.5, seed=540, name="h7_standing_random_e"),
+        W("random", length=13.0, width=5.2, frequency=4.0, seed=541, name="h7_standing_random_f"),
+        W("random", length=9.0, width=3.6, frequency=7.0, seed=542, name="h7_standing_random_g"),
+        W("random", length=11.5, width=4.2, frequency=9.0, seed=543, name="h7_standing_random_h"),
+        W("random", length=10.5, width=4.4, frequency=3.0, seed=558, name="h7_standing_random_i"),
+        W("random", length=12.5, width=4.6, frequency=5.0, seed=559, name="h7_standing_random_j"),
+        W("halves", length=10.5, width=4.4, frequency=5.0, seed=544, name="h7_standing_halves_a"),
+        W("halves", length=9.0, width=4.0, frequency=7.5, seed=545, name="h7_standing_halves_b"),
+    ]
+
+
+def paper_seventh_set() -> List[KnownSwimmer]:
+    """The seventh held-out set: :func:`seventh_set_candidates` labelled by the ground truths (the protrusion
+    bodies stroke at both drags by :func:`stroke_truth`; the whole-body ones are labelled by
+    :func:`undulation_truth`, :data:`SEVENTH_TRUTH_REJECTED` dropped, :data:`SEVENTH_RELABELLED` relabelled),
+    all of new sizes, seeds (501-560) and frequencies 3-10, weighted toward multi-cell appendages (eight of
+    the ten protrusion bodies), bodies actuated synchronously or at random whose displacement travels (five
+    relabelled undulation of 23 such candidates) and random-phase bodies; fixed before the classifier was
+    run on any of them, which is done once (docs/locomotion.md). Sets nothing."""
+    return _by_truth(seventh_set_candidates(), SEVENTH_RELABELLED, SEVENTH_TRUTH_REJECTED)
