@@ -274,8 +274,8 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
 
 namespace {
 
-/// evaluation.repeats and repeat_perturbation in range (the config's bounds, for a config that did
-/// not pass validate()).
+/// evaluation.repeats, repeat_perturbation and repeat_statistic valid (the config's bounds, for a
+/// config that did not pass validate()).
 void check_repeats(const EvaluationParams& p) {
   if (p.repeats < 1 || p.repeats > 64)
     throw ConfigError(fmt::format(
@@ -285,6 +285,10 @@ void check_repeats(const EvaluationParams& p) {
         fmt::format("evaluation.repeat_perturbation = {} is out of range (expected a length in "
                     "(0, 0.1], length units)",
                     p.repeat_perturbation));
+  if (p.repeat_statistic != "mean" && p.repeat_statistic != "min")
+    throw ConfigError(fmt::format(
+        "evaluation.repeat_statistic = \"{}\" is not known (expected \"mean\" or \"min\")",
+        p.repeat_statistic));
 }
 
 /// What every swim of one evaluation shares: the developed body and the swim options.
@@ -495,7 +499,10 @@ EvaluationResult evaluate_repeats(const Genome& genome, const Config& config,
   double squares = 0.0;
   for (double v : values) squares += (v - mean) * (v - mean);
   const double sd = repeats > 1 ? std::sqrt(squares / (repeats - 1)) : 0.0;
-  out.fitness = mean;
+  // Summed and compared in repeat order: the same bits for any thread count or rank.
+  out.fitness = config.evaluation.repeat_statistic == "min"
+                    ? *std::min_element(values.begin(), values.end())
+                    : mean;
   out.fitness_spread = sd == 0.0     ? 0.0
                        : mean != 0.0 ? sd / std::abs(mean)
                                      : std::numeric_limits<double>::infinity();

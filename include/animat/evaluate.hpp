@@ -365,7 +365,8 @@ class RepeatScorer {
 /// (each repeat swims every source direction of objective chemotaxis), repeat 0 from the
 /// unperturbed start and repeat j >= 1 with start_offset = start_perturbation(j, n,
 /// evaluation.repeat_perturbation). fitness = the mean of scorer.value() over the repeats (summed
-/// in repeat order, then divided by K), fitness_spread their relative spread; every other field
+/// in repeat order, then divided by K), or their minimum with evaluation.repeat_statistic = "min";
+/// fitness_spread their relative spread about the mean; every other field
 /// is repeat 0's, except seconds_swim (all repeats). If a repeat is unstable or invalid the
 /// evaluation is (fitness 0, spread 0, the reason names the repeat) and no later repeat is swum.
 /// For K = 1 it is evaluate() with the scorer's value, which evaluate() itself does not call.

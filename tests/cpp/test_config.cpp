@@ -187,9 +187,9 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
         for (double& x : w) x = x * 1.1 + 0.1;
         candidates.push_back(w);
       } else if (std::holds_alternative<std::string>(def)) {
-        for (const char* word :
-             {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",
-              "grn", "point", "distance", "front", "amplitude", "morphogen_gradient", "compliant"})
+        for (const char* word : {"explicit", "stable", "off", "select", "distance_per_size",
+                                 "chemical", "actuation", "grn", "point", "distance", "front",
+                                 "amplitude", "morphogen_gradient", "compliant", "min"})
           candidates.push_back(std::string(word));
       }
       for (const auto& cand : candidates) {

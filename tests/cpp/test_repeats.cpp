@@ -2,7 +2,9 @@
 // the mean of the K objective values (docs/notes/evolution.md, "Repeated swims").
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -125,6 +127,46 @@ TEST(Repeats, ThreeRepeatsAreTheMeanOfThreeSwimsWhoseFirstIsUnperturbed) {
   const EvaluationResult o = evaluate(e.genome, c, *make_objective(c.evaluation));
   EXPECT_EQ(o.fitness, r.fitness);
   EXPECT_EQ(o.fitness_spread, r.fitness_spread);
+}
+
+TEST(Repeats, TheMinStatisticIsTheWorstRepeatAndKeepsTheSpreadAboutTheMean) {
+  Evolved e = swimmer();
+  e.config.evaluation.repeats = 3;
+  const EvaluationResult mean = evaluate(e.genome, e.config);
+  e.config.evaluation.repeat_statistic = "min";
+  const EvaluationResult worst = evaluate(e.genome, e.config);
+  ASSERT_TRUE(worst.valid) << (worst.reasons.empty() ? "" : worst.reasons.front());
+
+  const Body body = body_of(e);
+  const Config& c = e.config;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < 3; ++j) {
+    const Points offset = start_perturbation(j, body.node_count(), 1e-6);
+    const SwimResult s =
+        swim(body, c.scene, c.physics, c.evaluation.steps, options_with(j > 0 ? &offset : nullptr));
+    ASSERT_TRUE(s.valid);
+    smallest = std::min(smallest, s.distance);
+  }
+  EXPECT_EQ(worst.fitness, smallest);
+  EXPECT_LT(worst.fitness, mean.fitness);  // the three repeats differ (the test above)
+  EXPECT_EQ(worst.fitness_spread, mean.fitness_spread);
+  EXPECT_EQ(worst.displacement, mean.displacement);
+  // Through the objective layer too, and the guard's reference keeps the statistic.
+  EXPECT_EQ(evaluate(e.genome, c, *make_objective(c.evaluation)).fitness, worst.fitness);
+  EXPECT_EQ(reference_config(c).evaluation.repeat_statistic, "min");
+}
+
+TEST(Repeats, AnUnknownStatisticIsRefusedNamingKeyAndValue) {
+  Evolved e = swimmer();
+  e.config.evaluation.repeats = 2;
+  e.config.evaluation.repeat_statistic = "median";
+  try {
+    (void)evaluate(e.genome, e.config);
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& err) {
+    EXPECT_NE(std::string(err.what()).find("evaluation.repeat_statistic"), std::string::npos);
+    EXPECT_NE(std::string(err.what()).find("median"), std::string::npos);
+  }
 }
 
 TEST(Repeats, DeterministicForAnyThreadCount) {

@@ -300,6 +300,7 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nenergy_accounting = ",
                           "\nrepeats = ",
                           "\nrepeat_perturbation = ",
+                          "\nrepeat_statistic = ",
                           "\ndivision_axis = ",
                           "\ndivision_max_contacts = ",
                           "\nupdate_period = ",

@@ -79,3 +79,27 @@ def test_fitness_spread_is_zero_for_one_swim_and_the_spread_of_several():
     assert len(seen) == 3
     assert seen[0] == one.fitness
     assert scored.fitness == sum(seen) / 3 == three.fitness
+
+
+def test_the_min_statistic_is_the_worst_repeat_and_an_unknown_one_is_refused():
+    genome, _ = animat.Genome.random_viable(seed=3, config=small_config())
+    seen = []
+
+    class Distance:
+        name = "distance_seen"
+        every = 0
+
+        def __call__(self, record):
+            seen.append(record.result.fitness)
+            return record.result.fitness
+
+    worst = small_config(repeats=3, repeat_perturbation=1e-3, repeat_statistic="min")
+    assert animat.Config.from_toml(worst.to_toml())["evaluation.repeat_statistic"] == "min"
+    scored = animat.evaluate(genome, worst, objective=Distance())
+    assert len(seen) == 3
+    assert scored.fitness == min(seen) == animat.evaluate(genome, worst).fitness
+    c = animat.Config()
+    assert c["evaluation.repeat_statistic"] == "mean"
+    with pytest.raises(ValueError) as e:
+        c["evaluation.repeat_statistic"] = "median"
+    assert "evaluation.repeat_statistic" in str(e.value) and "median" in str(e.value), str(e.value)
