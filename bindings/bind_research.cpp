@@ -26,6 +26,7 @@
 #include "animat/development.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
+#include "animat/evaluator.hpp"
 #include "animat/evolution.hpp"
 #include "animat/external_actuation.hpp"
 #include "animat/objective.hpp"
@@ -229,6 +230,27 @@ ExternalActuation::Mode actuation_mode(const std::string& mode) {
       "external actuation: unknown mode '{}' (expected rest_length or oscillator)", mode));
 }
 
+/// An objective that scores as `inner` does and keeps a copy of the body it was shown: the body
+/// the evaluation developed and swam (an observed evaluation is bit-identical to an unobserved
+/// one). value() runs only for a viable, stable and valid swim; with evaluation.repeats > 1 every
+/// repeat shows the same body, the first is kept. One per evaluation (value() writes the copy).
+class BodyKeeper final : public Objective {
+ public:
+  explicit BodyKeeper(const Objective& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  bool needs_body() const override { return true; }
+  long sample_every() const override { return inner_.sample_every(); }
+  double value(const EvaluationRecord& record) const override {
+    if (!body_) body_ = record.body;
+    return inner_.value(record);
+  }
+  std::optional<Body>& body() { return body_; }
+
+ private:
+  const Objective& inner_;
+  mutable std::optional<Body> body_;
+};
+
 std::vector<double> to_doubles(nb::handle obj) {
   const nb::module_ np = nb::module_::import_("numpy");
   nb::object a = np.attr("ascontiguousarray")(obj, "dtype"_a = np.attr("float64")).attr("ravel")();
@@ -425,6 +447,37 @@ void bind_research(nb::module_& m) {
       "Evaluate a genome as animat.evaluate does and return the EvaluationRecord an objective "
       "sees:\n"
       "the result, the body and the trajectory every `every` control steps (0 = no trajectory).");
+  m.def(
+      "_evaluate_population_bodies",
+      [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads,
+         nb::handle objective) {
+        const Config c = config.value_or(Config{});
+        validate(c);
+        const std::shared_ptr<const Objective> scored_by = objective_from_python(objective, c);
+        std::vector<std::optional<Body>> bodies(genomes.size());
+        // objective_fitness()'s function, keeping the body: the evaluator hands each genome of
+        // `genomes` by reference, so its index is its offset in the vector.
+        const FitnessFunction keep = [&](const Genome& genome) {
+          BodyKeeper keeper(*scored_by);
+          const EvaluationResult r = evaluate(genome, c, keeper);
+          Fitness f{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
+          f.morphology_kind = r.morphology_kind;
+          bodies[static_cast<std::size_t>(&genome - genomes.data())] = std::move(keeper.body());
+          return f;
+        };
+        std::vector<Fitness> fits;
+        {
+          nb::gil_scoped_release release;
+          fits = evaluate_all(genomes, keep, threads);
+        }
+        return std::make_tuple(std::move(fits), std::move(bodies));
+      },
+      "genomes"_a, "config"_a = nb::none(), "threads"_a = 0, "objective"_a = nb::none(),
+      "evaluate_population (the same Fitness, bit for bit) and the Body each evaluation developed "
+      "and swam\n"
+      "(None where the swim was not viable, stable and valid): (fitnesses, bodies). MAP-Elites "
+      "describes\n"
+      "its candidates from these bodies (animat.qd).");
   m.def("body_length", &body_length, "body"_a,
         "Length of a body along its longest axis: the largest distance between two cell centres at "
         "rest plus\n"

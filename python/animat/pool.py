@@ -1,17 +1,18 @@
 """Where the swims of MAP-Elites and NSGA-II run: threads in this process, or the ranks of an MPI job.
 
 A search (:class:`animat.MapElites`, :class:`animat.Nsga2`) evaluates a batch of genomes under a config
-with a **swim function**, ``swim(genomes, config) -> results`` (one result per genome, in order), a
-pure function of its arguments: MAP-Elites' is :func:`animat.evaluate_population` (OpenMP threads),
-NSGA-II's :func:`evaluate_results` (``animat.evaluate`` on Python threads). Each uses the config's
-``evolution.threads``.
+with a **swim function**, ``swim(genomes, config, **options) -> results`` (one result per genome, in
+order), a pure function of its arguments: MAP-Elites' is :func:`animat.evaluate_population` (OpenMP
+threads; with ``describe=names`` it also computes those descriptors of :data:`animat.DESCRIPTORS`
+from the bodies its evaluations built, see :mod:`animat.qd`), NSGA-II's :func:`evaluate_results`
+(``animat.evaluate`` on Python threads). Each uses the config's ``evolution.threads``.
 
 Over MPI (``run_map_elites(..., mpi=True)``, ``run_nsga2(..., mpi=True)``, ``animat map-elites|nsga2
 ... --mpi``), every rank calls the same function with the same arguments. Rank 0 runs the search (asks,
 tells, writes the run directory) and gives each batch to an :class:`MpiPool`: the batch is cut into one
 contiguous share per rank (rank 0 swims one too), the shares are sent as pickles (genomes, the config,
-the results: each pickles exactly), every rank swims its share with the same swim function, and the
-results come back in the order asked. So a run is bit-identical for any number of ranks. The other
+the options, the results: each pickles exactly), every rank swims its share with the same swim
+function and options, and the results come back in the order asked. So a run is bit-identical for any number of ranks. The other
 ranks wait in :func:`serve` until rank 0 ends the run: they then return its final checkpoint, or raise
 :class:`MpiAbort` when rank 0 stopped on an error. An exception while a rank swims is sent to rank 0,
 which raises it (naming the rank) and stops every rank.
@@ -21,14 +22,15 @@ from __future__ import annotations
 
 import os
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any, Callable, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from . import _core
 
 __all__ = ["MpiAbort", "MpiPool", "Swim", "evaluate_results", "serve"]
 
-#: A swim function: ``swim(genomes, config) -> results``, one per genome, in order.
-Swim = Callable[[List[Any], Any], List[Any]]
+#: A swim function: ``swim(genomes, config, **options) -> results``, one per genome, in order (the
+#: options, such as MAP-Elites' ``describe``, go to every rank as they are).
+Swim = Callable[..., List[Any]]
 
 
 def evaluate_results(genomes: Sequence[Any], config: Any) -> List[Any]:
@@ -49,14 +51,14 @@ class MpiAbort(RuntimeError):
     error itself)."""
 
 
-# The messages rank 0 scatters, one per rank: ("swim", config, share), ("stop", checkpoint) or
+# The messages rank 0 scatters, one per rank: ("swim", config, share, options), ("stop", checkpoint) or
 # ("abort", message). A rank answers a swim with ("ok", results) or ("error", message).
 _Reply = Tuple[str, Any]
 
 
-def _swim_share(swim: Swim, genomes: List[Any], config: Any) -> _Reply:
+def _swim_share(swim: Swim, genomes: List[Any], config: Any, options: Dict[str, Any]) -> _Reply:
     try:
-        return ("ok", swim(genomes, config))
+        return ("ok", swim(genomes, config, **options))
     except Exception as e:  # noqa: BLE001 - sent to rank 0, which raises it
         return ("error", f"{type(e).__name__}: {e}")
 
@@ -73,8 +75,8 @@ def _shares(items: List[Any], ranks: int) -> List[List[Any]]:
 
 
 class MpiPool:
-    """Rank 0's side of the pool: ``pool(genomes, config)`` swims a batch over every rank of ``comm``
-    with ``swim`` (rank 0 takes a share) and returns the results in order; :meth:`stop` (or
+    """Rank 0's side of the pool: ``pool(genomes, config, **options)`` swims a batch over every rank of
+    ``comm`` with ``swim`` (rank 0 takes a share) and returns the results in order; :meth:`stop` (or
     :meth:`abort`) ends :func:`serve` on the other ranks. ``what`` names the run in error messages."""
 
     def __init__(self, comm: Any, swim: Swim, what: str) -> None:
@@ -86,12 +88,12 @@ class MpiPool:
         self.ranks = int(comm.Get_size())
         self._open = True
 
-    def __call__(self, genomes: Sequence[Any], config: Any) -> List[Any]:
+    def __call__(self, genomes: Sequence[Any], config: Any, **options: Any) -> List[Any]:
         if not self._open:
             raise RuntimeError(f"{self.what}: the MPI pool is stopped")
         shares = _shares(list(genomes), self.ranks)
-        mine = self.comm.scatter([("swim", config, share) for share in shares], root=0)
-        replies = self.comm.gather(_swim_share(self.swim, mine[2], config), root=0)
+        mine = self.comm.scatter([("swim", config, share, options) for share in shares], root=0)
+        replies = self.comm.gather(_swim_share(self.swim, mine[2], config, options), root=0)
         failed = [f"rank {r}: {reply[1]}" for r, reply in enumerate(replies) if reply[0] != "ok"]
         if failed:
             raise RuntimeError(f"{self.what}: the evaluation failed on MPI {'; '.join(failed)}")
@@ -120,7 +122,7 @@ def serve(comm: Any, swim: Swim, what: str) -> Any:
         message: Optional[Tuple[Any, ...]] = comm.scatter(None, root=0)
         assert message is not None
         if message[0] == "swim":
-            comm.gather(_swim_share(swim, message[2], message[1]), root=0)
+            comm.gather(_swim_share(swim, message[2], message[1], message[3]), root=0)
         elif message[0] == "stop":
             return message[1]
         else:

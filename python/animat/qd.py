@@ -89,23 +89,42 @@ CHECKPOINT_FORMAT = "animat.map_elites/1"
 
 class _Subject:
     """One genome under a config, with the expensive intermediate results shared by the descriptors
-    (development once, the body and its shape once, the locomotion replay once)."""
+    (development once, the body and its shape once, the locomotion replay once). ``body``: the body
+    the evaluation itself developed and swam (``_core._evaluate_population_bodies``), the one
+    ``build_body(develop(genome, config))`` gives; with it nothing is developed again."""
 
-    def __init__(self, genome: Any, config: Any, evaluation: Any) -> None:
+    def __init__(self, genome: Any, config: Any, evaluation: Any, body: Any = None) -> None:
         self.genome = genome
         self.config = config
         self.evaluation = evaluation
+        self._body = body
 
     @cached_property
     def embryo(self) -> Any:
         return _core.develop(self.genome, self.config)
 
     @cached_property
-    def shape(self) -> Any:
+    def body(self) -> Any:
+        if self._body is not None:
+            return self._body
         from . import pipeline
+
+        return pipeline.build_body(self.embryo, config=self.config)
+
+    @property
+    def cells(self) -> int:
+        # the body has a node per cell centre of the embryo, with its oscillator
+        return len((self.embryo if self._body is None else self._body).positions)
+
+    @property
+    def frequency(self) -> np.ndarray:
+        return (self.embryo if self._body is None else self._body).frequency
+
+    @cached_property
+    def shape(self) -> Any:
         from .shape import body_shape
 
-        return body_shape(pipeline.build_body(self.embryo, config=self.config))
+        return body_shape(self.body)
 
     @cached_property
     def locomotion(self) -> str:
@@ -199,7 +218,7 @@ DESCRIPTORS: Dict[str, Descriptor] = {
             "number of cells of the developed embryo",
             1,
             65,
-            lambda s: len(s.embryo.positions),
+            lambda s: s.cells,
             "`animat.develop(genome, config)`: the number of cell centres",
         ),
         _table_entry(
@@ -239,7 +258,7 @@ DESCRIPTORS: Dict[str, Descriptor] = {
             "median oscillator frequency of the cells (rad per time unit)",
             0.5,
             6,
-            lambda s: float(np.median(s.embryo.frequency)),
+            lambda s: float(np.median(s.frequency)),
             "`numpy.median(animat.develop(genome, config).frequency)`",
         ),
         _table_entry(
@@ -804,8 +823,8 @@ class _SearchState:
     _swim: Swim
     _pool: Optional[Swim] = None
 
-    def _evaluate(self, genomes: List[Any], config: Any) -> List[Any]:
-        return (self._pool or self._swim)(genomes, config)
+    def _evaluate(self, genomes: List[Any], config: Any, **options: Any) -> List[Any]:
+        return (self._pool or self._swim)(genomes, config, **options)
 
     @property
     def config(self) -> Any:
@@ -852,12 +871,42 @@ def _python_objective(objective: ObjectiveLike) -> Optional[Objective]:
 
 def _fitnesses(objective: Optional[Objective]) -> Swim:
     """MAP-Elites' swim function (:mod:`animat.pool`): :func:`animat.evaluate_population` on the
-    config's ``evolution.threads`` with ``objective`` (a Python objective, or None: the config's)."""
+    config's ``evolution.threads`` with ``objective`` (a Python objective, or None: the config's).
 
-    def swim(genomes: List[Any], config: Any) -> List[Any]:
-        return evaluate_population(genomes, config, int(config["evolution.threads"]), objective=objective)
+    ``describe=names`` (descriptors of :data:`DESCRIPTORS`): a ``(Fitness, values)`` pair per genome
+    instead, ``values`` the descriptors in that order computed from the very body the evaluation
+    developed and swam (the same values as :func:`measure`, without developing the genome again), or
+    None where the swim was not viable, stable and valid (no candidate). Under MPI every rank
+    describes the genomes it swam."""
+
+    def swim(genomes: List[Any], config: Any, describe: Sequence[str] = ()) -> List[Any]:
+        threads = int(config["evolution.threads"])
+        if not describe:
+            return evaluate_population(genomes, config, threads, objective=objective)
+        table = [DESCRIPTORS[name]._of_subject for name in describe]
+        fits, bodies = cast(Any, _core)._evaluate_population_bodies(  # private: not in the stub
+            list(genomes), config, threads, _objective(objective)
+        )
+        out: List[Any] = []
+        for genome, fit, body in zip(genomes, fits, bodies):
+            values = None
+            if fit.viable and fit.stable and fit.valid:
+                subject = _Subject(genome, config, fit, body)
+                values = tuple(float(cast(Callable[[_Subject], float], f)(subject)) for f in table)
+            out.append((fit, values))
+        return out
 
     return swim
+
+
+def _worker_descriptors(descriptors: Sequence[Descriptor]) -> Tuple[str, ...]:
+    """The names of the table's descriptors among ``descriptors`` (any range): the swim computes them
+    where it swims (:func:`_fitnesses`); your own functions are computed by the search."""
+    return tuple(
+        d.name
+        for d in descriptors
+        if d._of_subject is not None and d.name in DESCRIPTORS and d._of_subject is DESCRIPTORS[d.name]._of_subject
+    )
 
 
 class MapElites(_SearchState):
@@ -1046,10 +1095,29 @@ class MapElites(_SearchState):
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: :func:`animat.evaluate_population` with the config's threads and the
         objective; over the MPI ranks under ``run_map_elites(..., mpi=True)``) and tell one generation;
-        returns its history row."""
+        returns its history row. By default the table's descriptors are computed where each genome
+        swam, from the body its evaluation built (the values :func:`measure` gives); with your own
+        ``evaluate``, ``tell`` computes them with :func:`measure`."""
         genomes = self.ask()
-        results = self._evaluate(genomes, self._config) if evaluate is None else evaluate(genomes)
-        return self.tell(list(results))
+        if evaluate is not None:
+            return self.tell(list(evaluate(genomes)))
+        descriptors = self.archive.descriptors
+        names = _worker_descriptors(descriptors)
+        pairs = self._evaluate(genomes, self._config, describe=names) if names else None
+        fits = [p[0] for p in pairs] if pairs is not None else self._evaluate(genomes, self._config)
+        rows: List[Optional[np.ndarray]] = []
+        for i, (genome, fit) in enumerate(zip(genomes, fits)):
+            if not (fit.viable and fit.stable and fit.valid):
+                rows.append(None)  # not a candidate: tell() skips it before reading its row
+                continue
+            done = dict(zip(names, pairs[i][1])) if pairs is not None else {}
+            rows.append(
+                np.array(
+                    [done[d.name] if d.name in done else d(genome, self._config, fit) for d in descriptors],
+                    dtype=np.float64,
+                )
+            )
+        return self.tell(fits, descriptors=rows)
 
     # --- state ------------------------------------------------------------------------------------
     @property

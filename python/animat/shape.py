@@ -257,7 +257,10 @@ def concavity(positions: np.ndarray, outline: Sequence[int], spacing: Optional[f
     triangle of touching cells."""
     p = np.asarray(positions, dtype=float)
     s = cell_spacing(p) if spacing is None else spacing
-    a_out, a_hull = _areas(p, outline)
+    return _concavity(*_areas(p, outline), s)
+
+
+def _concavity(a_out: float, a_hull: float, s: float) -> float:
     if a_hull < np.sqrt(3.0) / 4.0 * s * s:
         return 0.0
     return float(min(1.0, max(0.0, 1.0 - a_out / a_hull)))
@@ -278,7 +281,9 @@ def _segment_distances(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarra
     aq = q[:, None, :] - a[None, :, :]
     t = np.clip(np.einsum("nej,ej->ne", aq, ab) / ll, 0.0, 1.0)
     closest = a[None, :, :] + t[..., None] * ab[None, :, :]
-    return np.linalg.norm(q[:, None, :] - closest, axis=2)
+    d = q[:, None, :] - closest
+    x, y = d[..., 0], d[..., 1]
+    return np.sqrt(x * x + y * y)  # np.linalg.norm(d, axis=2), operation for operation
 
 
 def _inside(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -333,14 +338,21 @@ def _core_candidates(a: np.ndarray, b: np.ndarray, rho: float) -> Tuple[np.ndarr
 def _in_core_erosion(q: np.ndarray, a: np.ndarray, b: np.ndarray, rho: float) -> np.ndarray:
     """(N,) bool: q inside the polygon at depth >= ρ (up to rounding)."""
     out = np.zeros(len(q), dtype=bool)
-    for start in range(0, len(q), 2048):
-        chunk = q[start : start + 2048]
+    level = rho * (1 - 1e-9) - 1e-12
+    # A point inside at depth d has the open disc of radius d inside (no edge crosses it), and every
+    # inside point lies in the vertices' bounding box: a point outside that box shrunk by the depth
+    # (less a margin far above rounding) is no point of the erosion. Only the others are measured.
+    lo, hi = a.min(axis=0) + (level - 1e-9), a.max(axis=0) - (level - 1e-9)
+    (boxed,) = np.nonzero(np.all((q >= lo) & (q <= hi), axis=1))
+    for start in range(0, len(boxed), 2048):
+        rows = boxed[start : start + 2048]
+        chunk = q[rows]
         depth = _segment_distances(chunk, a, b).min(axis=1)
-        deep = depth >= rho * (1 - 1e-9) - 1e-12
+        deep = depth >= level
         if deep.any():
             idx = np.nonzero(deep)[0]
             deep[idx] = _inside(chunk[idx], a, b)
-        out[start : start + 2048] = deep
+        out[rows] = deep
     return out
 
 
@@ -370,16 +382,19 @@ def cell_heights(
     corners, o, t, v = _core_candidates(a, b, rho)
     lo, hi = a.min(axis=0) - 1e-9, a.max(axis=0) + 1e-9
     corners = corners[np.all((corners >= lo) & (corners <= hi), axis=1)]
-    corners = corners[_in_core_erosion(corners, a, b, rho)]
-    pool = [corners]
-    for x in u:  # each cell's own candidates; all of them are points of the erosion, so pool them
-        along = np.einsum("kj,kj->k", x - o, t)
-        radial = x - v
-        r = np.linalg.norm(radial, axis=1)
-        radial = v[r > 0] + rho * radial[r > 0] / r[r > 0, None]
-        own = np.concatenate([x[None, :], o + along[:, None] * t, radial])
-        pool.append(own[_in_core_erosion(own, a, b, rho)])
-    core = np.concatenate(pool)
+    # Each cell's own candidates (itself, its projections on the offset lines, its radial
+    # projections on the vertex circles); all of them are points of the erosion, so pool them with
+    # the corners. One batch for all cells: every value is computed row by row, as for one cell.
+    n = len(u)
+    rel = (u[:, None, :] - o[None, :, :]).reshape(-1, 2)
+    along = np.einsum("kj,kj->k", rel, np.tile(t, (n, 1)))
+    lines = np.tile(o, (n, 1)) + along[:, None] * np.tile(t, (n, 1))
+    radial = (u[:, None, :] - v[None, :, :]).reshape(-1, 2)
+    r = np.linalg.norm(radial, axis=1)
+    centres = np.tile(v, (n, 1))
+    circles = centres[r > 0] + rho * radial[r > 0] / r[r > 0, None]
+    core = np.concatenate([corners, u, lines, circles])
+    core = core[_in_core_erosion(core, a, b, rho)]
     if len(core) == 0:
         return None
     heights = np.linalg.norm(u[:, None, :] - core[None, :, :], axis=2).min(axis=1)
@@ -454,8 +469,8 @@ def describe(
     if n == 0:
         return Shape(0, s, 1.0, 0.0, 0.0, 0.0, 0, (), ())
     el = elongation(p, params, s)
-    conc = concavity(p, loop, s)
     a_out, a_hull = _areas(p, loop)
+    conc = _concavity(a_out, a_hull, s)
     heights = cell_heights(p, loop, params, s)
     if heights is None:
         return Shape(n, s, el, conc, a_out / s**2, a_hull / s**2, 0, (0.0,) * n, ())
