@@ -10,7 +10,9 @@
 # Grid (environment variables, space-separated): SCREEN_ENVS, SCREEN_GROWTH, SCREEN_DAMPING,
 # SCREEN_STIFFNESS, SCREEN_SEEDS; SCREEN_POPULATION, SCREEN_GENERATIONS; SCREEN_GUARD (the exploit
 # guard, evaluation.reference_check: "record" by default; "select" adds "_select" to the names);
-# SCREEN_SUBSTEPS (physics.substeps, the step's refinement: 1 by default; N > 1 adds "_sN").
+# SCREEN_SUBSTEPS (physics.substeps, the step's refinement: 1 by default; N > 1 adds "_sN");
+# SCREEN_REPEATS (evaluation.repeats: 1 by default; K > 1 adds "_rK") and SCREEN_STATISTIC
+# (evaluation.repeat_statistic: mean by default; min adds "_min").
 # Growth: "paper" (any cell divides along its orientation), "tipsN" (a cell divides only while it
 # touches at most N cells, its daughter placed outward: development.division_max_contacts = N,
 # development.division_axis = "outward"). Run names carry the growth unless it is "paper".
@@ -22,6 +24,8 @@ ENVS=${SCREEN_ENVS:-"dn0.5 dn10"}
 GROWTH=${SCREEN_GROWTH:-"paper"}
 GUARD=${SCREEN_GUARD:-record}
 SUBSTEPS=${SCREEN_SUBSTEPS:-1}
+REPEATS=${SCREEN_REPEATS:-1}
+STATISTIC=${SCREEN_STATISTIC:-mean}
 DAMPING=${SCREEN_DAMPING:-"4 1 0.25"}
 STIFFNESS=${SCREEN_STIFFNESS:-"100 30"}
 SEEDS=${SCREEN_SEEDS:-"1 2"}
@@ -47,15 +51,17 @@ one() {  # env growth damping stiffness seed
   local guard=(--set "evaluation.reference_check=$GUARD")
   [[ "$GUARD" == record ]] || name="${name%_seed*}_${GUARD}_seed${seed}"
   [[ "$SUBSTEPS" == 1 ]] || name="${name%_seed*}_s${SUBSTEPS}_seed${seed}"
+  [[ "$REPEATS" == 1 ]] || name="${name%_seed*}_r${REPEATS}_seed${seed}"
+  [[ "$STATISTIC" == mean ]] || name="${name%_seed*}_${STATISTIC}_seed${seed}"
   [[ -f "$KEEP/$name/best_genome.json" ]] && return 0
   evolve_kept "$name" "$KEEP/$name" "$WORK/$name" "$GENS" final \
     --config "configs/paper_${env}.toml" --set "evolution.population=$POP" \
     --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" "${grow[@]}" "${guard[@]}" \
-    --set "physics.substeps=$SUBSTEPS" \
-    --seed "$seed"
+    --set "physics.substeps=$SUBSTEPS" --set "evaluation.repeats=$REPEATS" \
+    --set "evaluation.repeat_statistic=$STATISTIC" --seed "$seed"
 }
 export -f one evolve_kept
-export EXE POP GENS KEEP WORK GUARD SUBSTEPS
+export EXE POP GENS KEEP WORK GUARD SUBSTEPS REPEATS STATISTIC
 points=()
 for env in $ENVS; do for g in $GROWTH; do for c in $DAMPING; do for k in $STIFFNESS; do
   for s in $SEEDS; do points+=("$env $g $c $k $s"); done
