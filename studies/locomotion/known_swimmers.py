@@ -37,8 +37,9 @@ construction, not by the classifier); :func:`rowing_phase` actuates a geometry s
 been seen and are now calibration, as are :func:`paper_third_set` and :func:`paper_fourth_set` (seen).
 Every whole-body swimmer of these sets is labelled by :func:`undulation_truth` (from its motion on the
 lattice it was built on: :func:`truth_label`); bodies on which a truth disagrees between drags are in no
-set. :func:`paper_fifth_set` is the held-out set of the stroke measured along a protrusion's axis, the
-backward bending wave and the undulation truth (run once, docs/locomotion.md).
+set. :func:`paper_fifth_set` and :func:`paper_sixth_set` were held out (run once) and are calibration now;
+:func:`paper_seventh_set` is the held-out set of the extension across the motion and of protrusions grown
+by their loops (run once, docs/locomotion.md).
 """
 
 from __future__ import annotations

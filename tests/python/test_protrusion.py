@@ -226,9 +226,9 @@ def test_held_out_swimmers(name, drag, expected):
         assert K.stroke_truth(HELD[name], tr).strokes
 
 
-def test_the_extension_runs_along_the_protrusions_own_axis():
-    # a two-cell chain on anchors at the origin: swinging it rigidly about them is sweep, not extension;
-    # stretching it along its axis is extension, for its tip as for its base
+def test_cell_strokes_can_measure_along_the_protrusions_own_axis():
+    # (outward None; the stroke rule measures across the motion) a two-cell chain on anchors at the origin:
+    # swinging it rigidly about them is sweep, not extension; stretching it along its axis is extension
     t = np.arange(160) / 40
     swing = 0.4 * np.sin(OMEGA * t)
     Q = np.zeros((len(t), 4, 2))
@@ -242,3 +242,29 @@ def test_the_extension_runs_along_the_protrusions_own_axis():
     Q[:, 2:, 1] *= 1 + 0.2 * np.cos(OMEGA * t)[:, None]  # and now it also stretches
     _, E = P.cell_strokes(Q, t, OMEGA, (1.0, 0.0), [2, 3], Q[:, :2].mean(axis=1), None)
     assert np.abs(E[1]) == pytest.approx(2 * np.abs(E[0]), rel=0.1) and np.abs(E[0]) > 0.15
+
+
+def test_cell_loops_are_signed_by_the_side():
+    t = np.arange(160) / 40
+    Q = np.zeros((len(t), 2, 2))
+    Q[:, 0, 0] = -0.3 * np.sin(OMEGA * t)  # out (+y) while it moves back (-x): the stroke's loop
+    Q[:, 0, 1] = 1.0 + 0.2 * np.cos(OMEGA * t)
+    Q[:, 1, 0] = 0.3 * np.sin(OMEGA * t)  # along a line: no loop
+    left = P.cell_loops(Q, t, OMEGA, (1.0, 0.0), 1.0)
+    assert left[0] == pytest.approx(math.pi * 0.06, rel=1e-6) and abs(left[1]) < 1e-12
+    assert P.cell_loops(Q, t, OMEGA, (1.0, 0.0), -1.0)[0] == pytest.approx(-math.pi * 0.06, rel=1e-6)
+
+
+def test_a_protrusion_found_in_part_grows_to_the_whole_appendage():
+    # every cell of each 2 x 2 block makes the stroke's loop, the core stands still: from its outer row
+    # alone each block grows to its four cells and no further; a reverse loop does not grow
+    s = K.appendage_swimmer("block2x2", at=(-1.5,))
+    Q, t, body, rest = _frames(s, sweep=-0.3, extension=0.2)
+    outer = [sorted(g)[2:] for g in s.appendages]  # the row farthest out (cells are listed row by row)
+    grown = P.grow_protrusions(Q, t, OMEGA, (1.0, 0.0), outer, body.springs, 1.0)
+    assert [tuple(g) for g in grown] == [tuple(sorted(g)) for g in s.appendages]
+    Qb, *_ = _frames(s, sweep=+0.3, extension=0.2)
+    assert P.grow_protrusions(Qb, t, OMEGA, (1.0, 0.0), outer, body.springs, 1.0) == outer
+    st = P.stroke_motion(Q, t, OMEGA, (1.0, 0.0), body.skin_loops[0], body.springs, rest)
+    a, b = st.pair
+    assert {st.protrusions[a], st.protrusions[b]} == {tuple(sorted(g)) for g in s.appendages} and st.strokes
