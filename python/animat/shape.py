@@ -187,9 +187,10 @@ def cell_spacing(positions: np.ndarray) -> float:
     p = np.asarray(positions, dtype=float)
     if len(p) < 2:
         return 1.0
-    d = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=2)
-    np.fill_diagonal(d, np.inf)
-    s = float(np.median(d.min(axis=1)))
+    dx, dy = p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1]
+    d2 = dx * dx + dy * dy  # the squares np.linalg.norm sums; the root of the least is the least norm
+    np.fill_diagonal(d2, np.inf)
+    s = float(np.median(np.sqrt(d2.min(axis=1))))
     return s if s > 0 else 1.0
 
 
@@ -274,7 +275,7 @@ def _areas(p: np.ndarray, outline: Sequence[int]) -> Tuple[float, float]:
 
 
 def _segment_distances(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(N, E) distances from points q to segments a→b."""
+    """(N, E) squared distances from points q to segments a→b (the squares ``np.linalg.norm`` sums)."""
     ab = b - a
     ll = np.einsum("ij,ij->i", ab, ab)
     ll = np.where(ll > 0, ll, 1.0)
@@ -283,7 +284,7 @@ def _segment_distances(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarra
     closest = a[None, :, :] + t[..., None] * ab[None, :, :]
     d = q[:, None, :] - closest
     x, y = d[..., 0], d[..., 1]
-    return np.sqrt(x * x + y * y)  # np.linalg.norm(d, axis=2), operation for operation
+    return x * x + y * y
 
 
 def _inside(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -344,10 +345,14 @@ def _in_core_erosion(q: np.ndarray, a: np.ndarray, b: np.ndarray, rho: float) ->
     # (less a margin far above rounding) is no point of the erosion. Only the others are measured.
     lo, hi = a.min(axis=0) + (level - 1e-9), a.max(axis=0) - (level - 1e-9)
     (boxed,) = np.nonzero(np.all((q >= lo) & (q <= hi), axis=1))
+    # Nor is a point nearer than that to a vertex: an edge from it is as near.
+    dx, dy = q[boxed, None, 0] - a[None, :, 0], q[boxed, None, 1] - a[None, :, 1]
+    boxed = boxed[(dx * dx + dy * dy).min(axis=1) >= (level - 1e-9) ** 2]
     for start in range(0, len(boxed), 2048):
         rows = boxed[start : start + 2048]
         chunk = q[rows]
-        depth = _segment_distances(chunk, a, b).min(axis=1)
+        # sqrt is correctly rounded, so monotonic: the root of the least square is the least norm
+        depth = np.sqrt(_segment_distances(chunk, a, b).min(axis=1))
         deep = depth >= level
         if deep.any():
             idx = np.nonzero(deep)[0]
@@ -397,7 +402,8 @@ def cell_heights(
     core = core[_in_core_erosion(core, a, b, rho)]
     if len(core) == 0:
         return None
-    heights = np.linalg.norm(u[:, None, :] - core[None, :, :], axis=2).min(axis=1)
+    dx, dy = u[:, None, 0] - core[None, :, 0], u[:, None, 1] - core[None, :, 1]
+    heights = np.sqrt((dx * dx + dy * dy).min(axis=1))  # the least norm (as in _in_core_erosion)
     return np.maximum(0.0, heights - rho)
 
 
