@@ -6,10 +6,10 @@ the random draws, is excluded from both), on `--threads` threads.
 
 For each setting it prints the wall time per evaluated offspring (the median of `--repeat` runs, each
 part's median too) and, for MAP-Elites, where it goes:
-the swims (`evaluate_population`), the descriptors (`animat.qd.measure`: development, body and shape,
-in Python under the GIL) and the exploit guard's reference swims (`physics.substeps x
-evaluation.reference_substeps` = 16 x the step, per new elite under "record"). The GA's guard
-re-evaluates only each new best of a generation.
+the swims (the evaluations, which keep their bodies), the descriptors (computed in Python under the
+GIL from those bodies, as `MapElites.step()` does) and the exploit guard's reference swims
+(`physics.substeps x evaluation.reference_substeps` = 16 x the step, per new elite under "record").
+The GA's guard re-evaluates only each new best of a generation.
 """
 
 import argparse
@@ -50,23 +50,32 @@ def ga_cost(config, generations):
 
 def map_elites_cost(config, generations, batch, descriptors, bins):
     clock = Clock()
-    measure, references = qd.measure, qd.MapElites._references
-    qd.measure = clock.wrap("descriptors", measure)  # tell() looks the module's measure up at each call
+    core = qd._core
+    bodies, references = core._evaluate_population_bodies, qd.MapElites._references
+    # step() swims the candidates with the bodies kept and describes them in its swim function
+    # (describe=...): swims = the evaluations, descriptors = the rest of that call.
+    core._evaluate_population_bodies = clock.wrap("swims", bodies)
     qd.MapElites._references = clock.wrap("reference", references)  # type: ignore[method-assign]
     try:
         me = animat.MapElites(config, animat.GridArchive(descriptors, bins), batch=batch)
-        threads = int(config["evolution.threads"])
-        swim = clock.wrap("swims", lambda genomes: animat.evaluate_population(genomes, config, threads))
-        me.step(swim)  # generation 0
+        swim = me._swim
+
+        def candidates(genomes, cfg, **options):
+            return (clock.wrap("candidates", swim) if options.get("describe") else swim)(genomes, cfg, **options)
+
+        me._swim = candidates
+        me.step()  # generation 0
         clock.seconds.clear()
         n0, t = me.evaluations, time.perf_counter()
         while me.generation < generations:
-            me.step(swim)
+            me.step()
         total = time.perf_counter() - t
     finally:
-        qd.measure, qd.MapElites._references = measure, references
+        core._evaluate_population_bodies, qd.MapElites._references = bodies, references
     n = me.evaluations - n0
-    parts = {k: v / n for k, v in clock.seconds.items()}
+    seconds = dict(clock.seconds)
+    seconds["descriptors"] = seconds.pop("candidates", 0.0) - seconds.get("swims", 0.0)
+    parts = {k: v / n for k, v in seconds.items()}
     return total / n, n, parts, me
 
 
