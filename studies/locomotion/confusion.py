@@ -1,13 +1,14 @@
 """Confusion matrices of animat.classify_locomotion with the paper's stroke rule on the hand-built
 swimmers of known_swimmers.py (paper_calibration_set, paper_held_out_set, paper_third_set,
-paper_fourth_set, paper_fifth_set and paper_sixth_set, all now calibration, and the seventh held-out set
-paper_seventh_set;
+paper_fourth_set, paper_fifth_set, paper_sixth_set and paper_seventh_set, all now calibration, and the
+eighth held-out set paper_eighth_set;
 2000 steps at d_N = 0.5 and 2), every label from the ground truths (stroke_truth, undulation_truth).
 
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py calibration,held-out,third
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py fourth,fifth
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py sixth
     OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py seventh
+    OMP_NUM_THREADS=1 PYTHONPATH=build/python .venv/bin/python studies/locomotion/confusion.py eighth
 
 prints one line per swim (distance, label (by the ground truths) and found mode, the stroke's pair score and area, and for
 the appendage swimmers the ground truth of known_swimmers.stroke_truth) and the matrix (rows: labelled undulation, synchronous contraction, protrusions, tail, other; columns: the same,
@@ -28,6 +29,7 @@ SETS = {
     "fifth": K.paper_fifth_set,
     "sixth": K.paper_sixth_set,
     "seventh": K.paper_seventh_set,
+    "eighth": K.paper_eighth_set,
 }
 
 

@@ -39,7 +39,8 @@ Every whole-body swimmer of these sets is labelled by :func:`undulation_truth` (
 contraction of its cells travels as a wave along the lattice it was built on, the paper's undulation:
 :func:`truth_label`); bodies on which a truth disagrees between drags are in no set.
 :func:`paper_fifth_set`, :func:`paper_sixth_set` and :func:`paper_seventh_set` were held out (run once)
-and are calibration now.
+and are calibration now; :func:`paper_eighth_set` is the held-out set of the undulation truth on the
+realised contraction (docs/locomotion.md).
 """
 
 from __future__ import annotations
@@ -92,6 +93,8 @@ __all__ = [
     "paper_fifth_set",
     "paper_sixth_set",
     "paper_seventh_set",
+    "eighth_set_candidates",
+    "paper_eighth_set",
 ]
 
 #: The paper's largest amplitude (development.amplitude_max): a cell changes its springs by ±20 %.
@@ -1716,3 +1719,134 @@ def paper_seventh_set() -> List[KnownSwimmer]:
     while their contraction does not) and random-phase bodies; fixed before the classifier was run on any of
     them, which was done once (docs/locomotion.md); calibration now."""
     return _by_truth(seventh_set_candidates(), SEVENTH_RELABELLED, SEVENTH_TRUTH_REJECTED)
+
+
+#: The eighth held-out set's appendage candidates that stroke at both drags by :func:`stroke_truth` (with
+#: :data:`EIGHTH_PHASES`): built after the undulation truth was grounded on the realised contraction, with
+#: new cores (8.75-12.25 long), seeds (601-620) and frequencies (quarter values, 3.25-7.25, used by no
+#: earlier set). Of 20 candidates (six one-cell, five two-cell chain, four three-cell chain and five 2 × 2
+#: block pairs) six one-cell, two two-cell chain, three three-cell chain and three block pairs stroke.
+EIGHTH_APPENDAGES = {
+    "h8_single_a": dict(kind="single", core_length=9.25, core_width=4.5, at=(-1.75,), frequency=5.25, seed=601),
+    "h8_single_b": dict(kind="single", core_length=10.75, core_width=4.9, at=(-2.25,), frequency=6.75, seed=602),
+    "h8_single_c": dict(kind="single", core_length=8.75, core_width=4.3, at=(-1.25,), frequency=4.25, seed=603),
+    "h8_single_d": dict(kind="single", core_length=11.25, core_width=5.1, at=(-2.5,), frequency=7.25, seed=604),
+    "h8_single_e": dict(kind="single", core_length=12.25, core_width=5.3, at=(-3.0,), frequency=5.75, seed=617),
+    "h8_single_f": dict(kind="single", core_length=9.75, core_width=4.7, at=(-1.5,), frequency=3.75, seed=618),
+    "h8_chain2_a": dict(kind="chain2", core_length=9.75, core_width=4.5, at=(-1.75,), frequency=5.75, seed=605),
+    "h8_chain2_b": dict(kind="chain2", core_length=10.25, core_width=4.7, at=(-2.0,), frequency=4.75, seed=606),
+    "h8_chain3_a": dict(kind="chain3", core_length=10.25, core_width=4.7, at=(-2.0,), frequency=5.25, seed=609),
+    "h8_chain3_b": dict(kind="chain3", core_length=9.25, core_width=4.3, at=(-1.5,), frequency=6.25, seed=610),
+    "h8_chain3_c": dict(kind="chain3", core_length=11.25, core_width=4.9, at=(-2.25,), frequency=4.25, seed=611),
+    "h8_block2x2_a": dict(kind="block2x2", core_length=10.75, core_width=5.1, at=(-2.0,), frequency=4.25, seed=613),
+    "h8_block2x2_b": dict(kind="block2x2", core_length=11.25, core_width=4.7, at=(-2.25,), frequency=4.75, seed=614),
+    "h8_block2x2_c": dict(kind="block2x2", core_length=12.25, core_width=5.5, at=(-2.75,), frequency=3.75, seed=615),
+}
+#: Their appendage phases (× π/4) by :func:`rowing_phase` (the ground truth; the classifier plays no part).
+EIGHTH_PHASES = {
+    "h8_single_a": 0,
+    "h8_single_b": 7,
+    "h8_single_c": 1,
+    "h8_single_d": 7,
+    "h8_single_e": 7,
+    "h8_single_f": 0,
+    "h8_chain2_a": 2,
+    "h8_chain2_b": 7,
+    "h8_chain3_a": 2,
+    "h8_chain3_b": 2,
+    "h8_chain3_c": 2,
+    "h8_block2x2_a": 3,
+    "h8_block2x2_b": 0,
+    "h8_block2x2_c": 1,
+}
+#: Candidates that do not stroke at both drags with any of the 8 phases: their geometry and what fails at
+#: their best phase (d_N = 0.5 / 2). In no set.
+EIGHTH_REJECTED = {
+    "h8_chain2_c": (
+        dict(kind="chain2", core_length=8.75, core_width=4.1, at=(-1.25,), frequency=6.25, seed=607),
+        "rowing 0.28 / rowing 0.22, 30 deg off its axis",
+    ),
+    "h8_chain2_d": (
+        dict(kind="chain2", core_length=11.75, core_width=5.3, at=(-2.75,), frequency=5.25, seed=608),
+        "moves towards its appendages at both drags",
+    ),
+    "h8_chain2_e": (
+        dict(kind="chain2", core_length=10.75, core_width=4.9, at=(-2.25,), frequency=3.25, seed=619),
+        "38 deg off its axis / strokes",
+    ),
+    "h8_chain3_d": (
+        dict(kind="chain3", core_length=12.25, core_width=5.3, at=(-2.75,), frequency=5.75, seed=612),
+        "rowing 0.24 / 0.23",
+    ),
+    "h8_block2x2_d": (
+        dict(kind="block2x2", core_length=9.75, core_width=4.9, at=(-1.75,), frequency=5.25, seed=616),
+        "rowing -0.41 / -0.13, moves towards its appendages",
+    ),
+    "h8_block2x2_e": (
+        dict(kind="block2x2", core_length=11.75, core_width=5.1, at=(-2.5,), frequency=4.25, seed=620),
+        "rowing 0.20, swims 0.20 spacings / rowing 0.13; moves towards its appendages",
+    ),
+}
+#: Whole-body candidates the undulation truth rejects (:func:`label_by_truth`, d_N = 0.5 and 2) ...
+EIGHTH_TRUTH_REJECTED: dict = {}
+#: ... and relabels.
+EIGHTH_RELABELLED: dict = {}
+
+
+def eighth_set_candidates() -> List[KnownSwimmer]:
+    """Every candidate of the eighth set with its built label, before the truths (the protrusion candidates
+    at their :data:`EIGHTH_PHASES` phase; the rejected ones of :data:`EIGHTH_REJECTED` are not built)."""
+    pi = math.pi
+    prot = [
+        appendage_swimmer(**g, appendage_phase=EIGHTH_PHASES[name] * pi / 4, anchor_shift=pi, name=name)
+        for name, g in EIGHTH_APPENDAGES.items()
+    ]
+    U, S, T, W = undulator, synchronous_contractor, tail_swimmer, standing_swimmer
+    return prot + [
+        U("contraction", length=10.25, width=2.3, frequency=6.25, wavelengths=1.0, seed=621, name="h8_und_a"),
+        U("contraction", length=11.75, width=2.5, frequency=5.25, wavelengths=1.25, seed=622, name="h8_und_b"),
+        U("contraction", length=12.75, width=2.7, frequency=4.75, wavelengths=1.5, seed=623, name="h8_und_c"),
+        U("contraction", length=9.75, width=2.5, frequency=7.25, wavelengths=1.0, seed=624, name="h8_und_d"),
+        U("contraction", length=13.25, width=2.3, frequency=3.75, wavelengths=1.75, seed=625, name="h8_und_e"),
+        U("bending", length=10.25, width=2.5, frequency=5.75, wavelengths=1.0, seed=626, name="h8_und_bend_a"),
+        U("bending", length=11.25, width=2.7, frequency=4.25, wavelengths=1.25, seed=627, name="h8_und_bend_b"),
+        U("bending", length=9.25, width=2.3, frequency=6.75, wavelengths=1.0, seed=628, name="h8_und_bend_c"),
+        U("bending", length=12.75, width=2.9, frequency=5.25, wavelengths=1.0, seed=629, name="h8_und_bend_d"),
+        U("bending", length=10.75, width=2.3, frequency=7.75, wavelengths=1.25, seed=630, name="h8_und_bend_e"),
+        U("across", length=6.75, width=7.25, frequency=5.75, seed=631, name="h8_und_across"),
+        S(length=9.25, width=5.1, frequency=5.75, seed=632, name="h8_sync_a"),
+        S(length=11.25, width=4.5, frequency=4.25, seed=633, name="h8_sync_b"),
+        S(length=8.25, width=5.3, frequency=8.75, seed=634, name="h8_sync_c"),
+        S(length=10.75, width=4.7, frequency=6.25, lag=0.3, seed=635, name="h8_sync_lag_a"),
+        S(length=12.25, width=4.9, frequency=3.75, lag=0.5, seed=636, name="h8_sync_lag_b"),
+        S(length=10.25, width=4.7, frequency=5.25, seed=637, shape="wedge", name="h8_sync_wedge_a"),
+        S(length=9.25, width=5.3, frequency=7.75, seed=638, shape="wedge", name="h8_sync_wedge_b"),
+        S(length=11.75, width=4.3, frequency=4.75, seed=639, shape="wedge", name="h8_sync_wedge_c"),
+        S(length=10.75, width=4.5, frequency=6.75, seed=640, shape="ellipse", name="h8_sync_ellipse_a"),
+        S(length=8.75, width=4.9, frequency=4.25, seed=641, shape="ellipse", name="h8_sync_ellipse_b"),
+        T(length=4, core_radius=2.35, frequency=6.25, wavelengths=0.5, seed=642, name="h8_tail4"),
+        T(length=5, core_radius=2.45, frequency=4.75, wavelengths=0.6, seed=643, name="h8_tail5"),
+        T(length=3, core_radius=2.55, frequency=8.25, wavelengths=0.45, seed=644, name="h8_tail3"),
+        W("random", length=9.25, width=3.9, frequency=5.25, seed=645, name="h8_standing_random_a"),
+        W("random", length=10.75, width=4.3, frequency=3.75, seed=646, name="h8_standing_random_b"),
+        W("random", length=12.25, width=4.7, frequency=6.75, seed=647, name="h8_standing_random_c"),
+        W("random", length=8.75, width=3.7, frequency=7.75, seed=648, name="h8_standing_random_d"),
+        W("random", length=11.25, width=4.9, frequency=4.25, seed=649, name="h8_standing_random_e"),
+        W("random", length=13.25, width=5.1, frequency=5.75, seed=650, name="h8_standing_random_f"),
+        W("random", length=9.75, width=4.1, frequency=8.75, seed=651, name="h8_standing_random_g"),
+        W("random", length=10.25, width=4.5, frequency=3.25, seed=652, name="h8_standing_random_h"),
+        W("halves", length=10.25, width=4.3, frequency=5.75, seed=653, name="h8_standing_halves_a"),
+        W("halves", length=9.25, width=3.9, frequency=6.75, seed=654, name="h8_standing_halves_b"),
+    ]
+
+
+def paper_eighth_set() -> List[KnownSwimmer]:
+    """The eighth held-out set: :func:`eighth_set_candidates` labelled by the ground truths (the protrusion
+    bodies stroke at both drags by :func:`stroke_truth`; the whole-body ones are labelled by
+    :func:`undulation_truth` on their realised contraction, :data:`EIGHTH_TRUTH_REJECTED` dropped,
+    :data:`EIGHTH_RELABELLED` relabelled), all of new sizes, seeds (601-654) and frequencies (quarter
+    values, 3.25-8.75), with ten wave undulators (five contraction, five bending) and one across, ten
+    synchronous bodies of three shapes (tear-drops, two with a lag, wedges, ellipses), eight random-phase
+    bodies and protrusion bodies of every appendage kind; fixed before the classifier was run on any of
+    them, which is done once (docs/locomotion.md). Sets nothing."""
+    return _by_truth(eighth_set_candidates(), EIGHTH_RELABELLED, EIGHTH_TRUTH_REJECTED)

@@ -22,6 +22,7 @@ CANDIDATES = {
     "fifth": (K.fifth_set_candidates, K.FIFTH_RELABELLED, K.FIFTH_TRUTH_REJECTED),
     "sixth": (K.sixth_set_candidates, K.SIXTH_RELABELLED, K.SIXTH_TRUTH_REJECTED),
     "seventh": (K.seventh_set_candidates, K.SEVENTH_RELABELLED, K.SEVENTH_TRUTH_REJECTED),
+    "eighth": (K.eighth_set_candidates, K.EIGHTH_RELABELLED, K.EIGHTH_TRUTH_REJECTED),
 }
 
 
