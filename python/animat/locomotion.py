@@ -43,8 +43,8 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
      (a rigid or resting body). Swimming bodies deform by 0.1–0.4 (amplitude up to 0.2 per cell,
      two cells per spring); a rigid body gives < 1e-9.
    - the paper's stroke (only when the body's outline is given: ``classify_locomotion(..., stroke=True)``;
-     off by default until it meets its held-out target, docs/locomotion.md): a symmetric pair of protrusions (:mod:`animat.shape`, at rest or during the last cycle) that
-     rows, extended while moving backwards and contracted on the return
+     off by default until it meets its held-out target, docs/locomotion.md): a symmetric pair of protrusions (:mod:`animat.shape`, at rest or during the last cycle; both
+     standing out at rest) that rows, extended while moving backwards and contracted on the return
      (:func:`animat.protrusion.stroke_motion`: pair score ``>= STROKE_SCORE`` 0.4 and loop area
      ``>= STROKE_AREA`` 0.1 spacings²): **protrusions**, but **undulation** mixed with protrusions when
      the wave criterion also holds (a slow wave makes an undulator's corners row). With the stroke rule
