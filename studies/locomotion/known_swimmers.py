@@ -39,8 +39,8 @@ Every whole-body swimmer of these sets is labelled by :func:`undulation_truth` (
 contraction of its cells travels as a wave along the lattice it was built on, the paper's undulation:
 :func:`truth_label`); bodies on which a truth disagrees between drags are in no set.
 :func:`paper_fifth_set`, :func:`paper_sixth_set` and :func:`paper_seventh_set` were held out (run once)
-and are calibration now; :func:`paper_eighth_set` is the held-out set of the undulation truth on the
-realised contraction (docs/locomotion.md).
+and are calibration now; :func:`paper_eighth_set`, the held-out set of the undulation truth on the
+realised contraction and of the pair at rest, was run once (docs/locomotion.md) and is calibration now.
 """
 
 from __future__ import annotations
@@ -1848,5 +1848,5 @@ def paper_eighth_set() -> List[KnownSwimmer]:
     values, 3.25-8.75), with ten wave undulators (five contraction, five bending) and one across, ten
     synchronous bodies of three shapes (tear-drops, two with a lag, wedges, ellipses), eight random-phase
     bodies and protrusion bodies of every appendage kind; fixed before the classifier was run on any of
-    them, which is done once (docs/locomotion.md). Sets nothing."""
+    them, which was done once (docs/locomotion.md); calibration now."""
     return _by_truth(eighth_set_candidates(), EIGHTH_RELABELLED, EIGHTH_TRUTH_REJECTED)
