@@ -8,6 +8,17 @@ import pytest
 import animat
 
 
+class DistanceSeen(list):
+    """A Python objective that scores the distance and keeps every value it was asked for."""
+
+    name = "distance_seen"
+    every = 0
+
+    def __call__(self, record):
+        self.append(record.result.fitness)
+        return record.result.fitness
+
+
 def small_config(**evaluation):
     c = animat.Config()
     c["evaluation.steps"] = 300
@@ -65,17 +76,8 @@ def test_fitness_spread_is_zero_for_one_swim_and_the_spread_of_several():
     back = pickle.loads(pickle.dumps(three))
     assert back.fitness == three.fitness and back.fitness_spread == three.fitness_spread
     # A Python objective scores every repeat; the fitness is the mean of its values.
-    seen = []
-
-    class Distance:
-        name = "distance_seen"
-        every = 0
-
-        def __call__(self, record):
-            seen.append(record.result.fitness)
-            return record.result.fitness
-
-    scored = animat.evaluate(genome, small_config(repeats=3, repeat_perturbation=1e-3), objective=Distance())
+    seen = DistanceSeen()
+    scored = animat.evaluate(genome, small_config(repeats=3, repeat_perturbation=1e-3), objective=seen)
     assert len(seen) == 3
     assert seen[0] == one.fitness
     assert scored.fitness == sum(seen) / 3 == three.fitness
@@ -83,19 +85,10 @@ def test_fitness_spread_is_zero_for_one_swim_and_the_spread_of_several():
 
 def test_the_min_statistic_is_the_worst_repeat_and_an_unknown_one_is_refused():
     genome, _ = animat.Genome.random_viable(seed=3, config=small_config())
-    seen = []
-
-    class Distance:
-        name = "distance_seen"
-        every = 0
-
-        def __call__(self, record):
-            seen.append(record.result.fitness)
-            return record.result.fitness
-
+    seen = DistanceSeen()
     worst = small_config(repeats=3, repeat_perturbation=1e-3, repeat_statistic="min")
     assert animat.Config.from_toml(worst.to_toml())["evaluation.repeat_statistic"] == "min"
-    scored = animat.evaluate(genome, worst, objective=Distance())
+    scored = animat.evaluate(genome, worst, objective=seen)
     assert len(seen) == 3
     assert scored.fitness == min(seen) == animat.evaluate(genome, worst).fitness
     c = animat.Config()
