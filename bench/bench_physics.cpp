@@ -124,8 +124,8 @@ BENCHMARK(BM_SwimStepBox2D)->Arg(32)->Arg(64)->Arg(128)->Arg(256);
 /// One effect alone, 32 cells: 0-4 springs, actuation, pressure, drag, collisions; 5 = no effect at
 /// all; 6 = all (the default scene); 7 skin_collision, 8 gravity, 9 ground (the floor 10 below the
 /// body: the contact test runs for every cell, nothing touches); 10 = the crawl scene
-/// (configs/crawl.toml's effects, the body resting on the floor). 0-6 keep their numbers so that
-/// older tables compare.
+/// (configs/crawl.toml's effects on the impulse floor, the body resting on it). 0-6 keep their
+/// numbers so that older tables compare.
 void BM_Effect(benchmark::State& state) {
   const int k = static_cast<int>(state.range(0));
   static constexpr const char* kLabels[] = {

@@ -48,7 +48,7 @@ EFFECTS = [
     "skin_collision",
     "gravity",
     "ground (no contact)",
-    "crawl scene (configs/crawl.toml, on the floor)",
+    "crawl scene (crawl effects, impulse floor, on the floor)",
 ]  # BM_Effect/0..10
 
 

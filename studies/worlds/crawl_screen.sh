@@ -53,7 +53,7 @@ one() {  # gravity stiffness frequency_max amplitude_max contact repeats statist
     --set "development.frequency_max=$f" --set "development.amplitude_max=$a" \
     --set "scene.ground_contact=$contact" --set "evolution.population=$POP" \
     --set "evaluation.reference_check=$guard" --seed "$seed" \
-    $([[ "$repeats" == 1 ]] || echo --set "evaluation.repeats=$repeats") \
+    --set "evaluation.repeats=$repeats" \
     $([[ "$statistic" == mean ]] || echo --set "evaluation.repeat_statistic=$statistic")
 }
 export -f one evolve_kept

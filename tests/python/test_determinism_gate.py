@@ -193,6 +193,12 @@ SCENES: Dict[str, Tuple[Optional[str], Dict[str, Any], Tuple[str, ...]]] = {
     "paper_dn10": ("configs/paper_dn10.toml", {}, ALL),
     "paper_dn0.2_64cells": ("configs/paper_dn0.2_64cells.toml", {}, ALL),
     "crawl": ("configs/crawl.toml", {}, ALL),
+    # the crawl world's impulse floor and one swim per genome
+    "crawl_impulse_one_swim": (
+        "configs/crawl.toml",
+        {"scene.ground_contact": "impulse", "evaluation.repeats": 1},
+        ALL,
+    ),
     "walk": ("configs/walk.toml", {}, ALL),
     "chemotaxis": ("configs/chemotaxis.toml", _CHEMOTAXIS_SHORT, ALL),
     "replication_dn2_run": ("tests/data/replication/dn2_run_0/config.toml", {}, ALL),
@@ -494,7 +500,8 @@ def test_the_gate_exercises_the_model() -> None:
     assert sum(not v["viable"] for v in default.values()) == 2
     assert sum(float.fromhex(default[name]["fitness"]) > 1.0 for name in SWIMMERS) >= 3
     assert pins["evaluation/collisions_f12_dn0.5"]["colliding_f12_dn0.5"]["collisions"] > 100
-    assert all(v["ground_contacts"] > 0 for v in pins["evaluation/crawl"].values() if v["viable"])
+    for crawl in ("crawl", "crawl_impulse_one_swim"):
+        assert all(v["ground_contacts"] > 0 for v in pins[f"evaluation/{crawl}"].values() if v["viable"])
     chemotaxis = pins["evaluation/chemotaxis"]["chemotaxis_amplitude_best"]
     assert chemotaxis["grn_updates"] > 0 and float.fromhex(chemotaxis["source_progress"]) > 0.1
     assert pins["evaluation/drag_stable"]["replication_dn10_best"]["drag_limited"] > 0
