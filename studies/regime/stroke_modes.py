@@ -1,5 +1,6 @@
 """Classifies evolved bests with the classifier's stroke path (issue #31, docs/locomotion.md):
-``animat.classify_locomotion(genome, config, stroke=True)`` next to the default classifier, for
+``animat.classify_locomotion(genome, config, stroke=True)`` next to the default classifier (the earlier
+rules, named explicitly: ``stroke=False``), for
 
 - ``replication``: the final best of every run of the replication study kept in ``data/replication``
   (``<env>/run_<i>/``: its ``config.toml`` and the last ``best/gen_*.json`` of ``best.tar.gz``, the
@@ -178,6 +179,20 @@ def search_best(folder: Path) -> Best:
     return _best("search", folder.name, env, seed, classes[name]["fitness"], classes[name]["genome"], config)
 
 
+def search_class_bests(folder: Path) -> Dict[str, Best]:
+    """Every morphology class's best of a kept search run (its class_bests.json, class name -> Best),
+    for studies/search/figures.py, which classifies them all (``search_best`` is the fittest of them)."""
+    config = animat.load_config(str(folder / "config.toml"))
+    classes = json.loads((folder / "class_bests.json").read_text())
+    env, rest = folder.name.split("_", 1)
+    if rest.startswith("64cells_"):
+        env = f"{env}_64cells"
+    seed = int(folder.name.rsplit("_seed", 1)[1])
+    return {
+        name: _best("search", folder.name, env, seed, c["fitness"], c["genome"], config) for name, c in classes.items()
+    }
+
+
 def search_bests(root: Path = SEARCH) -> List[Best]:
     if not root.is_dir():
         return []
@@ -189,11 +204,13 @@ def _num(x: Optional[float]) -> float:
 
 
 def classify_best(best: Best) -> Dict[str, Any]:
-    """The CSV row of one best: where it comes from, the default label
-    (``classify_locomotion(genome, config)``), the stroke path's label (``stroke=True``) and the stroke
-    path's numbers: the best symmetric pair's score and (smaller) loop area, whether it strokes, the
+    """The CSV row of one best: where it comes from, the default label (the earlier rules,
+    ``classify_locomotion(genome, config, stroke=False)``), the stroke path's label (``stroke=True``) and
+    the stroke path's numbers: the best symmetric pair's score and (smaller) loop area, whether it strokes, the
     protrusions and pairs found, the contraction wave and the bending wave."""
-    default = animat.classify_locomotion(best.genome, best.config)
+    # The earlier rules, named explicitly: "default" is what classify_locomotion did before the stroke
+    # path (the column keeps its name), whatever its default is now.
+    default = animat.classify_locomotion(best.genome, best.config, stroke=False)
     mode = animat.classify_locomotion(best.genome, best.config, stroke=True)
     s = mode.stroke
     w = mode.wave
