@@ -42,22 +42,25 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
    - ``deformation < NONE_DEFORMATION`` (0.01): **none**: the body does not deform periodically
      (a rigid or resting body). Swimming bodies deform by 0.1–0.4 (amplitude up to 0.2 per cell,
      two cells per spring); a rigid body gives < 1e-9.
-   - the paper's stroke (only when the body's outline is given: ``classify_locomotion(..., stroke=True)``;
-     off by default until it meets its held-out target, docs/locomotion.md): a symmetric pair of protrusions (:mod:`animat.shape`, at rest or during the last cycle; both
-     standing out at rest) that rows, extended while moving backwards and contracted on the return
-     (:func:`animat.protrusion.stroke_motion`: pair score ``>= STROKE_SCORE`` 0.4 and loop area
-     ``>= STROKE_AREA`` 0.1 spacings²): **protrusions**, but **undulation** mixed with protrusions when
-     the wave criterion also holds (a slow wave makes an undulator's corners row). With the stroke rule
-     a strain contrast without a rowing pair is no longer protrusions (next item): a **tail** when
-     the strained cells form one group or the outline has one protrusion, else the wave, synchrony
-     and "other" rules decide. Calibrated on ``paper_calibration_set`` of the hand-built swimmers
-     (studies/locomotion/known_swimmers.py), whose protrusion swimmers actuate every cell
-     (docs/locomotion.md).
+   - the paper's stroke (the *stroke path*: whenever the body's outline is known, i.e.
+     :func:`classify_locomotion` of a trajectory or of anything it replays, unless ``stroke=False``;
+     :func:`classify_motion` with ``outline``): a symmetric pair of protrusions (:mod:`animat.shape`, at
+     rest or during the last cycle; both standing out at rest) that rows, extended while moving
+     backwards and contracted on the return (:func:`animat.protrusion.stroke_motion`: pair score ``>=
+     STROKE_SCORE`` 0.4 and loop area ``>= STROKE_AREA`` 0.1 spacings²): **protrusions**, but
+     **undulation** mixed with protrusions when the wave criterion also holds (a slow wave makes an
+     undulator's corners row). On the stroke path a strain contrast without a rowing pair is not
+     protrusions (next item): it is a **tail** when the strained cells form one group or the outline has
+     one protrusion, else the wave, synchrony and "other" rules decide. Calibrated on the hand-built
+     swimmers of studies/locomotion/known_swimmers.py whose protrusion swimmers actuate every cell
+     (``paper_calibration_set`` and the sets after it) and checked on a held-out set run once: every
+     class ≥ 80 % (docs/locomotion.md, which gives the confusion matrices).
    - ``concentration >= PROTRUSION_CONCENTRATION`` (0.65), or a strain contrast (RMS contraction
      amplitude of the most strained 20 % of the cells over the median cell's) ``>= LOCAL_CONTRAST``
-     (3.5): **protrusions** when those cells (the most strained fifth if the contrast
-     decided, else the most mobile fifth) form two or more groups joined by springs, **tail** when they
-     form one. The contrast rule was added because hand-built protrusion swimmers
+     (3.5): on the stroke path a **tail** under the condition above; without it (``stroke=False``, the
+     earlier rules, or a positions array, which has no outline) **protrusions** when those cells (the
+     most strained fifth if the contrast decided, else the most mobile fifth) form two or more groups
+     joined by springs, **tail** when they form one. The contrast rule was added because hand-built protrusion swimmers
      (studies/locomotion/known_swimmers.py) put only 0.44–0.62 of the motion in their top fifth: the passive
      core of a soft body is pushed around by its appendages. For the old rule: the rest of the body
      moves with less than 37 % of the RMS amplitude of its most mobile fifth. Smooth whole-body
@@ -68,7 +71,7 @@ bests mix two. We decide automatically from the recorded swim, with numbers that
      WAVE_TI`` (0.15): **undulation** (listed as mixed with protrusions when both hold). π/2 is a
      quarter period across the body, the brief's and the paper's "wave travelling through the
      body"; the drag and inertia of synchronously driven bodies produce lags up to 0.74 rad. On the
-     stroke rule's path (``classify_locomotion(..., stroke=True)``) a *bending wave* also counts
+     stroke path a *bending wave* also counts
      (:func:`bending_wave`: the same fit, lag and TI on the strain of the springs along the body,
      signed by the side they lie on, fit ``>= BEND_FIT`` 0.65 and significant against shuffled positions,
      p ``<= BEND_P`` 0.01, running backward against the motion, ``BEND_BACKWARD``): the two sides of a
@@ -91,10 +94,11 @@ or 2π along the long axis or π across it gave fit ≥ 0.94, lag 2.2–6.3 and 
 concentration threshold could not be calibrated on real protrusion swimmers (none was at hand); it rests
 on the smooth-deformation bounds above and on a synthetic swimmer (two 3-cell appendages on a 19-cell
 blob that sweep and extend as the paper's Fig. 6 describes: 0.86). Hand-built swimmers of known mode
-(studies/locomotion/known_swimmers.py; the confusion matrices are in docs/replication.md) were swum: the
-contrast rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase)
-is still missed by the contraction fit (0.78–0.80, just under WAVE_FIT); on the stroke path
-:func:`bending_wave` finds it (docs/locomotion.md).
+with a passive core (studies/locomotion/known_swimmers.py, ``calibration_set``) were swum: the contrast
+rule and the tail mode come from that calibration set; a bending wave (two sides in antiphase) is
+missed by the contraction fit (0.78–0.80, just under WAVE_FIT); on the stroke path :func:`bending_wave`
+finds it. The stroke path's confusion matrices on swimmers of the paper's kind, labelled by ground
+truths of their motion, are in docs/locomotion.md and docs/replication.md.
 
 The paper's stroke, tested directly
 -----------------------------------
@@ -110,10 +114,12 @@ with its backward velocity along the direction of motion (+1 when it is farthest
 moves backwards fastest: a loop traversed out, back, in, forward; 0 for a purely radial or a purely
 sweeping motion, which are a quarter period apart; −1 for the loop the other way round). The *pair
 score* is the best min(rowing) over two protruding cells on opposite sides of the axis of motion; a
-swim *paddles* when it reaches ``PADDLE_ROWING`` (0.6). On the hand-built swimmers of
-studies/locomotion/known_swimmers.py the whole-body ones (undulators, synchronous contractors) score
-at most 0.49 (docs/replication.md); the hand-built protrusion swimmers do not paddle either (their appendages
-are driven to row but follow it only loosely), so the test has negative controls only.
+swim *paddles* when it reaches ``PADDLE_ROWING`` (0.6). On the hand-built swimmers with a passive core
+(studies/locomotion/known_swimmers.py, ``calibration_set`` and ``held_out_set``) the whole-body ones
+(undulators, synchronous contractors) score at most 0.49 and the protrusion swimmers do not paddle
+either (their appendages are driven to row but follow it only loosely); on the swimmers of the paper's
+kind labelled by ground truths (the stroke path's calibration and held-out sets, docs/replication.md)
+97 of 140 protrusion swims paddle and 1 of 186 whole-body swims. The classifier does not use it.
 
 Statistics (paper §6–§7)
 ------------------------
@@ -213,7 +219,7 @@ WAVE_FIT = 0.8
 WAVE_LAG = math.pi / 2
 #: Minimum travelling index for a wave (excludes standing patterns such as two halves in antiphase).
 WAVE_TI = 0.15
-#: Minimum fit of the bending wave (:func:`bending_wave`, the stroke rule's path only): set in the gap of
+#: Minimum fit of the bending wave (:func:`bending_wave`, the stroke path only): set in the gap of
 #: the calibration swims of studies/locomotion/known_swimmers.py (paper_calibration_set and the second
 #: held-out set, both seen): bending undulators 0.78-0.93, every other non-tail swim at most 0.49.
 BEND_FIT = 0.65
@@ -715,7 +721,7 @@ def classify_motion(
             (:func:`animat.protrusion.stroke_motion`) is measured and decides "protrusions" first.
         rest_positions: (n, 2) the body at rest, where protrusions are also looked for (with ``outline``).
         bending: also accept a bending wave (:func:`bending_wave`) as the wave criterion; default: with
-            ``outline`` (the stroke rule's path), so that the default classifier decides as before.
+            ``outline`` (the stroke path), so that without it the earlier rules decide.
     Returns:
         A :class:`LocomotionMode`.
     """
@@ -935,9 +941,9 @@ def classify_locomotion(
     omega: Optional[float] = None,
     cycles: float = 4,
     every: int = 1,
-    stroke: bool = False,
+    stroke: bool = True,
 ) -> LocomotionMode:
-    """Classify how a swimmer moves: undulation, synchronous contraction, protrusions, other or none.
+    """Classify how a swimmer moves: undulation, synchronous contraction, protrusions, tail, other or none.
 
     See the module docstring for the method and the thresholds.
 
@@ -952,9 +958,12 @@ def classify_locomotion(
             cells' frequencies (the dominant actuation); for a positions array, the deformation spectrum's
             peak.
         cycles: how many of the last periods to analyse (at most the second half of the swim).
-        stroke: also apply the paper's stroke rule (:mod:`animat.protrusion`, needs a body's outline).
-            With it a bending wave (:func:`bending_wave`) also counts as a wave. Off by default until
-            every class meets the held-out target (docs/locomotion.md).
+        stroke: the stroke path (default): also apply the paper's stroke rule (:mod:`animat.protrusion`,
+            measured on the body's outline) and count a bending wave (:func:`bending_wave`) as a wave;
+            every class reaches the held-out target there (docs/locomotion.md). ``False`` gives the earlier
+            rules (no stroke, no bending wave; the strain-contrast rule finds protrusions), for comparison
+            with results classified by them. A positions array has no outline: the earlier rules apply
+            to it either way.
     Returns:
         A :class:`LocomotionMode`.
     """

@@ -52,8 +52,9 @@ in shape during motion". :func:`stroke_motion` asks exactly that of a window of 
    0.16-0.68), while the pair of each of the 110 protrusion swims that stroke stands out at rest.
 
 The thresholds were set on the hand-built swimmers of ``paper_calibration_set`` in
-studies/locomotion/known_swimmers.py (swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; :func:`animat.locomotion.classify_motion`
-uses the rule as its first test for "protrusions" (docs/locomotion.md).
+studies/locomotion/known_swimmers.py (swum 2000 steps at d_N = 0.5 and 2), see :data:`STROKE_SCORE`; given the
+body's outline, :func:`animat.locomotion.classify_motion` uses the rule as its first test for "protrusions":
+the stroke path, which :func:`animat.locomotion.classify_locomotion` takes by default (docs/locomotion.md).
 """
 
 from __future__ import annotations

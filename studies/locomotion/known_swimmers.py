@@ -847,11 +847,12 @@ def classify_known(
     drags: Sequence[float] = (0.5, 2.0),
     steps: int = 2000,
     config: Optional[Any] = None,
-    stroke_rule: bool = False,
+    stroke_rule: bool = True,
 ) -> List[KnownResult]:
     """Swim every swimmer ``steps`` steps at every normal drag (d_T = d_N / 200, the paper's ratio, via the
     config default) and classify the recorded swim with :func:`animat.classify_locomotion`
-    (``stroke_rule``: with the paper's stroke rule, its ``stroke`` argument)."""
+    (``stroke_rule``, its ``stroke`` argument: the stroke path by default, as there; False: the earlier
+    rules)."""
     out = []
     for dn in drags:
         for s in swimmers:

@@ -88,11 +88,13 @@ def test_a_calibration_bending_undulator_is_undulation_with_the_stroke_rule_only
     s = next(s for s in K.calibration_candidates() if s.name == "undulator_bend_fast")
     assert s.name in K.TRUTH_REJECTED and s.name not in CAL
     tr = _swim(s, 0.5)
-    default = L.classify_locomotion(tr)
-    assert default.mode == "other" and default.bend is None  # the default classifier as before (docs/replication.md)
+    earlier = L.classify_locomotion(tr, stroke=False)
+    assert earlier.mode == "other" and earlier.bend is None  # the earlier rules look for no bending wave
     m = L.classify_locomotion(tr, stroke=True)
     assert m.mode == "undulation" and m.bend.is_wave and m.bend.fit >= L.BEND_FIT, m.reason
     assert not m.wave.is_wave  # the cells' contraction alone misses it
+    default = L.classify_locomotion(tr)  # the default classifier is the stroke path
+    assert (default.label, default.reason) == (m.label, m.reason)
 
 
 @pytest.mark.parametrize(

@@ -156,6 +156,8 @@ def test_classify_motion_without_an_outline_has_no_stroke():
     bare = L.classify_motion(tr.positions, tr.times, springs=tr.body.springs, omega=m.omega)
     assert bare.stroke is None and m.stroke is not None
     assert P.protrusion_stroke(tr, m) is m.stroke
+    default = P.protrusion_stroke(tr)  # by the default classifier, the stroke path: the same stroke
+    assert (default.score, default.area, default.pair) == (m.stroke.score, m.stroke.area, m.stroke.pair)
 
 
 def test_the_ground_truth_is_measured_on_the_built_appendages():
