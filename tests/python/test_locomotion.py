@@ -118,6 +118,8 @@ def rigidly_moved(P, t, angle=0.7, spin=0.05, shift=(3.0, -2.0)):
 
 
 # --- classification of synthetic swims ------------------------------------------------------------------
+# Positions arrays carry no outline, so classify_locomotion applies the earlier rules to them (the
+# stroke path needs the body's outline): these tests check the rules both paths share.
 
 
 def test_travelling_contraction_wave_is_undulation_with_its_phase_gradient():
@@ -288,10 +290,13 @@ def real_body_setup():
     return X, c
 
 
+@pytest.mark.parametrize("stroke", [True, False], ids=["stroke_path", "earlier_rules"])
 @pytest.mark.parametrize(
     "pattern,expected", [("sync", "synchronous contraction"), ("ramp", "undulation"), ("halves", "other")]
 )
-def test_real_swims_with_imposed_phases(real_body_setup, pattern, expected):
+def test_real_swims_with_imposed_phases(real_body_setup, pattern, expected, stroke):
+    # The calibration of the module docstring: the default classifier (the stroke path) and the earlier
+    # rules (stroke=False) agree on these whole-body patterns.
     X, config = real_body_setup
     n = len(X)
     x = X[:, 0]
@@ -302,7 +307,7 @@ def test_real_swims_with_imposed_phases(real_body_setup, pattern, expected):
     }[pattern]
     body = animat.build_body(X, np.full(n, 0.2), np.full(n, 8.0), phase)
     tr = animat.replay(body, config)
-    m = L.classify_locomotion(tr)
+    m = L.classify_locomotion(tr, stroke=stroke)
     assert m.omega == pytest.approx(8.0)
     assert m.mode == expected, m.reason
     if pattern == "ramp":
@@ -320,10 +325,10 @@ def test_classify_locomotion_replays_a_genome():
     config = animat.Config()
     config["evaluation.steps"] = 600
     genome = animat.Genome.random(VIABLE_SEEDS[0])
-    m = L.classify_locomotion(genome, config)
+    m = L.classify_locomotion(genome, config)  # the default classifier (the stroke path), of a genome ...
     assert m.mode in L.MODES
     tr = animat.replay(genome, config)
-    again = L.classify_locomotion(tr)
+    again = L.classify_locomotion(tr)  # ... and of its replay
     assert again.mode == m.mode and again.coherence == pytest.approx(m.coherence)
 
 
@@ -456,8 +461,12 @@ def test_replication_report_on_finished_and_partial_runs(tmp_path):
     animat.evolve(c, out=str(runs / "dn10" / "run_0"))  # a run without summary.json ("in progress")
     doc = tmp_path / "docs" / "replication.md"
     report = str(root / "studies" / "replication" / "replication_report.py")
+    # The calibration swims about 500 hand-built swims (minutes): test_replication_report_calibration_section
+    # checks its section on a few.
     out = subprocess.run(
-        [sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"], capture_output=True, text=True
+        [sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif", "--no-calibration"],
+        capture_output=True,
+        text=True,
     )
     assert out.returncode == 0, out.stderr
     text = doc.read_text()
@@ -513,9 +522,29 @@ def test_replication_report_on_finished_and_partial_runs(tmp_path):
         "dn10_run0_phase.png",
     }
     subprocess.run(
-        [sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif"],
+        [sys.executable, report, "--runs", str(runs), "--doc", str(doc), "--no-gif", "--no-calibration"],
         capture_output=True,
         text=True,
         check=True,
     )
     assert doc.read_text() == first
+
+
+def test_replication_report_calibration_section():
+    import replication_report as RR  # studies/replication (conftest.py)
+
+    import known_swimmers as K  # studies/locomotion (conftest.py)
+
+    cal = {s.name: s for s in K.paper_calibration_set()}
+    swum = K.classify_known([cal["paper_single"], cal["synchronous_teardrop"]], drags=(0.5,))
+    assert all(r.mode is not None and r.mode.stroke is not None for r in swum)  # the stroke path by default
+    unstable = K.KnownResult(cal["tail4"], 0.5, 2000, None, 0.0, False)
+    text = "\n".join(RR.calibration_lines({"calibration": swum, "eighth": [unstable]}))
+    assert (
+        "**Calibration sets** (2 bodies × 1 drag, 2 swims): synchronous contraction 1 of 1, protrusions 1 of 1." in text
+    )
+    assert "**Held-out set** (1 body × 1 drag, 1 swim): tail 0 of 1." in text
+    assert "| tail | 0 | 0 | 0 | 0 | 0 | 1 |" in text  # the held-out matrix has the unstable column
+    assert "| eighth | `tail4` | 0.5 | tail | unstable |" in text  # the misses: only the unstable swim
+    assert "| calibration |" not in text
+    assert "; protrusion swimmers " in text and " paddling; tails no pair in any of 0 swims;" in text
