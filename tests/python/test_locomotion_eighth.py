@@ -7,14 +7,9 @@ import pytest
 from animat import locomotion as L
 
 import known_swimmers as K  # studies/locomotion (conftest.py)
+from known_sets import check_classified_as_labelled, swim
 
 EIGHTH = {s.name: s for s in K.paper_eighth_set()}
-
-
-def _swim(swimmer, drag):
-    tr = K.swim_known(swimmer, drag)
-    assert tr.stable
-    return tr
 
 
 def test_the_eighth_set_is_labelled_by_the_ground_truths():
@@ -57,21 +52,13 @@ def test_the_eighth_set_is_labelled_by_the_ground_truths():
     ],
 )
 def test_eighth_held_out_swimmers(name, drag, expected):
-    s = EIGHTH[name]
-    tr = _swim(s, drag)
-    m = L.classify_locomotion(tr, stroke=True)
-    assert m.mode == expected == s.expected, m.reason
-    if s.appendages:
-        assert K.stroke_truth(s, tr).strokes
-    else:
-        u = K.undulation_truth(s, tr) if s.expected in K.WHOLE_BODY else None
-        assert u is None or u.undulates == (expected == "undulation")
+    check_classified_as_labelled(EIGHTH[name], drag, expected)
 
 
 @pytest.mark.xfail(strict=True, reason="eighth-set miss: a three-cell chain pair's contraction fits a wave")
 def test_eighth_chain3_pair_with_a_contraction_wave():
     s = EIGHTH["h8_chain3_a"]
-    tr = _swim(s, 0.5)
+    tr = swim(s, 0.5)
     assert K.stroke_truth(s, tr).strokes
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
@@ -80,7 +67,7 @@ def test_eighth_chain3_pair_with_a_contraction_wave():
 @pytest.mark.parametrize("drag", [0.5, 2.0])
 def test_eighth_block_pair_without_a_pair(drag):
     s = EIGHTH["h8_block2x2_c"]
-    tr = _swim(s, drag)
+    tr = swim(s, drag)
     assert K.stroke_truth(s, tr).strokes
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
@@ -88,6 +75,6 @@ def test_eighth_block_pair_without_a_pair(drag):
 @pytest.mark.xfail(strict=True, reason="eighth-set miss: a wedge's flat-back corners row (0.62, area 0.212)")
 def test_eighth_synchronous_wedge_found_stroking():
     s = EIGHTH["h8_sync_wedge_a"]
-    tr = _swim(s, 0.5)
+    tr = swim(s, 0.5)
     assert not K.undulation_truth(s, tr).undulates
     assert L.classify_locomotion(tr, stroke=True).mode == "synchronous contraction"

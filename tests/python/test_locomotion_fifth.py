@@ -7,14 +7,9 @@ import pytest
 from animat import locomotion as L
 
 import known_swimmers as K  # studies/locomotion (conftest.py)
+from known_sets import check_classified_as_labelled, swim
 
 FIFTH = {s.name: s for s in K.paper_fifth_set()}
-
-
-def _swim(swimmer, drag):
-    tr = K.swim_known(swimmer, drag)
-    assert tr.stable
-    return tr
 
 
 def test_the_fifth_set_is_labelled_by_the_ground_truths():
@@ -45,27 +40,19 @@ def test_the_fifth_set_is_labelled_by_the_ground_truths():
     ],
 )
 def test_fifth_held_out_swimmers(name, drag, expected):
-    s = FIFTH[name]
-    tr = _swim(s, drag)
-    m = L.classify_locomotion(tr, stroke=True)
-    assert m.mode == expected == s.expected, m.reason
-    if s.appendages:
-        assert K.stroke_truth(s, tr).strokes
-    else:
-        u = K.undulation_truth(s, tr) if s.expected in K.WHOLE_BODY else None
-        assert u is None or u.undulates == (expected == "undulation")
+    check_classified_as_labelled(FIFTH[name], drag, expected)
 
 
 @pytest.mark.xfail(strict=True, reason="fifth-set miss: only part of one chain protrudes by the shape, no pair")
 def test_fifth_chain2_pair_without_a_symmetric_pair():
-    tr = _swim(FIFTH["h5_chain2_b"], 0.5)
+    tr = swim(FIFTH["h5_chain2_b"], 0.5)
     assert K.stroke_truth(FIFTH["h5_chain2_b"], tr).strokes
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
 
 def test_fifth_chain3_pair_with_a_small_loop():
     """A miss when the extension ran along the chain's own axis (0.35); across the motion 0.57."""
-    tr = _swim(FIFTH["h5_chain3_d"], 0.5)
+    tr = swim(FIFTH["h5_chain3_d"], 0.5)
     assert K.stroke_truth(FIFTH["h5_chain3_d"], tr).strokes
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
@@ -73,7 +60,7 @@ def test_fifth_chain3_pair_with_a_small_loop():
 def test_fifth_block_pair_found_in_part():
     """The shape finds part of each block (three cells and two); grown by their loops, both are whole."""
     s = FIFTH["h5_block2x2_a"]
-    tr = _swim(s, 0.5)
+    tr = swim(s, 0.5)
     assert K.stroke_truth(s, tr).strokes
     m = L.classify_locomotion(tr, stroke=True)
     assert m.mode == "protrusions", m.reason
@@ -85,6 +72,6 @@ def test_fifth_slightly_lagged_body_is_synchronous():
     """Its displacement travels 1.66-1.81 rad over the body, its cells' contraction 0.03-0.34 rad: the
     paper's synchronous contraction by the truth, as the classifier finds."""
     s = FIFTH["h5_sync_lag"]
-    tr = _swim(s, 2.0)
+    tr = swim(s, 2.0)
     assert not K.undulation_truth(s, tr).undulates
     assert L.classify_locomotion(tr, stroke=True).mode == "synchronous contraction"

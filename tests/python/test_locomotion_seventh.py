@@ -7,14 +7,9 @@ import pytest
 from animat import locomotion as L
 
 import known_swimmers as K  # studies/locomotion (conftest.py)
+from known_sets import check_classified_as_labelled, swim
 
 SEVENTH = {s.name: s for s in K.paper_seventh_set()}
-
-
-def _swim(swimmer, drag):
-    tr = K.swim_known(swimmer, drag)
-    assert tr.stable
-    return tr
 
 
 def test_the_seventh_set_is_labelled_by_the_ground_truths():
@@ -51,21 +46,13 @@ def test_the_seventh_set_is_labelled_by_the_ground_truths():
     ],
 )
 def test_seventh_held_out_swimmers(name, drag, expected):
-    s = SEVENTH[name]
-    tr = _swim(s, drag)
-    m = L.classify_locomotion(tr, stroke=True)
-    assert m.mode == expected == s.expected, m.reason
-    if s.appendages:
-        assert K.stroke_truth(s, tr).strokes
-    else:
-        u = K.undulation_truth(s, tr) if s.expected in K.WHOLE_BODY else None
-        assert u is None or u.undulates == (expected == "undulation")
+    check_classified_as_labelled(SEVENTH[name], drag, expected)
 
 
 def test_seventh_block_grown_to_the_whole_appendage():
     """The shape finds part of each block; grown by their loops, the pair is the two whole blocks."""
     s = SEVENTH["h7_block2x2_h"]
-    tr = _swim(s, 2.0)
+    tr = swim(s, 2.0)
     st = L.classify_locomotion(tr, stroke=True).stroke
     a, b = st.pair
     assert {st.protrusions[a], st.protrusions[b]} == {tuple(g) for g in s.appendages}
@@ -76,7 +63,7 @@ def test_seventh_synchronous_body_whose_corners_row_only_in_motion(name, drag):
     """A pair of the tear-drop's corners rows (0.42-0.65, area 0.16-0.68), but neither corner (or only one)
     stands out at rest: not the paper's protrusions, which are part of the body's shape."""
     s = SEVENTH[name]
-    tr = _swim(s, drag)
+    tr = swim(s, drag)
     assert not K.undulation_truth(s, tr).undulates
     m = L.classify_locomotion(tr, stroke=True)
     assert m.mode == "synchronous contraction", m.reason
@@ -86,6 +73,6 @@ def test_seventh_synchronous_body_whose_corners_row_only_in_motion(name, drag):
 @pytest.mark.xfail(strict=True, reason="calibration miss: a random-phase body's bend runs backward (undulation)")
 def test_seventh_random_phase_body_that_bends():
     s = SEVENTH["h7_standing_random_j"]
-    tr = _swim(s, 0.5)
+    tr = swim(s, 0.5)
     assert not K.undulation_truth(s, tr).undulates  # its cells' contraction: coherence 0.35-0.37 < 0.4
     assert L.classify_locomotion(tr, stroke=True).mode == "other"

@@ -7,14 +7,9 @@ import pytest
 from animat import locomotion as L
 
 import known_swimmers as K  # studies/locomotion (conftest.py)
+from known_sets import check_classified_as_labelled, swim
 
 SIXTH = {s.name: s for s in K.paper_sixth_set()}
-
-
-def _swim(swimmer, drag):
-    tr = K.swim_known(swimmer, drag)
-    assert tr.stable
-    return tr
 
 
 def test_the_sixth_set_is_labelled_by_the_ground_truths():
@@ -47,21 +42,13 @@ def test_the_sixth_set_is_labelled_by_the_ground_truths():
     ],
 )
 def test_sixth_held_out_swimmers(name, drag, expected):
-    s = SIXTH[name]
-    tr = _swim(s, drag)
-    m = L.classify_locomotion(tr, stroke=True)
-    assert m.mode == expected == s.expected, m.reason
-    if s.appendages:
-        assert K.stroke_truth(s, tr).strokes
-    else:
-        u = K.undulation_truth(s, tr) if s.expected in K.WHOLE_BODY else None
-        assert u is None or u.undulates == (expected == "undulation")
+    check_classified_as_labelled(SIXTH[name], drag, expected)
 
 
 def test_sixth_chain3_pair_scoring_low():
     """A miss when the extension ran along the chain's own axis (0.13); across the motion 0.55."""
     s = SIXTH["h6_chain3_b"]
-    tr = _swim(s, 2.0)
+    tr = swim(s, 2.0)
     assert K.stroke_truth(s, tr).strokes
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
@@ -69,7 +56,7 @@ def test_sixth_chain3_pair_scoring_low():
 def test_sixth_block_pair_scoring_backwards():
     """A miss when only part of one block was measured (-0.21); grown to the whole block 0.58."""
     s = SIXTH["h6_block2x2_a"]
-    tr = _swim(s, 2.0)
+    tr = swim(s, 2.0)
     assert K.stroke_truth(s, tr).strokes
     assert L.classify_locomotion(tr, stroke=True).mode == "protrusions"
 
@@ -78,7 +65,7 @@ def test_sixth_synchronous_body_whose_displacement_travels():
     """Its displacement travels 2.25-2.68 rad over the body, its cells' contraction 0.31-0.54 rad: the
     paper's synchronous contraction by the truth, as the classifier finds."""
     s = SIXTH["h6_sync_c"]
-    tr = _swim(s, 0.5)
+    tr = swim(s, 0.5)
     u = K.undulation_truth(s, tr)
     assert not u.undulates and u.lag < K.TRUTH_WAVE_LAG and u.coherence > 0.95
     assert L.classify_locomotion(tr, stroke=True).mode == "synchronous contraction"
@@ -87,7 +74,7 @@ def test_sixth_synchronous_body_whose_displacement_travels():
 def test_sixth_random_phase_body_is_other():
     """Its displacement travels coherently (0.63-0.68), its cells' contraction does not (0.36)."""
     s = SIXTH["h6_standing_random_b"]
-    tr = _swim(s, 2.0)
+    tr = swim(s, 2.0)
     u = K.undulation_truth(s, tr)
     assert not u.undulates and u.coherence < K.TRUTH_WAVE_COHERENCE
     assert L.classify_locomotion(tr, stroke=True).mode == "other"
