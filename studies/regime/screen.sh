@@ -12,7 +12,8 @@
 # guard, evaluation.reference_check: "record" by default; "select" adds "_select" to the names);
 # SCREEN_SUBSTEPS (physics.substeps, the step's refinement: 1 by default; N > 1 adds "_sN");
 # SCREEN_REPEATS (evaluation.repeats: 1 by default; K > 1 adds "_rK") and SCREEN_STATISTIC
-# (evaluation.repeat_statistic: mean by default; min adds "_min").
+# (evaluation.repeat_statistic: mean by default; min adds "_min"); SCREEN_FREQUENCY_MAX
+# (development.frequency_max: 6 by default; F adds "_fF").
 # Growth: "paper" (any cell divides along its orientation), "tipsN" (a cell divides only while it
 # touches at most N cells, its daughter placed outward: development.division_max_contacts = N,
 # development.division_axis = "outward"). Run names carry the growth unless it is "paper".
@@ -26,6 +27,7 @@ GUARD=${SCREEN_GUARD:-record}
 SUBSTEPS=${SCREEN_SUBSTEPS:-1}
 REPEATS=${SCREEN_REPEATS:-1}
 STATISTIC=${SCREEN_STATISTIC:-mean}
+FREQUENCY_MAX=${SCREEN_FREQUENCY_MAX:-6}
 DAMPING=${SCREEN_DAMPING:-"4 1 0.25"}
 STIFFNESS=${SCREEN_STIFFNESS:-"100 30"}
 SEEDS=${SCREEN_SEEDS:-"1 2"}
@@ -53,15 +55,17 @@ one() {  # env growth damping stiffness seed
   [[ "$SUBSTEPS" == 1 ]] || name="${name%_seed*}_s${SUBSTEPS}_seed${seed}"
   [[ "$REPEATS" == 1 ]] || name="${name%_seed*}_r${REPEATS}_seed${seed}"
   [[ "$STATISTIC" == mean ]] || name="${name%_seed*}_${STATISTIC}_seed${seed}"
+  [[ "$FREQUENCY_MAX" == 6 ]] || name="${name%_seed*}_f${FREQUENCY_MAX}_seed${seed}"
   [[ -f "$KEEP/$name/best_genome.json" ]] && return 0
   evolve_kept "$name" "$KEEP/$name" "$WORK/$name" "$GENS" final \
     --config "configs/paper_${env}.toml" --set "evolution.population=$POP" \
     --set "scene.spring_damping=$c" --set "scene.spring_stiffness=$k" "${grow[@]}" "${guard[@]}" \
     --set "physics.substeps=$SUBSTEPS" --set "evaluation.repeats=$REPEATS" \
-    --set "evaluation.repeat_statistic=$STATISTIC" --seed "$seed"
+    --set "evaluation.repeat_statistic=$STATISTIC" \
+    --set "development.frequency_max=$FREQUENCY_MAX" --seed "$seed"
 }
 export -f one evolve_kept
-export EXE POP GENS KEEP WORK GUARD SUBSTEPS REPEATS STATISTIC
+export EXE POP GENS KEEP WORK GUARD SUBSTEPS REPEATS STATISTIC FREQUENCY_MAX
 points=()
 for env in $ENVS; do for g in $GROWTH; do for c in $DAMPING; do for k in $STIFFNESS; do
   for s in $SEEDS; do points+=("$env $g $c $k $s"); done

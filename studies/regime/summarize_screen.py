@@ -28,7 +28,7 @@ OUT_MD = ROOT / "studies" / "regime" / "screen.md"
 
 
 def point_of(folder: Path, config) -> tuple:
-    """(environment, growth, guard, substeps, repeats, damping, stiffness, seed) of a run kept by
+    """(environment, growth, guard, substeps, repeats, damping, stiffness, frequency_max, seed) of a run kept by
     screen.sh: the environment and seed from its name, the rest from its config. repeats is "1", or
     "K mean" / "K min" (evaluation.repeats and repeat_statistic)."""
     parts = folder.name.split("_")
@@ -42,6 +42,7 @@ def point_of(folder: Path, config) -> tuple:
         repeats_of(config),
         config.scene.spring_damping,
         config.scene.spring_stiffness,
+        config.development.frequency_max,
         int(parts[-1][4:]),
     )
 
@@ -57,7 +58,7 @@ def summarise_run(folder: Path) -> dict:
     genome = animat.Genome.from_json(json.dumps(entry["genome"]))
     with open(folder / "history.csv") as fh:
         last = list(csv.DictReader(fh))[-1]
-    env, growth, guard, substeps, repeats, c, k, seed = point_of(folder, config)
+    env, growth, guard, substeps, repeats, c, k, f, seed = point_of(folder, config)
     row = {
         "environment": env,
         "growth": growth,
@@ -66,6 +67,7 @@ def summarise_run(folder: Path) -> dict:
         "repeats": repeats,
         "spring_damping": c,
         "spring_stiffness": k,
+        "frequency_max": f,
         "seed": seed,
         "generations": int(last["generation"]),
         "best_reference": float(last["best_reference"]),
@@ -105,9 +107,10 @@ def main() -> int:
         "`studies/regime/results/screen.csv`. Medians over the seeds of each point; the criteria are those",
         "of `docs/regime.md`.",
         "",
-        "| environment | growth | guard | substeps | repeats | damping | stiffness | runs | generations | distance | reference error (max) | fluid share | "
-        "at frequency bound | median frequency | elongation | protrusions | symmetric pair | modes |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| environment | growth | guard | substeps | repeats | damping | stiffness | frequency max | runs | generations | distance | "
+        "reference error (max) | fluid share | at frequency bound | median frequency | elongation | protrusions | "
+        "symmetric pair | modes |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     point = lambda r: (  # noqa: E731
         r["environment"],
@@ -117,14 +120,18 @@ def main() -> int:
         r["repeats"],
         r["spring_damping"],
         r["spring_stiffness"],
+        r["frequency_max"],
     )
-    points = sorted({point(r) for r in rows}, key=lambda p: (float(p[0][2:]), p[1], p[2], p[3], p[4], -p[5], -p[6]))
-    for env, growth, guard, substeps, repeats, c, k in points:
-        sel = [r for r in rows if point(r) == (env, growth, guard, substeps, repeats, c, k)]
+    points = sorted(
+        {point(r) for r in rows}, key=lambda p: (float(p[0][2:]), p[1], p[2], p[3], p[4], -p[5], -p[6], p[7])
+    )
+    for env, growth, guard, substeps, repeats, c, k, f in points:
+        sel = [r for r in rows if point(r) == (env, growth, guard, substeps, repeats, c, k, f)]
         med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731, B023 (used in this iteration)
         modes = ", ".join(f"{m} {sum(r['mode'] == m for r in sel)}" for m in sorted({r["mode"] for r in sel}))
         lines.append(
-            f"| {env} | {growth} | {guard} | {substeps} | {repeats} | {c:g} | {k:g} | {len(sel)} | {min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
+            f"| {env} | {growth} | {guard} | {substeps} | {repeats} | {c:g} | {k:g} | {f:g} | {len(sel)} | "
+            f"{min(r['generations'] for r in sel)} | {med('fitness'):.1f} | "
             f"{max(abs(r['reference_error']) for r in sel):.2%} | {med('fluid_share'):.2f} | "
             f"{sum(r['at_frequency_bound'] >= 0.5 for r in sel)} of {len(sel)} | {med('frequency_median'):.2f} | "
             f"{med('elongation'):.2f} | {med('protrusions'):.0f} | {sum(r['symmetric_pair'] for r in sel)} of {len(sel)} | "
