@@ -223,6 +223,19 @@ TEST(CliErrors, UnknownConfigNameListsThePackagedOnes) {
   EXPECT_EQ(r.out, "");
 }
 
+TEST(Cli, PackagedConfigsWithADotInTheirNameResolveByName) {
+  // Run from the scratch directory, where no such file exists: the packaged configs answer.
+  for (const auto& [name, drag] : {std::pair<std::string, std::string>{"paper_dn0.5", "0.5"},
+                                   {"paper_dn0.2_64cells", "0.2"},
+                                   {"regime_dn0.5", "0.5"}}) {
+    const Result r = run("--print-config --config " + name);
+    ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
+    EXPECT_CONTAINS(r.out, "drag_normal = " + drag);
+  }
+  const Result r = run("--print-config --config paper_dn11");
+  EXPECT_CONTAINS(r.err, "paper_dn0.2_64cells, paper_dn0.5, paper_dn10");
+}
+
 TEST(CliErrors, UnknownOption) {
   const Result r = run("--print-config --bogus-option");
   EXPECT_NE(r.exit_code, 0);
