@@ -1,6 +1,6 @@
-"""Classifies evolved bests with the classifier's stroke path (issue #31, docs/locomotion.md):
-``animat.classify_locomotion(genome, config, stroke=True)`` next to the default classifier (the earlier
-rules, named explicitly: ``stroke=False``), for
+"""Classifies evolved bests with the classifier's stroke path (its default, docs/locomotion.md):
+``animat.classify_locomotion(genome, config, stroke=True)`` next to the earlier rules
+(``stroke=False``; the CSV's ``default_label``, the classifier's default before the stroke path), for
 
 - ``replication``: the final best of every run of the replication study kept in ``data/replication``
   (``<env>/run_<i>/``: its ``config.toml`` and the last ``best/gen_*.json`` of ``best.tar.gz``, the
@@ -41,7 +41,7 @@ from animat import locomotion as L
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies" / "replication"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from summarize_screen import point_of, repeats_of  # noqa: E402
+from summarize_screen import drag_of, point_of, repeats_of  # noqa: E402
 
 import replication_stats as RS  # noqa: E402
 
@@ -83,6 +83,7 @@ class Best:
     growth: str  # "paper" or "tips<N>" (development.division_max_contacts)
     damping: float
     stiffness: float
+    frequency_max: float
     repeats: str  # "1" or "K mean" / "K min"
     seed: int
     fitness: float
@@ -103,6 +104,7 @@ def _best(source: str, run: str, env: str, seed: int, fitness: float, genome_jso
         growth=growth_of(config),
         damping=float(config.scene.spring_damping),
         stiffness=float(config.scene.spring_stiffness),
+        frequency_max=float(config.development.frequency_max),
         repeats=repeats_of(config),
         seed=seed,
         fitness=float(fitness),
@@ -152,7 +154,7 @@ def screen_best(folder: Path) -> Best:
     """The final best kept by the calibration screen in ``folder`` (best_genome.json, config.toml)."""
     config = animat.load_config(str(folder / "config.toml"))
     entry = json.loads((folder / "best_genome.json").read_text())
-    env, _growth, _guard, _substeps, _repeats, _c, _k, seed = point_of(folder, config)
+    env, _growth, _guard, _substeps, _repeats, _c, _k, _f, seed = point_of(folder, config)
     return _best("screen", folder.name, env, seed, entry["fitness"], entry["genome"], config)
 
 
@@ -204,12 +206,11 @@ def _num(x: Optional[float]) -> float:
 
 
 def classify_best(best: Best) -> Dict[str, Any]:
-    """The CSV row of one best: where it comes from, the default label (the earlier rules,
+    """The CSV row of one best: where it comes from, the earlier rules' label (default_label,
     ``classify_locomotion(genome, config, stroke=False)``), the stroke path's label (``stroke=True``) and
     the stroke path's numbers: the best symmetric pair's score and (smaller) loop area, whether it strokes, the
     protrusions and pairs found, the contraction wave and the bending wave."""
-    # The earlier rules, named explicitly: "default" is what classify_locomotion did before the stroke
-    # path (the column keeps its name), whatever its default is now.
+    # The earlier rules, named explicitly (the CSV column keeps the name default_label).
     default = animat.classify_locomotion(best.genome, best.config, stroke=False)
     mode = animat.classify_locomotion(best.genome, best.config, stroke=True)
     s = mode.stroke
@@ -222,6 +223,7 @@ def classify_best(best: Best) -> Dict[str, Any]:
         "growth": best.growth,
         "damping": best.damping,
         "stiffness": best.stiffness,
+        "frequency_max": best.frequency_max,
         "repeats": best.repeats,
         "seed": best.seed,
         "fitness": best.fitness,
@@ -305,11 +307,11 @@ def replication_lines(rows: Sequence[Dict[str, Any]]) -> List[str]:
     out = [
         "### Replication: modes per environment",
         "",
-        "Main mode (a mixed best counts under its main mode): the stroke path / the default classifier / "
+        "Main mode (a mixed best counts under its main mode): the stroke path / the earlier rules / "
         'the paper (of 10; "?" where its words give no main-mode count). "any": bests with the mode as main '
         "mode or mixed in.",
         "",
-        "| mode | " + " | ".join(f"`{e}` (of {len(stroke[e])}): stroke / default / paper" for e in envs) + " |",
+        "| mode | " + " | ".join(f"`{e}` (of {len(stroke[e])}): stroke / earlier / paper" for e in envs) + " |",
         "| --- | " + " | ".join("---" for _ in envs) + " |",
     ]
     used = [
@@ -338,7 +340,7 @@ def replication_lines(rows: Sequence[Dict[str, Any]]) -> List[str]:
     out.append("Stroke labels per run: " + "; ".join(f"`{e}` {_counts(stroke[e])}" for e in envs) + ".")
     out.append("")
     drag = [e for e in envs if e in ("dn0.5", "dn2", "dn10")]
-    for name, labels in (("stroke path", stroke), ("default classifier", default)):
+    for name, labels in (("stroke path", stroke), ("earlier rules", default)):
         if len(drag) >= 2:
             out.append(
                 f"{name}: " + fisher_line("drag over the three 32-cell environments", {e: labels[e] for e in drag})
@@ -351,7 +353,16 @@ def replication_lines(rows: Sequence[Dict[str, Any]]) -> List[str]:
 
 
 def screen_key(r: Dict[str, Any], guard: str, substeps: int) -> Tuple:
-    return (r["environment"], r["growth"], guard, substeps, r["repeats"], float(r["damping"]), float(r["stiffness"]))
+    return (
+        r["environment"],
+        r["growth"],
+        guard,
+        substeps,
+        r["repeats"],
+        float(r["damping"]),
+        float(r["stiffness"]),
+        float(r["frequency_max"]),
+    )
 
 
 def screen_lines(rows: Sequence[Dict[str, Any]], points: Dict[str, Tuple[str, int]]) -> List[str]:
@@ -360,27 +371,35 @@ def screen_lines(rows: Sequence[Dict[str, Any]], points: Dict[str, Tuple[str, in
     if not rows:
         return []
     key = {r["run"]: screen_key(r, *points[r["run"]]) for r in rows}
-    grid = sorted(set(key.values()), key=lambda p: (float(p[0][2:]), p[1], p[2], p[3], p[4], -p[5], -p[6]))
+    grid = sorted(set(key.values()), key=lambda p: (drag_of(p[0]), p[1], p[2], p[3], p[4], -p[5], -p[6], p[7]))
     out = [
         "### Screen: modes per grid point",
         "",
-        "| environment | growth | guard | substeps | repeats | damping | stiffness | runs | stroke path | "
-        "default classifier |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| environment | growth | guard | substeps | repeats | damping | stiffness | frequency max | runs | stroke path | "
+        "earlier rules |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for p in grid:
         sel = [r for r in rows if key[r["run"]] == p]
-        env, growth, guard, substeps, repeats, c, k = p
+        env, growth, guard, substeps, repeats, c, k, f = p
         out.append(
-            f"| {env} | {growth} | {guard} | {substeps} | {repeats} | {c:g} | {k:g} | {len(sel)} | "
+            f"| {env} | {growth} | {guard} | {substeps} | {repeats} | {c:g} | {k:g} | {f:g} | {len(sel)} | "
             f"{_counts([r['stroke_label'] for r in sel])} | {_counts([r['default_label'] for r in sel])} |"
         )
     out.append("")
-    base = [r for r in rows if points[r["run"]] == ("record", 1) and r["repeats"] == "1"]
-    envs = sorted({r["environment"] for r in base}, key=lambda e: float(e[2:]))
+    base = [
+        r
+        for r in rows
+        if points[r["run"]] == ("record", 1)
+        and r["repeats"] == "1"
+        and float(r["stiffness"]) == 100
+        and float(r["frequency_max"]) == 6
+    ]
+    envs = sorted({r["environment"] for r in base}, key=drag_of)
     growths = sorted({r["growth"] for r in base})
     out.append(
-        "Pooled over the damping values at the base settings (guard record, substeps 1, repeats 1): mode against "
+        "Pooled over the damping values at the base settings (guard record, substeps 1, repeats 1, stiffness 100, "
+        "frequencies up to 6): mode against "
         "drag per growth rule (the drags run at all of the rule's damping values), mode against growth per drag "
         "(the damping values both rules were run at):"
     )
@@ -429,7 +448,7 @@ def search_lines(rows: Sequence[Dict[str, Any]]) -> List[str]:
     out = [
         "### Search comparison: modes of each run's best",
         "",
-        "| run | fitness | stroke path | default classifier | pair score | pair area |",
+        "| run | fitness | stroke path | earlier rules | pair score | pair area |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for r in rows:
@@ -442,12 +461,12 @@ def search_lines(rows: Sequence[Dict[str, Any]]) -> List[str]:
 
 
 def transition_lines(rows: Sequence[Dict[str, Any]]) -> List[str]:
-    """Main mode by the default classifier (rows) against the stroke path (columns), over all bests."""
+    """Main mode by the earlier rules (rows) against the stroke path (columns), over all bests."""
     modes = [m for m in L.MODES if any(main_mode(r[k]) == m for r in rows for k in ("default_label", "stroke_label"))]
     out = [
-        f"### Default classifier (rows) against the stroke path (columns), main modes, all {len(rows)} bests",
+        f"### The earlier rules (rows) against the stroke path (columns), main modes, all {len(rows)} bests",
         "",
-        "| default \\ stroke | " + " | ".join(modes) + " |",
+        "| earlier \\ stroke | " + " | ".join(modes) + " |",
         "| --- | " + " | ".join("---" for _ in modes) + " |",
     ]
     for a in modes:

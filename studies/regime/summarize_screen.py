@@ -32,10 +32,11 @@ def point_of(folder: Path, config) -> tuple:
     screen.sh: the environment and seed from its name, the rest from its config. repeats is "1", or
     "K mean" / "K min" (evaluation.repeats and repeat_statistic)."""
     parts = folder.name.split("_")
+    env = "_".join(parts[:2]) if parts[1] == "64cells" else parts[0]
     contacts = config.development.division_max_contacts
     growth = f"tips{contacts}" if contacts > 0 else "paper"
     return (
-        parts[0],
+        env,
         growth,
         config.evaluation.reference_check,
         config.physics.substeps,
@@ -45,6 +46,11 @@ def point_of(folder: Path, config) -> tuple:
         config.development.frequency_max,
         int(parts[-1][4:]),
     )
+
+
+def drag_of(env: str) -> float:
+    """d_N of an environment's name: "dn0.5" -> 0.5, "dn0.2_64cells" -> 0.2."""
+    return float(env[2:].split("_")[0])
 
 
 def repeats_of(config) -> str:
@@ -122,9 +128,7 @@ def main() -> int:
         r["spring_stiffness"],
         r["frequency_max"],
     )
-    points = sorted(
-        {point(r) for r in rows}, key=lambda p: (float(p[0][2:]), p[1], p[2], p[3], p[4], -p[5], -p[6], p[7])
-    )
+    points = sorted({point(r) for r in rows}, key=lambda p: (drag_of(p[0]), p[1], p[2], p[3], p[4], -p[5], -p[6], p[7]))
     for env, growth, guard, substeps, repeats, c, k, f in points:
         sel = [r for r in rows if point(r) == (env, growth, guard, substeps, repeats, c, k, f)]
         med = lambda key: statistics.median(r[key] for r in sel)  # noqa: E731, B023 (used in this iteration)

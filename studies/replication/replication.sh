@@ -24,6 +24,12 @@
 # next-cap), so that a short session leaves the runs at comparable lengths instead of finishing the
 # first few. Default 0: every run straight to the cap. (With an INDEX, the rounds stop as soon as the
 # least advanced run is one outside it.)
+# ANIMAT_REPLICATION_PRESET=regime grows the same study at the regime presets (configs/regime_<env>.toml,
+# docs/regime.md) instead of the paper's environments (configs/paper_<env>.toml, the default "paper"),
+# in the environments the preset has (regime: the three 32-cell ones); give it its own
+# ANIMAT_REPLICATION_DATA, _OUT, _DOC and _IMAGES (the page's figures, default docs/images/replication).
+# The paper's discussion (docs/notes/replication_discussion.md) and the controlled runs' section are
+# written for the paper preset only.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 HERE=studies/replication
@@ -34,6 +40,13 @@ DATA=${ANIMAT_REPLICATION_DATA:-data/replication}
 WORK=${ANIMAT_REPLICATION_OUT:-runs/replication}
 PARALLEL=${ANIMAT_REPLICATION_PARALLEL:-$(nproc)}
 DOC=${ANIMAT_REPLICATION_DOC:-docs/replication.md}
+PRESET=${ANIMAT_REPLICATION_PRESET:-paper}
+IMAGES=${ANIMAT_REPLICATION_IMAGES:-docs/images/replication}
+ENVS=()
+for env in dn0.5 dn2 dn10 dn0.2_64cells; do
+  [[ -f "configs/${PRESET}_${env}.toml" ]] && ENVS+=("$env")
+done
+(( ${#ENVS[@]} > 0 )) || { echo "replication: no configs/${PRESET}_<env>.toml" >&2; exit 2; }
 PY_PATH=${ANIMAT_PYTHONPATH:-build/python}
 if [[ -z "${ANIMAT_PYTHONPATH:-}" ]]; then
   scripts/setup.sh
@@ -49,7 +62,6 @@ git rev-parse HEAD > "$WORK/commit.txt" 2>/dev/null || true
 rm -f "$WORK"/*/summary.json  # stop reasons of this session only (an --index session writes none)
 : > "$WORK/experiment.log"
 ROUND=${ANIMAT_REPLICATION_ROUND:-0}
-ENVS=(dn0.5 dn2 dn10 dn0.2_64cells)
 START=$SECONDS
 # One call of the runner up to generation cap $1, within what is left of the session's budget.
 # --wall-seconds 0: no cumulative budget (evolution.wall_seconds counts over resumes); the session's
@@ -57,9 +69,9 @@ START=$SECONDS
 experiment() {
   local left=$(( SESSION - (SECONDS - START) ))
   (( left > 0 )) || return 124
-  timeout -s INT "$left" "${PY[@]}" -m animat experiment \
-    dn0.5=configs/paper_dn0.5.toml dn2=configs/paper_dn2.toml dn10=configs/paper_dn10.toml \
-    dn0.2_64cells=configs/paper_dn0.2_64cells.toml \
+  local env configs=()
+  for env in "${ENVS[@]}"; do configs+=("$env=configs/${PRESET}_${env}.toml"); done
+  timeout -s INT "$left" "${PY[@]}" -m animat experiment "${configs[@]}" \
     --runs "$RUNS" --parallel "$PARALLEL" --threads "$PARALLEL" --generations "$1" --wall-seconds 0 \
     "${INDEX_ARGS[@]}" --out "$WORK" >> "$WORK/experiment.log" 2>&1
 }
@@ -83,7 +95,11 @@ if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then
 fi
 "${PY[@]}" "$HERE/replication_store.py" pack "$WORK" "$DATA"
 CAUSES=${ANIMAT_REPLICATION_CAUSES:-data/replication_causes}  # the controlled runs, packed; their section if present
-CAUSE_ARGS=()
-[[ -d "$CAUSES" ]] && CAUSE_ARGS=(--causes "$CAUSES")
-"${PY[@]}" "$HERE/replication_report.py" --data "$DATA" --doc "$DOC" "${CAUSE_ARGS[@]}"
+REPORT_ARGS=(--images "$IMAGES")
+if [[ "$PRESET" == paper ]]; then
+  [[ -d "$CAUSES" ]] && REPORT_ARGS+=(--causes "$CAUSES")
+else
+  REPORT_ARGS+=(--discussion "$WORK/no_discussion.md")  # a file that does not exist: no discussion
+fi
+"${PY[@]}" "$HERE/replication_report.py" --data "$DATA" --doc "$DOC" "${REPORT_ARGS[@]}"
 if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then exit 1; fi

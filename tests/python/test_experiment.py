@@ -38,6 +38,15 @@ def test_paper_configs_hold_the_paper_settings(name, dn, cells):
     assert c["development.steps"] == 400
 
 
+@pytest.mark.parametrize("env", ["dn0.5", "dn2", "dn10"])
+def test_regime_presets_are_the_paper_environments_with_their_two_values(env):
+    paper = animat.load_config(str(ROOT / "configs" / f"paper_{env}.toml"))
+    regime = animat.load_config(str(ROOT / "configs" / f"regime_{env}.toml"))
+    changed = {key: regime[key] for key in paper.keys() if regime[key] != paper[key]}
+    assert changed == {"scene.spring_damping": 0.25, "evaluation.reference_check": "select"}
+    assert paper["scene.spring_damping"] == 4.0 and paper["evaluation.reference_check"] == "record"
+
+
 def test_experiment_runs_seeds_resumes_and_summarises(tmp_path):
     cfg = tmp_path / "tiny.toml"
     cfg.write_text(TINY)

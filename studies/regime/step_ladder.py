@@ -1,0 +1,78 @@
+"""Does a screen best's fitness converge as the step shrinks? Each final best kept by the calibration
+screen (studies/regime/screen/<run>/, its config.toml and best_genome.json) is swum again with its own
+config at physics.substeps 1, 2, 4, 16 and 32 (dt to dt/32, the same simulated time), and every
+fitness is compared with the one at dt/32. A smooth swim's error shrinks steadily; a chaotic one
+wanders (docs/regime.md, "The gap is not the step's").
+
+    PYTHONPATH=build/python .venv/bin/python studies/regime/step_ladder.py \\
+        --only 'dn*_c0.25_k100_seed*' 'dn*_tips2_c0.25_k100_seed*' 'dn*_c0.25_k100_f12_seed*'
+
+Writes studies/regime/results/step_ladder.csv (one row per best: run, fitness at each step, error
+at each step against dt/32) and prints a markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import fnmatch
+import json
+import sys
+from pathlib import Path
+
+import animat
+
+ROOT = Path(__file__).resolve().parents[2]
+SCREEN = ROOT / "studies" / "regime" / "screen"
+OUT = ROOT / "studies" / "regime" / "results" / "step_ladder.csv"
+SUBSTEPS = (1, 2, 4, 16, 32)
+
+
+def ladder(folder: Path) -> list:
+    """The best's fitness at each of SUBSTEPS (its config otherwise)."""
+    entry = json.loads((folder / "best_genome.json").read_text())
+    genome = animat.Genome.from_json(json.dumps(entry["genome"]))
+    out = []
+    for s in SUBSTEPS:
+        config = animat.load_config(str(folder / "config.toml"))
+        config.physics.substeps = config.physics.substeps * s
+        out.append(float(animat.evaluate(genome, config).fitness))
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
+    p.add_argument("--only", nargs="+", required=True, metavar="GLOB", help="screen runs to swim (folder names)")
+    p.add_argument("--out", type=Path, default=OUT)
+    args = p.parse_args(argv)
+    runs = [
+        f
+        for f in sorted(SCREEN.iterdir())
+        if (f / "best_genome.json").is_file() and any(fnmatch.fnmatch(f.name, g) for g in args.only)
+    ]
+    if not runs:
+        print(f"step_ladder: no kept run matches {args.only}", file=sys.stderr)
+        return 1
+    header = ["run"] + [f"fitness_s{s}" for s in SUBSTEPS] + [f"error_s{s}" for s in SUBSTEPS[:-1]]
+    lines = [
+        "| run | " + " | ".join(f"dt/{s}" if s > 1 else "dt" for s in SUBSTEPS[:-1]) + " | fitness at dt/32 |",
+        "| --- | " + " | ".join("---" for _ in SUBSTEPS) + " |",
+    ]
+    rows = []
+    for f in runs:
+        fit = ladder(f)
+        ref = fit[-1]
+        err = [x / ref - 1 for x in fit[:-1]]
+        rows.append([f.name] + [f"{x:.9g}" for x in fit] + [f"{e:.6g}" for e in err])
+        lines.append(f"| {f.name} | " + " | ".join(f"{e:+.2%}" for e in err) + f" | {ref:.2f} |")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    with open(args.out, "w", newline="") as fh:
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(header)
+        w.writerows(rows)
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
