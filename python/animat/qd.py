@@ -267,7 +267,7 @@ DESCRIPTORS: Dict[str, Descriptor] = {
             0,
             6,
             _locomotion_index,
-            "`animat.classify_locomotion(genome, config).mode` (replays the swim: one more evaluation)",
+            "`animat.classify_locomotion(genome, config).mode` (replays the swim and classifies it: about 12 evaluations)",
         ),
         _table_entry(
             "fitness",
