@@ -378,11 +378,12 @@ def test_a_gzip_bomb_is_refused_at_the_size_limit_in_bounded_memory(tmp_path, mo
     assert not (tmp_path / "work" / "dn2" / "run_0").exists()
 
 
-def test_every_committed_packed_run_has_a_manifest_and_unpacks_verified(tmp_path):
-    runs = [p for group in R.packed_runs(ROOT / "data" / "replication").values() for p in group]
-    assert len(runs) >= 40
+@pytest.mark.parametrize("study,count", [("replication", 40), ("replication_regime", 30)])
+def test_every_committed_packed_run_has_a_manifest_and_unpacks_verified(tmp_path, study, count):
+    runs = [p for group in R.packed_runs(ROOT / "data" / study).values() for p in group]
+    assert len(runs) >= count
     assert [p for p in runs if not (p / R.MANIFEST).is_file()] == []
-    done = R.unpack_tree(ROOT / "data" / "replication", tmp_path)
+    done = R.unpack_tree(ROOT / "data" / study, tmp_path)
     assert len(done) == len(runs)
     for p in runs:
         target = tmp_path / p.parent.name / p.name
