@@ -534,6 +534,25 @@ void validate(const Config& config, std::string_view source) {
   }
   // [islands]
   if (const std::string e = island_config_error(config.evolution); !e.empty()) fail(e);
+  // [search]: the names are checked by the Python tables that own them (animat.qd, animat.moo)
+  const SearchParams& search = config.search;
+  for (const auto& [key, list] : {std::pair{"descriptors", &search.descriptors},
+                                  std::pair{"objectives", &search.objectives}}) {
+    if (list->empty()) fail(fmt::format("search.{} = []: name at least one", key));
+    for (const auto& name : *list)
+      if (name.empty() || name.find_first_of(" \t\n,") != std::string::npos)
+        fail(fmt::format("search.{} = {}: entry {} is not a name", key, format_value(*list),
+                         quote(name)));
+  }
+  if (search.bins.size() != 1 && search.bins.size() != search.descriptors.size())
+    fail(fmt::format(
+        "search.bins = {}: give one count for every descriptor or one for each of the {} of "
+        "search.descriptors = {}",
+        format_value(search.bins), search.descriptors.size(), format_value(search.descriptors)));
+  for (double b : search.bins)
+    if (b != std::floor(b))
+      fail(fmt::format("search.bins = {}: entry {} is not a whole number",
+                       format_value(search.bins), format_double(b)));
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}",
                      config.development.min_cells, config.development.max_cells));

@@ -495,6 +495,7 @@ namespace {
 RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
                                    FitnessFunction fitness, FitnessFunction reference) {
   validate(config);
+  require_ga(config);
   if (!fitness) {
     // the real swim: its exploit guard re-evaluates each new best at the reference step
     fitness = swim_fitness(config);
@@ -734,6 +735,15 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
 }  // namespace
 
 const std::vector<std::string>& run_file_names() { return kRunFiles; }
+
+void require_ga(const Config& config) {
+  if (config.search.algorithm != "ga")
+    throw ConfigError(fmt::format(
+        "search.algorithm = \"{}\": this runs the GA; MAP-Elites and NSGA-II run in Python: "
+        "`animat evolve` with the same flags (python -m animat evolve), or animat.run_{} "
+        "(docs/search.md)",
+        config.search.algorithm, config.search.algorithm));
+}
 
 RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness,
                          FitnessFunction reference) {

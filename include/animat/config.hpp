@@ -17,6 +17,7 @@
 #include "animat/grn.hpp"
 #include "animat/physics.hpp"
 #include "animat/scene.hpp"
+#include "animat/search_params.hpp"
 
 namespace animat {
 
@@ -31,6 +32,7 @@ struct Config {
   EvaluationParams evaluation;
   EvolutionParams evolution;
   ControlParams control;
+  SearchParams search;
 };
 
 /// Calls v(section_name, params) for every section, in TOML order.
@@ -45,7 +47,8 @@ void visit_sections(C& c, V&& v) {
   v("physics", c.physics);
   v("evaluation", c.evaluation);
   v("evolution", c.evolution);
-  v("control", c.control);  // last: a run at the defaults hashes as before [control] existed
+  v("control", c.control);  // after the GA's sections: a run at the defaults hashes as before
+  v("search", c.search);    // [control] and [search] existed (their keys are late)
 }
 
 /// A config value, as seen by --set and the Python dict view.

@@ -73,4 +73,9 @@ struct RunSummary {
 RunSummary run_evolution(const Config& config, const RunOptions& options,
                          FitnessFunction fitness = {}, FitnessFunction reference = {});
 
+/// Throws ConfigError unless config.search.algorithm is "ga": run_evolution runs the GA, and a run
+/// directory's config.toml must say which search made it (MAP-Elites and NSGA-II are animat.qd and
+/// animat.moo, run by `animat evolve`).
+void require_ga(const Config& config);
+
 }  // namespace animat

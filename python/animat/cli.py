@@ -1,6 +1,7 @@
 """``animat`` (or ``python -m animat``): evolve, and the paper's figures and an animation of a run's best swimmer.
 
-    animat evolve [animat_evolve's flags]   # the engine, flags and output of animat_evolve
+    animat evolve [animat_evolve's flags]   # the config's search: the GA (animat_evolve), or with
+                                        #   search.algorithm = "map_elites" / "nsga2" those, same flags
     python -m animat show RUN_DIR       # figures/ development, construction, motion_cycle, phase_map, fitness_history
                                         #   (+ stiffness_map for a body with evolved stiffness)
     python -m animat animate RUN_DIR    # figures/best.gif
@@ -10,6 +11,7 @@
     mpirun -np R python -m animat experiment NAME=CONFIG ... --runs N --out DIR --mpi   # a study over MPI ranks
     python -m animat map-elites CONFIG --out DIR [--descriptors NAME,NAME] [--bins B,B] [--mpi]   # MAP-Elites
     python -m animat nsga2 CONFIG --out DIR [--objectives NAME:max,NAME:min] [--mpi]   # NSGA-II
+        (their options set search.descriptors, search.bins and search.objectives; OUT holding a run resumes it)
 
 Every command exits with status 1 and a one-line message for a missing or malformed run directory.
 """
@@ -17,10 +19,11 @@ Every command exits with status 1 and a one-line message for a missing or malfor
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
-from typing import List, Optional
+from typing import List, Optional, Sequence
 
 from .pool import MpiAbort
 
@@ -46,7 +49,8 @@ def _parser() -> argparse.ArgumentParser:
     sub.add_parser(
         "evolve",
         add_help=False,
-        help="run an evolution: animat_evolve's engine and flags (animat evolve --help lists them)",
+        help="run the config's search with animat_evolve's flags (animat evolve --help lists them): the GA "
+        "in animat_evolve's engine, or MAP-Elites / NSGA-II when search.algorithm says so",
     )
 
     s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
@@ -129,12 +133,6 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-#: What ``animat map-elites`` and ``animat nsga2`` search over when a new run names none.
-DEFAULT_DESCRIPTORS = "elongation,protrusions"
-DEFAULT_BINS = 10
-DEFAULT_OBJECTIVES = "distance:max,actuation_work_positive:min"
-
-
 def _search_parsers(sub) -> None:
     from .moo import CRITERIA
     from .qd import DESCRIPTORS
@@ -161,20 +159,24 @@ def _search_parsers(sub) -> None:
     m.add_argument(
         "--descriptors",
         metavar="NAME,NAME",
-        help=f"the archive's descriptors, of {', '.join(DESCRIPTORS)} (new run default {DEFAULT_DESCRIPTORS})",
+        help=f"the archive's descriptors, of {', '.join(DESCRIPTORS)}: sets search.descriptors (default: the config's)",
     )
     m.add_argument(
         "--bins",
         metavar="B[,B...]",
-        help=f"grid bins: one count for every descriptor, or one each (new run default {DEFAULT_BINS})",
+        help="grid bins: one count for every descriptor, or one each: sets search.bins (default: the config's)",
     )
     n.add_argument(
         "--objectives",
         metavar="NAME[:SENSE],...",
-        help=f"the objectives, each max or min (default: the table's sense), of {', '.join(CRITERIA)} "
-        f"(new run default {DEFAULT_OBJECTIVES})",
+        help=f"the objectives, each max or min (default: the table's sense), of {', '.join(CRITERIA)}: sets "
+        "search.objectives (default: the config's)",
     )
-    m.add_argument("--batch", type=int, help="offspring per generation (default evolution.population)")
+    m.add_argument(
+        "--batch",
+        type=int,
+        help="offspring per generation: sets search.batch (default: the config's; 0 = evolution.population)",
+    )
     n.add_argument(
         "--population", type=int, help="population and offspring per generation (default evolution.population)"
     )
@@ -201,6 +203,7 @@ def _search_parsers(sub) -> None:
             "the same run as without",
         )
         q.add_argument("--quiet", action="store_true", help="no line per generation")
+        q.set_defaults(resume=None, overwrite=False)  # OUT holding a run resumes it
 
 
 def has_evolved_stiffness(run, entry=None) -> bool:
@@ -416,11 +419,19 @@ def _at_least(option: str, value: Optional[int], least: int) -> None:
         raise ValueError(f"{option} must be >= {least}, got {value}")
 
 
-def _search_setup(args, what: str):
-    """The config, the generations and whether ``args.out`` is resumed, for map-elites and nsga2;
-    every check before any file is written."""
-    from .experiment import launched_ranks
+def _search_config(args, search: Sequence[str] = ()):
+    """CONFIG with the --set overrides and the search options' keys (``search``), checked together."""
     from .pipeline import load_config
+
+    config = load_config(args.config)
+    config.apply_overrides(list(args.set) + list(search))
+    return config
+
+
+def _search_setup(args, what: str, config):
+    """The generations and whether ``args.out`` is resumed, for a search from ``config``; every check
+    before any file is written."""
+    from .experiment import launched_ranks
 
     ranks = launched_ranks()
     if ranks > 1 and not args.mpi:
@@ -431,8 +442,6 @@ def _search_setup(args, what: str):
     _at_least("--seed", args.seed, 0)
     _at_least("--threads", args.threads, 0)
     _at_least("--generations", args.generations, 0)
-    config = load_config(args.config)
-    config.apply_overrides(list(args.set))
     generations = args.generations
     if generations is None:
         generations = int(config["evolution.generations"])
@@ -441,14 +450,14 @@ def _search_setup(args, what: str):
                 f"--generations is needed: the config's evolution.generations is 0, no cap, and {what} has no other stop"
             )
     checkpoint = args.out / "checkpoint.json"
-    return config, generations, checkpoint.is_file()
+    return generations, checkpoint.is_file() if args.resume is None else args.resume
 
 
-def _search(args, run, what: str, snapshots: str, line, **options) -> int:
-    """``run`` (run_map_elites or run_nsga2) into ``args.out`` with ``options`` and those every search
-    command shares; ``line(row)`` is printed after every generation (unless --quiet), a summary at the
-    end (rank 0 only over MPI)."""
-    config, generations, resume = _search_setup(args, what)
+def _search(args, config, run, what: str, snapshots: str, line, **options) -> int:
+    """``run`` (run_map_elites or run_nsga2) from ``config`` into ``args.out`` with ``options`` and
+    those every search command shares; ``line(row)`` is printed after every generation (unless
+    --quiet), a summary at the end (rank 0 only over MPI)."""
+    generations, resume = _search_setup(args, what, config)
 
     def report(row) -> None:
         if not args.quiet:
@@ -463,6 +472,7 @@ def _search(args, run, what: str, snapshots: str, line, **options) -> int:
         threads=args.threads,
         callback=report,
         mpi=args.mpi,
+        overwrite=args.overwrite,
         **options,
     )
     if args.mpi:
@@ -482,31 +492,34 @@ def cmd_map_elites(args) -> int:
 
     _at_least("--batch", args.batch, 1)
     _at_least("--archive-every", args.archive_every, 1)
-    given = args.descriptors is not None or args.bins is not None
-    names = _names("--descriptors", args.descriptors or DEFAULT_DESCRIPTORS, DESCRIPTORS)
-    bins_text = args.bins or str(DEFAULT_BINS)
-    try:
-        bins = [int(b) for b in bins_text.split(",")]
-    except ValueError:
-        raise ValueError(f"--bins {bins_text!r}: counts are integers, e.g. 10 or 12,8") from None
-    if len(bins) not in (1, len(names)) or min(bins) < 1:
-        raise ValueError(
-            f"--bins {bins_text!r}: one count >= 1 for every descriptor, or one each for the {len(names)} "
-            f"descriptors {','.join(names)}"
-        )
-    archive = None  # a resume's, unless given
-    if given or not (args.out / "checkpoint.json").is_file():
-        archive = GridArchive(names, bins if len(bins) > 1 else bins[0])
+    config = _search_config(args)
+    names = list(config["search.descriptors"])
+    search = []
+    if args.descriptors is not None:
+        names = _names("--descriptors", args.descriptors, DESCRIPTORS)
+        search.append(f"search.descriptors={json.dumps(names)}")
+    if args.bins is not None:
+        try:
+            bins = [int(b) for b in args.bins.split(",")]
+        except ValueError:
+            raise ValueError(f"--bins {args.bins!r}: counts are integers, e.g. 10 or 12,8") from None
+        if len(bins) not in (1, len(names)) or min(bins) < 1:
+            raise ValueError(
+                f"--bins {args.bins!r}: one count >= 1 for every descriptor, or one each for the {len(names)} "
+                f"descriptors {','.join(names)}"
+            )
+        search.append(f"search.bins={json.dumps(bins)}")
+    config.apply_overrides(search)
+    # A new run searches the config's grid; a resume its own archive, which a given one must match.
+    archive = GridArchive.from_config(config) if search else None
 
     return _search(
         args,
+        config,
         run_map_elites,
         "MAP-Elites",
         "archive",
-        lambda row: (
-            f"generation {row.generation:4d}: {row.elites} elites, coverage {row.coverage:.3f}, "
-            f"QD-score {row.qd_score:.6g}, best {row.best:.6g}"
-        ),
+        _archive_line,
         archive=archive,
         batch=args.batch,
         archive_every=args.archive_every,
@@ -514,36 +527,141 @@ def cmd_map_elites(args) -> int:
 
 
 def cmd_nsga2(args) -> int:
-    from .moo import CRITERIA, run_nsga2
+    from .moo import CRITERIA, objectives_from_config, run_nsga2
 
     _at_least("--population", args.population, 1)
     _at_least("--front-every", args.front_every, 1)
-    objectives = None
-    if args.objectives is not None or not (args.out / "checkpoint.json").is_file():
-        text = args.objectives or DEFAULT_OBJECTIVES
+    config = _search_config(args)
+    objectives = None  # a new run's: the config's; a resume's: its own, which given ones must match
+    if args.objectives is not None:
+        text = args.objectives
         pairs = [item.strip().partition(":") for item in text.split(",")]
         _names("--objectives", ",".join(name for name, _, _ in pairs), CRITERIA)
-        objectives = []
+        entries = []
         for name, _, sense in pairs:
             sense = sense.strip() or CRITERIA[name].sense
             if sense not in ("max", "min"):
                 what = f"sense {sense!r}" if sense else "no default sense"
                 raise ValueError(f"--objectives {text!r}: {name} has {what}: write {name}:max or {name}:min")
-            objectives.append((name, sense))
-
-    def line(row) -> str:
-        best = ", ".join(f"{name} {row[name]:.6g}" for name in row.dtype.names if name.startswith("best_"))
-        return f"generation {row.generation:4d}: front {row.front_size}, hypervolume {row.hypervolume:.6g}, {best}"
-
+            entries.append(f"{name}:{sense}")
+        config.apply_overrides([f"search.objectives={json.dumps(entries)}"])
+        objectives = objectives_from_config(config)
     return _search(
         args,
+        config,
         run_nsga2,
         "NSGA-II",
         "front",
-        line,
+        _front_line,
         objectives=objectives,
         population=args.population,
         front_every=args.front_every,
+    )
+
+
+def _front_line(row) -> str:
+    best = ", ".join(f"{name} {row[name]:.6g}" for name in row.dtype.names if name.startswith("best_"))
+    return f"generation {row.generation:4d}: front {row.front_size}, hypervolume {row.hypervolume:.6g}, {best}"
+
+
+def _evolve_parser() -> argparse.ArgumentParser:
+    """animat_evolve's flags, for a config whose search.algorithm is not the GA (``animat evolve``)."""
+    p = argparse.ArgumentParser(prog="animat evolve", add_help=False)
+    p.add_argument("--config")
+    p.add_argument("--set", action="append", default=[])
+    p.add_argument("--seed", type=int)
+    p.add_argument("--generations", type=int)
+    p.add_argument("--threads", type=int)
+    p.add_argument("--out", type=Path)
+    p.add_argument("--resume", type=Path)
+    p.add_argument("--overwrite", action="store_true")
+    p.add_argument("--print-config", action="store_true")
+    p.add_argument("--log-level")
+    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--mpi", action="store_true")
+    return p
+
+
+def _search_algorithm(argv: List[str]) -> str:
+    """search.algorithm of the config ``animat evolve argv`` would run; "ga" when it cannot tell (help,
+    a flag or config animat_evolve refuses: its message then says why)."""
+    from . import _core
+    from .pipeline import load_config
+
+    if any(a in ("-h", "--help") for a in argv):
+        return "ga"
+    try:
+        args, _ = _evolve_parser().parse_known_args(argv)
+        if args.resume is not None:
+            config = load_config(args.resume / "config.toml")
+        elif args.config is not None:
+            config = load_config(args.config)
+        else:
+            config = _core.Config()
+        config.apply_overrides(list(args.set))
+    except (Exception, SystemExit):
+        return "ga"
+    return str(config["search.algorithm"])
+
+
+def cmd_evolve(argv: List[str]) -> int:
+    """``animat evolve``: animat_evolve for the GA; MAP-Elites or NSGA-II, with the same flags, when
+    the config's search.algorithm says so."""
+    from . import _core
+    from .experiment import launched_ranks
+    from .moo import objectives_from_config, run_nsga2
+    from .pipeline import load_config
+    from .qd import GridArchive, run_map_elites
+
+    algorithm = _search_algorithm(argv)
+    if algorithm == "ga":
+        return _core.evolve_cli(argv)
+    try:
+        args = _evolve_parser().parse_args(argv)
+    except SystemExit as e:
+        return int(e.code or 0)
+    try:
+        if args.resume is not None and args.out is not None and args.resume != args.out:
+            raise ValueError("--resume and --out name different directories; --resume continues in place")
+        if args.resume is not None and args.overwrite:
+            raise ValueError("--resume continues the run and --overwrite replaces it; pass one of them")
+        if args.resume is not None and args.config is not None:
+            raise ValueError("--resume takes its config from the run directory; do not also pass --config")
+        if args.resume is not None:
+            config = load_config(args.resume / "config.toml")
+        else:
+            config = load_config(args.config) if args.config is not None else _core.Config()
+        config.apply_overrides(args.set)
+        if args.print_config:
+            print(config.to_toml(), end="")
+            return 0
+        if args.resume is None:  # the search's names, checked by the tables that own them, naming the file
+            try:
+                GridArchive.from_config(config) if algorithm == "map_elites" else objectives_from_config(config)
+            except ValueError as e:
+                raise ValueError(f"{args.config or 'the default config'}: {e}") from None
+        args.mpi = args.mpi or launched_ranks() > 1  # as animat_evolve: automatic under mpirun
+        seed = args.seed if args.seed is not None else int(config["evolution.seed"])
+        if args.out is None:
+            args.out = args.resume or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-seed{seed}"
+        args.resume = args.resume is not None
+        if algorithm == "map_elites":
+            return _search(args, config, run_map_elites, "MAP-Elites", "archive", _archive_line, archive_every=10)
+        return _search(args, config, run_nsga2, "NSGA-II", "front", _front_line, objectives=None, front_every=1)
+    except MpiAbort:  # a rank other than 0 of a run that rank 0 stopped: rank 0 says why
+        return 1
+    except KeyboardInterrupt as e:
+        print(f"animat evolve: {e or 'interrupted'}", file=sys.stderr)
+        return 130
+    except (FileNotFoundError, FileExistsError, NotADirectoryError, ValueError, RuntimeError, OSError) as e:
+        print(f"animat evolve: error: {e}", file=sys.stderr)
+        return 2
+
+
+def _archive_line(row) -> str:
+    return (
+        f"generation {row.generation:4d}: {row.elites} elites, coverage {row.coverage:.3f}, "
+        f"QD-score {row.qd_score:.6g}, best {row.best:.6g}"
     )
 
 
@@ -552,9 +670,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     ``animat evolve`` returns animat_evolve's)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] == "evolve":
-        from . import _core
-
-        return _core.evolve_cli(argv[1:])
+        return cmd_evolve(argv[1:])
     args = _parser().parse_args(argv)
     command = {
         "show": cmd_show,

@@ -92,6 +92,7 @@ __all__ = [
     "crowding_distance",
     "hypervolume",
     "history_dtype",
+    "objectives_from_config",
     "run_nsga2",
 ]
 
@@ -289,6 +290,29 @@ def _criterion(spec: CriterionLike) -> Criterion:
     raise TypeError(
         f"an objective is a name, a Criterion or a (name or function, 'max' or 'min') pair, got {spec!r:.80}"
     )
+
+
+def objectives_from_config(config: Any) -> List[Tuple[str, str]]:
+    """The objectives a new run from ``config`` optimises: ``search.objectives``, each ``"NAME"`` (the
+    table's sense) or ``"NAME:max"`` / ``"NAME:min"``, as ``(name, sense)`` pairs of :data:`CRITERIA`."""
+    entries = list(config["search.objectives"])
+    out = []
+    for entry in entries:
+        name, _, sense = entry.partition(":")
+        if name not in CRITERIA:
+            raise ValueError(
+                f"search.objectives = {json.dumps(entries)}: no objective {name!r}; the names are {', '.join(CRITERIA)}"
+            )
+        sense = sense or CRITERIA[name].sense
+        if sense not in ("max", "min"):
+            what = f"sense {sense!r}" if sense else "no default sense"
+            raise ValueError(
+                f"search.objectives = {json.dumps(entries)}: {name} has {what}: write {name}:max or {name}:min"
+            )
+        out.append((name, sense))
+    if len({name for name, _ in out}) != len(out):
+        raise ValueError(f"search.objectives = {json.dumps(entries)}: an objective appears twice")
+    return out
 
 
 def _criteria(specs: Iterable[CriterionLike]) -> Tuple[Criterion, ...]:
@@ -565,6 +589,9 @@ class Nsga2(_SearchState):
     ) -> None:
         self.criteria: Tuple[Criterion, ...] = _criteria(objectives)
         self._config = _core.Config() if config is None else config.copy()
+        # The run's config.toml says what it is (`animat evolve --resume` dispatches on it).
+        self._config["search.algorithm"] = "nsga2"
+        self._config["search.objectives"] = [f"{c.name}:{c.sense}" for c in self.criteria]
         objective = str(self._config["evaluation.objective"])
         if objective.startswith("python:"):
             raise ValueError(
@@ -1032,6 +1059,10 @@ def run_nsga2(
       continues from it and gives the very run an uninterrupted one gives (``objectives`` may then
       be None; your own functions must be passed again, and given objectives must be the run's).
 
+    A new run with ``objectives`` None optimises the config's ``search.objectives``
+    (:func:`objectives_from_config`): a config with ``search.algorithm = "nsga2"`` defines the whole run,
+    as ``animat evolve --config FILE`` runs it. The run's ``config.toml`` records the search it is.
+
     ``callback(row)`` is called after every generation; returning False stops (checkpointed). Returns
     the :class:`Nsga2`. A directory that holds a run is refused (FileExistsError) unless ``resume``
     or ``overwrite`` (which removes the files above and ``front/``, nothing else). On a resume, a
@@ -1060,12 +1091,12 @@ def run_nsga2(
 
     def check_new() -> None:
         if objectives is None:
-            raise ValueError("run_nsga2: the objectives are required for a new run")
+            objectives_from_config(config)  # the names and senses, before any file is written
 
     def new() -> Nsga2:
         return Nsga2(
             config,
-            cast(Any, objectives),
+            objectives if objectives is not None else objectives_from_config(config),
             population=population,
             seed=seed,
             crossover_fraction=crossover_fraction,

@@ -648,6 +648,19 @@ class GridArchive(_Archive):
             np.linspace(d.lo, d.hi, n + 1) for d, n in zip(self.descriptors, self.bins)
         )
 
+    @classmethod
+    def from_config(cls, config: Any) -> GridArchive:
+        """The grid a new run from ``config`` searches: ``search.descriptors`` (names of
+        :data:`DESCRIPTORS`) and ``search.bins`` (one count for all, or one each)."""
+        names = list(config["search.descriptors"])
+        for name in names:
+            if name not in DESCRIPTORS:
+                raise ValueError(
+                    f"search.descriptors = {json.dumps(names)}: no descriptor {name!r}; the names are {', '.join(DESCRIPTORS)}"
+                )
+        bins = [int(b) for b in config["search.bins"]]
+        return cls(names, bins[0] if len(bins) == 1 else bins)
+
     @property
     def cells(self) -> int:
         return int(np.prod(self.bins))
@@ -808,6 +821,9 @@ def _write_atomic(path: Path, text: str) -> Path:
 def _comparable(config: Any) -> Dict[str, Any]:
     d = config.to_dict()
     d.get("evolution", {}).pop("threads", None)
+    # [search] says how a new run from the config searches; a started run's checkpoint holds its
+    # archive or objectives (and runs started before [search] existed hold the defaults).
+    d.pop("search", None)
     return d
 
 
@@ -983,6 +999,13 @@ class MapElites(_SearchState):
         if not 0.0 <= self.crossover_fraction <= 1.0:
             raise ValueError(f"MapElites: crossover_fraction must be in [0, 1], got {self.crossover_fraction}")
         self.archive = archive
+        # The run's config.toml says what it is (`animat evolve --resume` dispatches on it); the
+        # checkpoint holds the archive itself (a CVT archive's centroids, custom ranges).
+        self._config["search.algorithm"] = "map_elites"
+        self._config["search.descriptors"] = [d.name for d in archive.descriptors]
+        if isinstance(archive, GridArchive):
+            self._config["search.bins"] = [float(b) for b in archive.bins]
+        self._config["search.batch"] = self.batch
         self._guard = str(self._config["evaluation.reference_check"])
         self._generation = -1
         self._evaluations = 0
@@ -1336,6 +1359,11 @@ def run_map_elites(
       continues from it (then ``archive`` may be None; your own descriptor functions go in
       ``descriptors``) and gives the very run an uninterrupted one gives.
 
+    A new run without ``archive`` searches the grid of the config's ``search.descriptors`` and
+    ``search.bins`` (:meth:`GridArchive.from_config`), with ``search.batch`` offspring per generation
+    unless ``batch`` is given: a config with ``search.algorithm = "map_elites"`` defines the whole run,
+    as ``animat evolve --config FILE`` runs it. The run's ``config.toml`` records the search it is.
+
     ``callback(row)`` is called after every generation; returning False stops (checkpointed). Returns
     the :class:`MapElites`. A directory that holds a run is refused (FileExistsError) unless ``resume``
     or ``overwrite`` (which removes the files above and ``archive/``, nothing else). On a resume, an
@@ -1365,13 +1393,14 @@ def run_map_elites(
 
     def check_new() -> None:
         if archive is None:
-            raise ValueError("run_map_elites: an archive is required for a new run")
+            GridArchive.from_config(config)  # the names and bins, before any file is written
 
     def new() -> MapElites:
+        from_config = int(config["search.batch"]) or None
         return MapElites(
             config,
-            cast(Any, archive),
-            batch=batch,
+            archive if archive is not None else GridArchive.from_config(config),
+            batch=batch if batch is not None else from_config,
             initial=initial,
             seed=seed,
             objective=objective,

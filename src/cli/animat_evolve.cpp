@@ -201,6 +201,7 @@ int animat_evolve_main(int argc, char** argv) {
       std::cout << animat::to_toml(config);
       return 0;
     }
+    animat::require_ga(config);
 
     animat::RunOptions options;
     options.resume = !resume_dir.empty();

@@ -236,6 +236,20 @@ TEST(Cli, PackagedConfigsWithADotInTheirNameResolveByName) {
   EXPECT_CONTAINS(r.err, "paper_dn0.2_64cells, paper_dn0.5, paper_dn10");
 }
 
+TEST(CliErrors, AnotherSearchAlgorithmIsRefusedBeforeAnyFileIsWritten) {
+  // MAP-Elites and NSGA-II run in Python (`animat evolve`): the GA must not fill a run directory
+  // whose config.toml says otherwise.
+  const fs::path out = scratch_dir() / "map_elites_run";
+  for (const char* algorithm : {"map_elites", "nsga2"}) {
+    const Result r = run(std::string("--set search.algorithm=") + algorithm +
+                         " --generations 1 --out map_elites_run");
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_CONTAINS(r.err, std::string("search.algorithm = \"") + algorithm + "\"");
+    EXPECT_CONTAINS(r.err, "animat evolve");
+    EXPECT_FALSE(fs::exists(out)) << "a refused command wrote " << out;
+  }
+}
+
 TEST(CliErrors, UnknownOption) {
   const Result r = run("--print-config --bogus-option");
   EXPECT_NE(r.exit_code, 0);

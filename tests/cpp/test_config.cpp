@@ -183,13 +183,16 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
         candidates.push_back(shorter);
         candidates.push_back(std::vector<std::string>{});
       } else if (const auto* v = std::get_if<std::vector<double>>(&def)) {
-        auto w = *v;
+        auto w = *v, whole = *v;
         for (double& x : w) x = x * 1.1 + 0.1;
+        for (double& x : whole) x += 1;  // search.bins: whole numbers only
         candidates.push_back(w);
+        candidates.push_back(whole);
       } else if (std::holds_alternative<std::string>(def)) {
-        for (const char* word : {"explicit", "stable", "off", "select", "distance_per_size",
-                                 "chemical", "actuation", "grn", "point", "distance", "front",
-                                 "amplitude", "morphogen_gradient", "compliant", "min"})
+        for (const char* word :
+             {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",
+              "grn", "point", "distance", "front", "amplitude", "morphogen_gradient", "compliant",
+              "min", "map_elites"})
           candidates.push_back(std::string(word));
       }
       for (const auto& cand : candidates) {
@@ -468,4 +471,37 @@ TEST(BadTomlString, NothingFallsBackSilently) {
     const std::string m = expect_config_error([&] { (void)config_from_toml(text, "t.toml"); });
     EXPECT_CONTAINS(m, "t.toml");
   }
+}
+
+TEST(ConfigSearch, TheSearchKeysAreCheckedTogetherNamingTheKey) {
+  Config c;
+  EXPECT_EQ(c.search.algorithm, "ga");  // the paper's GA unless a config says otherwise
+  c.search.descriptors = {"cells", "elongation", "frequency"};
+  c.search.bins = {4.0, 6.0, 8.0};
+  EXPECT_NO_THROW(animat::validate(c));
+  c.search.bins = {5.0};  // one count for every descriptor
+  EXPECT_NO_THROW(animat::validate(c));
+  const auto refused = [](const Config& bad, const std::string& words) {
+    try {
+      animat::validate(bad);
+      ADD_FAILURE() << "accepted: " << words;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  Config two = c;
+  two.search.bins = {4.0, 6.0};
+  refused(two,
+          "search.bins = [4.0, 6.0]: give one count for every descriptor or one for each of "
+          "the 3");
+  Config half = c;
+  half.search.bins = {2.5};
+  refused(half, "search.bins = [2.5]: entry 2.5 is not a whole number");
+  Config none = c;
+  none.search.objectives = {};
+  refused(none, "search.objectives = []: name at least one");
+  Config spaced = c;
+  spaced.search.descriptors = {"elongation", "two words"};
+  refused(spaced, "entry \"two words\" is not a name");
+  EXPECT_THROW(apply_override(c, "search.algorithm=\"cma_es\""), ConfigError);
 }

@@ -269,6 +269,14 @@ std::vector<Probe> probes_for(const FieldInfo& info, const std::string&) {
 
 std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<std::string>&) {
   std::vector<Probe> out;
+  if (info.choices.empty()) {  // names owned by a Python table (search.descriptors): any one word
+    out.push_back({"[\"a_name\"]", std::vector<std::string>{"a_name"}, true});
+    out.push_back({"[]", std::vector<std::string>{}, false});
+    out.push_back({"[\"\"]", std::vector<std::string>{""}, false});
+    out.push_back({"[\"a b\"]", std::vector<std::string>{"a b"}, false});
+    out.push_back({"[\"a\", \"a\"]", std::vector<std::string>{"a", "a"}, false});
+    return out;
+  }
   out.push_back({"[]", std::vector<std::string>{}, true});
   std::vector<std::string> all;
   for (auto c : info.choices) all.emplace_back(c);

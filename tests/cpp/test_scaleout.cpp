@@ -304,16 +304,21 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\ndivision_axis = ",
                           "\ndivision_max_contacts = ",
                           "\nupdate_period = ",
-                          "\nprotection_generations = "}) {
+                          "\nprotection_generations = ",
+                          "\nalgorithm = ",
+                          "\ndescriptors = ",
+                          "\nbins = ",
+                          "\nbatch = ",
+                          "\nobjectives = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     const auto from = text.rfind('\n', at - 1) + 1;
     ASSERT_EQ(text[from], '#') << key;
     text.erase(from, text.find('\n', at + 1) + 1 - from);
   }
-  // [control] is then empty: its header goes too.
-  ASSERT_TRUE(text.ends_with("\n[control]\n"));
-  text.erase(text.size() - std::string("\n[control]\n").size());
+  // [control] and [search] are then empty: their headers go too.
+  ASSERT_TRUE(text.ends_with("\n[control]\n\n[search]\n"));
+  text.erase(text.size() - std::string("\n[control]\n\n[search]\n").size());
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (unsigned char ch : text) {
     h ^= ch;

@@ -123,7 +123,9 @@ def test_to_dict_nested_and_typed():
         "evaluation",
         "evolution",
         "control",
+        "search",
     ]
+    assert d["search"]["descriptors"] == ["elongation", "protrusions"]
     assert d["grn"]["dt"] == 0.05 and isinstance(d["grn"]["dt"], float)
     assert isinstance(d["evolution"]["population"], int)
     assert isinstance(d["physics"]["drag_scheme"], str)

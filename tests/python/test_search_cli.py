@@ -209,6 +209,82 @@ def test_a_resume_that_would_change_the_run_is_refused_and_touches_nothing(
     assert files(out) == before
 
 
+# --- from the config: search.algorithm and `animat evolve` ---------------------------------------
+
+
+def search_config(tmp_path, command, **keys):
+    """A config file of paper_dn2 at SETS whose [search] section defines the run."""
+    c = small_config()
+    if command == "map-elites":
+        search = dict(algorithm="map_elites", descriptors=["cells", "frequency"], bins=[8.0, 5.0], batch=6)
+    else:
+        search = dict(algorithm="nsga2", objectives=["distance", "actuation_work_positive:min"])
+        c["evolution.population"] = 6
+    for key, value in {**search, **keys}.items():
+        c[f"search.{key}"] = value
+    path = tmp_path / f"{command}.toml"
+    path.write_text(c.to_toml())
+    return path
+
+
+@pytest.mark.parametrize("command", ["map-elites", "nsga2"])
+def test_animat_evolve_runs_the_configs_search_and_resumes_it(tmp_path, capsys, command):
+    config = search_config(tmp_path, command)
+    straight = tmp_path / "library"
+    if command == "map-elites":  # the archive and batch given: the same run
+        library_map_elites(straight)
+    else:
+        objectives = [("distance", "max"), ("actuation_work_positive", "min")]
+        animat.run_nsga2(animat.load_config(str(config)), objectives, straight, 3, threads=1)
+    out = tmp_path / "evolve"
+    base = ["evolve", "--threads", "1", "--quiet"]
+    assert cli.main([*base, "--config", str(config), "--out", str(out), "--generations", "1"]) == 0
+    assert "generation 1, 12 evaluations;" in capsys.readouterr().out
+    # The run directory says which search it is: --resume needs nothing else.
+    assert cli.main([*base, "--resume", str(out), "--generations", "3"]) == 0
+    assert "generation 3, 24 evaluations (resumed)" in capsys.readouterr().out
+    mine, theirs = files(out), files(straight)
+    if command == "map-elites":  # archive_every 10: the first session's last generation is extra
+        del mine["archive/gen_000001.csv"]
+    assert mine == theirs
+
+
+def test_the_library_run_records_its_search_in_config_toml(tmp_path):
+    library_map_elites(tmp_path / "me", generations=0)
+    c = animat.load_config(str(tmp_path / "me" / "config.toml"))
+    assert c["search.algorithm"] == "map_elites" and c["search.descriptors"] == ["cells", "frequency"]
+    assert c["search.bins"] == [8.0, 5.0] and c["search.batch"] == 6
+    library_nsga2(tmp_path / "ns", generations=0)
+    c = animat.load_config(str(tmp_path / "ns" / "config.toml"))
+    assert c["search.algorithm"] == "nsga2"
+    assert c["search.objectives"] == ["distance:max", "actuation_work_positive:min"]
+
+
+@pytest.mark.parametrize(
+    "command, key, value, message",
+    [
+        ("map-elites", "descriptors", ["cells", "wiggle"], 'search.descriptors = ["cells", "wiggle"]: no descriptor'),
+        ("nsga2", "objectives", ["distance", "max_speed"], "max_speed has no default sense: write max_speed:max"),
+        ("nsga2", "objectives", ["distance:up"], "search.objectives = [\"distance:up\"]: distance has sense 'up'"),
+    ],
+)
+def test_a_bad_search_key_is_refused_naming_the_file_and_writes_nothing(tmp_path, capsys, command, key, value, message):
+    config = search_config(tmp_path, command, **{key: value})
+    out = tmp_path / "run"
+    assert cli.main(["evolve", "--config", str(config), "--out", str(out), "--generations", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"animat evolve: error: {config}: ") and message in err, err
+    assert not out.exists()
+
+
+def test_the_ga_refuses_a_config_of_another_search(tmp_path):
+    config = small_config()
+    config["search.algorithm"] = "map_elites"
+    with pytest.raises(Exception, match='search.algorithm = "map_elites": this runs the GA'):
+        animat.evolve(config, out=str(tmp_path / "ga"), generations=1)
+    assert not (tmp_path / "ga").exists()
+
+
 # --- over MPI -------------------------------------------------------------------------------------
 
 
@@ -231,6 +307,21 @@ def test_two_ranks_write_the_threaded_run_bit_for_bit_and_resume_it(tmp_path, co
     if command == "map-elites":  # archive_every 10: the first session's last generation is extra
         del mine["archive/gen_000002.csv"]
     assert mine == theirs
+
+
+@needs_mpi
+def test_animat_evolve_under_mpirun_runs_the_configs_search_on_the_ranks(tmp_path):
+    # As animat_evolve: under mpirun the ranks swim without --mpi.
+    straight = tmp_path / "threads"
+    library_map_elites(straight)
+    out = tmp_path / "ranks"
+    config = search_config(tmp_path, "map-elites")
+    run = mpirun(
+        "-m", "animat", "evolve", "--config", str(config), "--out", str(out), "--generations", "3", "--threads", "1"
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert run.stdout.count(f"{out}: generation 3") == 1  # rank 0 reports, the others are quiet
+    assert files(out) == files(straight)
 
 
 @needs_mpi

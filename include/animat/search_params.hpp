@@ -1,0 +1,68 @@
+#pragma once
+// [search] section of the config: which search algorithm a run from this config uses, and the
+// settings of the two that are not the paper's GA. Data only: the GA is evolution.hpp (C++);
+// MAP-Elites and NSGA-II are animat.qd and animat.moo (Python), which own the tables of descriptor
+// and objective names these strings are checked against (docs/search.md).
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "animat/params.hpp"
+
+namespace animat {
+
+inline constexpr std::string_view kSearchAlgorithmNames[] = {"ga", "map_elites", "nsga2"};
+
+struct SearchParams {
+  /// "ga": the paper's GA ([evolution], animat_evolve); "map_elites", "nsga2": run by
+  /// `animat evolve` / animat.run_map_elites / animat.run_nsga2 [not in the paper: "ga"]
+  std::string algorithm = "ga";
+  /// map_elites: the grid archive's descriptors, names of animat.qd.DESCRIPTORS
+  std::vector<std::string> descriptors = {"elongation", "protrusions"};
+  /// map_elites: bins of each descriptor: one count for all, or one per descriptor
+  std::vector<double> bins = {10.0};
+  /// map_elites: offspring per generation; 0 = evolution.population
+  int batch = 0;
+  /// nsga2: the objectives, "NAME" (the table's sense) or "NAME:max" / "NAME:min", names of
+  /// animat.moo.CRITERIA
+  std::vector<std::string> objectives = {"distance:max", "actuation_work_positive:min"};
+};
+
+template <class V>
+void visit_fields(SearchParams& p, V&& v) {
+  v(FieldInfo{"algorithm",
+              "the search a run from this config uses: \"ga\" (the paper's GA, [evolution]), "
+              "\"map_elites\" or \"nsga2\" (run by `animat evolve`, not animat_evolve; "
+              "docs/search.md) [not in the paper: ga]",
+              Bounds::any(), kSearchAlgorithmNames, Identity::late},
+    p.algorithm);
+  v(FieldInfo{"descriptors",
+              "map_elites: the grid archive's descriptors (names of animat.qd.DESCRIPTORS: "
+              "cells, elongation, protrusions, frequency, locomotion, ...)",
+              Bounds::any(),
+              {},
+              Identity::late},
+    p.descriptors);
+  v(FieldInfo{"bins",
+              "map_elites: grid bins per descriptor, integers >= 1: one count for every "
+              "descriptor, or one each",
+              Bounds::closed(1, 100000),
+              {},
+              Identity::late},
+    p.bins);
+  v(FieldInfo{"batch",
+              "map_elites: offspring per generation; 0 = evolution.population",
+              Bounds::closed(0, 100000),
+              {},
+              Identity::late},
+    p.batch);
+  v(FieldInfo{"objectives",
+              "nsga2: the objectives, \"NAME\" (the table's sense) or \"NAME:max\" / \"NAME:min\" "
+              "(names of animat.moo.CRITERIA)",
+              Bounds::any(),
+              {},
+              Identity::late},
+    p.objectives);
+}
+
+}  // namespace animat
