@@ -203,6 +203,7 @@ SCENES: Dict[str, Tuple[Optional[str], Dict[str, Any], Tuple[str, ...]]] = {
     "regime_dn0.5": ("configs/regime_dn0.5.toml", {}, ALL),
     "regime_dn2": ("configs/regime_dn2.toml", {}, ALL),
     "regime_dn10": ("configs/regime_dn10.toml", {}, ALL),
+    "regime_dn0.2_64cells": ("configs/regime_dn0.2_64cells.toml", {}, ALL),
     "chemotaxis": ("configs/chemotaxis.toml", _CHEMOTAXIS_SHORT, ALL),
     "replication_dn2_run": ("tests/data/replication/dn2_run_0/config.toml", {}, ALL),
     "replication_dn10_run": ("tests/data/replication/dn10_run_0/config.toml", {}, ALL),

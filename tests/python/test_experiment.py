@@ -38,12 +38,12 @@ def test_paper_configs_hold_the_paper_settings(name, dn, cells):
     assert c["development.steps"] == 400
 
 
-@pytest.mark.parametrize("env", ["dn0.5", "dn2", "dn10"])
-def test_regime_presets_are_the_paper_environments_with_their_two_values(env):
+@pytest.mark.parametrize("env, damping", [("dn0.5", 0.25), ("dn2", 0.25), ("dn10", 0.25), ("dn0.2_64cells", 0.5)])
+def test_regime_presets_are_the_paper_environments_with_their_two_values(env, damping):
     paper = animat.load_config(str(ROOT / "configs" / f"paper_{env}.toml"))
     regime = animat.load_config(str(ROOT / "configs" / f"regime_{env}.toml"))
     changed = {key: regime[key] for key in paper.keys() if regime[key] != paper[key]}
-    assert changed == {"scene.spring_damping": 0.25, "evaluation.reference_check": "select"}
+    assert changed == {"scene.spring_damping": damping, "evaluation.reference_check": "select"}
     assert paper["scene.spring_damping"] == 4.0 and paper["evaluation.reference_check"] == "record"
 
 
