@@ -55,6 +55,7 @@ import json
 import math
 import os
 import shutil
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -903,14 +904,22 @@ def _fitnesses(objective: Optional[Objective]) -> Swim:
         fits, bodies = cast(Any, _core)._evaluate_population_bodies(  # private: not in the stub
             list(genomes), config, threads, _objective(objective)
         )
-        out: List[Any] = []
-        for genome, fit, body in zip(genomes, fits, bodies):
-            values = None
-            if fit.viable and fit.stable and fit.valid:
-                subject = _Subject(genome, config, fit, body)
-                values = tuple(float(cast(Callable[[_Subject], float], f)(subject)) for f in table)
-            out.append((fit, values))
-        return out
+
+        def one(item: Tuple[Any, Any, Any]) -> Tuple[Any, Optional[Tuple[float, ...]]]:
+            genome, fit, body = item
+            if not (fit.viable and fit.stable and fit.valid):
+                return fit, None
+            subject = _Subject(genome, config, fit, body)
+            return fit, tuple(float(cast(Callable[[_Subject], float], f)(subject)) for f in table)
+
+        items = list(zip(genomes, fits, bodies))
+        if threads == 1 or len(items) < 2:
+            return [one(item) for item in items]
+        # Each genome's descriptors depend on it alone, and the replays behind them release the
+        # GIL: on the evaluation's threads, in order, the same values.
+        workers = min(len(items), threads if threads > 0 else (os.cpu_count() or 1))
+        with ThreadPoolExecutor(workers) as pool:
+            return list(pool.map(one, items))
 
     return swim
 

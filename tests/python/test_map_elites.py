@@ -256,6 +256,19 @@ def new_run(threads=1, guard="record", archive=None):
     return animat.MapElites(small_config(guard, threads), archive, batch=8, seed=5, crossover_fraction=0.5)
 
 
+def test_the_descriptors_computed_on_threads_are_the_serial_ones():
+    # Each batch's descriptors run on the evaluation's threads: the locomotion replay and the shape
+    # give the same values, in the same order.
+    archive = lambda: animat.GridArchive(["locomotion", "concavity", "frequency"], bins=(5, 4, 4))  # noqa: E731
+    one, two = new_run(threads=1, archive=archive()), new_run(threads=2, archive=archive())
+    for _ in range(2):
+        one.step()
+        two.step()
+    assert len(one.archive) > 3
+    assert elites_of(one.archive) == elites_of(two.archive)
+    same_history(one.history, two.history)
+
+
 def test_map_elites_is_the_same_for_any_thread_count_and_for_ask_tell():
     one, two = new_run(threads=1), new_run(threads=2)
     for _ in range(3):
