@@ -9,6 +9,12 @@ wanders (docs/regime.md, "The gap is not the step's").
 
 Writes studies/regime/results/step_ladder.csv (one row per best: run, fitness at each step, error
 at each step against dt/32) and prints a markdown table.
+
+``--data DIR --out CSV`` swims the final bests of a packed study instead (data/<study>/<env>/run_<i>:
+config.toml and the last entry of best.tar.gz), one row per run named ENV/run_I:
+
+    PYTHONPATH=build/python .venv/bin/python studies/regime/step_ladder.py \
+        --data data/replication_regime --out studies/regime/results/step_ladder_replication_regime.csv
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ import csv
 import fnmatch
 import json
 import sys
+import tarfile
 from pathlib import Path
 
 import animat
@@ -28,9 +35,21 @@ OUT = ROOT / "studies" / "regime" / "results" / "step_ladder.csv"
 SUBSTEPS = (1, 2, 4, 16, 32)
 
 
+def final_best(run: Path) -> dict:
+    """The last lineage entry of a packed run's best.tar.gz."""
+    with tarfile.open(run / "best.tar.gz") as tar:
+        last = sorted(m for m in tar.getnames() if m.endswith(".json"))[-1]
+        member = tar.extractfile(last)
+        assert member is not None
+        return json.loads(member.read())
+
+
 def ladder(folder: Path) -> list:
     """The best's fitness at each of SUBSTEPS (its config otherwise)."""
-    entry = json.loads((folder / "best_genome.json").read_text())
+    if (folder / "best.tar.gz").is_file():
+        entry = final_best(folder)
+    else:
+        entry = json.loads((folder / "best_genome.json").read_text())
     genome = animat.Genome.from_json(json.dumps(entry["genome"]))
     out = []
     for s in SUBSTEPS:
@@ -42,14 +61,22 @@ def ladder(folder: Path) -> list:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
-    p.add_argument("--only", nargs="+", required=True, metavar="GLOB", help="screen runs to swim (folder names)")
+    p.add_argument("--only", nargs="+", metavar="GLOB", help="screen runs to swim (folder names)")
+    p.add_argument("--data", type=Path, help="a packed study: swim its runs' final bests instead")
     p.add_argument("--out", type=Path, default=OUT)
     args = p.parse_args(argv)
-    runs = [
-        f
-        for f in sorted(SCREEN.iterdir())
-        if (f / "best_genome.json").is_file() and any(fnmatch.fnmatch(f.name, g) for g in args.only)
-    ]
+    if (args.data is None) == (args.only is None):
+        p.error("give --only GLOB... (screen runs) or --data DIR (a packed study)")
+    if args.data is not None and args.out == OUT:
+        p.error("--data needs its own --out (the default is the screen's table)")
+    if args.data is not None:
+        runs = sorted(r for r in args.data.glob("*/run_*") if (r / "best.tar.gz").is_file())
+    else:
+        runs = [
+            f
+            for f in sorted(SCREEN.iterdir())
+            if (f / "best_genome.json").is_file() and any(fnmatch.fnmatch(f.name, g) for g in args.only)
+        ]
     if not runs:
         print(f"step_ladder: no kept run matches {args.only}", file=sys.stderr)
         return 1
@@ -63,8 +90,9 @@ def main(argv=None) -> int:
         fit = ladder(f)
         ref = fit[-1]
         err = [x / ref - 1 for x in fit[:-1]]
-        rows.append([f.name] + [f"{x:.9g}" for x in fit] + [f"{e:.6g}" for e in err])
-        lines.append(f"| {f.name} | " + " | ".join(f"{e:+.2%}" for e in err) + f" | {ref:.2f} |")
+        name = f"{f.parent.name}/{f.name}" if args.data is not None else f.name
+        rows.append([name] + [f"{x:.9g}" for x in fit] + [f"{e:.6g}" for e in err])
+        lines.append(f"| {name} | " + " | ".join(f"{e:+.2%}" for e in err) + f" | {ref:.2f} |")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "w", newline="") as fh:
         w = csv.writer(fh, lineterminator="\n")
