@@ -14,7 +14,7 @@ namespace animat {
 inline constexpr std::string_view kSearchAlgorithmNames[] = {"ga", "map_elites", "nsga2"};
 
 struct SearchParams {
-  /// "ga": the paper's GA ([evolution], animat_evolve); "map_elites", "nsga2": run by
+  /// "ga": the paper's GA (the evolution section, animat_evolve); "map_elites", "nsga2": run by
   /// `animat evolve` / animat.run_map_elites / animat.run_nsga2 [not in the paper: "ga"]
   std::string algorithm = "ga";
   /// map_elites: the grid archive's descriptors, names of animat.qd.DESCRIPTORS
@@ -31,7 +31,8 @@ struct SearchParams {
 template <class V>
 void visit_fields(SearchParams& p, V&& v) {
   v(FieldInfo{"algorithm",
-              "the search a run from this config uses: \"ga\" (the paper's GA, [evolution]), "
+              "the search a run from this config uses: \"ga\" (the paper's GA: the evolution "
+              "section's settings), "
               "\"map_elites\" or \"nsga2\" (run by `animat evolve`, not animat_evolve; "
               "docs/search.md) [not in the paper: ga]",
               Bounds::any(), kSearchAlgorithmNames, Identity::late},
