@@ -26,7 +26,7 @@
 # least advanced run is one outside it.)
 # ANIMAT_REPLICATION_PRESET=regime grows the same study at the regime presets (configs/regime_<env>.toml,
 # docs/regime.md) instead of the paper's environments (configs/paper_<env>.toml, the default "paper"),
-# in the environments the preset has (regime: the three 32-cell ones); give it its own
+# in the environments the preset has (regime: all four); give it its own
 # ANIMAT_REPLICATION_DATA, _OUT, _DOC and _IMAGES (the page's figures, default docs/images/replication).
 # The paper's discussion (docs/notes/replication_discussion.md) and the controlled runs' section are
 # written for the paper preset only.
