@@ -6,7 +6,10 @@
 Run ``i`` uses seed ``evolution.seed + i`` and lives in ``OUT/run_<i>``. Runs go one after another, or
 ``--parallel K`` at a time with the cores split between them (each run's ``evolution.threads`` is
 ``threads // K``; results do not depend on it). An interrupted experiment resumes: every run directory
-that holds a checkpoint is continued, and a finished run stops at once. ``OUT/summary.json`` and
+that holds a checkpoint is continued, and a finished run stops at once; a run whose checkpoint is already
+at or past the generation cap is left untouched (no file of it is rewritten), so a study grown in rounds
+of rising caps (``studies/replication/replication.sh``) keeps the config and status of its runs that are
+ahead. ``OUT/summary.json`` and
 ``OUT/summary.md`` hold the best fitness per run and the median with its spread.
 
 A study is several environments at once, ``NAME=CONFIG`` each, in ``OUT/NAME/run_<i>``, and
@@ -45,6 +48,37 @@ class RunRecord:
     wall_seconds: float
 
 
+def _checkpoint_generation(out: Path) -> int:
+    """The generation a run's checkpoint.json holds (its payload's ``generation``)."""
+    wrapper = json.loads((out / "checkpoint.json").read_text(encoding="utf-8"))
+    return int(json.loads(wrapper["payload"])["generation"])
+
+
+def _record_at_cap(config: _core.Config, out: Path, index: int) -> Optional[RunRecord]:
+    """The record of a run whose checkpoint is at or past the config's generation cap, read from its
+    files; None when it has no cap, no checkpoint or is below the cap (then it is resumed). Resuming it
+    would stop at once but rewrite its config.toml with the lower cap, its status and its resume.log."""
+    cap = int(config["evolution.generations"])
+    if cap <= 0 or not (out / "checkpoint.json").exists() or _checkpoint_generation(out) < cap:
+        return None
+    from .run import read_history
+
+    last = read_history(out / "history.csv")[-1]
+    status = json.loads((out / "status.json").read_text(encoding="utf-8")) if (out / "status.json").exists() else {}
+    return RunRecord(
+        index=index,
+        seed=int(config["evolution.seed"]),
+        path=str(out),
+        best=float(last["best"]),
+        generations=int(last["generation"]),
+        best_cells=int(last["best_cells"]),
+        stop_reason=str(
+            status.get("stop_reason", f"already at generation {int(last['generation'])}, past the cap {cap}")
+        ),
+        wall_seconds=float(last["wall_seconds"]),
+    )
+
+
 def _run_one(
     config: _core.Config,
     out: Path,
@@ -53,6 +87,9 @@ def _run_one(
     stop: Optional[threading.Event] = None,
     label: str = "",
 ) -> Optional[RunRecord]:
+    ahead = _record_at_cap(config, out, index)
+    if ahead is not None:
+        return ahead
     resume = (out / "checkpoint.json").exists()
     result = _core.evolve(config, out=str(out), resume=resume, quiet=quiet, stop=stop, label=label)
     if not result.history:  # stopped before its initial population was complete: nothing to record

@@ -67,6 +67,13 @@ def test_experiment_runs_seeds_resumes_and_summarises(tmp_path):
     c["evolution.generations"] = 3
     straight = animat.evolve(c)
     assert straight.history[-1].best == more[0].best
+    # A round with a lower cap (a study grown breadth first) leaves the runs that are ahead untouched.
+    files = ("config.toml", "history.csv", "checkpoint.json", "resume.log")  # resume.log: from the cap 2 -> 3
+    before = {f: (out / "run_0" / f).read_bytes() for f in files}
+    lower = animat.run_experiment(str(cfg), runs=2, out=str(out), generations=1, threads=2)
+    assert [(r.generations, r.best) for r in lower] == [(r.generations, r.best) for r in more]
+    assert {f: (out / "run_0" / f).read_bytes() for f in files} == before
+    assert lower[0].stop_reason == "already at generation 3, past the cap 1"
 
 
 def test_experiment_command_line(tmp_path):
