@@ -59,7 +59,12 @@ def _record_at_cap(config: _core.Config, out: Path, index: int) -> Optional[RunR
     files; None when it has no cap, no checkpoint or is below the cap (then it is resumed). Resuming it
     would stop at once but rewrite its config.toml with the lower cap, its status and its resume.log."""
     cap = int(config["evolution.generations"])
-    if cap <= 0 or not (out / "checkpoint.json").exists() or _checkpoint_generation(out) < cap:
+    if cap <= 0 or not (out / "checkpoint.json").exists():
+        return None
+    try:
+        if _checkpoint_generation(out) < cap:
+            return None
+    except (ValueError, KeyError, TypeError):  # unreadable: the resume reports it, naming the file
         return None
     from .run import read_history
 
