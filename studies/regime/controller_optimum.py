@@ -57,11 +57,9 @@ import csv
 import json
 import math
 import sys
-import tarfile
 from dataclasses import replace
 from multiprocessing import Pool
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
@@ -70,6 +68,9 @@ import animat
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies" / "locomotion"))
 from known_swimmers import KnownSwimmer, appendage_swimmer, hex_region, stroke_truth  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "studies" / "regime"))
+from step_ladder import final_best  # noqa: E402
 
 OUT = ROOT / "studies" / "regime" / "results" / "controller_optimum.csv"
 SEARCH_SUBSTEPS = 4
@@ -135,20 +136,6 @@ def distance(swimmer: KnownSwimmer, config) -> float:
     return float(r.distance) if r.stable and r.valid else 0.0
 
 
-def best_entry(run: Path, generation: Optional[int] = None) -> dict:
-    """The lineage entry of a packed run's best.tar.gz that was its best at ``generation`` (the last
-    entry at or before it; None: the last entry)."""
-    with tarfile.open(run / "best.tar.gz") as tar:
-        names = sorted(m for m in tar.getnames() if m.endswith(".json"))
-        if generation is not None:
-            names = [m for m in names if int(Path(m).stem.split("_")[-1]) <= generation]
-        if not names:
-            raise SystemExit(f"{run}: no best at or before generation {generation}")
-        member = tar.extractfile(names[-1])
-        assert member is not None
-        return json.loads(member.read())
-
-
 def evolved(spec: str) -> tuple:
     """The body of a packed run's best (``data/<study>/<env>/run_<i>[@GENERATION]``, the repository's
     path: its final best, or its best at GENERATION) as a KnownSwimmer with its GA-evolved controller,
@@ -156,7 +143,7 @@ def evolved(spec: str) -> tuple:
     path, _, generation = spec.partition("@")
     run = ROOT / path
     config = animat.load_config(str(run / "config.toml"))
-    entry = best_entry(run, int(generation) if generation else None)
+    entry = final_best(run, int(generation) if generation else None)
     genome = animat.Genome.from_json(json.dumps(entry["genome"]))
     e = animat.develop(genome, config)
     pos = np.asarray(e.positions, dtype=np.float64)

@@ -26,6 +26,7 @@ import json
 import sys
 import tarfile
 from pathlib import Path
+from typing import Optional
 
 import animat
 
@@ -35,11 +36,16 @@ OUT = ROOT / "studies" / "regime" / "results" / "step_ladder.csv"
 SUBSTEPS = (1, 2, 4, 16, 32)
 
 
-def final_best(run: Path) -> dict:
-    """The last lineage entry of a packed run's best.tar.gz."""
+def final_best(run: Path, generation: Optional[int] = None) -> dict:
+    """The last lineage entry of a packed run's best.tar.gz: its final best, or with ``generation``
+    its best at that generation (the last entry at or before it)."""
     with tarfile.open(run / "best.tar.gz") as tar:
-        last = sorted(m for m in tar.getnames() if m.endswith(".json"))[-1]
-        member = tar.extractfile(last)
+        names = sorted(m for m in tar.getnames() if m.endswith(".json"))
+        if generation is not None:
+            names = [m for m in names if int(Path(m).stem.split("_")[-1]) <= generation]
+        if not names:
+            raise SystemExit(f"{run}: no best at or before generation {generation}")
+        member = tar.extractfile(names[-1])
         assert member is not None
         return json.loads(member.read())
 
