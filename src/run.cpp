@@ -539,7 +539,22 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
     };
     probe_lock(opt.out);
     std::string checkpoint_text = check();
-    if (opt.resume) evo.restore(checkpoint_text, ckpt.string());
+    if (opt.resume) {
+      evo.restore(checkpoint_text, ckpt.string());
+      // Already at its cap, stalled or out of budget under these settings: nothing to evolve, so
+      // the directory is left as it is (its config.toml keeps the settings it ran under).
+      if (std::string reason = evo.stop_reason(); !reason.empty()) {
+        if (!opt.quiet)
+          spdlog::info("{}{} is at generation {}: {}; nothing to evolve, no file was written", tag,
+                       opt.out.string(), evo.generation(), reason);
+        RunSummary summary;
+        summary.stop_reason = std::move(reason);
+        summary.history = evo.history();
+        summary.best = evo.best();
+        summary.population = evo.population();
+        return summary;
+      }
+    }
     if (!opt.resume) {
       std::filesystem::create_directories(opt.out, ec);
       if (ec)

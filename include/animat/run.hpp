@@ -65,9 +65,11 @@ struct RunSummary {
 /// (path length, an existing run, a missing checkpoint), and on resume the checkpoint itself and
 /// the settings, which may differ from the run's config.toml only in resumable_keys() (the others
 /// are named in the ConfigError). Accepted changes are written to config.toml and noted in
-/// resume.log. A stop (stop_flag, stop_poll, or the callback returning false) leaves a checkpoint
-/// of the last complete generation; stop_reason is then "interrupted" (history empty if it came
-/// before generation 0 was complete, and nothing to resume). `fitness` defaults to
+/// resume.log. A resume that its settings stop at once (the generation cap already reached, the
+/// stall or the wall budget already spent) writes nothing and returns the run as it is, its
+/// stop_reason saying so. A stop (stop_flag, stop_poll, or the callback returning false) leaves a
+/// checkpoint of the last complete generation; stop_reason is then "interrupted" (history empty if
+/// it came before generation 0 was complete, and nothing to resume). `fitness` defaults to
 /// swim_fitness(config), and then `reference` to the exploit guard's
 /// swim_fitness(reference_config(config)) unless evaluation.reference_check is "off".
 RunSummary run_evolution(const Config& config, const RunOptions& options,

@@ -57,7 +57,7 @@ def _checkpoint_generation(out: Path) -> int:
 def _record_at_cap(config: _core.Config, out: Path, index: int) -> Optional[RunRecord]:
     """The record of a run whose checkpoint is at or past the config's generation cap, read from its
     files; None when it has no cap, no checkpoint or is below the cap (then it is resumed). Resuming it
-    would stop at once but rewrite its config.toml with the lower cap, its status and its resume.log."""
+    would change no file, but would give this round's cap as the reason the run stopped."""
     cap = int(config["evolution.generations"])
     if cap <= 0 or not (out / "checkpoint.json").exists():
         return None

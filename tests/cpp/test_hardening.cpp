@@ -791,6 +791,39 @@ TEST(ResumeSettings, ResumableKeysAreAcceptedAndRecorded) {
   fs::remove_all(run);
 }
 
+TEST(ResumeSettings, AResumeThatStopsAtOnceWritesNothing) {
+  // A run at generation 3 resumed with a cap of 2 has nothing to evolve: its config.toml keeps the
+  // cap it ran under (a rewrite to 2 would misstate the run), and no other file changes either.
+  const fs::path run = fresh_dir("resume_past_cap");
+  fs::copy(small_run(), run, fs::copy_options::recursive);
+  ASSERT_EQ(run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "3"}).rc, 0);
+  const auto before = snapshot(run);
+  const Shell r = run_exe({kExe, "--quiet", "--resume", run.string(), "--generations", "2"});
+  EXPECT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(snapshot(run), before) << "a resume past the cap changed the run directory";
+  EXPECT_EQ(load_config(run / "config.toml").evolution.generations, 3);
+
+  Config c = load_config(run / "config.toml");
+  RunOptions opt;
+  opt.out = run;
+  opt.resume = true;
+  opt.quiet = true;
+  for (const int cap : {1, 3}) {  // below the run's generation, and at it
+    c.evolution.generations = cap;
+    const RunSummary summary = run_evolution(c, opt, stub_fitness);
+    EXPECT_EQ(summary.stop_reason,
+              fmt::format("generation cap evolution.generations = {} reached", cap));
+    ASSERT_EQ(summary.history.size(), 4u);
+    EXPECT_EQ(summary.history.back().generation, 3);
+    EXPECT_EQ(summary.population.size(), 4u);
+    EXPECT_EQ(snapshot(run), before) << cap;
+  }
+  c.evolution.generations = 4;  // a higher cap evolves again
+  EXPECT_EQ(run_evolution(c, opt, stub_fitness).history.back().generation, 4);
+  EXPECT_EQ(load_config(run / "config.toml").evolution.generations, 4);
+  fs::remove_all(run);
+}
+
 TEST(ResumeSettings, InProcessResumeWithAnotherConfigWritesNothing) {
   const fs::path run = fresh_dir("resume_api");
   fs::copy(small_run(), run, fs::copy_options::recursive);
