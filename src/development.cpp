@@ -54,6 +54,10 @@ void validate(const DevelopmentParams& p) {
         "division_axis",
         fmt::format("unknown value '{}' (expected one of orientation, morphogen_gradient, outward)",
                     p.division_axis));
+  if (std::find(std::begin(kJitterStreamNames), std::end(kJitterStreamNames), p.jitter_stream) ==
+      std::end(kJitterStreamNames))
+    fail("jitter_stream",
+         fmt::format("unknown value '{}' (expected one of genome, fixed)", p.jitter_stream));
   if (p.division_max_contacts < 0)
     fail("division_max_contacts", fmt::format("must be >= 0, got {}", p.division_max_contacts));
   if (p.steps < 1) fail("steps", fmt::format("must be >= 1, got {}", p.steps));
@@ -669,7 +673,9 @@ Embryo develop(const Genome& genome, const GenomeParams& genome_params, const Gr
   const bool paths = grn.has_required_paths();
   const bool divide_reachable = grn.reaches(OutputChannel::divide);
   DevelopmentWorld world(std::move(grn), grn_params, params);
-  world.set_symmetry_seed(genome_hash(genome));
+  // jitter_stream = "fixed": any constant; this one is the first 64 bits of pi's fraction
+  world.set_symmetry_seed(params.jitter_stream == "fixed" ? 0x243F6A8885A308D3ULL
+                                                          : genome_hash(genome));
   world.add_cell(DevelopmentWorld::Vec2::Zero(), params.cell_radius,
                  DevelopmentWorld::Vec2(1.0, 0.0));
 

@@ -32,6 +32,9 @@ inline constexpr std::string_view kDevelopmentEffectNames[] = {"repulsion", "adh
 /// (away from the cells the mother touches).
 inline constexpr std::string_view kDivisionAxisNames[] = {"orientation", "morphogen_gradient",
                                                           "outward"};
+/// What seeds the placement jitter (DevelopmentParams::jitter_stream): "genome" (the genome's hash)
+/// or "fixed" (one stream for every genome).
+inline constexpr std::string_view kJitterStreamNames[] = {"genome", "fixed"};
 
 struct DevelopmentParams {
   int steps = 400;                ///< development steps [paper: 400]
@@ -45,9 +48,13 @@ struct DevelopmentParams {
   double cell_radius = 0.5;  ///< radius r0 of the first cell [choose]
   /// a daughter's radius is r0·(1 + max_growth·grow) [paper: up to +50%]
   double max_growth = 0.5;
-  /// daughter placement direction deviates by up to ± this angle (rad), seeded from the genome
+  /// daughter placement direction deviates by up to ± this angle (rad), seeded by jitter_stream
   /// [choose]
   double placement_jitter = 0.05;
+  /// What seeds the jitter's draws: "genome" (the genome's hash, so that any mutation redraws every
+  /// daughter's deviation) or "fixed" (one stream for every genome: a deviation depends only on the
+  /// step and the cell, and a mutation changes development only through what the GRN does) [choose]
+  std::string jitter_stream = "genome";
   /// daughter centre = mother centre + division_offset·r_mother·orientation [choose]
   double division_offset = 0.2;
   /// Placement direction of a daughter: "orientation" (the mother's orientation vector) [paper] or
@@ -121,10 +128,16 @@ void visit_fields(DevelopmentParams& p, V&& v) {
               Bounds::closed(0, 10)},
     p.max_growth);
   v(FieldInfo{"placement_jitter",
-              "daughter placement direction deviates by up to +-this angle (rad), seeded from the "
-              "genome hash; breaks exact symmetry [choose]",
+              "daughter placement direction deviates by up to +-this angle (rad), seeded by "
+              "jitter_stream; breaks exact symmetry [choose]",
               Bounds::closed(0, 3.2)},
     p.placement_jitter);
+  v(FieldInfo{"jitter_stream",
+              "what seeds the placement jitter: genome (the genome's hash: any mutation redraws "
+              "every daughter's deviation) or fixed (one stream for every genome: a mutation "
+              "changes development only through the GRN) [choose]",
+              Bounds::any(), kJitterStreamNames, Identity::late},
+    p.jitter_stream);
   v(FieldInfo{"division_offset",
               "daughter placed at division_offset*r_mother from the mother along its orientation "
               "[choose]",

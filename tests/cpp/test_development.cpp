@@ -214,6 +214,38 @@ TEST(Development, PlacementJitterIsBoundedSeededAndBreaksStraightLines) {
   EXPECT_EQ(line.positions.col(1).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(Development, AFixedJitterStreamLetsAnInertMutationKeepTheBody) {
+  // A promoter after the last gene regulates nothing: the GRN and its levels are those of g. Under
+  // the genome's stream its hash still redraws every daughter's deviation, and so the body; under
+  // the fixed stream the body is g's, bit for bit, and still not the straight line of no jitter.
+  const Genome g = bias_divide_genome();
+  Genome inert = g;
+  inert.elements.push_back(el(ElementType::promoter, 0, 9, 9));
+  ASSERT_NE(genome_hash(g), genome_hash(inert));
+  EXPECT_EQ(DevelopmentParams{}.jitter_stream, "genome");
+  const Embryo a = develop(g, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  const Embryo b = develop(inert, GenomeParams{}, GrnParams{}, DevelopmentParams{});
+  ASSERT_EQ(a.cell_count(), DevelopmentParams{}.max_cells);
+  ASSERT_EQ(b.cell_count(), a.cell_count());
+  EXPECT_GT((a.positions - b.positions).cwiseAbs().maxCoeff(), 1e-3);
+  DevelopmentParams fixed;
+  fixed.jitter_stream = "fixed";
+  const Embryo c = develop(g, GenomeParams{}, GrnParams{}, fixed);
+  const Embryo d = develop(inert, GenomeParams{}, GrnParams{}, fixed);
+  EXPECT_TRUE(c.positions == d.positions);
+  EXPECT_TRUE(c.outputs == d.outputs);
+  EXPECT_GT(c.positions.col(1).cwiseAbs().maxCoeff(), 1e-3);
+  fixed.jitter_stream = "hash";
+  try {
+    (void)develop(g, GenomeParams{}, GrnParams{}, fixed);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("development.jitter_stream"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("'hash'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Development, GradientDivisionAxisFollowsMaternalMorphogenZeroTurnedByRotate) {
   const Genome g = bias_divide_genome();
   const Grn grn(g, GenomeParams{});

@@ -302,6 +302,7 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nrepeat_perturbation = ",
                           "\nrepeat_statistic = ",
                           "\ndivision_axis = ",
+                          "\njitter_stream = ",
                           "\ndivision_max_contacts = ",
                           "\nupdate_period = ",
                           "\nprotection_generations = ",
