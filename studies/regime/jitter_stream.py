@@ -1,0 +1,146 @@
+"""Does the GA improve when a mutation no longer redraws the development's jitter?
+
+Every regime best loses most of its distance when its placement jitter is redrawn, and every mutation
+redraws it (development.jitter_stream = "genome", the seed is the genome's hash), so none of the GA's
+mutations keeps a best's body (mutation_effects.py). With jitter_stream = "fixed" the jitter is one
+stream for every genome and a mutation changes the body only through the GRN. This study evolves the
+regime preset at d_N = 0.5 and 10 under both streams, 4 runs each (evolution.seed + 0..3, the same seeds
+for both) to generation 200, and compares them: the best's reference fitness (dt/16, what the preset
+ranks by) over the generations, when it last rose, and the best's body and mode (stroke path) at
+generation 200. Under the genome's stream these runs are runs 0-3 of the regime replication
+(data/replication_regime), bit for bit (evolving them again to 200 gave the same histories), so they
+are read from there up to generation 200. The fixed stream's runs are packed in
+data/jitter_stream/<environment>/run_<i> (studies/replication/replication_store.py's format); about
+one core-hour:
+
+    PYTHONPATH=build/python .venv/bin/python -m animat experiment dn0.5=configs/regime_dn0.5.toml \\
+        dn10=configs/regime_dn10.toml --runs 4 --parallel 2 --threads 2 --generations 200 \\
+        --set development.jitter_stream=fixed --out runs/jitter_stream
+    PYTHONPATH=build/python .venv/bin/python studies/replication/replication_store.py pack \\
+        runs/jitter_stream data/jitter_stream
+    PYTHONPATH=build/python .venv/bin/python studies/regime/jitter_stream.py \\
+        --out studies/regime/results/jitter_stream.csv
+    # the table of docs/regime.md from the committed CSV
+    PYTHONPATH=build/python .venv/bin/python studies/regime/jitter_stream.py --summary
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import gzip
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import animat
+from animat.shape import genome_shape
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "studies" / "regime"))
+from step_ladder import final_best  # noqa: E402
+
+DATA = {"genome": ROOT / "data" / "replication_regime", "fixed": ROOT / "data" / "jitter_stream"}
+ENVS = ("dn0.5", "dn10")
+RUNS = 4
+OUT = ROOT / "studies" / "regime" / "results" / "jitter_stream.csv"
+STREAMS = ("genome", "fixed")
+CHECKPOINTS = (50, 100, 200)
+CAP = CHECKPOINTS[-1]
+
+
+def history(run: Path) -> list:
+    with gzip.open(run / "history.csv.gz", "rt") as fh:
+        return list(csv.DictReader(fh))
+
+
+def last_rise(rows: list) -> int:
+    """The generation at which the best's reference fitness last rose."""
+    found, best = 0, -math.inf
+    for r in rows:
+        ref = float(r["best_reference"])
+        if ref > best:
+            found, best = int(r["generation"]), ref
+    return found
+
+
+def row_of(run: Path) -> dict:
+    """The run up to generation CAP: its history and its best at CAP."""
+    rows = [r for r in history(run) if int(r["generation"]) <= CAP]
+    by_gen = {int(r["generation"]): r for r in rows}
+    config = animat.load_config(str(run / "config.toml"))
+    entry = final_best(run, CAP)
+    genome = animat.Genome.from_json(json.dumps(entry["genome"]))
+    shape = genome_shape(genome, config)
+    mode = animat.classify_locomotion(genome, config)
+    out = {
+        "stream": str(config["development.jitter_stream"]),
+        "environment": run.parent.name,
+        "run": run.name,
+        "generation": int(rows[-1]["generation"]),
+    }
+    for g in CHECKPOINTS:
+        out[f"best_reference_{g}"] = float(by_gen[g]["best_reference"]) if g in by_gen else math.nan
+    out["last_rise"] = last_rise(rows)
+    out["cells"] = shape.cell_count if shape else 0
+    out["elongation"] = shape.elongation if shape else math.nan
+    out["protrusions"] = len(shape.protrusions) if shape else 0
+    out["mode"] = mode.label
+    return out
+
+
+def summary(path: Path) -> str:
+    with open(path) as fh:
+        rows = list(csv.DictReader(fh))
+    out = [
+        "| environment | jitter stream | runs | best reference at generation "
+        + ", ".join(str(g) for g in CHECKPOINTS)
+        + ": median (range) | last rise: median (range) | elongation: median | modes |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for env in dict.fromkeys(r["environment"] for r in rows):
+        for stream in STREAMS:
+            sel = [r for r in rows if r["environment"] == env and r["stream"] == stream]
+            if not sel:
+                continue
+            cells = []
+            for g in CHECKPOINTS:
+                v = np.array([float(r[f"best_reference_{g}"]) for r in sel])
+                cells.append(f"{np.median(v):.1f} ({v.min():.1f}–{v.max():.1f})")
+            rise = np.array([int(r["last_rise"]) for r in sel])
+            modes: dict = {}
+            for r in sel:
+                modes[r["mode"]] = modes.get(r["mode"], 0) + 1
+            out.append(
+                f"| {env} | {stream} | {len(sel)} | "
+                + "; ".join(cells)
+                + f" | {int(np.median(rise))} ({rise.min()}–{rise.max()}) | "
+                + f"{np.median([float(r['elongation']) for r in sel]):.2f} | "
+                + ", ".join(f"{m} {n}" for m, n in sorted(modes.items(), key=lambda kv: -kv[1]))
+                + " |"
+            )
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", type=Path, default=OUT)
+    p.add_argument("--summary", action="store_true", help="print the table of docs/regime.md from --out")
+    args = p.parse_args(argv)
+    if not args.summary:
+        rows = [row_of(DATA[s] / env / f"run_{i}") for s in STREAMS for env in ENVS for i in range(RUNS)]
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        with open(args.out, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]), lineterminator="\n")
+            w.writeheader()
+            for row in rows:
+                w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+    print(summary(args.out))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
