@@ -41,6 +41,7 @@ from animat.shape import genome_shape
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies" / "regime"))
+from mutation_effects import write  # noqa: E402
 from step_ladder import final_best  # noqa: E402
 
 DATA = {"genome": ROOT / "data" / "replication_regime", "fixed": ROOT / "data" / "jitter_stream"}
@@ -131,13 +132,7 @@ def main(argv=None) -> int:
     p.add_argument("--summary", action="store_true", help="print the table of docs/regime.md from --out")
     args = p.parse_args(argv)
     if not args.summary:
-        rows = [row_of(DATA[s] / env / f"run_{i}") for s in STREAMS for env in ENVS for i in range(RUNS)]
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        with open(args.out, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]), lineterminator="\n")
-            w.writeheader()
-            for row in rows:
-                w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+        write([row_of(DATA[s] / env / f"run_{i}") for s in STREAMS for env in ENVS for i in range(RUNS)], args.out)
     print(summary(args.out))
     return 0
 

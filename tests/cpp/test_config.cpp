@@ -192,7 +192,7 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
         for (const char* word :
              {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",
               "grn", "point", "distance", "front", "amplitude", "morphogen_gradient", "compliant",
-              "min", "map_elites"})
+              "min", "map_elites", "fixed"})
           candidates.push_back(std::string(word));
       }
       for (const auto& cand : candidates) {

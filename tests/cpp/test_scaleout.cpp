@@ -24,6 +24,8 @@ using animat::test::stub_fitness;
 
 namespace {
 
+#include "../../src/run_identity_v1_comments.inc"
+
 Config island_config(int islands = 3, int population = 12, int interval = 2, int migrants = 1) {
   Config c;
   c.evolution.population = population;
@@ -252,7 +254,12 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
   // existed), with the resource knobs at their defaults; lines after them still count.
   Config plain = a;
   plain.evolution.threads = EvolutionParams{}.threads;
-  std::string text = to_toml(plain);
+  // with the keys' comments of that time (a key's documentation may change since)
+  std::string text = to_toml(plain, kV1Version, [](std::string_view key, std::string_view doc) {
+    for (const auto& [k, comment] : kV1Comments)
+      if (k == key) return std::string(comment);
+    return std::string(doc);
+  });
   const auto begin = text.find("# sub-populations evolving apart");
   const auto end = text.find('\n', text.find("\nmigrants = ") + 1) + 1;
   ASSERT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(begin),
