@@ -20,7 +20,15 @@ one core-hour:
         runs/jitter_stream data/jitter_stream
     PYTHONPATH=build/python .venv/bin/python studies/regime/jitter_stream.py \\
         --out studies/regime/results/jitter_stream.csv
-    # the table of docs/regime.md from the committed CSV
+    # each best at generation 200 with its controller searched on its body (controller_optimum.py)
+    for s in genome fixed; do
+      d=data/jitter_stream; [ $s = genome ] && d=data/replication_regime
+      PYTHONPATH=build/python .venv/bin/python studies/regime/controller_optimum.py --seeds 1 --jobs 2 \\
+          --evolved $d/dn0.5/run_0@200 $d/dn0.5/run_1@200 $d/dn0.5/run_2@200 $d/dn0.5/run_3@200 \\
+          $d/dn10/run_0@200 $d/dn10/run_1@200 $d/dn10/run_2@200 $d/dn10/run_3@200 \\
+          --out studies/regime/results/controller_optimum_${s}200.csv
+    done
+    # the tables of docs/regime.md from the committed CSVs
     PYTHONPATH=build/python .venv/bin/python studies/regime/jitter_stream.py --summary
 """
 
@@ -126,6 +134,29 @@ def summary(path: Path) -> str:
     return "\n".join(out)
 
 
+def controller_gains(results: Path) -> str:
+    """What a controller search adds to each stream's bests at generation 200, from
+    results/controller_optimum_<stream>200.csv."""
+    out = [
+        "| environment | jitter stream | bests | GA's controller at dt/16: median (range) | searched: median (range) | "
+        "gain: median (range) |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    rows = {s: list(csv.DictReader(open(results / f"controller_optimum_{s}200.csv"))) for s in STREAMS}
+    for env in ENVS:
+        for stream in STREAMS:
+            sel = [r for r in rows[stream] if r["environment"] == env]
+            ga = np.array([float(r["distance_evolved_s16"]) for r in sel])
+            cm = np.array([float(r["distance_s16"]) for r in sel])
+            gain = 100 * (cm / ga - 1.0)
+            out.append(
+                f"| {env} | {stream} | {len(sel)} | {np.median(ga):.1f} ({ga.min():.1f}–{ga.max():.1f}) | "
+                f"{np.median(cm):.1f} ({cm.min():.1f}–{cm.max():.1f}) | {np.median(gain):+.0f} % "
+                f"({gain.min():+.0f} to {gain.max():+.0f} %) |"
+            )
+    return "\n".join(out)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=Path, default=OUT)
@@ -134,6 +165,9 @@ def main(argv=None) -> int:
     if not args.summary:
         write([row_of(DATA[s] / env / f"run_{i}") for s in STREAMS for env in ENVS for i in range(RUNS)], args.out)
     print(summary(args.out))
+    if (args.out.parent / "controller_optimum_fixed200.csv").is_file():
+        print()
+        print(controller_gains(args.out.parent))
     return 0
 
 
