@@ -142,7 +142,10 @@ def controller_gains(results: Path) -> str:
         "gain: median (range) |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
-    rows = {s: list(csv.DictReader(open(results / f"controller_optimum_{s}200.csv"))) for s in STREAMS}
+    rows = {}
+    for s in STREAMS:
+        with open(results / f"controller_optimum_{s}200.csv") as fh:
+            rows[s] = list(csv.DictReader(fh))
     for env in ENVS:
         for stream in STREAMS:
             sel = [r for r in rows[stream] if r["environment"] == env]
