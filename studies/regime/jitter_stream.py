@@ -9,20 +9,21 @@ for both) to generation 200, and compares them: the best's reference fitness (dt
 ranks by) over the generations, when it last rose, and the best's body and mode (stroke path) at
 generation 200. Under the genome's stream these runs are runs 0-3 of the regime replication
 (data/replication_regime), bit for bit (evolving them again to 200 gave the same histories), so they
-are read from there up to generation 200. The fixed stream's runs are packed in
-data/jitter_stream/<environment>/run_<i> (studies/replication/replication_store.py's format); about
-one core-hour:
+are read from there up to generation 200. Under the fixed stream they are runs 0-3 of the same study
+at the fixed stream's preset (configs/regime_fixed_<env>.toml, data/replication_regime_fixed, grown
+by studies/replication/replication.sh as docs/regime.md says), read up to generation 200 too. They
+were made first on their own, in about one core-hour:
 
-    PYTHONPATH=build/python .venv/bin/python -m animat experiment dn0.5=configs/regime_dn0.5.toml \\
-        dn10=configs/regime_dn10.toml --runs 4 --parallel 2 --threads 2 --generations 200 \\
-        --set development.jitter_stream=fixed --out runs/jitter_stream
+    PYTHONPATH=build/python .venv/bin/python -m animat experiment dn0.5=configs/regime_fixed_dn0.5.toml \\
+        dn10=configs/regime_fixed_dn10.toml --runs 4 --parallel 2 --threads 2 --generations 200 \\
+        --out runs/replication_regime_fixed
     PYTHONPATH=build/python .venv/bin/python studies/replication/replication_store.py pack \\
-        runs/jitter_stream data/jitter_stream
+        runs/replication_regime_fixed data/replication_regime_fixed
     PYTHONPATH=build/python .venv/bin/python studies/regime/jitter_stream.py \\
         --out studies/regime/results/jitter_stream.csv
     # each best at generation 200 with its controller searched on its body (controller_optimum.py)
     for s in genome fixed; do
-      d=data/jitter_stream; [ $s = genome ] && d=data/replication_regime
+      d=data/replication_regime_fixed; [ $s = genome ] && d=data/replication_regime
       PYTHONPATH=build/python .venv/bin/python studies/regime/controller_optimum.py --seeds 1 --jobs 2 \\
           --evolved $d/dn0.5/run_0@200 $d/dn0.5/run_1@200 $d/dn0.5/run_2@200 $d/dn0.5/run_3@200 \\
           $d/dn10/run_0@200 $d/dn10/run_1@200 $d/dn10/run_2@200 $d/dn10/run_3@200 \\
@@ -52,7 +53,7 @@ sys.path.insert(0, str(ROOT / "studies" / "regime"))
 from mutation_effects import write  # noqa: E402
 from step_ladder import final_best  # noqa: E402
 
-DATA = {"genome": ROOT / "data" / "replication_regime", "fixed": ROOT / "data" / "jitter_stream"}
+DATA = {"genome": ROOT / "data" / "replication_regime", "fixed": ROOT / "data" / "replication_regime_fixed"}
 ENVS = ("dn0.5", "dn10")
 RUNS = 4
 OUT = ROOT / "studies" / "regime" / "results" / "jitter_stream.csv"

@@ -43,7 +43,7 @@ read as the study grows:
         --study data/replication_regime --envs dn0.5 dn10 --runs 0 1 2 3 --generation 200 \\
         --out studies/regime/results/mutation_effects_genome200.csv
     PYTHONPATH=build/python .venv/bin/python studies/regime/mutation_effects.py --jobs 2 \\
-        --study data/jitter_stream --envs dn0.5 dn10 --runs 0 1 2 3 --generation 200 \\
+        --study data/replication_regime_fixed --envs dn0.5 dn10 --runs 0 1 2 3 --generation 200 \\
         --out studies/regime/results/mutation_effects_fixed200.csv
     # each best developed again with its jitter redrawn, scaled or off (no mutation)
     PYTHONPATH=build/python .venv/bin/python studies/regime/mutation_effects.py --jitter \\
@@ -331,12 +331,18 @@ def summary(path: Path) -> str:
     return "\n".join(out)
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def study_arguments(doc: str) -> argparse.ArgumentParser:
+    """The command line's choice of bests: a packed study, its environments and runs, a generation."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--study", type=Path, default=ROOT / "data" / "replication_regime")
     p.add_argument("--envs", nargs="+", default=["dn0.5", "dn2", "dn10"])
     p.add_argument("--runs", type=int, nargs="+", default=list(range(10)))
     p.add_argument("--generation", type=int, default=424, help="each run's best at or before this generation")
+    return p
+
+
+def main(argv=None) -> int:
+    p = study_arguments(__doc__)
     p.add_argument("--mutants", type=int, default=400, help="GA mutants, and perturbations per sigma, per best")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument(

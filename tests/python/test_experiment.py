@@ -47,6 +47,15 @@ def test_regime_presets_are_the_paper_environments_with_their_two_values(env, da
     assert paper["scene.spring_damping"] == 4.0 and paper["evaluation.reference_check"] == "record"
 
 
+@pytest.mark.parametrize("env", ["dn0.5", "dn2", "dn10", "dn0.2_64cells"])
+def test_fixed_stream_presets_are_the_regime_presets_with_one_jitter_stream(env):
+    regime = animat.load_config(str(ROOT / "configs" / f"regime_{env}.toml"))
+    fixed = animat.load_config(str(ROOT / "configs" / f"regime_fixed_{env}.toml"))
+    changed = {key: fixed[key] for key in regime.keys() if fixed[key] != regime[key]}
+    assert changed == {"development.jitter_stream": "fixed"}
+    assert regime["development.jitter_stream"] == "genome"
+
+
 def test_experiment_runs_seeds_resumes_and_summarises(tmp_path):
     cfg = tmp_path / "tiny.toml"
     cfg.write_text(TINY)

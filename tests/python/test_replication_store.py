@@ -378,7 +378,9 @@ def test_a_gzip_bomb_is_refused_at_the_size_limit_in_bounded_memory(tmp_path, mo
     assert not (tmp_path / "work" / "dn2" / "run_0").exists()
 
 
-@pytest.mark.parametrize("study,count", [("replication", 40), ("replication_regime", 40), ("jitter_stream", 8)])
+@pytest.mark.parametrize(
+    "study,count", [("replication", 40), ("replication_regime", 40), ("replication_regime_fixed", 8)]
+)
 def test_every_committed_packed_run_has_a_manifest_and_unpacks_verified(tmp_path, study, count):
     runs = [p for group in R.packed_runs(ROOT / "data" / study).values() for p in group]
     assert len(runs) >= count
