@@ -19,7 +19,10 @@ threshold (gabriel_margins: the largest angle another centre sees the edge at is
   the relative change of the length of the centroid's path (the distance is its end-to-end length:
   a swim that only turns keeps its path length); ``springs_changed_distance`` and
   ``springs_changed_alpha_shape``, the springs the same two bodies' graphs differ by under body.graph's
-  other rules (docs/model.md "Other body graphs"; no swim).
+  other rules (docs/model.md "Other body graphs"; no swim); for eps >= 1e-3, ``change_retuned``: the
+  change once the frequency is re-tuned, the farthest swim of the new body with every cell's
+  frequency scaled by 0.80, 0.81, ..., 1.20 against the same for the best (the bests are tuned sharply
+  to their bodies' elastic modes, and a body change shifts the modes).
 
 With ``--mutants`` it sorts the GA's body-changing mutations of a best (Genome.mutate at the run's
 rates and seeds, the mutants of mutation_effects.py) by whether they keep the spring graph, to see
@@ -83,7 +86,10 @@ MEASURES = (
     "path_change",
     "springs_changed_distance",
     "springs_changed_alpha_shape",
+    "change_retuned",
 )
+RETUNE = np.round(np.arange(0.80, 1.2001, 0.01), 2)  # the frequency multipliers tried in re-tuning
+RETUNE_FROM = 1e-3  # smaller eps change the distance too little to re-tune
 OTHER_GRAPHS = ("distance", "alpha_shape")  # body.graph's other rules, at their default thresholds
 NEAR_ANGLE = 1.0  # degrees: a Delaunay edge this close to the Gabriel rule's threshold is near a flip
 EPS = (1e-6, 1e-5, 1e-4, 1e-3, 3e-3, 1e-2, 3e-2, 1e-1)
@@ -129,6 +135,18 @@ def path_length(genome, config) -> float:
     return float(np.sum(np.linalg.norm(np.diff(com, axis=0), axis=1)))
 
 
+def retuned(positions: np.ndarray, c: np.ndarray, config) -> float:
+    """The farthest swim of a body with every cell's frequency scaled by one of RETUNE (clipped to the
+    frequency range): what re-tuning the body's one frequency recovers."""
+    lo, hi = config["development.frequency_min"], config["development.frequency_max"]
+    best = -math.inf
+    for m in RETUNE:
+        tuned = c.copy()
+        tuned[:, 1] = np.clip(c[:, 1] * m, lo, hi)
+        best = max(best, swim(positions, tuned, config))
+    return best
+
+
 def ladder(task: tuple) -> list:
     """One best developed with its placement deviations scaled by 1 + eps, for every eps."""
     run, generation = task
@@ -139,6 +157,7 @@ def ladder(task: tuple) -> list:
     other0 = {g: springs(p0, c0, config, g) for g in OTHER_GRAPHS}
     base, base_path = swim(p0, c0, config), path_length(genome, config)
     margins = gabriel_margins(p0)
+    base_retuned = retuned(p0, c0, config)
     radius = config["development.cell_radius"]
     rows = []
     for eps in EPS:
@@ -174,6 +193,8 @@ def ladder(task: tuple) -> list:
         )
         for g in OTHER_GRAPHS:
             row[f"springs_changed_{g}"] = springs_changed(other0[g], springs(p, ctl, config, g))
+        if eps >= RETUNE_FROM:
+            row["change_retuned"] = retuned(p, ctl, config) / base_retuned - 1.0
         rows.append(row)
     return rows
 
@@ -253,8 +274,8 @@ def ladder_summary(path: Path) -> str:
         "| environment | eps | bests | shape distance (radii): median | control step: median | "
         "same springs: Gabriel, distance, alpha_shape | distance change: median (range) | "
         "with the same springs: median | with other springs: median | body alone: median | "
-        "controls alone: median | path length change: median |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "controls alone: median | path length change: median | frequency re-tuned: median |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     envs = list(dict.fromkeys(r["environment"] for r in rows))
     for env in envs:
@@ -267,7 +288,9 @@ def ladder_summary(path: Path) -> str:
                 f"| {env} | {eps:g} | {len(k)} | {np.median([number(r, 'shape_distance') for r in k]):.1e} | "
                 f"{np.median([number(r, 'control_step') for r in k]):.1e} | {', '.join(map(str, kept))} of {len(k)} | "
                 f"{pct([number(r, 'change') for r in k])} | {med(same, 'change')} | {med(other, 'change')} | "
-                f"{med(k, 'change_body')} | {med(k, 'change_controls')} | {med(k, 'path_change')} |"
+                f"{med(k, 'change_body')} | {med(k, 'change_controls')} | {med(k, 'path_change')} | "
+                + (med(k, "change_retuned") if eps >= RETUNE_FROM else "—")
+                + " |"
             )
     out += ["", "| environment | bests | Delaunay edges per best: median | within 1 degree of the Gabriel threshold |"]
     out.append("| --- | --- | --- | --- |")
