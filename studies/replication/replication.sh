@@ -26,8 +26,10 @@
 # least advanced run is one outside it.)
 # ANIMAT_REPLICATION_PRESET=regime grows the same study at the regime presets (configs/regime_<env>.toml,
 # docs/regime.md) instead of the paper's environments (configs/paper_<env>.toml, the default "paper"),
-# in the environments the preset has (regime: all four); give it its own
-# ANIMAT_REPLICATION_DATA, _OUT, _DOC and _IMAGES (the page's figures, default docs/images/replication).
+# in the environments the preset has (regime: all four); ANIMAT_REPLICATION_PRESET=regime_fixed grows
+# it at configs/regime_fixed_<env>.toml (the regime presets with development.jitter_stream = "fixed").
+# Give each its own ANIMAT_REPLICATION_DATA, _OUT, _DOC and _IMAGES (the page's figures, default
+# docs/images/replication).
 # The paper's discussion (docs/notes/replication_discussion.md) and the controlled runs' section are
 # written for the paper preset only.
 set -euo pipefail

@@ -730,16 +730,30 @@ def unpack_tree(root: Path, work: Path) -> List[Path]:
     return done
 
 
-def _stop_reasons(env_dir: Path) -> Dict[int, str]:
+def _stop_reasons(env_dir: Path) -> Dict[int, Tuple[int, str]]:
+    """Each run's (generation, stop reason) as ``env_dir/summary.json`` records them."""
     f = env_dir / "summary.json"
     if not f.is_file():
         return {}
-    return {int(r["index"]): str(r["stop_reason"]) for r in json.loads(f.read_text()).get("runs", [])}
+    return {
+        int(r["index"]): (int(r["generations"]), str(r["stop_reason"]))
+        for r in json.loads(f.read_text()).get("runs", [])
+    }
+
+
+def _last_history_generation(run: Path) -> Optional[int]:
+    try:
+        lines = [ln for ln in (run / "history.csv").read_text().splitlines() if ln.strip()]
+        return int(lines[-1].split(",")[0]) if len(lines) > 1 else None
+    except (OSError, ValueError):
+        return None
 
 
 def pack_tree(work: Path, root: Path) -> List[Path]:
     """Pack every run ``work/<env>/run_<i>`` with a checkpoint into ``root/<env>/run_<i>`` (stop reasons from
-    ``work/<env>/summary.json`` when the experiment wrote one). Returns the packed directories. Every run is
+    ``work/<env>/summary.json`` when the experiment wrote one and it records the generation the run's history
+    ends at: a session stopped before it wrote its summary leaves an earlier session's there, whose reason is
+    not this one's; the reason is then derived from the history). Returns the packed directories. Every run is
     checked first: when one is refused (see ``pack_run``), StoreError lists each refused run and no file is
     written."""
     plans, errors = [], []
@@ -749,7 +763,9 @@ def pack_tree(work: Path, root: Path) -> List[Path]:
             if run.name[4:].isdigit() and (run / "checkpoint.json").is_file():
                 dest = Path(root) / env.name / run.name
                 try:
-                    plans.append((dest, _prepare_pack(run, dest, reasons.get(int(run.name[4:])))))
+                    recorded = reasons.get(int(run.name[4:]))
+                    reason = recorded[1] if recorded and recorded[0] == _last_history_generation(run) else None
+                    plans.append((dest, _prepare_pack(run, dest, reason)))
                 except (StoreError, OSError) as e:
                     errors.append(str(e))
     if errors:

@@ -46,15 +46,23 @@ def test_unpack_then_pack_gives_the_same_bytes(tmp_path):
         R.unpack_run(PACKED, work)  # never overwrites a work directory that holds a run
 
 
-def test_pack_tree_takes_stop_reasons_from_the_summary_and_derives_them_otherwise(tmp_path):
+def test_pack_tree_takes_stop_reasons_from_a_current_summary_and_derives_them_otherwise(tmp_path):
     data = tmp_path / "data"
     shutil.copytree(PACKED, data / "dn2" / "run_0")
     work = tmp_path / "work"
     assert [p.name for p in R.unpack_tree(data, work)] == ["run_0"]
     assert R.unpack_tree(data, work) == []  # already unpacked: kept
-    (work / "dn2" / "summary.json").write_text(json.dumps({"runs": [{"index": 0, "stop_reason": "interrupted"}]}))
+    summary = {"runs": [{"index": 0, "generations": 100, "stop_reason": "interrupted"}]}
+    (work / "dn2" / "summary.json").write_text(json.dumps(summary))
     R.pack_tree(work, data)
     assert json.loads((data / "dn2" / "run_0" / "status.json").read_text())["stop_reason"] == "interrupted"
+    # A summary of an earlier session (one stopped before writing its own keeps it) is not this run's reason.
+    summary["runs"][0].update(generations=90, stop_reason="generation cap evolution.generations = 90 reached")
+    (work / "dn2" / "summary.json").write_text(json.dumps(summary))
+    (data / "dn2" / "run_0" / "status.json").write_text(json.dumps({"generation": 99, "stop_reason": "x"}))
+    R.pack_tree(work, data)
+    status = json.loads((data / "dn2" / "run_0" / "status.json").read_text())
+    assert status == {"generation": 100, "stop_reason": "generation cap evolution.generations = 100 reached"}
     (work / "dn2" / "summary.json").unlink()
     (data / "dn2" / "run_0" / "status.json").write_text(json.dumps({"generation": 99, "stop_reason": "x"}))
     R.pack_tree(work, data)  # the run moved since: the reason is derived from its config and history
