@@ -11,14 +11,22 @@ generation 200. Under the genome's stream these runs are runs 0-3 of the regime 
 (data/replication_regime), bit for bit (evolving them again to 200 gave the same histories), so they
 are read from there up to generation 200. Under the fixed stream they are runs 0-3 of the same study
 at the fixed stream's preset (configs/regime_fixed_<env>.toml, data/replication_regime_fixed, grown
-by studies/replication/replication.sh as docs/regime.md says), read up to generation 200 too. They
-were made first on their own, in about one core-hour:
+by studies/replication/replication.sh as docs/regime.md says), read up to generation 200 too. A third
+arm, at d_N = 0.5 only, adds the niching the paper suggests (§7) to the fixed stream: a new body plan is
+protected for 20 generations (evolution.protection_generations = 20, docs/model.md), the same 4 seeds
+(data/regime_protection). The first two arms were made first on their own, in about one core-hour:
 
     PYTHONPATH=build/python .venv/bin/python -m animat experiment dn0.5=configs/regime_fixed_dn0.5.toml \\
         dn10=configs/regime_fixed_dn10.toml --runs 4 --parallel 2 --threads 2 --generations 200 \\
         --out runs/replication_regime_fixed
     PYTHONPATH=build/python .venv/bin/python studies/replication/replication_store.py pack \\
         runs/replication_regime_fixed data/replication_regime_fixed
+    # the protected arm (about 40 core-minutes)
+    PYTHONPATH=build/python .venv/bin/python -m animat experiment dn0.5=configs/regime_fixed_dn0.5.toml \\
+        --set evolution.protection_generations=20 --runs 4 --parallel 2 --threads 2 --generations 200 \\
+        --out runs/regime_fixed_protection20
+    PYTHONPATH=build/python .venv/bin/python studies/replication/replication_store.py pack \\
+        runs/regime_fixed_protection20 data/regime_protection
     PYTHONPATH=build/python .venv/bin/python studies/regime/jitter_stream.py \\
         --out studies/regime/results/jitter_stream.csv
     # each best at generation 200 with its controller searched on its body (controller_optimum.py)
@@ -58,6 +66,11 @@ ENVS = ("dn0.5", "dn10")
 RUNS = 4
 OUT = ROOT / "studies" / "regime" / "results" / "jitter_stream.csv"
 STREAMS = ("genome", "fixed")
+# The fixed stream with the paper's suggested niching (evolution.protection_generations = 20), at
+# d_N = 0.5 only: the same seeds, so each run starts from the population of the fixed stream's run.
+PROTECTED = ROOT / "data" / "regime_protection"
+PROTECTION = 20
+PROTECTED_ENVS = ("dn0.5",)
 CHECKPOINTS = (50, 100, 200)
 CAP = CHECKPOINTS[-1]
 
@@ -88,6 +101,7 @@ def row_of(run: Path) -> dict:
     mode = animat.classify_locomotion(genome, config)
     out = {
         "stream": str(config["development.jitter_stream"]),
+        "protection_generations": int(config["evolution.protection_generations"]),
         "environment": run.parent.name,
         "run": run.name,
         "generation": int(rows[-1]["generation"]),
@@ -95,6 +109,9 @@ def row_of(run: Path) -> dict:
     for g in CHECKPOINTS:
         out[f"best_reference_{g}"] = float(by_gen[g]["best_reference"]) if g in by_gen else math.nan
     out["last_rise"] = last_rise(rows)
+    # viable individuals of a new body plan still protected, per generation (runs with protection only)
+    protected = [int(r["protected"]) for r in rows[1:] if r.get("protected")]
+    out["protected_median"] = float(np.median(protected)) if protected else math.nan
     out["cells"] = shape.cell_count if shape else 0
     out["elongation"] = shape.elongation if shape else math.nan
     out["protrusions"] = len(shape.protrusions) if shape else 0
@@ -108,14 +125,23 @@ def summary(path: Path) -> str:
     out = [
         "| environment | jitter stream | runs | best reference at generation "
         + ", ".join(str(g) for g in CHECKPOINTS)
-        + ": median (range) | last rise: median (range) | elongation: median | modes |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        + ": median (range) | last rise: median (range) | protected per generation: median | elongation: median "
+        "| modes |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
+    arms = dict.fromkeys((r["stream"], int(r.get("protection_generations") or 0)) for r in rows)
     for env in dict.fromkeys(r["environment"] for r in rows):
-        for stream in STREAMS:
-            sel = [r for r in rows if r["environment"] == env and r["stream"] == stream]
+        for stream, protection in arms:
+            sel = [
+                r
+                for r in rows
+                if r["environment"] == env
+                and r["stream"] == stream
+                and int(r.get("protection_generations") or 0) == protection
+            ]
             if not sel:
                 continue
+            label = f"{stream}, protection {protection}" if protection else stream
             cells = []
             for g in CHECKPOINTS:
                 v = np.array([float(r[f"best_reference_{g}"]) for r in sel])
@@ -125,9 +151,10 @@ def summary(path: Path) -> str:
             for r in sel:
                 modes[r["mode"]] = modes.get(r["mode"], 0) + 1
             out.append(
-                f"| {env} | {stream} | {len(sel)} | "
+                f"| {env} | {label} | {len(sel)} | "
                 + "; ".join(cells)
                 + f" | {int(np.median(rise))} ({rise.min()}–{rise.max()}) | "
+                + (f"{np.median([float(r['protected_median']) for r in sel]):.0f} | " if protection else "— | ")
                 + f"{np.median([float(r['elongation']) for r in sel]):.2f} | "
                 + ", ".join(f"{m} {n}" for m, n in sorted(modes.items(), key=lambda kv: -kv[1]))
                 + " |"
@@ -167,7 +194,9 @@ def main(argv=None) -> int:
     p.add_argument("--summary", action="store_true", help="print the table of docs/regime.md from --out")
     args = p.parse_args(argv)
     if not args.summary:
-        write([row_of(DATA[s] / env / f"run_{i}") for s in STREAMS for env in ENVS for i in range(RUNS)], args.out)
+        runs = [DATA[s] / env / f"run_{i}" for s in STREAMS for env in ENVS for i in range(RUNS)]
+        runs += [PROTECTED / env / f"run_{i}" for env in PROTECTED_ENVS for i in range(RUNS)]
+        write([row_of(run) for run in runs], args.out)
     print(summary(args.out))
     if (args.out.parent / "controller_optimum_fixed200.csv").is_file():
         print()

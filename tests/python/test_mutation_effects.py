@@ -89,10 +89,12 @@ def test_the_jitter_stream_table_is_read_from_the_packed_runs():
     import jitter_stream as js
 
     with open(ROOT / "studies" / "regime" / "results" / "jitter_stream.csv") as fh:
-        rows = {(r["stream"], r["environment"], r["run"]): r for r in csv.DictReader(fh)}
-    assert len(rows) == len(js.STREAMS) * len(js.ENVS) * js.RUNS
+        rows = {
+            (r["stream"], int(r["protection_generations"]), r["environment"], r["run"]): r for r in csv.DictReader(fh)
+        }
+    assert len(rows) == (len(js.STREAMS) * len(js.ENVS) + len(js.PROTECTED_ENVS)) * js.RUNS
     got = js.row_of(js.DATA["fixed"] / "dn0.5" / "run_0")
-    want = rows[("fixed", "dn0.5", "run_0")]
+    want = rows[("fixed", 0, "dn0.5", "run_0")]
     assert got["generation"] == int(want["generation"]) == js.CAP
     assert got["last_rise"] == int(want["last_rise"])
     for g in js.CHECKPOINTS:
@@ -100,3 +102,6 @@ def test_the_jitter_stream_table_is_read_from_the_packed_runs():
     assert got["mode"] == want["mode"]
     # the genome's stream is read from the regime replication, cut at the same generation
     assert js.row_of(js.DATA["genome"] / "dn10" / "run_3")["generation"] == js.CAP
+    protected = js.row_of(js.PROTECTED / "dn0.5" / "run_1")
+    assert protected["protection_generations"] == js.PROTECTION
+    assert protected["mode"] == rows[("fixed", js.PROTECTION, "dn0.5", "run_1")]["mode"]
