@@ -741,10 +741,19 @@ def _stop_reasons(env_dir: Path) -> Dict[int, Tuple[int, str]]:
     }
 
 
+def _history_lines(run: Path) -> List[str]:
+    """The non-empty lines of ``run/history.csv``, header first."""
+    return [ln for ln in (run / "history.csv").read_text().splitlines() if ln.strip()]
+
+
+def _last_generation(lines: Sequence[str]) -> Optional[int]:
+    """The generation of the last row of a history's lines; None when it has no row."""
+    return int(lines[-1].split(",")[0]) if len(lines) > 1 else None
+
+
 def _last_history_generation(run: Path) -> Optional[int]:
     try:
-        lines = [ln for ln in (run / "history.csv").read_text().splitlines() if ln.strip()]
-        return int(lines[-1].split(",")[0]) if len(lines) > 1 else None
+        return _last_generation(_history_lines(run))
     except (OSError, ValueError):
         return None
 
@@ -784,11 +793,10 @@ def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int,
     for env in envs:
         for i in range(runs):
             run = Path(work) / env / f"run_{i}"
-            history = run / "history.csv"
             last = 0
-            if history.is_file():
-                lines = [ln for ln in history.read_text().splitlines() if ln.strip()]
-                last = int(lines[-1].split(",")[0]) if len(lines) > 1 else 0
+            if (run / "history.csv").is_file():
+                lines = _history_lines(run)
+                last = _last_generation(lines) or 0
                 if "no improvement" in _derived_stop(run / "config.toml", lines):
                     continue
             if last >= generations:
