@@ -7,6 +7,8 @@ oscillators sit to their bounds. The criteria are defined in docs/regime.md.
         --data data/replication --out studies/regime/results/replication_today.csv
 
 writes one row per best and prints the per-environment medians that docs/regime.md quotes.
+``--reference`` swims at the exploit guard's reference step (dt/16 by default), the swim that a study
+ranked with ``evaluation.reference_check = "select"`` selected on.
 ``--set scene.spring_damping=1`` re-swims the same bodies with a constant changed.
 """
 
@@ -135,6 +137,13 @@ def main(argv=None) -> int:
         help="re-swim every best with this config value changed (e.g. scene.spring_damping=1): how "
         "the constants move the split for the same bodies",
     )
+    ap.add_argument(
+        "--reference",
+        action="store_true",
+        help="swim at the exploit guard's reference step (animat.reference_config: physics.substeps x "
+        "evaluation.reference_substeps), the swim a study with evaluation.reference_check = 'select' "
+        "ranks its elites by",
+    )
     args = ap.parse_args(argv)
     overrides = []
     for item in args.set:
@@ -152,6 +161,8 @@ def main(argv=None) -> int:
                 config = run.config
                 for key, value in overrides:
                     config[key] = value
+                if args.reference:
+                    config = animat.reference_config(config)
                 row = {"environment": env, "run": packed.name}
                 row.update(measure(run.best().genome, config))
                 rows.append(row)
