@@ -8,11 +8,13 @@ schedule at every step). Writes studies/control/results/ladder.csv and prints th
 
 from __future__ import annotations
 
-import csv
 import sys
 from pathlib import Path
 
 import animat
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from results_table import write_rows  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "data" / "control"
@@ -44,12 +46,7 @@ def main() -> int:
                         "grn_updates": r.grn_updates,
                     }
                 )
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    with open(OUT, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]), lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    write_rows(OUT, rows)
     print("| best | GRN schedule | " + " | ".join(f"dt/{s}" if s > 1 else "dt" for s in SUBSTEPS) + " | dt vs dt/64 |")
     print("| --- | --- | " + " | ".join("---" for _ in SUBSTEPS) + " | --- |")
     for name in BESTS:

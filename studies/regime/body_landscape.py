@@ -69,9 +69,11 @@ from mutation_effects import (  # noqa: E402
     step,
     study_arguments,
     swim,
-    write,
 )
 from step_ladder import final_best  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "studies"))
+from results_table import write_rows  # noqa: E402
 
 RESULTS = ROOT / "studies" / "regime" / "results"
 LADDER = RESULTS / "body_landscape.csv"
@@ -358,7 +360,7 @@ def main(argv=None) -> int:
         for got in pool.imap(work, tasks):
             rows += got
             print(f"{got[0]['environment']} {got[0]['run']}: {len(got)} rows" if got else "(no rows)", flush=True)
-    write(rows, out)
+    write_rows(out, rows)
     print(table(out))
     return 0
 

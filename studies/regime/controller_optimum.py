@@ -72,6 +72,9 @@ from known_swimmers import KnownSwimmer, appendage_swimmer, hex_region, stroke_t
 sys.path.insert(0, str(ROOT / "studies" / "regime"))
 from step_ladder import final_best  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "studies"))
+from results_table import write_rows  # noqa: E402
+
 OUT = ROOT / "studies" / "regime" / "results" / "controller_optimum.csv"
 SEARCH_SUBSTEPS = 4
 DRAGS = {env: f"configs/regime_{env}.toml" for env in ("dn0.5", "dn2", "dn10", "dn0.2_64cells")}
@@ -384,13 +387,7 @@ def main(argv=None) -> int:
                 + (f", rows {row['rows']} ({row['rowing_min']:+.2f})" if row["rows"] != "" else ""),
                 flush=True,
             )
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    fields = [k for k in dict.fromkeys(k for r in rows for k in r) if not k.startswith("_")]
-    with open(args.out, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items() if k in fields})
+    write_rows(args.out, rows)
     controllers = {f"{r['environment']}/{r['body']}/{r['control']}/seed{r['seed']}": r["_controller"] for r in rows}
     args.out.with_suffix(".json").write_text(json.dumps(controllers, indent=0) + "\n")
     print(

@@ -58,8 +58,10 @@ from animat.shape import genome_shape
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies" / "regime"))
-from mutation_effects import write  # noqa: E402
 from step_ladder import final_best  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "studies"))
+from results_table import write_rows  # noqa: E402
 
 DATA = {"genome": ROOT / "data" / "replication_regime", "fixed": ROOT / "data" / "replication_regime_fixed"}
 ENVS = ("dn0.5", "dn10")
@@ -196,7 +198,7 @@ def main(argv=None) -> int:
     if not args.summary:
         runs = [DATA[s] / env / f"run_{i}" for s in STREAMS for env in ENVS for i in range(RUNS)]
         runs += [PROTECTED / env / f"run_{i}" for env in PROTECTED_ENVS for i in range(RUNS)]
-        write([row_of(run) for run in runs], args.out)
+        write_rows(args.out, [row_of(run) for run in runs])
     print(summary(args.out))
     if (args.out.parent / "controller_optimum_fixed200.csv").is_file():
         print()

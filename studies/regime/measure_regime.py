@@ -15,7 +15,6 @@ ranked with ``evaluation.reference_check = "select"`` selected on.
 from __future__ import annotations
 
 import argparse
-import csv
 import statistics
 import sys
 import tempfile
@@ -27,6 +26,9 @@ import animat
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "replication"))
 from replication_store import packed_runs, unpack_run  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from results_table import write_rows  # noqa: E402
 
 COLUMNS = [
     "environment",
@@ -171,12 +173,7 @@ def main(argv=None) -> int:
                     f"f {row['frequency_median']:.2f} lowest mode {row['mode_lowest']:.2f}",
                     file=sys.stderr,
                 )
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS, lineterminator="\n")
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+    write_rows(args.out, rows, COLUMNS)
     print(
         "environment | bests | fluid share | damping share | frequency (median) | at bound (>= 0.95 f_max) | "
         "lowest elastic mode | modes within [f_min, f_max] | damping ratio at the frequency | max |residual|"

@@ -15,7 +15,6 @@ each generation counts. Writes one row per run and generation and prints the cou
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 import tempfile
@@ -28,6 +27,9 @@ from animat import locomotion as L
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "replication"))
 import replication_stats as RS  # noqa: E402
 from replication_store import packed_runs, unpack_run  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from results_table import write_rows  # noqa: E402
 
 COLUMNS = ["environment", "run", "generation", "best_generation", "fitness", "reference_fitness", "mode", "mixed"]
 #: the report's row order (studies/replication/replication_report.py, MODE_COLUMNS)
@@ -132,12 +134,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for packed in runs:
                 rows += run_rows(env, packed, Path(tmp) / env / packed.name, sorted(set(args.generations)))
                 print(f"{env} {packed.name}: {len(rows)} rows", file=sys.stderr)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS, lineterminator="\n")
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+    write_rows(args.out, rows, COLUMNS)
     print("\n".join(summary_lines(rows)))
     return 0
 

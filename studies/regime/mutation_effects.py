@@ -71,6 +71,9 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies" / "regime"))
 from step_ladder import final_best  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "studies"))
+from results_table import write_rows  # noqa: E402
+
 OUT = ROOT / "studies" / "regime" / "results" / "mutation_effects.csv"
 SUBSTEPS = 4
 SIGMAS = (0.01, 0.03, 0.1)
@@ -375,7 +378,7 @@ def main(argv=None) -> int:
         tasks = [(study / env / f"run_{i}", args.generation) for env in args.envs for i in args.runs]
         with Pool(args.jobs) as pool:
             rows = [r for got in pool.imap(jitter, tasks) for r in got]
-        write(rows, args.out)
+        write_rows(args.out, rows)
         print(jitter_summary(args.out))
         return 0
     tasks = [
@@ -393,19 +396,10 @@ def main(argv=None) -> int:
                 + ", ".join(f"{g['class']} {g['improve']}/{g['count']}" for g in got),
                 flush=True,
             )
-    write(rows, args.out)
+    write_rows(args.out, rows)
     print()
     print(summary(args.out))
     return 0
-
-
-def write(rows: list, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]), lineterminator="\n")
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
 
 
 if __name__ == "__main__":

@@ -21,6 +21,9 @@ from animat import shape
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from measure_regime import measure  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from results_table import write_rows  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 SCREEN = ROOT / "studies" / "regime" / "screen"
 OUT_CSV = ROOT / "studies" / "regime" / "results" / "screen.csv"
@@ -98,13 +101,7 @@ def main() -> int:
     if not rows:
         print(f"no kept runs in {SCREEN}", file=sys.stderr)
         return 1
-    OUT_CSV.parent.mkdir(parents=True, exist_ok=True)
-    keys = list(rows[0].keys())
-    with open(OUT_CSV, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys, lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    write_rows(OUT_CSV, rows)
     lines = [
         "# Calibration screen: results",
         "",
