@@ -7,7 +7,11 @@ checked), evaluates every asked genome as the engine does, and re-swims the inva
 physics.substeps multiplied by 2, 4 and 16. One row per invalid swim:
 
     PYTHONPATH=build/python .venv/bin/python studies/regime/invalid_swims.py \
-        --data data/replication_regime --out studies/regime/results/invalid_swims.csv [--jobs 2]
+        --data data/replication_regime --out studies/regime/results/invalid_swims.csv [--jobs 2] \
+        [--envs dn0.5 dn2 dn10] [--through 449]
+
+A replay costs the run again up to its last invalid swim, so ``--envs`` and ``--through`` (the last
+generation whose invalid swims are looked for) keep a pass to the runs and generations asked for.
 
 Reads the packed files directly (config.toml, history.csv.gz); writes nothing else.
 """
@@ -20,10 +24,14 @@ import gzip
 import io
 import sys
 from concurrent.futures import ProcessPoolExecutor
+from functools import partial
 from pathlib import Path
-from typing import List
+from typing import List, Optional, Set
 
 import animat
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from results_table import write_rows  # noqa: E402
 
 REFINEMENTS = (2, 4, 16)
 COLUMNS = ["env", "run", "generation", "reason", "first_invalid_step", "cells"] + [
@@ -36,11 +44,17 @@ def stored_history(run: Path) -> List[List[str]]:
         return list(csv.reader(io.StringIO(f.read())))
 
 
-def trace(run: Path) -> List[dict]:
+def invalid_generations(rows: List[List[str]], through: Optional[int] = None) -> Set[int]:
+    """The generations of a stored history (header first) that count invalid swims, up to ``through``."""
+    header, body = rows[0], rows[1:]
+    g, col = header.index("generation"), header.index("invalid")
+    return {int(r[g]) for r in body if int(r[col]) > 0 and (through is None or int(r[g]) <= through)}
+
+
+def trace(run: Path, through: Optional[int] = None) -> List[dict]:
     rows = stored_history(run)
     header, body = rows[0], rows[1:]
-    col = header.index("invalid")
-    wanted = {int(r[0]) for r in body if int(r[col]) > 0}
+    wanted = invalid_generations(rows, through)
     if not wanted:
         return []
     config = animat.load_config(str(run / "config.toml"))
@@ -85,18 +99,23 @@ def main(argv=None) -> int:
     p.add_argument("--data", type=Path, required=True, help="a packed study (data/<study>)")
     p.add_argument("--out", type=Path, required=True, help="the CSV to write")
     p.add_argument("--jobs", type=int, default=1, help="runs replayed at once")
+    p.add_argument("--envs", nargs="+", help="only these environments (default: all)")
+    p.add_argument("--through", type=int, help="only invalid swims up to this generation (default: all)")
     args = p.parse_args(argv)
+    if args.through is not None and args.through < 0:
+        p.error(f"--through: must be >= 0, got {args.through}")
     runs = sorted(r for r in args.data.glob("*/run_*") if (r / "history.csv.gz").is_file())
     if not runs:
         print(f"invalid_swims: no packed runs under {args.data}", file=sys.stderr)
         return 1
+    if args.envs:
+        missing = sorted(set(args.envs) - {r.parent.name for r in runs})
+        if missing:
+            p.error(f"--envs: {missing} not under --data {args.data}")
+        runs = [r for r in runs if r.parent.name in args.envs]
     with ProcessPoolExecutor(args.jobs) as pool:
-        rows = [row for found in pool.map(trace, runs) for row in found]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as f:
-        w = csv.DictWriter(f, COLUMNS)
-        w.writeheader()
-        w.writerows(rows)
+        rows = [row for found in pool.map(partial(trace, through=args.through), runs) for row in found]
+    write_rows(args.out, rows, COLUMNS)
     print(f"{len(rows)} invalid swims in {len(runs)} runs -> {args.out}")
     return 0
 
