@@ -26,7 +26,7 @@ from animat import locomotion as L
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "replication"))
 import replication_stats as RS  # noqa: E402
-from replication_store import packed_runs, unpack_run  # noqa: E402
+from replication_store import STALLED, packed_runs, unpack_run  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from results_table import write_rows  # noqa: E402
@@ -34,7 +34,6 @@ from results_table import write_rows  # noqa: E402
 COLUMNS = ["environment", "run", "generation", "best_generation", "fitness", "reference_fitness", "mode", "mixed"]
 #: the report's row order (studies/replication/replication_report.py, MODE_COLUMNS)
 MODES = ["undulation", "synchronous contraction", "protrusions", "tail", "other", "none"]
-STALLED = "no improvement"
 
 
 def best_at(lineage: Sequence[animat.LineageEntry], generation: int) -> Optional[animat.LineageEntry]:

@@ -305,6 +305,10 @@ def _history_generation(data: bytes, where: str) -> int:
     return len(lines) - 2
 
 
+#: how the engine's stop reason for the paper's stall rule begins ("no improvement for ...")
+STALLED = "no improvement"
+
+
 def _derived_stop(config: Path, history_lines: List[str]) -> str:
     """The stop rule the history shows as reached (the engine's wording), else "in progress"."""
     try:
@@ -797,12 +801,46 @@ def next_round_cap(work: Path, envs: Sequence[str], runs: int, generations: int,
             if (run / "history.csv").is_file():
                 lines = _history_lines(run)
                 last = _last_generation(lines) or 0
-                if "no improvement" in _derived_stop(run / "config.toml", lines):
+                if STALLED in _derived_stop(run / "config.toml", lines):
                     continue
             if last >= generations:
                 continue
             lowest = last if lowest is None else min(lowest, last)
     return -1 if lowest is None else min(lowest + round_size, generations)
+
+
+def growth(root: Path) -> Dict[str, List[Tuple[str, int, str]]]:
+    """``{env: [(run name, last generation, stop reason)]}`` of the packed runs under ``root``, from their
+    status.json: how far a study has grown, without unpacking it."""
+    out: Dict[str, List[Tuple[str, int, str]]] = {}
+    for env, runs in packed_runs(root).items():
+        rows = []
+        for run in runs:
+            status = json.loads((run / "status.json").read_text())
+            rows.append((run.name, int(status["generation"]), str(status.get("stop_reason", ""))))
+        out[env] = rows
+    return out
+
+
+def _span(values: Sequence[int]) -> str:
+    return f"{min(values)}" if min(values) == max(values) else f"{min(values)}-{max(values)}"
+
+
+def growth_lines(root: Path) -> List[str]:
+    """One line per environment: where its runs stand, and which runs the stall rule stopped where."""
+    lines = []
+    for env, rows in growth(root).items():
+        stalled = [(name, g) for name, g, why in rows if STALLED in why]
+        others = [g for _, g, why in rows if STALLED not in why]
+        parts = [f"{env}: {len(rows)} run{'s' if len(rows) != 1 else ''}"]
+        if others:
+            parts.append(f"{len(others)} at generation {_span(others)}")
+        if stalled:
+            parts.append(
+                f"{len(stalled)} stopped by the stall rule: " + ", ".join(f"{name} at {g}" for name, g in stalled)
+            )
+        lines.append("; ".join(parts))
+    return lines
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -823,7 +861,15 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     c.add_argument("--runs", type=int, required=True)
     c.add_argument("--generations", type=int, required=True)
     c.add_argument("--round", type=int, required=True, dest="round_size")
+    st = sub.add_parser("status", help="print how far the packed runs under DATA have grown, per environment")
+    st.add_argument("data", type=Path)
     args = p.parse_args(argv)
+    if args.command == "status":
+        if not args.data.is_dir():
+            print(f"replication_store: {args.data}: no such directory", file=sys.stderr)
+            return 1
+        print("\n".join(growth_lines(args.data)) or f"{args.data}: no packed runs")
+        return 0
     if args.command == "next-cap":
         print(next_round_cap(args.work, args.envs, args.runs, args.generations, args.round_size))
         return 0

@@ -99,6 +99,26 @@ def test_next_round_cap_grows_the_least_advanced_open_run(tmp_path):
         R.next_round_cap(work, ["a"], 2, 1000, 0)
 
 
+def test_status_says_how_far_each_environment_has_grown(tmp_path, capsys):
+    data = tmp_path / "data"
+    for i in range(3):
+        shutil.copytree(PACKED, data / "dn2" / f"run_{i}")
+    shutil.copytree(FIXTURES / "dn10_run_0", data / "dn10" / "run_0")
+    (data / "dn2" / "run_1" / "status.json").write_text(
+        json.dumps(
+            {"generation": 57, "stop_reason": "no improvement for evolution.stall_generations = 500 generations"}
+        )
+    )
+    (data / "dn2" / "run_2" / "status.json").write_text(json.dumps({"generation": 80, "stop_reason": "interrupted"}))
+    assert R.growth(data)["dn2"][1] == ("run_1", 57, "no improvement for evolution.stall_generations = 500 generations")
+    assert R.main(["status", str(data)]) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "dn10: 1 run; 1 at generation 100",
+        "dn2: 3 runs; 2 at generation 80-100; 1 stopped by the stall rule: run_1 at 57",
+    ]
+    assert R.main(["status", str(tmp_path / "missing")]) == 1
+
+
 def _two_packed_runs_and_report_command(tmp_path):
     """Data with the two frozen packed runs (dn2 and dn10, 100 generations) and the report command over it."""
     data = tmp_path / "data"
