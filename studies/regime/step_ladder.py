@@ -13,8 +13,9 @@ at each step against dt/32) and prints a markdown table.
 ``--data DIR --out CSV`` swims the final bests of a packed study instead (data/<study>/<env>/run_<i>:
 config.toml and the last entry of best.tar.gz), one row per run named ENV/run_I:
 
-    PYTHONPATH=build/python .venv/bin/python studies/regime/step_ladder.py \
-        --data data/replication_regime --out studies/regime/results/step_ladder_replication_regime.csv
+    PYTHONPATH=build/python .venv/bin/python studies/regime/step_ladder.py \\
+        --data data/replication_regime --out studies/regime/results/step_ladder_replication_regime.csv \\
+        [--jobs 2]
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import fnmatch
 import json
 import sys
 import tarfile
+from multiprocessing import Pool
 from pathlib import Path
 from typing import Optional
 
@@ -70,7 +72,10 @@ def main(argv=None) -> int:
     p.add_argument("--only", nargs="+", metavar="GLOB", help="screen runs to swim (folder names)")
     p.add_argument("--data", type=Path, help="a packed study: swim its runs' final bests instead")
     p.add_argument("--out", type=Path, default=OUT)
+    p.add_argument("--jobs", type=int, default=1, help="bests swum at once (default 1)")
     args = p.parse_args(argv)
+    if args.jobs < 1:
+        p.error(f"--jobs: must be >= 1, got {args.jobs}")
     if (args.data is None) == (args.only is None):
         p.error("give --only GLOB... (screen runs) or --data DIR (a packed study)")
     if args.data is not None and args.out == OUT:
@@ -92,8 +97,9 @@ def main(argv=None) -> int:
         "| --- | " + " | ".join("---" for _ in SUBSTEPS) + " |",
     ]
     rows = []
-    for f in runs:
-        fit = ladder(f)
+    with Pool(args.jobs) as pool:
+        fits = pool.map(ladder, runs, chunksize=1)
+    for f, fit in zip(runs, fits):
         ref = fit[-1]
         err = [x / ref - 1 for x in fit[:-1]]
         name = f"{f.parent.name}/{f.name}" if args.data is not None else f.name
