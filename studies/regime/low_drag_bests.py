@@ -8,7 +8,7 @@ titled with the run, the generation of its best, its fitness and the mode the cl
 The best of a run is its final best (the last entry of its lineage), replayed at the run's own config
 and classified as the replication report and mode_trajectory.py classify. Node colours are the cells'
 actuation states (red expanding, blue contracting, green neutral); each snapshot is rotated so that the
-swim points right. About a minute per environment.
+swim points right. Under a minute for both environments on 2 cores.
 """
 
 from __future__ import annotations
@@ -89,7 +89,7 @@ def draw(bests: Sequence[Best], envs: Sequence[str], frames: int = FRAMES):
                 ax.set_xlim(-half, half)
                 ax.set_ylim(-half, half)
                 ax.set_aspect("equal")
-            # a text, not a title: tight_layout would shrink the panels to fit a title spanning four
+            # a text, not a title: the label spans four panels and must not push them apart
             axes[i, j * frames].text(
                 0.0,
                 1.04,
