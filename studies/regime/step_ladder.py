@@ -15,7 +15,11 @@ config.toml and the last entry of best.tar.gz), one row per run named ENV/run_I:
 
     PYTHONPATH=build/python .venv/bin/python studies/regime/step_ladder.py \\
         --data data/replication_regime --out studies/regime/results/step_ladder_replication_regime.csv \\
-        [--jobs 2]
+        [--jobs 2] [--modes]
+
+``--modes`` also replays each best at every step and classifies its swim as the replication report
+does (``animat.classify_locomotion``, its stroke path), adding columns mode_s1 ... mode_s32: whether
+a best's mode survives refinement when its distance does not.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from pathlib import Path
 from typing import Optional
 
 import animat
+from animat import locomotion as L
 
 ROOT = Path(__file__).resolve().parents[2]
 SCREEN = ROOT / "studies" / "regime" / "screen"
@@ -52,19 +57,26 @@ def final_best(run: Path, generation: Optional[int] = None) -> dict:
         return json.loads(member.read())
 
 
-def ladder(folder: Path) -> list:
-    """The best's fitness at each of SUBSTEPS (its config otherwise)."""
+def ladder(folder: Path, modes: bool = False) -> tuple:
+    """The best's fitness at each of SUBSTEPS (its config otherwise), and with ``modes`` its main
+    locomotion mode at each (else an empty list)."""
     if (folder / "best.tar.gz").is_file():
         entry = final_best(folder)
     else:
         entry = json.loads((folder / "best_genome.json").read_text())
     genome = animat.Genome.from_json(json.dumps(entry["genome"]))
-    out = []
+    fits, found = [], []
     for s in SUBSTEPS:
         config = animat.load_config(str(folder / "config.toml"))
         config.physics.substeps = config.physics.substeps * s
-        out.append(float(animat.evaluate(genome, config).fitness))
-    return out
+        fits.append(float(animat.evaluate(genome, config).fitness))
+        if modes:
+            found.append(L.classify_locomotion(animat.replay(genome, config)).mode)
+    return fits, found
+
+
+def _ladder_with_modes(folder: Path) -> tuple:
+    return ladder(folder, modes=True)
 
 
 def main(argv=None) -> int:
@@ -73,6 +85,7 @@ def main(argv=None) -> int:
     p.add_argument("--data", type=Path, help="a packed study: swim its runs' final bests instead")
     p.add_argument("--out", type=Path, default=OUT)
     p.add_argument("--jobs", type=int, default=1, help="bests swum at once (default 1)")
+    p.add_argument("--modes", action="store_true", help="also classify each swim's mode at every step")
     args = p.parse_args(argv)
     if args.jobs < 1:
         p.error(f"--jobs: must be >= 1, got {args.jobs}")
@@ -92,19 +105,24 @@ def main(argv=None) -> int:
         print(f"step_ladder: no kept run matches {args.only}", file=sys.stderr)
         return 1
     header = ["run"] + [f"fitness_s{s}" for s in SUBSTEPS] + [f"error_s{s}" for s in SUBSTEPS[:-1]]
+    if args.modes:
+        header += [f"mode_s{s}" for s in SUBSTEPS]
     lines = [
         "| run | " + " | ".join(f"dt/{s}" if s > 1 else "dt" for s in SUBSTEPS[:-1]) + " | fitness at dt/32 |",
         "| --- | " + " | ".join("---" for _ in SUBSTEPS) + " |",
     ]
+    if args.modes:  # one more column: the mode, or the mode at each step where they differ
+        lines = [lines[0] + " mode (dt ... dt/32) |", lines[1] + " --- |"]
     rows = []
     with Pool(args.jobs) as pool:
-        fits = pool.map(ladder, runs, chunksize=1)
-    for f, fit in zip(runs, fits):
+        results = pool.map(_ladder_with_modes if args.modes else ladder, runs, chunksize=1)
+    for f, (fit, found) in zip(runs, results):
         ref = fit[-1]
         err = [x / ref - 1 for x in fit[:-1]]
         name = f"{f.parent.name}/{f.name}" if args.data is not None else f.name
-        rows.append([name] + [f"{x:.9g}" for x in fit] + [f"{e:.6g}" for e in err])
-        lines.append(f"| {name} | " + " | ".join(f"{e:+.2%}" for e in err) + f" | {ref:.2f} |")
+        rows.append([name] + [f"{x:.9g}" for x in fit] + [f"{e:.6g}" for e in err] + found)
+        mode = (" " + (found[0] if len(set(found)) == 1 else ", ".join(found)) + " |") if found else ""
+        lines.append(f"| {name} | " + " | ".join(f"{e:+.2%}" for e in err) + f" | {ref:.2f} |{mode}")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "w", newline="") as fh:
         w = csv.writer(fh, lineterminator="\n")
