@@ -50,3 +50,22 @@ def test_mode_at_dt_is_the_mode_the_trajectory_counts():
         assert row["mode_s1"] == last["mode"], row["run"]
         compared += 1
     assert compared >= 30
+
+
+def test_main_writes_a_mode_column_per_step(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(step_ladder, "SUBSTEPS", (1, 2))
+    run = tmp_path / "data" / "dn10" / "run_1"
+    run.mkdir(parents=True)
+    for name in ("config.toml", "best.tar.gz"):
+        (run / name).write_bytes((DATA / "dn10" / "run_1" / name).read_bytes())
+    out = tmp_path / "ladder.csv"
+    assert step_ladder.main(["--data", str(tmp_path / "data"), "--out", str(out), "--modes"]) == 0
+    with open(out, newline="") as fh:
+        (row,) = list(csv.DictReader(fh))
+    committed = _row(TABLE, run="dn10/run_1")
+    assert row["run"] == "dn10/run_1"
+    assert [row["mode_s1"], row["mode_s2"]] == [committed["mode_s1"], committed["mode_s2"]]
+    assert float(row["error_s1"]) == pytest.approx(float(row["fitness_s1"]) / float(row["fitness_s2"]) - 1)
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].endswith("| fitness at dt/32 | mode (dt ... dt/32) |")
+    assert printed[2].startswith("| dn10/run_1 |") and printed[2].endswith(f"| {committed['mode_s1']} |")
