@@ -30,6 +30,7 @@ import fnmatch
 import json
 import sys
 import tarfile
+from functools import partial
 from multiprocessing import Pool
 from pathlib import Path
 from typing import Optional
@@ -75,10 +76,6 @@ def ladder(folder: Path, modes: bool = False) -> tuple:
     return fits, found
 
 
-def _ladder_with_modes(folder: Path) -> tuple:
-    return ladder(folder, modes=True)
-
-
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
     p.add_argument("--only", nargs="+", metavar="GLOB", help="screen runs to swim (folder names)")
@@ -115,7 +112,7 @@ def main(argv=None) -> int:
         lines = [lines[0] + " mode (dt ... dt/32) |", lines[1] + " --- |"]
     rows = []
     with Pool(args.jobs) as pool:
-        results = pool.map(_ladder_with_modes if args.modes else ladder, runs, chunksize=1)
+        results = pool.map(partial(ladder, modes=args.modes), runs, chunksize=1)
     for f, (fit, found) in zip(runs, results):
         ref = fit[-1]
         err = [x / ref - 1 for x in fit[:-1]]
