@@ -199,12 +199,14 @@ class _Task:
 
 
 def _environments(configs: Sequence[str]) -> List[Tuple[str, str]]:
-    """``NAME=PATH`` or ``PATH`` (named by its file stem) -> [(name, path)], names unique."""
+    """``NAME=PATH`` or ``PATH`` -> [(name, path)], names unique. A PATH is named by its file name less
+    ``.toml``: ``configs/paper_dn0.5.toml`` and the packaged ``paper_dn0.5`` are both ``paper_dn0.5``
+    (not the stem, which cuts at the dot)."""
     envs = []
     for c in configs:
         name, sep, path = c.partition("=")
         if not sep:
-            name, path = Path(c).stem, c
+            name, path = Path(c).name.removesuffix(".toml"), c
         if not name or not path:
             raise ValueError(f"experiment: expected CONFIG or NAME=CONFIG, got {c!r}")
         envs.append((name, path))

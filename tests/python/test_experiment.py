@@ -85,6 +85,27 @@ def test_experiment_runs_seeds_resumes_and_summarises(tmp_path):
     assert lower[0].stop_reason == "already at generation 3, past the cap 1"
 
 
+def test_study_names_packaged_configs_and_files_by_their_whole_name(tmp_path):
+    # A dot in the name is part of it: paper_dn0.5 and paper_dn0.2_64cells are two environments.
+    out = tmp_path / "study"
+    tiny = ["evolution.population=8", "evaluation.steps=200"]
+    by_env = animat.run_study(
+        ["paper_dn0.5", "paper_dn0.2_64cells"], runs=1, out=str(out), generations=1, overrides=tiny, threads=2
+    )
+    assert list(by_env) == ["paper_dn0.5", "paper_dn0.2_64cells"]
+    for name, drag in (("paper_dn0.5", 0.5), ("paper_dn0.2_64cells", 0.2)):
+        assert json.loads((out / name / "summary.json").read_text())["config"] == name
+        assert animat.load_config(str(out / name / "run_0" / "config.toml"))["scene.drag_normal"] == drag
+    # A file is named by its file name less .toml, the same name as the packaged config it copies.
+    copy = tmp_path / "paper_dn0.5.toml"
+    copy.write_text((ROOT / "configs" / "paper_dn0.5.toml").read_text())
+    index = animat.run_study(
+        [str(copy), "paper_dn2"], runs=1, out=str(tmp_path / "files"), index=[0], overrides=tiny, generations=1
+    )
+    assert list(index) == ["paper_dn0.5", "paper_dn2"]
+    assert (tmp_path / "files" / "paper_dn0.5" / "run_0" / "history.csv").is_file()
+
+
 def test_experiment_command_line(tmp_path):
     cfg = tmp_path / "tiny.toml"
     cfg.write_text(TINY)
