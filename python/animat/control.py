@@ -3,13 +3,23 @@ swim physics with its actuation set by a controller, following the Gymnasium API
 
 ``gymnasium`` is an optional dependency (``pip install animat[control]``); without it SwimEnv
 raises ImportError naming the package. With it, ``import animat`` registers the environment as
-:data:`SWIM_ENV_ID` (``"animat/Swim-v0"``), so ``gymnasium.make("animat/Swim-v0", body=..., config=...)``
-builds one (the keyword arguments of :class:`SwimEnv`; ``episode_steps=`` sets its episode length,
-since ``gymnasium.make`` keeps ``max_episode_steps=`` for its own ``TimeLimit`` wrapper).
+:data:`SWIM_ENV_ID` (``"animat/Swim-v0"``), so ``gymnasium.make("animat/Swim-v0")`` builds one (any
+keyword argument of :class:`SwimEnv` passes through; ``episode_steps=`` sets its episode length,
+since ``gymnasium.make`` keeps ``max_episode_steps=`` for its own ``TimeLimit`` wrapper). Its spec's
+``max_episode_steps`` is :data:`DEFAULT_EPISODE_STEPS` (1000), the default env's episode; an env
+whose own episode is longer (a config with more ``evaluation.steps``) needs the same number as
+``gymnasium.make(..., max_episode_steps=)`` too, or the wrapper truncates it at 1000.
+
+Without a body the env swims :func:`default_swimmer` under the config (default: ``animat.Config()``,
+the paper's d_N = 2 environment): the best genome of the replication study at d_N = 2
+(``data/replication/dn2/run_9``, generation 549, the best of its ten runs), a 32-cell body that
+swims 37.95 length units in an evaluation's 4000 steps. It is packaged as ``default_swimmer.json``
+(:data:`DEFAULT_SWIMMER_PATH`).
 
 Actions set every cell's actuation (eq. 2: the rest length of spring (i, j) is
 ``(1 + u_i + u_j) L0``); the body's own oscillators are off. Actions are normalised to [-1, 1]
-(``normalize_actions=False``: in physical units, the ``physical_action_space``); with
+(``normalize_actions=False``: in physical units, the ``physical_action_space``, float64 so that the
+body's own controller passes unrounded; the normalised action space is float32); with
 ``a_max = development.amplitude_max`` (the paper's 0.2):
 
 - ``mode="rest_length"``: shape (n,), ``u_i = a_max · action_i`` (physically ``u`` in
@@ -25,7 +35,7 @@ Actions set every cell's actuation (eq. 2: the rest length of spring (i, j) is
 :meth:`SwimEnv.physical_action` and :meth:`SwimEnv.normalized_action` convert between the two. An
 action holds for ``frame_skip`` control steps.
 
-Observations, shape (4n + m,), float64, in the Box ``[-obs_limit, obs_limit]`` (default 10): the cell
+Observations, shape (4n + m,), float32, in the Box ``[-obs_limit, obs_limit]`` (default 10): the cell
 positions relative to the centre of mass in body lengths (n × 2, flattened; below 1 in magnitude for
 any body whose cells stay within its body length ``animat.body_length`` of each other), the cell
 velocities relative to the centre-of-mass velocity in body lengths per time unit (n × 2), and the
@@ -51,11 +61,21 @@ collision); the rewards do not look at it.
 (springs, skin, cells coloured by their term u_i: red lengthening, blue shortening), the camera on
 its centre of mass, a world-fixed grid and the path so far; ``metadata["render_fps"]`` is real time,
 ``1 / (physics.dt · frame_skip)``, so ``gymnasium.wrappers.RecordVideo`` writes the swim at its speed.
+``render_mode="human"``: the same picture in a matplotlib window, redrawn by every ``reset`` and
+``step`` at most ``render_fps`` times a second (``render()`` returns None). It needs a display and an
+interactive matplotlib backend (e.g. TkAgg). Without either, as matplotlib's own ``show()`` does,
+the env warns (a UserWarning saying which is missing) and shows nothing: it still runs, so a
+script written for a desktop runs on a server too, and ``render_mode="rgb_array"`` gives the frames.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
 from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
@@ -63,13 +83,31 @@ import numpy as np
 from . import _core
 from .trajectory import body_of
 
-__all__ = ["SwimEnv", "SWIM_ENV_OBJECTIVES", "SWIM_ENV_ID", "gymnasium_available", "register_envs"]
+__all__ = [
+    "SwimEnv",
+    "SWIM_ENV_OBJECTIVES",
+    "SWIM_ENV_ID",
+    "DEFAULT_EPISODE_STEPS",
+    "DEFAULT_SWIMMER_PATH",
+    "default_swimmer",
+    "gymnasium_available",
+    "register_envs",
+]
 
 #: The objectives SwimEnv can reward: the built-ins one swim decides (``animat.objectives()``).
 SWIM_ENV_OBJECTIVES = tuple(spec.name for spec in _core.objectives() if spec.one_swim)
 
 #: The Gymnasium id under which ``import animat`` registers :class:`SwimEnv`.
 SWIM_ENV_ID = "animat/Swim-v0"
+
+#: The swimmer of an env built without a body (module docstring: where it comes from).
+DEFAULT_SWIMMER_PATH = Path(__file__).with_name("default_swimmer.json")
+
+_DEFAULT_FRAME_SKIP = 4
+
+#: The episode of the default env (``evaluation.steps // frame_skip`` of ``animat.Config()``): the
+#: ``max_episode_steps`` of the registered spec.
+DEFAULT_EPISODE_STEPS = int(_core.Config()["evaluation.steps"]) // _DEFAULT_FRAME_SKIP
 
 try:  # optional dependency
     import gymnasium as _gym
@@ -87,12 +125,18 @@ def gymnasium_available() -> bool:
     return _gym is not None
 
 
+def default_swimmer() -> Any:
+    """The :class:`animat.Genome` an env swims without a body (module docstring: its origin)."""
+    return _core.Genome.load(str(DEFAULT_SWIMMER_PATH))
+
+
 class SwimEnv(_EnvBase):
     """A developed body swimming under external control (Gymnasium API; see the module docstring).
 
     Args:
         body: an :class:`animat.Body`, :class:`animat.Embryo`, :class:`animat.Genome` (developed with
-            ``config``) or a :class:`animat.LineageEntry` (e.g. ``run.best()``).
+            ``config``) or a :class:`animat.LineageEntry` (e.g. ``run.best()``); None (the default):
+            :func:`default_swimmer`.
         config: an :class:`animat.Config` (scene, physics, objective); None = defaults.
         mode: ``"rest_length"`` or ``"oscillator"``.
         frame_skip: control steps per environment step (each ``physics.dt``).
@@ -108,19 +152,20 @@ class SwimEnv(_EnvBase):
         normalize_actions: actions in [-1, 1] (default) or, if False, in physical units
             (``physical_action_space``).
         obs_limit: the observation Box is ``[-obs_limit, obs_limit]`` (finite, > 0; default 10).
-        render_mode: None or ``"rgb_array"``.
+        render_mode: None, ``"rgb_array"`` or ``"human"`` (a matplotlib window; without a display
+            or an interactive backend a warning and no window).
         render_size: (width, height) of a rendered frame in pixels (default (320, 240)).
     """
 
-    metadata: Dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 15}
+    metadata: Dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 15}
 
     def __init__(
         self,
-        body: Any,
+        body: Any = None,
         config: Any = None,
         *,
         mode: str = "rest_length",
-        frame_skip: int = 4,
+        frame_skip: int = _DEFAULT_FRAME_SKIP,
         max_episode_steps: Optional[int] = None,
         objective: Optional[str] = None,
         frequency: Any = None,
@@ -152,7 +197,7 @@ class SwimEnv(_EnvBase):
         width, height = (int(v) for v in render_size)
         if width < 32 or height < 32:
             raise ValueError(f"SwimEnv: render_size {tuple(render_size)} is too small (at least 32 x 32 pixels)")
-        self.body = body_of(body, self.config)
+        self.body = body_of(default_swimmer() if body is None else body, self.config)
         if self.body.node_count < 2:
             raise ValueError(f"SwimEnv: the body has {self.body.node_count} cell(s) and no springs; it cannot swim")
         self.mode = mode
@@ -197,7 +242,7 @@ class SwimEnv(_EnvBase):
             self.physical_action_space = _spaces.Box(low=low, high=high, dtype=np.float64)
         if self.normalize_actions:
             self.action_space = _spaces.Box(
-                low=-1.0, high=1.0, shape=self.physical_action_space.shape, dtype=np.float64
+                low=-1.0, high=1.0, shape=self.physical_action_space.shape, dtype=np.float32
             )
         else:
             self.action_space = self.physical_action_space
@@ -205,7 +250,7 @@ class SwimEnv(_EnvBase):
         #: Divisors of the physical observation (body length for positions and velocities, 1 for strains).
         self.obs_scale = np.concatenate([np.full(4 * n, self._length), np.ones(m)])
         self.observation_space = _spaces.Box(
-            low=-self.obs_limit, high=self.obs_limit, shape=(4 * n + m,), dtype=np.float64
+            low=-self.obs_limit, high=self.obs_limit, shape=(4 * n + m,), dtype=np.float32
         )
         #: Observation components clipped since ``reset`` (beyond ``obs_limit`` or not finite).
         self.obs_clipped = 0
@@ -219,6 +264,17 @@ class SwimEnv(_EnvBase):
         self._last_clipped = 0
         self._path: list = []
         self._canvas: Any = None
+        self._figure: Any = None
+        self._shown_at = -math.inf
+        if render_mode == "human":
+            self._figure, missing = _open_window((width, height))
+            if missing:
+                warnings.warn(
+                    f"SwimEnv: render_mode='human' shows no window: {missing}; render_mode='rgb_array' "
+                    "returns the frames instead",
+                    UserWarning,
+                    stacklevel=2,
+                )
 
     # --- actions --------------------------------------------------------------------------------------
     def physical_action(self, action: Any) -> np.ndarray:
@@ -274,7 +330,7 @@ class SwimEnv(_EnvBase):
         if self._last_clipped:
             obs[bad] = 0.0
             obs = np.clip(obs, -self.obs_limit, self.obs_limit)
-        return obs
+        return obs.astype(np.float32)  # a clipped value rounds to the Box's float32 bound
 
     def objective_value(self) -> float:
         """The objective of the swim so far (the rewards of an episode add up to it)."""
@@ -339,7 +395,10 @@ class SwimEnv(_EnvBase):
         self._value = 0.0
         self._failure = ""
         self.obs_clipped = 0
-        return self._observe(), self._info()
+        obs = self._observe()
+        if self.render_mode == "human":
+            self.render()
+        return obs, self._info()
 
     def step(self, action: Any) -> Tuple[np.ndarray, float, bool, bool, Dict[str, Any]]:
         """Apply ``action`` for ``frame_skip`` control steps. Returns (obs, reward, terminated,
@@ -376,16 +435,22 @@ class SwimEnv(_EnvBase):
             self._path.append(np.asarray(self._sim.center_of_mass()))
         reward = float(self._value - previous)
         truncated = not terminated and self._steps >= self.max_episode_steps
-        return self._observe(), reward, terminated, truncated, self._info()
+        obs = self._observe()
+        if self.render_mode == "human":
+            self.render()
+        return obs, reward, terminated, truncated, self._info()
 
     # --- rendering --------------------------------------------------------------------------------
     def render(self) -> Optional[np.ndarray]:
         """``render_mode="rgb_array"``: the body now as an (H, W, 3) uint8 array (module docstring);
-        ``render_mode=None``: nothing (None)."""
+        ``render_mode="human"``: the same picture drawn in the window (None; ``reset`` and ``step``
+        call it); ``render_mode=None``: nothing (None)."""
         if self.render_mode is None:
             return None
         if self._sim is None:
             raise RuntimeError("SwimEnv.render: call reset() first")
+        if self.render_mode == "human" and self._figure is None:
+            return None  # no window to draw in (warned at construction)
         canvas = self._canvas if self._canvas is not None else self._setup_render()
         pos = np.asarray(self._sim.positions)
         art = self._artists
@@ -408,6 +473,8 @@ class SwimEnv(_EnvBase):
         self._ax.set_xlim(x0, x1)
         self._ax.set_ylim(y0, y1)
         self._label.set_text(f"t = {self._sim.time:.2f}   distance {math.dist(path[-1], path[0]):.2f}")
+        if self.render_mode == "human":
+            return self._show()
         canvas.draw()
         width, height = self.render_size
         return np.array(np.asarray(canvas.buffer_rgba())[:height, :width, :3], dtype=np.uint8)
@@ -423,9 +490,13 @@ class SwimEnv(_EnvBase):
 
         width, height = self.render_size
         dpi = 100
-        fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
+        if self._figure is not None:  # human: the window's figure
+            fig = self._figure
+            self._canvas = fig.canvas
+        else:
+            fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
+            self._canvas = FigureCanvasAgg(fig)
         fig.patch.set_facecolor("white")
-        self._canvas = FigureCanvasAgg(fig)
         ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
         ax.set_axis_off()
         self._ax = ax
@@ -443,11 +514,59 @@ class SwimEnv(_EnvBase):
         self._label = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", ha="left", fontsize=8, color="#333333")
         return self._canvas
 
+    def _show(self) -> None:
+        """Draw the window's figure and let the GUI show it, at most ``render_fps`` frames a second."""
+        import matplotlib.pyplot as plt
+
+        wait = self._shown_at + 1.0 / self.metadata["render_fps"] - time.perf_counter()
+        self._figure.canvas.draw_idle()
+        plt.pause(max(wait, 1e-3))  # runs the GUI's event loop: the window repaints
+        self._shown_at = time.perf_counter()
+        return None
+
     def close(self) -> None:
-        """Drop the simulation and the rendering canvas."""
+        """Drop the simulation and the rendering canvas; close the window of ``render_mode="human"``."""
         self._sim = None
         self._actuation = None
         self._canvas = None
+        if self._figure is not None:
+            import matplotlib.pyplot as plt
+
+            plt.close(self._figure)
+            self._figure = None
+
+
+def _window_missing() -> str:
+    """Why this process has no display for a window ('' when it has one; Linux and other X11 or
+    Wayland systems need DISPLAY or WAYLAND_DISPLAY, macOS and Windows always have one)."""
+    if sys.platform in ("darwin", "win32") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return ""
+    return "there is no display (neither DISPLAY nor WAYLAND_DISPLAY is set)"
+
+
+def _open_window(size: Tuple[int, int]) -> Tuple[Any, str]:
+    """A pyplot figure of ``size`` pixels in a window of an interactive backend (shown by the first
+    render) and '', or None and why no window can open."""
+    missing = _window_missing()
+    if missing:
+        return None, missing
+    import matplotlib.pyplot as plt
+
+    dpi = 100
+    try:
+        fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
+    except Exception as e:  # e.g. an explicit MPLBACKEND=TkAgg whose display does not answer
+        return None, f"matplotlib could not open a window ({type(e).__name__}: {e})"
+    if getattr(fig.canvas, "required_interactive_framework", None) is None:  # Agg, PDF, ...: no window
+        backend = plt.get_backend()
+        plt.close(fig)
+        return None, (
+            f"matplotlib's backend {backend!r} draws no window (choose an interactive one, e.g. "
+            "MPLBACKEND=TkAgg, with its GUI toolkit installed)"
+        )
+    if fig.canvas.manager is not None:
+        fig.canvas.manager.set_window_title(SWIM_ENV_ID)
+    return fig, ""
 
 
 def _nice_spacing(span: float) -> float:
@@ -471,7 +590,9 @@ def register_envs() -> bool:
     if _gym is None:
         return False
     if SWIM_ENV_ID not in _gym.envs.registry:
-        _gym.register(id=SWIM_ENV_ID, entry_point="animat.control:_make_registered")
+        _gym.register(
+            id=SWIM_ENV_ID, entry_point="animat.control:_make_registered", max_episode_steps=DEFAULT_EPISODE_STEPS
+        )
     return True
 
 

@@ -1,7 +1,13 @@
 """animat.SwimEnv: the Gymnasium API on a developed body, actions driving the rest lengths."""
 
+import json
 import math
+import os
+import shutil
+import subprocess
+import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,6 +16,12 @@ import animat
 
 gymnasium = pytest.importorskip("gymnasium")
 from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+#: The warning of render_mode="human" where no window can open (a test process without a display).
+NO_WINDOW = "SwimEnv: render_mode='human' shows no window"
+#: animat.evaluate(default_swimmer(), Config()).fitness: the fitness its run recorded
+#: (data/replication/dn2/run_9, best/gen_000549.json).
+DEFAULT_SWIMMER_DISTANCE = 37.95199243852891
 
 
 @pytest.fixture(scope="module")
@@ -50,6 +62,7 @@ def test_passes_gymnasium_env_checker_without_a_warning(body_and_config, mode):
     body, c = body_and_config
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", message=NO_WINDOW)  # check_env makes the human mode too
         env = gymnasium.make(
             "animat/Swim-v0",
             body=body,
@@ -72,18 +85,138 @@ def test_passes_gymnasium_env_checker_without_a_warning(body_and_config, mode):
     assert np.all(np.isfinite(env.observation_space.low)) and np.all(np.isfinite(env.observation_space.high))
 
 
+def test_gymnasium_make_needs_no_arguments_and_swims_the_packaged_default_swimmer():
+    """As MuJoCo's Swimmer: gym.make with no body builds the packaged swimmer under the default
+    config, with float32 spaces and a spec whose max_episode_steps is the env's own episode; held for
+    that episode, the swimmer's own controller swims the distance its evolution recorded."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", message=NO_WINDOW)
+        env = gymnasium.make("animat/Swim-v0", render_mode="rgb_array")
+        check_env(env.unwrapped)
+        obs, _ = env.reset(seed=0)
+        obs, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+        assert env.render().shape == (240, 320, 3)
+        env.close()
+    genome = animat.control.default_swimmer()
+    body = animat.build_body(animat.develop(genome, animat.Config()))
+    assert body.node_count == env.unwrapped.body.node_count == 32
+    np.testing.assert_array_equal(env.unwrapped.body.positions, body.positions)
+    assert env.spec.max_episode_steps == animat.control.DEFAULT_EPISODE_STEPS == env.unwrapped.max_episode_steps == 1000
+    assert env.observation_space.dtype == env.action_space.dtype == np.float32
+    assert obs.dtype == np.float32 and env.observation_space.contains(obs)
+    assert env.observation_space.shape == (4 * 32 + body.spring_count,) and env.action_space.shape == (32,)
+    assert isinstance(reward, float) and not terminated and not truncated
+    assert animat.evaluate(genome, animat.Config()).fitness == DEFAULT_SWIMMER_DISTANCE
+
+    env = gymnasium.make("animat/Swim-v0", mode="oscillator", delayed_start=True, normalize_actions=False)
+    env.reset(seed=0)
+    action, total, steps = env.unwrapped.own_action(), 0.0, 0
+    while True:
+        _, reward, terminated, truncated, info = env.step(action)
+        total, steps = total + reward, steps + 1
+        if terminated or truncated:
+            break
+    assert truncated and not terminated and info["valid"] and steps == 1000  # the env's end and the spec's agree
+    assert env.unwrapped.objective_value() == DEFAULT_SWIMMER_DISTANCE  # bit for bit, as evaluate swims it
+    assert total == pytest.approx(DEFAULT_SWIMMER_DISTANCE, rel=1e-12)
+
+
+@pytest.mark.skipif(sys.platform in ("darwin", "win32"), reason="a display is found by DISPLAY / WAYLAND_DISPLAY")
+def test_human_rendering_without_a_window_warns_and_still_runs(body_and_config, monkeypatch):
+    """No display, or a backend that draws no window: a warning saying which, then an env that steps
+    and renders nothing (render() is None, as in human mode with a window)."""
+    import matplotlib
+
+    body, c = body_and_config
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.warns(UserWarning, match=r"shows no window: there is no display \(neither DISPLAY nor WAYLAND_DISPLAY"):
+        env = gymnasium.make("animat/Swim-v0", body=body, config=c, render_mode="human", episode_steps=3)
+    assert env.unwrapped._figure is None
+    env.reset(seed=0)
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    assert env.render() is None
+    env.close()
+    monkeypatch.setenv("DISPLAY", ":0")
+    matplotlib.use("Agg")
+    with pytest.warns(UserWarning, match=r"(?i)shows no window: matplotlib's backend 'agg' draws no window"):
+        animat.SwimEnv(body, c, render_mode="human").close()
+
+
+HUMAN_WINDOW_SCRIPT = """
+import json, warnings
+import gymnasium, matplotlib.pyplot as plt, numpy as np
+import animat
+from gymnasium.utils.env_checker import check_env
+warnings.simplefilter("error")
+env = gymnasium.make("animat/Swim-v0", render_mode="human", episode_steps=5)
+check_env(env.unwrapped)
+fig = env.unwrapped._figure
+env.reset(seed=0)
+rendered = []
+for _ in range(5):
+    env.step(env.action_space.sample())
+    rendered.append(env.render())
+window = fig.canvas.manager.window
+window.update()
+rgb = np.asarray(fig.canvas.buffer_rgba())[..., :3]
+report = {"backend": plt.get_backend(), "title": window.title(), "mapped": bool(window.winfo_ismapped()),
+          "drawn": float((rgb < 200).any(axis=2).mean()), "rendered": rendered}
+env.close()
+report["figures_after_close"] = plt.get_fignums()
+print(json.dumps(report))
+"""
+
+
+@pytest.mark.skipif(shutil.which("Xvfb") is None, reason="needs Xvfb, a virtual X display")
+def test_human_rendering_opens_a_matplotlib_window_on_a_display():
+    """On an X display (Xvfb) with TkAgg: the window opens titled with the env id, the body is drawn
+    in it, render() returns None, check_env passes with warnings as errors, and close() closes it."""
+    pytest.importorskip("tkinter")
+    read_end, write_end = os.pipe()
+    xvfb = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write_end), "-screen", "0", "640x480x24", "-nolisten", "tcp"],
+        pass_fds=(write_end,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write_end)
+    try:
+        with os.fdopen(read_end) as ready:
+            display = ready.readline().strip()  # Xvfb writes its display number once it accepts clients
+        assert display, "Xvfb exited before it was ready"
+        env = {**os.environ, "DISPLAY": f":{display}", "MPLBACKEND": "TkAgg"}
+        env["PYTHONPATH"] = os.pathsep.join(
+            p for p in [str(Path(animat.__file__).parents[1]), env.get("PYTHONPATH")] if p
+        )
+        run = subprocess.run(
+            [sys.executable, "-c", HUMAN_WINDOW_SCRIPT], env=env, capture_output=True, text=True, timeout=300
+        )
+    finally:
+        xvfb.terminate()
+        xvfb.wait()
+    assert run.returncode == 0, run.stderr
+    report = json.loads(run.stdout.strip().splitlines()[-1])
+    assert report["backend"].lower() == "tkagg" and report["title"] == "animat/Swim-v0" and report["mapped"]
+    assert report["drawn"] > 0.01  # the body's skin and springs, dark on white
+    assert report["rendered"] == [None] * 5 and report["figures_after_close"] == []
+
+
 def test_observations_are_relative_to_the_centre_of_mass_and_start_at_rest(body_and_config):
     body, c = body_and_config
     env = animat.SwimEnv(body, c)
     obs, info = env.reset(seed=1)
     n = body.node_count
-    length = animat._core.body_length(body)
-    rel = obs[: 2 * n].reshape(n, 2) * length  # in body lengths
+    physical = env.physical_observation()
+    rel = physical[: 2 * n].reshape(n, 2)
     np.testing.assert_allclose(rel.mean(axis=0), 0.0, atol=1e-9)
     np.testing.assert_allclose(rel + info["com"], np.asarray(body.positions), atol=1e-5)  # float32 Box2D positions
-    np.testing.assert_array_equal(obs[2 * n : 4 * n], 0.0)  # at rest
-    np.testing.assert_allclose(obs[4 * n :], 0.0, atol=1e-6)  # springs at their rest length
-    np.testing.assert_array_equal(obs, env.physical_observation() / env.obs_scale)
+    np.testing.assert_array_equal(physical[2 * n : 4 * n], 0.0)  # at rest
+    np.testing.assert_allclose(physical[4 * n :], 0.0, atol=1e-6)  # springs at their rest length
+    assert obs.dtype == np.float32 and env.observation_space.dtype == np.float32
+    np.testing.assert_array_equal(obs, (physical / env.obs_scale).astype(np.float32))  # in body lengths
     obs2, reward, terminated, truncated, _ = env.step(np.zeros(n))  # no actuation: nothing moves
     assert reward == 0.0 and not terminated and not truncated
     np.testing.assert_array_equal(obs2, obs)
@@ -271,7 +404,7 @@ def test_observations_stay_in_their_box_and_clipping_is_counted(body_and_config)
         scaled = tight.physical_observation() / tight.obs_scale
         beyond = np.abs(scaled) > 0.05
         assert info["obs_clipped"] == beyond.sum()
-        np.testing.assert_array_equal(obs, np.clip(scaled, -0.05, 0.05))
+        np.testing.assert_array_equal(obs, np.clip(scaled, -0.05, 0.05).astype(np.float32))
         assert tight.observation_space.contains(obs)
         total += info["obs_clipped"]
     assert tight.obs_clipped == total > 0
