@@ -9,16 +9,30 @@ A run directory holds::
     checkpoint.json   the state to resume from (absent in the first moments of a run)
 
 :class:`Run` reads all of it, including runs that are still going (a half-written last line of
-``history.csv`` is ignored, and a missing checkpoint is fine).
+``history.csv`` is ignored, and a missing checkpoint is fine). It also reads, in place and read-only:
+
+- a *packed* run (``data/README.md``; ``studies/replication/replication_store.py`` packs and unpacks
+  them): ``config.toml``, ``history.csv.gz``, ``best.tar.gz``, ``checkpoint.json.gz``, ``status.json``
+  and ``manifest.json``, whose sizes and sha256 digests are checked for every file read;
+- the run directory of a MAP-Elites or NSGA-II search (:func:`animat.run_map_elites`,
+  :func:`animat.run_nsga2`): ``history.csv`` with that search's columns and the snapshots
+  ``archive/gen_*.csv`` or ``front/gen_*.csv`` (:meth:`Run.snapshot`) in place of ``best/``.
 """
 
 from __future__ import annotations
 
+import csv
+import gzip
+import hashlib
+import io
 import json
 import re
-from dataclasses import dataclass
+import sys
+import tarfile
+import zlib
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -27,6 +41,8 @@ from . import _core
 __all__ = [
     "Run",
     "LineageEntry",
+    "Snapshot",
+    "PACKED_FILES",
     "HISTORY_DTYPE",
     "PROTECTED_HISTORY_DTYPE",
     "read_history",
@@ -122,7 +138,24 @@ def read_history(path: PathLike) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file (a run directory has a history.csv after its first generation)")
-    text = path.read_text(encoding="utf-8", errors="replace")
+    return _parse_history(path.read_text(encoding="utf-8", errors="replace"), path)
+
+
+def _search_history_dtype(header: List[str]) -> Optional[np.dtype]:
+    """The dtype of a MAP-Elites or NSGA-II ``history.csv`` with this header, or None for another header."""
+    if header[:3] == ["generation", "evaluations", "qd_score"]:
+        from .qd import QD_HISTORY_DTYPE
+
+        return QD_HISTORY_DTYPE
+    if header[:4] == ["generation", "evaluations", "front_size", "hypervolume"]:
+        from .moo import history_dtype as nsga2_history_dtype
+
+        return nsga2_history_dtype([n[len("best_") :] for n in header if n.startswith("best_")])
+    return None
+
+
+def _parse_history(text: str, path: Any) -> np.ndarray:
+    """:func:`read_history` of the text of ``path`` (a file, or a packed run's ``history.csv.gz``)."""
     lines = text.split("\n")
     # `text` ends with "\n" when complete: the last element is then "". Otherwise it is a partial row.
     complete = lines[:-1]
@@ -134,9 +167,17 @@ def read_history(path: PathLike) -> np.ndarray:
     header = complete[0].strip().split(",")
     olders = [[name for name in expected if name not in missing] for missing in _OLDER_HEADERS]
     dtype = HISTORY_DTYPE
+    search = _search_history_dtype(header)
     if header == list(PROTECTED_HISTORY_DTYPE.names or ()):
         dtype = PROTECTED_HISTORY_DTYPE
         expected = header
+    elif search is not None:
+        if header != list(search.names or ()):
+            raise ValueError(
+                f"{path}:1: unexpected header {complete[0].strip()!r} for a search run; expected "
+                f"{','.join(search.names or ())!r}"
+            )
+        dtype, expected = search, header
     elif header != expected and header not in olders:
         raise ValueError(f"{path}:1: unexpected header {complete[0].strip()!r}; expected {','.join(expected)!r}")
     column = {name: k for k, name in enumerate(header)}
@@ -166,8 +207,13 @@ def read_history(path: PathLike) -> np.ndarray:
 
 
 def _read_lineage_file(path: Path) -> LineageEntry:
+    return _lineage_entry(path.read_text(encoding="utf-8"), path)
+
+
+def _lineage_entry(text: str, path: Path) -> LineageEntry:
+    """The LineageEntry of a ``best/gen_*.json`` text read from ``path`` (named in errors)."""
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(text)
     except json.JSONDecodeError as e:
         raise ValueError(f"{path}: not valid JSON ({e})") from None
     if not isinstance(data, dict):
@@ -266,20 +312,170 @@ def morphology_distance(a, b) -> float:
 MORPHOLOGY_TOLERANCE = 0.25
 
 
-class Run:
-    """A run directory, read-only.
+#: The files of a packed run (``data/README.md``) besides ``manifest.json``, which lists their sizes and
+#: sha256 digests; :class:`Run` reads them in place.
+PACKED_FILES = ("config.toml", "history.csv.gz", "best.tar.gz", "checkpoint.json.gz", "status.json")
+_PACKED_NEEDED = ("history.csv.gz", "best.tar.gz")
+_MANIFEST = "manifest.json"
+_MANIFEST_FORMAT = "animat.replication_store.manifest"
+#: At most this many bytes from one gzip stream of a packed run without a manifest (a checkpoint is a few MB).
+_MAX_GUNZIPPED = 1 << 30
+_SNAPSHOT_NAME = re.compile(r"^gen_(\d+)\.csv$")
+#: The folder of snapshots of each search that writes them.
+_SNAPSHOT_FOLDERS = {"map_elites": "archive", "nsga2": "front"}
 
-    ``Run(path)`` checks that ``path`` is a directory with a readable ``config.toml``; everything
-    else is read when asked for, and read again every time, so a run in progress can be followed
-    by re-reading :attr:`history` and :attr:`best_genomes`.
+
+def _gunzip(data: bytes, where: Path, limit: int) -> bytes:
+    """The content of the gzip stream ``data`` (read from ``where``), at most ``limit`` bytes; ValueError
+    naming ``where`` for a corrupt, truncated or oversized stream (zlib checks the CRC and length)."""
+    d = zlib.decompressobj(16 + zlib.MAX_WBITS)
+    try:
+        out = d.decompress(data, limit + 1)
+    except zlib.error as e:
+        raise ValueError(f"{where}: corrupt gzip stream ({e})") from None
+    if len(out) > limit:
+        raise ValueError(f"{where}: expands past {limit} bytes, more than manifest.json says (corrupt?)")
+    if not d.eof:
+        raise ValueError(f"{where}: the gzip stream ends early (truncated)")
+    if d.unused_data:
+        raise ValueError(f"{where}: bytes after the end of the gzip stream (corrupt)")
+    return out
+
+
+def _check_digest(where: Path, what: str, data: bytes, want: Any) -> None:
+    """ValueError naming ``where`` unless ``data`` has the size and sha256 of the manifest entry ``want``."""
+    if not isinstance(want, dict):
+        raise ValueError(f"{where}: manifest.json has no entry for {what}")
+    if len(data) != want.get("size"):
+        raise ValueError(f"{where}: {what} is {len(data)} bytes, manifest.json says {want.get('size')}")
+    sha = hashlib.sha256(data).hexdigest()
+    if sha != want.get("sha256"):
+        raise ValueError(f"{where}: the sha256 of {what}, {sha}, is not manifest.json's {want.get('sha256')}")
+
+
+def _runs_below(path: Path) -> List[Path]:
+    return sorted({c.parent for c in list(path.glob("*/config.toml")) + list(path.glob("*/*/config.toml"))})
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """One snapshot of a search run: ``archive/gen_NNNNNN.csv`` (MAP-Elites: one row per elite) or
+    ``front/gen_NNNNNN.csv`` (NSGA-II: one row per genome of the first front).
+
+    Attributes:
+        kind: ``"archive"`` or ``"front"``.
+        generation: the generation after which it was written.
+        path: the file.
+        columns: every column but ``genome``: name -> array with one value per row (int64 for
+            ``index`` and ``generation``, the generation that made the genome; float64 otherwise). An
+            archive has ``index`` (the cell), ``objective``, ``fitness``, ``reference`` and its
+            descriptors; a front ``crowding``, the objectives, ``measured_<name>`` and ``reference_<name>``.
+        genomes: each row's genome as JSON text (:meth:`genome` parses one).
+        objectives: what "best" means: ``[("objective", "max")]`` for an archive, the objectives and
+            their senses (``"max"`` or ``"min"``) for a front, in the run's order.
+        descriptors: an archive's descriptor names (empty for a front).
+    """
+
+    kind: str
+    generation: int
+    path: Path
+    columns: Dict[str, np.ndarray]
+    genomes: List[str]
+    objectives: List[Tuple[str, str]]
+    descriptors: List[str] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return len(self.genomes)
+
+    def genome(self, row: int):
+        """The :class:`animat.Genome` of row ``row``."""
+        try:
+            return _core.Genome.from_json(self.genomes[row])
+        except ValueError as e:
+            raise ValueError(f"{self.path}: row {row + 2}: invalid genome: {e}") from None
+
+    def best(self) -> int:
+        """The row best by the first of :attr:`objectives` (-1 when there is none)."""
+        if not len(self):
+            return -1
+        name, sense = self.objectives[0]
+        values = np.asarray(self.columns[name], dtype=float)
+        values = np.where(np.isnan(values), -np.inf if sense == "max" else np.inf, values)
+        return int(np.argmax(values) if sense == "max" else np.argmin(values))
+
+
+def _objective_senses(config: Any, names: List[str]) -> List[Tuple[str, str]]:
+    """The sense of each NSGA-II objective column: from the config's ``search.objectives`` (``NAME:max``),
+    else the criterion's own (:data:`animat.moo.CRITERIA`), else ``"max"``."""
+    from .moo import CRITERIA
+
+    given = {}
+    for entry in list(config["search.objectives"]):
+        name, _, sense = str(entry).partition(":")
+        given[name] = sense
+    out = []
+    for name in names:
+        sense = given.get(name) or getattr(CRITERIA.get(name), "sense", "") or "max"
+        out.append((name, "min" if sense.startswith("min") else "max"))
+    return out
+
+
+def _read_snapshot(path: Path, kind: str, config: Any) -> Snapshot:
+    """A :class:`Snapshot` from its CSV file; ValueError naming the file and line when malformed."""
+    match = _SNAPSHOT_NAME.match(path.name)
+    generation = int(match.group(1)) if match else -1
+    with open(path, encoding="utf-8", newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows or not rows[0] or rows[0][-1] != "genome":
+        raise ValueError(f"{path}:1: not a {kind} snapshot (the last column is not genome)")
+    header = rows[0]
+    if kind == "archive":
+        needed = ["index", "objective", "fitness", "reference", "generation"]
+        if header[:5] != needed:
+            raise ValueError(f"{path}:1: expected the header to begin with {','.join(needed)}, got {','.join(header)}")
+        descriptors, objectives = header[5:-1], [("objective", "max")]
+    else:
+        if header[:2] != ["generation", "crowding"]:
+            raise ValueError(f"{path}:1: expected the header to begin with generation,crowding, got {','.join(header)}")
+        names = [n for n in header[2:-1] if not n.startswith(("measured_", "reference_"))]
+        descriptors, objectives = [], _objective_senses(config, names)
+    values: Dict[str, list] = {n: [] for n in header[:-1]}
+    genomes = []
+    for number, row in enumerate(rows[1:], start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise ValueError(f"{path}:{number}: expected {len(header)} comma-separated values, got {len(row)}")
+        try:
+            for name, v in zip(header[:-1], row):
+                values[name].append(int(v) if name in ("index", "generation") else float(v))
+        except ValueError:
+            raise ValueError(f"{path}:{number}: not a number in {','.join(row[:-1])!r}") from None
+        genomes.append(row[-1])
+    columns = {n: np.asarray(v, dtype=np.int64 if n in ("index", "generation") else np.float64) for n, v in values.items()}
+    return Snapshot(kind, generation, path, columns, genomes, objectives, descriptors)
+
+
+class Run:
+    """A run directory, read-only: that of the GA (``animat_evolve``, :func:`animat.evolve`), of a
+    MAP-Elites or NSGA-II search (:attr:`search`), or a packed run (:attr:`packed`).
+
+    ``Run(path)`` checks that ``path`` is a directory with a readable ``config.toml`` (and, for a
+    packed run, its ``history.csv.gz`` and ``best.tar.gz``); everything else is read when asked for,
+    and read again every time, so a run in progress can be followed by re-reading :attr:`history`
+    and :attr:`best_genomes`. A packed run is read in place without unpacking, every file checked
+    against the size and sha256 ``manifest.json`` lists (runs packed before manifests: the gzip
+    CRC only); ``studies/replication/replication_store.py unpack`` gives a run directory to resume.
 
     Raises:
-        FileNotFoundError: ``path`` or its ``config.toml`` does not exist.
-        ValueError: ``config.toml`` is not a valid config (the message names file, line and key).
+        FileNotFoundError: ``path`` or its ``config.toml`` does not exist (the message says when runs lie
+            below it), or a packed run lacks ``history.csv.gz`` or ``best.tar.gz``.
+        ValueError: ``config.toml`` is not a valid config (the message names file, line and key), or
+            a packed run's file does not match ``manifest.json``.
 
     Example::
 
-        run = animat.Run("runs/demo")
+        run = animat.Run("runs/demo")  # or a packed run: animat.Run("data/replication_regime/dn0.5/run_0")
         run.history["best"]            # best fitness per generation, (generations,) float64
         entry = run.best()             # LineageEntry of the best genome so far
         traj = animat.replay(entry.genome, run.config)
@@ -293,11 +489,78 @@ class Run:
             raise NotADirectoryError(f"{self.path}: not a directory (expected a run directory)")
         config_path = self.path / "config.toml"
         if not config_path.is_file():
-            raise FileNotFoundError(
-                f"{config_path}: missing; {self.path} is not a run directory written by animat_evolve "
-                "(expected config.toml, history.csv, best/)"
+            below = _runs_below(self.path)
+            hint = (
+                f"; it holds {len(below)} run(s) below it ({below[0].relative_to(self.path).as_posix()}, ...): "
+                f"`animat explore {self.path}` shows them all"
+                if below
+                else ""
             )
+            raise FileNotFoundError(
+                f"{config_path}: missing; {self.path} is neither a run directory (config.toml, history.csv, best/) "
+                f"nor a packed run (config.toml, history.csv.gz, best.tar.gz, manifest.json){hint}"
+            )
+        self._cache: Dict[str, Tuple[Tuple[int, int], Any]] = {}
+        self._manifest: Optional[dict] = None
+        self.packed = not (self.path / "history.csv").exists() and any(
+            (self.path / n).is_file() for n in PACKED_FILES[1:] + (_MANIFEST,)
+        )
+        """True for a packed run (``history.csv.gz``, ``best.tar.gz``, ... and no ``history.csv``)."""
+        if self.packed:
+            missing = [n for n in _PACKED_NEEDED if not (self.path / n).is_file()]
+            if missing:
+                raise FileNotFoundError(
+                    f"{self.path / missing[0]}: missing; {self.path} holds part of a packed run (data/README.md) "
+                    f"but not {' or '.join(missing)}"
+                )
+            if (self.path / _MANIFEST).is_file():
+                self._manifest = self._read_manifest()
+            self._packed_bytes("config.toml")  # checked against the manifest before it is trusted
         self._config = _core.load_config(str(config_path))
+
+    # --- the files of a packed run ---------------------------------------------------------------------
+
+    def _read_manifest(self) -> dict:
+        path = self.path / _MANIFEST
+        try:
+            m = json.loads(path.read_bytes())
+        except (ValueError, RecursionError) as e:
+            raise ValueError(f"{path}: not valid JSON ({e})") from None
+        if not (
+            isinstance(m, dict)
+            and m.get("format") == _MANIFEST_FORMAT
+            and isinstance(m.get("packed"), dict)
+            and isinstance(m.get("unpacked"), dict)
+        ):
+            raise ValueError(f"{path}: not a manifest of format {_MANIFEST_FORMAT} (with packed and unpacked)")
+        return m
+
+    def _packed_bytes(self, name: str) -> bytes:
+        """The bytes of the packed file ``name``, checked against the manifest."""
+        path = self.path / name
+        data = path.read_bytes()
+        if self._manifest is not None:
+            _check_digest(path, name, data, self._manifest["packed"].get(name))
+        return data
+
+    def _gunzipped(self, name: str) -> bytes:
+        """The content of the packed gzip file ``name``, checked against the manifest; kept while the
+        file is unchanged."""
+        path = self.path / name
+        st = path.stat()
+        key = (st.st_mtime_ns, st.st_size)
+        cached = self._cache.get(name)
+        if cached is not None and cached[0] == key:
+            return cached[1]
+        want = self._manifest["packed"].get(name, {}).get("gunzipped") if self._manifest is not None else None
+        limit = int(want["size"]) if isinstance(want, dict) and isinstance(want.get("size"), int) else _MAX_GUNZIPPED
+        data = _gunzip(self._packed_bytes(name), path, limit)
+        if self._manifest is not None:
+            _check_digest(path, f"the content of {name}", data, want)
+        self._cache[name] = (key, data)
+        return data
+
+    # --- what the run holds ----------------------------------------------------------------------------
 
     @property
     def config(self):
@@ -305,12 +568,22 @@ class Run:
         return self._config.copy()
 
     @property
+    def search(self) -> str:
+        """The search that wrote the run: ``"ga"`` (the paper's GA), ``"map_elites"`` or ``"nsga2"`` (its
+        config's ``search.algorithm``)."""
+        return str(self._config["search.algorithm"])
+
+    @property
     def history(self) -> np.ndarray:
         """Per-generation statistics from ``history.csv`` (structured array, see :func:`read_history`).
 
         Empty (shape (0,)) when the run has not finished generation 0 yet. Read afresh on every
-        access. Columns: ``run.history["best"]`` etc.; rows: ``run.history[-1]``.
+        access. Columns: ``run.history["best"]`` etc.; rows: ``run.history[-1]``. A MAP-Elites run has
+        :data:`animat.qd.QD_HISTORY_DTYPE`'s columns, an NSGA-II run :func:`animat.moo.history_dtype`'s.
         """
+        if self.packed:
+            text = self._gunzipped("history.csv.gz").decode("utf-8", errors="replace")
+            return _parse_history(text, self.path / "history.csv.gz")
         path = self.path / "history.csv"
         if not path.exists():
             return np.zeros(0, dtype=HISTORY_DTYPE).view(_history_type())
@@ -318,16 +591,111 @@ class Run:
 
     @property
     def best_genomes(self) -> List[LineageEntry]:
-        """The lineage of best genomes, oldest first: one :class:`LineageEntry` per ``best/gen_*.json``.
+        """The lineage of best genomes, oldest first: the record holders, each the genome that became the
+        best at its generation (not an ancestry: :meth:`ancestry` traces parents).
 
-        Each entry is the genome that became the best at that generation. Read afresh on every
-        access; a malformed file raises ValueError naming it.
+        A GA run: one :class:`LineageEntry` per ``best/gen_*.json`` (a packed run: per member of
+        ``best.tar.gz``; the entry's path is ``best.tar.gz/best/gen_*.json`` below the run). A search
+        run: the best row of each snapshot (:meth:`snapshot`) where it changed, by the archive's
+        objective (MAP-Elites) or the first objective (NSGA-II, in its sense); ``generation`` is the
+        generation that made the genome, ``fitness`` that objective's value.
+
+        Read afresh on every access; a malformed file raises ValueError naming it.
         """
+        if self.search in _SNAPSHOT_FOLDERS and not self.packed:
+            return self._search_lineage()
+        if self.packed:
+            return self._packed_lineage()
         folder = self.path / "best"
         if not folder.is_dir():
             return []
         files = sorted(p for p in folder.iterdir() if _LINEAGE_NAME.match(p.name))
         return [_read_lineage_file(p) for p in files]
+
+    def _packed_lineage(self) -> List[LineageEntry]:
+        path = self.path / "best.tar.gz"
+        entries = []
+        try:
+            with tarfile.open(fileobj=io.BytesIO(self._gunzipped("best.tar.gz")), mode="r:") as tar:
+                for member in tar.getmembers():
+                    name = member.name
+                    if not (member.isfile() and name.startswith("best/") and _LINEAGE_NAME.match(name[5:])):
+                        continue
+                    handle = tar.extractfile(member)
+                    data = handle.read() if handle is not None else b""
+                    if self._manifest is not None:
+                        _check_digest(path, name, data, self._manifest["unpacked"].get(name))
+                    entries.append((name, _lineage_entry(data.decode("utf-8", errors="replace"), path / name)))
+        except tarfile.TarError as e:
+            raise ValueError(f"{path}: not a tar archive of best/gen_*.json ({e})") from None
+        return [entry for _, entry in sorted(entries, key=lambda item: item[0])]
+
+    def snapshots(self) -> List[Tuple[int, Path]]:
+        """A search run's snapshots, oldest first: ``(generation, path)`` of every ``archive/gen_*.csv``
+        (MAP-Elites) or ``front/gen_*.csv`` (NSGA-II); empty for a GA run."""
+        folder = self.path / _SNAPSHOT_FOLDERS.get(self.search, "")
+        if self.search not in _SNAPSHOT_FOLDERS or not folder.is_dir():
+            return []
+        found = [(int(m.group(1)), p) for p in folder.iterdir() if (m := _SNAPSHOT_NAME.match(p.name))]
+        return sorted(found)
+
+    def snapshot(self, generation: Optional[int] = None) -> Snapshot:
+        """The archive (MAP-Elites) or front (NSGA-II) written after ``generation`` (default: the last
+        one written), as a :class:`Snapshot`.
+
+        Raises ValueError for a GA run, for a generation without a snapshot (naming those there are)
+        and for a malformed file (naming it and the line).
+        """
+        found = self.snapshots()
+        if not found:
+            if self.search not in _SNAPSHOT_FOLDERS:
+                raise ValueError(f"{self.path}: a GA run (search.algorithm = {self.search!r}) has no archive or front")
+            folder = self.path / _SNAPSHOT_FOLDERS[self.search]
+            raise ValueError(f"{folder}: no gen_*.csv yet (the run has not finished generation 0)")
+        if generation is None:
+            path = found[-1][1]
+        else:
+            paths = dict(found)
+            if int(generation) not in paths:
+                raise ValueError(
+                    f"{self.path}: no snapshot of generation {generation}; there are {', '.join(str(g) for g, _ in found)}"
+                )
+            path = paths[int(generation)]
+        return self._snapshot_file(path)
+
+    def _snapshot_file(self, path: Path) -> Snapshot:
+        st = path.stat()
+        key = (st.st_mtime_ns, st.st_size)
+        cached = self._cache.get(str(path))
+        if cached is not None and cached[0] == key:
+            return cached[1]
+        snap = _read_snapshot(path, _SNAPSHOT_FOLDERS[self.search], self._config)
+        self._cache[str(path)] = (key, snap)
+        return snap
+
+    def _search_lineage(self) -> List[LineageEntry]:
+        out: List[LineageEntry] = []
+        previous = None
+        for _, path in self.snapshots():
+            snap = self._snapshot_file(path)
+            k = snap.best()
+            if k < 0 or snap.genomes[k] == previous:
+                continue
+            previous = snap.genomes[k]
+            name = snap.objectives[0][0]
+            reference = "reference" if snap.kind == "archive" else f"reference_{name}"
+            genome = snap.genome(k)
+            out.append(
+                LineageEntry(
+                    int(snap.columns["generation"][k]),
+                    float(snap.columns[name][k]),
+                    int(_core.develop(genome, self._config).cell_count),
+                    genome,
+                    path,
+                    float(snap.columns[reference][k]) if reference in snap.columns else float("nan"),
+                )
+            )
+        return out
 
     def best(self) -> LineageEntry:
         """The current best: the last entry of :attr:`best_genomes`.
@@ -336,19 +704,37 @@ class Run:
         """
         lineage = self.best_genomes
         if not lineage:
-            raise ValueError(f"{self.path / 'best'}: no gen_*.json yet (the run has not finished generation 0)")
+            folder = self.path / _SNAPSHOT_FOLDERS.get(self.search, "best")
+            raise ValueError(f"{folder}: no gen_* file yet (the run has not finished generation 0)")
         return lineage[-1]
 
     @property
     def checkpoint(self) -> Optional[dict]:
-        """``checkpoint.json`` as a dict, or None when there is none yet."""
+        """``checkpoint.json`` (a packed run's ``checkpoint.json.gz``) as a dict, or None when there is none yet."""
         path = self.path / "checkpoint.json"
-        if not path.is_file():
+        if self.packed and (self.path / "checkpoint.json.gz").is_file():
+            path = self.path / "checkpoint.json.gz"
+            text = self._gunzipped("checkpoint.json.gz").decode("utf-8", errors="replace")
+        elif not path.is_file():
             return None
+        else:
+            text = path.read_text(encoding="utf-8")
         try:
-            return json.loads(path.read_text(encoding="utf-8"))
+            return json.loads(text)
         except json.JSONDecodeError as e:
             raise ValueError(f"{path}: not valid JSON ({e})") from None
+
+    @property
+    def status(self) -> Optional[dict]:
+        """A packed run's ``status.json``: ``{"generation": last generation, "stop_reason": why its last
+        session stopped}``; None for a run directory (or a packed run without one)."""
+        if not (self.packed and (self.path / "status.json").is_file()):
+            return None
+        try:
+            data = json.loads(self._packed_bytes("status.json"))
+        except ValueError as e:
+            raise ValueError(f"{self.path / 'status.json'}: not valid JSON ({e})") from None
+        return data if isinstance(data, dict) else None
 
     @property
     def generations(self) -> int:
@@ -359,19 +745,37 @@ class Run:
         """A few human-readable lines: path, generations, best fitness and its lineage."""
         h = self.history
         lineage = self.best_genomes
-        lines = [f"run {self.path}: {len(h)} generation(s) recorded"]
+        kind = {"map_elites": "MAP-Elites run", "nsga2": "NSGA-II run"}.get(self.search, "run")
+        lines = [f"{'packed ' if self.packed else ''}{kind} {self.path}: {len(h)} generation(s) recorded"]
         if len(h):
             last = h[-1]
-            lines.append(
-                f"  generation {int(last['generation'])}: best {last['best']:.4f}, mean {last['mean']:.4f}, "
-                f"viable {100 * last['viable_fraction']:.0f}%, {int(last['evaluations'])} evaluations, "
-                f"{last['wall_seconds']:.1f} s"
-            )
+            names = h.dtype.names or ()
+            if self.search == "map_elites" and "qd_score" in names:
+                text = (
+                    f"QD-score {last['qd_score']:.4g}, coverage {last['coverage']:.3f}, {int(last['elites'])} elites, "
+                    f"best {last['best']:.4f}, {int(last['evaluations'])} evaluations"
+                )
+            elif self.search == "nsga2" and "hypervolume" in names:
+                bests = ", ".join(f"{n} {last[n]:.4g}" for n in names if n.startswith("best_"))
+                text = (
+                    f"front of {int(last['front_size'])}, hypervolume {last['hypervolume']:.4g}, {bests}, "
+                    f"{int(last['evaluations'])} evaluations"
+                )
+            else:
+                text = (
+                    f"best {last['best']:.4f}, mean {last['mean']:.4f}, viable {100 * last['viable_fraction']:.0f}%, "
+                    f"{int(last['evaluations'])} evaluations, {last['wall_seconds']:.1f} s"
+                )
+            lines.append(f"  generation {int(last['generation'])}: {text}")
+        status = self.status
+        if status and status.get("stop_reason"):
+            lines.append(f"  stopped: {status['stop_reason']} (status.json)")
         if lineage:
             b = lineage[-1]
+            what = "improvement(s)" if self.search == "ga" else "change(s) of the best over the snapshots"
             lines.append(
                 f"  best genome: generation {b.generation}, fitness {b.fitness:.4f}, {b.cell_count} cells "
-                f"({len(lineage)} improvement(s))"
+                f"({len(lineage)} {what})"
             )
         return "\n".join(lines)
 
