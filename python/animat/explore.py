@@ -230,16 +230,14 @@ def _history_payload(history: np.ndarray, config: Any, max_points: int) -> Tuple
 
 
 def _entry_id(entry: Any) -> Optional[int]:
-    """The ``"id"`` of a lineage file (runs with a genealogy.csv write it), or None."""
-    try:
-        value = json.loads(Path(entry.path).read_text(encoding="utf-8")).get("id")
-    except (OSError, ValueError, AttributeError):
-        return None
-    return int(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+    """The ``"id"`` of a lineage entry (runs with a genealogy.csv write it), or None."""
+    value = getattr(entry, "id", -1)
+    return int(value) if value >= 0 else None
 
 
-def _summary(history: np.ndarray, path: Path) -> Dict[str, Any]:
-    """The runs table's row: the last generation's numbers, and why the run stopped (stopped.txt)."""
+def _summary(history: np.ndarray, path: Path, status: Optional[dict] = None) -> Dict[str, Any]:
+    """The runs table's row: the last generation's numbers, and why the run stopped (stopped.txt, or a
+    packed run's status.json)."""
     out: Dict[str, Any] = {"generations": len(history)}
     if len(history):
         last = history[-1]
@@ -254,6 +252,8 @@ def _summary(history: np.ndarray, path: Path) -> Dict[str, Any]:
         )
     stopped = path / "stopped.txt"
     out["stopped"] = stopped.read_text(errors="replace").strip()[:200] if stopped.is_file() else ""
+    if status and isinstance(status.get("stop_reason"), str) and status["stop_reason"] != "in progress":
+        out["stopped"] = status["stop_reason"][:200]
     return out
 
 
@@ -564,7 +564,7 @@ def run_data(ref: RunRef, *, frames: int = 200, max_points: int = 500, modes: bo
         "mode": None,
         "_config": config,
     }
-    data["summary"] = _summary(history, ref.path)
+    data["summary"] = _summary(history, ref.path, run.status)
     if not lineage_entries:
         data["swim_note"] = "no best yet (best/ is empty)"
         return data
@@ -587,7 +587,7 @@ def _live_version(refs: Sequence[RunRef]) -> str:
     """Changes whenever a history.csv or the lineage of one of the runs does."""
     parts = []
     for r in refs:
-        for name in ("history.csv", "best", "genealogy.csv"):
+        for name in ("history.csv", "best", "genealogy.csv", "history.csv.gz", "best.tar.gz", "archive", "front"):
             p = r.path / name
             try:
                 st = p.stat()
@@ -610,7 +610,7 @@ def live_data(refs: Sequence[RunRef], max_points: int = 500) -> dict:
             curves, flags = _history_payload(history, config, max_points)
             entry = {"label": ref.label, "history": curves, "flags": flags}
             entry["lineage"] = _lineage_payload(run.best_genomes)
-            entry["summary"] = _summary(history, ref.path)
+            entry["summary"] = _summary(history, ref.path, run.status)
         except (OSError, ValueError) as e:  # a file being rewritten: said, and tried again next poll
             entry = {"label": ref.label, "error": str(e)}
         runs.append(entry)
