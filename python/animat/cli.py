@@ -93,7 +93,17 @@ def _parser() -> argparse.ArgumentParser:
         "--out", type=Path, help="the page to write (default RUN_DIR/explore.html for one RUN_DIR; needed for several)"
     )
     x.add_argument("--modes", action="store_true", help="classify every best's locomotion (a few seconds per run)")
-    x.add_argument("--frames", type=int, default=200, help="frames of each best's swim at most (default 200)")
+    x.add_argument(
+        "--frames",
+        type=int,
+        help="frames of each best's swim at most (default 200; 60 on a page of more than 8 runs)",
+    )
+    x.add_argument(
+        "--replays",
+        type=int,
+        help="swims embedded per run besides the best's, of record holders or of a search's elites "
+        "(default 12; none on a page of more than 8 runs; a served page replays any on request)",
+    )
     x.add_argument("--max-points", type=int, default=500, help="generations per curve at most (default 500)")
     x.add_argument("--serve", action="store_true", help="serve the page on http://127.0.0.1:PORT/ until Ctrl-C")
     x.add_argument("--port", type=int, default=8765, help="port of --serve (default 8765; 0: any free port)")
@@ -224,14 +234,29 @@ def show_figures(run, only=None, *, frames: int = 6, steps: Optional[int] = None
     """The figures of ``animat show`` for a run (an :class:`animat.Run`), in order: a dict of figure
     name -> a function that draws it (a matplotlib Figure). ``only`` picks names of :data:`FIGURES`
     (default: all of them, ``stiffness_map`` only when the best body has evolved stiffness,
-    :func:`has_evolved_stiffness`). Every figure names the run's objective and world where it has
-    a title to do so."""
+    :func:`has_evolved_stiffness`; for a MAP-Elites or NSGA-II run, whose best is that of its last
+    archive or front, all but ``fitness_history``, which draws the GA's history). Every figure names
+    the run's objective and world where it has a title to do so."""
     import animat
     from animat import plot
 
     entry = run.best()
     config = run.config
-    wanted = list(only) if only else [n for n in FIGURES if n != "stiffness_map" or has_evolved_stiffness(run, entry)]
+    search = run.search != "ga"
+    if only and search and "fitness_history" in only:
+        raise ValueError(
+            f"{run.path}: fitness_history draws the GA's history.csv; this is a {run.search} run "
+            "(animat explore draws its curves and its archive or front)"
+        )
+    wanted = (
+        list(only)
+        if only
+        else [
+            n
+            for n in FIGURES
+            if (n != "stiffness_map" or has_evolved_stiffness(run, entry)) and not (search and n == "fitness_history")
+        ]
+    )
     objective, _, _ = plot.objective_info(config)
     label = f"best of {run.path.name}: generation {entry.generation}, fitness ({objective}) {entry.fitness:.3f}"
     cache = {}
@@ -267,9 +292,10 @@ def cmd_show(args) -> int:
     run = animat.Run(args.run)
     entry = run.best()
     out = args.out or run.path / "figures"
-    out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    for name, make in show_figures(run, args.only, frames=args.frames, steps=args.steps).items():
+    figures = show_figures(run, args.only, frames=args.frames, steps=args.steps)  # refuses before any file
+    out.mkdir(parents=True, exist_ok=True)
+    for name, make in figures.items():
         fig = make()
         path = out / f"{name}.png"
         fig.savefig(path, dpi=args.dpi)
@@ -327,8 +353,10 @@ def cmd_info(args) -> int:
 def cmd_explore(args) -> int:
     from . import explore
 
-    if args.frames < 2:
+    if args.frames is not None and args.frames < 2:
         raise ValueError(f"--frames must be at least 2, got {args.frames}")
+    if args.replays is not None and args.replays < 0:
+        raise ValueError(f"--replays must be at least 0, got {args.replays}")
     if args.max_points < 10:
         raise ValueError(f"--max-points must be at least 10, got {args.max_points}")
     if args.poll <= 0:
@@ -343,7 +371,7 @@ def cmd_explore(args) -> int:
         if len(args.runs) > 1:
             raise ValueError(f"{len(args.runs)} RUN_DIRs: name the page with --out FILE.html")
         out = Path(args.runs[0]) / "explore.html"
-    options = dict(frames=args.frames, max_points=args.max_points, modes=args.modes)
+    options = dict(frames=args.frames, max_points=args.max_points, modes=args.modes, replays=args.replays)
     t0 = time.perf_counter()
     live = {"poll": args.poll, "max_polls": 20000} if args.live else None
     page = explore.render_html(explore.build_data(args.runs, live=live, refs=refs, **options))

@@ -191,12 +191,48 @@ def downsample_indices(n: int, max_points: int, keep: Any = ()) -> np.ndarray:
 # --- history, flags, lineage ----------------------------------------------------------------------------
 
 
+def _best_column(history: np.ndarray) -> str:
+    """The column of the best value: ``best`` (the GA, MAP-Elites), else NSGA-II's first ``best_<objective>``."""
+    names = history.dtype.names or ()
+    return "best" if "best" in names else next((n for n in names if n.startswith("best_")), "best")
+
+
+#: The columns of a search run's history drawn beside its best, and their names on the page.
+_SEARCH_SERIES = {
+    "map_elites": (("qd_score", "QD-score"), ("coverage", "coverage"), ("elites", "elites")),
+    "nsga2": (("hypervolume", "hypervolume"), ("front_size", "front size")),
+}
+
+
 def _history_payload(history: np.ndarray, config: Any, max_points: int) -> Tuple[dict, dict]:
-    """The curves (downsampled) and the flagged generations (all of them) of one run's history."""
+    """The curves (downsampled) and the flagged generations (all of them) of one run's history. A
+    search run's history (MAP-Elites, NSGA-II) gives its best (NSGA-II: of the first objective) and,
+    under ``extra``, its own measures (:data:`_SEARCH_SERIES`); it has no mean, reference or flags."""
     n = len(history)
+    names = history.dtype.names or ()
+    no_flags: Dict[str, list] = {"invalid": [], "drag_limited": [], "guard": []}
     if n == 0:
         empty: Dict[str, list] = {k: [] for k in ("generation", "best", "mean", "reference", "viable")}
-        return {**empty, "total": 0, "changes_kept": True}, {"invalid": [], "drag_limited": [], "guard": []}
+        return {**empty, "total": 0, "changes_kept": True}, no_flags
+    if "mean" not in names:  # a search run
+        column = _best_column(history)
+        best = np.asarray(history[column], dtype=float)
+        changes = np.nonzero(np.diff(best) != 0)[0] + 1
+        idx = downsample_indices(n, max_points, changes)
+        h = history[idx]
+        search = "map_elites" if "qd_score" in names else "nsga2"
+        nothing = [None] * len(idx)
+        return {
+            "generation": [int(g) for g in h["generation"]],
+            "best": _nums(h[column]),
+            "best_column": column,
+            "mean": nothing,
+            "reference": nothing,
+            "viable": nothing,
+            "extra": {label: _nums(h[key]) for key, label in _SEARCH_SERIES[search] if key in names},
+            "total": n,
+            "changes_kept": bool(np.isin(changes, idx).all()),
+        }, no_flags
     best = np.asarray(history["best"], dtype=float)
     # The best is constant between its changes, so its step curve is exact when every change is kept.
     changes = np.nonzero(np.diff(best) != 0)[0] + 1
@@ -239,7 +275,19 @@ def _summary(history: np.ndarray, path: Path, status: Optional[dict] = None) -> 
     """The runs table's row: the last generation's numbers, and why the run stopped (stopped.txt, or a
     packed run's status.json)."""
     out: Dict[str, Any] = {"generations": len(history)}
-    if len(history):
+    names = history.dtype.names or ()
+    if len(history) and "mean" not in names:  # a search run: its own measures instead of the GA's
+        last = history[-1]
+        out.update(last_generation=int(last["generation"]), best=_num(last[_best_column(history)]))
+        out["evaluations"] = int(last["evaluations"])
+        if "qd_score" in names:
+            out["search"] = (
+                f"MAP-Elites: {int(last['elites'])} elites, coverage {last['coverage']:.3g}, "
+                f"QD-score {last['qd_score']:.4g}"
+            )
+        else:
+            out["search"] = f"NSGA-II: front of {int(last['front_size'])}, hypervolume {last['hypervolume']:.4g}"
+    elif len(history):
         last = history[-1]
         out.update(
             last_generation=int(last["generation"]),
@@ -536,9 +584,119 @@ def _shade(color: str, amount: float) -> str:
     return "#" + "".join(f"{int(round(c + (255 - c) * amount)):02x}" for c in rgb)
 
 
-def run_data(ref: RunRef, *, frames: int = 200, max_points: int = 500, modes: bool = False, max_nodes: int = 1500):
+def _search_payload(run: Any, max_rows: int) -> Optional[dict]:
+    """A search run's last snapshot for the page (None for a GA run): the MAP-Elites archive as a
+    heatmap over its first two descriptors (the grid of the checkpoint's archive; one row per elite),
+    or the NSGA-II front over its first two objectives (one row per genome)."""
+    if run.search not in ("map_elites", "nsga2"):
+        return None
+    try:
+        snap = run.snapshot()
+    except (OSError, ValueError) as e:
+        return {"kind": run.search, "note": str(e)}
+    n = len(snap)
+    order = list(range(n))
+    out: Dict[str, Any] = {"kind": run.search, "generation": snap.generation, "path": str(snap.path), "total": n}
+    if snap.kind == "archive":
+        names = snap.descriptors[:2]
+        geometry = _archive_geometry(run, snap)
+        values = [snap.columns[d] for d in names]
+        objective = snap.columns["objective"]
+        order = sorted(order, key=lambda k: -float(objective[k]) if math.isfinite(objective[k]) else math.inf)
+        rows = [
+            [k, *[_num(v[k]) for v in values], _num(objective[k]), int(snap.columns["generation"][k])]
+            for k in order[:max_rows]
+        ]
+        out.update(descriptors=geometry, objective="objective", rows=rows)
+    else:
+        names = [name for name, _ in snap.objectives[:2]]
+        out.update(objectives=[[name, sense] for name, sense in snap.objectives])
+        rows = [
+            [k, *[_num(snap.columns[name][k]) for name in names], int(snap.columns["generation"][k])]
+            for k in order[:max_rows]
+        ]
+        out.update(rows=rows)
+    out["best"] = snap.best()
+    return out
+
+
+def _archive_geometry(run: Any, snap: Any) -> List[dict]:
+    """The first two descriptors of an archive: name, range and bins of the checkpoint's grid archive;
+    for another archive (CVT) the range of the elites' values and no bins."""
+    geometry = {}
+    try:
+        state = (run.checkpoint or {}).get("archive") or {}
+    except (OSError, ValueError):
+        state = {}
+    if state.get("kind") == "grid":
+        for d, bins in zip(state.get("descriptors", []), state.get("bins", [])):
+            geometry[d.get("name")] = {"lo": _num(d.get("lo")), "hi": _num(d.get("hi")), "bins": int(bins)}
+    out = []
+    for name in snap.descriptors[:2]:
+        g = geometry.get(name)
+        if g is None:
+            v = np.asarray(snap.columns[name], dtype=float)
+            v = v[np.isfinite(v)]
+            g = {"lo": _num(v.min()) if len(v) else 0.0, "hi": _num(v.max()) if len(v) else 1.0, "bins": None}
+        out.append({"name": name, **g})
+    return out
+
+
+def individual(run: Any, key: str) -> Any:
+    """The individual of a run named by a page key: ``"lineage:J"`` (entry J of :attr:`Run.best_genomes`)
+    or ``"row:I"`` (row I of a search run's last snapshot), as a :class:`animat.LineageEntry`.
+    ValueError for another key."""
+    from .run import LineageEntry
+
+    kind, _, number = key.partition(":")
+    if not number.isdigit():
+        raise ValueError(f"no individual {key!r} (expected lineage:J or row:I)")
+    j = int(number)
+    if kind == "lineage":
+        lineage = run.best_genomes
+        if j >= len(lineage):
+            raise ValueError(f"{run.path}: no lineage entry {j} ({len(lineage)} there)")
+        return lineage[j]
+    if kind == "row":
+        snap = run.snapshot()
+        if j >= len(snap):
+            raise ValueError(f"{snap.path}: no row {j} ({len(snap)} there)")
+        name = snap.objectives[0][0]
+        return LineageEntry(
+            int(snap.columns["generation"][j]), float(snap.columns[name][j]), 0, snap.genome(j), snap.path
+        )
+    raise ValueError(f"no individual {key!r} (expected lineage:J or row:I)")
+
+
+def _replay_keys(lineage: List[dict], search: Optional[dict], count: int) -> List[str]:
+    """The individuals whose swims a page embeds besides the best's: the last ``count`` record holders
+    before the best (a GA run), or the ``count`` first rows of the snapshot payload (the best elites;
+    a front spread along its first objective)."""
+    if count <= 0:
+        return []
+    if search and search.get("rows"):
+        rows = search["rows"]
+        if search["kind"] == "nsga2" and len(rows) > count:
+            by_first = sorted(rows, key=lambda r: (r[1] is None, r[1] or 0.0))
+            rows = [by_first[k] for k in np.unique(np.linspace(0, len(rows) - 1, count).round().astype(int))]
+        return [f"row:{r[0]}" for r in rows[:count] if r[0] != search.get("best")]
+    return [f"lineage:{j}" for j in range(max(0, len(lineage) - 1 - count), len(lineage) - 1)]
+
+
+def run_data(
+    ref: RunRef,
+    *,
+    frames: int = 200,
+    max_points: int = 500,
+    modes: bool = False,
+    max_nodes: int = 1500,
+    replays: int = 0,
+):
     """The page's data for one run (a dict, JSON-ready): summary, curves, flags, lineage, genealogy,
-    swim, config (an :class:`animat.Config`, under ``"_config"``, removed before embedding)."""
+    swim, config (an :class:`animat.Config`, under ``"_config"``) and the whole best curve (``"_best"``:
+    generations and values), both removed before embedding; a search
+    run's last archive or front (``"search"``). ``replays``: swims of that many more individuals
+    (:func:`_replay_keys`) embedded under ``"replays"`` (key -> swim, at most 60 frames each)."""
     from . import plot as aplot
     from .run import Run
 
@@ -549,30 +707,52 @@ def run_data(ref: RunRef, *, frames: int = 200, max_points: int = 500, modes: bo
     lineage = _lineage_payload(lineage_entries)
     curves, flags = _history_payload(history, config, max_points)
     name, meaning, nonnegative = aplot.objective_info(config)
+    search = _search_payload(run, max_rows=2000)
+    if search and search["kind"] == "nsga2" and search.get("objectives"):
+        first, sense = search["objectives"][0]
+        name, meaning = first, f"the first NSGA-II objective ({sense}imised); the front trades it against the others"
+        nonnegative = None
     data: Dict[str, Any] = {
         "label": ref.label,
         "group": ref.group,
         "path": str(ref.path),
+        "kind": run.search,
+        "packed": bool(run.packed),
         "objective": {"name": name, "meaning": meaning, "nonnegative": nonnegative},
         "world": aplot.world_text(config),
         "history": curves,
         "flags": flags,
         "lineage": lineage,
-        "genealogy": _genealogy_payload(ref.path, lineage, max_nodes),
+        "genealogy": _genealogy_payload(ref.path, lineage, max_nodes)
+        if run.search == "ga"
+        else {
+            "note": f"a {run.search} run records no genealogy: its {'archive' if run.search == 'map_elites' else 'front'} is below"
+        },
+        "search": search,
         "swim": None,
         "swim_note": "",
+        "best_key": f"lineage:{len(lineage_entries) - 1}" if lineage_entries else None,
+        "replays": {},
         "mode": None,
         "_config": config,
     }
     data["summary"] = _summary(history, ref.path, run.status)
+    column = _best_column(history) if len(history) else "best"
+    data["_best"] = (
+        (np.asarray(history["generation"], dtype=np.int64), np.asarray(history[column], dtype=float))
+        if len(history)
+        else (np.zeros(0, dtype=np.int64), np.zeros(0))
+    )
     if not lineage_entries:
-        data["swim_note"] = "no best yet (best/ is empty)"
+        data["swim_note"] = "no best yet (best/ is empty)" if run.search == "ga" else "no best yet (no snapshot)"
         return data
     best = lineage_entries[-1]
     try:
         data["swim"] = _swim_payload(best, config, frames)
     except (ValueError, RuntimeError) as e:
         data["swim_note"] = f"the best of generation {best.generation} could not be replayed: {e}"
+    for key in _replay_keys(lineage, search, replays):
+        data["replays"][key] = individual_swim(run, key, min(frames, 60))
     if modes:
         from .locomotion import classify_locomotion
 
@@ -581,6 +761,15 @@ def run_data(ref: RunRef, *, frames: int = 200, max_points: int = 500, modes: bo
         except (ValueError, RuntimeError) as e:
             data["mode"] = f"(not classified: {e})"
     return data
+
+
+def individual_swim(run: Any, key: str, frames: int) -> dict:
+    """The swim payload of the individual ``key`` (:func:`individual`) of ``run`` (an :class:`animat.Run`);
+    ``{"error": ...}`` when it cannot be replayed."""
+    try:
+        return _swim_payload(individual(run, key), run.config, frames)
+    except (ValueError, RuntimeError) as e:
+        return {"error": f"{key} could not be replayed: {e}"}
 
 
 def _live_version(refs: Sequence[RunRef]) -> str:
@@ -617,13 +806,85 @@ def live_data(refs: Sequence[RunRef], max_points: int = 500) -> dict:
     return {"version": _live_version(refs), "runs": runs, "time": _dt.datetime.now().isoformat(timespec="seconds")}
 
 
+#: Runs on a page beyond which the defaults shrink: each best's swim gets :data:`STUDY_FRAMES` frames
+#: (not 200) and no other individual's swim is embedded (a served page replays any on demand).
+STUDY_RUNS = 8
+STUDY_FRAMES = 60
+#: Swims embedded besides the best's on a page of at most :data:`STUDY_RUNS` runs (:func:`_replay_keys`).
+REPLAYS = 12
+
+
+def _config_groups(refs: List[RunRef], configs: List[Any]) -> List[RunRef]:
+    """Runs given one by one (no group from an experiment directory) grouped by their config with
+    ``evolution.seed`` and ``evolution.threads`` left out: each group named by its runs' common parent
+    folder when that names the groups apart, else "config 1", "config 2", ..."""
+    if len(refs) < 2 or any(r.group for r in refs):
+        return refs
+    keys = []
+    for c in configs:
+        d = c.to_dict()
+        d.get("evolution", {}).pop("seed", None)
+        d.get("evolution", {}).pop("threads", None)
+        keys.append(json.dumps(d, sort_keys=True, default=str))
+    distinct = list(dict.fromkeys(keys))
+    parents = []
+    for key in distinct:
+        folders = {r.path.resolve().parent.name for r, k in zip(refs, keys) if k == key}
+        parents.append(folders.pop() if len(folders) == 1 else "")
+    names = (
+        parents
+        if all(parents) and len(set(parents)) == len(parents)
+        else [f"config {k + 1}" for k in range(len(distinct))]
+    )
+    return [RunRef(r.label, r.path, names[distinct.index(k)]) for r, k in zip(refs, keys)]
+
+
+def _group_payload(refs: List[RunRef], bests: List[Tuple[np.ndarray, np.ndarray]], max_points: int) -> List[dict]:
+    """Per group of runs (an environment of a study): the median and the quartiles of the best over the
+    runs that reached each generation (``n``: how many), downsampled to ``max_points`` generations."""
+    import warnings
+
+    out = []
+    for name in dict.fromkeys(r.group for r in refs):
+        members = [k for k, r in enumerate(refs) if r.group == name]
+        series = [bests[k] for k in members if len(bests[k][0])]
+        if not series:
+            out.append({"name": name, "runs": members, "generation": [], "median": [], "q1": [], "q3": [], "n": []})
+            continue
+        last = int(max(g.max() for g, _ in series))
+        table = np.full((len(series), last + 1), np.nan)
+        for row, (g, b) in enumerate(series):
+            keep = (g >= 0) & (g <= last)
+            table[row, g[keep]] = b[keep]
+        count = np.sum(np.isfinite(table), axis=0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a generation no run reached (a gap)
+            q1, median, q3 = np.nanpercentile(table, [25, 50, 75], axis=0)
+        reached = np.nonzero(count > 0)[0]
+        changes = np.nonzero(np.diff(median[reached]) != 0)[0] + 1
+        idx = reached[downsample_indices(len(reached), max_points, changes)]
+        out.append(
+            {
+                "name": name,
+                "runs": members,
+                "generation": [int(g) for g in idx],
+                "median": _nums(median[idx]),
+                "q1": _nums(q1[idx]),
+                "q3": _nums(q3[idx]),
+                "n": [int(c) for c in count[idx]],
+            }
+        )
+    return out
+
+
 def build_data(
     paths: Sequence[PathLike],
     *,
-    frames: int = 200,
+    frames: Optional[int] = None,
     max_points: int = 500,
     modes: bool = False,
     max_nodes: int = 1500,
+    replays: Optional[int] = None,
     title: Optional[str] = None,
     live: Optional[dict] = None,
     refs: Optional[List[RunRef]] = None,
@@ -631,19 +892,37 @@ def build_data(
     """The page's data (a dict, JSON-ready) for the runs of ``paths`` (see :func:`find_runs`).
 
     frames: at most this many frames of each best's swim (:func:`animat.animation.default_frames`:
-    the end of the swim, at least 8 frames per oscillation period). max_points: generations per
+    the end of the swim, at least 8 frames per oscillation period; default 200, or
+    :data:`STUDY_FRAMES` on a page of more than :data:`STUDY_RUNS` runs). max_points: generations per
     curve at most (downsampled beyond, every change of the best kept). modes: classify each best's
     locomotion (a few seconds per run). max_nodes: ancestors drawn at most in a genealogy (the
-    primary line and the youngest others). live: ``{"poll": seconds, "max_polls": N}`` for a served
-    live page.
+    primary line and the youngest others). replays: swims embedded per run besides the best's
+    (default :data:`REPLAYS`, none on a page of more than :data:`STUDY_RUNS` runs). live:
+    ``{"poll": seconds, "max_polls": N}`` for a served live page.
+
+    The runs are grouped (``"groups"``: median and quartiles of the best per generation): by the
+    environment folder of an experiment directory (``NAME/run_<i>``), else by config with the seed left out.
     """
     from . import __version__
 
     refs = find_runs(paths) if refs is None else refs
-    runs = [run_data(r, frames=frames, max_points=max_points, modes=modes, max_nodes=max_nodes) for r in refs]
-    for r, color in zip(runs, _colors(refs)):
-        r["color"] = color
-    diff = _config_diff([r.pop("_config") for r in runs])
+    study = len(refs) > STUDY_RUNS
+    frames = (STUDY_FRAMES if study else 200) if frames is None else frames
+    replays = (0 if study else REPLAYS) if replays is None else replays
+    runs = [
+        run_data(r, frames=frames, max_points=max_points, modes=modes, max_nodes=max_nodes, replays=replays)
+        for r in refs
+    ]
+    configs = [r.pop("_config") for r in runs]
+    bests = [r.pop("_best") for r in runs]
+    group_by = "folders" if any(r.group for r in refs) else "config"
+    refs = _config_groups(refs, configs)
+    for r, ref, color in zip(runs, refs, _colors(refs)):
+        r["color"], r["group"] = color, ref.group
+    groups = _group_payload(refs, bests, max_points)
+    for k, g in enumerate(groups):
+        g["color"] = _PALETTE[k % len(_PALETTE)]
+    diff = _config_diff(configs)
     if title is None:
         title = (
             f"animat run {refs[0].label}"
@@ -655,9 +934,11 @@ def build_data(
         "generated": _dt.datetime.now().isoformat(timespec="seconds"),
         "version": __version__,
         "runs": runs,
+        "groups": groups,
+        "group_by": group_by,
         "config_diff": diff,
         "modes": bool(modes),
-        "limits": {"frames": frames, "max_points": max_points, "max_nodes": max_nodes},
+        "limits": {"frames": frames, "max_points": max_points, "max_nodes": max_nodes, "replays": replays},
         "live": {**live, "version": _live_version(refs)} if live else None,
     }
 
@@ -694,7 +975,9 @@ def make_server(
     **kwargs: Any,
 ):
     """A :class:`http.server.ThreadingHTTPServer` on 127.0.0.1:``port`` (0: any free port) serving the
-    page at ``/`` and, with ``live``, the runs' current curves at ``/live.json`` (:func:`live_data`;
+    page at ``/``, the swim of any individual at ``/swim.json?run=K&key=KEY`` (:func:`individual_swim`;
+    the page asks for those it does not embed) and, with ``live``, the runs' current curves at
+    ``/live.json`` (:func:`live_data`;
     ``?since=VERSION`` answers ``{"changed": false}`` while nothing changed). The page polls every
     ``poll`` seconds (backing off to 30 s while nothing changes; at most ``max_polls`` times); a live
     page is built again when it is loaded after the runs changed, so a reload shows the newest best's
@@ -705,8 +988,12 @@ def make_server(
     from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
     from urllib.parse import parse_qs, urlparse
 
+    from .run import Run
+
     refs = find_runs(paths)
     max_points = int(kwargs.get("max_points", 500))
+    frames = int(kwargs.get("frames") or (STUDY_FRAMES if len(refs) > STUDY_RUNS else 200))
+    swims: Dict[Tuple[int, str], dict] = {}  # the individuals replayed on request
     liveinfo = {"poll": float(poll), "max_polls": int(max_polls)} if live else None
     built = {"version": _live_version(refs), "body": b""}
     if page is None:
@@ -735,6 +1022,23 @@ def make_server(
             url = urlparse(self.path)
             if url.path in ("/", "/index.html", "/explore.html"):
                 self._send(200, current_page(), "text/html; charset=utf-8")
+            elif url.path == "/swim.json":
+                query = parse_qs(url.query)
+                try:
+                    k = int(query.get("run", ["-1"])[0])
+                    key = query.get("key", [""])[0]
+                    if not 0 <= k < len(refs):
+                        raise ValueError(f"no run {k} (0..{len(refs) - 1})")
+                    with lock:
+                        cached = swims.get((k, key))
+                    if cached is None:
+                        cached = individual_swim(Run(refs[k].path), key, frames)
+                        with lock:
+                            swims[(k, key)] = cached
+                    answer = cached
+                except (OSError, ValueError) as e:
+                    answer = {"error": str(e)}
+                self._send(200, json.dumps(answer, allow_nan=False).encode("utf-8"), "application/json")
             elif url.path == "/live.json" and live:
                 since = parse_qs(url.query).get("since", [""])[0]
                 with lock:

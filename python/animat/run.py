@@ -22,12 +22,10 @@ A run directory holds::
 from __future__ import annotations
 
 import csv
-import gzip
 import hashlib
 import io
 import json
 import re
-import sys
 import tarfile
 import zlib
 from dataclasses import dataclass, field
@@ -452,7 +450,9 @@ def _read_snapshot(path: Path, kind: str, config: Any) -> Snapshot:
         except ValueError:
             raise ValueError(f"{path}:{number}: not a number in {','.join(row[:-1])!r}") from None
         genomes.append(row[-1])
-    columns = {n: np.asarray(v, dtype=np.int64 if n in ("index", "generation") else np.float64) for n, v in values.items()}
+    columns = {
+        n: np.asarray(v, dtype=np.int64 if n in ("index", "generation") else np.float64) for n, v in values.items()
+    }
     return Snapshot(kind, generation, path, columns, genomes, objectives, descriptors)
 
 

@@ -514,3 +514,216 @@ def test_cli_serves_the_page_on_localhost_until_interrupted(runs):
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+# --- MAP-Elites and NSGA-II runs; studies grouped by environment -------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def searches(tmp_path_factory):
+    """A 3-generation MAP-Elites run and a 3-generation NSGA-II run, as their commands write them."""
+    root = tmp_path_factory.mktemp("searches")
+    tiny = ["--set", "evaluation.steps=300", "--threads", "2", "--quiet", "--generations", "3"]
+    r = cli("map-elites", "paper_dn2", "--out", root / "me", "--set", "evolution.population=8", *tiny)
+    assert r.returncode == 0, r.stderr
+    r = cli("nsga2", "paper_dn2", "--out", root / "ns", "--population", "8", *tiny)
+    assert r.returncode == 0, r.stderr
+    return root
+
+
+def test_search_runs_read_with_their_history_snapshots_and_best(searches):
+    me, ns = animat.Run(searches / "me"), animat.Run(searches / "ns")
+    assert (me.search, ns.search) == ("map_elites", "nsga2")
+    assert me.generations == ns.generations == 4
+    assert me.history.dtype.names[:3] == ("generation", "evaluations", "qd_score")
+    assert "hypervolume" in ns.history.dtype.names and "best_distance" in ns.history.dtype.names
+    archive = me.snapshot()
+    assert archive.kind == "archive" and archive.generation == 3 and len(archive) == int(me.history["elites"][-1])
+    assert archive.descriptors == ["elongation", "protrusions"]
+    best = me.best()
+    assert best.fitness == pytest.approx(float(archive.columns["objective"].max()))
+    assert best.fitness == pytest.approx(float(me.history["best"][-1]))
+    front = ns.snapshot()
+    assert front.kind == "front" and len(front) == int(ns.history["front_size"][-1])
+    assert front.objectives == [("distance", "max"), ("actuation_work_positive", "min")]
+    assert ns.best().fitness == pytest.approx(float(ns.history["best_distance"][-1]))
+    with pytest.raises(ValueError, match="no snapshot of generation 2; there are 0, 3"):
+        me.snapshot(2)
+
+
+def test_cli_info_and_show_read_search_runs(searches, tmp_path):
+    r = cli("info", searches / "me")
+    assert r.returncode == 0 and "MAP-Elites run" in r.stdout and "QD-score" in r.stdout, r.stderr
+    r = cli("info", searches / "ns")
+    assert r.returncode == 0 and "NSGA-II run" in r.stdout and "hypervolume" in r.stdout, r.stderr
+    r = cli("show", searches / "me", "--out", tmp_path / "figures", "--frames", 2)
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in (tmp_path / "figures").iterdir()) == [
+        "construction.png",
+        "development.png",
+        "motion_cycle.png",
+        "phase_map.png",
+    ]
+    r = cli("show", searches / "ns", "--only", "fitness_history", "--out", tmp_path / "none")
+    assert r.returncode == 1 and "this is a nsga2 run" in r.stderr and not (tmp_path / "none").exists()
+
+
+def test_the_page_shows_the_archive_and_replays_an_elite(browser, searches, tmp_path):
+    run = animat.Run(searches / "me")
+    data = explore.build_data([searches / "me"], frames=20, replays=20)
+    r = data["runs"][0]
+    assert r["kind"] == "map_elites" and r["search"]["total"] == len(run.snapshot())
+    assert r["history"]["best"] == pytest.approx(run.history["best"].tolist(), rel=1e-5)
+    assert "QD-score" in r["history"]["extra"] and r["summary"]["search"].startswith("MAP-Elites")
+    assert len(r["replays"]) == len(run.snapshot()) - 1  # every elite but the best, which is the swim
+    path = explore.write_page([searches / "me"], tmp_path / "me.html", frames=20, replays=20)
+    page, problems = open_page(browser, path.as_uri())
+    search = page.evaluate("animatExplore.search")
+    assert search["drawn"] == len(run.snapshot()) and search["kind"] == "map_elites"
+    assert page.evaluate(INKED, "search-map") > 2000
+    before = page.evaluate(PIXELS, "swim")
+    other = next(k for k in range(len(run.snapshot())) if k != run.snapshot().best())
+    page.evaluate(f"animatExplore.showIndividual('row:{other}', 'the elite of row {other}')")
+    assert page.text_content("#swim-note").startswith(f"Replaying the elite of row {other}")
+    assert page.evaluate(PIXELS, "swim") != before and not page.is_hidden("#show-best")
+    page.click("#show-best")
+    assert page.text_content("#swim-note").startswith("Best of generation")
+    # a click on the heatmap replays the elite of that cell
+    k, x, y = next(p for p in search["points"] if p[0] == other)
+    page.click("#search-map", position={"x": x, "y": y})
+    assert page.text_content("#swim-note").startswith(f"Replaying the elite of row {other}")
+    assert "record holders, not an ancestry" in page.text_content("#lineage-note")
+    assert not problems and not page.evaluate("animatExplore.errors")
+    page.close()
+
+
+def test_the_page_shows_the_front_and_a_served_page_replays_any_genome(browser, searches):
+    front = animat.Run(searches / "ns").snapshot()
+    server = explore.make_server([searches / "ns"], port=0, frames=20, replays=0)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        page, problems = open_page(browser, server.url)
+        search = page.evaluate("animatExplore.search")
+        assert search["drawn"] == len(front) and search["kind"] == "nsga2"
+        assert page.evaluate("Object.keys(animatExplore.data.runs[0].replays).length") == 0
+        other = next(k for k in range(len(front)) if k != front.best())
+        k, x, y = next(p for p in search["points"] if p[0] == other)
+        page.click("#search-map", position={"x": x, "y": y})  # not in the page: fetched from swim.json
+        page.wait_for_function(f"animatExplore.data.runs[0].replays['row:{other}'] !== undefined")
+        assert page.text_content("#swim-note").startswith(f"Replaying the front's genome of row {other}")
+        assert page.evaluate(f"animatExplore.data.runs[0].replays['row:{other}'].generation") == int(
+            front.columns["generation"][other]
+        )
+        bad = json.loads(urllib.request.urlopen(server.url + "swim.json?run=0&key=row:999").read())
+        assert "no row 999" in bad["error"]
+        assert not problems and not page.evaluate("animatExplore.errors")
+        page.close()
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def test_a_click_in_the_genealogy_replays_an_ancestor_that_held_the_record(browser, runs, tmp_path):
+    path = explore.write_page([runs / "genealogy" / "run"], tmp_path / "g.html", frames=20)
+    page, problems = open_page(browser, path.as_uri())
+    assert page.eval_on_selector_all("#lineage tbody tr", "(rs) => rs.length") == 4
+    page.click("#lineage tbody tr >> nth=1")  # the best of generation 1, id 6
+    assert page.text_content("#swim-note").startswith("Replaying the best of generation 1")
+    page.click("#show-best")
+    assert page.text_content("#swim-note").startswith("Best of generation")
+    layout = {i: (x, y) for i, x, y in page.evaluate("animatExplore.genealogy.xy")}
+    x, y = layout[9]  # a record holder: the best of generation 2
+    page.click("#genealogy", position={"x": x, "y": y})
+    assert page.text_content("#swim-note").startswith("Replaying ancestor 9 (the best of generation 2)")
+    x, y = layout[12]  # an ancestor that never held the record: no genome to replay
+    page.click("#genealogy", position={"x": x, "y": y})
+    assert "keeps no genome" in page.text_content("#genealogy-readout")
+    assert page.text_content("#swim-note").startswith("Replaying ancestor 9")
+    assert not problems and not page.evaluate("animatExplore.errors")
+    page.close()
+
+
+def grouped_study(runs: Path, tmp_path: Path) -> Path:
+    """Two environments of three runs each (copies of the tiny runs, the best curve scaled per run)."""
+    study = tmp_path / "grouped"
+    for env, factor in (("low", 1.0), ("high", 10.0)):
+        for i in range(3):
+            run = study / env / f"run_{i}"
+            shutil.copytree(runs / "study" / "run_1", run)
+            lines = (run / "history.csv").read_text().splitlines()
+            col = lines[0].split(",").index("best")
+            rows = [line.split(",") for line in lines[1:]]
+            for g, row in enumerate(rows):
+                row[col] = repr(factor * (i + 1) * (g + 1))
+            (run / "history.csv").write_text("\n".join([lines[0]] + [",".join(r) for r in rows]) + "\n")
+    return study
+
+
+def test_groups_have_the_median_and_quartiles_of_their_runs(runs, tmp_path):
+    study = grouped_study(runs, tmp_path)
+    data = explore.build_data([study], frames=10)
+    assert data["group_by"] == "folders"
+    groups = {g["name"]: g for g in data["groups"]}
+    assert set(groups) == {"low", "high"} and groups["low"]["runs"] == [3, 4, 5]  # natural order: high first
+    generations = len(animat.Run(runs / "study" / "run_1").history)
+    low = groups["low"]
+    assert low["generation"] == list(range(generations)) and low["n"] == [3] * generations
+    assert low["median"] == pytest.approx([2.0 * (g + 1) for g in range(generations)])
+    assert low["q1"] == pytest.approx([1.5 * (g + 1) for g in range(generations)])
+    assert low["q3"] == pytest.approx([2.5 * (g + 1) for g in range(generations)])
+    assert groups["high"]["median"] == pytest.approx([20.0 * (g + 1) for g in range(generations)])
+    # runs given one by one: grouped by config, the seed left out
+    loose = explore.build_data([runs / "study" / "run_1", runs / "study" / "run_2"], frames=10)
+    assert loose["group_by"] == "config" and [g["runs"] for g in loose["groups"]] == [[0, 1]]
+    assert loose["groups"][0]["name"] == "study"
+
+
+def test_a_study_page_draws_groups_toggles_them_uses_a_log_scale_and_exports(browser, runs, tmp_path):
+    study = grouped_study(runs, tmp_path)
+    path = explore.write_page([study], tmp_path / "groups.html", frames=10)
+    page, problems = open_page(browser, path.as_uri())
+    curves = page.evaluate("animatExplore.curves")
+    assert curves["mode"] == "groups" and curves["groups"] == 2
+    assert page.eval_on_selector_all("#group-legend .legend-group", "(e) => e.length") == 2
+    assert page.is_hidden("#curves-legend")
+    before = page.evaluate(PIXELS, "curves")
+    page.click("#group-legend .legend-group >> nth=0")
+    assert page.evaluate("animatExplore.curves.groups") == 1 and page.evaluate(PIXELS, "curves") != before
+    page.click("#group-legend .legend-group >> nth=0")
+    linear = page.evaluate(PIXELS, "curves")
+    page.check("#log-scale")
+    assert page.evaluate("animatExplore.curves.log") and page.evaluate(PIXELS, "curves") != linear
+    page.uncheck("#log-scale")
+    with page.expect_download() as png:
+        page.click("#export-png")
+    assert png.value.suggested_filename == "fitness_groups.png"
+    assert Path(png.value.path()).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with page.expect_download() as svg:
+        page.click("#export-svg")
+    text = Path(svg.value.path()).read_text()
+    assert text.startswith("<svg") and text.count("<path") > 10 and ">generation</text>" in text
+    with page.expect_download() as table:
+        page.click("#export-csv")
+    rows = Path(table.value.path()).read_text().splitlines()
+    data = page.evaluate("animatExplore.data.groups")
+    assert rows[0] == "group,generation,runs,median_best,q1_best,q3_best"
+    assert len(rows) == 1 + sum(len(g["generation"]) for g in data)
+    assert rows[1].split(",")[:4] == [data[0]["name"], str(data[0]["generation"][0]), "3", repr(data[0]["median"][0])]
+    page.select_option("#curve-mode", "runs")
+    assert page.evaluate("animatExplore.curves.mode") == "runs" and not page.is_hidden("#curves-legend")
+    assert page.evaluate("animatExplore.curvesCsv()").splitlines()[0].startswith("run,group,generation,best")
+    assert not problems and not page.evaluate("animatExplore.errors")
+    page.close()
+
+
+def test_the_page_of_the_forty_packed_runs_stays_small_and_opens_on_the_groups(browser, tmp_path):
+    study = ROOT / "data" / "replication_regime"
+    path = explore.write_page([study], tmp_path / "study.html")
+    assert path.stat().st_size < 2_500_000, path.stat().st_size
+    page, problems = open_page(browser, path.as_uri())
+    assert page.evaluate("animatExplore.data.runs.length") == 40
+    assert page.evaluate("animatExplore.data.runs.every((r) => r.summary.generations > 500)")
+    assert page.evaluate("animatExplore.curves.mode") == "groups" and page.evaluate("animatExplore.curves.groups") == 4
+    assert not problems and not page.evaluate("animatExplore.errors")
+    page.close()
