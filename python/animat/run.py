@@ -117,7 +117,9 @@ def read_history(path: PathLike) -> np.ndarray:
     """Read a ``history.csv`` into a structured array of dtype :data:`HISTORY_DTYPE` (that of a run
     with morphological innovation protection, which has a ``protected`` column: :data:`PROTECTED_HISTORY_DTYPE`).
 
-    The file must start with the header ``generation,best,...``. A last line without its newline
+    The file must start with the header ``generation,best,...``, or be that of a MAP-Elites run
+    (:data:`animat.qd.QD_HISTORY_DTYPE`'s columns) or of an NSGA-II run (:func:`animat.moo.history_dtype`'s),
+    which read with those columns. A last line without its newline
     (a row being written by a run in progress) is ignored. Any other malformed line raises
     ValueError naming the file and the line number. A missing file raises FileNotFoundError.
 
@@ -674,9 +676,22 @@ class Run:
         return snap
 
     def _search_lineage(self) -> List[LineageEntry]:
+        found = self.snapshots()
+        history = self.history
+        names = history.dtype.names or ()
+        column = "best" if "best" in names else next((n for n in names if n.startswith("best_")), None)
+        if len(history) and column is not None and found:
+            # Only the snapshots that can show a new best: the first at or after each change of the
+            # history's best (a long run writes a snapshot every few generations).
+            best = np.asarray(history[column], dtype=float)
+            gens = np.asarray(history["generation"], dtype=np.int64)
+            changes = gens[np.concatenate([[0], np.nonzero(np.diff(best) != 0)[0] + 1])]
+            at = np.array([g for g, _ in found])
+            picked = np.unique(np.searchsorted(at, changes).clip(0, len(found) - 1))
+            found = [found[k] for k in sorted(set(picked.tolist()) | {len(found) - 1})]
         out: List[LineageEntry] = []
         previous = None
-        for _, path in self.snapshots():
+        for _, path in found:
             snap = self._snapshot_file(path)
             k = snap.best()
             if k < 0 or snap.genomes[k] == previous:

@@ -547,6 +547,16 @@ def test_search_runs_read_with_their_history_snapshots_and_best(searches):
     assert front.kind == "front" and len(front) == int(ns.history["front_size"][-1])
     assert front.objectives == [("distance", "max"), ("actuation_work_positive", "min")]
     assert ns.best().fitness == pytest.approx(float(ns.history["best_distance"][-1]))
+    # the lineage is every change of the best over all the snapshots (it reads only those after a change)
+    changes, previous = [], None
+    for g, _ in ns.snapshots():
+        snap = ns.snapshot(g)
+        if snap.genomes[snap.best()] != previous:
+            previous = snap.genomes[snap.best()]
+            changes.append(previous)
+    assert len(ns.snapshots()) == 4 and [e.genome.to_json() for e in ns.best_genomes] == [
+        animat.Genome.from_json(text).to_json() for text in changes
+    ]
     with pytest.raises(ValueError, match="no snapshot of generation 2; there are 0, 3"):
         me.snapshot(2)
 
