@@ -15,7 +15,15 @@ embedded as JSON. It shows
   phase, evolved stiffness or the chemical they sense), in its world as :mod:`animat.plot` draws it
   (the floor with effect ``ground``, the chemical source, the body graph), and the phase map;
 - the config keys whose values differ between the runs (for one run: from the animat defaults);
-- with ``modes=True``, the locomotion mode of every run's best (:func:`animat.classify_locomotion`).
+- with ``modes=True``, the locomotion mode of every run's best (:func:`animat.classify_locomotion`);
+- per group of runs (an environment folder of a study, or runs whose configs differ only by seed) the
+  median and interquartile band of the best, with group toggles, a log scale and the plot exported as
+  PNG, SVG or CSV;
+- for a MAP-Elites or NSGA-II run, its own measures and its last archive (a heatmap) or front; a click
+  on a cell, a front point, a lineage row or a record holder of the genealogy replays that genome.
+
+Any run :class:`animat.Run` reads is shown: a GA run directory, a packed run of ``data/`` (read in
+place) or a search run directory (docs/explore.md).
 
 :func:`serve` serves the page from a local HTTP server (127.0.0.1 only); with ``live=True`` the page
 polls ``/live.json`` and redraws the curves and the lineage while runs grow.
@@ -53,6 +61,8 @@ __all__ = [
     "ancestry",
     "downsample_indices",
     "live_data",
+    "individual",
+    "individual_swim",
     "TEMPLATE",
     "GENEALOGY_COLUMNS",
 ]
