@@ -53,9 +53,13 @@ def _parser() -> argparse.ArgumentParser:
         "in animat_evolve's engine, or MAP-Elites / NSGA-II when search.algorithm says so",
     )
 
-    s = sub.add_parser("show", help="write the paper's figures for the run's best genome into RUN_DIR/figures/")
+    s = sub.add_parser(
+        "show",
+        help="write the paper's figures for the run's best genome into RUN_DIR/figures/ "
+        "(a packed run of data/: runs/<its path below data>/figures/)",
+    )
     s.add_argument("run", metavar="RUN_DIR")
-    s.add_argument("--out", type=Path, help="output directory (default RUN_DIR/figures)")
+    s.add_argument("--out", type=Path, help="output directory (default RUN_DIR/figures; see above for a packed run)")
     s.add_argument(
         "--only",
         nargs="+",
@@ -78,19 +82,26 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--follow", action="store_true", default=None, help="camera follows the body")
     a.add_argument("--no-progress", action="store_true", help="no progress bar")
 
-    i = sub.add_parser("info", help="print a summary of a run directory")
+    i = sub.add_parser(
+        "info", help="print a summary of a run directory: a GA, MAP-Elites or NSGA-II run, or a packed run of data/"
+    )
     i.add_argument("run", metavar="RUN_DIR")
 
     x = sub.add_parser(
         "explore",
         help="write one self-contained HTML page for runs or a study (curves, lineage, genealogy, swims)",
-        description="One HTML page for one or several run directories, or an experiment directory of "
-        "`animat experiment`: fitness curves overlaid, the lineage and genealogy of each best, its swim "
-        "animated, the phase map, config differences. It works offline from a file (docs/python.md).",
+        description="One HTML page for one or several run directories (GA, MAP-Elites, NSGA-II, or packed runs "
+        "of data/), or an experiment directory of `animat experiment`: fitness curves overlaid or per group "
+        "(median and IQR), the lineage and genealogy of each best, its swim animated, a search's archive or "
+        "front, the phase map, config differences. It works offline from a file (docs/python.md, "
+        "docs/explore.md). Packed runs are read in place; their page goes to runs/<path below data>/.",
     )
     x.add_argument("runs", metavar="RUN_DIR", nargs="+", help="run directories or experiment directories")
     x.add_argument(
-        "--out", type=Path, help="the page to write (default RUN_DIR/explore.html for one RUN_DIR; needed for several)"
+        "--out",
+        type=Path,
+        help="the page to write (default RUN_DIR/explore.html for one RUN_DIR, runs/<path below data>/explore.html "
+        "for packed runs; needed for several)",
     )
     x.add_argument("--modes", action="store_true", help="classify every best's locomotion (a few seconds per run)")
     x.add_argument(
@@ -281,6 +292,17 @@ def show_figures(run, only=None, *, frames: int = 6, steps: Optional[int] = None
     return {name: makers[name] for name in FIGURES if name in wanted}
 
 
+def output_home(path: Path, packed: bool) -> Path:
+    """Where a command writes what it makes of the run (or study) at ``path``: ``path`` itself, but for
+    packed runs, which are read-only data (``data/``), ``runs/<the path below data/>`` of the current
+    directory (``runs/replication_regime/dn0.5/run_0``)."""
+    if not packed:
+        return path
+    parts = path.resolve().parts
+    below = parts[len(parts) - parts[::-1].index("data") :] if "data" in parts else parts[-1:]
+    return Path("runs", *below) if below else Path("runs")
+
+
 def cmd_show(args) -> int:
     import matplotlib
 
@@ -291,7 +313,7 @@ def cmd_show(args) -> int:
 
     run = animat.Run(args.run)
     entry = run.best()
-    out = args.out or run.path / "figures"
+    out = args.out or output_home(run.path, run.packed) / "figures"
     t0 = time.perf_counter()
     figures = show_figures(run, args.only, frames=args.frames, steps=args.steps)  # refuses before any file
     out.mkdir(parents=True, exist_ok=True)
@@ -370,7 +392,10 @@ def cmd_explore(args) -> int:
     if out is None and not args.serve:
         if len(args.runs) > 1:
             raise ValueError(f"{len(args.runs)} RUN_DIRs: name the page with --out FILE.html")
-        out = Path(args.runs[0]) / "explore.html"
+        from .run import Run
+
+        packed = any(Run(r.path).packed for r in refs)
+        out = output_home(Path(args.runs[0]), packed) / "explore.html"
     options = dict(frames=args.frames, max_points=args.max_points, modes=args.modes, replays=args.replays)
     t0 = time.perf_counter()
     live = {"poll": args.poll, "max_polls": 20000} if args.live else None

@@ -25,9 +25,10 @@ PACKED = STUDY / "dn0.5" / "run_0"
 NO_MANIFEST = ROOT / "data" / "replication_causes" / "drag_tangential_x10" / "run_0"
 
 
-def cli(*args):
+def cli(*args, cwd=None):
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    return subprocess.run([sys.executable, "-m", "animat", *map(str, args)], capture_output=True, text=True, env=env)
+    command = [sys.executable, "-m", "animat", *map(str, args)]
+    return subprocess.run(command, capture_output=True, text=True, env=env, cwd=cwd)
 
 
 @pytest.fixture(scope="module")
@@ -113,3 +114,16 @@ def test_explore_finds_the_forty_packed_runs_with_their_generations():
     assert data["summary"]["stopped"] == status["stop_reason"]
     assert len(data["lineage"]) == len(animat.Run(PACKED).best_genomes) > 1
     assert data["swim"] is not None and data["swim"]["generation"] == data["lineage"][-1]["generation"]
+
+
+def test_pages_and_figures_of_packed_runs_go_under_runs_not_into_data(tmp_path):
+    before = sorted(p.name for p in PACKED.iterdir())
+    r = cli("explore", PACKED, "--frames", 10, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    page = tmp_path / "runs" / "replication_regime" / "dn0.5" / "run_0" / "explore.html"
+    assert r.stdout.strip() == str(Path("runs", "replication_regime", "dn0.5", "run_0", "explore.html"))
+    assert page.is_file() and '"packed":true' in page.read_text()
+    r = cli("show", PACKED, "--only", "phase_map", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "runs" / "replication_regime" / "dn0.5" / "run_0" / "figures" / "phase_map.png").is_file()
+    assert sorted(p.name for p in PACKED.iterdir()) == before  # the packed run is read only
