@@ -321,6 +321,9 @@ _MANIFEST_FORMAT = "animat.replication_store.manifest"
 #: At most this many bytes from one gzip stream of a packed run without a manifest (a checkpoint is a few MB).
 _MAX_GUNZIPPED = 1 << 30
 _SNAPSHOT_NAME = re.compile(r"^gen_(\d+)\.csv$")
+#: What a run directory holds besides config.toml from its first moments on (``.lock``: a run is writing
+#: it; ``best/``, ``archive/``, ``front/``: made before the first generation ends).
+_RUN_MARKS = ("history.csv", "best", "checkpoint.json", "genealogy.csv", ".lock", "archive", "front", "stopped.txt")
 #: The folder of snapshots of each search that writes them.
 _SNAPSHOT_FOLDERS = {"map_elites": "archive", "nsga2": "front"}
 
@@ -518,6 +521,12 @@ class Run:
             if (self.path / _MANIFEST).is_file():
                 self._manifest = self._read_manifest()
             self._packed_bytes("config.toml")  # checked against the manifest before it is trusted
+        elif not any((self.path / n).exists() for n in _RUN_MARKS):
+            raise FileNotFoundError(
+                f"{self.path}: holds config.toml but nothing of a run (no history.csv, best/ or checkpoint.json, "
+                "and no run is writing it: no .lock); neither a run directory nor a packed run "
+                "(config.toml, history.csv.gz, best.tar.gz, manifest.json)"
+            )
         self._config = _core.load_config(str(config_path))
 
     # --- the files of a packed run ---------------------------------------------------------------------

@@ -94,6 +94,16 @@ def test_a_folder_that_is_no_run_says_so_and_names_the_runs_below(tmp_path):
         animat.Run(tmp_path / "notes")
     r = cli("info", STUDY)
     assert r.returncode == 1 and "animat explore" in r.stderr and "0 generation" not in r.stdout + r.stderr
+    # a config.toml alone, no run writing there: not a run of 0 generations
+    shutil.copy(PACKED / "config.toml", tmp_path / "notes" / "config.toml")
+    with pytest.raises(FileNotFoundError, match=r"notes: holds config.toml but nothing of a run"):
+        animat.Run(tmp_path / "notes")
+    r = cli("info", tmp_path / "notes")
+    assert r.returncode == 1 and "nothing of a run" in r.stderr and r.stdout == ""
+    r = cli("explore", tmp_path / "notes", "--out", tmp_path / "page.html")
+    assert r.returncode == 1 and "nothing of a run" in r.stderr and not (tmp_path / "page.html").exists()
+    (tmp_path / "notes" / ".lock").write_text("")  # a run writing it, in its first moments: 0 generations
+    assert animat.Run(tmp_path / "notes").generations == 0
 
 
 def test_animat_info_reads_a_packed_run():
