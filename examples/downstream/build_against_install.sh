@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs an animat build into a temporary prefix, then configures, builds and runs the downstream
-# project of this folder against that installation (find_package(animat CONFIG REQUIRED)).
+# project of this folder against that installation (find_package(animat CONFIG REQUIRED)). The project
+# sets no C++ standard: it builds only if the installed targets require C++20 themselves.
 #
 #   examples/downstream/build_against_install.sh BUILD_DIR [WORK_DIR]
 #
@@ -27,7 +28,18 @@ generator=()
 command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
 
 "$cmake" --install "$build" --prefix "$work/prefix" >/dev/null
+# The project sets no C++ standard: the package must require C++20 itself. Checked in the exported
+# targets too, since a compiler whose default is C++20 would build the project without it.
+targets=$(find "$work/prefix" -name animatTargets.cmake)
+if ! grep -q 'INTERFACE_COMPILE_FEATURES "cxx_std_20"' "$targets"; then
+  echo "FAIL: $targets: the exported targets do not require cxx_std_20 (INTERFACE_COMPILE_FEATURES)" >&2
+  exit 1
+fi
 "$cmake" -S "$here" -B "$work/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$work/prefix" ${CXX:+-DCMAKE_CXX_COMPILER="$CXX"} >/dev/null
-"$cmake" --build "$work/build" -j 2 >/dev/null
+if ! "$cmake" --build "$work/build" -j 2 >"$work/build.log" 2>&1; then
+  cat "$work/build.log" >&2
+  echo "FAIL: the downstream project did not build against the installed package (above)" >&2
+  exit 1
+fi
 "$work/build/swim_random"
