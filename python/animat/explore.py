@@ -620,6 +620,9 @@ def _search_payload(run: Any, max_rows: int) -> Optional[dict]:
         out.update(descriptors=geometry, objective="objective", rows=rows)
     else:
         names = [name for name, _ in snap.objectives[:2]]
+        first = np.asarray(snap.columns[names[0]], dtype=float)
+        sign = -1.0 if snap.objectives[0][1] == "max" else 1.0  # best first, by the first objective
+        order = sorted(order, key=lambda k: sign * float(first[k]) if math.isfinite(first[k]) else math.inf)
         out.update(objectives=[[name, sense] for name, sense in snap.objectives])
         rows = [
             [k, *[_num(snap.columns[name][k]) for name in names], int(snap.columns["generation"][k])]
@@ -654,28 +657,29 @@ def _archive_geometry(run: Any, snap: Any) -> List[dict]:
 
 def individual(run: Any, key: str) -> Any:
     """The individual of a run named by a page key: ``"lineage:J"`` (entry J of :attr:`Run.best_genomes`)
-    or ``"row:I"`` (row I of a search run's last snapshot), as a :class:`animat.LineageEntry`.
+    or ``"row:G:I"`` (row I of a search run's snapshot of generation G), as a :class:`animat.LineageEntry`.
     ValueError for another key."""
     from .run import LineageEntry
 
     kind, _, number = key.partition(":")
-    if not number.isdigit():
-        raise ValueError(f"no individual {key!r} (expected lineage:J or row:I)")
-    j = int(number)
+    generation, _, row = number.partition(":") if kind == "row" else ("", "", number)
+    if not row.isdigit() or not (generation.isdigit() or kind != "row"):
+        raise ValueError(f"no individual {key!r} (expected lineage:J or row:G:I)")
+    j = int(row)
     if kind == "lineage":
         lineage = run.best_genomes
         if j >= len(lineage):
             raise ValueError(f"{run.path}: no lineage entry {j} ({len(lineage)} there)")
         return lineage[j]
     if kind == "row":
-        snap = run.snapshot()
+        snap = run.snapshot(int(generation))
         if j >= len(snap):
             raise ValueError(f"{snap.path}: no row {j} ({len(snap)} there)")
         name = snap.objectives[0][0]
         return LineageEntry(
             int(snap.columns["generation"][j]), float(snap.columns[name][j]), 0, snap.genome(j), snap.path
         )
-    raise ValueError(f"no individual {key!r} (expected lineage:J or row:I)")
+    raise ValueError(f"no individual {key!r} (expected lineage:J or row:G:I)")
 
 
 def _replay_keys(lineage: List[dict], search: Optional[dict], count: int) -> List[str]:
@@ -689,7 +693,7 @@ def _replay_keys(lineage: List[dict], search: Optional[dict], count: int) -> Lis
         if search["kind"] == "nsga2" and len(rows) > count:
             by_first = sorted(rows, key=lambda r: (r[1] is None, r[1] or 0.0))
             rows = [by_first[k] for k in np.unique(np.linspace(0, len(rows) - 1, count).round().astype(int))]
-        return [f"row:{r[0]}" for r in rows[:count] if r[0] != search.get("best")]
+        return [f"row:{search['generation']}:{r[0]}" for r in rows[:count] if r[0] != search.get("best")]
     return [f"lineage:{j}" for j in range(max(0, len(lineage) - 1 - count), len(lineage) - 1)]
 
 

@@ -593,7 +593,7 @@ def test_the_page_shows_the_archive_and_replays_an_elite(browser, searches, tmp_
     assert page.evaluate(INKED, "search-map") > 2000
     before = page.evaluate(PIXELS, "swim")
     other = next(k for k in range(len(run.snapshot())) if k != run.snapshot().best())
-    page.evaluate(f"animatExplore.showIndividual('row:{other}', 'the elite of row {other}')")
+    page.evaluate(f"animatExplore.showIndividual('row:3:{other}', 'the elite of row {other}')")
     assert page.text_content("#swim-note").startswith(f"Replaying the elite of row {other}")
     assert page.evaluate(PIXELS, "swim") != before and not page.is_hidden("#show-best")
     page.click("#show-best")
@@ -620,13 +620,15 @@ def test_the_page_shows_the_front_and_a_served_page_replays_any_genome(browser, 
         other = next(k for k in range(len(front)) if k != front.best())
         k, x, y = next(p for p in search["points"] if p[0] == other)
         page.click("#search-map", position={"x": x, "y": y})  # not in the page: fetched from swim.json
-        page.wait_for_function(f"animatExplore.data.runs[0].replays['row:{other}'] !== undefined")
+        page.wait_for_function(f"animatExplore.data.runs[0].replays['row:3:{other}'] !== undefined")
         assert page.text_content("#swim-note").startswith(f"Replaying the front's genome of row {other}")
-        assert page.evaluate(f"animatExplore.data.runs[0].replays['row:{other}'].generation") == int(
+        assert page.evaluate(f"animatExplore.data.runs[0].replays['row:3:{other}'].generation") == int(
             front.columns["generation"][other]
         )
-        bad = json.loads(urllib.request.urlopen(server.url + "swim.json?run=0&key=row:999").read())
+        bad = json.loads(urllib.request.urlopen(server.url + "swim.json?run=0&key=row:3:999").read())
         assert "no row 999" in bad["error"]
+        bad = json.loads(urllib.request.urlopen(server.url + "swim.json?run=0&key=row:7:0").read())
+        assert "no snapshot of generation 7" in bad["error"]
         assert not problems and not page.evaluate("animatExplore.errors")
         page.close()
     finally:
