@@ -14,8 +14,8 @@ swim's CPU time is measured in the same process::
 
 writes one row per individual (run, its rank at dt, fitness and seconds at every step) and
 ``--summary CSV`` prints, per environment and step, against dt/32: the median and largest relative
-fitness error, the share of discordant pairs (two individuals whose order at that step is the
-reverse of their order at dt/32: a tournament the step decides wrongly), how often the two elites
+fitness error and how many errors exceed 1 %, the share of discordant pairs (two individuals whose order at that step is the
+reverse of their order at dt/32: a tournament the step decides wrongly), the same among pairs more than 1 % apart at dt/32, how often the two elites
 are the two best at dt/32, the shortfall of the step's best from the best at dt/32, and the cost of
 an evaluation against dt; the "select" row is today's rule (elites by dt/16 among the four fittest
 at dt).
@@ -28,6 +28,7 @@ import gzip
 import json
 import sys
 import time
+import tomllib
 from functools import partial
 from multiprocessing import Pool
 from pathlib import Path
@@ -40,7 +41,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from results_table import write_rows  # noqa: E402
 
 SUBSTEPS = (1, 2, 4, 8, 16, 32)
-REFERENCE = SUBSTEPS[-1]
 
 
 def last_population(run: Path) -> List[dict]:
@@ -64,33 +64,48 @@ def candidates(run: Path, top: int) -> List[dict]:
     return out
 
 
-def swim_ladder(run: Path, top: int) -> List[Dict[str, object]]:
-    """One row per candidate of ``run``: fitness and CPU seconds at each of SUBSTEPS."""
+def _config(run: Path, overrides: Sequence[str]):
+    """The run's config with ``KEY=VALUE`` overrides (VALUE in TOML syntax)."""
+    config = animat.load_config(str(run / "config.toml"))
+    for item in overrides:
+        key, _, value = item.partition("=")
+        config[key.strip()] = tomllib.loads(f"v = {value}")["v"]
+    return config
+
+
+def swim_ladder(
+    run: Path, top: int, substeps: Sequence[int] = SUBSTEPS, overrides: Sequence[str] = ()
+) -> List[Dict[str, object]]:
+    """One row per candidate of ``run``: fitness and CPU seconds at each of ``substeps`` (multiples of
+    the run's physics.substeps), with the config ``overrides`` applied."""
     rows = []
-    base = animat.load_config(str(run / "config.toml"))
+    base = _config(run, overrides)
     for rank, ind in enumerate(candidates(run, top)):
         genome = animat.Genome.from_json(json.dumps(ind["genome"]))
         row: Dict[str, object] = {"run": f"{run.parent.name}/{run.name}", "rank_dt": rank, "id": ind["id"]}
-        for s in SUBSTEPS:
-            config = animat.load_config(str(run / "config.toml"))
+        for s in substeps:
+            config = _config(run, overrides)
             config.physics.substeps = base.physics.substeps * s
             started = time.process_time()
             result = animat.evaluate(genome, config)
             row[f"seconds_s{s}"] = time.process_time() - started
             row[f"fitness_s{s}"] = float(result.fitness)
-        if row["fitness_s1"] != ind["fitness"]:
-            raise SystemExit(f"{run}: individual {ind['id']} swims to {row['fitness_s1']} at dt, "
-                             f"its checkpoint says {ind['fitness']} (not the run's build or config?)")
+        if not overrides and "fitness_s1" in row and row["fitness_s1"] != ind["fitness"]:
+            raise SystemExit(
+                f"{run}: individual {ind['id']} swims to {row['fitness_s1']} at dt, "
+                f"its checkpoint says {ind['fitness']} (not the run's build or config?)"
+            )
         rows.append(row)
     return rows
 
 
-def _discordant(fit: Sequence[float], ref: Sequence[float]) -> tuple:
-    """Pairs ordered differently by ``fit`` and ``ref`` (ties at the reference left out), and pairs."""
+def _discordant(fit: Sequence[float], ref: Sequence[float], apart: float = 0.0) -> tuple:
+    """Pairs ordered differently by ``fit`` and ``ref``, and pairs, among the pairs whose fitnesses at
+    the reference differ by more than ``apart`` of the larger (ties always left out)."""
     bad = total = 0
     for i in range(len(ref)):
         for j in range(i + 1, len(ref)):
-            if ref[i] == ref[j]:
+            if abs(ref[i] - ref[j]) <= apart * max(abs(ref[i]), abs(ref[j])) or ref[i] == ref[j]:
                 continue
             total += 1
             bad += (fit[i] - fit[j]) * (ref[i] - ref[j]) <= 0
@@ -107,50 +122,61 @@ def summary(path: Path) -> str:
 
     with open(path) as fh:
         rows = list(csv.DictReader(fh))
+    steps = sorted(int(k[len("fitness_s") :]) for k in rows[0] if k.startswith("fitness_s"))
+    reference, ladder = steps[-1], steps[:-1]
     runs: Dict[str, Dict[str, List[dict]]] = {}
     for r in rows:
         env, _ = r["run"].split("/")
         runs.setdefault(env, {}).setdefault(r["run"], []).append(r)
     lines = [
-        "| environment | step | median error | largest error | discordant pairs | elites right | "
-        "best's shortfall (median, largest) | cost against dt |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| environment | step | median error | errors over 1 % | discordant pairs | discordant pairs 1 % apart | "
+        "elites right | best's shortfall (median, largest) | cost against dt |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for env in sorted(runs):
-        per_step = {s: dict(err=[], bad=0, pairs=0, elites=0, short=[], secs=[]) for s in SUBSTEPS[:-1]}
+        per_step = {s: dict(err=[], bad=0, pairs=0, bad1=0, pairs1=0, elites=0, short=[], secs=[]) for s in ladder}
         select = dict(elites=0, short=[])
         for members in runs[env].values():
-            ref = [float(m[f"fitness_s{REFERENCE}"]) for m in members]
+            ref = [float(m[f"fitness_s{reference}"]) for m in members]
             everyone = list(range(len(members)))
             truth = set(_top(ref, 2, everyone))
             best_ref = max(ref)
-            base_secs = [float(m["seconds_s1"]) for m in members]
-            for s in SUBSTEPS[:-1]:
+            base_secs = [float(m[f"seconds_s{steps[0]}"]) for m in members]
+            for s in ladder:
                 fit = [float(m[f"fitness_s{s}"]) for m in members]
                 d = per_step[s]
                 d["err"] += [abs(f / r - 1) for f, r in zip(fit, ref) if r > 0]
                 bad, pairs = _discordant(fit, ref)
                 d["bad"] += bad
                 d["pairs"] += pairs
+                bad, pairs = _discordant(fit, ref, apart=0.01)
+                d["bad1"] += bad
+                d["pairs1"] += pairs
                 d["elites"] += set(_top(fit, 2, everyone)) == truth
                 d["short"].append(1 - ref[_top(fit, 1, everyone)[0]] / best_ref)
                 d["secs"] += [float(m[f"seconds_s{s}"]) / b for m, b in zip(members, base_secs)]
+            if not {1, 16} <= set(ladder):
+                continue
             # today's "select": the two best at dt/16 among the four fittest at dt
             ref16 = [float(m["fitness_s16"]) for m in members]
             chosen = _top(ref16, 2, _top([float(m["fitness_s1"]) for m in members], 4, everyone))
             select["elites"] += set(chosen) == truth
             select["short"].append(1 - ref[chosen[0]] / best_ref)
         n = len(runs[env])
-        for s in SUBSTEPS[:-1]:
+        for s in ladder:
             d = per_step[s]
             step = "dt" if s == 1 else f"dt/{s}"
+            over = sum(e > 0.01 for e in d["err"])
             lines.append(
-                f"| {env} | {step} | {median(d['err']):.2%} | {max(d['err']):.1%} | "
-                f"{d['bad'] / max(d['pairs'], 1):.1%} ({d['bad']} of {d['pairs']}) | {d['elites']} of {n} | "
+                f"| {env} | {step} | {median(d['err']):.2%} | {over} of {len(d['err'])} | "
+                f"{d['bad'] / max(d['pairs'], 1):.1%} ({d['bad']} of {d['pairs']}) | "
+                f"{d['bad1'] / max(d['pairs1'], 1):.1%} ({d['bad1']} of {d['pairs1']}) | {d['elites']} of {n} | "
                 f"{median(d['short']):.2%}, {max(d['short']):.1%} | {median(d['secs']):.2f}x |"
             )
+        if not select["short"]:
+            continue
         lines.append(
-            f"| {env} | select (dt, elites by dt/16 among 4) | | | | {select['elites']} of {n} | "
+            f"| {env} | select (dt, elites by dt/16 among 4) | | | | | {select['elites']} of {n} | "
             f"{median(select['short']):.2%}, {max(select['short']):.1%} | |"
         )
     return "\n".join(lines)
@@ -163,6 +189,21 @@ def main(argv=None) -> int:
     p.add_argument("--top", type=int, default=16, help="distinct fittest individuals per run (default 16)")
     p.add_argument("--jobs", type=int, default=1, help="runs swum at once (default 1)")
     p.add_argument("--envs", nargs="+", help="only these environments (folder names)")
+    p.add_argument(
+        "--substeps",
+        type=int,
+        nargs="+",
+        default=list(SUBSTEPS),
+        help="multiples of physics.substeps to swim at, the last the reference (default 1 2 4 8 16 32)",
+    )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config key of every run (TOML value), e.g. scene.spring_damping=0.5",
+    )
     p.add_argument("--summary", type=Path, metavar="CSV", help="print the table of a written CSV and exit")
     args = p.parse_args(argv)
     if args.summary is not None:
@@ -172,6 +213,8 @@ def main(argv=None) -> int:
         p.error("give --data DIR --out CSV (or --summary CSV)")
     if args.jobs < 1 or args.top < 2:
         p.error(f"--jobs must be >= 1 and --top >= 2, got {args.jobs} and {args.top}")
+    if len(args.substeps) < 2 or min(args.substeps) < 1 or sorted(set(args.substeps)) != args.substeps:
+        p.error(f"--substeps: at least two increasing positive multiples, got {args.substeps}")
     runs = sorted(r for r in args.data.glob("*/run_*") if (r / "checkpoint.json.gz").is_file())
     if args.envs:
         runs = [r for r in runs if r.parent.name in args.envs]
@@ -179,7 +222,9 @@ def main(argv=None) -> int:
         print(f"selection_step: no packed run under {args.data}", file=sys.stderr)
         return 1
     with Pool(args.jobs) as pool:
-        per_run = pool.map(partial(swim_ladder, top=args.top), runs, chunksize=1)
+        per_run = pool.map(
+            partial(swim_ladder, top=args.top, substeps=args.substeps, overrides=args.overrides), runs, chunksize=1
+        )
     write_rows(args.out, [row for rows in per_run for row in rows])
     print(summary(args.out))
     return 0
