@@ -72,7 +72,11 @@ def _parser() -> argparse.ArgumentParser:
 
     a = sub.add_parser("animate", help="render the run's best swimmer to RUN_DIR/figures/best.gif")
     a.add_argument("run", metavar="RUN_DIR")
-    a.add_argument("--out", type=Path, help="output file, .gif or .mp4 (default RUN_DIR/figures/best.gif)")
+    a.add_argument(
+        "--out",
+        type=Path,
+        help="output file, .gif or .mp4 (default RUN_DIR/figures/best.gif; for a packed run runs/<path below data>/figures/best.gif)",
+    )
     a.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
     a.add_argument("--max-frames", type=int, default=240, help="at most this many frames (default 240)")
     a.add_argument("--start", type=int, help="first control step to show (default: show the end of the swim)")
@@ -337,7 +341,7 @@ def cmd_animate(args) -> int:
     run = animat.Run(args.run)
     entry = run.best()
     config = run.config
-    out = args.out or run.path / "figures" / "best.gif"
+    out = args.out or output_home(run.path, run.packed) / "figures" / "best.gif"
     t0 = time.perf_counter()
     trajectory = animat.replay(entry, config, steps=args.steps)
     start = None if args.start is None else trajectory.frame_index(args.start)

@@ -136,4 +136,8 @@ def test_pages_and_figures_of_packed_runs_go_under_runs_not_into_data(tmp_path):
     r = cli("show", PACKED, "--only", "phase_map", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "runs" / "replication_regime" / "dn0.5" / "run_0" / "figures" / "phase_map.png").is_file()
+    r = cli("animate", PACKED, "--steps", 40, "--max-frames", 4, "--size", "80x60", "--no-progress", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == str(Path("runs", "replication_regime", "dn0.5", "run_0", "figures", "best.gif"))
+    assert (tmp_path / "runs" / "replication_regime" / "dn0.5" / "run_0" / "figures" / "best.gif").is_file()
     assert sorted(p.name for p in PACKED.iterdir()) == before  # the packed run is read only
