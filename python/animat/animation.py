@@ -78,8 +78,11 @@ def animate(
     the time, the control step and the swim's progress by the run's objective so far (progress
     toward the source for ``chemotaxis``, the horizontal distance for ``distance_x``, the signed
     distance along ``evaluation.direction`` for ``speed_toward``, else the distance travelled), and
-    a banner naming the world as it is (:func:`animat.plot.world_text`). :func:`frame_figure` draws
-    one such frame as a matplotlib Figure.
+    a banner naming the world as it is (:func:`animat.plot.world_text`). The texts take a band at the
+    top of the frame that the view keeps clear: the body, its track and the source are drawn below
+    it. :func:`frame_figure` draws one such frame as a matplotlib Figure. A chemotaxis swim is one
+    of its evaluation's swims (:func:`animat.replay`: by default the first), drawn with that swim's
+    source; a swim in which nothing moves is drawn with a warning (:func:`animat.plot.motionless`).
 
     Args:
         trajectory: an :class:`animat.Trajectory`; anything else accepted by
@@ -128,6 +131,7 @@ def animate(
     if ffmpeg:
         width += width % 2
         height += height % 2
+    overlay = _TextOverlay(width, height)
     stage = _Stage(
         tr,
         idx,
@@ -138,8 +142,8 @@ def animate(
         color_springs=color_springs,
         title=title,
         config=config,
+        overlay=overlay,
     )
-    overlay = _TextOverlay(width, height)
 
     show_bar = progress if progress is not None else (len(idx) >= 60 and _stderr_is_tty())
     try:
@@ -185,7 +189,7 @@ def animate(
             stage.canvas.draw()
             rgb = np.asarray(stage.canvas.buffer_rgba())[:height, :width, :3]
             text = stage.texts(f)
-            image = overlay.apply(rgb, text["clock"], text["caption"], text["motion"], text["world"])
+            image = overlay.apply(rgb, text)
             if proc is not None and proc.stdin is not None:
                 proc.stdin.write(np.asarray(image).tobytes())
             else:
@@ -236,29 +240,46 @@ def frame_figure(
     idx = _frame_indices(tr, frames, max_frames, start)
     if frame not in idx:
         idx = sorted(set(idx) | {frame})
+    width, height = int(size[0]), int(size[1])
+    overlay = _TextOverlay(width, height)
     stage = _Stage(
         tr,
         idx,
-        (int(size[0]), int(size[1])),
+        (width, height),
         follow=follow,
         align=align,
         trail=trail,
         color_springs=color_springs,
         title=title,
         config=config,
+        overlay=overlay,
     )
     stage.update(frame)
-    text = stage.texts(frame)
     fig = stage.fig
-    # figure coordinates, where the GIF's overlay writes them
-    fig.text(0.01, 0.99, text["clock"], va="top", ha="left", family="monospace", label="clock", fontsize=8)
-    fig.text(
-        0.01, 0.99 - 30.0 / size[1], text["world"], va="top", ha="left", label="world", color="#555555", fontsize=8
-    )
-    fig.text(0.99, 0.01, text["caption"], va="bottom", ha="right", label="caption", color="#555555", fontsize=8)
-    if text["motion"]:
-        fig.text(0.9375, 0.94, text["motion"], va="bottom", ha="center", label="motion", color="#777777", fontsize=8)
+    # where the GIF's overlay writes them, in the same fonts and sizes (pixels at 100 dpi -> points)
+    for t in overlay.layout(stage.texts(frame)):
+        (x, y), (ha, va) = t["xy"], _ANCHORS[t["anchor"]]
+        fig.text(
+            x / width,
+            1.0 - y / height,
+            t["text"],
+            ha=ha,
+            va=va,
+            family=t["family"],
+            fontsize=t["size"] * 72.0 / 100.0,
+            color=t["color"],
+            linespacing=1.0 + t["spacing"] / t["size"],
+            label=t["label"],
+        )
     return fig
+
+
+#: Pillow's text anchors (the overlay's) as matplotlib's (ha, va) (frame_figure).
+_ANCHORS = {"la": ("left", "top"), "rd": ("right", "bottom"), "md": ("center", "bottom")}
+#: Pixels kept between the texts and what the view draws.
+_TEXT_GAP = 4.0
+#: The chemical source's star (plot.draw_world: 16 points) as a radius in pixels at 100 dpi, plus its edge.
+_SOURCE_RADIUS_PX = 16 * 100 / 72 / 2 + 2
 
 
 def _frame_indices(tr, frames, max_frames, start) -> list:
@@ -275,7 +296,7 @@ class _Stage:
     """The matplotlib scene of :func:`animate`: built once, updated per frame (``update``), with the
     texts of each frame (``texts``)."""
 
-    def __init__(self, tr, idx, size, *, follow, align, trail, color_springs, title, config=None):
+    def __init__(self, tr, idx, size, *, follow, align, trail, color_springs, title, overlay, config=None):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.collections import LineCollection
         from matplotlib.figure import Figure
@@ -287,6 +308,7 @@ class _Stage:
         width, height = size
         if width < 32 or height < 32:
             raise ValueError(f"animate: size {size} too small (at least 32 x 32 pixels)")
+        aplot._warn_if_motionless(tr, "animate")
         self.tr, self.idx, self.trail, self.color_springs = tr, list(idx), trail, color_springs
         self.config = tr.config if tr.config is not None else (config if config is not None else _core.Config())
         self.scene = tr.meta.get("scene")
@@ -294,6 +316,16 @@ class _Stage:
             effects = list(aplot._scene_of(self.config, self.scene).effects)
             align = "gravity" not in effects and "ground" not in effects
         self.align = align
+        self.source_rel = aplot.chemical_source_of(self.config, self.scene)
+        self.caption = title if title is not None else "red: expanding   blue: contracting   green: neutral"
+        self.banner = aplot.world_text(self.config, self.scene, source_trial=tr.meta.get("source_trial"))
+        self.objective = str(self.config["evaluation.objective"])
+        # the bands of the texts at the top and the bottom, as fractions of the height: kept clear of
+        # the body, its track and the source
+        top_px, bottom_px = overlay.bands(self.texts(idx[0]))
+        top, bottom = top_px / height, bottom_px / height
+        if top + bottom > 0.6:  # a frame too small for its texts: the texts give way
+            top, bottom = 0.6 * top / (top + bottom), 0.6 * bottom / (top + bottom)
         rot = aplot.rotation_to(tr.direction) if align else np.eye(2)
         origin = tr.com[idx[0]] if align else np.zeros(2)  # unrotated: world coordinates (the floor's height)
         self.to_view = lambda p: (np.asarray(p, dtype=float) - origin) @ rot.T
@@ -302,29 +334,40 @@ class _Stage:
         r = aplot._node_radius(tr.body)
         aspect = width / height
 
-        # View: the body's largest extent (relative to its centre of mass) plus a margin.
+        # View: the body's largest extent (relative to its centre of mass) plus a margin, between the
+        # bands of the texts (the view's height minus the bands holds what is drawn).
+        below = 1.0 - top - bottom
         sel = self.world[idx]
         rel = sel - self.com[idx][:, None, :]
         half = np.abs(rel).max(axis=(0, 1)) + r + 0.5
-        view_w = max(2 * half[0], 2 * half[1] * aspect) * 1.3
+        view_w = max(2 * half[0], 2 * half[1] * aspect / below) * 1.3
         lo, hi = sel.reshape(-1, 2).min(axis=0) - r - 0.5, sel.reshape(-1, 2).max(axis=0) + r + 0.5
-        span = hi - lo
-        fixed_w = max(span[0], span[1] * aspect) * 1.1
+
+        def fitted(lo, hi):  # the width of a fixed view showing [lo, hi] between the bands
+            return max((hi - lo)[0], (hi - lo)[1] * aspect / below) * 1.1
+
+        fixed_w = fitted(lo, hi)
         if follow is None:
             follow = fixed_w > 2.0 * view_w
-        source = aplot.chemical_source_of(self.config, self.scene)
-        self.source_rel = source
-        if source is not None and not follow:  # a source near enough is kept in the fixed view
+        source = self.source_rel
+        if source is not None and not follow:  # a source near enough is kept in the fixed view, star whole
             s_xy = self.to_view((tr.com[0] + source)[None, :])[0]
-            lo2, hi2 = np.minimum(lo, s_xy - 1.0), np.maximum(hi, s_xy + 1.0)
-            wide = max((hi2 - lo2)[0], (hi2 - lo2)[1] * aspect) * 1.1
+            margin = 1.0
+            for _ in range(3):  # the star's radius in world units depends on the view it widens
+                lo2, hi2 = np.minimum(lo, s_xy - margin), np.maximum(hi, s_xy + margin)
+                wide = fitted(lo2, hi2)
+                margin = max(margin, 1.2 * _SOURCE_RADIUS_PX * wide / width)
+            lo2, hi2 = np.minimum(lo, s_xy - margin), np.maximum(hi, s_xy + margin)
+            wide = fitted(lo2, hi2)
             if wide <= 2.5 * fixed_w:
                 lo, hi, fixed_w = lo2, hi2, wide
         self.follow = follow
-        self.fixed_centre = (lo + hi) / 2
         if not follow:
             view_w = fixed_w
         self.view_w, self.view_h = view_w, view_w / aspect
+        # the centre of the view sits above the centre of what is drawn by half the bands' difference
+        self.lift = np.array([0.0, (top - bottom) * self.view_h / 2])
+        self.fixed_centre = (lo + hi) / 2 + self.lift
 
         dpi = 100
         self.fig = fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
@@ -391,9 +434,6 @@ class _Stage:
                     zorder=6,
                 )
             )
-        self.caption = title if title is not None else "red: expanding   blue: contracting   green: neutral"
-        self.banner = aplot.world_text(self.config, self.scene)
-        self.objective = str(self.config["evaluation.objective"])
         self.springs = np.asarray(tr.body.springs)
         self.aplot = aplot
 
@@ -421,7 +461,7 @@ class _Stage:
             length = min(dist, 0.3 * min(self.view_w, self.view_h))
             tip = c + (to / dist * length if dist > 0 else 0.0)
             self.arrow.set_positions(tuple(c), tuple(tip))
-        centre = c if self.follow else self.fixed_centre
+        centre = c + self.lift if self.follow else self.fixed_centre
         self.ax.set_xlim(centre[0] - self.view_w / 2, centre[0] + self.view_w / 2)
         self.ax.set_ylim(centre[1] - self.view_h / 2, centre[1] + self.view_h / 2)
 
@@ -447,40 +487,100 @@ class _Stage:
 
 
 class _TextOverlay:
-    """Text drawn with Pillow (much faster than matplotlib text), in matplotlib's DejaVu fonts."""
+    """Text drawn with Pillow (much faster than matplotlib text), in matplotlib's DejaVu fonts: the
+    clock at the top left, the world below it (wrapped at its "; " to the frame's width), the
+    caption at the bottom right, "motion" at the top right. :meth:`layout` says where;
+    :func:`frame_figure` writes the same texts there with matplotlib."""
 
     def __init__(self, width: int, height: int):
         from matplotlib import font_manager
         from PIL import ImageFont
 
         scale = max(0.7, min(width, 1.6 * height) / 560)
+        self.mono_size, self.sans_size = int(round(12 * scale)), int(round(10 * scale))
         try:
-            self.mono = ImageFont.truetype(font_manager.findfont("DejaVu Sans Mono"), int(round(12 * scale)))
-            self.sans = ImageFont.truetype(font_manager.findfont("DejaVu Sans"), int(round(10 * scale)))
+            self.mono = ImageFont.truetype(font_manager.findfont("DejaVu Sans Mono"), self.mono_size)
+            self.sans = ImageFont.truetype(font_manager.findfont("DejaVu Sans"), self.sans_size)
         except Exception:  # pragma: no cover - no FreeType
             self.mono = self.sans = ImageFont.load_default()
         self.width, self.height = width, height
         self.margin = int(round(6 * scale))
 
-    def apply(self, rgb: np.ndarray, top_left: str, bottom_right: str, top_right: str, below: str = ""):
+    def _wrap(self, text: str) -> str:
+        """``text`` broken after its "; " where a line would pass the frame's right margin."""
+        lines: list = []
+        for part in text.split("; "):
+            joined = f"{lines[-1]}; {part}" if lines else part
+            if lines and self.sans.getlength(joined) > self.width - 2 * self.margin:
+                lines[-1] += ";"
+                lines.append(part)
+            elif lines:
+                lines[-1] = joined
+            else:
+                lines.append(part)
+        return "\n".join(lines)
+
+    def layout(self, texts: dict) -> list:
+        """The texts of one frame (:meth:`_Stage.texts`) as dicts: ``text``, ``xy`` (pixels),
+        ``anchor`` (Pillow's), ``family``, ``size`` (pixels), ``spacing`` (pixels between lines),
+        ``color``, ``label`` and ``box`` (left, top, right, bottom in pixels)."""
+        from PIL import Image, ImageDraw
+
+        draw = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+        m = self.margin
+        out = []
+
+        def add(label, text, xy, anchor, mono, color):
+            font = self.mono if mono else self.sans
+            box = draw.multiline_textbbox(xy, text, font=font, anchor=anchor, spacing=2)
+            out.append(
+                dict(
+                    label=label,
+                    text=text,
+                    xy=xy,
+                    anchor=anchor,
+                    family="monospace" if mono else "sans-serif",
+                    size=self.mono_size if mono else self.sans_size,
+                    spacing=2,
+                    color=color,
+                    box=box,
+                )
+            )
+            return box
+
+        clock = add("clock", texts["clock"], (m, m), "la", True, "#222222")
+        if texts.get("world"):
+            add("world", self._wrap(texts["world"]), (m, clock[3] + m // 2), "la", False, "#555555")
+        if texts.get("caption"):
+            add("caption", texts["caption"], (self.width - m, self.height - m), "rd", False, "#555555")
+        if texts.get("motion"):
+            add(
+                "motion",
+                texts["motion"],
+                (int(0.9375 * self.width), int(0.085 * self.height) - 2),
+                "md",
+                False,
+                "#777777",
+            )
+        return out
+
+    def bands(self, texts: dict) -> Tuple[float, float]:
+        """Pixels at the top (clock, world, motion) and at the bottom (caption) that the texts of
+        :meth:`layout` take, each with a gap."""
+        boxes = {t["label"]: t["box"] for t in self.layout(texts)}
+        top = max(boxes[k][3] for k in ("clock", "world", "motion") if k in boxes) + _TEXT_GAP
+        bottom = self.height - boxes["caption"][1] + _TEXT_GAP if "caption" in boxes else 0.0
+        return float(top), float(bottom)
+
+    def apply(self, rgb: np.ndarray, texts: dict):
         from PIL import Image, ImageDraw
 
         image = Image.fromarray(np.ascontiguousarray(rgb))
         draw = ImageDraw.Draw(image)
-        m = self.margin
-        draw.multiline_text((m, m), top_left, font=self.mono, fill=(34, 34, 34), spacing=2)
-        if below:  # a line under the top-left block: the world
-            bottom = draw.multiline_textbbox((m, m), top_left, font=self.mono, spacing=2)[3]
-            draw.text((m, bottom + m // 2), below, font=self.sans, fill=(85, 85, 85))
-        if bottom_right:
-            draw.text((self.width - m, self.height - m), bottom_right, font=self.sans, fill=(85, 85, 85), anchor="rd")
-        if top_right:
-            draw.text(
-                (int(0.9375 * self.width), int(0.085 * self.height) - 2),
-                top_right,
-                font=self.sans,
-                fill=(119, 119, 119),
-                anchor="md",
+        for t in self.layout(texts):
+            font = self.mono if t["family"] == "monospace" else self.sans
+            draw.multiline_text(
+                t["xy"], t["text"], font=font, fill=t["color"], anchor=t["anchor"], spacing=t["spacing"]
             )
         return image
 

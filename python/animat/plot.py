@@ -21,11 +21,17 @@ function               paper        shows
 swims in. Every figure names the world as it is (:func:`world_text`: the fluid only with effect
 ``drag``, gravity and the floor only with theirs), the run's objective (:func:`objective_info`) and
 the body graph used (:func:`graph_name`).
+
+A swim in which no cell moves (:func:`motionless`: a run's best can be such a body when nothing that
+moves scored better yet) draws its figures with a warning (:func:`motion_cycle`,
+:func:`animat.animate`). Under GRN control with ``control.actuation = "direct"`` the developed
+phases drive nothing (:func:`oscillator_phases_used`), so :func:`phase_map` draws a note instead.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import matplotlib
@@ -42,7 +48,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from .run import MORPHOLOGY_TOLERANCE, Run
-from .trajectory import CONTRACTING, EXPANDING, NEUTRAL, STATE_NAMES, Trajectory, body_of
+from .trajectory import CONTRACTING, EXPANDING, NEUTRAL, STATE_NAMES, Trajectory, _swims_per_source, body_of
 
 __all__ = [
     "development",
@@ -64,6 +70,8 @@ __all__ = [
     "graph_name",
     "draw_world",
     "chemical_source_of",
+    "motionless",
+    "oscillator_phases_used",
     "FLOOR_COLOR",
     "GROUND_COLOR",
     "SOURCE_COLOR",
@@ -106,11 +114,18 @@ def _scene_of(config: Any = None, scene: Any = None) -> Any:
     return _core.Scene.from_config(config if config is not None else _core.Config())
 
 
-def world_text(config: Any = None, scene: Any = None) -> str:
+def world_text(config: Any = None, scene: Any = None, *, source_trial: Optional[int] = None) -> str:
     """One line naming the world a swim happens in, as it is: the fluid (``d_N``, ``d_T``) only when
     effect ``drag`` is in the scene ("no fluid drag" otherwise), gravity and the floor only when
     effects ``gravity`` / ``ground`` are, the GRN controller under ``control.mode = "grn"`` and the
     chemical source when there is one (see :func:`chemical_source_of`).
+
+    Under objective ``chemotaxis`` an evaluation swims toward ``evaluation.source_directions``
+    sources (:func:`animat.trajectory.chemotaxis_source`), none of them at ``scene.chemical_source``
+    itself: without ``source_trial`` the text says how far and how many ("point source 20 from the
+    start, 4 directions"); with it (a replayed swim: ``trajectory.meta["source_trial"]``, whose
+    config holds that swim's source) where that swim's source is and which swim it is ("point source
+    at (-5.83, -19.1) from the start (swim 1 of 4)").
 
     ``scene`` (an :class:`animat.Scene`) overrides ``config``'s scene (default: animat defaults)."""
     cfg = config if config is not None else _core.Config()
@@ -134,7 +149,14 @@ def world_text(config: Any = None, scene: Any = None) -> str:
     source = chemical_source_of(cfg, sc)
     if source is not None:
         kind = sc.chemical if sc.chemical != "none" else "chemotaxis"
-        parts.append(f"{kind} source at ({source[0]:g}, {source[1]:g}) from the start")
+        trials = _swims_per_source(cfg)
+        at = f"{kind} source at ({source[0]:.3g}, {source[1]:.3g}) from the start"
+        if not trials:
+            parts.append(at)
+        elif source_trial is None:
+            parts.append(f"{kind} source {float(np.hypot(*source)):g} from the start, {trials} directions")
+        else:
+            parts.append(f"{at} (swim {source_trial + 1} of {trials})")
     return "; ".join(parts)
 
 
@@ -248,6 +270,42 @@ def draw_world(
             scaley=False,
         )
     return out
+
+
+def oscillator_phases_used(config: Any = None) -> bool:
+    """Whether the developed oscillators' phases shape the swim: always in open loop (the paper's
+    eq. 2) and under ``control.mode = "grn"`` with ``control.actuation = "amplitude"`` (the GRN sets
+    the amplitudes of those oscillators); not with ``"direct"``, where the GRN writes every term u_i
+    itself and no oscillator runs (docs/control.md)."""
+    cfg = config if config is not None else _core.Config()
+    return str(cfg["control.mode"]) != "grn" or str(cfg["control.actuation"]) != "direct"
+
+
+#: :func:`motionless`: no cell moves farther than this fraction of the body length from its start.
+MOTIONLESS_TOLERANCE = 1e-6
+
+
+def motionless(trajectory: Trajectory, tolerance: float = MOTIONLESS_TOLERANCE) -> bool:
+    """True when no cell of the swim moves farther from where it started than ``tolerance`` body
+    lengths (``animat.body_length``): a body at rest for the whole swim."""
+    pos = np.asarray(trajectory.positions)
+    if len(pos) < 2:
+        return True
+    moved = float(np.linalg.norm(pos - pos[0], axis=2).max())
+    return moved <= tolerance * float(_core.body_length(trajectory.body))
+
+
+def _warn_if_motionless(trajectory: Trajectory, caller: str) -> None:
+    """Warn that a figure of ``trajectory`` shows a body at rest (see :func:`motionless`)."""
+    if motionless(trajectory):
+        steps = int(trajectory.steps[-1] - trajectory.steps[0]) if len(trajectory.steps) else 0
+        warnings.warn(
+            f"{caller}: the body does not move (no cell moves in the {steps} steps of the swim). A run's best is "
+            "such a body while nothing that moves has scored better: a short run, or an objective that "
+            "standing still does not lose (chemotaxis)",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 # --- helpers ------------------------------------------------------------------------------------------
@@ -613,6 +671,7 @@ def motion_cycle(
     frames = list(tr.cycle_frames(count) if frames is None else frames)
     if not frames:
         raise ValueError("motion_cycle: no frames to draw")
+    _warn_if_motionless(tr, "motion_cycle")
     for f in frames:
         if not -tr.frame_count <= f < tr.frame_count:
             raise ValueError(f"motion_cycle: frame {f} out of range (trajectory has {tr.frame_count} frames)")
@@ -687,7 +746,8 @@ def motion_cycle(
         title
         or f"Motion cycle (paper Figs. 4-6): steps {int(tr.steps[frames[0]])}-"
         f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g} in "
-        f"{int(tr.steps[-1] - tr.steps[0])} steps\n{world_text(tr.config, tr.meta.get('scene'))}",
+        f"{int(tr.steps[-1] - tr.steps[0])} steps\n"
+        f"{world_text(tr.config, tr.meta.get('scene'), source_trial=tr.meta.get('source_trial'))}",
         fontsize=9.5,
     )
     fig.tight_layout(rect=(0, 0.07, 1, 1))
@@ -743,6 +803,10 @@ def phase_map(
     next to it and in the title. When all phases are equal every node is red and the range is
     ``[max - 1, max]``; the title says "all equal".
 
+    Under ``control.mode = "grn"`` with ``control.actuation = "direct"`` (``config``) no oscillator
+    runs, so no phase drives the swim (:func:`oscillator_phases_used`): the figure has no phase map,
+    only a text saying so (a figure with no Axes; with ``ax``, that Axes turned off with the text).
+
     Args:
         body: an :class:`animat.Body`, Embryo, Genome / LineageEntry (developed with ``config``)
             or a Trajectory.
@@ -753,6 +817,18 @@ def phase_map(
         The Figure. The node collection (label ``"nodes"``) carries the phases as its array and
         the Normalize as its ``norm``.
     """
+    if not oscillator_phases_used(config if config is not None else getattr(body, "config", None)):
+        note = (
+            "No phase map: under GRN control with control.actuation = 'direct'\nthe GRN writes every "
+            "cell's term u_i while swimming;\nno oscillator runs, so no phase drives the swim"
+        )
+        if ax is None:
+            fig = plt.figure(figsize=(5.0, 1.6))
+            fig.text(0.5, 0.5, note, ha="center", va="center", fontsize=9, label="no phase map")
+            return fig
+        ax.set_axis_off()
+        ax.text(0.5, 0.5, note, ha="center", va="center", fontsize=8, transform=ax.transAxes, label="no phase map")
+        return _map_axes(ax, np.ones(2), False)[0]
     body = body_of(body, config)
     phase = np.asarray(body.phase, dtype=float)
     pos = np.asarray(body.positions)
@@ -891,6 +967,10 @@ def fitness_history(
     no value drawn is negative: a signed objective (speed_toward, distance_minus_energy,
     chemotaxis, a Python one) is drawn whole, with 0 marked.
 
+    Under GRN control with ``control.actuation = "direct"`` the thumbnails are plain (no phase drives
+    those swims, :func:`oscillator_phases_used`). The layout is matplotlib's constrained one: the axis
+    labels and the two-line title stay inside the figure whatever the width of the tick labels.
+
     Args:
         run: an :class:`animat.Run` or a run directory path.
         max_thumbnails: at most this many thumbnails (always the first and the last morphology;
@@ -913,20 +993,10 @@ def fitness_history(
     else:
         shown = changes[:k]
 
-    fig = plt.figure(figsize=(10, 6.2 if shown else 4.2))
+    fig = plt.figure(figsize=(10, 6.2 if shown else 4.2), layout="constrained")
     gs: Any = None
     if shown:
-        gs = fig.add_gridspec(
-            2,
-            max(len(shown), 1),
-            height_ratios=[1.0, 1.5],
-            hspace=0.25,
-            left=0.07,
-            right=0.98,
-            top=0.88,
-            bottom=0.09,
-            wspace=0.12,
-        )
+        gs = fig.add_gridspec(2, max(len(shown), 1), height_ratios=[1.0, 1.5])
         main = fig.add_subplot(gs[1, :])
     else:
         main = fig.add_subplot()
@@ -972,16 +1042,16 @@ def fitness_history(
             ax.set_axis_off()
             continue
         ph = np.asarray(body.phase)
-        if len(ph) and np.ptp(ph) > 0:
+        if len(ph) and np.ptp(ph) > 0 and oscillator_phases_used(cfg):
             phase_map(body, ax=ax, colorbar=False, title="")
             for t in list(ax.texts):
                 t.remove()
             note = f"φ {ph.min():.2f}-{ph.max():.2f}"
-        else:  # no phase shift among the cells (paper Fig. 8: such bodies are not coloured)
+        else:  # no phase shift among the cells (paper Fig. 8: such bodies are not coloured), or none used
             pos = np.asarray(body.positions)
             draw_body(ax, body, pos, "#f2f2f2")
             _frame_axes(ax, pos.min(axis=0), pos.max(axis=0), _node_radius(body) + 0.5)
-            note = "no phase shift"
+            note = "no phase shift" if oscillator_phases_used(cfg) else "GRN control (direct)"
         ax.set_title(f"gen {entry.generation}: {entry.fitness:.3g}\n{note}", fontsize=8)
         con = ConnectionPatch(
             xyA=(0.5, 0.0),
@@ -994,15 +1064,15 @@ def fitness_history(
         )
         fig.add_artist(con)
     n_changes = len(changes)
+    coloured = "nodes coloured by phase" if oscillator_phases_used(cfg) else "plain nodes"
     fig.suptitle(
         title
-        or f"Fitness history (paper Figs. 8-9): {run.path.name}, {len(hist)} generations, "
-        f"{len(lineage)} improvements, {n_changes} morpholog{'y' if n_changes == 1 else 'ies'}"
-        f"{f' ({len(shown)} shown, nodes coloured by phase)' if shown else ''}",
+        or f"Fitness history (paper Figs. 8-9): {run.path.name}\n{len(hist)} generations, "
+        f"{len(lineage)} improvement{'' if len(lineage) == 1 else 's'}, "
+        f"{n_changes} morpholog{'y' if n_changes == 1 else 'ies'}"
+        f"{f' ({len(shown)} shown, {coloured})' if shown else ''}",
         fontsize=10,
     )
-    if not shown:
-        fig.tight_layout()
     return fig
 
 

@@ -40,6 +40,7 @@ __all__ = [
     "STATE_NAMES",
     "DEFAULT_NEUTRAL",
     "body_of",
+    "chemotaxis_source",
 ]
 
 #: Actuation state codes used in :attr:`Trajectory.node_state` and :attr:`Trajectory.spring_state`.
@@ -103,6 +104,33 @@ def classify_rates(rates: np.ndarray, threshold: float) -> np.ndarray:
     return out
 
 
+def _swims_per_source(config: Any) -> int:
+    """The swims of one evaluation, one per source direction, under an objective that one swim does
+    not decide (``chemotaxis``: ``evaluation.source_directions``); 0 under any other objective."""
+    name = str(config["evaluation.objective"])
+    if any(spec.name == name and not spec.one_swim for spec in _core.objectives()):
+        return max(1, int(config["evaluation.source_directions"]))
+    return 0
+
+
+def chemotaxis_source(config: Any, trial: int = 0) -> np.ndarray:
+    """The chemical source of swim ``trial`` of an evaluation under objective ``chemotaxis``,
+    relative to the body's start centre: ``scene.chemical_source`` rotated by offset + 2π·trial/T
+    (T = ``evaluation.source_directions``), the offset uniform in [0, 2π) drawn from
+    ``evaluation.source_seed``, the same for every genome (docs/control.md). The engine's own
+    ``source_direction`` (src/evaluate.cpp), computed the same way: the swims of
+    :func:`replay` with ``source_trial`` 0 to T - 1 average to the evaluation's fitness.
+    """
+    count = max(1, int(config["evaluation.source_directions"]))
+    if not 0 <= trial < count:
+        raise ValueError(f"chemotaxis_source: trial {trial} is not one of the {count} evaluation.source_directions")
+    offset = 2.0 * math.pi * _core.Rng(int(config["evaluation.source_seed"])).uniform()
+    angle = offset + 2.0 * math.pi * trial / count
+    x, y = (float(v) for v in config["scene.chemical_source"])
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([c * x - s * y, s * x + c * y])
+
+
 def body_of(thing: Any, config: Optional[Any] = None):
     """The :class:`animat.Body` of a Body, an Embryo, a Genome, a LineageEntry or a Trajectory.
 
@@ -144,8 +172,9 @@ class Trajectory:
     The body (``body``: springs, skin, regions, oscillator parameters) is the :class:`animat.Body`
     that swam. ``stable`` is False if the simulation left its valid domain; the frames then stop
     at the last valid state and ``failure`` holds the message. ``config`` is the config it swam
-    with; ``meta`` holds ``neutral``, ``control`` ("open_loop" or "grn") and ``scene`` (the
-    :class:`animat.Scene` that overrode ``config.scene``, or None).
+    with; ``meta`` holds ``neutral``, ``control`` ("open_loop" or "grn"), ``scene`` (the
+    :class:`animat.Scene` that overrode ``config.scene``, or None) and, under objective
+    ``chemotaxis``, ``source_trial`` and ``source_trials`` (which of the evaluation's swims it is).
     """
 
     body: Any
@@ -283,6 +312,7 @@ def replay(
     every: int = 1,
     scene: Optional[Any] = None,
     neutral: float = DEFAULT_NEUTRAL,
+    source_trial: Optional[int] = None,
 ) -> Trajectory:
     """Swim a genome (or a developed embryo, or a body) again and record it.
 
@@ -302,13 +332,21 @@ def replay(
         scene: an :class:`animat.Scene` overriding ``config.scene``.
         neutral: the neutral band as a fraction of the body's largest cell rate ``max_i a_i f_i``
             (see the module docstring); 0 makes every moving cell red or blue.
+        source_trial: objective ``chemotaxis`` only: which of the evaluation's
+            ``evaluation.source_directions`` swims to replay (default 0, the first).
 
     Under ``control.mode = "grn"`` (docs/control.md) the genome's GRN drives the actuation while it
     swims, as in ``animat.evaluate`` (the chemical source at ``scene.chemical_source`` from the start
-    centre: the objective ``chemotaxis`` scores this swim's progress toward it, averaged over turned
-    sources); the cell terms are the controller's, their rates the terms' time derivative between
+    centre); the cell terms are the controller's, their rates the terms' time derivative between
     frames, and the neutral band ``neutral`` times the largest rate seen. That needs the genome: a
     Body or an Embryo under such a config is a ValueError.
+
+    Under objective ``chemotaxis`` an evaluation swims once per source direction and scores the mean
+    progress toward the source; the replay is one of those swims, ``source_trial`` (default the
+    first, the one whose diagnostics the evaluation records), with the source where that swim has it
+    (:func:`chemotaxis_source`, never ``scene.chemical_source`` itself). The trajectory's ``config``
+    (and ``scene``) then hold that source, so figures draw it where the body swam toward it, and
+    ``meta`` says which swim it is: ``source_trial`` and ``source_trials`` (T).
 
     Returns:
         A :class:`Trajectory`. A swim that leaves the simulator's valid domain stops early:
@@ -326,6 +364,22 @@ def replay(
     if n_steps < 0:
         raise ValueError(f"replay: steps must be >= 0, got {n_steps}")
     grn = str(cfg["control.mode"]) == "grn"
+    trials = _swims_per_source(cfg)
+    meta: dict = {"neutral": float(neutral), "control": "grn" if grn else "open_loop"}
+    if source_trial is not None and not trials:
+        raise ValueError(
+            f"replay: source_trial is for objective 'chemotaxis' (one swim per source direction), "
+            f"not {cfg['evaluation.objective']!r}"
+        )
+    if trials:  # the swim of the evaluation: its source, sensed (config) and drawn (config, scene)
+        trial = 0 if source_trial is None else int(source_trial)
+        source = [float(v) for v in chemotaxis_source(cfg, trial)]
+        cfg = cfg.copy()
+        cfg["scene.chemical_source"] = source
+        if scene is not None:
+            scene = scene.replace(chemical_source=source)
+        meta.update(source_trial=trial, source_trials=trials)
+    meta["scene"] = scene
     genome = genome_or_body
     if hasattr(genome, "genome") and not isinstance(genome, _core.Genome):  # LineageEntry
         genome = genome.genome
@@ -412,5 +466,5 @@ def replay(
         config=cfg,
         stable=not failure,
         failure=failure,
-        meta={"neutral": float(neutral), "control": "grn" if grn else "open_loop", "scene": scene},
+        meta=meta,
     )

@@ -146,15 +146,21 @@ def test_crawl_gif_draws_the_floor_and_names_the_world(tmp_path):
 
 
 def test_chemotaxis_gif_draws_the_source_and_the_progress_toward_it(chemotaxis, tmp_path):
+    """A chemotaxis replay is the evaluation's first swim, toward that swim's source (never
+    scene.chemical_source itself, where no evaluation puts one), and draws that source."""
     from animat import plot
+    from animat.trajectory import chemotaxis_source
 
     genome, config = chemotaxis
     tr = animat.replay(genome, config, steps=600, every=10)
-    # the swim is the GRN-controlled one evaluate() scores, not the open-loop oscillators
+    source = chemotaxis_source(config, 0)
+    assert tr.meta["source_trial"] == 0 and tr.meta["source_trials"] == config["evaluation.source_directions"] == 4
+    assert not np.allclose(source, config["scene.chemical_source"])  # turned by the seed's offset
+    np.testing.assert_array_equal(tr.config["scene.chemical_source"], source)
+    # the swim is the GRN-controlled one evaluate() scores, toward that source
     assert tr.meta["control"] == "grn"
-    ref = animat.grn_swim(genome, config, steps=600, every=10)
+    ref = animat.grn_swim(genome, config, steps=600, every=10, source=list(source))
     assert np.allclose(tr.com, ref["com"]) and np.allclose(tr.node_terms, ref["terms"])
-    source = np.asarray(config["scene.chemical_source"])
     fig = frame_figure(tr, align=False, size=(400, 240))
     ax = fig.axes[0]
     stars = [ln for ln in ax.get_lines() if ln.get_label() == "chemical source"]
@@ -167,7 +173,8 @@ def test_chemotaxis_gif_draws_the_source_and_the_progress_toward_it(chemotaxis, 
     progress = np.linalg.norm(source) - np.linalg.norm(source - d)
     assert "to source" in text["clock"] and f"{progress:8.3f}" in text["clock"]
     assert "distance" not in text["clock"]
-    assert "point source at (20, 0)" in text["world"] and "GRN control" in text["world"]
+    at = f"point source at ({source[0]:.3g}, {source[1]:.3g}) from the start (swim 1 of 4)"
+    assert at in text["world"].replace("\n", " ") and "GRN control" in text["world"]
     # aligned (the default in a fluid), the star is rotated with the world but stays as far from the start
     fig = frame_figure(tr, size=(400, 240))
     star = next(ln for ln in fig.axes[0].get_lines() if ln.get_label() == "chemical source")
@@ -177,3 +184,87 @@ def test_chemotaxis_gif_draws_the_source_and_the_progress_toward_it(chemotaxis, 
     )
     out = animat.animate(tr, tmp_path / "chem.gif", max_frames=6, size=(400, 240), align=False, progress=False)
     assert min(count_colour(out, plot.SOURCE_COLOR)) > 20
+
+
+def control_run(name):
+    """A run of data/control (flat files: config, history, best genome) as (genome, config)."""
+    run = ROOT / "data" / "control" / name
+    return animat.Genome.load(f"{run}_best_genome.json"), animat.load_config(f"{run}_config.toml")
+
+
+def test_the_replays_of_every_source_direction_average_to_the_evaluations_fitness():
+    """chemotaxis_amplitude_seed1 swims away from scene.chemical_source (+x, -0.59 in 2000 steps: what
+    the replay used to draw) while its fitness is +0.47: the mean progress over the evaluation's four
+    turned sources, which replay(source_trial=k) swims one by one."""
+    from animat.trajectory import chemotaxis_source
+
+    genome, config = control_run("chemotaxis_amplitude_seed1")
+    result = animat.evaluate(genome, config)
+    progress = []
+    for k in range(4):
+        tr = animat.replay(genome, config, every=100, source_trial=k)
+        source = chemotaxis_source(config, k)
+        assert tr.meta["source_trial"] == k and np.linalg.norm(source) == pytest.approx(20.0, rel=1e-12)
+        progress.append(np.linalg.norm(source) - np.linalg.norm(source - (tr.com[-1] - tr.com[0])))
+    assert result.source_progress == pytest.approx(0.47014513761968235, rel=1e-12)
+    assert np.mean(progress) == pytest.approx(result.source_progress, rel=1e-12)
+    assert progress[0] == pytest.approx(0.8528, abs=1e-4)  # the first swim, the default replay's
+    with pytest.raises(ValueError, match="not one of the 4 evaluation.source_directions"):
+        animat.replay(genome, config, steps=10, source_trial=4)
+    with pytest.raises(ValueError, match="source_trial is for objective 'chemotaxis'"):
+        animat.replay(wave_body(), steps=10, source_trial=0)
+
+
+def window_boxes(fig):
+    """The display boxes of the frame's texts, its source star and its nodes (each node's disc)."""
+    renderer = fig.canvas.get_renderer()
+    ax = fig.axes[0]
+    texts = {t.get_label(): t.get_window_extent(renderer) for t in fig.texts}
+    star = next(ln for ln in ax.get_lines() if ln.get_label() == "chemical source").get_window_extent(renderer)
+    nodes = next(c for c in ax.collections if c.get_label() == "nodes")
+    centres = ax.transData.transform(nodes.get_offsets())
+    radius = (ax.transData.transform([[nodes._widths[0], 0]]) - ax.transData.transform([[0, 0]]))[0, 0]
+    return texts, star, centres, radius
+
+
+@pytest.mark.parametrize("name", ["chemotaxis_amplitude_seed1", "chemotaxis_amplitude_seed2"])
+def test_the_texts_keep_clear_of_the_source_and_the_body(name):
+    """The star of seed 1's source sat under the world text, seed 2's under the caption; now the
+    view keeps the bands of the texts clear: no text box overlaps the star's or a node's."""
+    genome, config = control_run(name)
+    tr = animat.replay(genome, config, every=10)
+    for frame in (0, -1):
+        fig = frame_figure(tr, frame)
+        fig.canvas.draw()
+        texts, star, centres, radius = window_boxes(fig)
+        assert set(texts) == {"clock", "world", "caption", "motion"}
+        frame_box = fig.bbox
+        assert (
+            frame_box.x0 <= star.x0 and star.x1 <= frame_box.x1 and frame_box.y0 <= star.y0 and star.y1 <= frame_box.y1
+        )
+        for label, box in texts.items():
+            assert not box.overlaps(star), (label, box, star)
+            near_x = (centres[:, 0] + radius > box.x0) & (centres[:, 0] - radius < box.x1)
+            near_y = (centres[:, 1] + radius > box.y0) & (centres[:, 1] - radius < box.y1)
+            assert not np.any(near_x & near_y), label
+
+
+def test_a_body_that_does_not_move_is_drawn_with_a_warning(tmp_path):
+    """The open-loop chemotaxis run's best (generation 0, fitness 0) has every amplitude 0."""
+    from animat import plot
+
+    genome, config = control_run("chemotaxis_open_loop_seed1")
+    still = animat.replay(genome, config, steps=200, every=10)
+    assert plot.motionless(still) and np.all(np.asarray(still.body.amplitude) == 0.0)
+    with pytest.warns(UserWarning, match=r"animate: the body does not move \(no cell moves in the 200 steps"):
+        animat.animate(still, tmp_path / "still.gif", max_frames=3, size=(200, 120), progress=False)
+    with pytest.warns(UserWarning, match="motion_cycle: the body does not move"):
+        plot.motion_cycle(still, count=3)
+    moving = animat.replay(wave_body(), steps=60, every=2)
+    assert not plot.motionless(moving)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        animat.animate(moving, tmp_path / "moving.gif", max_frames=3, size=(200, 120), progress=False)
+        plot.motion_cycle(moving, count=3)

@@ -248,8 +248,14 @@ def test_world_text_names_the_world_as_it_is():
     text = plot.world_text(crawl)
     assert "d_N" not in text and "drag" in text and "gravity g = 1" in text and "floor at y = 0" in text
     chem = animat.load_config(str(ROOT / "configs" / "chemotaxis.toml"))
-    text = plot.world_text(chem)
-    assert "fluid d_N = 2" in text and "GRN control" in text and "point source at (20, 0)" in text
+    text = plot.world_text(chem)  # no evaluation swims toward (20, 0) itself: four turned directions
+    assert "fluid d_N = 2" in text and "GRN control" in text and "point source 20 from the start, 4 directions" in text
+    assert "(20, 0)" not in text
+    turned = chem.copy()
+    turned["scene.chemical_source"] = [-5.83, -19.13]
+    assert plot.world_text(turned, source_trial=0).endswith(
+        "point source at (-5.83, -19.1) from the start (swim 1 of 4)"
+    )
     assert plot.chemical_source_of(animat.Config()) is None
     assert list(plot.chemical_source_of(chem)) == [20.0, 0.0]
 
@@ -356,3 +362,59 @@ def test_show_draws_the_stiffness_map_of_evolved_stiffness(run, tmp_path):
     # the same run's construction names its alpha-shape graph, and the history its objective
     assert "alpha-shape graph" in makers["construction"]().axes[2].get_title()
     assert fitness_axes(makers["fitness_history"]()).get_ylabel() == "fitness: distance"
+
+
+def control_run_dir(name, tmp_path):
+    """A run directory of data/control's flat files (config, history, best genome) for animat.Run:
+    the best genome recorded at the generation where the best fitness was reached."""
+    import csv
+    import shutil
+
+    data = ROOT / "data" / "control"
+    run = tmp_path / name
+    (run / "best").mkdir(parents=True)
+    shutil.copy(data / f"{name}_config.toml", run / "config.toml")
+    shutil.copy(data / f"{name}_history.csv", run / "history.csv")
+    rows = list(csv.DictReader((run / "history.csv").open()))
+    best = max(float(r["best"]) for r in rows)
+    generation = next(int(r["generation"]) for r in rows if float(r["best"]) == best)
+    genome = json.loads((data / f"{name}_best_genome.json").read_text())
+    entry = {"cell_count": 32, "fitness": best, "generation": generation, "genome": genome}
+    (run / "best" / f"gen_{generation:06d}.json").write_text(json.dumps(entry))
+    return animat.Run(run)
+
+
+def test_no_phase_map_for_bodies_the_grn_drives_directly(tmp_path):
+    """Under control.actuation = "direct" no oscillator runs: no phase axes, a note instead, and the
+    history's thumbnails are plain; under "amplitude" the phases still time the oscillators."""
+    direct = control_run_dir("chemotaxis_grn_seed1", tmp_path)
+    assert direct.config["control.mode"] == "grn" and direct.config["control.actuation"] == "direct"
+    assert not plot.oscillator_phases_used(direct.config)
+    fig = plot.phase_map(direct.best(), config=direct.config)
+    assert fig.axes == []
+    assert [t.get_label() for t in fig.texts] == ["no phase map"] and "direct" in fig.texts[0].get_text()
+    fig = plot.fitness_history(direct)
+    thumbnails = [ax for ax in fig.axes if ax.get_label() != "fitness"]
+    assert thumbnails and all(nodes_of(ax).get_array() is None for ax in thumbnails)
+    assert thumbnails[-1].get_title().endswith("GRN control (direct)") and "plain nodes" in fig._suptitle.get_text()
+    amplitude = control_run_dir("chemotaxis_amplitude_seed2", tmp_path)
+    assert amplitude.config["control.actuation"] == "amplitude" and plot.oscillator_phases_used(amplitude.config)
+    fig = plot.phase_map(amplitude.best(), config=amplitude.config)
+    assert len(fig.axes) == 2 and nodes_of(fig.axes[0]).get_array() is not None  # the map and its colour bar
+    assert plot.oscillator_phases_used(animat.Config())
+
+
+def test_fitness_history_of_negative_values_keeps_its_labels_in_the_figure(tmp_path):
+    """The open-loop chemotaxis run's mean fitness goes down to -0.0015: the wide tick labels pushed
+    the y label out of the figure, and the one-line title was wider than the figure."""
+    run = control_run_dir("chemotaxis_open_loop_seed1", tmp_path)
+    assert float(run.history["mean"].min()) < -0.001
+    fig = plot.fitness_history(run)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ax = fitness_axes(fig)
+    assert ax.get_ylim()[0] < -0.001
+    frame = fig.bbox
+    for artist in (ax.yaxis.label, fig._suptitle, *ax.get_yticklabels()):
+        box = artist.get_window_extent(renderer)
+        assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1, artist
