@@ -742,10 +742,15 @@ def motion_cycle(
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
     period = tr.period()
     cycle = f"dominant period {period / tr.dt:.0f} steps" if math.isfinite(period) else "no oscillation"
+    source = chemical_source_of(tr.config, tr.meta.get("scene"))
+    toward = ""
+    if source is not None and tr.meta.get("source_trial") is not None:  # one swim of a chemotaxis evaluation
+        gain = float(np.linalg.norm(source) - np.linalg.norm(source - tr.displacement))
+        toward = f" ({gain:.3g} toward the source)"
     fig.suptitle(
         title
         or f"Motion cycle (paper Figs. 4-6): steps {int(tr.steps[frames[0]])}-"
-        f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g} in "
+        f"{int(tr.steps[frames[-1]])}, {cycle}; distance {tr.distance:.3g}{toward} in "
         f"{int(tr.steps[-1] - tr.steps[0])} steps\n"
         f"{world_text(tr.config, tr.meta.get('scene'), source_trial=tr.meta.get('source_trial'))}",
         fontsize=9.5,

@@ -418,3 +418,21 @@ def test_fitness_history_of_negative_values_keeps_its_labels_in_the_figure(tmp_p
     for artist in (ax.yaxis.label, fig._suptitle, *ax.get_yticklabels()):
         box = artist.get_window_extent(renderer)
         assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1, artist
+
+
+def test_motion_cycle_of_a_chemotaxis_swim_names_its_source_and_the_progress_toward_it():
+    from animat.trajectory import chemotaxis_source
+
+    data = ROOT / "data" / "control" / "chemotaxis_amplitude_seed1"
+    config = animat.load_config(f"{data}_config.toml")
+    tr = animat.replay(animat.Genome.load(f"{data}_best_genome.json"), config, steps=600, every=5)
+    source = chemotaxis_source(config, 0)
+    gain = np.linalg.norm(source) - np.linalg.norm(source - tr.displacement)
+    fig = plot.motion_cycle(tr, count=3)
+    title = fig._suptitle.get_text()
+    assert f"distance {tr.distance:.3g} ({gain:.3g} toward the source) in 600 steps" in title
+    assert f"point source at ({source[0]:.3g}, {source[1]:.3g}) from the start (swim 1 of 4)" in title
+    star = next(ln for ax in fig.axes for ln in ax.get_lines() if ln.get_label() == "chemical source")
+    rot = plot.rotation_to(tr.direction)
+    frames = tr.cycle_frames(3)
+    np.testing.assert_allclose(np.column_stack(star.get_data())[0], (tr.com[0] + source - tr.com[frames[0]]) @ rot.T)
