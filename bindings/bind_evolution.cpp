@@ -73,14 +73,25 @@ void bind_evolution(nb::module_& m) {
       .def(
           "__init__",
           [](Fitness* f, double fitness, bool viable, bool stable, int cell_count, bool valid,
-             long drag_limited, int morphology_kind) {
+             long drag_limited, int morphology_kind, double actuation_work,
+             double actuation_work_positive, double actuation_work_absolute, double max_speed) {
             if (drag_limited < 0) throw nb::value_error("Fitness: drag_limited must be >= 0");
             if (morphology_kind < 0) throw nb::value_error("Fitness: morphology_kind must be >= 0");
-            new (f)
-                Fitness{fitness, viable, stable, cell_count, valid, drag_limited, morphology_kind};
+            new (f) Fitness{fitness,
+                            viable,
+                            stable,
+                            cell_count,
+                            valid,
+                            drag_limited,
+                            morphology_kind,
+                            actuation_work,
+                            actuation_work_positive,
+                            actuation_work_absolute,
+                            max_speed};
           },
           "fitness"_a = 0.0, "viable"_a = true, "stable"_a = true, "cell_count"_a = 0,
-          "valid"_a = true, "drag_limited"_a = 0, "morphology_kind"_a = 0,
+          "valid"_a = true, "drag_limited"_a = 0, "morphology_kind"_a = 0, "actuation_work"_a = 0.0,
+          "actuation_work_positive"_a = 0.0, "actuation_work_absolute"_a = 0.0, "max_speed"_a = 0.0,
           "A fitness to tell() the GA: the objective's value, whether the genome was viable "
           "(non-viable ones\n"
           "are never selected before viable ones), whether its swim was stable, its cell count, "
@@ -89,7 +100,9 @@ void bind_evolution(nb::module_& m) {
           "\"stable\" only), and\n"
           "the body plan's coarse class (EvaluationResult.morphology_kind; what "
           "evolution.protection_generations\n"
-          "compares; 0 = unknown).")
+          "compares; 0 = unknown), and the swim's measures that MAP-Elites' descriptors and "
+          "NSGA-II's criteria\n"
+          "read in animat_evolve (EvaluationResult's fields of the same names).")
       .def("__eq__", [](const Fitness& a, const Fitness& b) { return a == b; })
       // Float-like: `ind.fitness` is the record, and it formats, converts and orders as its value,
       // as LineageEntry.fitness and the history's floats do.
@@ -110,7 +123,7 @@ void bind_evolution(nb::module_& m) {
       .def("__gt__", [](const Fitness& a, const Fitness& b) { return a.fitness > b.fitness; })
       .def("__ge__", [](const Fitness& a, const Fitness& b) { return a.fitness >= b.fitness; })
       // The pickled state is the tuple of the descriptor's fields; 5 entries: pickled before
-      // drag_limited, 6: before morphology_kind.
+      // drag_limited, 6: before morphology_kind, 7: before the swim's measures.
       .def("__getstate__",
            [](const Fitness& f) {
              nb::list state;

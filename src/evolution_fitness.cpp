@@ -10,6 +10,16 @@
 
 namespace animat {
 
+Fitness fitness_of(const EvaluationResult& r) {
+  Fitness f{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
+  f.morphology_kind = r.morphology_kind;
+  f.actuation_work = r.actuation_work;
+  f.actuation_work_positive = r.actuation_work_positive;
+  f.actuation_work_absolute = r.actuation_work_absolute;
+  f.max_speed = r.max_speed;
+  return f;
+}
+
 FitnessFunction swim_fitness(const Config& config) {
   return objective_fitness(config, make_objective(config.evaluation));
 }
@@ -20,10 +30,7 @@ FitnessFunction objective_fitness(const Config& config,
   if (!objective) throw Error("objective_fitness: no objective");
   auto shared = std::make_shared<const Config>(config);
   return [shared, objective = std::move(objective)](const Genome& genome) {
-    const EvaluationResult r = evaluate(genome, *shared, *objective);
-    Fitness f{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
-    f.morphology_kind = r.morphology_kind;
-    return f;
+    return fitness_of(evaluate(genome, *shared, *objective));
   };
 }
 

@@ -492,6 +492,43 @@ std::string local_time_stamp() {
 
 namespace {
 
+// Everything in the run directory that can refuse the command, before any file is written: on
+// resume, the directory, its checkpoint (whose text is returned) and the settings (the accepted
+// changes go to `changed`); otherwise an existing run, unless it is to be overwritten.
+std::string check_run_directory(const Config& config, const RunOptions& opt,
+                                std::vector<std::string>& changed) {
+  std::error_code ec;
+  if (opt.resume) {
+    if (!std::filesystem::is_directory(opt.out, ec))
+      throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
+    const std::filesystem::path ckpt = opt.out / "checkpoint.json";
+    if (!std::filesystem::exists(ckpt, ec))
+      throw CheckpointError(fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
+    changed = check_resume_settings(config, opt.out);
+    return read_file(ckpt);
+  }
+  if (!opt.overwrite) refuse_existing_run(config, opt.out);
+  return {};
+}
+
+// resume.log: the settings a resume changed (accepted by check_resume_settings), one line.
+void note_resume(const Config& config, const RunOptions& opt, const std::string& tag,
+                 int generation, const std::vector<std::string>& changed) {
+  if (changed.empty()) return;
+  const Config stored = load_config(opt.out / "config.toml");
+  std::string note = fmt::format("{} resumed at generation {}:", local_time_stamp(), generation);
+  for (const auto& key : changed) {
+    note += fmt::format(" {} {} -> {};", key, format_config_value(get_value(stored, key)),
+                        format_config_value(get_value(config, key)));
+    if (!opt.quiet)
+      spdlog::info("{}resume: {} changed from {} to {}", tag, key,
+                   format_config_value(get_value(stored, key)),
+                   format_config_value(get_value(config, key)));
+  }
+  note.back() = '\n';
+  append(opt.out / "resume.log", note);
+}
+
 RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
                                    FitnessFunction fitness, FitnessFunction reference) {
   validate(config);
@@ -524,19 +561,8 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
   if (writing) {
     check_run_path(opt.out);
     std::error_code ec;
-    auto check = [&]() -> std::string {  // the checkpoint's text when resuming
-      if (opt.resume) {
-        if (!std::filesystem::is_directory(opt.out, ec))
-          throw IoError(fmt::format("{}: resume directory does not exist", opt.out.string()));
-        if (!std::filesystem::exists(ckpt, ec))
-          throw CheckpointError(
-              fmt::format("{}: no checkpoint.json to resume from", opt.out.string()));
-        changed_on_resume = check_resume_settings(config, opt.out);
-        return read_file(ckpt);
-      }
-      if (!opt.overwrite) refuse_existing_run(config, opt.out);
-      return {};
-    };
+    // the checkpoint's text when resuming
+    auto check = [&] { return check_run_directory(config, opt, changed_on_resume); };
     probe_lock(opt.out);
     std::string checkpoint_text = check();
     if (opt.resume) {
@@ -577,21 +603,7 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
     if (ec)
       throw IoError(
           fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
-    if (!changed_on_resume.empty()) {
-      const Config stored = load_config(opt.out / "config.toml");
-      std::string note =
-          fmt::format("{} resumed at generation {}:", local_time_stamp(), evo.generation());
-      for (const auto& key : changed_on_resume) {
-        note += fmt::format(" {} {} -> {};", key, format_config_value(get_value(stored, key)),
-                            format_config_value(get_value(config, key)));
-        if (!opt.quiet)
-          spdlog::info("{}resume: {} changed from {} to {}", tag, key,
-                       format_config_value(get_value(stored, key)),
-                       format_config_value(get_value(config, key)));
-      }
-      note.back() = '\n';
-      append(opt.out / "resume.log", note);
-    }
+    note_resume(config, opt, tag, evo.generation(), changed_on_resume);
     write_atomically(opt.out / "config.toml", to_toml(config));
   }
 
@@ -747,17 +759,161 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
   return summary;
 }
 
+// ---------------------------------------------------------------------------------------------------
+// The other searches (search.hpp): the same run directory, lock, checks and checkpoints.
+
+std::string search_header(const std::vector<HistoryColumn>& columns) {
+  std::string out;
+  for (const auto& c : columns) out += (out.empty() ? "" : ",") + c.name;
+  return out + "\n";
+}
+
+std::string search_row(const std::vector<HistoryColumn>& columns, const std::vector<double>& row) {
+  std::string out;
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    if (c > 0) out += ',';
+    if (columns[c].integer)
+      out += fmt::format("{}", static_cast<std::int64_t>(row[c]));
+    else if (columns[c].name == "wall_seconds")  // as the GA's: the only machine-dependent column
+      out += fmt::format("{:.3f}", row[c]);
+    else
+      out += fmt::format("{}", row[c]);
+  }
+  return out + "\n";
+}
+
+SearchSummary run_search_unchecked(const Config& config, const RunOptions& opt,
+                                   FitnessFunction fitness, FitnessFunction reference) {
+  validate(config);
+  if (config.search.algorithm == "ga")
+    throw ConfigError(
+        "search.algorithm = \"ga\": run_search runs MAP-Elites and NSGA-II; the GA is "
+        "run_evolution");
+  const bool writing = !opt.out.empty();
+  std::vector<std::string> changed_on_resume;
+  if (opt.resume && !writing) throw Error("run_search: resume needs a run directory");
+  if (opt.resume && opt.overwrite)
+    throw Error("run_search: resume and overwrite contradict each other");
+  // Everything that can refuse the command, before any file is written: the run directory (a
+  // resume's settings first: a changed search.algorithm is named as such), then the search itself
+  // (a [search] setting or size it refuses), then the checkpoint; checked again under the lock.
+  auto check = [&] { return check_run_directory(config, opt, changed_on_resume); };
+  std::string checkpoint_text;
+  if (writing) {
+    check_run_path(opt.out);
+    probe_lock(opt.out);
+    checkpoint_text = check();
+  }
+  std::unique_ptr<Search> search =
+      make_search(config, std::move(fitness), std::move(reference), opt.evaluator);
+  search->set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
+  const std::string tag = opt.label.empty() ? std::string() : "[" + opt.label + "] ";
+  const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
+  const auto columns = search->history_columns();
+  SearchSummary summary;
+  summary.algorithm = config.search.algorithm;
+  summary.columns = columns;
+  auto finish = [&](std::string reason) {
+    summary.stop_reason = std::move(reason);
+    summary.history = search->history();
+    summary.generation = search->generation();
+    return summary;
+  };
+  std::optional<RunLock> lock;
+  if (writing) {
+    std::error_code ec;
+    if (opt.resume) {
+      search->restore(checkpoint_text, ckpt.string());
+      if (std::string reason = search->stop_reason(); !reason.empty()) {
+        if (!opt.quiet)
+          spdlog::info("{}{} is at generation {}: {}; nothing to search, no file was written", tag,
+                       opt.out.string(), search->generation(), reason);
+        return finish(std::move(reason));
+      }
+    } else {
+      std::filesystem::create_directories(opt.out, ec);
+      if (ec)
+        throw IoError(
+            fmt::format("{}: cannot create run directory: {}", opt.out.string(), ec.message()));
+    }
+    lock.emplace(opt.out);
+    if (const std::string again = check(); again != checkpoint_text)
+      search->restore(again, ckpt.string());
+    lock->started();
+    if (opt.on_start) opt.on_start();
+    if (opt.overwrite) clear_run_directory(opt.out);
+    remove_leftover_temporaries(opt.out);
+    note_resume(config, opt, tag, search->generation(), changed_on_resume);
+    write_atomically(opt.out / "config.toml", to_toml(config));
+    if (opt.resume) {
+      std::string rows = search_header(columns);
+      for (const auto& row : search->history()) rows += search_row(columns, row);
+      write_atomically(hist, rows);  // drops rows written after the checkpoint
+    }
+  }
+  if (!opt.quiet)
+    spdlog::info("{}{} {} at generation {}", tag, opt.resume ? "resumed" : "started",
+                 config.search.algorithm, search->generation());
+  int since_checkpoint = 0;
+  bool dirty = false;
+  std::string reason;
+  while (true) {
+    reason = search->stop_reason();
+    if (reason.empty() &&
+        ((opt.stop_flag && opt.stop_flag->load()) || (opt.stop_poll && opt.stop_poll())))
+      reason = "interrupted";
+    if (!reason.empty()) break;
+    try {
+      search->step();
+    } catch (const Interrupted&) {
+      reason = "interrupted";  // the generation in progress is dropped; resuming recomputes it
+      break;
+    }
+    const auto history = search->history();
+    if (writing) {
+      if (history.size() == 1)
+        write_atomically(hist, search_header(columns) + search_row(columns, history.back()));
+      else
+        append(hist, search_row(columns, history.back()));
+      dirty = true;
+      if (++since_checkpoint >= config.evolution.checkpoint_every || history.size() == 1) {
+        write_atomically(ckpt, search->checkpoint());
+        since_checkpoint = 0;
+        dirty = false;
+      }
+    }
+    if (!opt.quiet) {
+      std::string line;
+      for (std::size_t c = 1; c < columns.size(); ++c)
+        line += fmt::format(" {} {:.6g}", columns[c].name, history.back()[c]);
+      spdlog::info("{}gen {:5d} |{}", tag, search->generation(), line);
+    }
+  }
+  if (writing && dirty) write_atomically(ckpt, search->checkpoint());
+  if (!opt.quiet) spdlog::info("{}stopped at generation {}: {}", tag, search->generation(), reason);
+  return finish(std::move(reason));
+}
+
 }  // namespace
 
 const std::vector<std::string>& run_file_names() { return kRunFiles; }
 
 void require_ga(const Config& config) {
   if (config.search.algorithm != "ga")
-    throw ConfigError(fmt::format(
-        "search.algorithm = \"{}\": this runs the GA; MAP-Elites and NSGA-II run in Python: "
-        "`animat evolve` with the same flags (python -m animat evolve), or animat.run_{} "
-        "(docs/search.md)",
-        config.search.algorithm, config.search.algorithm));
+    throw ConfigError(
+        fmt::format("search.algorithm = \"{}\": this runs the GA; MAP-Elites and NSGA-II run by "
+                    "animat_evolve (run_search) or in Python: `animat evolve` with the same flags "
+                    "(python -m animat evolve), or animat.run_{} (docs/search.md)",
+                    config.search.algorithm, config.search.algorithm));
+}
+
+SearchSummary run_search(const Config& config, const RunOptions& opt, FitnessFunction fitness,
+                         FitnessFunction reference) {
+  try {
+    return run_search_unchecked(config, opt, std::move(fitness), std::move(reference));
+  } catch (const std::filesystem::filesystem_error& e) {
+    throw IoError(fmt::format("{}: {}", e.path1().string(), e.code().message()));
+  }
 }
 
 RunSummary run_evolution(const Config& config, const RunOptions& opt, FitnessFunction fitness,

@@ -54,6 +54,13 @@ struct Fitness {
   /// Coarse class of the body plan (morphology_kind() in body.hpp; 0 if not viable or unknown):
   /// what the morphological innovation protection (evolution.protection_generations) compares.
   int morphology_kind = 0;
+  // Measures of the swim (EvaluationResult's fields of the same names; 0 if not viable): what
+  // MAP-Elites' descriptors and NSGA-II's criteria read (search.hpp, measures()), so that no
+  // genome is developed or swum again to describe it.
+  double actuation_work = 0.0;
+  double actuation_work_positive = 0.0;
+  double actuation_work_absolute = 0.0;
+  double max_speed = 0.0;
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
@@ -81,7 +88,24 @@ void visit_fields(F& f, V&& v)
     "given); evolution.protection_generations protects an offspring whose class differs from its "
     "parents'.",
     f.morphology_kind);
+  v("actuation_work", "Net mechanical work of actuation on the springs (0 if not viable).",
+    f.actuation_work);
+  v("actuation_work_positive",
+    "Positive actuation work, per spring and Box2D step: what the actuators spend (0 if not "
+    "viable).",
+    f.actuation_work_positive);
+  v("actuation_work_absolute",
+    "Absolute actuation work, per spring and Box2D step (0 if not viable).",
+    f.actuation_work_absolute);
+  v("max_speed", "Largest cell speed seen in the swim (0 if not viable).", f.max_speed);
 }
+
+struct EvaluationResult;  // evaluate.hpp
+
+/// What the searches know of an evaluation: its Fitness fields copied from the EvaluationResult
+/// (the fitness, the verdicts, the cell count, the morphology kind and the swim's measures). The
+/// one conversion: swim_fitness's and every other evaluator's.
+[[nodiscard]] Fitness fitness_of(const EvaluationResult& result);
 
 /// Deterministic, thread-safe fitness of a genome. The real one develops and swims (swim_fitness);
 /// tests plug in cheap stubs.

@@ -11,6 +11,7 @@
 
 #include "animat/errors.hpp"
 #include "animat/evolution.hpp"
+#include "animat/search.hpp"
 
 namespace animat {
 
@@ -76,8 +77,28 @@ RunSummary run_evolution(const Config& config, const RunOptions& options,
                          FitnessFunction fitness = {}, FitnessFunction reference = {});
 
 /// Throws ConfigError unless config.search.algorithm is "ga": run_evolution runs the GA, and a run
-/// directory's config.toml must say which search made it (MAP-Elites and NSGA-II are animat.qd and
-/// animat.moo, run by `animat evolve`).
+/// directory's config.toml must say which search made it (MAP-Elites and NSGA-II: run_search).
 void require_ga(const Config& config);
+
+/// What a run of run_search did.
+struct SearchSummary {
+  std::string algorithm;
+  std::vector<HistoryColumn> columns;
+  std::vector<std::vector<double>> history;  ///< one row per generation, in `columns` order
+  std::string stop_reason;
+  int generation = -1;
+};
+
+/// Runs (or resumes) the search of config.search.algorithm ("map_elites" or "nsga2"; search.hpp)
+/// in options.out with run_evolution's guarantees: everything that can refuse the command is
+/// checked before any file is written (the [search] settings and every size, the run directory,
+/// on resume the checkpoint and the settings, [search] included, which may differ from the run's
+/// config.toml only in resumable_keys()), the directory is locked for the run's life, and the
+/// checkpoint is checksummed and checked on load. Writes config.toml, history.csv (the search's
+/// history columns) and checkpoint.json (every evolution.checkpoint_every generations and at the
+/// end). RunOptions::callback is not called; on_start is. `fitness` and `reference` as for
+/// run_evolution.
+SearchSummary run_search(const Config& config, const RunOptions& options,
+                         FitnessFunction fitness = {}, FitnessFunction reference = {});
 
 }  // namespace animat

@@ -1,8 +1,9 @@
 #pragma once
 // [search] section of the config: which search algorithm a run from this config uses, and the
-// settings of the two that are not the paper's GA. Data only: the GA is evolution.hpp (C++);
-// MAP-Elites and NSGA-II are animat.qd and animat.moo (Python), which own the tables of descriptor
-// and objective names these strings are checked against (docs/search.md).
+// settings of the two that are not the paper's GA. Data only: the searches are search.hpp (C++:
+// animat_evolve, whose descriptors and criteria are the measures of search.hpp's table) and
+// animat.qd and animat.moo (Python, with their own larger tables of descriptor and objective names;
+// docs/search.md). The names are checked where a search is made.
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,17 +15,19 @@ namespace animat {
 inline constexpr std::string_view kSearchAlgorithmNames[] = {"ga", "map_elites", "nsga2"};
 
 struct SearchParams {
-  /// "ga": the paper's GA (the evolution section, animat_evolve); "map_elites", "nsga2": run by
-  /// `animat evolve` / animat.run_map_elites / animat.run_nsga2 [not in the paper: "ga"]
+  /// "ga": the paper's GA (the evolution section); "map_elites", "nsga2": run by animat_evolve
+  /// (search.hpp), `animat evolve`, animat.run_map_elites and animat.run_nsga2 [not in the paper:
+  /// "ga"]
   std::string algorithm = "ga";
-  /// map_elites: the grid archive's descriptors, names of animat.qd.DESCRIPTORS
+  /// map_elites: the grid archive's descriptors: names of search.hpp's measures() with a range
+  /// (animat_evolve) or of animat.qd.DESCRIPTORS (`animat evolve`)
   std::vector<std::string> descriptors = {"elongation", "protrusions"};
   /// map_elites: bins of each descriptor: one count for all, or one per descriptor
   std::vector<double> bins = {10.0};
   /// map_elites: offspring per generation; 0 = evolution.population
   int batch = 0;
-  /// nsga2: the objectives, "NAME" (the table's sense) or "NAME:max" / "NAME:min", names of
-  /// animat.moo.CRITERIA
+  /// nsga2: the objectives, "NAME" (the table's sense) or "NAME:max" / "NAME:min": names of
+  /// search.hpp's measures() (animat_evolve) or of animat.moo.CRITERIA (`animat evolve`)
   std::vector<std::string> objectives = {"distance:max", "actuation_work_positive:min"};
 };
 
@@ -33,13 +36,14 @@ void visit_fields(SearchParams& p, V&& v) {
   v(FieldInfo{"algorithm",
               "the search a run from this config uses: \"ga\" (the paper's GA: the evolution "
               "section's settings), "
-              "\"map_elites\" or \"nsga2\" (run by `animat evolve`, not animat_evolve; "
+              "\"map_elites\" or \"nsga2\" (run by animat_evolve and `animat evolve`; "
               "docs/search.md) [not in the paper: ga]",
               Bounds::any(), kSearchAlgorithmNames, Identity::late},
     p.algorithm);
   v(FieldInfo{"descriptors",
-              "map_elites: the grid archive's descriptors (names of animat.qd.DESCRIPTORS: "
-              "cells, elongation, protrusions, frequency, locomotion, ...)",
+              "map_elites: the grid archive's descriptors (animat_evolve: cells, fitness; "
+              "`animat evolve`: names of animat.qd.DESCRIPTORS: cells, elongation, protrusions, "
+              "frequency, locomotion, ...)",
               Bounds::any(),
               {},
               Identity::late},
@@ -59,7 +63,9 @@ void visit_fields(SearchParams& p, V&& v) {
     p.batch);
   v(FieldInfo{"objectives",
               "nsga2: the objectives, \"NAME\" (the table's sense) or \"NAME:max\" / \"NAME:min\" "
-              "(names of animat.moo.CRITERIA)",
+              "(animat_evolve: fitness or the evaluation.objective's name, cells, actuation_work, "
+              "actuation_work_positive, actuation_work_absolute, max_speed; `animat evolve`: names "
+              "of animat.moo.CRITERIA)",
               Bounds::any(),
               {},
               Identity::late},

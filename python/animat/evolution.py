@@ -207,7 +207,9 @@ def record_evaluation(genome: Any, config: Any = None, every: int = 20) -> Any:
 
 def to_fitness(value: Any) -> Any:
     """A :class:`animat.Fitness` from what an evaluator returns: a Fitness; an EvaluationResult
-    (its fitness, viable, stable, cell_count, valid, drag_limited, morphology_kind); ``None`` (not viable); or a
+    (its fitness, viable, stable, cell_count, valid, drag_limited, morphology_kind and the swim's
+    measures: actuation_work, actuation_work_positive, actuation_work_absolute, max_speed, as
+    animat_evolve's evaluations give them); ``None`` (not viable); or a
     number (a viable genome's fitness; it must be finite; its morphology kind is unknown, 0, so that
     ``evolution.protection_generations`` protects nothing)."""
     if isinstance(value, _core.Fitness):
@@ -221,6 +223,10 @@ def to_fitness(value: Any) -> Any:
             value.valid,
             value.drag_limited,
             value.morphology_kind,
+            value.actuation_work,
+            value.actuation_work_positive,
+            value.actuation_work_absolute,
+            value.max_speed,
         )
     if value is None:
         return _core.Fitness(0.0, False, True, 0)

@@ -24,6 +24,7 @@
 #include "animat/mpi.hpp"
 #include "animat/objective_table.hpp"
 #include "animat/run.hpp"
+#include "animat/search.hpp"
 
 namespace {
 
@@ -40,15 +41,16 @@ extern "C" void on_signal(int) { g_stop.store(true); }
   std::string text = fmt::format("animat_evolve: error: MPI job stopped: {}\n", e.what());
   const auto ckpt = out / "checkpoint.json";
   try {
-    animat::Evolution probe(config, [](const animat::Genome&) { return animat::Fitness{}; });
+    const auto probe =
+        animat::make_search(config, [](const animat::Genome&) { return animat::Fitness{}; });
     std::ifstream in(ckpt, std::ios::binary);
-    probe.restore(
+    probe->restore(
         std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()),
         ckpt.string());
     text += fmt::format(
         "animat_evolve: {} is intact (generation {}; the generation being evaluated is lost).\n"
         "Continue with any number of ranks:  mpirun -np RANKS animat_evolve --resume {}\n",
-        ckpt.string(), probe.generation(), out.string());
+        ckpt.string(), probe->generation(), out.string());
   } catch (const std::exception& c) {
     text += fmt::format("animat_evolve: no checkpoint to resume from ({})\n", c.what());
   }
@@ -201,7 +203,6 @@ int animat_evolve_main(int argc, char** argv) {
       std::cout << animat::to_toml(config);
       return 0;
     }
-    animat::require_ga(config);
 
     animat::RunOptions options;
     options.resume = !resume_dir.empty();
@@ -253,6 +254,27 @@ int animat_evolve_main(int argc, char** argv) {
         std::filesystem::remove(stopped);
       }
     };
+    if (config.search.algorithm != "ga") {  // MAP-Elites, NSGA-II (search.hpp)
+      animat::SearchSummary found;
+      try {
+        found = animat::run_search(config, options);
+      } catch (const animat::mpi::JobStopped& e) {
+        mpi_stopped(e, options.out, config);
+      } catch (const animat::mpi::RankFailure& e) {
+        mpi_stopped(e, options.out, config);
+      }
+      std::printf("\nStopped at generation %d: %s\n", found.generation, found.stop_reason.c_str());
+      if (!found.history.empty()) {
+        std::printf("Last generation:");
+        for (std::size_t c = 0; c < found.columns.size(); ++c)
+          std::printf(" %s %g", found.columns[c].name.c_str(), found.history.back()[c]);
+        std::printf("\n");
+      }
+      std::printf("Results in %s: config.toml, history.csv, checkpoint.json\n",
+                  options.out.c_str());
+      std::printf("Resume:     animat_evolve --resume %s --generations N\n", options.out.c_str());
+      return found.stop_reason == "interrupted" ? 130 : 0;
+    }
     animat::RunSummary summary;
     try {
       summary = animat::run_evolution(config, options);

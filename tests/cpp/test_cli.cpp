@@ -5,16 +5,20 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
+#include "search_support.hpp"
 
 using namespace animat;
+using animat::test::csv_without_wall;
 namespace fs = std::filesystem;
 
 namespace {
@@ -236,17 +240,49 @@ TEST(Cli, PackagedConfigsWithADotInTheirNameResolveByName) {
   EXPECT_CONTAINS(r.err, "paper_dn0.2_64cells, paper_dn0.5, paper_dn10");
 }
 
-TEST(CliErrors, AnotherSearchAlgorithmIsRefusedBeforeAnyFileIsWritten) {
-  // MAP-Elites and NSGA-II run in Python (`animat evolve`): the GA must not fill a run directory
-  // whose config.toml says otherwise.
+TEST(CliErrors, SearchSettingsAnimatEvolveCannotRunAreRefusedBeforeAnyFileIsWritten) {
+  // The default descriptors (elongation, protrusions) are computed by animat.qd (Python); a grid
+  // too large for memory is refused by its size; the GA must not fill a run directory whose
+  // config.toml says otherwise.
   const fs::path out = scratch_dir() / "map_elites_run";
-  for (const char* algorithm : {"map_elites", "nsga2"}) {
-    const Result r = run(std::string("--set search.algorithm=") + algorithm +
-                         " --generations 1 --out map_elites_run");
+  for (const auto& [flags, message] : std::initializer_list<std::pair<std::string, std::string>>{
+           {"--set search.algorithm=map_elites", "search.descriptors: no measure \"elongation\""},
+           {"--set search.algorithm=map_elites --set 'search.descriptors=[\"cells\",\"fitness\"]' "
+            "--set 'search.bins=[100000]'",
+            "search.bins = [100000, 100000]"},
+           {"--set search.algorithm=nsga2 --set 'search.objectives=[\"distance\",\"smoothness\"]'",
+            "search.objectives: no measure \"smoothness\""}}) {
+    const Result r = run(flags + " --generations 1 --out map_elites_run");
     EXPECT_EQ(r.exit_code, 2) << r.err;
-    EXPECT_CONTAINS(r.err, std::string("search.algorithm = \"") + algorithm + "\"");
-    EXPECT_CONTAINS(r.err, "animat evolve");
+    EXPECT_CONTAINS(r.err, message);
     EXPECT_FALSE(fs::exists(out)) << "a refused command wrote " << out;
+  }
+}
+
+TEST(Cli, MapElitesAndNsga2RunIdenticallyOnAnyThreadCountAndAcrossAResume) {
+  const std::string small =
+      "--set evolution.population=6 --set search.batch=6 --set evaluation.steps=40 --seed 3 "
+      "--set 'search.descriptors=[\"cells\",\"fitness\"]' --set 'search.bins=[8,5]' ";
+  for (const char* algorithm : {"map_elites", "nsga2"}) {
+    SCOPED_TRACE(algorithm);
+    const std::string flags = small + "--set search.algorithm=" + algorithm + " ";
+    const fs::path one = scratch_dir() / "search_one", two = scratch_dir() / "search_two";
+    const fs::path resumed = scratch_dir() / "search_resumed";
+    Result r = run(flags + "--generations 3 --threads 1 --out '" + one.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_CONTAINS(r.out, "Stopped at generation 3: generation cap");
+    r = run(flags + "--generations 3 --threads 2 --out '" + two.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run(flags + "--generations 1 --threads 2 --out '" + resumed.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run("--resume '" + resumed.string() + "' --generations 3 --threads 1");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string history = csv_without_wall(slurp(one / "history.csv"));
+    EXPECT_EQ(std::count(history.begin(), history.end(), '\n'), 5);  // the header, generations 0-3
+    EXPECT_EQ(csv_without_wall(slurp(two / "history.csv")), history);
+    EXPECT_EQ(csv_without_wall(slurp(resumed / "history.csv")), history);
+    EXPECT_CONTAINS(slurp(resumed / "resume.log"), "evolution.generations 1 -> 3");
+    for (const auto& d : {one, two, resumed}) fs::remove_all(d);
   }
 }
 

@@ -1,0 +1,338 @@
+#pragma once
+// One search interface (ask / tell / checkpoint) and its algorithms: the paper's GA (evolution.hpp,
+// adapted unchanged), MAP-Elites over a grid archive and NSGA-II, chosen by search.algorithm.
+//
+// Design:
+// - Search: ask() gives the genomes to evaluate next, tell() takes their Fitness (evolution.hpp) in
+//   order. tell() is atomic: it checks every value and evaluates the exploit guard's references
+//   before it changes anything, so a refused or interrupted tell leaves the search as it was, its
+//   ask still pending. step() is ask, evaluate, tell.
+// - Every search evaluates through an Evaluator (evaluator.hpp: OpenMP threads or MPI ranks), and
+//   every random number of generation g, offspring i derives from Rng::derive(seed, g, i): a run is
+//   bit-identical for any thread or rank count and across checkpoint and resume.
+// - Measures: what MAP-Elites' descriptors and NSGA-II's criteria read of an evaluation comes from
+//   one table, measures(), of Fitness fields that the evaluation's own swim filled
+//   (objective_fitness): no genome is developed or swum again to describe it.
+// - Breeding: offspring() is the one variation step of MAP-Elites and NSGA-II (a parent, with
+//   probability crossover_fraction a second one and crossover, then mutation), drawn as animat.qd
+//   and animat.moo draw it. The GA keeps its own order of draws (tournaments first), which the
+//   determinism gate pins.
+// - Checkpoints: JSON text whose payload carries an FNV-1a checksum and the run identity; restore()
+//   checks the checksum, format, version and identity, every field's type and range, and that the
+//   content is what the engine would have computed (a hand edit with a valid checksum is refused).
+// - Sizes: every count that sizes memory (archive cells, batch, population) is bounded, and a
+//   bad one is a ConfigError naming the key and value, raised when the search is made, before a
+//   run writes any file.
+// - The exploit guard (evaluation.reference_check): "record" evaluates each new elite (MAP-Elites)
+//   or front member (NSGA-II) again at the reference step; "select" is refused by both for now.
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "animat/evolution.hpp"
+#include "animat/genome.hpp"
+#include "animat/random.hpp"
+
+namespace animat {
+
+struct Config;
+class Evaluator;
+
+// ---------------------------------------------------------------------------------------------------
+// Measures
+
+/// A number read from one evaluation's Fitness: a descriptor of MAP-Elites or a criterion of
+/// NSGA-II.
+struct Measure {
+  const char* name;
+  const char* meaning;
+  /// The range of a descriptor (a grid over [lo, hi)); lo == hi: a criterion only.
+  double lo, hi;
+  bool maximize;  ///< the criterion's default sense
+  double (*of)(const Fitness&);
+};
+
+/// The measures, in table order. "fitness" is the config's evaluation.objective, which may also be
+/// named by its own name (e.g. "distance" when evaluation.objective = "distance").
+[[nodiscard]] std::span<const Measure> measures();
+/// The measure `name` under `config`; ConfigError naming `key` (e.g. "search.descriptors") and the
+/// name when there is none, listing the names there are.
+[[nodiscard]] const Measure& find_measure(std::string_view name, const Config& config,
+                                          std::string_view key);
+
+/// The exactly rounded sum of `values` (Python's math.fsum): the QD-score and the hypervolume do
+/// not depend on the order of their terms.
+[[nodiscard]] double exact_sum(std::span<const double> values);
+
+// ---------------------------------------------------------------------------------------------------
+// NSGA-II's pieces, on plain values (every objective minimised: negate the maximised ones)
+
+/// Whether a is no worse than b in every objective and better in one.
+[[nodiscard]] bool dominates(std::span<const double> a, std::span<const double> b);
+/// The fronts of `points` (rows of equal length), best first, each listing row indices in
+/// increasing order (Deb et al.'s fast non-dominated sort; equal points share a front).
+[[nodiscard]] std::vector<std::vector<std::size_t>> non_dominated_sort(
+    const std::vector<std::vector<double>>& points);
+/// Deb et al.'s crowding distance of the points of one front: per objective, a stable sort by
+/// value; both ends get infinity and every other point adds (next - previous) / (max - min)
+/// (nothing when max = min). One or two points: all infinity.
+[[nodiscard]] std::vector<double> crowding_distance(const std::vector<std::vector<double>>& points);
+/// The hypervolume that `points` dominate, bounded by `reference` (one or two objectives; points
+/// not better than the reference in every objective add nothing). Error for three or more.
+[[nodiscard]] double hypervolume(const std::vector<std::vector<double>>& points,
+                                 std::span<const double> reference);
+
+// ---------------------------------------------------------------------------------------------------
+// The interface
+
+/// One column of a search's history (history.csv): integers are written without a fraction.
+struct HistoryColumn {
+  std::string name;
+  bool integer = false;
+};
+
+/// What every search algorithm is (see the design above).
+class Search {
+ public:
+  virtual ~Search() = default;
+  /// "ga", "map_elites" or "nsga2" (search.algorithm).
+  [[nodiscard]] virtual std::string_view algorithm() const = 0;
+  /// The genomes that need a fitness next, in order; again before tell(): the same genomes.
+  virtual std::vector<Genome> ask() = 0;
+  /// The fitness of every genome of the last ask(), in order; true when a generation completed
+  /// (history() has its row). Atomic: throws Error, and changes nothing, for a count mismatch or a
+  /// value the search refuses (naming the value's index and what is wrong).
+  virtual bool tell(const std::vector<Fitness>& fitness) = 0;
+  /// ask(), evaluate with the search's evaluator (honouring the stop request: Interrupted), tell(),
+  /// until a generation completes.
+  void step();
+  /// -1 before the first generation is complete.
+  [[nodiscard]] virtual int generation() const = 0;
+  [[nodiscard]] virtual std::int64_t evaluations() const = 0;
+  /// Why the run should stop now ("" = keep going): the generation cap, the wall-clock budget (and
+  /// the GA's stall).
+  [[nodiscard]] virtual std::string stop_reason() const = 0;
+  [[nodiscard]] virtual std::vector<HistoryColumn> history_columns() const = 0;
+  /// One row per generation, in history_columns() order.
+  [[nodiscard]] virtual std::vector<std::vector<double>> history() const = 0;
+  /// The whole state (no pending ask) as checksummed JSON text; restore() refuses a corrupt,
+  /// foreign or inconsistent one (CheckpointError naming `source`).
+  [[nodiscard]] virtual std::string checkpoint() const = 0;
+  virtual void restore(std::string_view text, std::string_view source) = 0;
+  /// Checked between evaluations by step().
+  void set_stop(StopRequest stop) { stop_ = std::move(stop); }
+
+ protected:
+  StopRequest stop_;
+  std::shared_ptr<Evaluator> evaluator_;
+};
+
+/// The search of config.search.algorithm: `fitness` (default swim_fitness(config)) evaluates on
+/// `evaluator` (default: this process's OpenMP threads); `reference` is the exploit guard's
+/// (default swim_fitness(reference_config(config)) unless evaluation.reference_check is "off").
+/// Throws ConfigError for [search] settings that cannot run (naming the key and value).
+[[nodiscard]] std::unique_ptr<Search> make_search(const Config& config,
+                                                  FitnessFunction fitness = {},
+                                                  FitnessFunction reference = {},
+                                                  std::shared_ptr<Evaluator> evaluator = nullptr);
+
+/// The GA (Evolution) behind the Search interface: the same engine, the same results.
+class GaSearch final : public Search {
+ public:
+  GaSearch(const Config& config, FitnessFunction fitness, FitnessFunction reference,
+           std::shared_ptr<Evaluator> evaluator);
+  [[nodiscard]] std::string_view algorithm() const override { return "ga"; }
+  std::vector<Genome> ask() override;
+  bool tell(const std::vector<Fitness>& fitness) override;
+  [[nodiscard]] int generation() const override { return evo_.generation(); }
+  [[nodiscard]] std::int64_t evaluations() const override { return evo_.evaluations(); }
+  [[nodiscard]] std::string stop_reason() const override { return evo_.stop_reason(); }
+  [[nodiscard]] std::vector<HistoryColumn> history_columns() const override;
+  [[nodiscard]] std::vector<std::vector<double>> history() const override;
+  [[nodiscard]] std::string checkpoint() const override { return evo_.checkpoint(); }
+  void restore(std::string_view text, std::string_view source) override {
+    evo_.restore(text, source);
+  }
+  [[nodiscard]] const Evolution& evolution() const { return evo_; }
+
+ private:
+  Evolution evo_;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// MAP-Elites
+
+/// An archive holds at most this many cells (search.bins' product).
+inline constexpr std::int64_t kMaxArchiveCells = 1000000;
+
+/// One elite of an archive.
+struct Elite {
+  Genome genome;
+  Fitness result;
+  std::vector<double> descriptors;
+  /// What the archive compares: the fitness.
+  double objective = 0.0;
+  /// Fitness at the exploit guard's reference step; NaN = not evaluated.
+  double reference = std::numeric_limits<double>::quiet_NaN();
+  int generation = 0;  ///< the generation that made it
+};
+
+/// A regular grid over the descriptors: descriptor j is divided into bins[j] equal bins over [lo,
+/// hi) (edges lo + k (hi - lo) / bins, the last one hi); a value below lo goes to the first bin,
+/// one at or above hi to the last. The cell index is the row-major index of the bins (animat.qd's
+/// GridArchive, pyribs's order).
+class GridArchive {
+ public:
+  /// ConfigError naming search.bins for a count < 1 or a grid of more than kMaxArchiveCells cells.
+  GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins);
+  [[nodiscard]] std::size_t cells() const { return cells_; }
+  [[nodiscard]] std::size_t dims() const { return descriptors_.size(); }
+  [[nodiscard]] const std::vector<const Measure*>& descriptors() const { return descriptors_; }
+  [[nodiscard]] const std::vector<int>& bins() const { return bins_; }
+  /// The cell of finite descriptor values.
+  [[nodiscard]] std::size_t index_of(std::span<const double> values) const;
+  /// Offers a candidate: enters when its cell is empty or its objective is strictly greater than
+  /// the elite's. Returns whether it entered.
+  bool add(Elite elite);
+  [[nodiscard]] const std::map<std::size_t, Elite>& elites() const { return elites_; }
+  std::map<std::size_t, Elite>& elites() { return elites_; }
+  /// Σ objective over the elites (exact_sum).
+  [[nodiscard]] double qd_score() const;
+  [[nodiscard]] double coverage() const;
+  /// The elite of the greatest objective (the lowest cell among equals); null when empty.
+  [[nodiscard]] const Elite* best() const;
+
+ private:
+  std::vector<const Measure*> descriptors_;
+  std::vector<int> bins_;
+  std::size_t cells_ = 1;
+  std::map<std::size_t, Elite> elites_;
+};
+
+/// MAP-Elites (Mouret & Clune 2015) over a GridArchive of search.descriptors with search.bins, as
+/// animat.qd.MapElites: generation 0 (and any generation while the archive is empty) asks
+/// search.batch random viable genomes (genome i: the first viable draw of
+/// Rng::derive(seed, g, i)); later ones search.batch offspring() of elites picked uniformly in cell
+/// order. A candidate enters when it is viable, stable and valid and beats its cell's elite.
+class MapElites final : public Search {
+ public:
+  MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
+            std::shared_ptr<Evaluator> evaluator);
+  [[nodiscard]] std::string_view algorithm() const override { return "map_elites"; }
+  std::vector<Genome> ask() override;
+  bool tell(const std::vector<Fitness>& fitness) override;
+  [[nodiscard]] int generation() const override { return generation_; }
+  [[nodiscard]] std::int64_t evaluations() const override { return evaluations_; }
+  [[nodiscard]] std::string stop_reason() const override;
+  [[nodiscard]] std::vector<HistoryColumn> history_columns() const override;
+  [[nodiscard]] std::vector<std::vector<double>> history() const override { return history_; }
+  [[nodiscard]] std::string checkpoint() const override;
+  void restore(std::string_view text, std::string_view source) override;
+  [[nodiscard]] const GridArchive& archive() const { return archive_; }
+  [[nodiscard]] int batch() const { return batch_; }
+
+ private:
+  [[nodiscard]] std::vector<double> row(int added, int discarded) const;
+  [[nodiscard]] int disagreements(const GridArchive& archive) const;
+
+  std::shared_ptr<const Config> config_;
+  std::uint64_t identity_;
+  FitnessFunction reference_;
+  GridArchive archive_;
+  int batch_;
+  int generation_ = -1;
+  std::int64_t evaluations_ = 0, reference_evaluations_ = 0;
+  double wall_offset_ = 0.0, started_ = 0.0;
+  std::vector<std::vector<double>> history_;
+  std::optional<std::vector<Genome>> asked_;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// NSGA-II
+
+/// One member of NSGA-II's population.
+struct Solution {
+  Genome genome;
+  Fitness result;
+  /// One value per criterion (NaN when infeasible), in the criteria's own units and senses.
+  std::vector<double> objectives;
+  /// The criteria at the exploit guard's reference step (NaN where that swim was not valid); empty
+  /// when not evaluated there.
+  std::vector<double> reference;
+  int generation = 0;
+  bool feasible = false;  ///< viable, stable and valid
+  int rank = 0;           ///< its front in the selection (infeasible or a copy: past the last)
+  double crowding = 0.0;  ///< its crowding distance there (0 when infeasible or a copy)
+};
+
+/// NSGA-II (Deb et al. 2002) over the criteria of search.objectives ("NAME", "NAME:max",
+/// "NAME:min"), as animat.moo.Nsga2: generation 0 asks evolution.population random viable genomes;
+/// later ones as many offspring() of parents chosen by binary tournament (lower rank, then larger
+/// crowding distance, then the first drawn); the next population is Deb's (mu + lambda) selection
+/// of parents and candidates, copies and infeasible candidates last.
+class Nsga2 final : public Search {
+ public:
+  Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction reference,
+        std::shared_ptr<Evaluator> evaluator);
+  [[nodiscard]] std::string_view algorithm() const override { return "nsga2"; }
+  std::vector<Genome> ask() override;
+  bool tell(const std::vector<Fitness>& fitness) override;
+  [[nodiscard]] int generation() const override { return generation_; }
+  [[nodiscard]] std::int64_t evaluations() const override { return evaluations_; }
+  [[nodiscard]] std::string stop_reason() const override;
+  [[nodiscard]] std::vector<HistoryColumn> history_columns() const override;
+  [[nodiscard]] std::vector<std::vector<double>> history() const override { return history_; }
+  [[nodiscard]] std::string checkpoint() const override;
+  void restore(std::string_view text, std::string_view source) override;
+  [[nodiscard]] const std::vector<Solution>& population() const { return population_; }
+  /// The feasible members of rank 0, ordered by the first criterion, best first (then the next
+  /// ..., then population order).
+  [[nodiscard]] std::vector<const Solution*> front() const;
+  /// The hypervolume's reference point: the worst value of every criterion over the feasible
+  /// candidates of the first generation that had any (empty until then).
+  [[nodiscard]] const std::vector<double>& reference_point() const { return reference_point_; }
+
+ private:
+  [[nodiscard]] std::vector<double> criteria_of(const Fitness& f) const;
+  [[nodiscard]] std::vector<double> minimised(const std::vector<double>& values) const;
+  [[nodiscard]] std::vector<Solution> select(std::vector<Solution> pool,
+                                             const std::vector<bool>& copy) const;
+  [[nodiscard]] std::vector<double> row(const std::vector<Solution>& population,
+                                        const std::vector<double>& reference_point, int discarded,
+                                        int copies) const;
+
+  std::shared_ptr<const Config> config_;
+  std::uint64_t identity_;
+  FitnessFunction reference_;
+  std::vector<const Measure*> criteria_;
+  std::vector<std::string> names_;  ///< as search.objectives names them
+  std::vector<bool> maximize_;
+  int size_;
+  int generation_ = -1;
+  std::int64_t evaluations_ = 0, reference_evaluations_ = 0;
+  double wall_offset_ = 0.0, started_ = 0.0;
+  std::vector<double> reference_point_;  ///< empty until set
+  std::vector<Solution> population_;
+  std::vector<std::vector<double>> history_;
+  std::optional<std::vector<Genome>> asked_;
+};
+
+/// The variation step of MAP-Elites and NSGA-II for offspring i of generation g: rng =
+/// Rng::derive(seed, g, i); a parent pick(rng); with probability crossover_fraction (rng.uniform()
+/// < crossover_fraction) a second pick(rng) and crossover; then mutation, all from rng.
+[[nodiscard]] Genome offspring(const Config& config, std::uint64_t seed, int g, std::size_t i,
+                               double crossover_fraction,
+                               const std::function<const Genome&(Rng&)>& pick);
+
+/// The first viable genome drawn from `rng` (Genome.random_viable): developed only; Error after
+/// evolution.max_init_tries draws.
+[[nodiscard]] Genome random_viable_genome(const Config& config, Rng& rng);
+
+}  // namespace animat

@@ -1,0 +1,379 @@
+// MAP-Elites over a grid archive (search.hpp), as animat.qd.MapElites draws and archives.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
+#include "animat/objective_table.hpp"
+#include "animat/run_identity.hpp"
+#include "animat/search.hpp"
+#include "search_state.hpp"
+
+namespace animat {
+
+using namespace search_state;
+
+namespace {
+
+constexpr int kMapElitesVersion = 1;
+constexpr const char* kMapElitesFormat = "animat.map_elites";
+
+std::string bins_text(const std::vector<int>& bins) {
+  return fmt::format("[{}]", fmt::join(bins, ", "));
+}
+
+bool nonnegative_objective(const Config& c) {
+  const ObjectiveSpec* spec = find_objective(c.evaluation.objective);
+  return spec != nullptr && spec->nonnegative;
+}
+
+// A candidate may enter the archive: viable, stable and valid (the engine scores the others 0).
+bool archivable(const Fitness& f) { return f.viable && f.stable && f.valid; }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+GridArchive::GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins)
+    : descriptors_(std::move(descriptors)), bins_(std::move(bins)) {
+  if (bins_.size() != descriptors_.size())
+    throw ConfigError(fmt::format("search.bins = {}: one count per descriptor ({}) is needed",
+                                  bins_text(bins_), descriptors_.size()));
+  double product = 1.0;
+  for (int b : bins_) {
+    if (b < 1)
+      throw ConfigError(
+          fmt::format("search.bins = {}: every count must be >= 1", bins_text(bins_)));
+    product *= b;
+  }
+  // Checked in floating point first: the integer product of 4 x 100000 bins would wrap.
+  if (product > static_cast<double>(kMaxArchiveCells))
+    throw ConfigError(fmt::format(
+        "search.bins = {} over {} descriptors makes {:.6g} cells; an archive holds at most {} "
+        "(fewer bins, or fewer descriptors)",
+        bins_text(bins_), descriptors_.size(), product, kMaxArchiveCells));
+  cells_ = 1;
+  for (int b : bins_) cells_ *= static_cast<std::size_t>(b);
+}
+
+std::size_t GridArchive::index_of(std::span<const double> values) const {
+  std::size_t index = 0;
+  for (std::size_t j = 0; j < descriptors_.size(); ++j) {
+    const int n = bins_[j];
+    const double lo = descriptors_[j]->lo, hi = descriptors_[j]->hi, x = values[j];
+    // numpy.linspace(lo, hi, n + 1): edge k is k * step + lo, the last one hi exactly
+    const double step = (hi - lo) / n;
+    auto edge = [&](int k) { return k == n ? hi : k * step + lo; };
+    int b = 0;
+    if (x >= hi) {
+      b = n - 1;
+    } else if (x >= lo) {
+      b = std::clamp(static_cast<int>(std::floor((x - lo) / step)), 0, n - 1);
+      while (b + 1 < n && edge(b + 1) <= x) ++b;
+      while (b > 0 && edge(b) > x) --b;
+    }
+    index = index * static_cast<std::size_t>(n) + static_cast<std::size_t>(b);
+  }
+  return index;
+}
+
+bool GridArchive::add(Elite elite) {
+  const std::size_t cell = index_of(elite.descriptors);
+  auto it = elites_.find(cell);
+  if (it != elites_.end() && !(elite.objective > it->second.objective)) return false;
+  elites_[cell] = std::move(elite);
+  return true;
+}
+
+double GridArchive::qd_score() const {
+  std::vector<double> terms;
+  terms.reserve(elites_.size());
+  for (const auto& [cell, e] : elites_) terms.push_back(e.objective);
+  return exact_sum(terms);
+}
+
+double GridArchive::coverage() const {
+  return static_cast<double>(elites_.size()) / static_cast<double>(cells_);
+}
+
+const Elite* GridArchive::best() const {
+  const Elite* best = nullptr;
+  for (const auto& [cell, e] : elites_)
+    if (best == nullptr || e.objective > best->objective) best = &e;
+  return best;
+}
+
+// ---------------------------------------------------------------------------------------------------
+namespace {
+
+std::vector<const Measure*> descriptors_of(const Config& config) {
+  std::vector<const Measure*> out;
+  for (const std::string& name : config.search.descriptors) {
+    const Measure& m = find_measure(name, config, "search.descriptors");
+    if (!(m.lo < m.hi))
+      throw ConfigError(fmt::format(
+          "search.descriptors: \"{}\" has no range in animat_evolve (a criterion of NSGA-II "
+          "only); its descriptors are those with a range: fitness, cells",
+          name));
+    out.push_back(&m);
+  }
+  return out;
+}
+
+std::vector<int> bins_of(const Config& config) {
+  const auto& b = config.search.bins;
+  const std::size_t dims = config.search.descriptors.size();
+  std::vector<int> out;
+  for (std::size_t j = 0; j < dims; ++j)
+    out.push_back(static_cast<int>(b.size() == 1 ? b[0] : b.at(j)));
+  return out;
+}
+
+void refuse_select(const Config& config, std::string_view who) {
+  if (config.evaluation.reference_check == "select")
+    throw ConfigError(fmt::format(
+        "evaluation.reference_check = \"select\": {} in animat_evolve has the exploit guard "
+        "\"record\" and \"off\" only; \"select\" runs in Python (`animat evolve`)",
+        who));
+}
+
+}  // namespace
+
+MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
+                     std::shared_ptr<Evaluator> evaluator)
+    : config_(std::make_shared<const Config>(config)),
+      identity_(run_identity(config)),
+      archive_(descriptors_of(config), bins_of(config)),
+      batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
+      started_(now_seconds()) {
+  refuse_select(config, "MAP-Elites");
+  if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
+  evaluator_ = evaluator ? std::move(evaluator)
+                         : (fitness ? make_local_evaluator(config, std::move(fitness)) : nullptr);
+}
+
+std::vector<Genome> MapElites::ask() {
+  if (asked_) return *asked_;
+  const int g = generation_ + 1;
+  const auto seed = static_cast<std::uint64_t>(config_->evolution.seed);
+  const auto n = static_cast<std::size_t>(batch_);
+  std::vector<Genome> out(n);
+  if (archive_.elites().empty()) {
+    parallel_for(n, config_->evolution.threads, [&](std::size_t i) {
+      Rng rng = Rng::derive(seed, static_cast<std::uint64_t>(g), i);
+      out[i] = random_viable_genome(*config_, rng);
+    });
+  } else {
+    std::vector<const Genome*> parents;
+    for (const auto& [cell, e] : archive_.elites()) parents.push_back(&e.genome);
+    const auto top = static_cast<std::int64_t>(parents.size()) - 1;
+    const auto pick = [&](Rng& rng) -> const Genome& {
+      return *parents[static_cast<std::size_t>(rng.integer(0, top))];
+    };
+    for (std::size_t i = 0; i < n; ++i)
+      out[i] = offspring(*config_, seed, g, i, config_->evolution.crossover_fraction, pick);
+  }
+  asked_ = std::move(out);
+  return *asked_;
+}
+
+bool MapElites::tell(const std::vector<Fitness>& fitness) {
+  if (!asked_) throw Error("MapElites.tell: nothing was asked (call ask() first)");
+  const std::vector<Genome>& genomes = *asked_;
+  if (fitness.size() != genomes.size())
+    throw Error(
+        fmt::format("MapElites.tell: {} fitness values for the {} genomes of the last ask()",
+                    fitness.size(), genomes.size()));
+  const bool nonnegative = nonnegative_objective(*config_);
+  // 1. Check every value and find where each candidate would go; nothing changes yet.
+  std::vector<std::vector<double>> values(fitness.size());
+  for (std::size_t k = 0; k < fitness.size(); ++k) {
+    const Fitness& f = fitness[k];
+    if (!std::isfinite(f.fitness) || (nonnegative && f.fitness < 0.0))
+      refuse("MapElites", k,
+             fmt::format("fitness {} (a fitness must be finite{})", f.fitness,
+                         nonnegative ? fmt::format(" and >= 0 under evaluation.objective = \"{}\"",
+                                                   config_->evaluation.objective)
+                                     : std::string()));
+    if (f.cell_count < 0) refuse("MapElites", k, fmt::format("cell_count {}", f.cell_count));
+    if (!archivable(f)) continue;
+    for (const Measure* d : archive_.descriptors()) {
+      const double x = d->of(f);
+      if (!std::isfinite(x))
+        refuse("MapElites", k,
+               fmt::format("descriptor {} = {} (a descriptor must be finite)", d->name, x));
+      values[k].push_back(x);
+    }
+  }
+  const int g = generation_ + 1;
+  std::map<std::size_t, std::size_t> winner;  // cell -> the candidate that holds it at the end
+  int added = 0, candidates = 0;
+  for (std::size_t k = 0; k < fitness.size(); ++k) {
+    if (!archivable(fitness[k])) continue;
+    ++candidates;
+    const std::size_t cell = archive_.index_of(values[k]);
+    double current = -std::numeric_limits<double>::infinity();
+    bool held = false;
+    if (auto w = winner.find(cell); w != winner.end()) {
+      current = fitness[w->second].fitness;
+      held = true;
+    } else if (auto e = archive_.elites().find(cell); e != archive_.elites().end()) {
+      current = e->second.objective;
+      held = true;
+    }
+    if (held && !(fitness[k].fitness > current)) continue;
+    winner[cell] = k;
+    ++added;
+  }
+  // 2. The exploit guard: the reference of every elite that entered (may throw: still nothing
+  // changed).
+  std::vector<Fitness> refs;
+  if (reference_) {
+    std::vector<const Genome*> todo;
+    for (const auto& [cell, k] : winner) todo.push_back(&genomes[k]);
+    refs = evaluate_references(reference_, *config_, todo, "MapElites.tell");
+  }
+  // 3. Commit.
+  std::size_t r = 0;
+  for (const auto& [cell, k] : winner) {
+    Elite e{genomes[k],
+            fitness[k],
+            values[k],
+            fitness[k].fitness,
+            reference_ ? refs[r++].fitness : std::numeric_limits<double>::quiet_NaN(),
+            g};
+    archive_.elites()[cell] = std::move(e);
+  }
+  if (reference_) reference_evaluations_ += static_cast<std::int64_t>(winner.size());
+  evaluations_ += static_cast<std::int64_t>(fitness.size());
+  generation_ = g;
+  asked_.reset();
+  history_.push_back(row(added, static_cast<int>(fitness.size()) - candidates));
+  return true;
+}
+
+int MapElites::disagreements(const GridArchive& archive) const {
+  int n = 0;
+  for (const auto& [cell, e] : archive.elites())
+    if (!std::isnan(e.reference) &&
+        reference_disagrees(e.result.fitness, e.reference, config_->evaluation))
+      ++n;
+  return n;
+}
+
+std::vector<double> MapElites::row(int added, int discarded) const {
+  const Elite* best = archive_.best();
+  return {static_cast<double>(generation_),
+          static_cast<double>(evaluations_),
+          archive_.qd_score(),
+          archive_.coverage(),
+          best ? best->objective : std::numeric_limits<double>::quiet_NaN(),
+          static_cast<double>(archive_.elites().size()),
+          static_cast<double>(added),
+          static_cast<double>(discarded),
+          static_cast<double>(reference_evaluations_),
+          static_cast<double>(disagreements(archive_)),
+          wall_offset_ + now_seconds() - started_};
+}
+
+std::vector<HistoryColumn> MapElites::history_columns() const {
+  return {{"generation", true},    {"evaluations", true},  {"qd_score", false},
+          {"coverage", false},     {"best", false},        {"elites", true},
+          {"added", true},         {"discarded", true},    {"reference_evaluations", true},
+          {"disagreements", true}, {"wall_seconds", false}};
+}
+
+std::string MapElites::stop_reason() const {
+  return stop_rule(*config_, generation_, wall_offset_ + now_seconds() - started_);
+}
+
+std::string MapElites::checkpoint() const {
+  if (generation_ < 0) throw Error("MapElites.checkpoint: no generation completed yet");
+  json p;
+  p["format"] = kMapElitesFormat;
+  p["version"] = kMapElitesVersion;
+  p["identity"] = fmt::format("{:016x}", identity_);
+  p["generation"] = generation_;
+  p["evaluations"] = evaluations_;
+  p["reference_evaluations"] = reference_evaluations_;
+  p["wall_seconds"] = history_.back().back();
+  json elites = json::array();
+  for (const auto& [cell, e] : archive_.elites())
+    elites.push_back(json{{"cell", cell},
+                          {"genome", json::parse(to_json(e.genome))},
+                          {"result", fitness_to_json(e.result)},
+                          {"reference", nan_or(e.reference)},
+                          {"generation", e.generation}});
+  p["elites"] = std::move(elites);
+  p["history"] = history_to_json(history_, history_columns());
+  return seal(p);
+}
+
+void MapElites::restore(std::string_view text, std::string_view source) {
+  const json p = unseal(text, source, kMapElitesFormat, kMapElitesVersion, identity_);
+  auto fail = [&](const std::string& what) { inconsistent(source, what); };
+  reading_checkpoint(source, [&] {
+    const int generation = static_cast<int>(int_field(p, "generation", 0, 100000000));
+    const std::int64_t evaluations = int_field(p, "evaluations", 0, 1LL << 53);
+    const std::int64_t reference_evaluations = int_field(p, "reference_evaluations", 0, 1LL << 53);
+    const double wall = number_field(p, "wall_seconds");
+    GridArchive archive(archive_.descriptors(), archive_.bins());
+    if (!p.contains("elites") || !p["elites"].is_array()) fail("no list of elites");
+    if (p["elites"].size() > archive.cells())
+      fail(fmt::format("{} elites for {} cells", p["elites"].size(), archive.cells()));
+    const bool nonnegative = nonnegative_objective(*config_);
+    for (const json& je : p["elites"]) {
+      Elite e;
+      const auto cell = static_cast<std::size_t>(
+          int_field(je, "cell", 0, static_cast<long long>(archive.cells()) - 1));
+      if (!je.contains("genome")) fail(fmt::format("the elite of cell {} has no genome", cell));
+      e.genome = genome_from_json(je["genome"].dump(), config_->genome, source);
+      if (!je.contains("result")) fail(fmt::format("the elite of cell {} has no result", cell));
+      e.result = fitness_from_json(je["result"]);
+      if (!archivable(e.result))
+        fail(fmt::format("the elite of cell {} is not viable, stable and valid", cell));
+      if (nonnegative && e.result.fitness < 0.0)
+        fail(fmt::format("the elite of cell {} has fitness {} (a fitness is >= 0)", cell,
+                         e.result.fitness));
+      for (const Measure* d : archive.descriptors()) {
+        const double x = d->of(e.result);
+        if (!std::isfinite(x))
+          fail(fmt::format("the elite of cell {} has {} = {}", cell, d->name, x));
+        e.descriptors.push_back(x);
+      }
+      if (archive.index_of(e.descriptors) != cell)
+        fail(fmt::format("the elite of cell {} belongs to cell {} by its descriptors", cell,
+                         archive.index_of(e.descriptors)));
+      if (archive.elites().contains(cell)) fail(fmt::format("cell {} holds two elites", cell));
+      e.objective = e.result.fitness;
+      e.reference = nan_or_number(je, "reference");
+      e.generation = static_cast<int>(int_field(je, "generation", 0, generation));
+      archive.elites()[cell] = std::move(e);
+    }
+    const auto columns = history_columns();
+    const auto hist = history_from_json(p.contains("history") ? p["history"] : json(), columns);
+    check_history(hist, generation, source);
+    // The last row is what the engine computes from the archive.
+    MapElites probe(*this);
+    probe.archive_ = archive;
+    probe.generation_ = generation;
+    probe.evaluations_ = evaluations;
+    probe.reference_evaluations_ = reference_evaluations;
+    const std::vector<double>& last = hist.back();
+    std::vector<double> expected = probe.row(static_cast<int>(last[6]), static_cast<int>(last[7]));
+    expected.back() = wall;
+    check_last_row(last, expected, columns, "the archive", source);
+    archive_ = std::move(archive);
+    generation_ = generation;
+    evaluations_ = evaluations;
+    reference_evaluations_ = reference_evaluations;
+    history_ = hist;
+    wall_offset_ = wall;
+    started_ = now_seconds();
+    asked_.reset();
+  });
+}
+
+}  // namespace animat

@@ -1,0 +1,433 @@
+// NSGA-II over the criteria of search.objectives (search.hpp), as animat.moo.Nsga2 draws, sorts
+// and selects.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+#include "../json_util.hpp"
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
+#include "animat/run_identity.hpp"
+#include "animat/search.hpp"
+#include "search_state.hpp"
+
+namespace animat {
+
+using namespace search_state;
+
+namespace {
+
+constexpr int kNsga2Version = 1;
+constexpr const char* kNsga2Format = "animat.nsga2";
+/// The sort compares every pair of parents and candidates (2 N members).
+constexpr int kMaxNsga2Population = 10000;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool archivable(const Fitness& f) { return f.viable && f.stable && f.valid; }
+
+json crowding_json(double x) { return std::isinf(x) ? json("inf") : json(x); }
+
+double crowding_field(const json& j) {
+  if (j.is_object() && j.contains("crowding") && j["crowding"] == "inf")
+    return std::numeric_limits<double>::infinity();
+  const double x = number_field(j, "crowding");
+  if (x < 0.0) throw CheckpointError(fmt::format("field \"crowding\" is {}, expected >= 0", x));
+  return x;
+}
+
+json values_json(const std::vector<double>& v) {
+  json out = json::array();
+  for (double x : v) out.push_back(nan_or(x));
+  return out;
+}
+
+}  // namespace
+
+Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction reference,
+             std::shared_ptr<Evaluator> evaluator)
+    : config_(std::make_shared<const Config>(config)),
+      identity_(run_identity(config)),
+      size_(config.evolution.population),
+      started_(now_seconds()) {
+  if (config.evaluation.reference_check == "select")
+    throw ConfigError(
+        "evaluation.reference_check = \"select\": NSGA-II in animat_evolve has the exploit guard "
+        "\"record\" and \"off\" only; \"select\" runs in Python (`animat evolve`)");
+  if (size_ > kMaxNsga2Population)
+    throw ConfigError(fmt::format(
+        "evolution.population = {}: NSGA-II sorts parents and candidates together, comparing "
+        "every pair; its population is at most {}",
+        size_, kMaxNsga2Population));
+  for (const std::string& spec : config.search.objectives) {
+    const auto colon = spec.find(':');
+    const std::string name = spec.substr(0, colon);
+    const Measure& m = find_measure(name, config, "search.objectives");
+    bool maximize = m.maximize;
+    if (colon != std::string::npos) {
+      const std::string sense = spec.substr(colon + 1);
+      if (sense != "max" && sense != "min")
+        throw ConfigError(fmt::format(
+            "search.objectives: \"{}\": the sense after ':' is \"max\" or \"min\", not \"{}\"",
+            spec, sense));
+      maximize = sense == "max";
+    }
+    for (std::size_t j = 0; j < criteria_.size(); ++j)
+      if (criteria_[j] == &m)
+        throw ConfigError(
+            fmt::format("search.objectives: \"{}\" names the criterion {} twice", spec, m.name));
+    criteria_.push_back(&m);
+    names_.push_back(name);
+    maximize_.push_back(maximize);
+  }
+  if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
+  evaluator_ = evaluator ? std::move(evaluator)
+                         : (fitness ? make_local_evaluator(config, std::move(fitness)) : nullptr);
+}
+
+std::vector<double> Nsga2::criteria_of(const Fitness& f) const {
+  std::vector<double> out;
+  if (!archivable(f)) return std::vector<double>(criteria_.size(), kNaN);
+  for (const Measure* c : criteria_) out.push_back(c->of(f));
+  return out;
+}
+
+std::vector<double> Nsga2::minimised(const std::vector<double>& values) const {
+  std::vector<double> out(values.size());
+  for (std::size_t j = 0; j < values.size(); ++j) out[j] = maximize_[j] ? -values[j] : values[j];
+  return out;
+}
+
+std::vector<Genome> Nsga2::ask() {
+  if (asked_) return *asked_;
+  const int g = generation_ + 1;
+  const auto seed = static_cast<std::uint64_t>(config_->evolution.seed);
+  const auto n = static_cast<std::size_t>(size_);
+  std::vector<Genome> out(n);
+  if (population_.empty()) {
+    parallel_for(n, config_->evolution.threads, [&](std::size_t i) {
+      Rng rng = Rng::derive(seed, static_cast<std::uint64_t>(g), i);
+      out[i] = random_viable_genome(*config_, rng);
+    });
+  } else {
+    const auto top = static_cast<std::int64_t>(population_.size()) - 1;
+    // Binary tournament: lower rank, then larger crowding distance, then the first drawn.
+    const auto pick = [&](Rng& rng) -> const Genome& {
+      const Solution& a = population_[static_cast<std::size_t>(rng.integer(0, top))];
+      const Solution& b = population_[static_cast<std::size_t>(rng.integer(0, top))];
+      if (b.rank < a.rank || (b.rank == a.rank && b.crowding > a.crowding)) return b.genome;
+      return a.genome;
+    };
+    for (std::size_t i = 0; i < n; ++i)
+      out[i] = offspring(*config_, seed, g, i, config_->evolution.crossover_fraction, pick);
+  }
+  asked_ = std::move(out);
+  return *asked_;
+}
+
+std::vector<Solution> Nsga2::select(std::vector<Solution> pool,
+                                    const std::vector<bool>& copy) const {
+  const auto n = static_cast<std::size_t>(size_);
+  std::vector<std::size_t> feasible;
+  for (std::size_t i = 0; i < pool.size(); ++i)
+    if (pool[i].feasible && !copy[i]) feasible.push_back(i);
+  std::vector<std::vector<double>> values, raw;
+  for (std::size_t i : feasible) {
+    values.push_back(minimised(pool[i].objectives));
+    raw.push_back(pool[i].objectives);
+  }
+  const auto fronts = non_dominated_sort(values);
+  std::vector<bool> chosen(pool.size(), false);
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < fronts.size() && count < n; ++k) {
+    std::vector<std::vector<double>> front_values;
+    for (std::size_t i : fronts[k]) front_values.push_back(raw[i]);
+    // on the criteria's own values, as animat.moo (the order of equal values decides the ends)
+    const std::vector<double> d = crowding_distance(front_values);
+    std::vector<std::size_t> members;
+    for (std::size_t j = 0; j < fronts[k].size(); ++j) {
+      const std::size_t i = feasible[fronts[k][j]];
+      pool[i].rank = static_cast<int>(k);
+      pool[i].crowding = d[j];
+      members.push_back(i);
+    }
+    if (count + members.size() <= n) {
+      for (std::size_t i : members) chosen[i] = true;
+      count += members.size();
+    } else {
+      std::vector<std::size_t> order(members.size());
+      std::iota(order.begin(), order.end(), 0);
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        if (d[a] != d[b]) return d[a] > d[b];
+        return members[a] < members[b];
+      });
+      for (std::size_t j = 0; count < n; ++j, ++count) chosen[members[order[j]]] = true;
+    }
+  }
+  for (std::size_t i = 0; i < pool.size(); ++i)
+    if (!pool[i].feasible || copy[i]) {
+      pool[i].rank = static_cast<int>(fronts.size());
+      pool[i].crowding = 0.0;
+      if (count < n) {
+        chosen[i] = true;
+        ++count;
+      }
+    }
+  std::vector<Solution> out;
+  for (std::size_t i = 0; i < pool.size(); ++i)
+    if (chosen[i]) out.push_back(std::move(pool[i]));
+  return out;
+}
+
+bool Nsga2::tell(const std::vector<Fitness>& fitness) {
+  if (!asked_) throw Error("Nsga2.tell: nothing was asked (call ask() first)");
+  const std::vector<Genome>& genomes = *asked_;
+  if (fitness.size() != genomes.size())
+    throw Error(fmt::format("Nsga2.tell: {} fitness values for the {} genomes of the last ask()",
+                            fitness.size(), genomes.size()));
+  // 1. Check every value; nothing changes before the commit below.
+  const int g = generation_ + 1;
+  std::vector<Solution> candidates;
+  for (std::size_t k = 0; k < fitness.size(); ++k) {
+    const Fitness& f = fitness[k];
+    if (!std::isfinite(f.fitness))
+      refuse("Nsga2", k, fmt::format("fitness {} (a fitness must be finite)", f.fitness));
+    if (f.cell_count < 0) refuse("Nsga2", k, fmt::format("cell_count {}", f.cell_count));
+    Solution s{genomes[k], f, criteria_of(f), {}, g, archivable(f)};
+    if (s.feasible)
+      for (std::size_t j = 0; j < criteria_.size(); ++j)
+        if (!std::isfinite(s.objectives[j]))
+          refuse("Nsga2", k,
+                 fmt::format("criterion {} = {} (a criterion must be finite)", criteria_[j]->name,
+                             s.objectives[j]));
+    candidates.push_back(std::move(s));
+  }
+  std::vector<double> reference_point = reference_point_;
+  if (reference_point.empty()) {
+    for (const Solution& s : candidates) {
+      if (!s.feasible) continue;
+      if (reference_point.empty()) {
+        reference_point = s.objectives;
+        continue;
+      }
+      for (std::size_t j = 0; j < criteria_.size(); ++j)
+        reference_point[j] = maximize_[j] ? std::min(reference_point[j], s.objectives[j])
+                                          : std::max(reference_point[j], s.objectives[j]);
+    }
+  }
+  std::vector<Solution> pool = population_;
+  const std::size_t parents = pool.size();
+  for (Solution& s : candidates) pool.push_back(std::move(s));
+  // Copies: a genome equal to an earlier member's adds no point to the front.
+  std::vector<bool> copy(pool.size(), false);
+  std::unordered_multimap<std::uint64_t, std::size_t> seen;
+  int copies = 0, discarded = 0;
+  for (std::size_t i = 0; i < pool.size(); ++i) {
+    const std::uint64_t h = genome_hash(pool[i].genome);
+    auto [lo, hi] = seen.equal_range(h);
+    for (auto it = lo; it != hi; ++it)
+      if (pool[it->second].genome == pool[i].genome) copy[i] = true;
+    seen.emplace(h, i);
+    if (i >= parents) {
+      copies += copy[i] ? 1 : 0;
+      discarded += pool[i].feasible ? 0 : 1;
+    }
+  }
+  std::vector<Solution> population = select(std::move(pool), copy);
+  // 2. The exploit guard: the front's new members at the reference step (may throw: nothing has
+  // changed yet).
+  std::int64_t referenced = 0;
+  if (reference_) {
+    std::vector<std::size_t> pending;
+    std::vector<const Genome*> todo;
+    for (std::size_t k = 0; k < population.size(); ++k)
+      if (population[k].rank == 0 && population[k].feasible && population[k].reference.empty()) {
+        pending.push_back(k);
+        todo.push_back(&population[k].genome);
+      }
+    const std::vector<Fitness> refs = evaluate_references(reference_, *config_, todo, "Nsga2.tell");
+    for (std::size_t r = 0; r < pending.size(); ++r)
+      population[pending[r]].reference = criteria_of(refs[r]);
+    referenced = static_cast<std::int64_t>(pending.size());
+  }
+  // 3. Commit.
+  population_ = std::move(population);
+  reference_point_ = std::move(reference_point);
+  reference_evaluations_ += referenced;
+  evaluations_ += static_cast<std::int64_t>(fitness.size());
+  generation_ = g;
+  asked_.reset();
+  history_.push_back(row(population_, reference_point_, discarded, copies));
+  history_.back().back() = wall_offset_ + now_seconds() - started_;
+  return true;
+}
+
+std::vector<const Solution*> Nsga2::front() const {
+  std::vector<const Solution*> out;
+  for (const Solution& s : population_)
+    if (s.feasible && s.rank == 0) out.push_back(&s);
+  std::stable_sort(out.begin(), out.end(), [&](const Solution* a, const Solution* b) {
+    return minimised(a->objectives) < minimised(b->objectives);
+  });
+  return out;
+}
+
+std::vector<double> Nsga2::row(const std::vector<Solution>& population,
+                               const std::vector<double>& reference_point, int discarded,
+                               int copies) const {
+  std::vector<std::vector<double>> front, front_minimised;
+  int disagreements = 0, feasible = 0;
+  for (const Solution& s : population) {
+    feasible += s.feasible ? 1 : 0;
+    if (!s.feasible || s.rank != 0) continue;
+    front.push_back(s.objectives);
+    front_minimised.push_back(minimised(s.objectives));
+    if (s.reference.empty()) continue;
+    for (std::size_t j = 0; j < criteria_.size(); ++j)
+      if (std::isnan(s.reference[j]) ||
+          reference_disagrees(s.objectives[j], s.reference[j], config_->evaluation)) {
+        ++disagreements;
+        break;
+      }
+  }
+  double hv = kNaN;
+  if (!reference_point.empty() && criteria_.size() <= 2)
+    hv = hypervolume(front_minimised, minimised(reference_point));
+  std::vector<double> out = {static_cast<double>(generation_), static_cast<double>(evaluations_),
+                             static_cast<double>(front.size()), hv};
+  for (std::size_t j = 0; j < criteria_.size(); ++j) {
+    double best = kNaN;
+    for (const auto& v : front)
+      if (std::isnan(best) || (maximize_[j] ? v[j] > best : v[j] < best)) best = v[j];
+    out.push_back(best);
+  }
+  for (const int x : {feasible, discarded, copies}) out.push_back(static_cast<double>(x));
+  out.push_back(static_cast<double>(reference_evaluations_));
+  out.push_back(static_cast<double>(disagreements));
+  out.push_back(0.0);  // wall_seconds, set by the caller
+  return out;
+}
+
+std::vector<HistoryColumn> Nsga2::history_columns() const {
+  std::vector<HistoryColumn> out = {
+      {"generation", true}, {"evaluations", true}, {"front_size", true}, {"hypervolume", false}};
+  // named as search.objectives names them ("best_distance" for the objective "distance")
+  for (const std::string& name : names_) out.push_back({"best_" + name, false});
+  for (const char* name :
+       {"feasible", "discarded", "copies", "reference_evaluations", "disagreements"})
+    out.push_back({name, true});
+  out.push_back({"wall_seconds", false});
+  return out;
+}
+
+std::string Nsga2::stop_reason() const {
+  return stop_rule(*config_, generation_, wall_offset_ + now_seconds() - started_);
+}
+
+std::string Nsga2::checkpoint() const {
+  if (generation_ < 0) throw Error("Nsga2.checkpoint: no generation completed yet");
+  json p;
+  p["format"] = kNsga2Format;
+  p["version"] = kNsga2Version;
+  p["identity"] = fmt::format("{:016x}", identity_);
+  p["generation"] = generation_;
+  p["evaluations"] = evaluations_;
+  p["reference_evaluations"] = reference_evaluations_;
+  p["wall_seconds"] = history_.back().back();
+  p["reference_point"] = reference_point_.empty() ? json(nullptr) : values_json(reference_point_);
+  json members = json::array();
+  for (const Solution& s : population_) {
+    json j{{"genome", json::parse(to_json(s.genome))},
+           {"result", fitness_to_json(s.result)},
+           {"generation", s.generation},
+           {"rank", s.rank},
+           {"crowding", crowding_json(s.crowding)}};
+    if (!s.reference.empty()) j["reference"] = values_json(s.reference);
+    members.push_back(std::move(j));
+  }
+  p["population"] = std::move(members);
+  p["history"] = history_to_json(history_, history_columns());
+  return seal(p);
+}
+
+void Nsga2::restore(std::string_view text, std::string_view source) {
+  const json p = unseal(text, source, kNsga2Format, kNsga2Version, identity_);
+  auto fail = [&](const std::string& what) { inconsistent(source, what); };
+  reading_checkpoint(source, [&] {
+    const int generation = static_cast<int>(int_field(p, "generation", 0, 100000000));
+    const std::int64_t evaluations = int_field(p, "evaluations", 0, 1LL << 53);
+    const std::int64_t reference_evaluations = int_field(p, "reference_evaluations", 0, 1LL << 53);
+    const double wall = number_field(p, "wall_seconds");
+    const std::size_t m = criteria_.size();
+    auto read_values = [&](const json& j, const char* what, bool allow_nan) {
+      if (!j.is_array() || j.size() != m) fail(fmt::format("{} must list {} values", what, m));
+      std::vector<double> v;
+      for (const json& x : j) {
+        if (allow_nan && x.is_null()) {
+          v.push_back(kNaN);
+          continue;
+        }
+        if (!x.is_number() || !std::isfinite(x.get<double>()))
+          fail(fmt::format("{} holds {}, expected a finite number", what, detail::describe(x)));
+        v.push_back(x.get<double>());
+      }
+      return v;
+    };
+    std::vector<double> reference_point;
+    if (!p.contains("reference_point")) fail("no reference_point");
+    if (!p["reference_point"].is_null())
+      reference_point = read_values(p["reference_point"], "reference_point", false);
+    if (!p.contains("population") || !p["population"].is_array()) fail("no population");
+    if (p["population"].size() != static_cast<std::size_t>(size_))
+      fail(fmt::format("{} members, evolution.population is {}", p["population"].size(), size_));
+    std::vector<Solution> population;
+    for (const json& j : p["population"]) {
+      Solution s;
+      if (!j.contains("genome") || !j.contains("result"))
+        fail(fmt::format("member {} has no genome or result", population.size()));
+      s.genome = genome_from_json(j["genome"].dump(), config_->genome, source);
+      s.result = fitness_from_json(j["result"]);
+      s.feasible = archivable(s.result);
+      s.objectives = criteria_of(s.result);
+      if (s.feasible)
+        for (std::size_t c = 0; c < m; ++c)
+          if (!std::isfinite(s.objectives[c]))
+            fail(fmt::format("member {} has {} = {}", population.size(), criteria_[c]->name,
+                             s.objectives[c]));
+      s.generation = static_cast<int>(int_field(j, "generation", 0, generation));
+      s.rank = static_cast<int>(int_field(j, "rank", 0, 2 * static_cast<long long>(size_)));
+      s.crowding = crowding_field(j);
+      if (j.contains("reference")) s.reference = read_values(j["reference"], "reference", true);
+      population.push_back(std::move(s));
+    }
+    const auto columns = history_columns();
+    const auto hist = history_from_json(p.contains("history") ? p["history"] : json(), columns);
+    check_history(hist, generation, source);
+    // The last row is what the engine computes from the population.
+    Nsga2 probe(*this);
+    probe.generation_ = generation;
+    probe.evaluations_ = evaluations;
+    probe.reference_evaluations_ = reference_evaluations;
+    const std::vector<double>& last = hist.back();
+    const std::size_t at = 4 + m;  // feasible, discarded, copies, ...
+    std::vector<double> expected =
+        probe.row(population, reference_point, static_cast<int>(last[at + 1]),
+                  static_cast<int>(last[at + 2]));
+    expected.back() = wall;
+    check_last_row(last, expected, columns, "the population", source);
+    population_ = std::move(population);
+    reference_point_ = std::move(reference_point);
+    generation_ = generation;
+    evaluations_ = evaluations;
+    reference_evaluations_ = reference_evaluations;
+    history_ = hist;
+    wall_offset_ = wall;
+    started_ = now_seconds();
+    asked_.reset();
+  });
+}
+
+}  // namespace animat

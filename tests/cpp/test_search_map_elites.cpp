@@ -1,0 +1,276 @@
+// MAP-Elites and its grid archive (search.hpp), checked in milliseconds with a cheap deterministic
+// stub fitness: the grid's bins, bounded sizes, an atomic tell, thread-count invariance and
+// checkpoints that are checked on load.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluator.hpp"
+#include "animat/search.hpp"
+#include "search_support.hpp"
+#include "test_support.hpp"
+
+using namespace animat;
+using animat::test::refused_digit_changes;
+using animat::test::reseal;
+using animat::test::search_stub;
+using animat::test::without_wall;
+
+namespace {
+
+Config me_config(int threads = 1) {
+  Config c;
+  c.search.algorithm = "map_elites";
+  c.search.descriptors = {"cells", "fitness"};
+  c.search.bins = {8.0, 5.0};
+  c.search.batch = 12;
+  c.evolution.seed = 3;
+  c.evolution.threads = threads;
+  c.evaluation.reference_check = "off";
+  return c;
+}
+
+MapElites make(const Config& c) {
+  return MapElites(c, search_stub, {}, make_local_evaluator(search_stub, c.evolution.threads));
+}
+
+}  // namespace
+
+TEST(GridArchive, BinsFollowTheEdgesAndClipOutsideTheRange) {
+  Config c = me_config();
+  const Measure* cells = &find_measure("cells", c, "search.descriptors");
+  const Measure* fitness = &find_measure("fitness", c, "search.descriptors");
+  GridArchive a({cells, fitness}, {8, 5});  // cells: edges 1, 9, 17, ..., 65; fitness: 0, 10, ...
+  EXPECT_EQ(a.cells(), 40U);
+  const auto at = [&](double x, double y) {
+    const double v[] = {x, y};
+    return a.index_of(v);
+  };
+  EXPECT_EQ(at(1, 0), 0U);
+  EXPECT_EQ(at(8.999, 9.999), 0U);
+  EXPECT_EQ(at(9, 10), 1U * 5 + 1);  // a value on an interior edge belongs to the bin above
+  EXPECT_EQ(at(64.9, 49.9), 7U * 5 + 4);
+  EXPECT_EQ(at(65, 50), 7U * 5 + 4);  // hi itself: the last bin
+  EXPECT_EQ(at(-3, -1), 0U);          // below lo: the first bin
+  EXPECT_EQ(at(1e9, 1e9), 7U * 5 + 4);
+}
+
+TEST(GridArchive, AnEliteIsReplacedOnlyByAStrictlyBetterCandidate) {
+  Config c = me_config();
+  GridArchive a({&find_measure("cells", c, "k")}, {4});
+  Elite e;
+  e.descriptors = {5.0};
+  e.objective = 2.0;
+  EXPECT_TRUE(a.add(e));
+  EXPECT_FALSE(a.add(e));  // a tie keeps the elite
+  e.objective = 3.0;
+  EXPECT_TRUE(a.add(e));
+  e.descriptors = {60.0};
+  e.objective = 0.5;
+  EXPECT_TRUE(a.add(e));
+  EXPECT_EQ(a.elites().size(), 2U);
+  EXPECT_DOUBLE_EQ(a.qd_score(), 3.5);
+  EXPECT_DOUBLE_EQ(a.coverage(), 0.5);
+  EXPECT_EQ(a.best()->objective, 3.0);
+}
+
+TEST(GridArchive, ExactSumIsMathFsum) {
+  const double terms[] = {1e16, 1.0, -1e16, 1.0};
+  EXPECT_EQ(exact_sum(terms), 2.0);  // a plain sum gives 0 or 1
+  const double tenths[] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1};
+  EXPECT_EQ(exact_sum(tenths), 1.0);
+  EXPECT_EQ(exact_sum({}), 0.0);
+}
+
+TEST(MapElites, TooManyCellsAreRefusedNamingTheKeyAndValue) {
+  Config c = me_config();
+  c.search.bins = {100000.0};
+  try {
+    (void)make(c);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("search.bins = [100000, 100000]"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e+10 cells"), std::string::npos) << e.what();
+  }
+  // Four descriptors of 100000 bins: 1e20 cells, past what an int64 holds, refused the same way.
+  c.search.descriptors = {"cells", "fitness", "cells", "fitness"};
+  EXPECT_THROW((void)make(c), ConfigError);
+}
+
+TEST(MapElites, DescriptorsOutsideTheTableOrWithoutARangeAreRefusedByName) {
+  Config c = me_config();
+  c.search.descriptors = {"elongation", "cells"};
+  try {
+    (void)make(c);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("search.descriptors: no measure \"elongation\""),
+              std::string::npos)
+        << e.what();
+  }
+  c.search.descriptors = {"actuation_work_positive", "cells"};
+  EXPECT_THROW((void)make(c), ConfigError);
+  c = me_config();
+  c.evaluation.reference_check = "select";
+  EXPECT_THROW((void)make(c), ConfigError);
+}
+
+TEST(MapElites, FirstGenerationIsRandomViableGenomesThenOffspringOfElites) {
+  const Config c = me_config();
+  MapElites me = make(c);
+  const std::vector<Genome> first = me.ask();
+  ASSERT_EQ(first.size(), 12U);
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    Rng rng = Rng::derive(3, 0, i);
+    EXPECT_EQ(first[i], random_viable_genome(c, rng)) << i;
+  }
+  EXPECT_EQ(me.ask(), first);  // asking again: the same genomes
+  me.step();
+  EXPECT_EQ(me.generation(), 0);
+  EXPECT_GT(me.archive().elites().size(), 0U);
+  me.step();
+  me.step();
+  const auto h = me.history();
+  ASSERT_EQ(h.size(), 3U);
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    EXPECT_EQ(h[k][0], static_cast<double>(k));
+    EXPECT_EQ(h[k][1], 12.0 * static_cast<double>(k + 1));  // evaluations
+  }
+  EXPECT_EQ(h.back()[5], static_cast<double>(me.archive().elites().size()));
+  EXPECT_EQ(h.back()[2], me.archive().qd_score());
+  for (const auto& [cell, e] : me.archive().elites()) {
+    EXPECT_EQ(cell, me.archive().index_of(e.descriptors));
+    EXPECT_EQ(e.objective, search_stub(e.genome).fitness);
+  }
+}
+
+TEST(MapElites, ResultsDoNotDependOnTheThreadCount) {
+  MapElites one = make(me_config(1)), two = make(me_config(2));
+  for (int g = 0; g < 4; ++g) {
+    one.step();
+    two.step();
+  }
+  EXPECT_EQ(without_wall(one.history()), without_wall(two.history()));
+  EXPECT_EQ(one.ask(), two.ask());
+}
+
+TEST(MapElites, ARefusedTellChangesNothing) {
+  MapElites me = make(me_config());
+  me.step();
+  const std::vector<Genome> asked = me.ask();
+  const std::string before = me.checkpoint();
+  std::vector<Fitness> told;
+  for (const Genome& g : asked) told.push_back(search_stub(g));
+  for (const double bad : {std::numeric_limits<double>::infinity(), std::nan(""), -2.0, 1e308}) {
+    std::vector<Fitness> f = told;
+    std::size_t k = 0;
+    while (!f[k].viable) ++k;
+    f[k].fitness = bad;
+    if (bad == 1e308) {
+      // finite, but a descriptor range of [0, 50): clipped to the last bin, accepted
+      MapElites copy = make(me_config());
+      copy.restore(before, "copy");
+      (void)copy.ask();
+      EXPECT_TRUE(copy.tell(f));
+      continue;
+    }
+    try {
+      me.tell(f);
+      FAIL() << "accepted fitness " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(fmt::format("value {}", k)), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("fitness"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(me.checkpoint(), before);
+    EXPECT_EQ(me.ask(), asked);
+  }
+  EXPECT_THROW(me.tell(std::vector<Fitness>(told.size() - 1)), Error);
+  EXPECT_EQ(me.checkpoint(), before);
+  EXPECT_TRUE(me.tell(told));
+  EXPECT_EQ(me.generation(), 1);
+}
+
+TEST(MapElites, CheckpointRestoreContinuesIdentically) {
+  const Config c = me_config();
+  MapElites straight = make(c), first = make(c);
+  for (int g = 0; g < 5; ++g) straight.step();
+  for (int g = 0; g < 2; ++g) first.step();
+  MapElites resumed = make(c);
+  resumed.restore(first.checkpoint(), "checkpoint.json");
+  EXPECT_EQ(resumed.history(), first.history());
+  for (int g = 0; g < 3; ++g) resumed.step();
+  EXPECT_EQ(without_wall(resumed.history()), without_wall(straight.history()));
+  EXPECT_EQ(resumed.ask(), straight.ask());
+}
+
+TEST(MapElites, CorruptOrHandEditedCheckpointsAreRefused) {
+  const Config c = me_config();
+  MapElites me = make(c);
+  me.step();
+  me.step();
+  const std::string text = me.checkpoint();
+  // Every one-digit change of the text is refused (the checksum, or the JSON, catches it).
+  const auto [refused, changed] = refused_digit_changes(text, 97, [&](const std::string& bad) {
+    MapElites target = make(c);
+    target.restore(bad, "ckpt");
+  });
+  EXPECT_GT(changed, 5);
+  EXPECT_EQ(refused, changed);
+  // Hand edits with a valid checksum: what the engine could never have written.
+  const auto refuses = [&](const std::function<void(nlohmann::json&)>& edit, const char* what) {
+    MapElites target = make(c);
+    try {
+      target.restore(reseal(text, edit), "ckpt");
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const CheckpointError& e) {
+      EXPECT_NE(std::string(e.what()).find("ckpt"), std::string::npos) << e.what();
+    }
+  };
+  refuses([](nlohmann::json& p) { p["elites"][0]["result"]["fitness"] = 49.0; }, "fitness");
+  refuses([](nlohmann::json& p) { p["elites"][0]["cell"] = 39; }, "cell");
+  refuses([](nlohmann::json& p) { p["generation"] = 5; }, "generation");
+  refuses([](nlohmann::json& p) { p["evaluations"] = 7; }, "evaluations");
+  refuses([](nlohmann::json& p) { p["history"][1]["qd_score"] = 1.0; }, "qd_score");
+  refuses([](nlohmann::json& p) { p["elites"][0]["result"]["viable"] = false; }, "viable");
+  refuses([](nlohmann::json& p) { p["format"] = "animat.nsga2"; }, "format");
+  // Another run's configuration (its identity).
+  Config other = c;
+  other.search.bins = {4.0};
+  MapElites foreign = make(other);
+  EXPECT_THROW(foreign.restore(text, "ckpt"), CheckpointError);
+}
+
+TEST(MapElites, TheRecordGuardEvaluatesEachNewEliteAtTheReferenceStep) {
+  Config c = me_config();
+  c.evaluation.reference_check = "record";
+  int references = 0;
+  std::mutex m;
+  const FitnessFunction reference = [&](const Genome& g) {
+    std::lock_guard<std::mutex> lock(m);
+    ++references;
+    Fitness f = search_stub(g);
+    f.fitness *= 0.5;  // disagrees with the nominal fitness
+    return f;
+  };
+  MapElites me(c, search_stub, reference, make_local_evaluator(search_stub, 1));
+  me.step();
+  const auto row = me.history().back();
+  EXPECT_EQ(row[8], static_cast<double>(references));  // reference_evaluations
+  EXPECT_EQ(row[8], static_cast<double>(me.archive().elites().size()));
+  int disagree = 0;
+  for (const auto& [cell, e] : me.archive().elites()) {
+    EXPECT_EQ(e.reference, 0.5 * e.result.fitness);
+    disagree += reference_disagrees(e.result.fitness, e.reference, c.evaluation) ? 1 : 0;
+  }
+  EXPECT_EQ(row[9], static_cast<double>(disagree));
+}
