@@ -249,7 +249,8 @@ def show_figures(run, only=None, *, frames: int = 6, steps: Optional[int] = None
     """The figures of ``animat show`` for a run (an :class:`animat.Run`), in order: a dict of figure
     name -> a function that draws it (a matplotlib Figure). ``only`` picks names of :data:`FIGURES`
     (default: all of them, ``stiffness_map`` only when the best body has evolved stiffness,
-    :func:`has_evolved_stiffness`; for a MAP-Elites or NSGA-II run, whose best is that of its last
+    :func:`has_evolved_stiffness`, ``phase_map`` only when oscillators drive the swim,
+    :func:`animat.plot.oscillator_phases_used`; for a MAP-Elites or NSGA-II run, whose best is that of its last
     archive or front, all but ``fitness_history``, which draws the GA's history). Every figure names
     the run's objective and world where it has a title to do so."""
     import animat
@@ -269,7 +270,9 @@ def show_figures(run, only=None, *, frames: int = 6, steps: Optional[int] = None
         else [
             n
             for n in FIGURES
-            if (n != "stiffness_map" or has_evolved_stiffness(run, entry)) and not (search and n == "fitness_history")
+            if (n != "stiffness_map" or has_evolved_stiffness(run, entry))
+            and not (search and n == "fitness_history")
+            and (n != "phase_map" or plot.oscillator_phases_used(config))  # no oscillator runs: nothing to map
         ]
     )
     objective, _, _ = plot.objective_info(config)

@@ -478,6 +478,7 @@ def _swim_payload(entry: Any, config: Any, frames: int) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # an unstable swim: said on the page
         tr = replay(entry, config)
+    config = tr.config  # a chemotaxis replay swims one of the evaluation's sources, not scene.chemical_source
     scene: Any = _core.Scene.from_config(config)
     effects = list(scene.effects)
     idx = np.asarray(default_frames(tr, max_frames=max(2, frames)), dtype=np.int64)
@@ -499,7 +500,8 @@ def _swim_payload(entry: Any, config: Any, frames: int) -> dict:
     label, progress = _progress(tr, config, source_rel)
     path_idx = np.unique(np.linspace(0, tr.frame_count - 1, min(tr.frame_count, 240)).round().astype(np.int64))
     stiffness = np.asarray(getattr(body, "stiffness", np.empty(0)), dtype=float)
-    world: Dict[str, Any] = {"banner": aplot.world_text(config), "floor": None, "source": None, "chemical": None}
+    banner = aplot.world_text(config, source_trial=tr.meta.get("source_trial"))
+    world: Dict[str, Any] = {"banner": banner, "floor": None, "source": None, "chemical": None}
     if "ground" in effects:
         world["floor"] = _num(scene.ground_height)
     if source_rel is not None:

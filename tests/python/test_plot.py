@@ -436,3 +436,22 @@ def test_motion_cycle_of_a_chemotaxis_swim_names_its_source_and_the_progress_tow
     rot = plot.rotation_to(tr.direction)
     frames = tr.cycle_frames(3)
     np.testing.assert_allclose(np.column_stack(star.get_data())[0], (tr.com[0] + source - tr.com[frames[0]]) @ rot.T)
+
+
+def test_show_and_explore_draw_a_chemotaxis_run_as_its_evaluation_swims(tmp_path):
+    """`animat show` draws no phase map where no oscillator runs, and the explore page replays one of
+    the evaluation's sources and draws that source, not scene.chemical_source (where no evaluation
+    puts one)."""
+    from animat import explore
+    from animat.cli import show_figures
+    from animat.trajectory import chemotaxis_source
+
+    direct = control_run_dir("chemotaxis_grn_seed1", tmp_path)
+    assert "phase_map" not in show_figures(direct) and "motion_cycle" in show_figures(direct)
+    amplitude = control_run_dir("chemotaxis_amplitude_seed1", tmp_path)
+    assert "phase_map" in show_figures(amplitude)
+    swim = explore._swim_payload(amplitude.best(), amplitude.config, frames=4)
+    source = chemotaxis_source(amplitude.config, 0)
+    assert f"at ({source[0]:.3g}, {source[1]:.3g}) from the start (swim 1 of" in swim["world"]["banner"]
+    nominal = np.asarray(amplitude.config["scene.chemical_source"], dtype=float)
+    assert not np.allclose(source, nominal)  # the case the page drew wrongly
