@@ -1,8 +1,10 @@
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/function.h>
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/shared_ptr.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/string_view.h>
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
@@ -18,6 +20,7 @@
 #include "animat/evolution.hpp"
 #include "animat/objective.hpp"
 #include "animat/run.hpp"
+#include "animat/search.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;
@@ -51,6 +54,91 @@ GenerationStats stats_from_dict(const nb::dict& d) {
 // An Evolution's ask() and tell() run without the GIL (the exploit guard's reference swims, a
 // Python objective scoring them on the evaluation threads): every method holds a lease on its
 // engine, and a second thread gets a RuntimeError instead of a data race.
+// The C++ searches (search.hpp) behind one class: ask/tell/step/checkpoint of the config's
+// search.algorithm, with the config's own evaluation (swim_fitness) and exploit guard.
+struct SearchEngine {
+  std::unique_ptr<Search> search;
+};
+
+class SearchLease : public ThreadLease<SearchEngine> {
+ public:
+  SearchLease(const SearchEngine& s, const char* method)
+      : ThreadLease(s, "SearchEngine", method,
+                    "this search is in use by another thread (an ask() or tell() is running); "
+                    "drive it from one thread at a time") {}
+};
+
+void bind_search(nb::module_& m) {
+  nb::class_<SearchEngine>(m, "SearchEngine",
+                           "The search of a config's search.algorithm as animat_evolve runs it "
+                           "(search.hpp): \"ga\",\n\"map_elites\" or \"nsga2\", driven by "
+                           "ask()/tell() or step().")
+      .def(
+          "__init__",
+          [](SearchEngine* e, const Config& c) { new (e) SearchEngine{make_search(c)}; },
+          "config"_a,
+          "The search of config (search.algorithm); a [search] setting it cannot run is a "
+          "ValueError naming\nthe key and value.")
+      .def_prop_ro("algorithm",
+                   [](const SearchEngine& e) { return std::string(e.search->algorithm()); })
+      .def(
+          "ask",
+          [](SearchEngine& e) {
+            SearchLease lease(e, "ask");
+            nb::gil_scoped_release release;  // draws the initial genomes on the threads
+            return e.search->ask();
+          },
+          "The genomes that need a fitness next, in order (the same until tell()).")
+      .def(
+          "tell",
+          [](SearchEngine& e, const std::vector<Fitness>& fitness) {
+            SearchLease lease(e, "tell");
+            nb::gil_scoped_release release;  // the exploit guard's reference swims
+            return e.search->tell(fitness);
+          },
+          "fitness"_a,
+          "The Fitness of every genome of the last ask(), in order; True when a generation "
+          "completed. All or\nnothing: a refused value (an error naming its index and what is "
+          "wrong) changes nothing.")
+      .def(
+          "step",
+          [](SearchEngine& e) {
+            SearchLease lease(e, "step");
+            nb::gil_scoped_release release;
+            e.search->step();
+          },
+          "Ask, evaluate with the config's own evaluation on evolution.threads, tell.")
+      .def_prop_ro("generation", [](const SearchEngine& e) { return e.search->generation(); })
+      .def_prop_ro("evaluations", [](const SearchEngine& e) { return e.search->evaluations(); })
+      .def_prop_ro(
+          "history_columns",
+          [](const SearchEngine& e) {
+            std::vector<std::pair<std::string, bool>> out;
+            for (const auto& c : e.search->history_columns()) out.emplace_back(c.name, c.integer);
+            return out;
+          },
+          "(name, integer) of every history column, in order.")
+      .def_prop_ro(
+          "history", [](const SearchEngine& e) { return e.search->history(); },
+          "One row per generation (history_columns' order), as floats.")
+      .def(
+          "checkpoint",
+          [](const SearchEngine& e) {
+            SearchLease lease(e, "checkpoint");
+            return e.search->checkpoint();
+          },
+          "The whole state as checksummed JSON text (restore() reads it back).")
+      .def(
+          "restore",
+          [](SearchEngine& e, std::string_view text, std::string_view source) {
+            SearchLease lease(e, "restore");
+            e.search->restore(text, source);
+          },
+          "text"_a, "source"_a = "checkpoint",
+          "Restores a checkpoint() of the same config (an error for a corrupt, foreign or "
+          "inconsistent one).");
+}
+
 class EngineLease : public ThreadLease<Evolution> {
  public:
   EngineLease(const Evolution& e, const char* method)
@@ -545,6 +633,8 @@ void bind_evolution(nb::module_& m) {
       "than both\n"
       "evaluation.reference_tolerance (relative to the reference) and "
       "evaluation.reference_abs_tolerance.");
+
+  bind_search(m);
 
   m.def(
       "reference_config", [](const Config& config) { return reference_config(config); }, "config"_a,

@@ -1,0 +1,92 @@
+"""The C++ searches of animat_evolve (animat._core.SearchEngine, search.hpp) are animat.qd's MAP-Elites
+and animat.moo's NSGA-II: told the same fitness, they ask the same genomes and write the same history
+rows, generation after generation (a cheap deterministic stub stands in for the swims)."""
+
+import hashlib
+import math
+
+import pytest
+
+import animat
+from animat import _core
+
+
+def stub(genome):
+    """A Fitness that depends on the genome only: a quarter not viable, the rest spread over the
+    descriptors' ranges and the criteria."""
+    h = int(hashlib.sha256(genome.to_json().encode()).hexdigest()[:15], 16)
+    if h % 4 == 0:
+        return animat.Fitness(0.0, False, True, 0)
+    fitness = (h >> 8) % 5000 / 100.0
+    return animat.Fitness(
+        fitness, True, True, 1 + (h >> 24) % 64, actuation_work_positive=fitness * (1 + (h >> 32) % 100 / 50.0)
+    )
+
+
+def config_for(algorithm, seed):
+    config = animat.Config()
+    config["search.algorithm"] = algorithm
+    config["search.descriptors"] = ["cells", "fitness"]
+    config["search.bins"] = [8.0, 5.0]
+    config["search.batch"] = 12
+    config["search.objectives"] = ["distance:max", "actuation_work_positive:min"]
+    config["evolution.population"] = 12
+    config["evolution.seed"] = seed
+    config["evolution.threads"] = 1
+    config["evaluation.reference_check"] = "off"
+    return config
+
+
+def same(a, b):
+    return len(a) == len(b) and all(x == y or (math.isnan(x) and math.isnan(y)) for x, y in zip(a, b))
+
+
+def test_map_elites_is_animat_qd():
+    config = config_for("map_elites", 3)
+    engine = _core.SearchEngine(config)
+    me = animat.MapElites(config, animat.GridArchive(["cells", "fitness"], bins=(8, 5)), batch=12, seed=3)
+    assert [c[0] for c in engine.history_columns][:10] == list(animat.QD_HISTORY_DTYPE.names)
+    for _ in range(6):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in me.ask()]
+        told = [stub(g) for g in genomes]
+        assert engine.tell(told)
+        rows = [[f.cell_count, f.fitness] if f.viable else None for f in told]
+        row = me.tell(told, descriptors=rows)
+        assert same(engine.history[-1][:10], [float(x) for x in row]), (engine.history[-1], row)
+    assert engine.history[-1][5] > 3  # the archive holds several elites: a real comparison
+
+
+def test_nsga2_is_animat_moo():
+    config = config_for("nsga2", 5)
+    engine = _core.SearchEngine(config)
+    nsga = animat.Nsga2(config, [("distance", "max"), ("actuation_work_positive", "min")], population=12, seed=5)
+    assert [c[0] for c in engine.history_columns][:-1] == list(nsga.history_dtype.names)
+    for _ in range(6):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in nsga.ask()]
+        told = [stub(g) for g in genomes]
+        assert engine.tell(told)
+        row = nsga.tell([[f.fitness, f.actuation_work_positive] if f.viable else None for f in told])
+        assert same(engine.history[-1][:-1], [float(x) for x in row]), (engine.history[-1], row)
+    assert engine.history[-1][2] > 2  # a front of several members: a real comparison
+
+
+def test_a_refused_tell_changes_nothing_and_names_the_value():
+    engine = _core.SearchEngine(config_for("map_elites", 3))
+    genomes = engine.ask()
+    told = [stub(g) for g in genomes]
+    k = next(i for i, f in enumerate(told) if f.viable)
+    bad = list(told)
+    bad[k] = animat.Fitness(math.inf, True, True, 5)
+    with pytest.raises(Exception, match=f"value {k} .*fitness inf"):
+        engine.tell(bad)
+    assert engine.generation == -1 and engine.history == []
+    assert [g.to_json() for g in engine.ask()] == [g.to_json() for g in genomes]
+    assert engine.tell(told)
+    text = engine.checkpoint()
+    again = _core.SearchEngine(config_for("map_elites", 3))
+    again.restore(text)
+    assert again.history == engine.history
+    with pytest.raises(Exception, match="checksum"):
+        again.restore(text.replace('\\"generation\\":0', '\\"generation\\":1'))
