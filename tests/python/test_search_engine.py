@@ -90,3 +90,30 @@ def test_a_refused_tell_changes_nothing_and_names_the_value():
     assert again.history == engine.history
     with pytest.raises(Exception, match="checksum"):
         again.restore(text.replace('\\"generation\\":0', '\\"generation\\":1'))
+
+
+@pytest.mark.parametrize("algorithm", ["map_elites", "nsga2"])
+def test_the_record_guard_swims_the_same_references(algorithm):
+    # The exploit guard "record" swims each new elite (front member) at the reference step, as
+    # animat.qd and animat.moo do: the same genomes, the same reference values, the same counts.
+    config = config_for(algorithm, 7)
+    config["evaluation.reference_check"] = "record"
+    config["evaluation.steps"] = 40
+    engine = _core.SearchEngine(config)
+    if algorithm == "map_elites":
+        search = animat.MapElites(config, animat.GridArchive(["cells", "fitness"], bins=(8, 5)), batch=12, seed=7)
+    else:
+        search = animat.Nsga2(config, [("distance", "max"), ("actuation_work_positive", "min")], population=12, seed=7)
+    for _ in range(3):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in search.ask()]
+        told = [stub(g) for g in genomes]
+        engine.tell(told)
+        if algorithm == "map_elites":
+            row = search.tell(told, descriptors=[[f.cell_count, f.fitness] if f.viable else None for f in told])
+        else:
+            row = search.tell([[f.fitness, f.actuation_work_positive] if f.viable else None for f in told])
+        assert same(
+            engine.history[-1][:-1] if algorithm == "nsga2" else engine.history[-1][:10], [float(x) for x in row]
+        )
+    assert row["reference_evaluations"] > 0
