@@ -24,7 +24,8 @@
 //   bad one is a ConfigError naming the key and value, raised when the search is made, before a
 //   run writes any file.
 // - The exploit guard (evaluation.reference_check): "record" evaluates each new elite (MAP-Elites)
-//   or front member (NSGA-II) again at the reference step; "select" is refused by both for now.
+//   or front member (NSGA-II) again at the reference step; "select" evaluates every candidate
+//   there first and compares the reference values, as animat.qd and animat.moo do.
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -177,7 +178,8 @@ struct Elite {
   Genome genome;
   Fitness result;
   std::vector<double> descriptors;
-  /// What the archive compares: the fitness.
+  /// What the archive compares: the fitness, or under evaluation.reference_check = "select" the
+  /// reference fitness.
   double objective = 0.0;
   /// Fitness at the exploit guard's reference step; NaN = not evaluated.
   double reference = std::numeric_limits<double>::quiet_NaN();
@@ -245,6 +247,7 @@ class MapElites final : public Search {
   std::shared_ptr<const Config> config_;
   std::uint64_t identity_;
   FitnessFunction reference_;
+  bool select_ = false;  ///< the exploit guard "select": the archive compares reference fitness
   GridArchive archive_;
   int batch_;
   int generation_ = -1;
@@ -261,7 +264,9 @@ class MapElites final : public Search {
 struct Solution {
   Genome genome;
   Fitness result;
-  /// One value per criterion (NaN when infeasible), in the criteria's own units and senses.
+  /// What the selection compares, one value per criterion (NaN when infeasible), in the
+  /// criteria's own units and senses: the measured values (criteria of `result`), or under
+  /// evaluation.reference_check = "select" the reference ones.
   std::vector<double> objectives;
   /// The criteria at the exploit guard's reference step (NaN where that swim was not valid); empty
   /// when not evaluated there.
@@ -302,6 +307,8 @@ class Nsga2 final : public Search {
  private:
   [[nodiscard]] std::vector<double> criteria_of(const Fitness& f) const;
   [[nodiscard]] std::vector<double> minimised(const std::vector<double>& values) const;
+  /// Under "select": the objectives become the reference criteria (feasible only if finite).
+  void compare_reference(Solution& s) const;
   [[nodiscard]] std::vector<Solution> select(std::vector<Solution> pool,
                                              const std::vector<bool>& copy) const;
   [[nodiscard]] std::vector<double> row(const std::vector<Solution>& population,
@@ -311,6 +318,7 @@ class Nsga2 final : public Search {
   std::shared_ptr<const Config> config_;
   std::uint64_t identity_;
   FitnessFunction reference_;
+  bool select_ = false;  ///< the exploit guard "select": the selection compares reference criteria
   std::vector<const Measure*> criteria_;
   std::vector<std::string> names_;  ///< as search.objectives names them
   std::vector<bool> maximize_;

@@ -131,14 +131,6 @@ std::vector<int> bins_of(const Config& config) {
   return out;
 }
 
-void refuse_select(const Config& config, std::string_view who) {
-  if (config.evaluation.reference_check == "select")
-    throw ConfigError(fmt::format(
-        "evaluation.reference_check = \"select\": {} in animat_evolve has the exploit guard "
-        "\"record\" and \"off\" only; \"select\" runs in Python (`animat evolve`)",
-        who));
-}
-
 }  // namespace
 
 MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
@@ -148,8 +140,8 @@ MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunct
       archive_(descriptors_of(config), bins_of(config)),
       batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
       started_(now_seconds()) {
-  refuse_select(config, "MAP-Elites");
   if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
+  select_ = reference_ && config.evaluation.reference_check == "select";
   evaluator_ = evaluator ? std::move(evaluator)
                          : (fitness ? make_local_evaluator(config, std::move(fitness)) : nullptr);
 }
@@ -208,49 +200,60 @@ bool MapElites::tell(const std::vector<Fitness>& fitness) {
     }
   }
   const int g = generation_ + 1;
+  // 2. The exploit guard "select": every candidate's reference fitness, which the archive then
+  // compares, before anything changes (it may throw).
+  std::vector<std::size_t> candidates;
+  for (std::size_t k = 0; k < fitness.size(); ++k)
+    if (archivable(fitness[k])) candidates.push_back(k);
+  std::vector<double> objective(fitness.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> reference = objective;
+  for (std::size_t k : candidates) objective[k] = fitness[k].fitness;
+  if (select_) {
+    std::vector<const Genome*> todo;
+    for (std::size_t k : candidates) todo.push_back(&genomes[k]);
+    const auto refs = evaluate_references(reference_, *config_, todo, "MapElites.tell");
+    for (std::size_t r = 0; r < candidates.size(); ++r)
+      objective[candidates[r]] = reference[candidates[r]] = refs[r].fitness;
+  }
+  // 3. Where each candidate goes, in the order of ask(): a cell's elite gives way to a strictly
+  // greater objective.
   std::map<std::size_t, std::size_t> winner;  // cell -> the candidate that holds it at the end
-  int added = 0, candidates = 0;
-  for (std::size_t k = 0; k < fitness.size(); ++k) {
-    if (!archivable(fitness[k])) continue;
-    ++candidates;
+  int added = 0;
+  for (std::size_t k : candidates) {
     const std::size_t cell = archive_.index_of(values[k]);
     double current = -std::numeric_limits<double>::infinity();
     bool held = false;
     if (auto w = winner.find(cell); w != winner.end()) {
-      current = fitness[w->second].fitness;
+      current = objective[w->second];
       held = true;
     } else if (auto e = archive_.elites().find(cell); e != archive_.elites().end()) {
       current = e->second.objective;
       held = true;
     }
-    if (held && !(fitness[k].fitness > current)) continue;
+    if (held && !(objective[k] > current)) continue;
     winner[cell] = k;
     ++added;
   }
-  // 2. The exploit guard: the reference of every elite that entered (may throw: still nothing
-  // changed).
-  std::vector<Fitness> refs;
-  if (reference_) {
+  // 4. The exploit guard "record": the reference of every elite that entered (may throw: still
+  // nothing changed).
+  if (reference_ && !select_) {
     std::vector<const Genome*> todo;
     for (const auto& [cell, k] : winner) todo.push_back(&genomes[k]);
-    refs = evaluate_references(reference_, *config_, todo, "MapElites.tell");
+    const auto refs = evaluate_references(reference_, *config_, todo, "MapElites.tell");
+    std::size_t r = 0;
+    for (const auto& [cell, k] : winner) reference[k] = refs[r++].fitness;
   }
-  // 3. Commit.
-  std::size_t r = 0;
-  for (const auto& [cell, k] : winner) {
-    Elite e{genomes[k],
-            fitness[k],
-            values[k],
-            fitness[k].fitness,
-            reference_ ? refs[r++].fitness : std::numeric_limits<double>::quiet_NaN(),
-            g};
-    archive_.elites()[cell] = std::move(e);
-  }
-  if (reference_) reference_evaluations_ += static_cast<std::int64_t>(winner.size());
+  // 5. Commit.
+  for (const auto& [cell, k] : winner)
+    archive_.elites()[cell] =
+        Elite{genomes[k], fitness[k], values[k], objective[k], reference[k], g};
+  if (reference_)
+    reference_evaluations_ +=
+        static_cast<std::int64_t>(select_ ? candidates.size() : winner.size());
   evaluations_ += static_cast<std::int64_t>(fitness.size());
   generation_ = g;
   asked_.reset();
-  history_.push_back(row(added, static_cast<int>(fitness.size()) - candidates));
+  history_.push_back(row(added, static_cast<int>(fitness.size() - candidates.size())));
   return true;
 }
 
@@ -347,8 +350,14 @@ void MapElites::restore(std::string_view text, std::string_view source) {
         fail(fmt::format("the elite of cell {} belongs to cell {} by its descriptors", cell,
                          archive.index_of(e.descriptors)));
       if (archive.elites().contains(cell)) fail(fmt::format("cell {} holds two elites", cell));
-      e.objective = e.result.fitness;
       e.reference = nan_or_number(je, "reference");
+      // under "select" the archive compares the reference fitness
+      e.objective = select_ ? e.reference : e.result.fitness;
+      if (std::isnan(e.objective))
+        fail(
+            fmt::format("the elite of cell {} has no reference fitness (evaluation.reference_check "
+                        "= \"select\")",
+                        cell));
       e.generation = static_cast<int>(int_field(je, "generation", 0, generation));
       archive.elites()[cell] = std::move(e);
     }

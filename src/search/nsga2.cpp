@@ -53,10 +53,6 @@ Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction refe
       identity_(run_identity(config)),
       size_(config.evolution.population),
       started_(now_seconds()) {
-  if (config.evaluation.reference_check == "select")
-    throw ConfigError(
-        "evaluation.reference_check = \"select\": NSGA-II in animat_evolve has the exploit guard "
-        "\"record\" and \"off\" only; \"select\" runs in Python (`animat evolve`)");
   if (size_ > kMaxNsga2Population)
     throw ConfigError(fmt::format(
         "evolution.population = {}: NSGA-II sorts parents and candidates together, comparing "
@@ -84,6 +80,7 @@ Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction refe
     maximize_.push_back(maximize);
   }
   if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
+  select_ = reference_ && config.evaluation.reference_check == "select";
   evaluator_ = evaluator ? std::move(evaluator)
                          : (fitness ? make_local_evaluator(config, std::move(fitness)) : nullptr);
 }
@@ -99,6 +96,15 @@ std::vector<double> Nsga2::minimised(const std::vector<double>& values) const {
   std::vector<double> out(values.size());
   for (std::size_t j = 0; j < values.size(); ++j) out[j] = maximize_[j] ? -values[j] : values[j];
   return out;
+}
+
+void Nsga2::compare_reference(Solution& s) const {
+  // "select": the selection compares the reference criteria; a candidate with none, or one that
+  // is not finite (its reference swim was not valid), is not feasible.
+  bool finite = !s.reference.empty();
+  for (double x : s.reference) finite = finite && std::isfinite(x);
+  if (!s.reference.empty()) s.objectives = s.reference;
+  s.feasible = finite;
 }
 
 std::vector<Genome> Nsga2::ask() {
@@ -205,6 +211,37 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness) {
                              s.objectives[j]));
     candidates.push_back(std::move(s));
   }
+  // 2. The exploit guard "select": the reference criteria of every feasible candidate, which the
+  // selection then compares (a copy of a genome seen before takes its reference: the same swim).
+  std::int64_t referenced = 0;
+  if (select_) {
+    // by hash, in order: the first of equal genomes is the one a copy takes its reference from
+    std::unordered_map<std::uint64_t, std::vector<const Solution*>> known;
+    for (const Solution& s : population_) known[genome_hash(s.genome)].push_back(&s);
+    const auto find = [&](const Genome& g) -> const Solution* {
+      if (auto it = known.find(genome_hash(g)); it != known.end())
+        for (const Solution* s : it->second)
+          if (s->genome == g) return s;
+      return nullptr;
+    };
+    std::vector<std::size_t> first;
+    std::vector<const Genome*> todo;
+    for (std::size_t k = 0; k < candidates.size(); ++k)
+      if (candidates[k].feasible && find(candidates[k].genome) == nullptr) {
+        known[genome_hash(candidates[k].genome)].push_back(&candidates[k]);
+        first.push_back(k);
+        todo.push_back(&candidates[k].genome);
+      }
+    const auto refs = evaluate_references(reference_, *config_, todo, "Nsga2.tell");
+    for (std::size_t r = 0; r < first.size(); ++r)
+      candidates[first[r]].reference = criteria_of(refs[r]);
+    referenced = static_cast<std::int64_t>(first.size());
+    for (Solution& s : candidates) {
+      if (!s.feasible) continue;
+      if (const Solution* seen = find(s.genome); seen != &s) s.reference = seen->reference;
+      compare_reference(s);
+    }
+  }
   std::vector<double> reference_point = reference_point_;
   if (reference_point.empty()) {
     for (const Solution& s : candidates) {
@@ -237,10 +274,9 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness) {
     }
   }
   std::vector<Solution> population = select(std::move(pool), copy);
-  // 2. The exploit guard: the front's new members at the reference step (may throw: nothing has
-  // changed yet).
-  std::int64_t referenced = 0;
-  if (reference_) {
+  // 3. The exploit guard "record": the front's new members at the reference step (may throw:
+  // nothing has changed yet).
+  if (reference_ && !select_) {
     std::vector<std::size_t> pending;
     std::vector<const Genome*> todo;
     for (std::size_t k = 0; k < population.size(); ++k)
@@ -253,7 +289,7 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness) {
       population[pending[r]].reference = criteria_of(refs[r]);
     referenced = static_cast<std::int64_t>(pending.size());
   }
-  // 3. Commit.
+  // 4. Commit.
   population_ = std::move(population);
   reference_point_ = std::move(reference_point);
   reference_evaluations_ += referenced;
@@ -288,7 +324,7 @@ std::vector<double> Nsga2::row(const std::vector<Solution>& population,
     if (s.reference.empty()) continue;
     for (std::size_t j = 0; j < criteria_.size(); ++j)
       if (std::isnan(s.reference[j]) ||
-          reference_disagrees(s.objectives[j], s.reference[j], config_->evaluation)) {
+          reference_disagrees(criteria_of(s.result)[j], s.reference[j], config_->evaluation)) {
         ++disagreements;
         break;
       }
@@ -401,6 +437,7 @@ void Nsga2::restore(std::string_view text, std::string_view source) {
       s.rank = static_cast<int>(int_field(j, "rank", 0, 2 * static_cast<long long>(size_)));
       s.crowding = crowding_field(j);
       if (j.contains("reference")) s.reference = read_values(j["reference"], "reference", true);
+      if (select_ && s.feasible) compare_reference(s);
       population.push_back(std::move(s));
     }
     const auto columns = history_columns();

@@ -119,9 +119,6 @@ TEST(MapElites, DescriptorsOutsideTheTableOrWithoutARangeAreRefusedByName) {
   }
   c.search.descriptors = {"actuation_work_positive", "cells"};
   EXPECT_THROW((void)make(c), ConfigError);
-  c = me_config();
-  c.evaluation.reference_check = "select";
-  EXPECT_THROW((void)make(c), ConfigError);
 }
 
 TEST(MapElites, FirstGenerationIsRandomViableGenomesThenOffspringOfElites) {
@@ -273,4 +270,30 @@ TEST(MapElites, TheRecordGuardEvaluatesEachNewEliteAtTheReferenceStep) {
     disagree += reference_disagrees(e.result.fitness, e.reference, c.evaluation) ? 1 : 0;
   }
   EXPECT_EQ(row[9], static_cast<double>(disagree));
+}
+
+TEST(MapElites, TheSelectGuardComparesTheReferenceFitness) {
+  Config c = me_config();
+  c.evaluation.reference_check = "select";
+  // The reference step reverses the ranking: an elite must be the best by its reference.
+  const FitnessFunction reference = [](const Genome& g) {
+    Fitness f = search_stub(g);
+    f.fitness = 50.0 - f.fitness;
+    return f;
+  };
+  MapElites me(c, search_stub, reference, make_local_evaluator(search_stub, 1));
+  me.step();
+  me.step();
+  int candidates = 0;
+  for (const auto& row : me.history()) candidates += 12 - static_cast<int>(row[7]);
+  EXPECT_EQ(me.history().back()[8],
+            static_cast<double>(candidates));  // every candidate's reference
+  for (const auto& [cell, e] : me.archive().elites()) {
+    EXPECT_EQ(e.reference, 50.0 - e.result.fitness);
+    EXPECT_EQ(e.objective, e.reference);
+  }
+  EXPECT_EQ(me.history().back()[4], me.archive().best()->reference);
+  MapElites resumed(c, search_stub, reference, make_local_evaluator(search_stub, 1));
+  resumed.restore(me.checkpoint(), "checkpoint.json");
+  EXPECT_EQ(resumed.history(), me.history());
 }

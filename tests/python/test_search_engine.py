@@ -92,12 +92,14 @@ def test_a_refused_tell_changes_nothing_and_names_the_value():
         again.restore(text.replace('\\"generation\\":0', '\\"generation\\":1'))
 
 
+@pytest.mark.parametrize("guard", ["record", "select"])
 @pytest.mark.parametrize("algorithm", ["map_elites", "nsga2"])
-def test_the_record_guard_swims_the_same_references(algorithm):
-    # The exploit guard "record" swims each new elite (front member) at the reference step, as
-    # animat.qd and animat.moo do: the same genomes, the same reference values, the same counts.
+def test_the_exploit_guard_swims_the_same_references(algorithm, guard):
+    # The exploit guard swims each new elite or front member ("record"), or every candidate before
+    # the archive or the selection compares the reference values ("select"), as animat.qd and
+    # animat.moo do: the same genomes, the same reference values, the same counts.
     config = config_for(algorithm, 7)
-    config["evaluation.reference_check"] = "record"
+    config["evaluation.reference_check"] = guard
     config["evaluation.steps"] = 40
     engine = _core.SearchEngine(config)
     if algorithm == "map_elites":
