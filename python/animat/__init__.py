@@ -94,6 +94,7 @@ from .run import (
     PROTECTED_HISTORY_DTYPE,
     LineageEntry,
     Run,
+    Snapshot,
     morphology_distance,
     read_genealogy,
     read_history,
@@ -220,6 +221,7 @@ __all__ = [
     # analysis
     "Run",
     "LineageEntry",
+    "Snapshot",
     "HISTORY_DTYPE",
     "PROTECTED_HISTORY_DTYPE",
     "read_history",
