@@ -888,6 +888,10 @@ SearchSummary run_search_unchecked(const Config& config, const RunOptions& opt,
         line += fmt::format(" {} {:.6g}", columns[c].name, history.back()[c]);
       spdlog::info("{}gen {:5d} |{}", tag, search->generation(), line);
     }
+    if (opt.search_callback && !opt.search_callback(*search)) {
+      reason = "stopped by callback";
+      break;
+    }
   }
   if (writing && dirty) write_atomically(ckpt, search->checkpoint());
   if (!opt.quiet) spdlog::info("{}stopped at generation {}: {}", tag, search->generation(), reason);

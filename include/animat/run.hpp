@@ -35,6 +35,9 @@ struct RunOptions {
   /// Called after every generation, generation 0 of a new run included; return false to stop
   /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;
+  /// run_search's callback: called after every generation with the search; return false to stop
+  /// (checkpointed).
+  std::function<bool(const Search&)> search_callback;
   /// Called once every check has passed and the run directory is locked, before the first write to
   /// it (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in
   /// place).
@@ -96,8 +99,8 @@ struct SearchSummary {
 /// config.toml only in resumable_keys()), the directory is locked for the run's life, and the
 /// checkpoint is checksummed and checked on load. Writes config.toml, history.csv (the search's
 /// history columns) and checkpoint.json (every evolution.checkpoint_every generations and at the
-/// end). RunOptions::callback is not called; on_start is. `fitness` and `reference` as for
-/// run_evolution.
+/// end). RunOptions::search_callback is called after every generation (not callback); on_start
+/// before the first write. `fitness` and `reference` as for run_evolution.
 SearchSummary run_search(const Config& config, const RunOptions& options,
                          FitnessFunction fitness = {}, FitnessFunction reference = {});
 

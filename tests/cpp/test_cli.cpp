@@ -1,16 +1,22 @@
 // animat_evolve command line: --print-config prints the resolved config as TOML that parses back to
 // the same config; --config/--set/--seed/--generations/--threads change it; every bad option exits
 // non-zero with a message on stderr naming the problem.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "animat/config.hpp"
@@ -284,6 +290,53 @@ TEST(Cli, MapElitesAndNsga2RunIdenticallyOnAnyThreadCountAndAcrossAResume) {
     EXPECT_CONTAINS(slurp(resumed / "resume.log"), "evolution.generations 1 -> 3");
     for (const auto& d : {one, two, resumed}) fs::remove_all(d);
   }
+}
+
+TEST(Cli, AKilledSearchResumesToTheSameResults) {
+  // A MAP-Elites run without a generation cap is killed (SIGKILL) once its checkpoint holds
+  // generation 2, wherever it then is; resumed to generation 5 it equals the uninterrupted run. No
+  // sleeps on the way: the conditions are polled (a hang guard of 600 s only catches a hang).
+  const std::string flags =
+      "--set search.algorithm=map_elites --set search.batch=6 --set evaluation.steps=40 --seed 4 "
+      "--set 'search.descriptors=[\"cells\",\"fitness\"]' --set 'search.bins=[8,5]' --quiet ";
+  const fs::path straight = scratch_dir() / "kill_straight", killed = scratch_dir() / "kill_killed";
+  Result r = run(flags + "--generations 5 --threads 1 --out '" + straight.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path pid_file = scratch_dir() / "kill.pid";
+  const std::string start = "cd '" + scratch_dir().string() + "' && '" + ANIMAT_EVOLVE_EXE + "' " +
+                            flags + "--threads 2 --out '" + killed.string() +
+                            "' >/dev/null 2>&1 & echo $! > '" + pid_file.string() + "'";
+  ASSERT_EQ(std::system(start.c_str()), 0);
+  const pid_t pid = static_cast<pid_t>(std::stol(slurp(pid_file)));
+  const auto hang_guard = std::chrono::steady_clock::now() + std::chrono::seconds(600);
+  auto checkpoint_generation = [&] {
+    try {
+      const auto outer = nlohmann::json::parse(slurp(killed / "checkpoint.json"));
+      return nlohmann::json::parse(outer.at("payload").get<std::string>())
+          .at("generation")
+          .get<int>();
+    } catch (const std::exception&) {
+      return -1;  // not written yet (the rename makes a written one whole)
+    }
+  };
+  while (checkpoint_generation() < 2) {
+    ASSERT_LT(std::chrono::steady_clock::now(), hang_guard) << "hang guard: no checkpoint";
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // polling the condition
+  }
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  // The kernel drops the dead process's lock: wait until the lock file can be locked.
+  for (bool free = false; !free;) {
+    ASSERT_LT(std::chrono::steady_clock::now(), hang_guard) << "hang guard: the lock is held";
+    const int fd = ::open((killed / ".lock").c_str(), O_RDONLY);
+    free = fd < 0 || ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    if (fd >= 0) ::close(fd);
+  }
+  r = run("--quiet --resume '" + killed.string() + "' --generations 5 --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(csv_without_wall(slurp(killed / "history.csv")),
+            csv_without_wall(slurp(straight / "history.csv")));
+  fs::remove_all(straight);
+  fs::remove_all(killed);
 }
 
 TEST(CliErrors, UnknownOption) {

@@ -4,8 +4,11 @@
 // file.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -162,4 +165,39 @@ TEST(SearchRun, TheGaIsRunEvolutionsAndASearchRunIsNot) {
   EXPECT_THROW((void)run_evolution(search_config("nsga2"), quiet_in(dir), search_stub),
                ConfigError);
   EXPECT_FALSE(fs::exists(dir));
+}
+
+TEST(SearchRun, ASecondWriterIsRefusedWhileARunHoldsItsDirectory) {
+  // While a run is paused in its callback (it holds the directory), another run_search and the CLI
+  // are refused naming the holder, and nothing changes. No sleeps: the callback runs them.
+  const Config c = search_config("nsga2");
+  const fs::path dir = fresh_dir("search_run", "two_writers");
+  bool checked = false;
+  RunOptions o = quiet_in(dir);
+  o.search_callback = [&](const Search& s) {
+    if (s.generation() != 2) return true;
+    checked = true;
+    const auto before = snapshot(dir);
+    RunOptions again = quiet_in(dir);
+    again.resume = true;
+    EXPECT_THROW((void)run_search(c, again, search_stub), RunDirectoryBusy);
+    const std::string cmd = std::string("'") + ANIMAT_EVOLVE_EXE + "' --quiet --resume '" +
+                            dir.string() + "' --generations 9 2>&1";
+    std::string output;
+    if (FILE* p = ::popen(cmd.c_str(), "r")) {
+      char buf[4096];
+      for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) output.append(buf, n);
+      EXPECT_NE(::pclose(p), 0) << output;
+    }
+    EXPECT_NE(output.find("in use by another animat process (pid " + std::to_string(::getpid())),
+              std::string::npos)
+        << output;
+    EXPECT_EQ(snapshot(dir), before);
+    return true;
+  };
+  const SearchSummary s = run_search(c, o, search_stub);
+  EXPECT_TRUE(checked);
+  EXPECT_EQ(s.generation, 6);
+  EXPECT_FALSE(fs::exists(dir / ".lock")) << "a run that ends removes its lock file";
+  fs::remove_all(dir);
 }
