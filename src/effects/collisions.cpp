@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -28,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include "../box_pair_list.hpp"
 #include "effect_support.hpp"
 #include "triangle_filter.hpp"
 
@@ -100,6 +102,9 @@ int roots_in_unit_interval(double A, double B, double C, std::array<double, 2>& 
 class Collisions final : public Effect {
  public:
   static constexpr int kMaxEvents = 64;
+  /// How far (length units) the skin items' boxes are widened for the list of skin pairs: the
+  /// list is rebuilt when a box leaves its widened box.
+  static constexpr double kSkinMargin = 0.5;
 
   Collisions(const Body& body, const SceneParams& p)
       : restitution_(p.collision_restitution),
@@ -180,12 +185,14 @@ class Collisions final : public Effect {
     exact_band_.assign(at(n_), 0);
     for (int i = 0; i < n_; ++i) {
       if (!on_skin[at(i)]) continue;
-      items_.push_back({0, 0, 0, 0, i, -1});
+      items_.push_back({i, -1});
       for (int e : skin_edges)
         if (i != a_[at(e)] && i != b_[at(e)] && band_of(i, e) < tol_) exact_band_[at(i)] = 1;
     }
-    for (int e : skin_edges) items_.push_back({0, 0, 0, 0, -1, e});
+    for (int e : skin_edges) items_.push_back({-1, e});
     for (std::size_t k = 0; k < items_.size(); ++k) order_.push_back(static_cast<int>(k));
+    boxes_.assign(items_.size(), detail::Box{0.0, 0.0, 0.0, 0.0});
+    rank_.assign(items_.size(), 0);
 
     for (auto* v : {&w0x_, &w0y_, &wx_, &wy_, &qx_, &qy_, &motion_, &ex_, &ey_})
       v->assign(at(n_), 0.0);
@@ -196,6 +203,11 @@ class Collisions final : public Effect {
     }
     const std::size_t skin_vertices = items_.size() - skin_edges.size();
     candidates_.reserve(3 * tris_.size() + fixed_.size() + skin_vertices * skin_edges.size());
+    skin_pairs_.reset(items_.size(), kSkinMargin, skin_vertices * skin_edges.size());
+    listed_.reserve(skin_vertices * skin_edges.size());
+#if ANIMAT_SELF_CHECK
+    self_check_.reserve(skin_vertices * skin_edges.size());
+#endif
   }
   std::string_view name() const override { return "collisions"; }
   Stage stage() const override { return Stage::constraint; }
@@ -321,7 +333,6 @@ class Collisions final : public Effect {
     double band4;
   };
   struct Item {  // a skin vertex (vertex >= 0) or a skin edge (edge >= 0) in the sort and sweep
-    double lo, hi, ylo, yhi;
     int vertex, edge;
   };
 
@@ -367,43 +378,121 @@ class Collisions final : public Effect {
     for (const Pair& p : fixed_)
       if (boxes_meet(p)) candidates_.push_back(p);
     if (items_.empty()) return;
-    // Skin: sort and sweep the swept x-extents (insertion sort: the order barely changes).
-    for (Item& it : items_) {
+    // Skin: the swept boxes of the skin vertices (widened by the tolerance) and edges, sorted by
+    // their lower x (insertion sort: the order barely changes). The candidates are the pairs a
+    // sweep along that order finds, in its order; from the list of pairs that can overlap while
+    // every box stays within its box of the list's last build widened by kSkinMargin
+    // (src/box_pair_list.hpp), or from the sweep itself when no list can be built.
+    for (std::size_t k = 0; k < items_.size(); ++k) {
+      const Item& it = items_[k];
+      detail::Box& box = boxes_[k];
       if (it.vertex >= 0) {
         const auto v = at(it.vertex);
         const double x1 = ex[v], y1 = ey[v];
-        it.lo = std::min(qx[v], x1) - tol_;
-        it.hi = std::max(qx[v], x1) + tol_;
-        it.ylo = std::min(qy[v], y1) - tol_;
-        it.yhi = std::max(qy[v], y1) + tol_;
+        box.lo = std::min(qx[v], x1) - tol_;
+        box.hi = std::max(qx[v], x1) + tol_;
+        box.ylo = std::min(qy[v], y1) - tol_;
+        box.yhi = std::max(qy[v], y1) + tol_;
       } else {
         const auto a = at(a_[at(it.edge)]), b = at(b_[at(it.edge)]);
         const double ax1 = ex[a], ay1 = ey[a];
         const double bx1 = ex[b], by1 = ey[b];
-        it.lo = std::min(std::min(qx[a], ax1), std::min(qx[b], bx1));
-        it.hi = std::max(std::max(qx[a], ax1), std::max(qx[b], bx1));
-        it.ylo = std::min(std::min(qy[a], ay1), std::min(qy[b], by1));
-        it.yhi = std::max(std::max(qy[a], ay1), std::max(qy[b], by1));
+        box.lo = std::min(std::min(qx[a], ax1), std::min(qx[b], bx1));
+        box.hi = std::max(std::max(qx[a], ax1), std::max(qx[b], bx1));
+        box.ylo = std::min(std::min(qy[a], ay1), std::min(qy[b], by1));
+        box.yhi = std::max(std::max(qy[a], ay1), std::max(qy[b], by1));
       }
     }
     for (std::size_t q = 1; q < order_.size(); ++q)
-      for (std::size_t r = q; r > 0 && items_[at(order_[r])].lo < items_[at(order_[r - 1])].lo; --r)
+      for (std::size_t r = q; r > 0 && boxes_[at(order_[r])].lo < boxes_[at(order_[r - 1])].lo; --r)
         std::swap(order_[r], order_[r - 1]);
+#if ANIMAT_SELF_CHECK
+    const std::size_t first_skin = candidates_.size();
+#endif
+    if (skin_pairs_.holds(boxes_.data()) ||
+        skin_pairs_.build(boxes_.data(), [&](int p, int o) { return skin_pair(p, o) >= 0; }))
+      add_listed_skin_pairs();
+    else
+      sweep_skin();
+#if ANIMAT_SELF_CHECK
+    check_skin_candidates(first_skin);
+#endif
+  }
+
+  /// For skin items p and o, a vertex and an edge that may collide, the vertex's item; else -1
+  /// (two vertices, two edges, or the vertex is an end of the edge or its triangle's opposite
+  /// vertex).
+  [[nodiscard]] int skin_pair(int p, int o) const {
+    const Item& ip = items_[at(p)];
+    const Item& io = items_[at(o)];
+    if ((ip.vertex >= 0) == (io.vertex >= 0)) return -1;
+    const int vi = ip.vertex >= 0 ? p : o;
+    const int v = items_[at(vi)].vertex;
+    const int e = ip.vertex >= 0 ? io.edge : ip.edge;
+    if (v == a_[at(e)] || v == b_[at(e)] || v == opposite_[at(e)]) return -1;
+    return vi;
+  }
+
+  void add_skin_candidate(const Item& p, const Item& o) {
+    const int v = p.vertex >= 0 ? p.vertex : o.vertex;
+    const int e = p.vertex >= 0 ? o.edge : p.edge;
+    candidates_.push_back({v, e, exact_band_[at(v)] ? band_of(v, e) : tol_});
+  }
+
+  /// The skin candidates by the sort and sweep over every item (boxes_ sorted in order_).
+  void sweep_skin() {
     for (std::size_t q = 0; q < order_.size(); ++q) {
-      const Item& p = items_[at(order_[q])];
+      const detail::Box& p = boxes_[at(order_[q])];
       for (std::size_t r = q + 1; r < order_.size(); ++r) {
-        const Item& o = items_[at(order_[r])];
+        const detail::Box& o = boxes_[at(order_[r])];
         if (o.lo > p.hi) break;
-        if ((p.vertex >= 0) == (o.vertex >= 0)) continue;
+        if (skin_pair(order_[q], order_[r]) < 0) continue;
         if (o.ylo > p.yhi || o.yhi < p.ylo) continue;
-        const int v = p.vertex >= 0 ? p.vertex : o.vertex;
-        const int e = p.vertex >= 0 ? o.edge : p.edge;
-        // own edge, or its triangle's
-        if (v == a_[at(e)] || v == b_[at(e)] || v == opposite_[at(e)]) continue;
-        candidates_.push_back({v, e, exact_band_[at(v)] ? band_of(v, e) : tol_});
+        add_skin_candidate(items_[at(order_[q])], items_[at(order_[r])]);
       }
     }
   }
+
+  /// The same candidates in the same order from skin_pairs_ (every box finite and within its
+  /// widened box, so the list holds every overlapping pair). With the items sorted, the sweep
+  /// finds exactly the eligible pairs whose (closed) boxes overlap: for p before o, p.lo <= o.lo
+  /// <= o.hi, so `o.lo <= p.hi` is the x overlap; and it adds them ordered by the position of the
+  /// earlier item in order_, then of the later one.
+  void add_listed_skin_pairs() {
+    for (std::size_t q = 0; q < order_.size(); ++q) rank_[at(order_[q])] = static_cast<int>(q);
+    listed_.clear();
+    for (const auto& [p, o] : skin_pairs_.pairs()) {
+      if (!detail::boxes_overlap(boxes_[at(p)], boxes_[at(o)])) continue;
+      const auto rp = static_cast<std::uint64_t>(rank_[at(p)]);
+      const auto ro = static_cast<std::uint64_t>(rank_[at(o)]);
+      listed_.push_back(rp < ro ? (rp << 32) | ro : (ro << 32) | rp);
+    }
+    std::sort(listed_.begin(), listed_.end());
+    for (const std::uint64_t key : listed_)
+      add_skin_candidate(items_[at(order_[static_cast<std::size_t>(key >> 32)])],
+                         items_[at(order_[static_cast<std::size_t>(key & 0xffffffffU)])]);
+  }
+
+#if ANIMAT_SELF_CHECK
+  /// Whether the skin candidates from `first` on are those of the sweep over every item, in the
+  /// same order; aborts if not.
+  void check_skin_candidates(std::size_t first) {
+    self_check_.assign(candidates_.begin() + static_cast<std::ptrdiff_t>(first), candidates_.end());
+    candidates_.resize(first);
+    sweep_skin();
+    const bool same = self_check_.size() == candidates_.size() - first &&
+                      std::equal(self_check_.begin(), self_check_.end(),
+                                 candidates_.begin() + static_cast<std::ptrdiff_t>(first),
+                                 [](const Pair& x, const Pair& y) {
+                                   return x.cell == y.cell && x.edge == y.edge && x.band == y.band;
+                                 });
+    if (same) return;
+    std::fprintf(stderr,
+                 "collisions: the listed skin candidates (%zu) differ from the sweep's (%zu)\n",
+                 self_check_.size(), candidates_.size() - first);
+    std::abort();
+  }
+#endif
 
 #if ANIMAT_SELF_CHECK
   /// The full triangle test of gather(): whether it rejects the triangle.
@@ -627,11 +716,18 @@ class Collisions final : public Effect {
   std::vector<int> a_, b_;  // edges a cell may not cross
   // per edge: the opposite vertex of its triangular region (-1: none)
   std::vector<int> opposite_;
-  std::vector<double> rx_, ry_;  // rest positions (per-pair tolerance)
-  std::vector<Triangle> tris_;   // triangular regions
-  std::vector<Pair> fixed_;      // vertex-edge pairs of larger regions
-  std::vector<Item> items_;      // skin vertices and skin edges
-  std::vector<int> order_;       // items sorted by their swept x-extent (kept between steps)
+  std::vector<double> rx_, ry_;        // rest positions (per-pair tolerance)
+  std::vector<Triangle> tris_;         // triangular regions
+  std::vector<Pair> fixed_;            // vertex-edge pairs of larger regions
+  std::vector<Item> items_;            // skin vertices and skin edges
+  std::vector<detail::Box> boxes_;     // per item, its swept box in the current gather
+  std::vector<int> order_;             // items sorted by their swept x-extent (kept between steps)
+  std::vector<int> rank_;              // per item, its position in order_ (add_listed_skin_pairs)
+  detail::BoxPairList skin_pairs_;     // the skin item pairs that can overlap (a Verlet list)
+  std::vector<std::uint64_t> listed_;  // scratch: the overlapping listed pairs' positions
+#if ANIMAT_SELF_CHECK
+  std::vector<Pair> self_check_;  // scratch of check_skin_candidates()
+#endif
   // skin vertices whose band differs from the tolerance for some edge
   std::vector<char> exact_band_;
   std::vector<Pair> candidates_;
