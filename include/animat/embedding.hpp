@@ -3,6 +3,7 @@
 // edge; regions oppose compression): every region keeps the sign of its rest area, and the skin
 // stays a simple polygon (no two skin edges that share no end intersect). EmbeddingMonitor checks
 // both on a sequence of frames, independently of the effect that is meant to guarantee them.
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -12,8 +13,13 @@ struct Body;
 
 class EmbeddingMonitor {
  public:
-  EmbeddingMonitor() = default;
+  EmbeddingMonitor();
   explicit EmbeddingMonitor(const Body& body);
+  EmbeddingMonitor(const EmbeddingMonitor& other);
+  EmbeddingMonitor& operator=(const EmbeddingMonitor& other);
+  EmbeddingMonitor(EmbeddingMonitor&&) noexcept;
+  EmbeddingMonitor& operator=(EmbeddingMonitor&&) noexcept;
+  ~EmbeddingMonitor();
 
   /// Checks one frame (positions, n each); adds to the totals. Returns whether the embedding is
   /// intact in this frame. Allocates nothing.
@@ -34,6 +40,9 @@ class EmbeddingMonitor {
   [[nodiscard]] int count_skin_crossings(std::span<const double> x, std::span<const double> y);
 
  private:
+  /// count_skin_crossings() from the pairs kept between frames (what observe() uses).
+  int skin_crossings_now(std::span<const double> x, std::span<const double> y);
+
   // the vertices of every region with a rest area, one after another
   std::vector<int> region_nodes_;
   std::vector<int> region_start_;   // where each such region starts in region_nodes_ (and the end)
@@ -41,6 +50,10 @@ class EmbeddingMonitor {
   std::vector<int> sa_, sb_;        // skin edges
   std::vector<int> order_;          // skin edges sorted by their smallest x (kept between frames)
   std::vector<double> lo_, hi_;     // per skin edge, x extent of this frame
+  // the skin edge pairs that can cross, kept between frames (src/box_pair_list.hpp); a copy
+  // copies them
+  struct SkinPairs;
+  std::unique_ptr<SkinPairs> pairs_;
   long frames_ = 0;
   double min_ratio_ = 1.0;
   long inverted_ = 0;

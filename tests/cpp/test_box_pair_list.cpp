@@ -1,6 +1,6 @@
-// The Verlet list of boxes behind the collisions effect's skin candidates (src/box_pair_list.hpp):
-// while every box stays within its widened box, the listed pairs that overlap are exactly the
-// pairs that overlap, at the edge of the bound too.
+// The Verlet list of boxes behind the collisions effect's skin candidates and the embedding
+// monitor's skin crossings (src/box_pair_list.hpp): while every box stays within its widened box,
+// the listed pairs that overlap are exactly the pairs that overlap, at the edge of the bound too.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +11,10 @@
 #include <vector>
 
 #include "../../src/box_pair_list.hpp"
+#include "animat/embedding.hpp"
+#include "animat/physics.hpp"
+#include "animat/scene.hpp"
+#include "evolved_support.hpp"
 
 namespace animat {
 namespace {
@@ -151,6 +155,34 @@ TEST(BoxPairList, ListedOverlapsAreEveryOverlapFrameByFrameOfRandomMotion) {
   EXPECT_GT(reused, 300);
   EXPECT_GT(list.builds(), 300);
   EXPECT_GT(overlaps, 3000);
+}
+
+TEST(Embedding, TheMonitorCountsEveryFrameAsTheSweepOverAllSkinEdgesDoes) {
+  // The old penalty lets this evolved swimmer's skin cross itself (test_collisions.cpp): the
+  // monitor's count from its kept pairs, frame by frame, against the sweep over every skin edge.
+  const auto genomes = evolved_genomes();
+  const Evolved& e = named(genomes, "exploit_old_physics_dn0.5.json");
+  const Body body = body_of(e);
+  SceneParams scene = e.config.scene;
+  scene.effects = {"springs", "actuation", "pressure", "drag", "skin_collision"};
+  Simulation sim(body, scene);
+  EmbeddingMonitor monitor(body), sweep(body);
+  long crossings = 0;
+  for (int k = 0; k < 4000; ++k) {
+    sim.step();
+    const SwimState& s = sim.state();
+    const long before = monitor.skin_crossings();
+    monitor.observe(s.x, s.y);
+    const int want = sweep.count_skin_crossings(s.x, s.y);
+    ASSERT_EQ(monitor.skin_crossings() - before, want) << "step " << k;
+    crossings += want;
+  }
+  EXPECT_GT(crossings, 100) << "the case must cross to test anything";
+  // A copy goes on as the original does.
+  EmbeddingMonitor copy = monitor;
+  const SwimState& s = sim.state();
+  EXPECT_EQ(copy.observe(s.x, s.y), monitor.observe(s.x, s.y));
+  EXPECT_EQ(copy.skin_crossings(), monitor.skin_crossings());
 }
 
 }  // namespace
