@@ -13,12 +13,20 @@ swim's CPU time is measured in the same process::
         --data data/replication_regime --out studies/regime/results/selection_step_regime.csv --jobs 2
 
 writes one row per individual (run, its rank at dt, fitness and seconds at every step) and
-``--summary CSV`` prints, per environment and step, against dt/32: the median and largest relative
-fitness error and how many errors exceed 1 %, the share of discordant pairs (two individuals whose order at that step is the
-reverse of their order at dt/32: a tournament the step decides wrongly), the same among pairs more than 1 % apart at dt/32, how often the two elites
-are the two best at dt/32, the shortfall of the step's best from the best at dt/32, and the cost of
-an evaluation against dt; the "select" row is today's rule (elites by dt/16 among the four fittest
-at dt).
+``--summary CSV`` prints, per environment and step, against the finest step (dt/32): the median
+relative fitness error and how many errors exceed 1 %, the share of discordant pairs (two
+individuals whose order at that step is the reverse of their order at dt/32: a tournament the step
+decides wrongly), the same among pairs more than 1 % apart at dt/32, how often the two elites are the
+two best at dt/32, the shortfall of the step's best from the best at dt/32, and the cost of an
+evaluation against the coarsest step; the "select" row is today's rule (elites by dt/16 among the
+four fittest at dt).
+
+``--set KEY=VALUE`` swims the same individuals with other constants and ``--substeps`` at other
+steps: whether their swims converge at a higher spring damping, for instance::
+
+    PYTHONPATH=build/python .venv/bin/python studies/regime/selection_step.py \\
+        --data data/replication_regime --envs dn0.5 --substeps 16 32 --set scene.spring_damping=1 \\
+        --out studies/regime/results/selection_step_dn0.5_damping1.csv
 """
 
 from __future__ import annotations
@@ -130,7 +138,7 @@ def summary(path: Path) -> str:
         runs.setdefault(env, {}).setdefault(r["run"], []).append(r)
     lines = [
         "| environment | step | median error | errors over 1 % | discordant pairs | discordant pairs 1 % apart | "
-        "elites right | best's shortfall (median, largest) | cost against dt |",
+        "elites right | best's shortfall (median, largest) | cost against the coarsest step |",
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for env in sorted(runs):
