@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -478,6 +479,21 @@ void bind_research(nb::module_& m) {
       "(None where the swim was not viable, stable and valid): (fitnesses, bodies). MAP-Elites "
       "describes\n"
       "its candidates from these bodies (animat.qd).");
+  m.def(
+      "source_direction",
+      [](const Config& config, int trial) {
+        const int count = std::max(1, config.evaluation.source_directions);
+        if (trial < 0 || trial >= count)
+          throw ConfigError(fmt::format(
+              "source_direction: trial {} is not one of the {} evaluation.source_directions", trial,
+              count));
+        return source_direction(config, trial);
+      },
+      "config"_a, "trial"_a,
+      "Objective chemotaxis: the chemical source of swim `trial` of an evaluation, relative to the "
+      "body's\n"
+      "start centre: scene.chemical_source turned by the run's offset + 2*pi*trial/T (T =\n"
+      "evaluation.source_directions), as the evaluation places it.");
   m.def("body_length", &body_length, "body"_a,
         "Length of a body along its longest axis: the largest distance between two cell centres at "
         "rest plus\n"

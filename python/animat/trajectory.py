@@ -117,18 +117,14 @@ def chemotaxis_source(config: Any, trial: int = 0) -> np.ndarray:
     """The chemical source of swim ``trial`` of an evaluation under objective ``chemotaxis``,
     relative to the body's start centre: ``scene.chemical_source`` rotated by offset + 2π·trial/T
     (T = ``evaluation.source_directions``), the offset uniform in [0, 2π) drawn from
-    ``evaluation.source_seed``, the same for every genome (docs/control.md). The engine's own
-    ``source_direction`` (src/evaluate.cpp), computed the same way: the swims of
-    :func:`replay` with ``source_trial`` 0 to T - 1 average to the evaluation's fitness.
+    ``evaluation.source_seed``, the same for every genome (docs/control.md). The engine computes it
+    (``source_direction``, src/evaluate.cpp): the swims of :func:`replay` with ``source_trial`` 0 to
+    T - 1 average to the evaluation's fitness.
     """
     count = max(1, int(config["evaluation.source_directions"]))
     if not 0 <= trial < count:
         raise ValueError(f"chemotaxis_source: trial {trial} is not one of the {count} evaluation.source_directions")
-    offset = 2.0 * math.pi * _core.Rng(int(config["evaluation.source_seed"])).uniform()
-    angle = offset + 2.0 * math.pi * trial / count
-    x, y = (float(v) for v in config["scene.chemical_source"])
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([c * x - s * y, s * x + c * y])
+    return np.asarray(_core.source_direction(config, int(trial)), dtype=float)
 
 
 def body_of(thing: Any, config: Optional[Any] = None):
