@@ -294,14 +294,9 @@ std::string MapElites::stop_reason() const {
 
 std::string MapElites::checkpoint() const {
   if (generation_ < 0) throw Error("MapElites.checkpoint: no generation completed yet");
-  json p;
-  p["format"] = kMapElitesFormat;
-  p["version"] = kMapElitesVersion;
-  p["identity"] = fmt::format("{:016x}", identity_);
-  p["generation"] = generation_;
-  p["evaluations"] = evaluations_;
-  p["reference_evaluations"] = reference_evaluations_;
-  p["wall_seconds"] = history_.back().back();
+  json p =
+      payload_head(kMapElitesFormat, kMapElitesVersion, identity_,
+                   {generation_, evaluations_, reference_evaluations_, history_.back().back()});
   json elites = json::array();
   for (const auto& [cell, e] : archive_.elites())
     elites.push_back(json{{"cell", cell},
@@ -318,10 +313,7 @@ void MapElites::restore(std::string_view text, std::string_view source) {
   const json p = unseal(text, source, kMapElitesFormat, kMapElitesVersion, identity_);
   auto fail = [&](const std::string& what) { inconsistent(source, what); };
   reading_checkpoint(source, [&] {
-    const int generation = static_cast<int>(int_field(p, "generation", 0, 100000000));
-    const std::int64_t evaluations = int_field(p, "evaluations", 0, 1LL << 53);
-    const std::int64_t reference_evaluations = int_field(p, "reference_evaluations", 0, 1LL << 53);
-    const double wall = number_field(p, "wall_seconds");
+    const auto [generation, evaluations, reference_evaluations, wall] = read_counters(p);
     GridArchive archive(archive_.descriptors(), archive_.bins());
     if (!p.contains("elites") || !p["elites"].is_array()) fail("no list of elites");
     if (p["elites"].size() > archive.cells())

@@ -365,14 +365,9 @@ std::string Nsga2::stop_reason() const {
 
 std::string Nsga2::checkpoint() const {
   if (generation_ < 0) throw Error("Nsga2.checkpoint: no generation completed yet");
-  json p;
-  p["format"] = kNsga2Format;
-  p["version"] = kNsga2Version;
-  p["identity"] = fmt::format("{:016x}", identity_);
-  p["generation"] = generation_;
-  p["evaluations"] = evaluations_;
-  p["reference_evaluations"] = reference_evaluations_;
-  p["wall_seconds"] = history_.back().back();
+  json p =
+      payload_head(kNsga2Format, kNsga2Version, identity_,
+                   {generation_, evaluations_, reference_evaluations_, history_.back().back()});
   p["reference_point"] = reference_point_.empty() ? json(nullptr) : values_json(reference_point_);
   json members = json::array();
   for (const Solution& s : population_) {
@@ -393,10 +388,7 @@ void Nsga2::restore(std::string_view text, std::string_view source) {
   const json p = unseal(text, source, kNsga2Format, kNsga2Version, identity_);
   auto fail = [&](const std::string& what) { inconsistent(source, what); };
   reading_checkpoint(source, [&] {
-    const int generation = static_cast<int>(int_field(p, "generation", 0, 100000000));
-    const std::int64_t evaluations = int_field(p, "evaluations", 0, 1LL << 53);
-    const std::int64_t reference_evaluations = int_field(p, "reference_evaluations", 0, 1LL << 53);
-    const double wall = number_field(p, "wall_seconds");
+    const auto [generation, evaluations, reference_evaluations, wall] = read_counters(p);
     const std::size_t m = criteria_.size();
     auto read_values = [&](const json& j, const char* what, bool allow_nan) {
       if (!j.is_array() || j.size() != m) fail(fmt::format("{} must list {} values", what, m));

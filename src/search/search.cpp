@@ -261,6 +261,27 @@ json unseal(std::string_view text, std::string_view source, std::string_view for
   return p;
 }
 
+json payload_head(std::string_view format, int version, std::uint64_t identity, const Counters& c) {
+  json p;
+  p["format"] = std::string(format);
+  p["version"] = version;
+  p["identity"] = hex(identity);
+  p["generation"] = c.generation;
+  p["evaluations"] = c.evaluations;
+  p["reference_evaluations"] = c.reference_evaluations;
+  p["wall_seconds"] = c.wall_seconds;
+  return p;
+}
+
+Counters read_counters(const json& p) {
+  Counters c;
+  c.generation = static_cast<int>(int_field(p, "generation", 0, 100000000));
+  c.evaluations = int_field(p, "evaluations", 0, 1LL << 53);
+  c.reference_evaluations = int_field(p, "reference_evaluations", 0, 1LL << 53);
+  c.wall_seconds = number_field(p, "wall_seconds");
+  return c;
+}
+
 long long int_field(const json& j, const char* key, long long lo, long long hi) {
   if (!j.is_object() || !j.contains(key))
     throw CheckpointError(fmt::format("field \"{}\" is missing", key));

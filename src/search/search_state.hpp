@@ -30,6 +30,18 @@ std::string seal(const json& payload);
 json unseal(std::string_view text, std::string_view source, std::string_view format, int version,
             std::uint64_t identity);
 
+/// What every search's checkpoint counts: the generation, the evaluations, the exploit guard's
+/// evaluations and the wall-clock seconds of the run so far.
+struct Counters {
+  int generation = -1;
+  std::int64_t evaluations = 0, reference_evaluations = 0;
+  double wall_seconds = 0.0;
+};
+/// The payload's head: format, version, identity and the counters.
+json payload_head(std::string_view format, int version, std::uint64_t identity, const Counters& c);
+/// The counters of a payload, type- and range-checked.
+Counters read_counters(const json& payload);
+
 long long int_field(const json& j, const char* key, long long lo, long long hi);
 double number_field(const json& j, const char* key);
 bool bool_field(const json& j, const char* key);
