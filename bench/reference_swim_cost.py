@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""What the exploit guard's reference swims cost per generation (docs/performance.md): a GA run of
+a config (default: the regime preset, configs/regime_dn0.5.toml, evaluation.reference_check =
+"select") driven through animat.GA on one thread, with the CPU time of the generation's own
+evaluations (animat.evaluate, here) apart from the CPU time inside ask() and tell(), which is the
+reference swims at dt/reference_substeps of the elite candidates plus the GA's own work (about a
+millisecond a generation, docs/performance.md).
+
+    PYTHONPATH=build/python .venv/bin/python bench/reference_swim_cost.py --generations 20 --seed 1
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import animat
+from animat.pipeline import load_config
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--config", default=str(REPO / "configs" / "regime_dn0.5.toml"))
+    ap.add_argument("--generations", type=int, default=20)
+    ap.add_argument("--seed", type=int, default=1)
+    args = ap.parse_args()
+    config = load_config(args.config)
+    config["evolution.seed"] = args.seed
+    config["evolution.threads"] = 1  # the reference swims on this thread too
+    ga = animat.GA(config)
+    rows = []  # per completed generation: (generation, evaluations, evaluation CPU s, guard CPU s)
+    evaluations, eval_cpu, guard_cpu = 0, 0.0, 0.0
+    while len(rows) <= args.generations:
+        t0 = time.process_time()
+        genomes = ga.ask()
+        guard_cpu += time.process_time() - t0
+        t0 = time.process_time()
+        results = [animat.evaluate(g, config) for g in genomes]
+        eval_cpu += time.process_time() - t0
+        evaluations += len(genomes)
+        t0 = time.process_time()
+        stats = ga.tell(results)
+        guard_cpu += time.process_time() - t0
+        if stats is not None:
+            rows.append((stats.generation, evaluations, eval_cpu, guard_cpu))
+            evaluations, eval_cpu, guard_cpu = 0, 0.0, 0.0
+    print(
+        f"config {args.config}, seed {args.seed}, reference_check = {config['evaluation.reference_check']}, "
+        f"reference_substeps = {config['evaluation.reference_substeps']}; CPU seconds, one thread"
+    )
+    print(
+        "| generation | evaluations | their CPU s | CPU s in ask() + tell() (reference swims) | guard over evaluations |"
+    )
+    print("|---|---|---|---|---|")
+    for g, n, e, r in rows:
+        print(f"| {g} | {n} | {e:.2f} | {r:.2f} | {r / e:.2f}x |")
+    later = rows[1:]
+    if later:
+        e = statistics.median(r[2] for r in later)
+        r = statistics.median(r[3] for r in later)
+        share = sum(x[3] for x in later) / sum(x[2] + x[3] for x in later)
+        print(
+            f"\nlater generations (median): evaluations {e:.2f} s, guard {r:.2f} s; "
+            f"the guard is {share:.0%} of their CPU time in all"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
