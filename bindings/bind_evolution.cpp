@@ -637,6 +637,45 @@ void bind_evolution(nb::module_& m) {
   bind_search(m);
 
   m.def(
+      "run_search",
+      [](const Config& c, std::filesystem::path out, bool resume, bool overwrite, bool quiet) {
+        RunOptions opt;
+        opt.out = std::move(out);
+        opt.resume = resume;
+        opt.overwrite = overwrite;
+        opt.quiet = quiet;
+        bool interrupted = false;
+        // Polled between evaluations (about every 20 ms): Ctrl-C stops the run with a checkpoint.
+        opt.stop_poll = [&interrupted] {
+          nb::gil_scoped_acquire gil;
+          interrupted = interrupted || PyErr_CheckSignals() != 0;
+          return interrupted;
+        };
+        SearchSummary summary;
+        {
+          nb::gil_scoped_release release;
+          summary = run_search(c, opt);
+        }
+        if (interrupted) throw nb::python_error();  // the KeyboardInterrupt, after the checkpoint
+        nb::dict d;
+        d["algorithm"] = summary.algorithm;
+        nb::list columns;
+        for (const auto& col : summary.columns) columns.append(col.name);
+        d["columns"] = columns;
+        d["history"] = summary.history;
+        d["stop_reason"] = summary.stop_reason;
+        d["generation"] = summary.generation;
+        return d;
+      },
+      "config"_a, "out"_a, "resume"_a = false, "overwrite"_a = false, "quiet"_a = true,
+      "Run (or resume) the config's MAP-Elites or NSGA-II as animat_evolve does (search.hpp): the "
+      "run\ndirectory out (config.toml, history.csv, checkpoint.json) is locked while it runs, its "
+      "checkpoint is\nchecked on load, and a resume may change only the resumable keys. Returns "
+      "a dict: algorithm,\ncolumns, history (rows of floats), stop_reason, generation. The GIL "
+      "is released while it runs;\nCtrl-C stops it with a checkpoint of the last complete "
+      "generation and raises KeyboardInterrupt.");
+
+  m.def(
       "reference_config", [](const Config& config) { return reference_config(config); }, "config"_a,
       "The config of the exploit guard's reference swim (the engine's): a copy of config with\n"
       "physics.substeps multiplied by evaluation.reference_substeps. The GA, MAP-Elites and "

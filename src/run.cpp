@@ -1,5 +1,6 @@
-// The run directory (run_evolution): config.toml, history.csv, the best's lineage, checkpoints,
-// resumes and the directory's lock, around the GA engine of evolution.cpp.
+// The run directory (run_evolution, run_search): config.toml, history.csv, the best's lineage,
+// checkpoints, resumes and the directory's lock, around the GA engine of evolution.cpp and the
+// other searches of search.hpp.
 #include "animat/run.hpp"
 
 #include <fcntl.h>

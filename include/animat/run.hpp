@@ -1,7 +1,8 @@
 #pragma once
 // A run on disk (the run layer): run_evolution() drives an Evolution and keeps its run directory:
 // config.toml, history.csv, the best's lineage in best/, checkpoints, resume.log (islands.csv with
-// islands), under the directory's lock.
+// islands), under the directory's lock; run_search() does the same for MAP-Elites and NSGA-II
+// (search.hpp): config.toml, history.csv, checkpoints and resume.log.
 #include <atomic>
 #include <filesystem>
 #include <functional>

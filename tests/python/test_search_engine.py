@@ -119,3 +119,19 @@ def test_the_exploit_guard_swims_the_same_references(algorithm, guard):
             engine.history[-1][:-1] if algorithm == "nsga2" else engine.history[-1][:10], [float(x) for x in row]
         )
     assert row["reference_evaluations"] > 0
+
+
+def test_run_search_resumes_to_the_same_run(tmp_path):
+    config = config_for("nsga2", 9)
+    config["evaluation.steps"] = 40
+    config["evolution.generations"] = 4
+    straight = _core.run_search(config, tmp_path / "straight")
+    assert straight["generation"] == 4 and straight["stop_reason"].startswith("generation cap")
+    config["evolution.generations"] = 2
+    _core.run_search(config, tmp_path / "resumed")
+    with pytest.raises(Exception, match="already holds a run"):
+        _core.run_search(config, tmp_path / "resumed")
+    config["evolution.generations"] = 4
+    resumed = _core.run_search(config, tmp_path / "resumed", resume=True)
+    assert [row[:-1] for row in resumed["history"]] == [row[:-1] for row in straight["history"]]
+    assert resumed["columns"][-1] == "wall_seconds"
