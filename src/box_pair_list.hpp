@@ -45,13 +45,17 @@ class BoxPairList {
   /// build, and for a box with a NaN bound).
   [[nodiscard]] bool holds(const Box* boxes) const {
     if (!built_) return false;
-    for (std::size_t k = 0; k < wide_.size(); ++k) {
-      const Box& b = boxes[k];
-      const Box& w = wide_[k];
-      if (!(b.lo >= w.lo && b.hi <= w.hi && b.ylo >= w.ylo && b.yhi <= w.yhi)) return false;
-    }
+    for (std::size_t k = 0; k < wide_.size(); ++k)
+      if (!contains(k, boxes[k])) return false;
     return true;
   }
+  /// Whether box k, `b`, lies within its widened box (holds() is: built() and this for every box).
+  [[nodiscard]] bool contains(std::size_t k, const Box& b) const {
+    const Box& w = wide_[k];
+    return b.lo >= w.lo && b.hi <= w.hi && b.ylo >= w.ylo && b.yhi <= w.yhi;
+  }
+  /// Whether the last build() succeeded.
+  [[nodiscard]] bool built() const { return built_; }
 
   /// Widens every box by the margin and keeps the pairs (p, q), p < q, with eligible(p, q) whose
   /// widened boxes overlap, in no particular order. False (and no list) if a widened bound is

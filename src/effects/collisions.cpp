@@ -383,6 +383,7 @@ class Collisions final : public Effect {
     // sweep along that order finds, in its order; from the list of pairs that can overlap while
     // every box stays within its box of the list's last build widened by kSkinMargin
     // (src/box_pair_list.hpp), or from the sweep itself when no list can be built.
+    bool held = skin_pairs_.built();  // every box within its widened box (skin_pairs_.holds())
     for (std::size_t k = 0; k < items_.size(); ++k) {
       const Item& it = items_[k];
       detail::Box& box = boxes_[k];
@@ -402,6 +403,7 @@ class Collisions final : public Effect {
         box.ylo = std::min(std::min(qy[a], ay1), std::min(qy[b], by1));
         box.yhi = std::max(std::max(qy[a], ay1), std::max(qy[b], by1));
       }
+      held = skin_pairs_.contains(k, box) && held;
     }
     for (std::size_t q = 1; q < order_.size(); ++q)
       for (std::size_t r = q; r > 0 && boxes_[at(order_[r])].lo < boxes_[at(order_[r - 1])].lo; --r)
@@ -409,7 +411,7 @@ class Collisions final : public Effect {
 #if ANIMAT_SELF_CHECK
     const std::size_t first_skin = candidates_.size();
 #endif
-    if (skin_pairs_.holds(boxes_.data()) ||
+    if (held ||
         skin_pairs_.build(boxes_.data(), [&](int p, int o) { return skin_pair(p, o) >= 0; }))
       add_listed_skin_pairs();
     else
@@ -459,18 +461,26 @@ class Collisions final : public Effect {
   /// <= o.hi, so `o.lo <= p.hi` is the x overlap; and it adds them ordered by the position of the
   /// earlier item in order_, then of the later one.
   void add_listed_skin_pairs() {
-    for (std::size_t q = 0; q < order_.size(); ++q) rank_[at(order_[q])] = static_cast<int>(q);
     listed_.clear();
-    for (const auto& [p, o] : skin_pairs_.pairs()) {
-      if (!detail::boxes_overlap(boxes_[at(p)], boxes_[at(o)])) continue;
-      const auto rp = static_cast<std::uint64_t>(rank_[at(p)]);
-      const auto ro = static_cast<std::uint64_t>(rank_[at(o)]);
-      listed_.push_back(rp < ro ? (rp << 32) | ro : (ro << 32) | rp);
+    for (const auto& [p, o] : skin_pairs_.pairs())
+      if (detail::boxes_overlap(boxes_[at(p)], boxes_[at(o)]))
+        listed_.push_back((static_cast<std::uint64_t>(p) << 32) | static_cast<std::uint64_t>(o));
+    if (listed_.size() > 1) {  // their order in the sweep (one pair has no order to keep)
+      for (std::size_t q = 0; q < order_.size(); ++q) rank_[at(order_[q])] = static_cast<int>(q);
+      for (std::uint64_t& key : listed_) {
+        const auto rp = static_cast<std::uint64_t>(rank_[static_cast<std::size_t>(key >> 32)]);
+        const auto ro =
+            static_cast<std::uint64_t>(rank_[static_cast<std::size_t>(key & 0xffffffffU)]);
+        key = rp < ro ? (rp << 32) | ro : (ro << 32) | rp;
+      }
+      std::sort(listed_.begin(), listed_.end());
+      for (std::uint64_t& key : listed_)
+        key = (static_cast<std::uint64_t>(order_[static_cast<std::size_t>(key >> 32)]) << 32) |
+              static_cast<std::uint64_t>(order_[static_cast<std::size_t>(key & 0xffffffffU)]);
     }
-    std::sort(listed_.begin(), listed_.end());
     for (const std::uint64_t key : listed_)
-      add_skin_candidate(items_[at(order_[static_cast<std::size_t>(key >> 32)])],
-                         items_[at(order_[static_cast<std::size_t>(key & 0xffffffffU)])]);
+      add_skin_candidate(items_[static_cast<std::size_t>(key >> 32)],
+                         items_[static_cast<std::size_t>(key & 0xffffffffU)]);
   }
 
 #if ANIMAT_SELF_CHECK
