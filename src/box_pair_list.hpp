@@ -30,9 +30,29 @@ inline bool boxes_overlap(const Box& a, const Box& b) {
 
 class BoxPairList {
  public:
+  BoxPairList() = default;
+  /// A copy keeps the room for max_pairs kept pairs, so that its build() allocates nothing either.
+  BoxPairList(const BoxPairList& other) { *this = other; }
+  BoxPairList& operator=(const BoxPairList& other) {
+    if (this == &other) return *this;
+    margin_ = other.margin_;
+    max_pairs_ = other.max_pairs_;
+    wide_ = other.wide_;
+    order_ = other.order_;
+    pairs_.reserve(max_pairs_);
+    pairs_ = other.pairs_;
+    built_ = other.built_;
+    builds_ = other.builds_;
+    return *this;
+  }
+  BoxPairList(BoxPairList&&) noexcept = default;
+  BoxPairList& operator=(BoxPairList&&) noexcept = default;
+  ~BoxPairList() = default;
+
   /// Sized for `count` boxes and at most `max_pairs` kept pairs: the only allocation.
   void reset(std::size_t count, double margin, std::size_t max_pairs) {
     margin_ = margin;
+    max_pairs_ = max_pairs;
     wide_.assign(count, Box{0.0, 0.0, 0.0, 0.0});
     order_.clear();
     for (std::size_t k = 0; k < count; ++k) order_.push_back(static_cast<int>(k));
@@ -99,8 +119,9 @@ class BoxPairList {
   static std::size_t at(int i) { return static_cast<std::size_t>(i); }
 
   double margin_ = 0.0;
-  std::vector<Box> wide_;   // per box, the box at the last build widened by the margin
-  std::vector<int> order_;  // boxes sorted by their widened lower x (kept between builds)
+  std::size_t max_pairs_ = 0;  // the room reserved in pairs_
+  std::vector<Box> wide_;      // per box, the box at the last build widened by the margin
+  std::vector<int> order_;     // boxes sorted by their widened lower x (kept between builds)
   std::vector<std::pair<int, int>> pairs_;
   bool built_ = false;
   long builds_ = 0;

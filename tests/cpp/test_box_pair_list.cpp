@@ -14,6 +14,7 @@
 #include "animat/embedding.hpp"
 #include "animat/physics.hpp"
 #include "animat/scene.hpp"
+#include "counting_allocator.hpp"  // a build allocates nothing
 #include "evolved_support.hpp"
 
 namespace animat {
@@ -124,6 +125,34 @@ TEST(BoxPairList, ANonFiniteBoxIsNeverListed) {
   boxes[1].ylo = 0.0;
   boxes[0].lo = -inf;
   EXPECT_FALSE(list.build(boxes.data(), yes));
+}
+
+TEST(BoxPairList, BuildAllocatesNothingAndNorDoesACopysBuild) {
+  // Ten boxes far apart (no pair kept), then all on top of each other (every pair kept): the
+  // list, and a copy made while it kept nothing, build the 45 pairs in the room reset() made.
+  auto yes = [](int, int) { return true; };
+  std::vector<Box> apart, together;
+  for (int k = 0; k < 10; ++k) {
+    apart.push_back({10.0 * k, 10.0 * k + 1.0, 0.0, 1.0});
+    together.push_back({0.0, 1.0, 0.0, 1.0});
+  }
+  BoxPairList list;
+  list.reset(apart.size(), 0.25, apart.size() * (apart.size() - 1) / 2);
+  ASSERT_TRUE(list.build(apart.data(), yes));
+  ASSERT_TRUE(list.pairs().empty());
+  BoxPairList copy = list;
+  BoxPairList assigned;
+  assigned = list;
+  g_allocations = 0;
+  g_counting = true;
+  const bool built = list.build(together.data(), yes) && copy.build(together.data(), yes) &&
+                     assigned.build(together.data(), yes);
+  g_counting = false;
+  ASSERT_TRUE(built);
+  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_EQ(list.pairs().size(), 45u);
+  EXPECT_EQ(copy.pairs().size(), 45u);
+  EXPECT_EQ(assigned.pairs().size(), 45u);
 }
 
 TEST(BoxPairList, ListedOverlapsAreEveryOverlapFrameByFrameOfRandomMotion) {
