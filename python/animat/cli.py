@@ -403,10 +403,18 @@ def cmd_explore(args) -> int:
 
         packed = any(Run(r.path).packed for r in refs)
         out = output_home(Path(args.runs[0]), packed) / "explore.html"
-    options = dict(frames=args.frames, max_points=args.max_points, modes=args.modes, replays=args.replays)
     t0 = time.perf_counter()
     live = {"poll": args.poll, "max_polls": 20000} if args.live else None
-    page = explore.render_html(explore.build_data(args.runs, live=live, refs=refs, **options))
+    data = explore.build_data(
+        args.runs,
+        frames=args.frames,
+        max_points=args.max_points,
+        modes=args.modes,
+        replays=args.replays,
+        live=live,
+        refs=refs,
+    )
+    page = explore.render_html(data)
     if out is not None:
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text(page, encoding="utf-8")
@@ -424,7 +432,10 @@ def cmd_explore(args) -> int:
                 poll=args.poll,
                 page=page,
                 log=lambda m: print(m, flush=True),
-                **options,
+                frames=args.frames,
+                max_points=args.max_points,
+                modes=args.modes,
+                replays=args.replays,
             )
         except KeyboardInterrupt:
             print("(stopped serving)", file=sys.stderr)
