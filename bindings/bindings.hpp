@@ -24,6 +24,7 @@ void bind_body(nanobind::module_& m);
 void bind_physics(nanobind::module_& m);
 void bind_evolution(nanobind::module_& m);
 void bind_research(nanobind::module_& m);
+void bind_locomotion(nanobind::module_& m);
 
 /// The objective `objective` names: None = the config's (evaluation.objective), a str = that
 /// built-in, otherwise a Python objective object (name, every, callable with an EvaluationRecord).

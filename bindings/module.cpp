@@ -56,4 +56,5 @@ NB_MODULE(_core, m) {
   animat::py::bind_physics(m);
   animat::py::bind_evolution(m);
   animat::py::bind_research(m);
+  animat::py::bind_locomotion(m);
 }

@@ -1,0 +1,48 @@
+// The measures' table (search.hpp): what MAP-Elites' descriptors and NSGA-II's criteria read of
+// an evaluation's Fitness.
+#include <fmt/format.h>
+
+#include "animat/config.hpp"
+#include "animat/errors.hpp"
+#include "animat/search.hpp"
+
+namespace animat {
+
+
+namespace {
+
+// Descriptor ranges are animat.qd.DESCRIPTORS' (the paper's settings): integer descriptors one
+// wider than their values, so that hi - lo bins give each value its own bin.
+constexpr Measure kMeasures[] = {
+    {"fitness", "the objective's value (evaluation.objective)", 0.0, 50.0, true,
+     [](const Fitness& f) { return f.fitness; }},
+    {"cells", "number of cells of the developed embryo", 1.0, 65.0, true,
+     [](const Fitness& f) { return static_cast<double>(f.cell_count); }},
+    {"actuation_work", "net mechanical work of actuation on the springs", 0.0, 0.0, false,
+     [](const Fitness& f) { return f.actuation_work; }},
+    {"actuation_work_positive", "positive actuation work: what the actuators spend", 0.0, 0.0,
+     false, [](const Fitness& f) { return f.actuation_work_positive; }},
+    {"actuation_work_absolute", "absolute actuation work", 0.0, 0.0, false,
+     [](const Fitness& f) { return f.actuation_work_absolute; }},
+    {"max_speed", "largest cell speed seen in the swim", 0.0, 0.0, true,
+     [](const Fitness& f) { return f.max_speed; }},
+};
+
+}  // namespace
+
+std::span<const Measure> measures() { return kMeasures; }
+
+const Measure& find_measure(std::string_view name, const Config& config, std::string_view key) {
+  if (name == config.evaluation.objective) return kMeasures[0];
+  for (const Measure& m : kMeasures)
+    if (name == m.name) return m;
+  std::string names;
+  for (const Measure& m : kMeasures) names += (names.empty() ? "" : ", ") + std::string(m.name);
+  throw ConfigError(
+      fmt::format("{}: no measure \"{}\" in animat_evolve; its measures are {} (and \"{}\", the "
+                  "evaluation.objective, as \"fitness\"); the others of animat.qd.DESCRIPTORS and "
+                  "animat.moo.CRITERIA run in Python (`animat evolve`)",
+                  key, name, names, config.evaluation.objective));
+}
+
+}  // namespace animat
