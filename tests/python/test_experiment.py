@@ -56,6 +56,20 @@ def test_fixed_stream_presets_are_the_regime_presets_with_one_jitter_stream(env)
     assert regime["development.jitter_stream"] == "genome"
 
 
+@pytest.mark.parametrize("env, damping", [("dn0.5", None), ("dn10", None), ("dn0.2_64cells", 1.0)])
+def test_long_replication_presets_select_at_dt4_with_the_reference_at_dt16(env, damping):
+    fixed = animat.load_config(str(ROOT / "configs" / f"regime_fixed_{env}.toml"))
+    dt4 = animat.load_config(str(ROOT / "configs" / f"regime_dt4_{env}.toml"))
+    changed = {key: dt4[key] for key in fixed.keys() if dt4[key] != fixed[key]}
+    expected = {"physics.substeps": 4, "evaluation.reference_substeps": 4, "evolution.generations": 5000}
+    if damping is not None:
+        expected["scene.spring_damping"] = damping
+    assert changed == expected
+    # the same reference step as the fixed-stream preset's: dt/16
+    assert fixed["physics.substeps"] * fixed["evaluation.reference_substeps"] == 16
+    assert dt4["physics.substeps"] * dt4["evaluation.reference_substeps"] == 16
+
+
 def test_experiment_runs_seeds_resumes_and_summarises(tmp_path):
     cfg = tmp_path / "tiny.toml"
     cfg.write_text(TINY)
