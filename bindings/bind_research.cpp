@@ -461,8 +461,7 @@ void bind_research(nb::module_& m) {
         const FitnessFunction keep = [&](const Genome& genome) {
           BodyKeeper keeper(*scored_by);
           const EvaluationResult r = evaluate(genome, c, keeper);
-          Fitness f{r.fitness, r.viable, r.stable, r.cell_count, r.valid, r.drag_limited};
-          f.morphology_kind = r.morphology_kind;
+          const Fitness f = fitness_of(r);
           bodies[static_cast<std::size_t>(&genome - genomes.data())] = std::move(keeper.body());
           return f;
         };
