@@ -553,6 +553,18 @@ void validate(const Config& config, std::string_view source) {
     if (b != std::floor(b))
       fail(fmt::format("search.bins = {}: entry {} is not a whole number",
                        format_value(search.bins), format_double(b)));
+  if (!search.ranges.empty() && search.ranges.size() != 2 * search.descriptors.size())
+    fail(fmt::format(
+        "search.ranges = {}: give lo and hi for each of the {} of search.descriptors = {} ({} "
+        "numbers), or [] for the measures table's ranges",
+        format_value(search.ranges), search.descriptors.size(), format_value(search.descriptors),
+        2 * search.descriptors.size()));
+  for (std::size_t j = 0; j + 1 < search.ranges.size(); j += 2)
+    if (!std::isfinite(search.ranges[j]) || !std::isfinite(search.ranges[j + 1]) ||
+        !(search.ranges[j] < search.ranges[j + 1]))
+      fail(fmt::format("search.ranges = {}: the range of \"{}\", [{}, {}], is not finite lo < hi",
+                       format_value(search.ranges), search.descriptors[j / 2],
+                       format_double(search.ranges[j]), format_double(search.ranges[j + 1])));
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}",
                      config.development.min_cells, config.development.max_cells));

@@ -186,18 +186,28 @@ struct Elite {
   int generation = 0;  ///< the generation that made it
 };
 
+/// The range [lo, hi) of a grid's descriptor.
+struct Range {
+  double lo, hi;
+};
+
 /// A regular grid over the descriptors: descriptor j is divided into bins[j] equal bins over [lo,
 /// hi) (edges lo + k (hi - lo) / bins, the last one hi); a value below lo goes to the first bin,
 /// one at or above hi to the last. The cell index is the row-major index of the bins (animat.qd's
 /// GridArchive, pyribs's order).
 class GridArchive {
  public:
-  /// ConfigError naming search.bins for a count < 1 or a grid of more than kMaxArchiveCells cells.
-  GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins);
+  /// `ranges`: one per descriptor (search.ranges); empty: each measure's own range. ConfigError
+  /// naming search.bins for a count < 1 or a grid of more than kMaxArchiveCells cells, and naming
+  /// search.ranges for a count other than one per descriptor or a range that is not finite lo < hi.
+  GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins,
+              std::vector<Range> ranges = {});
   [[nodiscard]] std::size_t cells() const { return cells_; }
   [[nodiscard]] std::size_t dims() const { return descriptors_.size(); }
   [[nodiscard]] const std::vector<const Measure*>& descriptors() const { return descriptors_; }
   [[nodiscard]] const std::vector<int>& bins() const { return bins_; }
+  /// The range of every descriptor, in descriptor order.
+  [[nodiscard]] const std::vector<Range>& ranges() const { return ranges_; }
   /// The cell of finite descriptor values.
   [[nodiscard]] std::size_t index_of(std::span<const double> values) const;
   /// Offers a candidate: enters when its cell is empty or its objective is strictly greater than
@@ -214,11 +224,13 @@ class GridArchive {
  private:
   std::vector<const Measure*> descriptors_;
   std::vector<int> bins_;
+  std::vector<Range> ranges_;
   std::size_t cells_ = 1;
   std::map<std::size_t, Elite> elites_;
 };
 
-/// MAP-Elites (Mouret & Clune 2015) over a GridArchive of search.descriptors with search.bins, as
+/// MAP-Elites (Mouret & Clune 2015) over a GridArchive of search.descriptors with search.bins and
+/// search.ranges, as
 /// animat.qd.MapElites: generation 0 (and any generation while the archive is empty) asks
 /// search.batch random viable genomes (genome i: the first viable draw of
 /// Rng::derive(seed, g, i)); later ones search.batch offspring() of elites picked uniformly in cell

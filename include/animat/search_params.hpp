@@ -24,6 +24,9 @@ struct SearchParams {
   std::vector<std::string> descriptors = {"elongation", "protrusions"};
   /// map_elites: bins of each descriptor: one count for all, or one per descriptor
   std::vector<double> bins = {10.0};
+  /// map_elites: the grid's range of each descriptor, lo and hi in descriptor order ([lo1, hi1,
+  /// lo2, hi2, ...]); [] = the ranges of the measures table
+  std::vector<double> ranges = {};
   /// map_elites: offspring per generation; 0 = evolution.population
   int batch = 0;
   /// nsga2: the objectives, "NAME" (the table's sense) or "NAME:max" / "NAME:min": names of
@@ -55,6 +58,14 @@ void visit_fields(SearchParams& p, V&& v) {
               {},
               Identity::late},
     p.bins);
+  v(FieldInfo{"ranges",
+              "map_elites: the grid's range of each descriptor, finite lo < hi pairs in "
+              "descriptor order ([lo1, hi1, lo2, hi2, ...]); [] = each descriptor's range in the "
+              "measures table (a measure without one then needs a range here)",
+              Bounds::any(),
+              {},
+              Identity::late},
+    p.ranges);
   v(FieldInfo{"batch",
               "map_elites: offspring per generation; 0 = evolution.population",
               Bounds::closed(0, 100000),

@@ -36,8 +36,21 @@ bool archivable(const Fitness& f) { return f.viable && f.stable && f.valid; }
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
-GridArchive::GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins)
-    : descriptors_(std::move(descriptors)), bins_(std::move(bins)) {
+GridArchive::GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins,
+                         std::vector<Range> ranges)
+    : descriptors_(std::move(descriptors)), bins_(std::move(bins)), ranges_(std::move(ranges)) {
+  if (ranges_.empty())
+    for (const Measure* d : descriptors_) ranges_.push_back({d->lo, d->hi});
+  if (ranges_.size() != descriptors_.size())
+    throw ConfigError(fmt::format("search.ranges: {} ranges for {} descriptors; give one each",
+                                  ranges_.size(), descriptors_.size()));
+  for (std::size_t j = 0; j < ranges_.size(); ++j)
+    if (!std::isfinite(ranges_[j].lo) || !std::isfinite(ranges_[j].hi) ||
+        !(ranges_[j].lo < ranges_[j].hi))
+      throw ConfigError(fmt::format(
+          "search.ranges: the range of \"{}\", [{}, {}], is not finite lo < hi (a measure "
+          "without a range in the table needs one in search.ranges)",
+          descriptors_[j]->name, ranges_[j].lo, ranges_[j].hi));
   if (bins_.size() != descriptors_.size())
     throw ConfigError(fmt::format("search.bins = {}: one count per descriptor ({}) is needed",
                                   bins_text(bins_), descriptors_.size()));
@@ -62,7 +75,7 @@ std::size_t GridArchive::index_of(std::span<const double> values) const {
   std::size_t index = 0;
   for (std::size_t j = 0; j < descriptors_.size(); ++j) {
     const int n = bins_[j];
-    const double lo = descriptors_[j]->lo, hi = descriptors_[j]->hi, x = values[j];
+    const double lo = ranges_[j].lo, hi = ranges_[j].hi, x = values[j];
     // numpy.linspace(lo, hi, n + 1): edge k is k * step + lo, the last one hi exactly
     const double step = (hi - lo) / n;
     auto edge = [&](int k) { return k == n ? hi : k * step + lo; };
@@ -112,13 +125,25 @@ std::vector<const Measure*> descriptors_of(const Config& config) {
   std::vector<const Measure*> out;
   for (const std::string& name : config.search.descriptors) {
     const Measure& m = find_measure(name, config, "search.descriptors");
-    if (!(m.lo < m.hi))
+    if (!(m.lo < m.hi) && config.search.ranges.empty())
       throw ConfigError(fmt::format(
-          "search.descriptors: \"{}\" has no range in animat_evolve (a criterion of NSGA-II "
-          "only); its descriptors are those with a range: fitness, cells",
+          "search.descriptors: \"{}\" has no range in the measures table (a criterion of "
+          "NSGA-II only): give the descriptors' ranges in search.ranges, or use those with a "
+          "range: fitness, cells",
           name));
     out.push_back(&m);
   }
+  return out;
+}
+
+// search.ranges as pairs; empty: the measures' own ranges (GridArchive).
+std::vector<Range> ranges_of(const Config& config) {
+  const auto& r = config.search.ranges;
+  std::vector<Range> out;
+  if (r.size() % 2 != 0)
+    throw ConfigError(fmt::format("search.ranges: {} numbers; give lo and hi for each descriptor",
+                                  r.size()));
+  for (std::size_t j = 0; j < r.size(); j += 2) out.push_back({r[j], r[j + 1]});
   return out;
 }
 
@@ -137,7 +162,7 @@ MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunct
                      std::shared_ptr<Evaluator> evaluator)
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
-      archive_(descriptors_of(config), bins_of(config)),
+      archive_(descriptors_of(config), bins_of(config), ranges_of(config)),
       batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
       started_(now_seconds()) {
   if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
@@ -314,7 +339,7 @@ void MapElites::restore(std::string_view text, std::string_view source) {
   auto fail = [&](const std::string& what) { inconsistent(source, what); };
   reading_checkpoint(source, [&] {
     const auto [generation, evaluations, reference_evaluations, wall] = read_counters(p);
-    GridArchive archive(archive_.descriptors(), archive_.bins());
+    GridArchive archive(archive_.descriptors(), archive_.bins(), archive_.ranges());
     if (!p.contains("elites") || !p["elites"].is_array()) fail("no list of elites");
     if (p["elites"].size() > archive.cells())
       fail(fmt::format("{} elites for {} cells", p["elites"].size(), archive.cells()));

@@ -63,6 +63,45 @@ TEST(GridArchive, BinsFollowTheEdgesAndClipOutsideTheRange) {
   EXPECT_EQ(at(1e9, 1e9), 7U * 5 + 4);
 }
 
+TEST(GridArchive, RangesOtherThanTheTablesPlaceTheEdges) {
+  Config c = me_config();
+  const Measure* cells = &find_measure("cells", c, "search.descriptors");
+  GridArchive a({cells}, {4}, {{10.0, 30.0}});  // edges 10, 15, 20, 25, 30
+  ASSERT_EQ(a.ranges().size(), 1U);
+  EXPECT_EQ(a.ranges()[0].lo, 10.0);
+  EXPECT_EQ(a.ranges()[0].hi, 30.0);
+  const auto at = [&](double x) {
+    const double v[] = {x};
+    return a.index_of(v);
+  };
+  EXPECT_EQ(at(1), 0U);  // below lo (the table's lo is 1): the first bin
+  EXPECT_EQ(at(14.999), 0U);
+  EXPECT_EQ(at(15), 1U);
+  EXPECT_EQ(at(29.999), 3U);
+  EXPECT_EQ(at(64), 3U);  // at or above hi: the last bin
+  GridArchive table({cells}, {4});
+  EXPECT_EQ(table.ranges()[0].lo, cells->lo);
+  EXPECT_EQ(table.ranges()[0].hi, cells->hi);
+}
+
+TEST(GridArchive, ARangeThatIsNotFiniteLoBelowHiIsRefusedNamingTheKey) {
+  Config c = me_config();
+  const Measure* cells = &find_measure("cells", c, "search.descriptors");
+  for (const Range r : {Range{3.0, 3.0}, Range{5.0, 1.0},
+                        Range{0.0, std::numeric_limits<double>::infinity()},
+                        Range{std::numeric_limits<double>::quiet_NaN(), 1.0}}) {
+    try {
+      GridArchive a({cells}, {4}, {r});
+      FAIL() << "no error for [" << r.lo << ", " << r.hi << "]";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("search.ranges: the range of \"cells\""),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_THROW(GridArchive({cells}, {4}, {{0.0, 1.0}, {0.0, 1.0}}), ConfigError);
+}
+
 TEST(GridArchive, AnEliteIsReplacedOnlyByAStrictlyBetterCandidate) {
   Config c = me_config();
   GridArchive a({&find_measure("cells", c, "k")}, {4});
@@ -118,7 +157,52 @@ TEST(MapElites, DescriptorsOutsideTheTableOrWithoutARangeAreRefusedByName) {
         << e.what();
   }
   c.search.descriptors = {"actuation_work_positive", "cells"};
-  EXPECT_THROW((void)make(c), ConfigError);
+  try {
+    (void)make(c);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("give the descriptors' ranges in search.ranges"),
+              std::string::npos)
+        << e.what();
+  }
+  // With search.ranges, a measure without a range of its own is a descriptor.
+  c.search.ranges = {0.0, 100.0, 1.0, 65.0};
+  const MapElites me = make(c);
+  EXPECT_EQ(me.archive().ranges()[0].hi, 100.0);
+  EXPECT_EQ(me.archive().ranges()[1].lo, 1.0);
+  c.search.ranges = {0.0, 100.0, 1.0};
+  try {
+    (void)make(c);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("search.ranges: 3 numbers"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(MapElites, SearchRangesAreCheckedWithTheConfig) {
+  Config c = me_config();
+  c.search.ranges = {0.0, 100.0};
+  try {
+    validate(c);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("search.ranges = [0.0, 100.0]: give lo and hi for each of "
+                                         "the 2 of search.descriptors"),
+              std::string::npos)
+        << e.what();
+  }
+  c.search.ranges = {0.0, 100.0, 7.0, 7.0};
+  try {
+    validate(c);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("the range of \"fitness\", [7.0, 7.0], is not finite lo < hi"),
+              std::string::npos)
+        << e.what();
+  }
+  c.search.ranges = {0.0, 100.0, 0.0, 7.0};
+  EXPECT_NO_THROW(validate(c));
 }
 
 TEST(MapElites, FirstGenerationIsRandomViableGenomesThenOffspringOfElites) {
