@@ -57,6 +57,40 @@ def test_map_elites_is_animat_qd():
     assert engine.history[-1][5] > 3  # the archive holds several elites: a real comparison
 
 
+def test_search_ranges_are_animat_qd_descriptor_ranges():
+    # search.ranges is what ("name", lo, hi) descriptors are to animat.qd: the same grid edges, so
+    # the same cells, elites and parents.
+    config = config_for("map_elites", 4)
+    config["search.bins"] = [6.0, 4.0]
+    config["search.ranges"] = [10.0, 40.0, 5.0, 45.0]
+    engine = _core.SearchEngine(config)
+    archive = animat.GridArchive([("cells", 10.0, 40.0), ("fitness", 5.0, 45.0)], bins=(6, 4))
+    me = animat.MapElites(config, archive, batch=12, seed=4)
+    for _ in range(6):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in me.ask()]
+        told = [stub(g) for g in genomes]
+        assert engine.tell(told)
+        row = me.tell(told, descriptors=[[f.cell_count, f.fitness] if f.viable else None for f in told])
+        assert same(engine.history[-1][:10], [float(x) for x in row]), (engine.history[-1], row)
+    assert engine.history[-1][5] > 3  # several elites: a real comparison
+
+
+@pytest.mark.parametrize(
+    "ranges, message",
+    [
+        ([0.0, 10.0], r"search.ranges = \[0.0, 10.0\]: give lo and hi for each of the 2"),
+        ([0.0, 10.0, 3.0, 3.0], r'the range of "fitness", \[3.0, 3.0\], is not finite lo < hi'),
+        ([0.0, math.inf, 0.0, 1.0], r"search.ranges = \[0.0, inf, 0.0, 1.0\]: entry inf: must be finite"),
+    ],
+)
+def test_bad_search_ranges_are_refused_by_key_and_value(ranges, message):
+    config = config_for("map_elites", 3)
+    with pytest.raises(Exception, match=message):
+        config["search.ranges"] = ranges
+        _core.SearchEngine(config)
+
+
 def test_nsga2_is_animat_moo():
     config = config_for("nsga2", 5)
     engine = _core.SearchEngine(config)
