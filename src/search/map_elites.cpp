@@ -141,8 +141,8 @@ std::vector<Range> ranges_of(const Config& config) {
   const auto& r = config.search.ranges;
   std::vector<Range> out;
   if (r.size() % 2 != 0)
-    throw ConfigError(fmt::format("search.ranges: {} numbers; give lo and hi for each descriptor",
-                                  r.size()));
+    throw ConfigError(
+        fmt::format("search.ranges: {} numbers; give lo and hi for each descriptor", r.size()));
   for (std::size_t j = 0; j < r.size(); j += 2) out.push_back({r[j], r[j + 1]});
   return out;
 }

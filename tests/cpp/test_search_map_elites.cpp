@@ -87,9 +87,9 @@ TEST(GridArchive, RangesOtherThanTheTablesPlaceTheEdges) {
 TEST(GridArchive, ARangeThatIsNotFiniteLoBelowHiIsRefusedNamingTheKey) {
   Config c = me_config();
   const Measure* cells = &find_measure("cells", c, "search.descriptors");
-  for (const Range r : {Range{3.0, 3.0}, Range{5.0, 1.0},
-                        Range{0.0, std::numeric_limits<double>::infinity()},
-                        Range{std::numeric_limits<double>::quiet_NaN(), 1.0}}) {
+  for (const Range r :
+       {Range{3.0, 3.0}, Range{5.0, 1.0}, Range{0.0, std::numeric_limits<double>::infinity()},
+        Range{std::numeric_limits<double>::quiet_NaN(), 1.0}}) {
     try {
       GridArchive a({cells}, {4}, {r});
       FAIL() << "no error for [" << r.lo << ", " << r.hi << "]";
@@ -197,8 +197,9 @@ TEST(MapElites, SearchRangesAreCheckedWithTheConfig) {
     validate(c);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("the range of \"fitness\", [7.0, 7.0], is not finite lo < hi"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("the range of \"fitness\", [7.0, 7.0], is not finite lo < hi"),
+        std::string::npos)
         << e.what();
   }
   c.search.ranges = {0.0, 100.0, 0.0, 7.0};
