@@ -147,12 +147,12 @@ TEST(MapElites, TooManyCellsAreRefusedNamingTheKeyAndValue) {
 
 TEST(MapElites, DescriptorsOutsideTheTableOrWithoutARangeAreRefusedByName) {
   Config c = me_config();
-  c.search.descriptors = {"elongation", "cells"};
+  c.search.descriptors = {"locomotion", "cells"};
   try {
     (void)make(c);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("search.descriptors: no measure \"elongation\""),
+    EXPECT_NE(std::string(e.what()).find("search.descriptors: no measure \"locomotion\""),
               std::string::npos)
         << e.what();
   }
