@@ -1,5 +1,105 @@
 #pragma once
 // The locomotion mode of a swim (undulation, synchronous contraction, protrusions, tail, other,
-// none), classified from frames of the swim as animat.locomotion classifies them.
+// none), classified from frames of the swim as animat.locomotion.classify_motion classifies them,
+// so that the engine can classify the evaluation's own swim instead of swimming it again.
+//
+// Frames. animat.replay(thing, config, every=1) records frame 0 (the start state, t = 0) and one
+// frame after every control step (t = k·dt), steps + 1 frames in all. The classifier reads only its
+// window: the last min(cycles, floor(second half / period)) whole periods 2π/ω of the record (at
+// least the last 8 frames). A recorder therefore needs only the frames of steps
+// k >= steps - ceil(cycles · period / dt) - 1 (never more than steps / 2 + 2 of them): with
+// cycles = 4 and the slowest oscillator of the default ranges that is at most 4·2π/(f_min·dt) + 2
+// frames, known before the swim once ω is (window_start_step() computes the first step to keep).
+//
+// Not ported: the stroke path of animat.locomotion (the paper's protrusion stroke of
+// animat.protrusion, which needs the shape's protruding cells of animat.shape.cell_heights). This
+// classifier is classify_motion without an outline (the earlier rules), with the bending wave
+// optional (`bending`, which animat.locomotion's stroke path turns on).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
 
-namespace animat {}  // namespace animat
+#include "animat/types.hpp"
+
+namespace animat {
+
+/// The modes, in the order of animat.locomotion.MODES.
+enum class Locomotion : int {
+  undulation = 0,
+  synchronous_contraction,
+  protrusions,
+  tail,
+  other,
+  none,
+};
+/// The name animat.locomotion.MODES gives a mode ("synchronous contraction", ...).
+[[nodiscard]] const char* locomotion_name(Locomotion mode);
+
+/// Node positions of a swim: frame-major, `cells` × 2 values (x, y) per frame, one time per frame
+/// (uniformly sampled, increasing).
+struct MotionFrames {
+  int cells = 0;
+  std::vector<double> xy;
+  std::vector<double> times;
+  [[nodiscard]] int frame_count() const { return static_cast<int>(times.size()); }
+};
+
+/// The circular-linear phase fit of a contraction field (animat.locomotion.WaveFit).
+struct WaveMeasure {
+  std::array<double, 2> gradient{0.0, 0.0};  ///< phase gradient, rad per length unit (body frame)
+  double fit = 0.0;                          ///< weighted resultant after removing the gradient
+  double lag = 0.0;                          ///< total phase lag across the moving cells (rad)
+  double travelling_index = 0.0;
+  double coherence = 0.0;
+  double angle = 0.0;    ///< degrees between the wave's travel and the motion; NaN when undefined
+  bool is_wave = false;  ///< the wave criterion holds
+  double p_value = 0.0;  ///< permutation p-value (bending wave only; NaN otherwise)
+};
+
+/// The classifier's result: the numbers of animat.locomotion.LocomotionMode.
+struct LocomotionMode {
+  Locomotion mode = Locomotion::none;
+  std::vector<Locomotion> mixed;  ///< other modes whose criterion also holds
+  double deformation = 0.0;
+  double coherence = 0.0;
+  double concentration = 0.0;
+  double travelling_index = 0.0;
+  bool has_wave = false;  ///< `wave` was measured (false for mode none)
+  WaveMeasure wave;
+  bool has_bend = false;  ///< `bend` was measured (bending on and a deforming body)
+  WaveMeasure bend;
+  double omega = 0.0;
+  double cycles = 0.0;                        ///< periods in the window
+  int frames = 0;                             ///< frames in the window (the last `frames` frames)
+  std::array<double, 2> direction{1.0, 0.0};  ///< direction of motion, body frame
+  double speed = 0.0;
+  std::vector<int> top_cells;              ///< the most mobile 20 % of the cells, ascending
+  std::vector<double> phases, amplitudes;  ///< of each cell's contraction
+  double contrast = 0.0;
+  int groups = 0;
+};
+
+/// Classifies a swim as animat.locomotion.classify_motion(positions, times, springs=springs,
+/// omega=omega, cycles=cycles, bending=bending) does (no outline). Deterministic: the bending
+/// wave's shuffles use Rng(kBendSeed), not numpy's generator, so its p-value differs from Python's
+/// by the sampling error of 999 shuffles. Throws std::invalid_argument for fewer than 8 frames,
+/// sizes that do not match or a spring naming no cell.
+[[nodiscard]] LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& springs,
+                                             double omega, double cycles = 4.0,
+                                             bool bending = false);
+
+/// Seed of the bending wave's shuffles (animat.locomotion.BEND_SEED's role).
+inline constexpr std::uint64_t kBendSeed = 0;
+
+/// The dominant actuation frequency of a body (rad per time unit), as animat.Trajectory.period()
+/// picks it: the amplitude-weighted median of the frequencies of the cells with a > 0 and f > 0;
+/// 0 when no cell oscillates.
+[[nodiscard]] double dominant_frequency(const Vector& amplitude, const Vector& frequency);
+
+/// The first control step whose frame (t = step·dt) the classifier's window can need for a swim of
+/// `steps` control steps at angular frequency `omega` with `cycles` periods: record the frames of
+/// steps window_start_step(...) .. steps.
+[[nodiscard]] int window_start_step(int steps, double dt, double omega, double cycles = 4.0);
+
+}  // namespace animat
