@@ -1,0 +1,125 @@
+"""The engine's locomotion classifier (``_core._classify_motion``, include/animat/locomotion.hpp) against
+animat.locomotion.classify_motion, on stored bests and on synthetic swims.
+
+Every deterministic number agrees to RTOL: both sides solve the same least-squares fits and grid searches,
+the C++ with a closed-form 2-D rotation (Python: an SVD) and a QR solve (Python: lstsq), which differ by
+round-off only. The bending wave's p-value comes from 999 shuffles drawn by a different generator (the
+project's Rng, not numpy's), so it agrees within the sampling error of the permutation test.
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import animat
+from animat import _core
+from animat import locomotion as L
+
+ROOT = Path(__file__).resolve().parents[2]
+#: One stored best per replication condition and two of the 64-cell condition (a few seconds each).
+BESTS = ["dn0.5/run_0", "dn0.5/run_1", "dn2/run_0", "dn2/run_1", "dn10/run_0", "dn10/run_1", "dn0.2_64cells/run_0"]
+RTOL = 1e-6
+
+
+def _p_tolerance(p):
+    """Four standard errors of a permutation p-value from 999 shuffles, plus one shuffle."""
+    return 4 * math.sqrt(max(p, 1e-3) * (1 - p) / 999) + 1 / 1000
+
+
+def _compare_wave(py, cc, bending):
+    assert cc is not None
+    assert cc["fit"] == pytest.approx(py.fit, rel=RTOL, abs=1e-9)
+    assert cc["lag"] == pytest.approx(py.lag, rel=RTOL, abs=1e-9)
+    assert cc["travelling_index"] == pytest.approx(py.travelling_index, rel=RTOL, abs=1e-9)
+    assert cc["coherence"] == pytest.approx(py.coherence, rel=RTOL, abs=1e-9)
+    assert np.allclose(cc["gradient"], np.asarray(py.gradient), rtol=RTOL, atol=1e-9)
+    if math.isfinite(py.angle):
+        assert cc["angle"] == pytest.approx(py.angle, rel=RTOL, abs=1e-6)
+    if bending:
+        assert cc["p_value"] == pytest.approx(py.p_value, abs=_p_tolerance(py.p_value))
+
+
+def _compare(positions, times, springs, omega, bending):
+    py = L.classify_motion(positions, times, springs=springs, omega=omega, bending=bending)
+    cc = _core._classify_motion(positions, times, springs, omega, 4.0, bending)
+    assert cc["mode"] == py.mode, (cc, py)
+    assert cc["mixed"] == tuple(py.mixed)
+    assert cc["frames"] == py.frames
+    assert np.allclose(cc["direction"], py.direction, rtol=RTOL, atol=1e-9)
+    for key in ("omega", "cycles", "speed"):
+        assert cc[key] == pytest.approx(getattr(py, key), rel=RTOL, abs=1e-9), key
+    assert cc["deformation"] == pytest.approx(py.deformation, rel=RTOL, abs=1e-9)
+    if py.mode != "none":  # a rigid body's other measures are ratios of round-off
+        for key in ("coherence", "concentration", "travelling_index"):
+            assert cc[key] == pytest.approx(getattr(py, key), rel=RTOL, abs=1e-9), key
+        assert list(cc["top_cells"]) == list(py.top_cells)
+        assert np.allclose(cc["amplitudes"], py.amplitudes, rtol=RTOL, atol=1e-12)
+        assert cc["contrast"] == pytest.approx(py.contrast, rel=RTOL)
+        assert cc["groups"] == py.groups
+        _compare_wave(py.wave, cc["wave"], False)
+    if py.bend is not None:
+        _compare_wave(py.bend, cc["bend"], True)
+    return py, cc
+
+
+@pytest.mark.parametrize("best", BESTS)
+def test_engine_classifies_stored_bests_as_python(best):
+    run = animat.Run(ROOT / "data" / "replication" / best)
+    tr = animat.replay(run.best(), run.config)
+    omega = _core._dominant_frequency(tr.body.amplitude, tr.body.frequency)
+    assert omega == pytest.approx(2 * math.pi / tr.period(), rel=1e-12)
+    for bending in (False, True):
+        _compare(tr.positions, tr.times, tr.body.springs, omega, bending)
+
+
+def _strip(length=12, rows=3):
+    pts = [(i + 0.5 * (j % 2), (j - (rows - 1) / 2) * math.sqrt(3) / 2) for j in range(rows) for i in range(length)]
+    X = np.array(pts)
+    X += np.random.default_rng(0).uniform(-0.02, 0.02, X.shape)
+    return X - X.mean(axis=0)
+
+
+def _swim(kind, omega=2 * math.pi):
+    """A 3-row strip (its Gabriel graph as springs) carried along and turned: a bending wave, a
+    contraction wave, breathing, random phases per cell, or at rest."""
+    X = _strip()
+    t = np.arange(400) / 40
+    x, y = X[None, :, 0], X[None, :, 1]
+    arg = 0.6 * x - omega * t[:, None]
+    P = np.repeat(X[None], len(t), axis=0)
+    if kind == "bending":
+        P[:, :, 0] = x - y * 0.18 * np.cos(arg)
+        P[:, :, 1] = y + 0.3 * np.sin(arg)
+    elif kind == "contraction":
+        P[:, :, 0] = x - 0.25 * np.cos(arg)
+    elif kind == "breathing":
+        P = P * (1 + 0.1 * np.sin(omega * t))[:, None, None]
+    elif kind == "random":
+        phase = np.random.default_rng(1).uniform(0, 2 * math.pi, len(X))
+        P = P + 0.15 * np.sin(omega * t[:, None, None] + phase[None, :, None]) * np.array([1.0, 0.5])
+    turn = 0.1 * t
+    c, s = np.cos(turn)[:, None], np.sin(turn)[:, None]
+    Q = np.stack([c * P[:, :, 0] - s * P[:, :, 1] + 0.2 * t[:, None], s * P[:, :, 0] + c * P[:, :, 1]], axis=2)
+    return Q, t, np.asarray(_core.gabriel_graph(X))
+
+
+@pytest.mark.parametrize("kind", ["bending", "contraction", "breathing", "random", "rest"])
+def test_engine_classifies_synthetic_swims_as_python(kind):
+    P, t, springs = _swim(kind)
+    for bending in (False, True):
+        py, _ = _compare(P, t, springs, 2 * math.pi, bending)
+    expected = {"contraction": "undulation", "breathing": "synchronous contraction", "rest": "none"}
+    if kind in expected:
+        assert py.mode == expected[kind]
+
+
+def test_engine_refuses_bad_frames():
+    P, t, springs = _swim("rest")
+    with pytest.raises(ValueError, match="at least 8 frames"):
+        _core._classify_motion(P[:7], t[:7], springs, 1.0)
+    with pytest.raises(ValueError, match="times"):
+        _core._classify_motion(P, t[:-1], springs, 1.0)
+    with pytest.raises(ValueError, match="names cell 99"):
+        _core._classify_motion(P, t, [[0, 99]], 1.0)
