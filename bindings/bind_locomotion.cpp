@@ -1,9 +1,11 @@
 // The locomotion classifier of the engine (locomotion.hpp), for tests against animat.locomotion.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -45,7 +47,7 @@ nb::dict wave_dict(const WaveMeasure& w) {
 }
 
 nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, double omega,
-                  double cycles, bool bending) {
+                  double cycles, bool bending, std::optional<double> swim_start) {
   const Contig p = float_array(positions, 3, "positions");
   if (p.shape(2) != 2)
     throw std::invalid_argument("_classify_motion: positions must be (frames, n, 2)");
@@ -54,6 +56,7 @@ nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, do
   frames.cells = static_cast<int>(p.shape(1));
   frames.xy.assign(p.data(), p.data() + p.size());
   frames.times.assign(t.data(), t.data() + t.size());
+  if (swim_start) frames.swim_start = *swim_start;
   if (frames.frame_count() != static_cast<int>(p.shape(0)))
     throw std::invalid_argument("_classify_motion: " + std::to_string(t.size()) + " times for " +
                                 std::to_string(p.shape(0)) + " frames");
@@ -98,9 +101,10 @@ nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, do
 
 void bind_locomotion(nb::module_& m) {
   m.def("_classify_motion", &classify, "positions"_a, "times"_a, "springs"_a, "omega"_a,
-        "cycles"_a = 4.0, "bending"_a = false,
+        "cycles"_a = 4.0, "bending"_a = false, "swim_start"_a = nb::none(),
         "The engine's locomotion classifier (animat.locomotion.classify_motion without an outline; "
-        "bending: also the bending wave): a dict of the LocomotionMode's numbers, mode and mixed "
+        "bending: also the bending wave; swim_start: the swim's first time when the frames "
+        "are only its end): a dict of the LocomotionMode's numbers, mode and mixed "
         "as names of animat.locomotion.MODES.");
   m.def(
       "_dominant_frequency",

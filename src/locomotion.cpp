@@ -428,9 +428,11 @@ WaveMeasure bending_wave(const Aligned& al, const Harmonic& harmonic, const Inde
 }
 
 /// The window of classify_motion: its first frame and its length in periods.
-std::pair<int, double> window(const std::vector<double>& t, double omega, double cycles) {
+std::pair<int, double> window(const std::vector<double>& t, double swim_start, double omega,
+                              double cycles) {
   const int nf = static_cast<int>(t.size());
-  const double duration = t.back() - t.front();
+  const double t0 = std::isnan(swim_start) ? t.front() : swim_start;
+  const double duration = t.back() - t0;
   int first = nf;
   double k = 0.0;
   if (omega > 0 && std::isfinite(omega)) {
@@ -443,7 +445,7 @@ std::pair<int, double> window(const std::vector<double>& t, double omega, double
     while (first > 0 && t[first - 1] >= from) --first;
     if (nf - first < 8) first = nf - 8;
   } else {
-    const double from = t.front() + 0.5 * duration;
+    const double from = t0 + 0.5 * duration;
     while (first > 0 && t[first - 1] >= from) --first;
   }
   return {first, k};
@@ -484,7 +486,7 @@ int window_start_step(int steps, double dt, double omega, double cycles) {
   std::vector<double> t(static_cast<std::size_t>(steps) + 1);
   for (int s = 0; s <= steps; ++s) t[static_cast<std::size_t>(s)] = s * dt;
   if (steps + 1 < 8) return 0;
-  return std::max(0, window(t, omega, cycles).first - 1);
+  return std::max(0, window(t, kNaN, omega, cycles).first - 1);
 }
 
 LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& springs, double omega,
@@ -499,6 +501,10 @@ LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& spr
   if (nf_all < 8)
     throw std::invalid_argument("classify_motion: need at least 8 frames, got " +
                                 std::to_string(nf_all));
+  if (!std::isnan(frames.swim_start) && !(frames.swim_start <= frames.times.front()))
+    throw std::invalid_argument("classify_motion: swim_start " + std::to_string(frames.swim_start) +
+                                " is after the first frame's time " +
+                                std::to_string(frames.times.front()));
   for (Eigen::Index s = 0; s < springs.rows(); ++s)
     for (int e = 0; e < 2; ++e)
       if (springs(s, e) < 0 || springs(s, e) >= n)
@@ -508,7 +514,7 @@ LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& spr
 
   LocomotionMode out;
   out.omega = omega;
-  const auto [first, k] = window(frames.times, omega, cycles);
+  const auto [first, k] = window(frames.times, frames.swim_start, omega, cycles);
   out.cycles = k;
   out.frames = nf_all - first;
   const int nf = out.frames;

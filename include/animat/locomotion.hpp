@@ -5,11 +5,14 @@
 //
 // Frames. animat.replay(thing, config, every=1) records frame 0 (the start state, t = 0) and one
 // frame after every control step (t = k·dt), steps + 1 frames in all. The classifier reads only its
-// window: the last min(cycles, floor(second half / period)) whole periods 2π/ω of the record (at
-// least the last 8 frames). A recorder therefore needs only the frames of steps
-// k >= steps - ceil(cycles · period / dt) - 1 (never more than steps / 2 + 2 of them): with
-// cycles = 4 and the slowest oscillator of the default ranges that is at most 4·2π/(f_min·dt) + 2
-// frames, known before the swim once ω is (window_start_step() computes the first step to keep).
+// window: the last k = min(cycles, floor(second half / period)) whole periods 2π/ω of the record
+// (at least the last 8 frames), so it never reaches before step steps / 2. A recorder therefore
+// needs only the frames of steps window_start_step(steps, dt, ω, cycles) .. steps, about
+// k·2π/(ω·dt) + 2 of them, known before the swim once ω is (dominant_frequency() of the body).
+// With the defaults (4000 steps of dt = 1/60, cycles = 4, f in [0.5, 6]): 253 frames at f = 6,
+// 1509 at f = 0.5 (where the second half holds only 2 whole periods), never more than 2002:
+// preallocate steps / 2 + 2 frames of cells × 2 doubles. Pass them with MotionFrames::swim_start
+// = 0 (the time of frame 0) and the classification is the full record's, bit for bit.
 //
 // Not ported: the stroke path of animat.locomotion (the paper's protrusion stroke of
 // animat.protrusion, which needs the shape's protruding cells of animat.shape.cell_heights). This
@@ -17,6 +20,7 @@
 // optional (`bending`, which animat.locomotion's stroke path turns on).
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -42,6 +46,10 @@ struct MotionFrames {
   int cells = 0;
   std::vector<double> xy;
   std::vector<double> times;
+  /// The time of the swim's first frame when the frames are only its end (a recorder that kept the
+  /// steps from window_start_step() on): the window is chosen from the whole swim's duration, so it
+  /// is the window of the full record. NaN: times.front() (the frames are the whole swim).
+  double swim_start = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] int frame_count() const { return static_cast<int>(times.size()); }
 };
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
@@ -148,6 +149,44 @@ TEST(Locomotion, WindowStartCoversTheClassifiersWindow) {
   const int first = window_start_step(4000, 1.0 / 60, 3.0);
   EXPECT_GE(first, 3490);
   EXPECT_LE(first, 3498);
+}
+
+TEST(Locomotion, TheWindowsFramesAloneClassifyAsTheWholeRecord) {
+  // A recorder keeps the frames from window_start_step() on and says when the swim started.
+  const MotionFrames whole = ladder_swim([](int cell, double t) -> std::array<double, 2> {
+    return {0.2 * std::sin(kOmega * t - 0.6 * (cell / 2)), 0.05 * std::sin(kOmega * t + cell)};
+  });
+  const int first = window_start_step(whole.frame_count() - 1, kDt, kOmega);
+  MotionFrames end;
+  end.cells = whole.cells;
+  end.swim_start = 0.0;
+  end.times.assign(whole.times.begin() + first, whole.times.end());
+  end.xy.assign(whole.xy.begin() + static_cast<std::ptrdiff_t>(first) * 2 * whole.cells,
+                whole.xy.end());
+  const LocomotionMode a = classify_motion(whole, ladder_springs(), kOmega, 4.0, true);
+  const LocomotionMode b = classify_motion(end, ladder_springs(), kOmega, 4.0, true);
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_LT(b.frames, end.frame_count() + 1);
+  EXPECT_EQ(a.mode, b.mode);
+  EXPECT_EQ(a.deformation, b.deformation);
+  EXPECT_EQ(a.wave.fit, b.wave.fit);
+  EXPECT_EQ(a.bend.p_value, b.bend.p_value);
+  EXPECT_EQ(a.phases, b.phases);
+  // Without swim_start the end alone is a shorter swim: its second half holds fewer periods.
+  end.swim_start = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_LT(classify_motion(end, ladder_springs(), kOmega).cycles, 4.0);
+  end.swim_start = end.times.front() + kDt;
+  EXPECT_THROW((void)classify_motion(end, ladder_springs(), kOmega), std::invalid_argument);
+}
+
+TEST(Locomotion, WindowStartForTheDefaultSwim) {
+  // 4000 steps of 1/60 (the defaults): at f = 6, 4 periods are 251.3 steps; at f = 0.5 the second
+  // half holds 2 whole periods, 1508.0 steps (+ 1 frame of margin). A recorder of steps / 2 + 2
+  // frames always suffices.
+  EXPECT_EQ(4000 - window_start_step(4000, 1.0 / 60, 6.0) + 1, 253);
+  EXPECT_EQ(4000 - window_start_step(4000, 1.0 / 60, 0.5) + 1, 1509);
+  for (double f : {0.5, 0.51, 0.7, 1.0, 3.0, 6.0, 0.0})
+    EXPECT_LE(4000 - window_start_step(4000, 1.0 / 60, f) + 1, 4000 / 2 + 2) << f;
 }
 
 TEST(Locomotion, RefusesTooFewFramesAndBadSprings) {

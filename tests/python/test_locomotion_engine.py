@@ -71,7 +71,13 @@ def test_engine_classifies_stored_bests_as_python(best):
     omega = _core._dominant_frequency(tr.body.amplitude, tr.body.frequency)
     assert omega == pytest.approx(2 * math.pi / tr.period(), rel=1e-12)
     for bending in (False, True):
-        _compare(tr.positions, tr.times, tr.body.springs, omega, bending)
+        _, whole = _compare(tr.positions, tr.times, tr.body.springs, omega, bending)
+    # What a recorder keeps during the swim (locomotion.hpp): the frames from the window's start on.
+    steps = int(run.config["evaluation.steps"])
+    first = _core._locomotion_window_start(steps, float(run.config["physics.dt"]), omega)
+    assert len(tr.times) == steps + 1 and steps + 1 - first <= steps // 2 + 2
+    end = _core._classify_motion(tr.positions[first:], tr.times[first:], tr.body.springs, omega, 4.0, True, 0.0)
+    assert repr(end) == repr(whole)  # bit for bit (repr: nan equals nan)
 
 
 def _strip(length=12, rows=3):
