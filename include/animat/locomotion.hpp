@@ -62,7 +62,9 @@ struct WaveMeasure {
   double coherence = 0.0;
   double angle = 0.0;    ///< degrees between the wave's travel and the motion; NaN when undefined
   bool is_wave = false;  ///< the wave criterion holds
-  double p_value = 0.0;  ///< permutation p-value (bending wave only; NaN otherwise)
+  /// Permutation p-value of the bending wave, computed only when every other bending criterion
+  /// holds (the shuffles cost most of the classifier); NaN otherwise and for the contraction wave.
+  double p_value = 0.0;
 };
 
 /// The classifier's result: the numbers of animat.locomotion.LocomotionMode.
