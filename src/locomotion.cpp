@@ -199,54 +199,53 @@ std::vector<double> shuffled_fits(const std::vector<Complex>& zw, double total,
   const std::size_t m = zw.size();
   std::vector<double> out(static_cast<std::size_t>(permutations), 0.0);
   Rng rng(kBendSeed);
-  std::vector<double> x(coords);
-  // e^{-i g x_k} of the coarse grid for every position: a shuffle only reorders them.
-  std::vector<std::size_t> index(m);
+  // A shuffle only reorders the positions, so every e^{-i g x} it needs is in a table over the
+  // unshuffled positions: e^{-i g_a x} of the coarse grid, and e^{-i o_j x} of the offsets o_j of
+  // each refinement's 21 points from its centre (the value at a point is then the value at the
+  // centre times that factor).
   std::vector<Complex> coarse(static_cast<std::size_t>(kGrid) * m);
   for (int a = 0; a < kGrid; ++a)
     for (std::size_t k = 0; k < m; ++k)
       coarse[a * m + k] = std::polar(1.0, -grid_point(a) * coords[k]);
-  std::vector<Complex> rot(m), cur(m);
+  std::vector<Complex> offset(static_cast<std::size_t>(kRefinements * kRefine) * m);
+  double step = 2 * kPi / (kGrid - 1);
+  for (int round = 0; round < kRefinements; ++round, step /= 10) {
+    for (int j = 0; j < kRefine; ++j)
+      for (std::size_t k = 0; k < m; ++k)
+        offset[(round * kRefine + j) * m + k] =
+            std::polar(1.0, -refine_point(0.0, step, j) * coords[k]);
+  }
+  std::vector<std::size_t> index(m);
+  std::vector<Complex> at(m);  // zw e^{-i g x} at the current best g, shuffled order
   for (int p = 0; p < permutations; ++p) {
     std::iota(index.begin(), index.end(), std::size_t{0});
     for (std::size_t k = m; k > 1; --k) std::swap(index[k - 1], index[rng.below(k)]);
-    for (std::size_t k = 0; k < m; ++k) x[k] = coords[index[k]];
-    double g = 0.0, r = -1.0;
+    int best = 0;
+    double r = -1.0;
     for (int a = 0; a < kGrid; ++a) {
       Complex sum = 0.0;
       for (std::size_t k = 0; k < m; ++k) sum += mul(zw[k], coarse[a * m + index[k]]);
       const double v = std::abs(sum) / total;
       if (v > r) {
         r = v;
-        g = grid_point(a);
+        best = a;
       }
     }
-    double step = 2 * kPi / (kGrid - 1);
+    for (std::size_t k = 0; k < m; ++k) at[k] = mul(zw[k], coarse[best * m + index[k]]);
     for (int round = 0; round < kRefinements; ++round) {
-      const double centre = g;
-      double rr = -1.0, gg = centre;
-      // e^{-i q_j x} = e^{-i q_0 x} (e^{-i Δ x})^j along the 21 equally spaced points q_j.
-      const double delta = 2 * step / (kRefine - 1);
-      for (std::size_t k = 0; k < m; ++k) {
-        cur[k] = mul(zw[k], std::polar(1.0, -(centre - step) * x[k]));
-        rot[k] = std::polar(1.0, -delta * x[k]);
-      }
+      const Complex* table = offset.data() + static_cast<std::size_t>(round * kRefine) * m;
+      r = -1.0;
+      best = 0;
       for (int j = 0; j < kRefine; ++j) {
-        const double q = refine_point(centre, step, j);
         Complex sum = 0.0;
-        for (std::size_t k = 0; k < m; ++k) {
-          sum += cur[k];
-          cur[k] = mul(cur[k], rot[k]);
-        }
+        for (std::size_t k = 0; k < m; ++k) sum += mul(at[k], table[j * m + index[k]]);
         const double v = std::abs(sum) / total;
-        if (v > rr) {
-          rr = v;
-          gg = q;
+        if (v > r) {
+          r = v;
+          best = j;
         }
       }
-      g = gg;
-      r = rr;
-      step /= 10;
+      for (std::size_t k = 0; k < m; ++k) at[k] = mul(at[k], table[best * m + index[k]]);
     }
     out[static_cast<std::size_t>(p)] = r;
   }
