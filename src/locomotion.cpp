@@ -192,12 +192,13 @@ std::pair<std::array<double, 2>, double> circular_linear_fit(const std::vector<C
   return {best, best_r};
 }
 
-/// shuffled_fits: the 1-D fit of zw against `permutations` shuffles of `coords`, with the same
-/// search; the shuffles come from Rng(kBendSeed) (Fisher-Yates).
-std::vector<double> shuffled_fits(const std::vector<Complex>& zw, double total,
-                                  const std::vector<double>& coords, int permutations) {
+/// shuffled_fits, counted: how many of `permutations` shuffles of `coords` fit zw at least as well
+/// as `fit` (the 1-D fit, same search), stopping once `enough` do. The shuffles come from
+/// Rng(kBendSeed) (Fisher-Yates).
+int shuffles_fitting(const std::vector<Complex>& zw, double total,
+                     const std::vector<double>& coords, int permutations, double fit, int enough) {
   const std::size_t m = zw.size();
-  std::vector<double> out(static_cast<std::size_t>(permutations), 0.0);
+  int count = 0;
   Rng rng(kBendSeed);
   // A shuffle only reorders the positions, so every e^{-i g x} it needs is in a table over the
   // unshuffled positions: e^{-i g_a x} of the coarse grid, and e^{-i o_j x} of the offsets o_j of
@@ -247,9 +248,9 @@ std::vector<double> shuffled_fits(const std::vector<Complex>& zw, double total,
       }
       for (std::size_t k = 0; k < m; ++k) at[k] = mul(at[k], table[best * m + index[k]]);
     }
-    out[static_cast<std::size_t>(p)] = r;
+    if (r >= fit && ++count >= enough) break;
   }
-  return out;
+  return count;
 }
 
 /// The window's body-frame frames (procrustes_frames, 4 rounds): Q[f] = (P[f] − centroid) R[f].
@@ -425,14 +426,17 @@ WaveMeasure bending_wave(const Aligned& al, const Harmonic& harmonic, const Inde
   w.travelling_index = travelling_index(z);
   w.coherence = phase_coherence(z);
   // The permutation test costs most of the classifier: run it only when it decides, i.e. when
-  // every other criterion holds (else p_value stays NaN, "not tested").
+  // every other criterion holds, and only until it fails (else p_value stays NaN).
   w.p_value = kNaN;
   if (fit >= kBendFit && w.lag >= kWaveLag && w.travelling_index >= kWaveTi &&
       w.angle >= kBendBackward) {
-    const std::vector<double> null = shuffled_fits(zw, total, u, kBendPermutations);
-    const auto beat = std::count_if(null.begin(), null.end(), [&](double r) { return r >= fit; });
-    w.p_value = static_cast<double>(1 + beat) / (1 + kBendPermutations);
-    w.is_wave = w.p_value <= kBendP;
+    // p = (1 + beat) / (1 + N) <= kBendP needs beat <= kBendP (1 + N) - 1: stop at one more.
+    const int enough = static_cast<int>(std::floor(kBendP * (1 + kBendPermutations) + 1e-9));
+    const int beat = shuffles_fitting(zw, total, u, kBendPermutations, fit, enough);
+    if (beat < enough) {
+      w.p_value = static_cast<double>(1 + beat) / (1 + kBendPermutations);
+      w.is_wave = w.p_value <= kBendP;
+    }
   }
   return w;
 }

@@ -63,7 +63,9 @@ struct WaveMeasure {
   double angle = 0.0;    ///< degrees between the wave's travel and the motion; NaN when undefined
   bool is_wave = false;  ///< the wave criterion holds
   /// Permutation p-value of the bending wave, computed only when every other bending criterion
-  /// holds (the shuffles cost most of the classifier); NaN otherwise and for the contraction wave.
+  /// holds and only while it can still reach BEND_P (the shuffles cost most of the classifier): NaN
+  /// when not tested or when 10 shuffles already fit as well (p > 0.01); NaN for the contraction
+  /// wave.
   double p_value = 0.0;
 };
 
