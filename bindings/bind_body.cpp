@@ -1,5 +1,6 @@
 // Python bindings of the body stage: Delaunay and Gabriel graphs, and the Body built from cell
 // centres.
+#include <fmt/format.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
@@ -7,6 +8,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "animat/config.hpp"
 #include "animat/development.hpp"
 #include "animat/errors.hpp"
+#include "animat/shape.hpp"
 #include "bindings.hpp"
 
 namespace nb = nanobind;
@@ -263,11 +266,57 @@ void bind_body(nb::module_& m) {
   // The C++ geometry behind morphology_kind, for the tests that hold it to animat.shape.
   m.def(
       "_elongation",
-      [](nb::handle points, double cell_diameter) {
-        return elongation(to_points(points, "_elongation"), cell_diameter);
+      [](nb::handle points, double cell_diameter, std::optional<double> spacing) {
+        const Points p = to_points(points, "_elongation");
+        return spacing ? elongation(p, cell_diameter, *spacing) : elongation(p, cell_diameter);
       },
-      "points"_a, "cell_diameter"_a = 1.0,
-      "The C++ elongation of morphology_kind (animat.shape.elongation computes the same).");
+      "points"_a, "cell_diameter"_a = 1.0, "spacing"_a = nb::none(),
+      "The engine's elongation (shape.hpp), which animat.shape.elongation and morphology_kind "
+      "use;\n"
+      "`spacing` is s (default: the cell spacing of `points`).");
+  m.def(
+      "_describe_shape",
+      [](nb::handle points, const std::vector<int>& outline,
+         std::optional<std::vector<int>> springs, double cell_diameter, double core_radius,
+         double min_height, double pair_tolerance, std::optional<double> spacing) {
+        const Points p = to_points(points, "_describe_shape");
+        IndexPairs links;
+        if (springs) {
+          if (springs->size() % 2 != 0)
+            throw GeometryError(fmt::format("_describe_shape: springs hold {} indices, not pairs",
+                                            springs->size()));
+          links = Eigen::Map<const IndexPairs>(springs->data(),
+                                               static_cast<Eigen::Index>(springs->size() / 2), 2);
+        }
+        const Shape sh = describe_shape(p, outline, springs ? &links : nullptr,
+                                        {cell_diameter, core_radius, min_height, pair_tolerance},
+                                        spacing.value_or(std::numeric_limits<double>::quiet_NaN()));
+        nb::list protrusions;
+        for (const Protrusion& pr : sh.protrusions)
+          protrusions.append(
+              nb::make_tuple(pr.cells, pr.height, nb::make_tuple(pr.centroid[0], pr.centroid[1])));
+        nb::list pairs;
+        for (const auto& [i, j] : sh.symmetric_pairs) pairs.append(nb::make_tuple(i, j));
+        nb::dict out;
+        out["cell_count"] = sh.cell_count;
+        out["spacing"] = sh.spacing;
+        out["elongation"] = sh.elongation;
+        out["concavity"] = sh.concavity;
+        out["outline_area"] = sh.outline_area;
+        out["hull_area"] = sh.hull_area;
+        out["has_core"] = sh.has_core;
+        out["core_cells"] = sh.core_cells;
+        out["heights"] = sh.heights;
+        out["protrusions"] = protrusions;
+        out["symmetric_pairs"] = pairs;
+        return out;
+      },
+      "points"_a, "outline"_a, "springs"_a, "cell_diameter"_a, "core_radius"_a, "min_height"_a,
+      "pair_tolerance"_a, "spacing"_a = nb::none(),
+      "The engine's shape descriptors (shape.hpp) of cells at `points` with the outer `outline`\n"
+      "and the springs (flat [i0, j0, i1, j1, ...], or None: group by distance), `spacing` s\n"
+      "(None: the cell spacing): a dict of animat.shape.Shape's fields and has_core, protrusions\n"
+      "as (cells, height, centroid). animat.shape.describe calls it.");
   m.def(
       "_cell_spacing",
       [](nb::handle points) { return cell_spacing(to_points(points, "_cell_spacing")); },

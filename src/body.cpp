@@ -18,6 +18,7 @@
 
 #include "animat/development.hpp"
 #include "animat/errors.hpp"
+#include "animat/shape.hpp"
 #include "body_geometry.hpp"
 
 namespace animat {
@@ -352,31 +353,6 @@ double cell_spacing(const Points& positions) {
   const double s =
       n % 2 ? nearest[n / 2] : (nearest[n / 2 - 1] + nearest[n / 2]) / 2.0;  // numpy's median
   return s > 0.0 ? s : 1.0;
-}
-
-double elongation(const Points& positions, double cell_diameter) {
-  const Eigen::Index n = positions.rows();
-  if (n == 0) return 1.0;
-  const double s = cell_spacing(positions);
-  const double count = static_cast<double>(n);
-  const double mx = positions.col(0).sum() / count, my = positions.col(1).sum() / count;
-  double xx = 0.0, yy = 0.0, xy = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double x = positions(i, 0) - mx, y = positions(i, 1) - my;
-    xx += x * x;
-    yy += y * y;
-    xy += x * y;
-  }
-  const double disc = (cell_diameter * s) * (cell_diameter * s) / 16.0;
-  xx = xx / count + disc;
-  yy = yy / count + disc;
-  xy /= count;
-  // The eigenvalues of the symmetric 2 × 2 matrix [[xx, xy], [xy, yy]].
-  const double mid = 0.5 * (xx + yy), radius = std::hypot(0.5 * (xx - yy), xy);
-  const double major = mid + radius, minor = mid - radius;
-  if (major <= 0.0) return 1.0;
-  if (minor <= 1e-12 * major) return std::numeric_limits<double>::infinity();
-  return std::sqrt(major / minor);
 }
 
 int morphology_kind(const Points& positions) {

@@ -21,6 +21,7 @@
 #include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
+#include "animat/shape.hpp"
 
 namespace animat {
 
@@ -39,6 +40,16 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// The median of the cells' oscillator frequencies (numpy's: the mean of the two middle values for
+/// an even count); 0 for no cell.
+double median_frequency(const Body& body) {
+  std::vector<double> f(body.frequency.data(), body.frequency.data() + body.frequency.size());
+  if (f.empty()) return 0.0;
+  std::sort(f.begin(), f.end());
+  const std::size_t n = f.size();
+  return n % 2 ? f[n / 2] : (f[n / 2 - 1] + f[n / 2]) / 2.0;
 }
 
 /// Half the median rest length: the floor of the stretch denominators.
@@ -342,6 +353,12 @@ bool develop_body(const Genome& genome, const Config& config, EvaluationResult& 
   out.region_count = body.region_count();
   out.skin_edge_count = static_cast<int>(body.skin.rows());
   out.morphology_kind = morphology_kind(body.positions);
+  const Shape shape = body_shape(body);
+  out.elongation = shape.elongation;
+  out.protrusions = static_cast<int>(shape.protrusions.size());
+  out.symmetric_pair = shape.symmetric_pairs.empty() ? 0 : 1;
+  out.concavity = shape.concavity;
+  out.frequency = median_frequency(body);
 
   SwimOptions& options = d.options;
   options.check_embedding = config.evaluation.check_embedding;

@@ -17,6 +17,11 @@ Fitness fitness_of(const EvaluationResult& r) {
   f.actuation_work_positive = r.actuation_work_positive;
   f.actuation_work_absolute = r.actuation_work_absolute;
   f.max_speed = r.max_speed;
+  f.elongation = r.elongation;
+  f.protrusions = r.protrusions;
+  f.symmetric_pair = r.symmetric_pair;
+  f.concavity = r.concavity;
+  f.frequency = r.frequency;
   return f;
 }
 

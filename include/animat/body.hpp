@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "animat/params.hpp"
+#include "animat/shape.hpp"  // elongation(), which morphology_kind() bands
 #include "animat/types.hpp"
 
 namespace animat {
@@ -122,12 +123,6 @@ struct Body {
 /// values for an even count); 1 for fewer than 2 cells or a median of 0. The length unit of the
 /// shape descriptors (animat.shape.cell_spacing computes the same).
 [[nodiscard]] double cell_spacing(const Points& positions);
-
-/// sqrt(λ1/λ2) of the cells' principal second moments about their centroid: the eigenvalues of the
-/// covariance of the cell centres plus (cell_diameter·s)²/16 on the diagonal (s = cell_spacing(),
-/// each cell a uniform disc), λ1 >= λ2. 1 for no cell; infinity when λ2 <= 1e-12 λ1 (possible only
-/// with cell_diameter = 0). Exactly animat.shape.elongation (to rounding).
-[[nodiscard]] double elongation(const Points& positions, double cell_diameter = 1.0);
 
 /// Elongation bands of morphology_kind(): band k holds the elongations in [1.5^k, 1.5^(k+1)), the
 /// last one everything from 1.5^15 (438) up.

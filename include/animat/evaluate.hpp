@@ -153,6 +153,12 @@ struct EvaluationResult {
   int cell_count = 0;
   /// The body plan's coarse class (morphology_kind() in body.hpp); 0 without a body (not viable).
   int morphology_kind = 0;
+  // The body at rest (shape.hpp) and its oscillators; 0 without a body (not viable).
+  double elongation = 0.0;
+  int protrusions = 0;
+  int symmetric_pair = 0;  ///< 1 when two protrusions mirror each other, else 0
+  double concavity = 0.0;
+  double frequency = 0.0;            ///< median oscillator frequency of the cells
   std::vector<std::string> reasons;  ///< non-viability reasons or the instability description
   // Diagnostics.
   Eigen::Vector2d displacement{0.0, 0.0};  ///< COM(end) − COM(start)
@@ -304,6 +310,24 @@ void visit_fields(R& r, V&& v)
     "Coarse class of the body plan: cell_count * 16 + elongation band (floor(log_1.5 "
     "elongation), clamped to [0, 15]); 0 if not viable.",
     r.morphology_kind);
+  v("elongation",
+    "sqrt of the ratio of the principal second moments of the body at rest "
+    "(animat.shape.body_shape(body).elongation); 0 if not viable.",
+    r.elongation);
+  v("protrusions",
+    "Parts sticking out of the body's core (animat.shape.body_shape(body).protrusion_count); 0 if "
+    "not viable.",
+    r.protrusions);
+  v("symmetric_pair",
+    "1 when two protrusions mirror each other about a principal axis, else 0 "
+    "(animat.shape.body_shape(body).symmetric_pair).",
+    r.symmetric_pair);
+  v("concavity",
+    "1 - outline area / hull area of the body at rest (animat.shape.body_shape(body).concavity); 0 "
+    "if not viable.",
+    r.concavity);
+  v("frequency", "Median oscillator frequency of the cells (rad per time unit); 0 if not viable.",
+    r.frequency);
   v("reasons", "Non-viability reasons, or the instability description.", r.reasons);
   v("spring_count", "Springs of the body.", r.spring_count);
   v("region_count", "Regions of the body.", r.region_count);

@@ -61,6 +61,12 @@ struct Fitness {
   double actuation_work_positive = 0.0;
   double actuation_work_absolute = 0.0;
   double max_speed = 0.0;
+  // Measures of the body at rest (shape.hpp) and of its oscillators; 0 if not viable.
+  double elongation = 0.0;
+  int protrusions = 0;
+  int symmetric_pair = 0;
+  double concavity = 0.0;
+  double frequency = 0.0;
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
@@ -98,6 +104,14 @@ void visit_fields(F& f, V&& v)
     "Absolute actuation work, per spring and Box2D step (0 if not viable).",
     f.actuation_work_absolute);
   v("max_speed", "Largest cell speed seen in the swim (0 if not viable).", f.max_speed);
+  v("elongation", "Elongation of the body at rest (animat.shape; 0 if not viable).", f.elongation);
+  v("protrusions", "Protrusions of the body at rest (animat.shape; 0 if not viable).",
+    f.protrusions);
+  v("symmetric_pair",
+    "1 when two protrusions mirror each other about a principal axis, else 0 (animat.shape).",
+    f.symmetric_pair);
+  v("concavity", "Concavity of the body at rest (animat.shape; 0 if not viable).", f.concavity);
+  v("frequency", "Median oscillator frequency of the cells (0 if not viable).", f.frequency);
 }
 
 struct EvaluationResult;  // evaluate.hpp

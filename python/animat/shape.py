@@ -13,6 +13,10 @@ cell indices counter-clockwise around the body, a dangling edge walked twice) an
 springs ``(m, 2)`` (for grouping cells into protrusions). :func:`body_shape` takes an
 :class:`animat.Body`, :func:`genome_shape` a genome and a config (develop, build the body, describe).
 
+The engine computes the measures (``include/animat/shape.hpp``; this module calls it): every
+evaluation carries its body's ``elongation``, ``protrusions``, ``symmetric_pair`` and ``concavity``
+(:class:`animat.EvaluationResult`, the searches' Fitness), with the defaults of :class:`ShapeParams`.
+
 Elongation
     ``sqrt(λ1 / λ2)``, λ1 ≥ λ2 the principal second moments (eigenvalues of the covariance matrix)
     of the cells about their centroid, each cell counted as a uniform disc of diameter
@@ -77,6 +81,8 @@ from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
+
+from . import _core
 
 __all__ = [
     "ShapeParams",
@@ -212,79 +218,33 @@ def principal_axes(
 
 
 def elongation(positions: np.ndarray, params: ShapeParams = ShapeParams(), spacing: Optional[float] = None) -> float:
-    """sqrt(λ1/λ2) of the cells' principal second moments (module docstring); 1.0 for one cell."""
-    p = np.asarray(positions, dtype=float)
-    if len(p) == 0:
-        return 1.0
-    lam, _ = principal_axes(p, params, spacing)
-    if lam[1] <= 0:
-        return 1.0
-    if lam[0] <= 1e-12 * lam[1]:
-        return float("inf")
-    return float(np.sqrt(lam[1] / lam[0]))
-
-
-def _shoelace(v: np.ndarray) -> float:
-    if len(v) < 3:
-        return 0.0
-    x, y = v[:, 0], v[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
-
-
-def _hull(p: np.ndarray) -> np.ndarray:
-    """Convex hull vertices, counter-clockwise (Andrew's monotone chain)."""
-    pts = sorted(map(tuple, np.unique(p, axis=0)))
-    if len(pts) < 3:
-        return np.array(pts, dtype=float).reshape(-1, 2)
-
-    def cross(o: Tuple[float, float], a: Tuple[float, float], b: Tuple[float, float]) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: List[Tuple[float, float]] = []
-    for q in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], q) <= 0:
-            lower.pop()
-        lower.append(q)
-    upper: List[Tuple[float, float]] = []
-    for q in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], q) <= 0:
-            upper.pop()
-        upper.append(q)
-    return np.array(lower[:-1] + upper[:-1], dtype=float)
+    """sqrt(λ1/λ2) of the cells' principal second moments (module docstring); 1.0 for one cell.
+    Computed by the engine (``shape.hpp``), which also bands it for ``morphology_kind``."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 2)
+    return float(_core._elongation(p, params.cell_diameter, spacing))
 
 
 def concavity(positions: np.ndarray, outline: Sequence[int], spacing: Optional[float] = None) -> float:
     """1 − A_outline / A_hull (module docstring); 0 for a body whose hull is smaller than one
     triangle of touching cells."""
-    p = np.asarray(positions, dtype=float)
-    s = cell_spacing(p) if spacing is None else spacing
-    return _concavity(*_areas(p, outline), s)
+    return float(_engine_shape(positions, outline, None, ShapeParams(), spacing)["concavity"])
 
 
-def _concavity(a_out: float, a_hull: float, s: float) -> float:
-    if a_hull < np.sqrt(3.0) / 4.0 * s * s:
-        return 0.0
-    return float(min(1.0, max(0.0, 1.0 - a_out / a_hull)))
+def _engine_shape(
+    positions: Any, outline: Optional[Sequence[int]], springs: Any, params: ShapeParams, spacing: Optional[float] = None
+) -> Dict[str, Any]:
+    """The engine's descriptors (``shape.hpp``, the one definition of this module's measures) as a
+    dict of :class:`Shape`'s fields and ``has_core``."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 2)
+    loop = [] if outline is None else [int(i) for i in outline]
+    flat = None if springs is None else [int(k) for k in np.asarray(springs, dtype=np.int64).reshape(-1)]
+    return _core._describe_shape(
+        p, loop, flat, params.cell_diameter, params.core_radius, params.min_height, params.pair_tolerance, spacing
+    )
 
 
-def _areas(p: np.ndarray, outline: Sequence[int]) -> Tuple[float, float]:
-    loop = np.asarray(outline, dtype=np.int64)
-    a_out = abs(_shoelace(p[loop])) if len(loop) >= 3 else 0.0
-    a_hull = abs(_shoelace(_hull(p))) if len(p) >= 3 else 0.0
-    return a_out, a_hull
-
-
-def _segment_distances(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(N, E) squared distances from points q to segments a→b (the squares ``np.linalg.norm`` sums)."""
-    ab = b - a
-    ll = np.einsum("ij,ij->i", ab, ab)
-    ll = np.where(ll > 0, ll, 1.0)
-    aq = q[:, None, :] - a[None, :, :]
-    t = np.clip(np.einsum("nej,ej->ne", aq, ab) / ll, 0.0, 1.0)
-    closest = a[None, :, :] + t[..., None] * ab[None, :, :]
-    d = q[:, None, :] - closest
-    x, y = d[..., 0], d[..., 1]
-    return x * x + y * y
+# The pieces of the exact construction of the core, in numpy: the reference that
+# tests/python/test_qd_descriptors.py rebuilds the engine's cell heights from.
 
 
 def _inside(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -336,31 +296,6 @@ def _core_candidates(a: np.ndarray, b: np.ndarray, rho: float) -> Tuple[np.ndarr
     return np.concatenate(points), o, t, v
 
 
-def _in_core_erosion(q: np.ndarray, a: np.ndarray, b: np.ndarray, rho: float) -> np.ndarray:
-    """(N,) bool: q inside the polygon at depth >= ρ (up to rounding)."""
-    out = np.zeros(len(q), dtype=bool)
-    level = rho * (1 - 1e-9) - 1e-12
-    # A point inside at depth d has the open disc of radius d inside (no edge crosses it), and every
-    # inside point lies in the vertices' bounding box: a point outside that box shrunk by the depth
-    # (less a margin far above rounding) is no point of the erosion. Only the others are measured.
-    lo, hi = a.min(axis=0) + (level - 1e-9), a.max(axis=0) - (level - 1e-9)
-    (boxed,) = np.nonzero(np.all((q >= lo) & (q <= hi), axis=1))
-    # Nor is a point nearer than that to a vertex: an edge from it is as near.
-    dx, dy = q[boxed, None, 0] - a[None, :, 0], q[boxed, None, 1] - a[None, :, 1]
-    boxed = boxed[(dx * dx + dy * dy).min(axis=1) >= (level - 1e-9) ** 2]
-    for start in range(0, len(boxed), 2048):
-        rows = boxed[start : start + 2048]
-        chunk = q[rows]
-        # sqrt is correctly rounded, so monotonic: the root of the least square is the least norm
-        depth = np.sqrt(_segment_distances(chunk, a, b).min(axis=1))
-        deep = depth >= level
-        if deep.any():
-            idx = np.nonzero(deep)[0]
-            deep[idx] = _inside(chunk[idx], a, b)
-        out[rows] = deep
-    return out
-
-
 def cell_heights(
     positions: np.ndarray, outline: Sequence[int], params: ShapeParams = ShapeParams(), spacing: Optional[float] = None
 ) -> Optional[np.ndarray]:
@@ -370,41 +305,10 @@ def cell_heights(
 
     Exact up to rounding: the nearest point of the eroded outline {depth >= ρ} to a cell is either
     the cell itself, its projection on an edge's offset line, its radial projection on a vertex's
-    circle of radius ρ, or a corner where two of those meet; every candidate at depth >= ρ counts."""
-    p = np.asarray(positions, dtype=float)
-    loop = np.asarray(outline, dtype=np.int64)
-    if len(p) < 3 or len(loop) < 3:
-        return None
-    s = cell_spacing(p) if spacing is None else spacing
-    u = p / s
-    a = u[loop]
-    b = np.roll(a, -1, axis=0)
-    keep = np.any(a != b, axis=1)
-    a, b = a[keep], b[keep]
-    if len(a) < 3:
-        return None
-    rho = params.core_radius
-    corners, o, t, v = _core_candidates(a, b, rho)
-    lo, hi = a.min(axis=0) - 1e-9, a.max(axis=0) + 1e-9
-    corners = corners[np.all((corners >= lo) & (corners <= hi), axis=1)]
-    # Each cell's own candidates (itself, its projections on the offset lines, its radial
-    # projections on the vertex circles); all of them are points of the erosion, so pool them with
-    # the corners. One batch for all cells: every value is computed row by row, as for one cell.
-    n = len(u)
-    rel = (u[:, None, :] - o[None, :, :]).reshape(-1, 2)
-    along = np.einsum("kj,kj->k", rel, np.tile(t, (n, 1)))
-    lines = np.tile(o, (n, 1)) + along[:, None] * np.tile(t, (n, 1))
-    radial = (u[:, None, :] - v[None, :, :]).reshape(-1, 2)
-    r = np.linalg.norm(radial, axis=1)
-    centres = np.tile(v, (n, 1))
-    circles = centres[r > 0] + rho * radial[r > 0] / r[r > 0, None]
-    core = np.concatenate([corners, u, lines, circles])
-    core = core[_in_core_erosion(core, a, b, rho)]
-    if len(core) == 0:
-        return None
-    dx, dy = u[:, None, 0] - core[None, :, 0], u[:, None, 1] - core[None, :, 1]
-    heights = np.sqrt((dx * dx + dy * dy).min(axis=1))  # the least norm (as in _in_core_erosion)
-    return np.maximum(0.0, heights - rho)
+    circle of radius ρ, or a corner where two of those meet; every candidate at depth >= ρ counts.
+    Computed by the engine (``shape.hpp``)."""
+    d = _engine_shape(positions, outline, None, params, spacing)
+    return np.array(d["heights"], dtype=float) if d["has_core"] else None
 
 
 def connected_groups(members: Sequence[int], links: Sequence[Tuple[int, int]]) -> List[List[int]]:
@@ -467,43 +371,21 @@ def describe(
 ) -> Shape:
     """The descriptors of cells at ``positions`` (n, 2) with the outer ``outline`` (cell indices,
     counter-clockwise; ``Body.skin_loops[0]``; None or empty for fewer than two cells) and optional
-    ``springs`` (m, 2) used to group protruding cells."""
-    p = np.asarray(positions, dtype=float).reshape(-1, 2)
-    n = len(p)
-    loop = [] if outline is None else [int(i) for i in outline]
-    s = cell_spacing(p)
-    if n == 0:
-        return Shape(0, s, 1.0, 0.0, 0.0, 0.0, 0, (), ())
-    el = elongation(p, params, s)
-    a_out, a_hull = _areas(p, loop)
-    conc = _concavity(a_out, a_hull, s)
-    heights = cell_heights(p, loop, params, s)
-    if heights is None:
-        return Shape(n, s, el, conc, a_out / s**2, a_hull / s**2, 0, (0.0,) * n, ())
-    protruding = [i for i in range(n) if heights[i] >= params.min_height]
-    links: List[Tuple[int, int]] = [(loop[k], loop[(k + 1) % len(loop)]) for k in range(len(loop))]
-    if springs is not None:
-        links += [(int(i), int(j)) for i, j in np.asarray(springs, dtype=np.int64).reshape(-1, 2)]
-    else:
-        d = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=2)
-        links += [(i, j) for i in protruding for j in protruding if i < j and d[i, j] < 1.5 * s]
-    found = []
-    for g in connected_groups(protruding, links):
-        cx, cy = p[g].mean(axis=0)
-        found.append(Protrusion(tuple(g), float(max(heights[g])), (float(cx), float(cy))))
-    found.sort(key=lambda pr: (-pr.size, -pr.height, pr.cells))
-    pairs = symmetric_pairs(p, found, params, s)
+    ``springs`` (m, 2) used to group protruding cells. Computed by the engine (``shape.hpp``), which
+    also gives every evaluation's elongation, protrusions, symmetric_pair and concavity."""
+    d = _engine_shape(positions, outline, springs, params)
+    found = tuple(Protrusion(tuple(cells), float(h), (float(c[0]), float(c[1]))) for cells, h, c in d["protrusions"])
     return Shape(
-        n,
-        s,
-        el,
-        conc,
-        a_out / s**2,
-        a_hull / s**2,
-        n - len(protruding),
-        tuple(map(float, heights)),
-        tuple(found),
-        tuple(pairs),
+        int(d["cell_count"]),
+        float(d["spacing"]),
+        float(d["elongation"]),
+        float(d["concavity"]),
+        float(d["outline_area"]),
+        float(d["hull_area"]),
+        int(d["core_cells"]),
+        tuple(float(h) for h in d["heights"]),
+        found,
+        tuple((int(i), int(j)) for i, j in d["symmetric_pairs"]),
     )
 
 

@@ -8,7 +8,6 @@
 
 namespace animat {
 
-
 namespace {
 
 // Descriptor ranges are animat.qd.DESCRIPTORS' (the paper's settings): integer descriptors one
@@ -26,6 +25,16 @@ constexpr Measure kMeasures[] = {
      [](const Fitness& f) { return f.actuation_work_absolute; }},
     {"max_speed", "largest cell speed seen in the swim", 0.0, 0.0, true,
      [](const Fitness& f) { return f.max_speed; }},
+    {"elongation", "elongation of the body at rest (animat.shape)", 1.0, 4.0, true,
+     [](const Fitness& f) { return f.elongation; }},
+    {"protrusions", "number of protrusions: parts sticking out of the body's core", 0.0, 8.0, true,
+     [](const Fitness& f) { return static_cast<double>(f.protrusions); }},
+    {"symmetric_pair", "1 when two protrusions mirror each other about a principal axis, else 0",
+     0.0, 2.0, true, [](const Fitness& f) { return static_cast<double>(f.symmetric_pair); }},
+    {"concavity", "1 - outline area / convex hull area of the body at rest", 0.0, 0.5, true,
+     [](const Fitness& f) { return f.concavity; }},
+    {"frequency", "median oscillator frequency of the cells (rad per time unit)", 0.5, 6.0, true,
+     [](const Fitness& f) { return f.frequency; }},
 };
 
 }  // namespace
@@ -38,11 +47,11 @@ const Measure& find_measure(std::string_view name, const Config& config, std::st
     if (name == m.name) return m;
   std::string names;
   for (const Measure& m : kMeasures) names += (names.empty() ? "" : ", ") + std::string(m.name);
-  throw ConfigError(
-      fmt::format("{}: no measure \"{}\" in animat_evolve; its measures are {} (and \"{}\", the "
-                  "evaluation.objective, as \"fitness\"); the others of animat.qd.DESCRIPTORS and "
-                  "animat.moo.CRITERIA run in Python (`animat evolve`)",
-                  key, name, names, config.evaluation.objective));
+  throw ConfigError(fmt::format(
+      "{}: no measure \"{}\" in animat_evolve; its measures are {} (and \"{}\", the "
+      "evaluation.objective, as \"fitness\"); animat.qd.DESCRIPTORS' locomotion and the "
+      "other criteria of animat.moo.CRITERIA run in Python (`animat evolve`)",
+      key, name, names, config.evaluation.objective));
 }
 
 }  // namespace animat

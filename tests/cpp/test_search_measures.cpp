@@ -1,0 +1,119 @@
+// The measures' table (search.hpp): the shape and frequency measures that every evaluation carries
+// (EvaluationResult -> Fitness), their ranges (animat.qd.DESCRIPTORS') and their names.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "animat/body.hpp"
+#include "animat/config.hpp"
+#include "animat/development.hpp"
+#include "animat/errors.hpp"
+#include "animat/evaluate.hpp"
+#include "animat/evolution.hpp"
+#include "animat/genome.hpp"
+#include "animat/random.hpp"
+#include "animat/search.hpp"
+#include "animat/shape.hpp"
+
+using namespace animat;
+
+namespace {
+
+/// numpy's median of the cells' frequencies.
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2.0;
+}
+
+}  // namespace
+
+TEST(Measures, ShapeAndFrequencyHaveQdsRangesAndReadTheirFitnessFields) {
+  const Config c;
+  Fitness f;
+  f.elongation = 2.5;
+  f.protrusions = 3;
+  f.symmetric_pair = 1;
+  f.concavity = 0.125;
+  f.frequency = 4.25;
+  struct Row {
+    const char* name;
+    double lo, hi, value;
+  };
+  for (const Row& r : {Row{"elongation", 1.0, 4.0, 2.5}, Row{"protrusions", 0.0, 8.0, 3.0},
+                       Row{"symmetric_pair", 0.0, 2.0, 1.0}, Row{"concavity", 0.0, 0.5, 0.125},
+                       Row{"frequency", 0.5, 6.0, 4.25}}) {
+    const Measure& m = find_measure(r.name, c, "search.descriptors");
+    EXPECT_EQ(std::string(m.name), r.name);
+    EXPECT_EQ(m.lo, r.lo) << r.name;
+    EXPECT_EQ(m.hi, r.hi) << r.name;
+    EXPECT_EQ(m.of(f), r.value) << r.name;
+  }
+  std::set<std::string> names;
+  for (const Measure& m : measures()) EXPECT_TRUE(names.insert(m.name).second) << m.name;
+}
+
+TEST(Measures, TheDefaultDescriptorsAreMeasuresOfTheEngine) {
+  const Config c;
+  ASSERT_EQ(c.search.descriptors, (std::vector<std::string>{"elongation", "protrusions"}));
+  for (const std::string& name : c.search.descriptors)
+    EXPECT_EQ(std::string(find_measure(name, c, "search.descriptors").name), name);
+}
+
+TEST(Measures, AnUnknownNameIsRefusedNamingTheKeyAndListingTheMeasures) {
+  const Config c;
+  try {
+    (void)find_measure("locomotion", c, "search.descriptors");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("search.descriptors: no measure \"locomotion\""), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("elongation, protrusions, symmetric_pair, concavity, frequency"),
+              std::string::npos)
+        << what;
+  }
+}
+
+TEST(Measures, AnEvaluationCarriesTheShapeAndFrequencyOfItsBody) {
+  Config c;
+  c.evaluation.steps = 20;
+  Rng rng(11);
+  for (int k = 0; k < 8; ++k) {
+    const Genome g = random_viable_genome(c, rng);
+    const Fitness f = fitness_of(evaluate(g, c));
+    ASSERT_TRUE(f.viable) << k;
+    const Embryo e = develop(g, c.genome, c.grn, c.development);
+    const Body body = build_body(e, c.body);
+    const Shape sh = body_shape(body);
+    EXPECT_EQ(f.elongation, sh.elongation) << k;
+    EXPECT_EQ(f.protrusions, static_cast<int>(sh.protrusions.size())) << k;
+    EXPECT_EQ(f.symmetric_pair, sh.symmetric_pairs.empty() ? 0 : 1) << k;
+    EXPECT_EQ(f.concavity, sh.concavity) << k;
+    EXPECT_EQ(f.frequency,
+              median(std::vector<double>(body.frequency.data(),
+                                         body.frequency.data() + body.frequency.size())))
+        << k;
+    EXPECT_GE(f.elongation, 1.0) << k;
+  }
+}
+
+TEST(Measures, ANonViableEvaluationHasZeroMeasures) {
+  Config c;
+  c.evaluation.steps = 20;
+  Rng rng(5);
+  Fitness f;
+  f.viable = true;
+  for (int k = 0; k < 200 && f.viable; ++k)
+    f = fitness_of(evaluate(random_genome(c.genome, rng), c));
+  ASSERT_FALSE(f.viable) << "no random genome of 200 is non-viable";
+  EXPECT_EQ(f.elongation, 0.0);
+  EXPECT_EQ(f.protrusions, 0);
+  EXPECT_EQ(f.symmetric_pair, 0);
+  EXPECT_EQ(f.concavity, 0.0);
+  EXPECT_EQ(f.frequency, 0.0);
+}
