@@ -75,10 +75,14 @@ void bind_search(nb::module_& m) {
                            "ask()/tell() or step().")
       .def(
           "__init__",
-          [](SearchEngine* e, const Config& c) { new (e) SearchEngine{make_search(c)}; },
-          "config"_a,
+          [](SearchEngine* e, const Config& c, const std::vector<std::string>& supplied) {
+            new (e) SearchEngine{make_search(c, {}, {}, nullptr, supplied)};
+          },
+          "config"_a, "supplied"_a = std::vector<std::string>{},
           "The search of config (search.algorithm); a [search] setting it cannot run is a "
-          "ValueError naming\nthe key and value.")
+          "ValueError naming\nthe key and value. supplied: names of search.descriptors whose "
+          "values the caller computes\nand passes to tell(fitness, values) (MAP-Elites; their "
+          "ranges in search.ranges).")
       .def_prop_ro("algorithm",
                    [](const SearchEngine& e) { return std::string(e.search->algorithm()); })
       .def(
@@ -91,12 +95,17 @@ void bind_search(nb::module_& m) {
           "The genomes that need a fitness next, in order (the same until tell()).")
       .def(
           "tell",
-          [](SearchEngine& e, const std::vector<Fitness>& fitness) {
+          [](SearchEngine& e, const std::vector<Fitness>& fitness,
+             const std::vector<std::vector<double>>& values) {
             SearchLease lease(e, "tell");
+            auto* me = dynamic_cast<MapElites*>(e.search.get());
+            if (!values.empty() && (me == nullptr || me->supplied().empty()))
+              throw Error(
+                  "SearchEngine.tell: values are for supplied descriptors; this search has none");
             nb::gil_scoped_release release;  // the exploit guard's reference swims
-            return e.search->tell(fitness);
+            return me ? me->tell(fitness, values) : e.search->tell(fitness);
           },
-          "fitness"_a,
+          "fitness"_a, "values"_a = std::vector<std::vector<double>>{},
           "The Fitness of every genome of the last ask(), in order; True when a generation "
           "completed. All or\nnothing: a refused value (an error naming its index and what is "
           "wrong) changes nothing.")

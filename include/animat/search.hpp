@@ -138,11 +138,13 @@ class Search {
 /// The search of config.search.algorithm: `fitness` (default swim_fitness(config)) evaluates on
 /// `evaluator` (default: this process's OpenMP threads); `reference` is the exploit guard's
 /// (default swim_fitness(reference_config(config)) unless evaluation.reference_check is "off").
+/// `supplied`: MAP-Elites' descriptors whose values the caller passes to tell (MapElites).
 /// Throws ConfigError for [search] settings that cannot run (naming the key and value).
 [[nodiscard]] std::unique_ptr<Search> make_search(const Config& config,
                                                   FitnessFunction fitness = {},
                                                   FitnessFunction reference = {},
-                                                  std::shared_ptr<Evaluator> evaluator = nullptr);
+                                                  std::shared_ptr<Evaluator> evaluator = nullptr,
+                                                  const std::vector<std::string>& supplied = {});
 
 /// The GA (Evolution) behind the Search interface: the same engine, the same results.
 class GaSearch final : public Search {
@@ -235,13 +237,24 @@ class GridArchive {
 /// search.batch random viable genomes (genome i: the first viable draw of
 /// Rng::derive(seed, g, i)); later ones search.batch offspring() of elites picked uniformly in cell
 /// order. A candidate enters when it is viable, stable and valid and beats its cell's elite.
+///
+/// Descriptors the caller computes (animat.qd's Python descriptors): the names of
+/// search.descriptors listed in `supplied` are not read from the measures table (search.ranges
+/// gives their ranges); tell(fitness, supplied) takes their values, one row per genome in
+/// `supplied`'s order, and the checkpoint keeps each elite's.
 class MapElites final : public Search {
  public:
   MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-            std::shared_ptr<Evaluator> evaluator);
+            std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied = {});
   [[nodiscard]] std::string_view algorithm() const override { return "map_elites"; }
   std::vector<Genome> ask() override;
-  bool tell(const std::vector<Fitness>& fitness) override;
+  bool tell(const std::vector<Fitness>& fitness) override { return tell(fitness, {}); }
+  /// tell() with the values of the supplied descriptors: a row per genome (read only for the
+  /// viable, stable and valid ones, whose values must be finite); refused, changing nothing, by
+  /// the value's index and descriptor name.
+  bool tell(const std::vector<Fitness>& fitness, const std::vector<std::vector<double>>& supplied);
+  /// The names of the descriptors the caller supplies, in their rows' order.
+  [[nodiscard]] const std::vector<std::string>& supplied() const { return supplied_->names; }
   [[nodiscard]] int generation() const override { return generation_; }
   [[nodiscard]] std::int64_t evaluations() const override { return evaluations_; }
   [[nodiscard]] std::string stop_reason() const override;
@@ -256,10 +269,18 @@ class MapElites final : public Search {
   [[nodiscard]] std::vector<double> row(int added, int discarded) const;
   [[nodiscard]] int disagreements(const GridArchive& archive) const;
 
+  /// The supplied descriptors' names and their measures (no function: `of` is null), which the
+  /// archive points to; shared by copies.
+  struct Supplied {
+    std::vector<std::string> names;
+    std::vector<Measure> measures;
+  };
+
   std::shared_ptr<const Config> config_;
   std::uint64_t identity_;
   FitnessFunction reference_;
   bool select_ = false;  ///< the exploit guard "select": the archive compares reference fitness
+  std::shared_ptr<const Supplied> supplied_;
   GridArchive archive_;
   int batch_;
   int generation_ = -1;

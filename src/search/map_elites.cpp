@@ -121,9 +121,22 @@ const Elite* GridArchive::best() const {
 // ---------------------------------------------------------------------------------------------------
 namespace {
 
-std::vector<const Measure*> descriptors_of(const Config& config) {
+// search.descriptors' measures: those named in `supplied` (the caller's), the others the table's.
+std::vector<const Measure*> descriptors_of(const Config& config,
+                                           const std::vector<Measure>& supplied) {
   std::vector<const Measure*> out;
   for (const std::string& name : config.search.descriptors) {
+    const auto own = std::find_if(supplied.begin(), supplied.end(),
+                                  [&](const Measure& m) { return m.name == name; });
+    if (own != supplied.end()) {
+      if (config.search.ranges.empty())
+        throw ConfigError(fmt::format(
+            "search.descriptors: \"{}\" is supplied by the caller: give the descriptors' ranges "
+            "in search.ranges",
+            name));
+      out.push_back(&*own);
+      continue;
+    }
     const Measure& m = find_measure(name, config, "search.descriptors");
     if (!(m.lo < m.hi) && config.search.ranges.empty())
       throw ConfigError(fmt::format(
@@ -159,10 +172,27 @@ std::vector<int> bins_of(const Config& config) {
 }  // namespace
 
 MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-                     std::shared_ptr<Evaluator> evaluator)
+                     std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied)
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
-      archive_(descriptors_of(config), bins_of(config), ranges_of(config)),
+      supplied_([&] {
+        auto out = std::make_shared<Supplied>();
+        out->names = supplied;
+        for (const std::string& name : out->names) {
+          if (std::count(out->names.begin(), out->names.end(), name) > 1)
+            throw ConfigError(fmt::format("MapElites: descriptor \"{}\" is supplied twice", name));
+          if (std::find(config.search.descriptors.begin(), config.search.descriptors.end(), name) ==
+              config.search.descriptors.end())
+            throw ConfigError(fmt::format(
+                "MapElites: the supplied descriptor \"{}\" is not one of search.descriptors",
+                name));
+          // `name` lives in out->names, which no longer changes: the pointer stays valid
+          out->measures.push_back(
+              Measure{name.c_str(), "supplied by the caller", 0.0, 0.0, true, nullptr});
+        }
+        return std::shared_ptr<const Supplied>(std::move(out));
+      }()),
+      archive_(descriptors_of(config, supplied_->measures), bins_of(config), ranges_of(config)),
       batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
       started_(now_seconds()) {
   if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
@@ -196,13 +226,22 @@ std::vector<Genome> MapElites::ask() {
   return *asked_;
 }
 
-bool MapElites::tell(const std::vector<Fitness>& fitness) {
+bool MapElites::tell(const std::vector<Fitness>& fitness,
+                     const std::vector<std::vector<double>>& supplied) {
   if (!asked_) throw Error("MapElites.tell: nothing was asked (call ask() first)");
   const std::vector<Genome>& genomes = *asked_;
   if (fitness.size() != genomes.size())
     throw Error(
         fmt::format("MapElites.tell: {} fitness values for the {} genomes of the last ask()",
                     fitness.size(), genomes.size()));
+  const std::size_t own = supplied_->names.size();
+  if (own == 0 && !supplied.empty())
+    throw Error("MapElites.tell: supplied values, but no descriptor is supplied by the caller");
+  if (own > 0 && supplied.size() != genomes.size())
+    throw Error(fmt::format(
+        "MapElites.tell: {} rows of supplied descriptor values for the {} genomes of the last "
+        "ask()",
+        supplied.size(), genomes.size()));
   const bool nonnegative = nonnegative_objective(*config_);
   // 1. Check every value and find where each candidate would go; nothing changes yet.
   std::vector<std::vector<double>> values(fitness.size());
@@ -216,8 +255,13 @@ bool MapElites::tell(const std::vector<Fitness>& fitness) {
                                      : std::string()));
     if (f.cell_count < 0) refuse("MapElites", k, fmt::format("cell_count {}", f.cell_count));
     if (!archivable(f)) continue;
+    if (own > 0 && supplied[k].size() != own)
+      refuse("MapElites", k,
+             fmt::format("{} supplied descriptor values for the {} supplied descriptors",
+                         supplied[k].size(), own));
     for (const Measure* d : archive_.descriptors()) {
-      const double x = d->of(f);
+      const double x =
+          d->of ? d->of(f) : supplied[k][static_cast<std::size_t>(d - supplied_->measures.data())];
       if (!std::isfinite(x))
         refuse("MapElites", k,
                fmt::format("descriptor {} = {} (a descriptor must be finite)", d->name, x));
@@ -323,12 +367,20 @@ std::string MapElites::checkpoint() const {
       payload_head(kMapElitesFormat, kMapElitesVersion, identity_,
                    {generation_, evaluations_, reference_evaluations_, history_.back().back()});
   json elites = json::array();
-  for (const auto& [cell, e] : archive_.elites())
+  for (const auto& [cell, e] : archive_.elites()) {
     elites.push_back(json{{"cell", cell},
                           {"genome", json::parse(to_json(e.genome))},
                           {"result", fitness_to_json(e.result)},
                           {"reference", nan_or(e.reference)},
                           {"generation", e.generation}});
+    // the values of the caller's descriptors, which the result does not hold
+    if (!supplied_->names.empty()) {
+      json own = json::array();
+      for (std::size_t j = 0; j < archive_.dims(); ++j)
+        if (archive_.descriptors()[j]->of == nullptr) own.push_back(e.descriptors[j]);
+      elites.back()["supplied"] = std::move(own);
+    }
+  }
   p["elites"] = std::move(elites);
   p["history"] = history_to_json(history_, history_columns());
   return seal(p);
@@ -357,8 +409,20 @@ void MapElites::restore(std::string_view text, std::string_view source) {
       if (nonnegative && e.result.fitness < 0.0)
         fail(fmt::format("the elite of cell {} has fitness {} (a fitness is >= 0)", cell,
                          e.result.fitness));
+      const std::size_t own = supplied_->names.size();
+      if (own > 0 &&
+          (!je.contains("supplied") || !je["supplied"].is_array() || je["supplied"].size() != own))
+        fail(fmt::format("the elite of cell {} has no list of its {} supplied descriptor values",
+                         cell, own));
       for (const Measure* d : archive.descriptors()) {
-        const double x = d->of(e.result);
+        double x = std::numeric_limits<double>::quiet_NaN();
+        if (d->of) {
+          x = d->of(e.result);
+        } else if (const json& v =
+                       je["supplied"][static_cast<std::size_t>(d - supplied_->measures.data())];
+                   v.is_number()) {
+          x = v.get<double>();
+        }
         if (!std::isfinite(x))
           fail(fmt::format("the elite of cell {} has {} = {}", cell, d->name, x));
         e.descriptors.push_back(x);

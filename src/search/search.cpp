@@ -143,9 +143,13 @@ std::vector<std::vector<double>> GaSearch::history() const {
 }
 
 std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitness,
-                                    FitnessFunction reference,
-                                    std::shared_ptr<Evaluator> evaluator) {
+                                    FitnessFunction reference, std::shared_ptr<Evaluator> evaluator,
+                                    const std::vector<std::string>& supplied) {
   validate(config);
+  if (!supplied.empty() && config.search.algorithm != "map_elites")
+    throw ConfigError(fmt::format(
+        "search.algorithm = \"{}\": descriptors supplied by the caller are MAP-Elites' only",
+        config.search.algorithm));
   if (!fitness) {
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off")
@@ -158,7 +162,7 @@ std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitnes
                                       std::move(evaluator));
   if (algorithm == "map_elites")
     return std::make_unique<MapElites>(config, std::move(fitness), std::move(reference),
-                                       std::move(evaluator));
+                                       std::move(evaluator), supplied);
   if (algorithm == "nsga2")
     return std::make_unique<Nsga2>(config, std::move(fitness), std::move(reference),
                                    std::move(evaluator));

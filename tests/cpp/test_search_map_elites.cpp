@@ -382,3 +382,82 @@ TEST(MapElites, TheSelectGuardComparesTheReferenceFitness) {
   resumed.restore(me.checkpoint(), "checkpoint.json");
   EXPECT_EQ(resumed.history(), me.history());
 }
+
+namespace {
+
+// A descriptor the table lacks, its values the caller's: genome k of a batch gets (k mod 4) / 4.
+Config supplied_config() {
+  Config c = me_config();
+  c.search.descriptors = {"shade", "cells"};
+  c.search.bins = {4.0, 8.0};
+  c.search.ranges = {0.0, 1.0, 1.0, 65.0};
+  return c;
+}
+
+MapElites make_supplied(const Config& c) {
+  return MapElites(c, search_stub, {}, make_local_evaluator(search_stub, c.evolution.threads),
+                   {"shade"});
+}
+
+std::vector<std::vector<double>> shades(std::size_t n) {
+  std::vector<std::vector<double>> out;
+  for (std::size_t k = 0; k < n; ++k) out.push_back({static_cast<double>(k % 4) / 4.0});
+  return out;
+}
+
+}  // namespace
+
+TEST(MapElites, SuppliedDescriptorsAreTheCallersValues) {
+  const Config c = supplied_config();
+  MapElites me = make_supplied(c);
+  ASSERT_EQ(me.supplied(), std::vector<std::string>{"shade"});
+  for (int g = 0; g < 3; ++g) {
+    const auto genomes = me.ask();
+    std::vector<Fitness> told;
+    for (const Genome& genome : genomes) told.push_back(search_stub(genome));
+    ASSERT_TRUE(me.tell(told, shades(genomes.size())));
+  }
+  ASSERT_GE(me.archive().elites().size(), 3U);
+  for (const auto& [cell, e] : me.archive().elites()) {
+    EXPECT_EQ(cell / 8, static_cast<std::size_t>(e.descriptors[0] * 4.0));  // the shade's bin
+    EXPECT_EQ(e.descriptors[1], static_cast<double>(e.result.cell_count));
+  }
+  // The checkpoint keeps the supplied values: a restore is the same archive.
+  MapElites again = make_supplied(c);
+  again.restore(me.checkpoint(), "checkpoint");
+  ASSERT_EQ(again.archive().elites().size(), me.archive().elites().size());
+  for (const auto& [cell, e] : me.archive().elites())
+    EXPECT_EQ(again.archive().elites().at(cell).descriptors, e.descriptors);
+}
+
+TEST(MapElites, SuppliedValuesAreCheckedBeforeAnythingChanges) {
+  const Config c = supplied_config();
+  MapElites me = make_supplied(c);
+  const auto genomes = me.ask();
+  std::vector<Fitness> told;
+  for (const Genome& genome : genomes) told.push_back(search_stub(genome));
+  std::size_t k = 0;
+  while (!(told[k].viable && told[k].stable && told[k].valid)) ++k;
+  auto bad = shades(genomes.size());
+  bad[k][0] = std::numeric_limits<double>::quiet_NaN();
+  try {
+    (void)me.tell(told, bad);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(fmt::format("value {}", k)), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("descriptor shade = nan"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)me.tell(told), Error);  // no rows
+  EXPECT_THROW((void)me.tell(told, shades(genomes.size() - 1)), Error);
+  EXPECT_EQ(me.generation(), -1);
+  EXPECT_TRUE(me.archive().elites().empty());
+  EXPECT_TRUE(me.tell(told, shades(genomes.size())));
+  // Without search.ranges a supplied descriptor has no range; a table search refuses rows.
+  Config no_ranges = c;
+  no_ranges.search.ranges = {};
+  EXPECT_THROW((void)make_supplied(no_ranges), ConfigError);
+  MapElites plain = make(me_config());
+  (void)plain.ask();
+  EXPECT_THROW((void)plain.tell(told, shades(genomes.size())), Error);
+}

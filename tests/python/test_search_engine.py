@@ -76,6 +76,36 @@ def test_search_ranges_are_animat_qd_descriptor_ranges():
     assert engine.history[-1][5] > 3  # several elites: a real comparison
 
 
+def test_supplied_descriptors_are_animat_qd_python_descriptors():
+    # A descriptor the engine's table lacks is computed by the caller and passed to tell, as
+    # animat.qd takes a Python function's values: the same cells, elites and parents.
+    def shade(genome, config=None, evaluation=None):
+        return int(hashlib.sha256(genome.to_json().encode()).hexdigest()[20:24], 16) / 65536.0
+
+    config = config_for("map_elites", 6)
+    config["search.descriptors"] = ["shade", "cells"]
+    config["search.bins"] = [4.0, 8.0]
+    config["search.ranges"] = [0.0, 1.0, 1.0, 65.0]
+    engine = _core.SearchEngine(config, supplied=["shade"])
+    me = animat.MapElites(config, animat.GridArchive([(shade, 0.0, 1.0), "cells"], bins=(4, 8)), batch=12, seed=6)
+    for _ in range(6):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in me.ask()]
+        told = [stub(g) for g in genomes]
+        assert engine.tell(told, values=[[shade(g)] for g in genomes])
+        row = me.tell(told, descriptors=[[shade(g), f.cell_count] if f.viable else None for g, f in zip(genomes, told)])
+        assert same(engine.history[-1][:10], [float(x) for x in row]), (engine.history[-1], row)
+    assert engine.history[-1][5] > 3  # several elites: a real comparison
+    again = _core.SearchEngine(config, supplied=["shade"])
+    again.restore(engine.checkpoint())
+    assert again.history == engine.history
+    with pytest.raises(Exception, match="descriptor shade = nan"):
+        genomes = again.ask()
+        again.tell([stub(g) for g in genomes], values=[[math.nan]] * len(genomes))
+    with pytest.raises(Exception, match="supplied descriptors"):
+        _core.SearchEngine(config_for("map_elites", 6)).tell([], values=[[0.5]])
+
+
 @pytest.mark.parametrize(
     "ranges, message",
     [
