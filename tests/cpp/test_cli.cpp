@@ -247,12 +247,13 @@ TEST(Cli, PackagedConfigsWithADotInTheirNameResolveByName) {
 }
 
 TEST(CliErrors, SearchSettingsAnimatEvolveCannotRunAreRefusedBeforeAnyFileIsWritten) {
-  // The default descriptors (elongation, protrusions) are computed by animat.qd (Python); a grid
+  // locomotion is computed by animat.qd (Python); a grid
   // too large for memory is refused by its size; the GA must not fill a run directory whose
   // config.toml says otherwise.
   const fs::path out = scratch_dir() / "map_elites_run";
   for (const auto& [flags, message] : std::initializer_list<std::pair<std::string, std::string>>{
-           {"--set search.algorithm=map_elites", "search.descriptors: no measure \"elongation\""},
+           {"--set search.algorithm=map_elites --set 'search.descriptors=[\"locomotion\",\"cells\"]'",
+            "search.descriptors: no measure \"locomotion\""},
            {"--set search.algorithm=map_elites --set 'search.descriptors=[\"cells\",\"fitness\"]' "
             "--set 'search.bins=[100000]'",
             "search.bins = [100000, 100000]"},
