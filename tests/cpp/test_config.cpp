@@ -188,6 +188,10 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
         for (double& x : whole) x += 1;  // search.bins: whole numbers only
         candidates.push_back(w);
         candidates.push_back(whole);
+        if (v->empty()) {  // search.ranges: a lo < hi pair per descriptor, one or two of them
+          candidates.push_back(std::vector<double>{0.1, 1.0 / 3.0});
+          candidates.push_back(std::vector<double>{0.1, 1.0 / 3.0, 2.5e-7, 123456.789});
+        }
       } else if (std::holds_alternative<std::string>(def)) {
         for (const char* word :
              {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",

@@ -297,6 +297,18 @@ std::vector<Probe> probes_for(const FieldInfo& info, const std::vector<double>& 
     for (double d : v) parts.push_back(toml_double(d));
     out.push_back({fmt::format("[{}]", fmt::join(parts, ", ")), v, inside});
   };
+  if (current.empty()) {  // search.ranges: free lo < hi pairs, one per descriptor (two by default)
+    out.push_back({"[]", current, true});
+    out.push_back(
+        {"[0.5, 2.5, -1e300, 1e300]", std::vector<double>{0.5, 2.5, -1e300, 1e300}, true});
+    out.push_back({"[0.5, 2.5]", std::vector<double>{0.5, 2.5}, false});  // one pair of two
+    out.push_back({"[2.5, 0.5, 0.0, 4.0]", std::vector<double>{2.5, 0.5, 0.0, 4.0}, false});
+    out.push_back({"[0.5, 0.5, 0.0, 4.0]", std::vector<double>{0.5, 0.5, 0.0, 4.0}, false});
+    out.push_back(
+        {"[nan, 2.5, 0.0, 4.0]", std::vector<double>{std::nan(""), 2.5, 0.0, 4.0}, false});
+    out.push_back({"[0.5, inf, 0.0, 4.0]", std::vector<double>{0.5, INFINITY, 0.0, 4.0}, false});
+    return out;
+  }
   const Bounds& b = info.bounds;
   EXPECT_TRUE(std::isfinite(b.lo) && std::isfinite(b.hi))
       << info.name << " has an unbounded range " << b.describe();

@@ -316,6 +316,7 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nalgorithm = ",
                           "\ndescriptors = ",
                           "\nbins = ",
+                          "\nranges = ",
                           "\nbatch = ",
                           "\nobjectives = "}) {
     const auto at = text.find(key);
