@@ -27,7 +27,9 @@
 # ANIMAT_REPLICATION_PRESET=regime grows the same study at the regime presets (configs/regime_<env>.toml,
 # docs/regime.md) instead of the paper's environments (configs/paper_<env>.toml, the default "paper"),
 # in the environments the preset has (regime: all four); ANIMAT_REPLICATION_PRESET=regime_fixed grows
-# it at configs/regime_fixed_<env>.toml (the regime presets with development.jitter_stream = "fixed").
+# it at configs/regime_fixed_<env>.toml (the regime presets with development.jitter_stream = "fixed"),
+# and ANIMAT_REPLICATION_PRESET=regime_dt4 at configs/regime_dt4_<env>.toml (the long replication:
+# selection at dt/4, the reference at dt/16, cap 5000; three environments).
 # Give each its own ANIMAT_REPLICATION_DATA, _OUT, _DOC and _IMAGES (the page's figures, default
 # docs/images/replication).
 # The paper's discussion (docs/notes/replication_discussion.md) and the controlled runs' section are

@@ -408,7 +408,13 @@ def test_a_gzip_bomb_is_refused_at_the_size_limit_in_bounded_memory(tmp_path, mo
 
 @pytest.mark.parametrize(
     "study,count",
-    [("replication", 40), ("replication_regime", 40), ("replication_regime_fixed", 40), ("regime_protection", 4)],
+    [
+        ("replication", 40),
+        ("replication_regime", 40),
+        ("replication_regime_fixed", 40),
+        ("replication_long", 30),
+        ("regime_protection", 4),
+    ],
 )
 def test_every_committed_packed_run_has_a_manifest_and_unpacks_verified(tmp_path, study, count):
     runs = [p for group in R.packed_runs(ROOT / "data" / study).values() for p in group]
