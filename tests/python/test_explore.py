@@ -493,6 +493,9 @@ def test_cli_serves_the_page_on_localhost_until_interrupted(runs):
         stderr=subprocess.PIPE,
         text=True,
         env=env,
+        # A suite started by a non-interactive shell's `cmd &` passes SIGINT on ignored, and the
+        # server would never see the Ctrl-C below: restore it, as a terminal gives it.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     try:
         assert proc.stdout is not None
