@@ -252,7 +252,8 @@ TEST(CliErrors, SearchSettingsAnimatEvolveCannotRunAreRefusedBeforeAnyFileIsWrit
   // config.toml says otherwise.
   const fs::path out = scratch_dir() / "map_elites_run";
   for (const auto& [flags, message] : std::initializer_list<std::pair<std::string, std::string>>{
-           {"--set search.algorithm=map_elites --set 'search.descriptors=[\"locomotion\",\"cells\"]'",
+           {"--set search.algorithm=map_elites --set "
+            "'search.descriptors=[\"locomotion\",\"cells\"]'",
             "search.descriptors: no measure \"locomotion\""},
            {"--set search.algorithm=map_elites --set 'search.descriptors=[\"cells\",\"fitness\"]' "
             "--set 'search.bins=[100000]'",
