@@ -449,6 +449,10 @@ void bind_research(nb::module_& m) {
       "sees:\n"
       "the result, the body and the trajectory every `every` control steps (0 = no trajectory).");
   m.def(
+      "fitness_of", [](const EvaluationResult& r) { return fitness_of(r); }, "result"_a,
+      "The Fitness the searches know of an evaluation (evolution.hpp fitness_of): every Fitness "
+      "field\ncopied from the EvaluationResult, as animat_evolve's evaluations give them.");
+  m.def(
       "_evaluate_population_bodies",
       [](const std::vector<Genome>& genomes, std::optional<Config> config, int threads,
          nb::handle objective) {

@@ -207,27 +207,14 @@ def record_evaluation(genome: Any, config: Any = None, every: int = 20) -> Any:
 
 def to_fitness(value: Any) -> Any:
     """A :class:`animat.Fitness` from what an evaluator returns: a Fitness; an EvaluationResult
-    (its fitness, viable, stable, cell_count, valid, drag_limited, morphology_kind and the swim's
-    measures: actuation_work, actuation_work_positive, actuation_work_absolute, max_speed, as
-    animat_evolve's evaluations give them); ``None`` (not viable); or a
+    (every Fitness field copied from it, as animat_evolve's evaluations give them:
+    ``_core.fitness_of``); ``None`` (not viable); or a
     number (a viable genome's fitness; it must be finite; its morphology kind is unknown, 0, so that
     ``evolution.protection_generations`` protects nothing)."""
     if isinstance(value, _core.Fitness):
         return value
     if isinstance(value, _core.EvaluationResult):
-        return _core.Fitness(
-            value.fitness,
-            value.viable,
-            value.stable,
-            value.cell_count,
-            value.valid,
-            value.drag_limited,
-            value.morphology_kind,
-            value.actuation_work,
-            value.actuation_work_positive,
-            value.actuation_work_absolute,
-            value.max_speed,
-        )
+        return _core.fitness_of(value)
     if value is None:
         return _core.Fitness(0.0, False, True, 0)
     if isinstance(value, (bool, np.bool_)):
