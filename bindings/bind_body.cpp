@@ -263,11 +263,11 @@ void bind_body(nb::module_& m) {
       "principal second moments, each cell a disc of one cell spacing); 0 for no cell. "
       "EvaluationResult\n"
       "and Fitness carry it for an evaluated genome (its body's rest positions).");
-  // The C++ geometry behind morphology_kind, for the tests that hold it to animat.shape.
+  // The C++ geometry behind morphology_kind and animat.shape (which calls these two).
   m.def(
-      "_elongation",
+      "shape_elongation",
       [](nb::handle points, double cell_diameter, std::optional<double> spacing) {
-        const Points p = to_points(points, "_elongation");
+        const Points p = to_points(points, "shape_elongation");
         return spacing ? elongation(p, cell_diameter, *spacing) : elongation(p, cell_diameter);
       },
       "points"_a, "cell_diameter"_a = 1.0, "spacing"_a = nb::none(),
@@ -275,16 +275,16 @@ void bind_body(nb::module_& m) {
       "use;\n"
       "`spacing` is s (default: the cell spacing of `points`).");
   m.def(
-      "_describe_shape",
+      "describe_shape",
       [](nb::handle points, const std::vector<int>& outline,
          std::optional<std::vector<int>> springs, double cell_diameter, double core_radius,
          double min_height, double pair_tolerance, std::optional<double> spacing) {
-        const Points p = to_points(points, "_describe_shape");
+        const Points p = to_points(points, "describe_shape");
         IndexPairs links;
         if (springs) {
           if (springs->size() % 2 != 0)
-            throw GeometryError(fmt::format("_describe_shape: springs hold {} indices, not pairs",
-                                            springs->size()));
+            throw GeometryError(
+                fmt::format("describe_shape: springs hold {} indices, not pairs", springs->size()));
           links = Eigen::Map<const IndexPairs>(springs->data(),
                                                static_cast<Eigen::Index>(springs->size() / 2), 2);
         }

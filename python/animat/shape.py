@@ -221,7 +221,7 @@ def elongation(positions: np.ndarray, params: ShapeParams = ShapeParams(), spaci
     """sqrt(λ1/λ2) of the cells' principal second moments (module docstring); 1.0 for one cell.
     Computed by the engine (``shape.hpp``), which also bands it for ``morphology_kind``."""
     p = np.asarray(positions, dtype=float).reshape(-1, 2)
-    return float(_core._elongation(p, params.cell_diameter, spacing))
+    return float(_core.shape_elongation(p, params.cell_diameter, spacing))
 
 
 def concavity(positions: np.ndarray, outline: Sequence[int], spacing: Optional[float] = None) -> float:
@@ -238,7 +238,7 @@ def _engine_shape(
     p = np.asarray(positions, dtype=float).reshape(-1, 2)
     loop = [] if outline is None else [int(i) for i in outline]
     flat = None if springs is None else [int(k) for k in np.asarray(springs, dtype=np.int64).reshape(-1)]
-    return _core._describe_shape(
+    return _core.describe_shape(
         p, loop, flat, params.cell_diameter, params.core_radius, params.min_height, params.pair_tolerance, spacing
     )
 

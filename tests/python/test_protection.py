@@ -42,7 +42,7 @@ def test_the_cxx_elongation_is_animat_shapes_on_random_viable_bodies():
             p = np.asarray(body.positions)
             assert animat._core._cell_spacing(p) == pytest.approx(shape.cell_spacing(p), rel=1e-9, abs=0)
             e = shape.elongation(p)
-            assert animat._core._elongation(p) == pytest.approx(e, rel=1e-9, abs=0)
+            assert animat._core.shape_elongation(p) == pytest.approx(e, rel=1e-9, abs=0)
             kind = animat.morphology_kind(p)
             assert kind == len(p) * 16 + _band(e)
             result = animat.evaluate(genome, config)
@@ -57,7 +57,7 @@ def test_the_cxx_elongation_is_animat_shapes_on_random_viable_bodies():
             for diameter in (1.0, 0.5):
                 params = shape.ShapeParams(cell_diameter=diameter)
                 expected = shape.elongation(p, params)
-                assert animat._core._elongation(p, diameter) == pytest.approx(expected, rel=1e-9, abs=0)
+                assert animat._core.shape_elongation(p, diameter) == pytest.approx(expected, rel=1e-9, abs=0)
     assert animat.morphology_kind(np.zeros((0, 2))) == 0
     assert animat.morphology_kind([[0.0, 0.0]]) == 16
 

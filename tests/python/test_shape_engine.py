@@ -142,8 +142,8 @@ def test_engine_shape_equals_the_definitions_on_evolved_and_random_bodies(bodies
 
 def test_the_engine_elongation_is_the_one_morphology_kind_bands(bodies):
     for body in bodies:
-        assert S.elongation(body.positions) == _core._elongation(body.positions)
-        assert S.body_shape(body).elongation == _core._elongation(body.positions)
+        assert S.elongation(body.positions) == _core.shape_elongation(body.positions)
+        assert S.body_shape(body).elongation == _core.shape_elongation(body.positions)
 
 
 def test_an_outline_index_that_is_no_cell_is_refused_by_value():
