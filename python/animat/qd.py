@@ -50,11 +50,15 @@ Example::
 from __future__ import annotations
 
 import csv
+import fcntl
+import hashlib
 import io
 import json
 import math
 import os
 import shutil
+import socket
+import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -83,7 +87,7 @@ __all__ = [
 PathLike = Union[str, "os.PathLike[str]"]
 
 #: Version tag of :meth:`MapElites.checkpoint`.
-CHECKPOINT_FORMAT = "animat.map_elites/1"
+CHECKPOINT_FORMAT = "animat.map_elites/2"
 
 # --- descriptors ----------------------------------------------------------------------------------
 
@@ -687,6 +691,12 @@ class GridArchive(_Archive):
         return {"bins": list(self.bins)}
 
 
+#: The most cells of a :class:`CVTArchive`, and the most sample-centroid distances of one of its
+#: Lloyd iterations (samples × cells): bounds that keep its k-means to seconds and its memory small.
+MAX_CVT_CELLS = 10_000
+MAX_CVT_WORK = 2_000_000_000
+
+
 class CVTArchive(_Archive):
     """An archive on a centroidal Voronoi tessellation (Vassiliades et al. 2018): ``cells`` centroids
     in the descriptor box; a value belongs to the cell of its nearest centroid.
@@ -704,7 +714,7 @@ class CVTArchive(_Archive):
 
     Args:
         descriptors: as for :class:`GridArchive`.
-        cells: number of centroids.
+        cells: number of centroids (at most :data:`MAX_CVT_CELLS`; ValueError beyond).
         seed: seed of the samples.
         samples: sample count (default ``max(1000, 20 * cells)``).
         iterations: the most Lloyd iterations (default 100).
@@ -728,6 +738,13 @@ class CVTArchive(_Archive):
         n = max(1000, 20 * cells) if samples is None else int(samples)
         if cells < 1 or n < cells:
             raise ValueError(f"CVTArchive: need 1 <= cells <= samples, got cells={cells}, samples={n}")
+        if cells > MAX_CVT_CELLS:
+            raise ValueError(f"CVTArchive: cells = {cells} is more than {MAX_CVT_CELLS} (the most a CVT archive holds)")
+        if n * cells > MAX_CVT_WORK:
+            raise ValueError(
+                f"CVTArchive: samples = {n} with cells = {cells} makes {n * cells:.3g} distances per Lloyd "
+                f"iteration, more than {MAX_CVT_WORK:.3g}: fewer samples or cells"
+            )
         self.seed = int(seed)
         self.samples = n
         self._unit = _kmeans(np.random.default_rng(self.seed).random((n, self.dims)), cells, int(iterations))
@@ -880,6 +897,36 @@ class _SearchState:
         return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, **kwargs)
 
 
+def _same_config(config: Any, saved: Any, objective: ObjectiveLike, source: str) -> None:
+    """Refuses a config to resume the run of ``saved`` with that differs from it but for
+    ``evolution.threads``, or sets a [search] key otherwise (:func:`_same_search`)."""
+    mine = _config_for(config, _objective(objective))
+    mine["evolution.seed"] = int(saved["evolution.seed"])
+    if _comparable(mine) != _comparable(saved):
+        raise ValueError(
+            f"{source}: MapElites.restore: the config differs from the checkpoint's (only evolution.threads may)"
+        )
+    _same_search(mine, saved, source)
+
+
+def _same_search(given: Any, saved: Any, source: str) -> None:
+    """Refuses a config whose [search] sets a key (to other than its default) that the run has
+    otherwise: a resume continues the search it started."""
+    default = _core.Config().to_dict().get("search", {})
+    run = saved.to_dict().get("search", {})
+    for key, value in given.to_dict().get("search", {}).items():
+        mine = run.get(key)
+        if value == default.get(key):
+            continue
+        if key == "bins" and isinstance(value, list) and len(value) == 1 and isinstance(mine, list):
+            value = value * len(mine)  # one count for every descriptor
+        if value != mine:
+            raise ValueError(
+                f"{source}: search.{key} = {json.dumps(value)} is not the run's {json.dumps(mine)}: "
+                "a resume continues the search it started"
+            )
+
+
 def _python_objective(objective: ObjectiveLike) -> Optional[Objective]:
     """The Python objective of a search's ``objective`` argument (None for a name or None)."""
     obj = _objective(objective)
@@ -924,22 +971,62 @@ def _fitnesses(objective: Optional[Objective]) -> Swim:
     return swim
 
 
+#: The table's descriptors that every evaluation's :class:`animat.Fitness` carries (the engine's
+#: measures, computed during the swim): read from the Fitness told, never computed again.
+_FITNESS_MEASURES: Dict[str, Callable[[Any], float]] = {
+    "cells": lambda f: float(f.cell_count),
+    "elongation": lambda f: float(f.elongation),
+    "protrusions": lambda f: float(f.protrusions),
+    "symmetric_pair": lambda f: float(f.symmetric_pair),
+    "concavity": lambda f: float(f.concavity),
+    "frequency": lambda f: float(f.frequency),
+    "fitness": lambda f: float(f.fitness),
+}
+
+
+def _is_table_entry(d: Descriptor) -> bool:
+    return d.name in DESCRIPTORS and d._of_subject is not None and d._of_subject is DESCRIPTORS[d.name]._of_subject
+
+
 def _worker_descriptors(descriptors: Sequence[Descriptor]) -> Tuple[str, ...]:
-    """The names of the table's descriptors among ``descriptors`` (any range): the swim computes them
-    where it swims (:func:`_fitnesses`); your own functions are computed by the search."""
-    return tuple(
-        d.name
-        for d in descriptors
-        if d._of_subject is not None and d.name in DESCRIPTORS and d._of_subject is DESCRIPTORS[d.name]._of_subject
+    """The names of the table's descriptors among ``descriptors`` (any range) that the Fitness does not
+    carry: the swim computes them where it swims (:func:`_fitnesses`); your own functions are computed
+    by the search."""
+    return tuple(d.name for d in descriptors if _is_table_entry(d) and d.name not in _FITNESS_MEASURES)
+
+
+def _not_archivable(f: Any) -> Any:
+    """``f`` marked invalid: a candidate without descriptor values, which the engine counts discarded."""
+    return _core.Fitness(
+        f.fitness,
+        f.viable,
+        f.stable,
+        f.cell_count,
+        False,
+        f.drag_limited,
+        f.morphology_kind,
+        f.actuation_work,
+        f.actuation_work_positive,
+        f.actuation_work_absolute,
+        f.max_speed,
     )
+
+
+def _checksum(state: Mapping[str, Any]) -> str:
+    body = json.dumps({k: v for k, v in state.items() if k != "checksum"}, sort_keys=True, allow_nan=False)
+    return hashlib.sha256(body.encode("utf-8")).hexdigest()
 
 
 class MapElites(_SearchState):
     """MAP-Elites driven by ``ask``/``tell`` (or :meth:`step`), over a :class:`GridArchive` or a
-    :class:`CVTArchive` (see the module docstring for what is archived and the exploit guard).
+    :class:`CVTArchive`: a thin layer over the engine's search (``animat._core.SearchEngine`` with
+    ``search.algorithm = "map_elites"``, what ``animat_evolve`` runs). The engine breeds, archives,
+    runs the exploit guard and writes the history and the checkpoint; this class computes the
+    descriptors the engine does not measure (your functions, ``locomotion``) and passes them as
+    supplied values, and :attr:`archive` is a view of the engine's elites after every ``tell``.
 
     ``ask()`` returns the batch of generation g = ``generation + 1``: for generation 0 (and whenever
-    the archive is empty), ``initial`` random viable genomes, genome i drawn by
+    the archive is empty), ``batch`` random viable genomes, genome i drawn by
     ``animat.Genome.random_viable(seed=animat.Rng.derive(seed, g, i), config)``; afterwards ``batch``
     offspring, offspring i varied with the stream ``rng = animat.Rng.derive(seed, g, i)``: a parent
     ``elites[rng.integer(0, n - 1)]`` (the n elites in cell order); with probability
@@ -949,7 +1036,17 @@ class MapElites(_SearchState):
 
     ``tell(results)`` takes one result per asked genome, in order: :class:`animat.EvaluationResult`
     (``animat.evaluate``), :class:`animat.Fitness`, a number or None (non-viable); ``descriptors=``
-    gives their descriptor values instead of computing them (a row of None: not archived).
+    gives their descriptor values instead of computing them (a row of None or with a NaN: not
+    archived). The table's descriptors that every evaluation measures (``cells``, ``elongation``,
+    ``protrusions``, ``symmetric_pair``, ``concavity``, ``frequency``, ``fitness``) are read from the
+    Fitness; a plain number is described with :func:`measure`. A tell is all or nothing: a string, a
+    fitness the objective forbids (negative, not finite), one so large that the QD-score could
+    overflow (above ``sys.float_info.max / cells``), or a descriptor value that is infinite is a
+    ValueError or TypeError naming the value, and the search is left as it was.
+
+    A CVT archive is searched as a grid the engine knows: the cell (the nearest centroid, computed
+    here) is a supplied descriptor with one bin per cell, and each descriptor a supplied one with one
+    bin, so the engine's cells are the archive's.
 
     Example::
 
@@ -960,12 +1057,14 @@ class MapElites(_SearchState):
 
     Args:
         config: the run's :class:`animat.Config` (default: the embedded paper setting).
-        archive: the archive, filled in place (it may hold elites already: a run continues from them).
-        batch: offspring per generation (default ``evolution.population``).
-        initial: random genomes of generation 0 (default ``batch``).
+        archive: an empty archive, filled in place (a run continues from a checkpoint: :meth:`restore`).
+        batch: genomes per generation (default ``evolution.population``).
+        initial: random genomes of generation 0: ``batch`` (the only value the engine runs).
         seed: the run's seed (default ``evolution.seed``; it is written into the config).
         objective: as for :class:`animat.GA`: a built-in name, a callable of an
-            :class:`animat.EvaluationRecord` or an :class:`animat.Objective`.
+            :class:`animat.EvaluationRecord` or an :class:`animat.Objective`. A Python objective's
+            values are computed here and told to the engine, which cannot swim with it: it needs
+            ``evaluation.reference_check = "off"`` (ValueError otherwise).
         crossover_fraction: share of offspring made by crossover (default ``evolution.crossover_fraction``).
         threads: evaluation threads of :meth:`step` and the exploit guard (default ``evolution.threads``;
             0 = all cores). The run does not depend on it.
@@ -985,6 +1084,11 @@ class MapElites(_SearchState):
     ) -> None:
         if not isinstance(archive, _Archive):
             raise TypeError(f"MapElites: archive must be a GridArchive or a CVTArchive, got {type(archive).__name__}")
+        if len(archive):
+            raise ValueError(
+                f"MapElites: the archive holds {len(archive)} elites; a search starts from an empty one "
+                "(continue a run with MapElites.restore or MapElites.load)"
+            )
         self._config = _config_for(config, _objective(objective))
         self._objective = _python_objective(objective)
         self._swim = _fitnesses(self._objective)
@@ -994,19 +1098,31 @@ class MapElites(_SearchState):
                 f"MapElites: evaluation.objective = {name!r} is a Python objective: pass "
                 "objective=animat.Objective(...) with that name"
             )
+        if self._objective is not None and str(self._config["evaluation.reference_check"]) != "off":
+            raise ValueError(
+                f"MapElites: evaluation.reference_check = {str(self._config['evaluation.reference_check'])!r} "
+                f"with the Python objective {name!r}: the engine's exploit guard swims with a built-in "
+                'objective; set evaluation.reference_check = "off"'
+            )
         if seed is not None:
             self._config["evolution.seed"] = int(seed)
         if threads is not None:
             self._config["evolution.threads"] = int(threads)
         self.seed = int(self._config["evolution.seed"])
         self.batch = int(self._config["evolution.population"]) if batch is None else int(batch)
-        self.initial = self.batch if initial is None else int(initial)
+        if initial is not None and int(initial) != self.batch:
+            raise ValueError(
+                f"MapElites: initial = {initial} differs from batch = {self.batch}; generation 0 asks "
+                "batch random genomes"
+            )
+        self.initial = self.batch
         cf = float(self._config["evolution.crossover_fraction"]) if crossover_fraction is None else crossover_fraction
+        if self.batch < 1:
+            raise ValueError(f"MapElites: batch must be >= 1, got {self.batch}")
+        if not 0.0 <= float(cf) <= 1.0:
+            raise ValueError(f"MapElites: crossover_fraction must be in [0, 1], got {cf}")
         self.crossover_fraction = float(cf)
-        if self.batch < 1 or self.initial < 1:
-            raise ValueError(f"MapElites: batch and initial must be >= 1, got {self.batch}, {self.initial}")
-        if not 0.0 <= self.crossover_fraction <= 1.0:
-            raise ValueError(f"MapElites: crossover_fraction must be in [0, 1], got {self.crossover_fraction}")
+        self._config["evolution.crossover_fraction"] = self.crossover_fraction
         self.archive = archive
         # The run's config.toml says what it is (`animat evolve --resume` dispatches on it); the
         # checkpoint holds the archive itself (a CVT archive's centroids, custom ranges).
@@ -1015,36 +1131,41 @@ class MapElites(_SearchState):
         if isinstance(archive, GridArchive):
             self._config["search.bins"] = [float(b) for b in archive.bins]
         self._config["search.batch"] = self.batch
-        self._guard = str(self._config["evaluation.reference_check"])
-        self._generation = -1
-        self._evaluations = 0
-        self._reference_evaluations = 0
-        self._history: List[Tuple[Any, ...]] = []
+        engine_config, supplied = self._engine_config()
+        self._engine = _core.SearchEngine(engine_config, supplied=supplied)
+        self._width = len(supplied)
         self._asked: Optional[List[Any]] = None
+
+    def _engine_config(self) -> Tuple[Any, List[str]]:
+        """The engine's config: the run's with the archive as a grid of supplied descriptors (a CVT
+        archive: its cell with one bin per cell, then every descriptor with one bin)."""
+        cfg = self._config.copy()
+        archive = self.archive
+        names = [d.name for d in archive.descriptors]
+        ranges = [x for d in archive.descriptors for x in (d.lo, d.hi)]
+        if isinstance(archive, GridArchive):
+            bins = [float(b) for b in archive.bins]
+        else:
+            names = ["cvt_cell", *names]
+            bins = [float(archive.cells)] + [1.0] * archive.dims
+            ranges = [0.0, float(archive.cells), *ranges]
+        cfg["search.algorithm"] = "map_elites"
+        cfg["search.descriptors"] = names
+        cfg["search.bins"] = bins
+        cfg["search.ranges"] = ranges
+        cfg["search.batch"] = self.batch
+        if self._objective is not None:
+            # The engine cannot call Python: this search tells it the objective's values (and has no
+            # exploit guard), so its config names a built-in objective that may be negative instead.
+            cfg["evaluation.objective"] = "speed_toward"
+        return cfg, names
 
     # --- the loop ---------------------------------------------------------------------------------
     def ask(self) -> List[Any]:
         """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
         if self._asked is None:
-            self._asked = self._draw(self._generation + 1)
+            self._asked = self._engine.ask()
         return list(self._asked)
-
-    def _draw(self, g: int) -> List[Any]:
-        cfg = self._config
-        elites = self.archive.elites()
-        if not elites:
-            return [_core.Genome.random_viable(_core.Rng.derive(self.seed, g, i), cfg)[0] for i in range(self.initial)]
-        points = int(cfg["mutation.crossover_points"])
-        top = len(elites) - 1
-        out = []
-        for i in range(self.batch):
-            rng = _core.Rng.derive(self.seed, g, i)
-            child = elites[rng.integer(0, top)].genome
-            if rng.uniform() < self.crossover_fraction:
-                other = elites[rng.integer(0, top)].genome
-                child = child.crossover(other, rng, points)
-            out.append(child.mutate(rng, cfg))
-        return out
 
     def tell(self, results: Sequence[Any], descriptors: Optional[Sequence[Optional[Values]]] = None) -> Any:
         """The result of every genome of the last ``ask()``, in order (see the class docstring);
@@ -1056,85 +1177,105 @@ class MapElites(_SearchState):
             raise ValueError(f"MapElites.tell: {len(results)} results for the {len(genomes)} genomes asked")
         if descriptors is not None and len(descriptors) != len(genomes):
             raise ValueError(f"MapElites.tell: {len(descriptors)} descriptor rows for {len(genomes)} genomes")
+        limit = sys.float_info.max / self.archive.cells
         fits = []
         for i, r in enumerate(results):
+            if isinstance(r, (str, bytes)):
+                raise TypeError(f"MapElites.tell: value {i} ({r!r:.60}) is a string; tell a number, None or a Fitness")
             try:
-                fits.append(to_fitness(r))
+                fit = to_fitness(r)
             except (TypeError, ValueError) as e:
                 raise type(e)(f"MapElites.tell: value {i} ({r!r:.60}): {e}") from None
-        g = self._generation + 1
-        cfg = self._config
-        # The candidates that may enter: viable, stable, valid, with every descriptor a number.
-        candidates: List[Tuple[Any, float, np.ndarray]] = []
+            if abs(fit.fitness) > limit:
+                raise ValueError(
+                    f"MapElites.tell: value {i}: fitness {fit.fitness!r} is beyond ±{limit:.6g}, where the "
+                    f"QD-score of {self.archive.cells} cells could overflow; nothing was told"
+                )
+            fits.append(fit)
+        told, rows = [], []
         for i, (genome, fit, raw) in enumerate(zip(genomes, fits, results)):
-            if not (fit.viable and fit.stable and fit.valid):
+            values = None
+            if fit.viable and fit.stable and fit.valid:
+                values = self._values(i, genome, fit, raw, descriptors)
+            if values is None:
+                told.append(fit if not (fit.viable and fit.stable and fit.valid) else _not_archivable(fit))
+                rows.append([math.nan] * self._width)
                 continue
-            if descriptors is not None:
-                row = descriptors[i]
-                values = None if row is None else np.asarray(row, dtype=np.float64).reshape(-1)
+            told.append(fit)
+            if isinstance(self.archive, CVTArchive):
+                cell = cast(int, self.archive.index_of(values))  # every value is a number here
+                rows.append([float(cell), *values.tolist()])
             else:
-                evaluation = raw if isinstance(raw, _core.EvaluationResult) else fit
-                values = measure(genome, cfg, self.archive.descriptors, evaluation)
-            if values is None or np.isnan(values).any():
-                continue
-            candidates.append((genome, float(fit.fitness), values))
-        references: List[float] = [float("nan")] * len(candidates)
-        if self._guard == "select" and candidates:
-            references = self._references([c[0] for c in candidates])
-        added = 0
-        entered: Dict[int, bool] = {}
-        for (genome, fitness, values), ref in zip(candidates, references):
-            objective = ref if self._guard == "select" else fitness
-            if self.archive.add(genome, fitness, values, objective=objective, reference=ref, generation=g):
-                added += 1
-                index = self.archive.index_of(values)
-                assert index is not None
-                entered[index] = True
-        if self._guard == "record" and entered:
-            cells = sorted(entered)
-            for index, ref in zip(cells, self._references([self.archive[i].genome for i in cells])):
-                self.archive._set_reference(index, ref)
-        self._evaluations += len(genomes)
-        self._generation = g
+                rows.append(values.tolist())
+        self._engine.tell(told, rows)
         self._asked = None
-        best = self.archive.best()
-        disagreements = sum(
-            1
-            for e in self.archive.elites()
-            if not math.isnan(e.reference) and _core.reference_disagrees(e.fitness, e.reference, cfg)
-        )
-        self._history.append(
-            (
-                g,
-                self._evaluations,
-                self.archive.qd_score(),
-                self.archive.coverage(),
-                float("nan") if best is None else best.objective,
-                len(self.archive),
-                added,
-                len(genomes) - len(candidates),
-                self._reference_evaluations,
-                disagreements,
-            )
-        )
+        self._refresh()
         return self.history[-1]
 
-    def _references(self, genomes: List[Any]) -> List[float]:
-        fits = self._evaluate(genomes, _core.reference_config(self._config))
-        self._reference_evaluations += len(genomes)
-        return [float(f.fitness) for f in fits]
+    def _values(
+        self, i: int, genome: Any, fit: Any, raw: Any, rows: Optional[Sequence[Optional[Values]]]
+    ) -> Optional[np.ndarray]:
+        """The descriptor values of candidate i (None: it has none and is not archived)."""
+        ds = self.archive.descriptors
+        if rows is not None:
+            if rows[i] is None:
+                return None
+            values = np.asarray(rows[i], dtype=np.float64).reshape(-1)
+            if len(values) != len(ds):
+                raise ValueError(
+                    f"MapElites.tell: descriptor row {i} has {len(values)} values for the "
+                    f"{len(ds)} descriptors {self.archive.names}"
+                )
+        elif isinstance(raw, (_core.Fitness, _core.EvaluationResult)):
+            subject = _Subject(genome, self._config, raw)
+            values = np.array(
+                [
+                    _FITNESS_MEASURES[d.name](fit)
+                    if d.name in _FITNESS_MEASURES and _is_table_entry(d)
+                    else d._value(subject)
+                    for d in ds
+                ],
+                dtype=np.float64,
+            )
+        else:
+            measured = measure(genome, self._config, ds, fit)
+            if measured is None:
+                return None
+            values = measured
+        return None if np.isnan(values).any() else values
+
+    def _refresh(self) -> None:
+        """Makes :attr:`archive` the engine's elites (cell, genome, fitness, reference, generation and
+        descriptor values, read from its checkpoint)."""
+        self.archive.clear()
+        if self._engine.generation < 0:
+            return
+        payload = json.loads(json.loads(self._engine.checkpoint())["payload"])
+        select = str(self._config["evaluation.reference_check"]) == "select"
+        skip = 1 if isinstance(self.archive, CVTArchive) else 0
+        for e in payload["elites"]:
+            fitness = float(e["result"]["fitness"])
+            reference = _from_json_float(e["reference"])
+            self.archive._elites[int(e["cell"])] = Elite(
+                int(e["cell"]),
+                _core.Genome.from_json(json.dumps(e["genome"])),
+                fitness,
+                reference if select else fitness,
+                tuple(float(x) for x in e["supplied"][skip:]),
+                reference,
+                int(e["generation"]),
+            )
 
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: :func:`animat.evaluate_population` with the config's threads and the
         objective; over the MPI ranks under ``run_map_elites(..., mpi=True)``) and tell one generation;
-        returns its history row. By default the table's descriptors are computed where each genome
-        swam, from the body its evaluation built (the values :func:`measure` gives); with your own
-        ``evaluate``, ``tell`` computes them with :func:`measure`."""
+        returns its history row. The descriptors every evaluation measures are read from its Fitness,
+        the table's others (``locomotion``) computed where each genome swam, from the body its
+        evaluation built; your own functions are called here."""
         genomes = self.ask()
         if evaluate is not None:
             return self.tell(list(evaluate(genomes)))
-        descriptors = self.archive.descriptors
-        names = _worker_descriptors(descriptors)
+        names = _worker_descriptors(self.archive.descriptors)
         pairs = self._evaluate(genomes, self._config, describe=names) if names else None
         fits = [p[0] for p in pairs] if pairs is not None else self._evaluate(genomes, self._config)
         rows: List[Optional[np.ndarray]] = []
@@ -1143,9 +1284,17 @@ class MapElites(_SearchState):
                 rows.append(None)  # not a candidate: tell() skips it before reading its row
                 continue
             done = dict(zip(names, pairs[i][1])) if pairs is not None else {}
+            subject = _Subject(genome, self._config, fit)
             rows.append(
                 np.array(
-                    [done[d.name] if d.name in done else d(genome, self._config, fit) for d in descriptors],
+                    [
+                        done[d.name]
+                        if d.name in done
+                        else _FITNESS_MEASURES[d.name](fit)
+                        if d.name in _FITNESS_MEASURES and _is_table_entry(d)
+                        else d._value(subject)
+                        for d in self.archive.descriptors
+                    ],
                     dtype=np.float64,
                 )
             )
@@ -1153,26 +1302,42 @@ class MapElites(_SearchState):
 
     # --- state ------------------------------------------------------------------------------------
     @property
+    def generation(self) -> int:
+        """The last completed generation (-1 before the first ``tell``)."""
+        return int(self._engine.generation)
+
+    @property
+    def evaluations(self) -> int:
+        """Candidates told so far."""
+        return int(self._engine.evaluations)
+
+    @property
     def history(self) -> np.recarray:
         """One row per generation (:data:`QD_HISTORY_DTYPE`): ``h["qd_score"]``, ``h[-1].coverage`` ..."""
-        return np.array(self._history, dtype=QD_HISTORY_DTYPE).view(np.recarray)
+        columns = QD_HISTORY_DTYPE.names or ()
+        rows = []
+        for row in self._engine.history:
+            values = [
+                int(x) if QD_HISTORY_DTYPE[j].kind == "i" else float(x) for j, x in enumerate(row[: len(columns)])
+            ]
+            values[2] -= self.archive.qd_offset * values[5]  # the engine sums objectives with no offset
+            rows.append(tuple(values))
+        return np.array(rows, dtype=QD_HISTORY_DTYPE).view(np.recarray)
 
     def checkpoint(self) -> Dict[str, Any]:
-        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back). A
-        pending ``ask()`` is not saved: asking again after a restore gives the same genomes."""
-        return {
+        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back): the
+        engine's checksummed checkpoint (``engine``; None before the first ``tell``), the run's config
+        and the archive's definition, under a SHA-256 ``checksum`` of the rest. A pending ``ask()`` is
+        not saved: asking again after a restore gives the same genomes."""
+        state: Dict[str, Any] = {
             "format": CHECKPOINT_FORMAT,
             "config": self._config.to_toml(),
-            "seed": self.seed,
             "batch": self.batch,
-            "initial": self.initial,
-            "crossover_fraction": self.crossover_fraction,
-            "generation": self._generation,
-            "evaluations": self._evaluations,
-            "reference_evaluations": self._reference_evaluations,
-            "history": [[_json_float(x) if isinstance(x, float) else x for x in row] for row in self._history],
-            "archive": self.archive.state(),
+            "archive": {k: v for k, v in self.archive.state().items() if k != "elites"},
+            "engine": self._engine.checkpoint() if self._engine.generation >= 0 else None,
         }
+        state["checksum"] = _checksum(state)
+        return state
 
     @classmethod
     def restore(
@@ -1183,54 +1348,53 @@ class MapElites(_SearchState):
         objective: ObjectiveLike = None,
         descriptors: Iterable[DescriptorLike] = (),
         threads: Optional[int] = None,
+        source: str = "checkpoint",
     ) -> MapElites:
         """A MapElites from :meth:`checkpoint` (a dict, or its JSON text). ``config``: default the saved
         one; another must equal it but for ``evolution.threads`` (ValueError). ``descriptors``: your own
-        descriptor functions, by name (see :meth:`GridArchive.from_state`); ``objective``: a Python
-        objective must be passed again."""
-        if isinstance(state, (str, bytes)):
-            state = json.loads(state)
-        assert isinstance(state, Mapping)
-        if state.get("format") != CHECKPOINT_FORMAT:
-            raise ValueError(
-                f"not a MapElites checkpoint (format {state.get('format')!r}, expected {CHECKPOINT_FORMAT})"
-            )
-        saved = _core.Config.from_toml(state["config"], "checkpoint")
+        descriptor functions, by name (see :meth:`GridArchive.from_state`). A checkpoint that is not
+        one, was edited or is inconsistent is a ValueError naming ``source`` (the file, for
+        :meth:`load`), and the engine checks its own part (checksum, identity, elites, history)."""
+        try:
+            if isinstance(state, (str, bytes)):
+                state = json.loads(state)
+            if not isinstance(state, Mapping) or state.get("format") != CHECKPOINT_FORMAT:
+                found = state.get("format") if isinstance(state, Mapping) else type(state).__name__
+                raise ValueError(f"not a MapElites checkpoint (format {found!r}, expected {CHECKPOINT_FORMAT})")
+            if state.get("checksum") != _checksum(state):
+                raise ValueError("its checksum does not match its content (edited or corrupt)")
+            saved = _core.Config.from_toml(state["config"], source)
+            definition = {**state["archive"], "elites": []}
+            batch = int(state["batch"])
+            engine_text = state["engine"]
+        except (ValueError, KeyError, TypeError, AttributeError) as e:
+            raise ValueError(f"{source}: {e}") from None
         if config is None:
             config = saved
         else:
-            mine = _config_for(config, _objective(objective))
-            mine["evolution.seed"] = int(state["seed"])
-            if _comparable(mine) != _comparable(saved):
-                raise ValueError(
-                    "MapElites.restore: the config differs from the checkpoint's (only evolution.threads may)"
-                )
-        archive = _Archive.from_state(state["archive"], descriptors)
-        me = cls(
-            config,
-            archive,
-            batch=state["batch"],
-            initial=state["initial"],
-            seed=state["seed"],
-            objective=objective,
-            crossover_fraction=state["crossover_fraction"],
-            threads=threads,
-        )
-        me._generation = int(state["generation"])
-        me._evaluations = int(state["evaluations"])
-        me._reference_evaluations = int(state["reference_evaluations"])
-        me._history = [
-            tuple(_from_json_float(x) if QD_HISTORY_DTYPE[j].kind == "f" else int(x) for j, x in enumerate(row))
-            for row in state["history"]
-        ]
+            _same_config(config, saved, objective, source)
+        archive = _Archive.from_state(definition, descriptors)
+        me = cls(config, archive, batch=batch, seed=int(saved["evolution.seed"]), objective=objective, threads=threads)
+        if engine_text is not None:
+            me._engine.restore(engine_text, source)
+            me._refresh()
         return me
+
+    @classmethod
+    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Any:
+        """:meth:`restore` from a file written by :meth:`save` (or the run directory of a search);
+        errors name the file."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "checkpoint.json"
+        return cls.restore(path.read_text(encoding="utf-8"), config, source=str(path), **kwargs)
 
     def __reduce__(self) -> Tuple[Any, ...]:
         # Pickles as its checkpoint, with the Python objective and your own descriptor functions.
         return (_restore, (self.checkpoint(), self._objective, self.archive._own_descriptors()))
 
     def __repr__(self) -> str:
-        return f"<animat.MapElites generation {self._generation}, batch {self.batch}, {self.archive!r}>"
+        return f"<animat.MapElites generation {self.generation}, batch {self.batch}, {self.archive!r}>"
 
 
 def _restore(
@@ -1312,13 +1476,32 @@ def _run_search(
         if has_run and not overwrite:
             raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
         check_new()
+        search = new()  # its sizes are checked here, before any file is touched
+    lock = _RunLock(out)
+    try:
         if overwrite:
             for f in _RUN_FILES:
                 (out / f).unlink(missing_ok=True)
             shutil.rmtree(out / snapshots, ignore_errors=True)
-        search = new()
-    (out / snapshots).mkdir(parents=True, exist_ok=True)
-    _write_atomic(out / "config.toml", search.config.to_toml())
+        (out / snapshots).mkdir(parents=True, exist_ok=True)
+        _write_atomic(out / "config.toml", search.config.to_toml())
+        _steps(search, out, snapshots, every, generations, write_snapshot, callback, pool)
+    finally:
+        lock.release()
+    return search
+
+
+def _steps(
+    search: Any,
+    out: Path,
+    snapshots: str,
+    every: int,
+    generations: int,
+    write_snapshot: Callable[[Any, Path], Any],
+    callback: Optional[Callable[[Any], Optional[bool]]],
+    pool: Optional[Swim],
+) -> None:
+    """The generations of :func:`_run_search`, each saved as it completes."""
     search._pool = pool
     try:
         while search.generation < generations:
@@ -1334,7 +1517,49 @@ def _run_search(
                 break
     finally:
         search._pool = None
-    return search
+
+
+class _RunLock:
+    """One writer per run directory: an advisory lock (flock) on ``out/.lock``, the lock file that
+    ``animat_evolve`` and :func:`animat.evolve` hold (src/run.cpp), so a second writer of any of them
+    is refused (BlockingIOError naming the holder's pid) before it writes anything. The file names
+    its holder; the holder removes it on release. The kernel drops the lock when its process ends."""
+
+    def __init__(self, out: Path) -> None:
+        out.mkdir(parents=True, exist_ok=True)
+        self.path = out / ".lock"
+        for _ in range(100):
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC | os.O_NOFOLLOW, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = " ".join(os.pread(fd, 512, 0).decode("utf-8", "replace").split())
+                os.close(fd)
+                raise BlockingIOError(
+                    f"{out}: the run directory is in use by another animat process "
+                    f"({holder or 'one just starting'}, holding {self.path}); one process writes a run "
+                    "directory at a time. Wait for it to end, then resume; or use another directory. "
+                    "Nothing was written."
+                ) from None
+            # its last holder removes the file on release: the file locked must be the one on disk
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        else:
+            raise OSError(f"{self.path}: cannot lock the run directory: the lock file keeps being replaced")
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"pid {os.getpid()}\nhost {socket.gethostname() or 'unknown'}\n".encode(), 0)
+        self.fd = fd
+
+    def release(self) -> None:
+        try:
+            self.path.unlink(missing_ok=True)
+        finally:
+            os.close(self.fd)
 
 
 def run_map_elites(
@@ -1389,7 +1614,9 @@ def run_map_elites(
     extra = tuple(descriptors) + (tuple(archive.descriptors) if archive is not None else ())
 
     def load(path: Path) -> MapElites:
-        me = MapElites.load(path, config, objective=objective, descriptors=extra, threads=threads)
+        # the run's config first: a given archive is then compared with the run's by name
+        own = threads if threads is not None or config is None else int(config["evolution.threads"])
+        me = MapElites.load(path, objective=objective, descriptors=extra, threads=own)
         _same_as_run(
             "run_map_elites",
             archive=(None if archive is None else _archive_definition(archive), _archive_definition(me.archive)),
@@ -1398,6 +1625,8 @@ def run_map_elites(
             seed=(seed, me.seed),
             crossover_fraction=(crossover_fraction, me.crossover_fraction),
         )
+        if config is not None:
+            _same_config(config, me._config, objective, str(path / "checkpoint.json"))
         return me
 
     def check_new() -> None:

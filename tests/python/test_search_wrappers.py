@@ -1,0 +1,227 @@
+"""animat.MapElites is a wrapper over the engine's search (animat._core.SearchEngine): what the
+engine refuses, the wrapper refuses, naming the value, key or file, and a refusal changes nothing
+(the search's state, the run directory's files). A cheap deterministic stub stands in for the swims."""
+
+import hashlib
+import json
+import math
+
+import pytest
+
+import animat
+from animat import qd
+
+
+def stub(genome):
+    """A Fitness that depends on the genome only: a quarter not viable, the rest spread over the cells
+    and fitness descriptors."""
+    h = int(hashlib.sha256(genome.to_json().encode()).hexdigest()[:15], 16)
+    if h % 4 == 0:
+        return animat.Fitness(0.0, False, True, 0)
+    return animat.Fitness((h >> 8) % 5000 / 100.0, True, True, 1 + (h >> 24) % 64)
+
+
+def small_config():
+    config = animat.Config()
+    config["evaluation.steps"] = 200
+    config["evaluation.reference_check"] = "off"
+    config["evolution.threads"] = 1
+    return config
+
+
+def new_search(generations=2):
+    me = animat.MapElites(small_config(), animat.GridArchive(["cells", "fitness"], bins=(8, 5)), batch=12, seed=3)
+    while me.generation < generations - 1:
+        me.tell([stub(g) for g in me.ask()])
+    return me
+
+
+def state_of(me):
+    elites = [(e.index, e.genome.to_json(), e.fitness, e.descriptors, e.generation) for e in me.archive.elites()]
+    return me.checkpoint()["engine"], me.generation, me.history.tolist(), elites
+
+
+# --- tell -----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "told, error, message",
+    [
+        (1e308, ValueError, r"value 0: fitness 1e\+308 is beyond ±4\.49\d*e\+306, where the QD-score of 40 cells"),
+        (animat.Fitness(1e308, True, True, 3), ValueError, r"value 0: fitness 1e\+308 is beyond"),
+        (-1.0, ValueError, r"value 0 .*fitness -1 \(a fitness must be finite and >= 0"),
+        ("3.0", TypeError, r"value 0 \('3\.0'\) is a string"),
+        (math.inf, ValueError, r"value 0 \(inf\): a fitness must be finite"),
+    ],
+)
+def test_a_refused_tell_changes_nothing(told, error, message):
+    me = new_search()
+    before = state_of(me)
+    genomes = me.ask()
+    with pytest.raises(error, match=message):
+        me.tell([told] * len(genomes))
+    assert state_of(me) == before
+    assert [g.to_json() for g in me.ask()] == [g.to_json() for g in genomes]  # still pending
+    me.tell([stub(g) for g in genomes])
+    assert me.generation == before[1] + 1
+
+
+def test_a_descriptor_returning_inf_is_refused_by_name():
+    def reach(genome, config=None, evaluation=None):
+        return math.inf
+
+    me = animat.MapElites(small_config(), animat.GridArchive([(reach, 0.0, 1.0), "cells"], bins=(4, 8)), batch=12)
+    genomes = me.ask()
+    with pytest.raises(ValueError, match=r"descriptor reach = inf"):
+        me.tell([stub(g) for g in genomes])
+    assert me.generation == -1 and len(me.archive) == 0 and len(me.history) == 0
+
+
+# --- checkpoints ----------------------------------------------------------------------------------
+
+
+def fnv1a(text):
+    h = 0xCBF29CE484222325
+    for b in text.encode("utf-8"):
+        h = ((h ^ b) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    return f"{h:016x}"
+
+
+def resealed(state, edit):
+    """The checkpoint with the engine's payload edited by ``edit`` and both checksums made to match:
+    a hand edit that only the engine's consistency checks can find."""
+    outer = json.loads(state["engine"])
+    assert outer["checksum"] == fnv1a(outer["payload"])  # the engine's seal, recomputed here
+    payload = json.loads(outer["payload"])
+    edit(payload)
+    body = json.dumps(payload, separators=(",", ":"))
+    state = dict(state, engine=json.dumps({"checksum": fnv1a(body), "payload": body}, separators=(",", ":")))
+    state["checksum"] = qd._checksum(state)
+    return state
+
+
+def drop_history_row(p):
+    del p["history"][1]
+
+
+def edit_generation(p):
+    p["generation"] += 1
+
+
+def fitness_times_ten(p):
+    p["elites"][0]["result"]["fitness"] *= 10
+
+
+@pytest.mark.parametrize("edit", [edit_generation, drop_history_row, fitness_times_ten])
+def test_a_hand_edited_checkpoint_is_refused_naming_the_file(tmp_path, edit):
+    me = new_search(3)
+    path = me.save(tmp_path / "search.json")
+    assert animat.MapElites.load(path).history.tolist() == me.history.tolist()
+    path.write_text(json.dumps(resealed(me.checkpoint(), edit)))
+    text = path.read_text()
+    with pytest.raises(ValueError, match=rf"^{path}: "):
+        animat.MapElites.load(path)
+    assert path.read_text() == text
+
+
+def test_a_one_digit_corruption_is_refused_naming_the_file(tmp_path):
+    me = new_search(3)
+    path = me.save(tmp_path / "search.json")
+    text = path.read_text()
+    digits = [i for i, c in enumerate(text) if c.isdigit()]
+    for i in digits[:: max(1, len(digits) // 40)]:
+        path.write_text(text[:i] + str((int(text[i]) + 1) % 10) + text[i + 1 :])
+        with pytest.raises(ValueError, match=rf"^{path}: "):
+            animat.MapElites.load(path)
+
+
+def test_a_checkpoint_of_another_kind_is_refused_naming_the_file(tmp_path):
+    path = tmp_path / "search.json"
+    for text in ("[1, 2]", '{"format": "animat.map_elites/1"}', "{not json"):
+        path.write_text(text)
+        with pytest.raises(ValueError, match=rf"^{path}: "):
+            animat.MapElites.load(path)
+
+
+# --- the run directory ----------------------------------------------------------------------------
+
+
+def files_of(out):
+    return {p.relative_to(out).as_posix(): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+
+
+def run(out, generations, **options):
+    return animat.run_map_elites(
+        small_config(), out, generations, animat.GridArchive(["cells", "fitness"], (8, 5)), batch=6, **options
+    )
+
+
+def test_a_run_directory_has_one_writer(tmp_path):
+    out = tmp_path / "run"
+    run(out, 0)
+    before = files_of(out)
+    assert ".lock" not in before  # released at the end of the run
+    lock = qd._RunLock(out)  # another writer holds it
+    try:
+        with pytest.raises(
+            BlockingIOError, match=r"in use by another animat process \(pid \d+ host .*Nothing was written"
+        ):
+            run(out, 1, resume=True)
+        with pytest.raises(BlockingIOError):
+            run(out, 1, overwrite=True)
+        assert {k: v for k, v in files_of(out).items() if k != ".lock"} == before
+    finally:
+        lock.release()
+    assert run(out, 1, resume=True).generation == 1
+
+
+def test_a_resume_with_changed_search_keys_is_refused_naming_the_key(tmp_path):
+    out = tmp_path / "run"
+    config = small_config()
+    config["search.algorithm"] = "map_elites"
+    config["search.descriptors"] = ["cells", "fitness"]
+    config["search.bins"] = [4.0]
+    animat.run_map_elites(config, out, 0, batch=6)
+    before = files_of(out)
+    animat.run_map_elites(config, out, 0, resume=True)  # the same config resumes
+    changed = config.copy()
+    changed["search.bins"] = [6.0]
+    with pytest.raises(ValueError, match=r"checkpoint.json: search.bins = \[6.0, 6.0\] is not the run\'s \[4.0, 4.0\]"):
+        animat.run_map_elites(changed, out, 1, resume=True)
+    assert files_of(out) == before
+
+
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_an_archive_too_large_is_refused_before_any_file_is_written(tmp_path, overwrite):
+    out = tmp_path / "run"
+    if overwrite:
+        run(out, 0)
+    before = files_of(out) if overwrite else None
+    config = small_config()
+    config["search.algorithm"] = "map_elites"
+    config["search.descriptors"] = ["cells", "fitness", "elongation", "frequency"]
+    config["search.bins"] = [100000.0]
+    with pytest.raises(ValueError, match=r"search\.bins = \[100000, 100000, 100000, 100000\] .* at most 1000000"):
+        animat.run_map_elites(config, out, 1, overwrite=overwrite)
+    assert (files_of(out) if overwrite else out.exists()) == (before if overwrite else False)
+
+
+def test_a_cvt_archive_too_large_is_refused_naming_the_value():
+    with pytest.raises(ValueError, match=r"CVTArchive: cells = 100000 is more than 10000"):
+        animat.CVTArchive(["elongation", "frequency"], cells=100000)
+    with pytest.raises(ValueError, match=r"samples = 2000000 with cells = 2000 makes 4e\+09 distances"):
+        animat.CVTArchive(["elongation", "frequency"], cells=2000, samples=2_000_000)
+
+
+def test_a_python_objective_is_told_to_the_engine_and_may_be_negative():
+    objective = animat.Objective(lambda record: -2.0, name="below_zero")
+    me = animat.MapElites(small_config(), animat.GridArchive(["cells"], 4), batch=6, objective=objective)
+    genomes = me.ask()
+    row = me.tell([-2.0] * len(genomes), descriptors=[[10.0]] * len(genomes))
+    assert (row.elites, row.best, me.archive.best().fitness) == (1, -2.0, -2.0)
+    guarded = small_config()
+    guarded["evaluation.reference_check"] = "record"
+    with pytest.raises(
+        ValueError, match=r"evaluation.reference_check = 'record' with the Python objective 'python:below_zero'"
+    ):
+        animat.MapElites(guarded, animat.GridArchive(["cells"], 4), batch=6, objective=objective)
