@@ -528,6 +528,11 @@ def _floats(values: Optional[Iterable[Any]]) -> Optional[Floats]:
     return None if values is None else tuple(_dec(v) for v in values)
 
 
+#: The largest NSGA-II population (the engine's bound): the selection compares every pair of the
+#: 2 × population parents and candidates.
+MAX_POPULATION = 10_000
+
+
 class Nsga2(_SearchState):
     """NSGA-II driven by ``ask``/``tell`` (or :meth:`step`) over several objectives (see the module
     docstring for the objectives, what is feasible and the exploit guard).
@@ -612,8 +617,11 @@ class Nsga2(_SearchState):
         self.population_size = int(self._config["evolution.population"]) if population is None else int(population)
         cf = float(self._config["evolution.crossover_fraction"]) if crossover_fraction is None else crossover_fraction
         self.crossover_fraction = float(cf)
-        if self.population_size < 1:
-            raise ValueError(f"Nsga2: population must be >= 1, got {self.population_size}")
+        if not 1 <= self.population_size <= MAX_POPULATION:
+            raise ValueError(
+                f"Nsga2: population (evolution.population) = {self.population_size}: it must be 1 to "
+                f"{MAX_POPULATION} (the selection compares every pair of parents and candidates)"
+            )
         if not 0.0 <= self.crossover_fraction <= 1.0:
             raise ValueError(f"Nsga2: crossover_fraction must be in [0, 1], got {self.crossover_fraction}")
         self._reference_point: Optional[Floats] = None

@@ -225,3 +225,22 @@ def test_a_python_objective_is_told_to_the_engine_and_may_be_negative():
         ValueError, match=r"evaluation.reference_check = 'record' with the Python objective 'python:below_zero'"
     ):
         animat.MapElites(guarded, animat.GridArchive(["cells"], 4), batch=6, objective=objective)
+
+
+def test_an_nsga2_population_too_large_is_refused_before_any_file_is_written(tmp_path, capsys):
+    from animat import cli
+
+    out = tmp_path / "run"
+    argv = [
+        "nsga2",
+        "paper_dn2",
+        "--out",
+        str(out),
+        "--generations",
+        "1",
+        "--objectives",
+        "distance,actuation_work_positive",
+    ]
+    assert cli.main([*argv, "--population", "10000000"]) == 1
+    assert "population (evolution.population) = 10000000: it must be 1 to 10000" in capsys.readouterr().err
+    assert not out.exists()
