@@ -13,12 +13,17 @@ and evaluated by the same evaluators as the GA (:func:`animat.evaluate_populatio
 - :class:`GridArchive` (a regular grid) and :class:`CVTArchive` (a centroidal Voronoi tessellation).
 - :class:`MapElites`: ask/tell, ``step()``, ``history``, ``checkpoint()`` / :meth:`MapElites.restore`.
 - :func:`run_map_elites`: a run directory (``config.toml``, ``history.csv``, ``archive/gen_*.csv``,
-  ``checkpoint.json``) that resumes.
+  ``checkpoint.json``, locked by ``.lock`` while it runs) that resumes.
+
+**The engine.** :class:`MapElites` is a thin layer over the engine's search
+(``animat._core.SearchEngine``, ``search.algorithm = "map_elites"``): the engine breeds, archives,
+runs the exploit guard and keeps the history and the checksummed checkpoint; this module holds the
+descriptor table, the archive views and the descriptors the engine does not measure.
 
 **Determinism.** Every random number of generation g, offspring i is drawn from
 ``animat.Rng.derive(seed, g, i)`` and the parents are picked from the elites in cell order, so a run is
 a function of (config, archive definition, seed, batch, crossover_fraction) alone: identical for any
-thread count, and across checkpoint and resume.
+thread count, and across checkpoint and resume (the checkpoint also records wall-clock seconds).
 
 **What is archived.** A candidate enters the archive only when its genome is viable, its swim stable
 and valid (no simulator exploit: the engine scores those 0) and every descriptor is a number (not
