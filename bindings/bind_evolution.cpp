@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <atomic>
+#include <cmath>
 #include <mutex>
 #include <unordered_set>
 
@@ -68,6 +69,62 @@ class SearchLease : public ThreadLease<SearchEngine> {
                     "drive it from one thread at a time") {}
 };
 
+// The engine's search as the algorithm `A` that a method needs; an error naming the method and
+// the engine's algorithm otherwise.
+template <class A>
+A& engine_as(const SearchEngine& e, const char* method, const char* algorithm) {
+  auto* out = dynamic_cast<A*>(e.search.get());
+  if (out == nullptr)
+    throw Error(
+        fmt::format("SearchEngine.{}: a {} search only; this one is search.algorithm = "
+                    "\"{}\"",
+                    method, algorithm, e.search->algorithm()));
+  return *out;
+}
+
+nb::dict elite_dict(std::size_t cell, const Elite& e) {
+  nb::dict d;
+  d["index"] = cell;
+  d["genome"] = e.genome;
+  d["fitness"] = e.result;
+  d["values"] = e.descriptors;
+  d["objective"] = e.objective;
+  d["reference"] = e.reference;
+  d["generation"] = e.generation;
+  return d;
+}
+
+nb::dict archive_dict(const GridArchive& a) {
+  nb::dict d;
+  std::vector<std::string> names;
+  std::vector<double> lower, upper;
+  for (std::size_t j = 0; j < a.dims(); ++j) {
+    names.emplace_back(a.descriptors()[j]->name);
+    lower.push_back(a.ranges()[j].lo);
+    upper.push_back(a.ranges()[j].hi);
+  }
+  d["kind"] = "grid";
+  d["descriptors"] = names;
+  d["lower"] = lower;
+  d["upper"] = upper;
+  d["cells"] = a.cells();
+  d["bins"] = a.bins();
+  return d;
+}
+
+nb::dict solution_dict(const Solution& s) {
+  nb::dict d;
+  d["genome"] = s.genome;
+  d["fitness"] = s.result;
+  d["objectives"] = s.objectives;
+  d["reference"] = s.reference;
+  d["generation"] = s.generation;
+  d["feasible"] = s.feasible;
+  d["rank"] = s.rank;
+  d["crowding"] = s.crowding;
+  return d;
+}
+
 void bind_search(nb::module_& m) {
   nb::class_<SearchEngine>(m, "SearchEngine",
                            "The search of a config's search.algorithm as animat_evolve runs it "
@@ -80,9 +137,10 @@ void bind_search(nb::module_& m) {
           },
           "config"_a, "supplied"_a = std::vector<std::string>{},
           "The search of config (search.algorithm); a [search] setting it cannot run is a "
-          "ValueError naming\nthe key and value. supplied: names of search.descriptors whose "
-          "values the caller computes\nand passes to tell(fitness, values) (MAP-Elites; their "
-          "ranges in search.ranges).")
+          "ValueError naming\nthe key and value. supplied: names of search.descriptors "
+          "(MAP-Elites; their ranges in\nsearch.ranges) or of search.objectives entries (NSGA-II; "
+          "each entry NAME:max or NAME:min) whose\nvalues the caller computes and passes to "
+          "tell(fitness, values), a row per genome in supplied order.")
       .def_prop_ro("algorithm",
                    [](const SearchEngine& e) { return std::string(e.search->algorithm()); })
       .def(
@@ -98,12 +156,12 @@ void bind_search(nb::module_& m) {
           [](SearchEngine& e, const std::vector<Fitness>& fitness,
              const std::vector<std::vector<double>>& values) {
             SearchLease lease(e, "tell");
-            auto* me = dynamic_cast<MapElites*>(e.search.get());
-            if (!values.empty() && (me == nullptr || me->supplied().empty()))
+            if (!values.empty() && e.search->supplied().empty())
               throw Error(
-                  "SearchEngine.tell: values are for supplied descriptors; this search has none");
+                  "SearchEngine.tell: values are for supplied descriptors or criteria; this search "
+                  "has none");
             nb::gil_scoped_release release;  // the exploit guard's reference swims
-            return me ? me->tell(fitness, values) : e.search->tell(fitness);
+            return e.search->tell(fitness, values);
           },
           "fitness"_a, "values"_a = std::vector<std::vector<double>>{},
           "The Fitness of every genome of the last ask(), in order; True when a generation "
@@ -145,7 +203,90 @@ void bind_search(nb::module_& m) {
           },
           "text"_a, "source"_a = "checkpoint",
           "Restores a checkpoint() of the same config (an error for a corrupt, foreign or "
-          "inconsistent one).");
+          "inconsistent one).")
+      .def(
+          "elites",
+          [](const SearchEngine& e) {
+            SearchLease lease(e, "elites");
+            const auto& me = engine_as<MapElites>(e, "elites", "map_elites");
+            nb::list out;
+            for (const auto& [cell, elite] : me.archive().elites())
+              out.append(elite_dict(cell, elite));
+            return out;
+          },
+          "MAP-Elites: the archive's elites in cell order, each a dict: index (its cell), genome, "
+          "fitness\n(Fitness), values (every descriptor, in search.descriptors order), objective "
+          "(what the archive\ncompares), reference (the exploit guard's fitness; NaN = none), "
+          "generation (the one that made it).")
+      .def_prop_ro(
+          "archive",
+          [](const SearchEngine& e) {
+            SearchLease lease(e, "archive");
+            return archive_dict(engine_as<MapElites>(e, "archive", "map_elites").archive());
+          },
+          "MAP-Elites: the archive's geometry, a dict: kind (\"grid\"), descriptors (names), "
+          "lower, upper\n(each descriptor's range), cells, bins (per descriptor).")
+      .def(
+          "index_of",
+          [](const SearchEngine& e, const std::vector<double>& values) {
+            SearchLease lease(e, "index_of");
+            const GridArchive& a = engine_as<MapElites>(e, "index_of", "map_elites").archive();
+            if (values.size() != a.dims())
+              throw Error(fmt::format("SearchEngine.index_of: {} values for the {} descriptors",
+                                      values.size(), a.dims()));
+            for (std::size_t j = 0; j < values.size(); ++j)
+              if (!std::isfinite(values[j]))
+                throw Error(fmt::format(
+                    "SearchEngine.index_of: descriptor {} = {} (a descriptor must be finite)",
+                    a.descriptors()[j]->name, values[j]));
+            return a.index_of(values);
+          },
+          "values"_a,
+          "MAP-Elites: the archive cell of finite descriptor values (search.descriptors order).")
+      .def(
+          "population",
+          [](const SearchEngine& e) {
+            SearchLease lease(e, "population");
+            nb::list out;
+            for (const Solution& s : engine_as<Nsga2>(e, "population", "nsga2").population())
+              out.append(solution_dict(s));
+            return out;
+          },
+          "NSGA-II: the population in order, each a dict: genome, fitness (Fitness), objectives "
+          "(what the\nselection compares, one per criterion; NaN when infeasible), reference (the "
+          "criteria at the\nexploit guard's reference step; empty when not evaluated there), "
+          "generation, feasible, rank,\ncrowding.")
+      .def(
+          "front",
+          [](const SearchEngine& e) {
+            SearchLease lease(e, "front");
+            const auto& nsga = engine_as<Nsga2>(e, "front", "nsga2");
+            std::vector<std::size_t> out;
+            for (const Solution* s : nsga.front())
+              out.push_back(static_cast<std::size_t>(s - nsga.population().data()));
+            return out;
+          },
+          "NSGA-II: the population indices of the front (feasible members of rank 0), ordered by "
+          "the first\ncriterion, best first (then the next ..., then population order).")
+      .def_prop_ro(
+          "reference_point",
+          [](const SearchEngine& e) {
+            SearchLease lease(e, "reference_point");
+            return engine_as<Nsga2>(e, "reference_point", "nsga2").reference_point();
+          },
+          "NSGA-II: the hypervolume's reference point, one value per criterion (empty until "
+          "set).")
+      .def_prop_ro(
+          "criteria",
+          [](const SearchEngine& e) {
+            const auto& nsga = engine_as<Nsga2>(e, "criteria", "nsga2");
+            std::vector<std::pair<std::string, std::string>> out;
+            for (std::size_t j = 0; j < nsga.criteria().size(); ++j)
+              out.emplace_back(nsga.criteria()[j], nsga.maximized()[j] ? "max" : "min");
+            return out;
+          },
+          "NSGA-II: (name, \"max\" or \"min\") of every criterion, in search.objectives "
+          "order.");
 }
 
 class EngineLease : public ThreadLease<Evolution> {
@@ -647,12 +788,26 @@ void bind_evolution(nb::module_& m) {
 
   m.def(
       "run_search",
-      [](const Config& c, std::filesystem::path out, bool resume, bool overwrite, bool quiet) {
+      [](const Config& c, std::filesystem::path out, bool resume, bool overwrite, bool quiet,
+         const std::vector<std::string>& supplied, nb::object evaluate, nb::object describe) {
         RunOptions opt;
         opt.out = std::move(out);
         opt.resume = resume;
         opt.overwrite = overwrite;
         opt.quiet = quiet;
+        opt.supplied = supplied;
+        // The hooks run on this thread with the GIL; what they raise stops the run as it is.
+        if (!evaluate.is_none())
+          opt.evaluate = [evaluate](const std::vector<Genome>& genomes) {
+            nb::gil_scoped_acquire gil;
+            return nb::cast<std::vector<Fitness>>(evaluate(genomes));
+          };
+        if (!describe.is_none())
+          opt.describe = [describe](const std::vector<Genome>& genomes,
+                                    const std::vector<Fitness>& fitness) {
+            nb::gil_scoped_acquire gil;
+            return nb::cast<std::vector<std::vector<double>>>(describe(genomes, fitness));
+          };
         bool interrupted = false;
         // Polled between evaluations (about every 20 ms): Ctrl-C stops the run with a checkpoint.
         opt.stop_poll = [&interrupted] {
@@ -677,12 +832,19 @@ void bind_evolution(nb::module_& m) {
         return d;
       },
       "config"_a, "out"_a, "resume"_a = false, "overwrite"_a = false, "quiet"_a = true,
+      "supplied"_a = std::vector<std::string>{}, "evaluate"_a = nb::none(),
+      "describe"_a = nb::none(),
       "Run (or resume) the config's MAP-Elites or NSGA-II as animat_evolve does (search.hpp): the "
       "run\ndirectory out (config.toml, history.csv, checkpoint.json) is locked while it runs, its "
       "checkpoint is\nchecked on load, and a resume may change only the resumable keys. Returns "
       "a dict: algorithm,\ncolumns, history (rows of floats), stop_reason, generation. The GIL "
       "is released while it runs;\nCtrl-C stops it with a checkpoint of the last complete "
-      "generation and raises KeyboardInterrupt.");
+      "generation and raises KeyboardInterrupt.\nHooks (called with the GIL, once per "
+      "generation): evaluate(genomes) -> list of Fitness replaces\nthe config's own evaluation; "
+      "describe(genomes, fitness) -> one row per genome of the values of the\nsupplied "
+      "descriptors (MAP-Elites) or criteria (NSGA-II), in supplied order. An exception raised in "
+      "a\nhook stops the run and is raised here; the last checkpoint stays, and resume=True "
+      "continues from it.");
 
   m.def(
       "reference_config", [](const Config& config) { return reference_config(config); }, "config"_a,

@@ -806,7 +806,14 @@ SearchSummary run_search_unchecked(const Config& config, const RunOptions& opt,
     checkpoint_text = check();
   }
   std::unique_ptr<Search> search =
-      make_search(config, std::move(fitness), std::move(reference), opt.evaluator);
+      make_search(config, std::move(fitness), std::move(reference), opt.evaluator, opt.supplied);
+  if (!search->supplied().empty() && !opt.describe)
+    throw Error(fmt::format(
+        "run_search: the caller supplies {} ({}) but gives no describe hook",
+        fmt::join(search->supplied(), ", "),
+        config.search.algorithm == "nsga2" ? "search.objectives" : "search.descriptors"));
+  if (search->supplied().empty() && opt.describe)
+    throw Error("run_search: a describe hook, but the caller supplies no descriptor or criterion");
   search->set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
   const std::string tag = opt.label.empty() ? std::string() : "[" + opt.label + "] ";
   const std::filesystem::path ckpt = opt.out / "checkpoint.json", hist = opt.out / "history.csv";
@@ -865,7 +872,7 @@ SearchSummary run_search_unchecked(const Config& config, const RunOptions& opt,
       reason = "interrupted";
     if (!reason.empty()) break;
     try {
-      search->step();
+      search->step(opt.evaluate, opt.describe);
     } catch (const Interrupted&) {
       reason = "interrupted";  // the generation in progress is dropped; resuming recomputes it
       break;

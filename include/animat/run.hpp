@@ -39,6 +39,14 @@ struct RunOptions {
   /// run_search's callback: called after every generation with the search; return false to stop
   /// (checkpointed).
   std::function<bool(const Search&)> search_callback;
+  /// run_search: the names of the measures whose values `describe` gives (make_search's
+  /// `supplied`: MAP-Elites' descriptors or NSGA-II's criteria).
+  std::vector<std::string> supplied;
+  /// run_search: evaluates every generation's genomes instead of the evaluator (Search::step's
+  /// hook); null = the evaluator.
+  Search::EvaluateHook evaluate;
+  /// run_search: the supplied values of every genome of a generation (Search::step's hook).
+  Search::DescribeHook describe;
   /// Called once every check has passed and the run directory is locked, before the first write to
   /// it (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in
   /// place).
@@ -101,7 +109,9 @@ struct SearchSummary {
 /// checkpoint is checksummed and checked on load. Writes config.toml, history.csv (the search's
 /// history columns) and checkpoint.json (every evolution.checkpoint_every generations and at the
 /// end). RunOptions::search_callback is called after every generation (not callback); on_start
-/// before the first write. `fitness` and `reference` as for run_evolution.
+/// before the first write; RunOptions::evaluate and describe evaluate and describe each
+/// generation, and what they throw stops the run (propagated; the last checkpoint stays as it
+/// was, and a resume continues from it). `fitness` and `reference` as for run_evolution.
 SearchSummary run_search(const Config& config, const RunOptions& options,
                          FitnessFunction fitness = {}, FitnessFunction reference = {});
 

@@ -68,6 +68,27 @@ struct Measure {
 [[nodiscard]] const Measure& find_measure(std::string_view name, const Config& config,
                                           std::string_view key);
 
+/// Measures whose values the caller computes and passes to tell (MapElites' supplied descriptors,
+/// Nsga2's supplied criteria): their names, and measures without a function (`of` is null) that
+/// the archive or the criteria point to. Not copyable (the measures point into the names); a
+/// search shares its one.
+struct SuppliedMeasures {
+  /// ConfigError unless every name is one of `allowed` (the entries of the config key `key`) and
+  /// is listed once.
+  SuppliedMeasures(std::vector<std::string> names, const std::vector<std::string>& allowed,
+                   std::string_view key);
+  SuppliedMeasures(const SuppliedMeasures&) = delete;
+  SuppliedMeasures& operator=(const SuppliedMeasures&) = delete;
+  /// The position of `m` in `names` (m one of `measures`).
+  [[nodiscard]] std::size_t index_of(const Measure* m) const {
+    return static_cast<std::size_t>(m - measures.data());
+  }
+  [[nodiscard]] const Measure* find(std::string_view name) const;
+
+  std::vector<std::string> names;
+  std::vector<Measure> measures;
+};
+
 /// The exactly rounded sum of `values` (Python's math.fsum): the QD-score and the hypervolume do
 /// not depend on the order of their terms.
 [[nodiscard]] double exact_sum(std::span<const double> values);
@@ -111,9 +132,26 @@ class Search {
   /// (history() has its row). Atomic: throws Error, and changes nothing, for a count mismatch or a
   /// value the search refuses (naming the value's index and what is wrong).
   virtual bool tell(const std::vector<Fitness>& fitness) = 0;
+  /// tell() with the values of the measures the caller supplies (supplied()): one row per genome,
+  /// in supplied() order, read only for the genomes the search keeps (viable, stable and valid),
+  /// whose values must be finite; refused, changing nothing, by the value's index and the
+  /// measure's name. A search that supplies none takes no rows.
+  virtual bool tell(const std::vector<Fitness>& fitness,
+                    const std::vector<std::vector<double>>& supplied);
+  /// The names of the measures whose values the caller passes to tell (none by default).
+  [[nodiscard]] virtual const std::vector<std::string>& supplied() const;
+  /// A generation's evaluation by the caller: the Fitness of every genome, in order.
+  using EvaluateHook = std::function<std::vector<Fitness>(const std::vector<Genome>&)>;
+  /// The values of the supplied measures of every genome (a row each, in supplied() order).
+  using DescribeHook = std::function<std::vector<std::vector<double>>(const std::vector<Genome>&,
+                                                                      const std::vector<Fitness>&)>;
   /// ask(), evaluate with the search's evaluator (honouring the stop request: Interrupted), tell(),
   /// until a generation completes.
-  void step();
+  void step() { step({}, {}); }
+  /// step() with the caller's hooks: `evaluate` replaces the search's evaluator (null: the
+  /// evaluator), `describe` gives the supplied values (null: none). What a hook throws stops the
+  /// step and leaves the search as it was before its ask.
+  void step(const EvaluateHook& evaluate, const DescribeHook& describe);
   /// -1 before the first generation is complete.
   [[nodiscard]] virtual int generation() const = 0;
   [[nodiscard]] virtual std::int64_t evaluations() const = 0;
@@ -138,7 +176,8 @@ class Search {
 /// The search of config.search.algorithm: `fitness` (default swim_fitness(config)) evaluates on
 /// `evaluator` (default: this process's OpenMP threads); `reference` is the exploit guard's
 /// (default swim_fitness(reference_config(config)) unless evaluation.reference_check is "off").
-/// `supplied`: MAP-Elites' descriptors whose values the caller passes to tell (MapElites).
+/// `supplied`: MAP-Elites' descriptors or NSGA-II's criteria whose values the caller passes to
+/// tell (MapElites, Nsga2).
 /// Throws ConfigError for [search] settings that cannot run (naming the key and value).
 [[nodiscard]] std::unique_ptr<Search> make_search(const Config& config,
                                                   FitnessFunction fitness = {},
@@ -154,6 +193,7 @@ class GaSearch final : public Search {
   [[nodiscard]] std::string_view algorithm() const override { return "ga"; }
   std::vector<Genome> ask() override;
   bool tell(const std::vector<Fitness>& fitness) override;
+  using Search::tell;
   [[nodiscard]] int generation() const override { return evo_.generation(); }
   [[nodiscard]] std::int64_t evaluations() const override { return evo_.evaluations(); }
   [[nodiscard]] std::string stop_reason() const override { return evo_.stop_reason(); }
@@ -249,12 +289,12 @@ class MapElites final : public Search {
   [[nodiscard]] std::string_view algorithm() const override { return "map_elites"; }
   std::vector<Genome> ask() override;
   bool tell(const std::vector<Fitness>& fitness) override { return tell(fitness, {}); }
-  /// tell() with the values of the supplied descriptors: a row per genome (read only for the
-  /// viable, stable and valid ones, whose values must be finite); refused, changing nothing, by
-  /// the value's index and descriptor name.
-  bool tell(const std::vector<Fitness>& fitness, const std::vector<std::vector<double>>& supplied);
+  bool tell(const std::vector<Fitness>& fitness,
+            const std::vector<std::vector<double>>& supplied) override;
   /// The names of the descriptors the caller supplies, in their rows' order.
-  [[nodiscard]] const std::vector<std::string>& supplied() const { return supplied_->names; }
+  [[nodiscard]] const std::vector<std::string>& supplied() const override {
+    return supplied_->names;
+  }
   [[nodiscard]] int generation() const override { return generation_; }
   [[nodiscard]] std::int64_t evaluations() const override { return evaluations_; }
   [[nodiscard]] std::string stop_reason() const override;
@@ -269,18 +309,11 @@ class MapElites final : public Search {
   [[nodiscard]] std::vector<double> row(int added, int discarded) const;
   [[nodiscard]] int disagreements(const GridArchive& archive) const;
 
-  /// The supplied descriptors' names and their measures (no function: `of` is null), which the
-  /// archive points to; shared by copies.
-  struct Supplied {
-    std::vector<std::string> names;
-    std::vector<Measure> measures;
-  };
-
   std::shared_ptr<const Config> config_;
   std::uint64_t identity_;
   FitnessFunction reference_;
   bool select_ = false;  ///< the exploit guard "select": the archive compares reference fitness
-  std::shared_ptr<const Supplied> supplied_;
+  std::shared_ptr<const SuppliedMeasures> supplied_;  ///< shared by copies
   GridArchive archive_;
   int batch_;
   int generation_ = -1;
@@ -304,6 +337,9 @@ struct Solution {
   /// The criteria at the exploit guard's reference step (NaN where that swim was not valid); empty
   /// when not evaluated there.
   std::vector<double> reference;
+  /// The values of the criteria the caller supplies (Nsga2::supplied() order); empty when none
+  /// are supplied or the member is not feasible.
+  std::vector<double> supplied;
   int generation = 0;
   bool feasible = false;  ///< viable, stable and valid
   int rank = 0;           ///< its front in the selection (infeasible or a copy: past the last)
@@ -315,13 +351,26 @@ struct Solution {
 /// later ones as many offspring() of parents chosen by binary tournament (lower rank, then larger
 /// crowding distance, then the first drawn); the next population is Deb's (mu + lambda) selection
 /// of parents and candidates, copies and infeasible candidates last.
+///
+/// Criteria the caller computes (animat.moo's Python criteria): the names of search.objectives
+/// listed in `supplied` are not read from the measures table, and their entries must give the
+/// sense ("NAME:max" or "NAME:min"); tell(fitness, supplied) takes their values, one row per
+/// genome in `supplied`'s order, and the checkpoint keeps each member's. At the exploit guard's
+/// reference step a supplied criterion keeps its supplied value (the caller describes the genome;
+/// the engine cannot measure it again).
 class Nsga2 final : public Search {
  public:
   Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-        std::shared_ptr<Evaluator> evaluator);
+        std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied = {});
   [[nodiscard]] std::string_view algorithm() const override { return "nsga2"; }
   std::vector<Genome> ask() override;
-  bool tell(const std::vector<Fitness>& fitness) override;
+  bool tell(const std::vector<Fitness>& fitness) override { return tell(fitness, {}); }
+  bool tell(const std::vector<Fitness>& fitness,
+            const std::vector<std::vector<double>>& supplied) override;
+  /// The names of the criteria the caller supplies, in their rows' order.
+  [[nodiscard]] const std::vector<std::string>& supplied() const override {
+    return supplied_->names;
+  }
   [[nodiscard]] int generation() const override { return generation_; }
   [[nodiscard]] std::int64_t evaluations() const override { return evaluations_; }
   [[nodiscard]] std::string stop_reason() const override;
@@ -336,9 +385,15 @@ class Nsga2 final : public Search {
   /// The hypervolume's reference point: the worst value of every criterion over the feasible
   /// candidates of the first generation that had any (empty until then).
   [[nodiscard]] const std::vector<double>& reference_point() const { return reference_point_; }
+  /// The criteria's names, as search.objectives names them, in order.
+  [[nodiscard]] const std::vector<std::string>& criteria() const { return names_; }
+  /// Whether each criterion is maximised (else minimised), in criteria() order.
+  [[nodiscard]] const std::vector<bool>& maximized() const { return maximize_; }
 
  private:
-  [[nodiscard]] std::vector<double> criteria_of(const Fitness& f) const;
+  /// The criteria of `f` with the supplied values `own` (NaN when `f` is not feasible).
+  [[nodiscard]] std::vector<double> criteria_of(const Fitness& f,
+                                                std::span<const double> own) const;
   [[nodiscard]] std::vector<double> minimised(const std::vector<double>& values) const;
   /// Under "select": the objectives become the reference criteria (feasible only if finite).
   void compare_reference(Solution& s) const;
@@ -352,6 +407,7 @@ class Nsga2 final : public Search {
   std::uint64_t identity_;
   FitnessFunction reference_;
   bool select_ = false;  ///< the exploit guard "select": the selection compares reference criteria
+  std::shared_ptr<const SuppliedMeasures> supplied_;  ///< shared by copies
   std::vector<const Measure*> criteria_;
   std::vector<std::string> names_;  ///< as search.objectives names them
   std::vector<bool> maximize_;

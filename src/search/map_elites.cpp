@@ -175,23 +175,8 @@ MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunct
                      std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied)
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
-      supplied_([&] {
-        auto out = std::make_shared<Supplied>();
-        out->names = supplied;
-        for (const std::string& name : out->names) {
-          if (std::count(out->names.begin(), out->names.end(), name) > 1)
-            throw ConfigError(fmt::format("MapElites: descriptor \"{}\" is supplied twice", name));
-          if (std::find(config.search.descriptors.begin(), config.search.descriptors.end(), name) ==
-              config.search.descriptors.end())
-            throw ConfigError(fmt::format(
-                "MapElites: the supplied descriptor \"{}\" is not one of search.descriptors",
-                name));
-          // `name` lives in out->names, which no longer changes: the pointer stays valid
-          out->measures.push_back(
-              Measure{name.c_str(), "supplied by the caller", 0.0, 0.0, true, nullptr});
-        }
-        return std::shared_ptr<const Supplied>(std::move(out));
-      }()),
+      supplied_(std::make_shared<const SuppliedMeasures>(supplied, config.search.descriptors,
+                                                         "search.descriptors")),
       archive_(descriptors_of(config, supplied_->measures), bins_of(config), ranges_of(config)),
       batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
       started_(now_seconds()) {
@@ -235,13 +220,7 @@ bool MapElites::tell(const std::vector<Fitness>& fitness,
         fmt::format("MapElites.tell: {} fitness values for the {} genomes of the last ask()",
                     fitness.size(), genomes.size()));
   const std::size_t own = supplied_->names.size();
-  if (own == 0 && !supplied.empty())
-    throw Error("MapElites.tell: supplied values, but no descriptor is supplied by the caller");
-  if (own > 0 && supplied.size() != genomes.size())
-    throw Error(fmt::format(
-        "MapElites.tell: {} rows of supplied descriptor values for the {} genomes of the last "
-        "ask()",
-        supplied.size(), genomes.size()));
+  check_supplied_rows("MapElites", own, supplied.size(), genomes.size());
   const bool nonnegative = nonnegative_objective(*config_);
   // 1. Check every value and find where each candidate would go; nothing changes yet.
   std::vector<std::vector<double>> values(fitness.size());
@@ -260,8 +239,7 @@ bool MapElites::tell(const std::vector<Fitness>& fitness,
              fmt::format("{} supplied descriptor values for the {} supplied descriptors",
                          supplied[k].size(), own));
     for (const Measure* d : archive_.descriptors()) {
-      const double x =
-          d->of ? d->of(f) : supplied[k][static_cast<std::size_t>(d - supplied_->measures.data())];
+      const double x = d->of ? d->of(f) : supplied[k][supplied_->index_of(d)];
       if (!std::isfinite(x))
         refuse("MapElites", k,
                fmt::format("descriptor {} = {} (a descriptor must be finite)", d->name, x));
@@ -418,9 +396,7 @@ void MapElites::restore(std::string_view text, std::string_view source) {
         double x = std::numeric_limits<double>::quiet_NaN();
         if (d->of) {
           x = d->of(e.result);
-        } else if (const json& v =
-                       je["supplied"][static_cast<std::size_t>(d - supplied_->measures.data())];
-                   v.is_number()) {
+        } else if (const json& v = je["supplied"][supplied_->index_of(d)]; v.is_number()) {
           x = v.get<double>();
         }
         if (!std::isfinite(x))

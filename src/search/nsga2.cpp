@@ -47,10 +47,24 @@ json values_json(const std::vector<double>& v) {
 
 }  // namespace
 
+namespace {
+
+// The names of search.objectives' entries ("NAME", "NAME:max", "NAME:min").
+std::vector<std::string> objective_names(const Config& config) {
+  std::vector<std::string> out;
+  for (const std::string& spec : config.search.objectives)
+    out.push_back(spec.substr(0, spec.find(':')));
+  return out;
+}
+
+}  // namespace
+
 Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-             std::shared_ptr<Evaluator> evaluator)
+             std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied)
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
+      supplied_(std::make_shared<const SuppliedMeasures>(supplied, objective_names(config),
+                                                         "search.objectives")),
       size_(config.evolution.population),
       started_(now_seconds()) {
   if (size_ > kMaxNsga2Population)
@@ -61,7 +75,13 @@ Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction refe
   for (const std::string& spec : config.search.objectives) {
     const auto colon = spec.find(':');
     const std::string name = spec.substr(0, colon);
-    const Measure& m = find_measure(name, config, "search.objectives");
+    const Measure* own = supplied_->find(name);
+    if (own != nullptr && colon == std::string::npos)
+      throw ConfigError(fmt::format(
+          "search.objectives: \"{}\" is supplied by the caller: give its sense, \"{}:max\" or "
+          "\"{}:min\"",
+          spec, name, name));
+    const Measure& m = own != nullptr ? *own : find_measure(name, config, "search.objectives");
     bool maximize = m.maximize;
     if (colon != std::string::npos) {
       const std::string sense = spec.substr(colon + 1);
@@ -85,10 +105,10 @@ Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction refe
                          : (fitness ? make_local_evaluator(config, std::move(fitness)) : nullptr);
 }
 
-std::vector<double> Nsga2::criteria_of(const Fitness& f) const {
+std::vector<double> Nsga2::criteria_of(const Fitness& f, std::span<const double> own) const {
   std::vector<double> out;
   if (!archivable(f)) return std::vector<double>(criteria_.size(), kNaN);
-  for (const Measure* c : criteria_) out.push_back(c->of(f));
+  for (const Measure* c : criteria_) out.push_back(c->of ? c->of(f) : own[supplied_->index_of(c)]);
   return out;
 }
 
@@ -188,12 +208,15 @@ std::vector<Solution> Nsga2::select(std::vector<Solution> pool,
   return out;
 }
 
-bool Nsga2::tell(const std::vector<Fitness>& fitness) {
+bool Nsga2::tell(const std::vector<Fitness>& fitness,
+                 const std::vector<std::vector<double>>& supplied) {
   if (!asked_) throw Error("Nsga2.tell: nothing was asked (call ask() first)");
   const std::vector<Genome>& genomes = *asked_;
   if (fitness.size() != genomes.size())
     throw Error(fmt::format("Nsga2.tell: {} fitness values for the {} genomes of the last ask()",
                             fitness.size(), genomes.size()));
+  const std::size_t own = supplied_->names.size();
+  check_supplied_rows("Nsga2", own, supplied.size(), genomes.size());
   // 1. Check every value; nothing changes before the commit below.
   const int g = generation_ + 1;
   std::vector<Solution> candidates;
@@ -202,7 +225,13 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness) {
     if (!std::isfinite(f.fitness))
       refuse("Nsga2", k, fmt::format("fitness {} (a fitness must be finite)", f.fitness));
     if (f.cell_count < 0) refuse("Nsga2", k, fmt::format("cell_count {}", f.cell_count));
-    Solution s{genomes[k], f, criteria_of(f), {}, g, archivable(f)};
+    if (own > 0 && archivable(f) && supplied[k].size() != own)
+      refuse("Nsga2", k,
+             fmt::format("{} supplied criterion values for the {} supplied criteria",
+                         supplied[k].size(), own));
+    Solution s{genomes[k], f, {}, {}, {}, g, archivable(f)};
+    if (own > 0 && s.feasible) s.supplied = supplied[k];
+    s.objectives = criteria_of(f, s.supplied);
     if (s.feasible)
       for (std::size_t j = 0; j < criteria_.size(); ++j)
         if (!std::isfinite(s.objectives[j]))
@@ -234,7 +263,7 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness) {
       }
     const auto refs = evaluate_references(reference_, *config_, todo, "Nsga2.tell");
     for (std::size_t r = 0; r < first.size(); ++r)
-      candidates[first[r]].reference = criteria_of(refs[r]);
+      candidates[first[r]].reference = criteria_of(refs[r], candidates[first[r]].supplied);
     referenced = static_cast<std::int64_t>(first.size());
     for (Solution& s : candidates) {
       if (!s.feasible) continue;
@@ -286,7 +315,7 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness) {
       }
     const std::vector<Fitness> refs = evaluate_references(reference_, *config_, todo, "Nsga2.tell");
     for (std::size_t r = 0; r < pending.size(); ++r)
-      population[pending[r]].reference = criteria_of(refs[r]);
+      population[pending[r]].reference = criteria_of(refs[r], population[pending[r]].supplied);
     referenced = static_cast<std::int64_t>(pending.size());
   }
   // 4. Commit.
@@ -323,8 +352,8 @@ std::vector<double> Nsga2::row(const std::vector<Solution>& population,
     front_minimised.push_back(minimised(s.objectives));
     if (s.reference.empty()) continue;
     for (std::size_t j = 0; j < criteria_.size(); ++j)
-      if (std::isnan(s.reference[j]) ||
-          reference_disagrees(criteria_of(s.result)[j], s.reference[j], config_->evaluation)) {
+      if (std::isnan(s.reference[j]) || reference_disagrees(criteria_of(s.result, s.supplied)[j],
+                                                            s.reference[j], config_->evaluation)) {
         ++disagreements;
         break;
       }
@@ -377,6 +406,8 @@ std::string Nsga2::checkpoint() const {
            {"rank", s.rank},
            {"crowding", crowding_json(s.crowding)}};
     if (!s.reference.empty()) j["reference"] = values_json(s.reference);
+    // the values of the caller's criteria, which the result does not hold
+    if (!s.supplied.empty()) j["supplied"] = values_json(s.supplied);
     members.push_back(std::move(j));
   }
   p["population"] = std::move(members);
@@ -419,7 +450,15 @@ void Nsga2::restore(std::string_view text, std::string_view source) {
       s.genome = genome_from_json(j["genome"].dump(), config_->genome, source);
       s.result = fitness_from_json(j["result"]);
       s.feasible = archivable(s.result);
-      s.objectives = criteria_of(s.result);
+      const std::size_t own = supplied_->names.size();
+      if (own > 0 && s.feasible) {
+        if (!j.contains("supplied") || !j["supplied"].is_array() || j["supplied"].size() != own)
+          fail(fmt::format("member {} has no list of its {} supplied criterion values",
+                           population.size(), own));
+        for (const json& x : j["supplied"])
+          s.supplied.push_back(x.is_number() ? x.get<double>() : kNaN);
+      }
+      s.objectives = criteria_of(s.result, s.supplied);
       if (s.feasible)
         for (std::size_t c = 0; c < m; ++c)
           if (!std::isfinite(s.objectives[c]))

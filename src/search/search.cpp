@@ -87,17 +87,62 @@ Genome offspring(const Config& config, std::uint64_t seed, int g, std::size_t i,
 // ---------------------------------------------------------------------------------------------------
 // The interface
 
-void Search::step() {
-  if (!evaluator_) throw Error("Search::step: no evaluator (drive this search with ask and tell)");
+SuppliedMeasures::SuppliedMeasures(std::vector<std::string> names_in,
+                                   const std::vector<std::string>& allowed, std::string_view key)
+    : names(std::move(names_in)) {
+  for (const std::string& name : names) {
+    if (std::count(names.begin(), names.end(), name) > 1)
+      throw ConfigError(fmt::format("{}: \"{}\" is supplied by the caller twice", key, name));
+    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
+      throw ConfigError(
+          fmt::format("{}: the caller supplies \"{}\", which is not one of its entries ({})", key,
+                      name, fmt::join(allowed, ", ")));
+    // `name` lives in `names`, which no longer changes: the pointer stays valid
+    measures.push_back(Measure{name.c_str(), "supplied by the caller", 0.0, 0.0, true, nullptr});
+  }
+}
+
+const Measure* SuppliedMeasures::find(std::string_view name) const {
+  for (const Measure& m : measures)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+bool Search::tell(const std::vector<Fitness>& fitness,
+                  const std::vector<std::vector<double>>& supplied) {
+  if (!supplied.empty())
+    throw Error(fmt::format(
+        "{}.tell: supplied values, but this search has no measure supplied by the caller",
+        algorithm()));
+  return tell(fitness);
+}
+
+const std::vector<std::string>& Search::supplied() const {
+  static const std::vector<std::string> none;
+  return none;
+}
+
+void Search::step(const EvaluateHook& evaluate, const DescribeHook& describe) {
+  if (!evaluator_ && !evaluate)
+    throw Error("Search::step: no evaluator (drive this search with ask and tell)");
   while (true) {
     const std::vector<Genome> genomes = ask();
     std::vector<Fitness> fitness;
-    try {
-      fitness = evaluator_->evaluate(genomes, stop_);
-    } catch (const Interrupted&) {
-      throw Interrupted(fmt::format("interrupted during generation {}", generation() + 1));
+    if (evaluate) {
+      fitness = evaluate(genomes);
+    } else {
+      try {
+        fitness = evaluator_->evaluate(genomes, stop_);
+      } catch (const Interrupted&) {
+        throw Interrupted(fmt::format("interrupted during generation {}", generation() + 1));
+      }
     }
-    if (tell(fitness)) return;
+    if (fitness.size() != genomes.size())
+      throw Error(fmt::format("{}: the evaluation gave {} fitness values for {} genomes",
+                              algorithm(), fitness.size(), genomes.size()));
+    std::vector<std::vector<double>> values;
+    if (describe) values = describe(genomes, fitness);
+    if (tell(fitness, values)) return;
   }
 }
 
@@ -146,10 +191,10 @@ std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitnes
                                     FitnessFunction reference, std::shared_ptr<Evaluator> evaluator,
                                     const std::vector<std::string>& supplied) {
   validate(config);
-  if (!supplied.empty() && config.search.algorithm != "map_elites")
-    throw ConfigError(fmt::format(
-        "search.algorithm = \"{}\": descriptors supplied by the caller are MAP-Elites' only",
-        config.search.algorithm));
+  if (!supplied.empty() && config.search.algorithm == "ga")
+    throw ConfigError(
+        "search.algorithm = \"ga\": measures supplied by the caller are MAP-Elites' descriptors "
+        "or NSGA-II's criteria; the GA has none");
   if (!fitness) {
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off")
@@ -165,7 +210,7 @@ std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitnes
                                        std::move(evaluator), supplied);
   if (algorithm == "nsga2")
     return std::make_unique<Nsga2>(config, std::move(fitness), std::move(reference),
-                                   std::move(evaluator));
+                                   std::move(evaluator), supplied);
   throw ConfigError(fmt::format("search.algorithm = \"{}\": no such search", algorithm));
 }
 
@@ -362,6 +407,17 @@ std::string stop_rule(const Config& config, int generation, double wall) {
   if (ep.wall_seconds > 0 && wall >= ep.wall_seconds)
     return fmt::format("wall-clock budget evolution.wall_seconds = {} s used", ep.wall_seconds);
   return {};
+}
+
+void check_supplied_rows(std::string_view who, std::size_t own, std::size_t rows,
+                         std::size_t genomes) {
+  if (own == 0 && rows > 0)
+    throw Error(
+        fmt::format("{}.tell: supplied values, but no measure is supplied by the caller", who));
+  if (own > 0 && rows != genomes)
+    throw Error(
+        fmt::format("{}.tell: {} rows of supplied values for the {} genomes of the last ask()", who,
+                    rows, genomes));
 }
 
 void refuse(std::string_view who, std::size_t k, const std::string& what) {

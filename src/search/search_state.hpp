@@ -87,6 +87,11 @@ void reading_checkpoint(std::string_view source, Read&& read) {
 /// generation cap evolution.generations, the wall-clock budget evolution.wall_seconds.
 std::string stop_rule(const Config& config, int generation, double wall);
 
+/// Refuses supplied values where the search has no supplied measure (own = 0), and a row count
+/// other than one per genome of the last ask().
+void check_supplied_rows(std::string_view who, std::size_t own, std::size_t rows,
+                         std::size_t genomes);
+
 /// Error of a tell(): "WHO.tell: value K (genome K of the last ask()) is refused: WHAT".
 [[noreturn]] void refuse(std::string_view who, std::size_t k, const std::string& what);
 

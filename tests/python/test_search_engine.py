@@ -3,6 +3,7 @@ and animat.moo's NSGA-II: told the same fitness, they ask the same genomes and w
 rows, generation after generation (a cheap deterministic stub stands in for the swims)."""
 
 import hashlib
+import json
 import math
 
 import pytest
@@ -199,3 +200,200 @@ def test_run_search_resumes_to_the_same_run(tmp_path):
     resumed = _core.run_search(config, tmp_path / "resumed", resume=True)
     assert [row[:-1] for row in resumed["history"]] == [row[:-1] for row in straight["history"]]
     assert resumed["columns"][-1] == "wall_seconds"
+
+
+def test_map_elites_state_is_animat_qd_archive():
+    # elites(), archive and index_of() are the archive animat.qd builds from the same stubs: the same
+    # cells, genomes, values, objectives and generations.
+    config = config_for("map_elites", 3)
+    config["search.ranges"] = [1.0, 65.0, 0.0, 50.0]
+    engine = _core.SearchEngine(config)
+    me = animat.MapElites(
+        config, animat.GridArchive([("cells", 1.0, 65.0), ("fitness", 0.0, 50.0)], bins=(8, 5)), batch=12, seed=3
+    )
+    for _ in range(4):
+        genomes = engine.ask()
+        me.ask()
+        told = [stub(g) for g in genomes]
+        engine.tell(told)
+        me.tell(told, descriptors=[[f.cell_count, f.fitness] if f.viable else None for f in told])
+    assert engine.archive == {
+        "kind": "grid",
+        "descriptors": ["cells", "fitness"],
+        "lower": [1.0, 0.0],
+        "upper": [65.0, 50.0],
+        "cells": 40,
+        "bins": [8, 5],
+    }
+    elites = engine.elites()
+    expected = me.archive.elites()
+    assert len(elites) == len(expected) > 3
+    for got, want in zip(elites, expected):
+        assert got["index"] == want.index
+        assert got["genome"].to_json() == want.genome.to_json()
+        assert got["fitness"].fitness == want.fitness and got["objective"] == want.objective
+        assert got["values"] == [got["fitness"].cell_count, got["fitness"].fitness] == list(want.descriptors)
+        assert math.isnan(got["reference"]) and math.isnan(want.reference)
+        assert got["generation"] == want.generation
+        assert engine.index_of(got["values"]) == got["index"] == me.archive.index_of(want.descriptors)
+    assert engine.index_of([0.0, 49.0]) == 4 and engine.index_of([1000.0, -1.0]) == 35
+    with pytest.raises(ValueError, match="descriptor fitness = nan"):
+        engine.index_of([3.0, math.nan])
+    with pytest.raises(ValueError, match="1 values for the 2 descriptors"):
+        engine.index_of([3.0])
+    with pytest.raises(ValueError, match=r"SearchEngine.population: a nsga2 search only; .*\"map_elites\""):
+        engine.population()
+
+
+def test_nsga2_state_is_animat_moo_population():
+    # population(), front(), reference_point and criteria are animat.moo's for the same stubs.
+    config = config_for("nsga2", 5)
+    engine = _core.SearchEngine(config)
+    assert engine.criteria == [("distance", "max"), ("actuation_work_positive", "min")]
+    assert engine.reference_point == [] and engine.population() == [] and engine.front() == []
+    nsga = animat.Nsga2(config, [("distance", "max"), ("actuation_work_positive", "min")], population=12, seed=5)
+    for _ in range(5):
+        genomes = engine.ask()
+        nsga.ask()
+        told = [stub(g) for g in genomes]
+        engine.tell(told)
+        nsga.tell([[f.fitness, f.actuation_work_positive] if f.viable else None for f in told])
+    population = engine.population()
+    assert len(population) == len(nsga.population) == 12
+    for got, want in zip(population, nsga.population):
+        assert got["genome"].to_json() == want.genome.to_json()
+        assert same(got["objectives"], want.objectives)
+        assert got["reference"] == [] and want.reference is None
+        assert (got["generation"], got["feasible"], got["rank"]) == (want.generation, want.feasible, want.rank)
+        assert got["crowding"] == want.crowding
+        assert got["fitness"].fitness == stub(got["genome"]).fitness
+    front = engine.front()
+    assert len(front) > 2
+    assert [population[i]["genome"].to_json() for i in front] == [s.genome.to_json() for s in nsga.front()]
+    assert engine.reference_point == list(nsga.reference_point)
+    with pytest.raises(ValueError, match=r"SearchEngine.elites: a map_elites search only"):
+        engine.elites()
+    with pytest.raises(ValueError, match=r"SearchEngine.archive: a map_elites search only"):
+        engine.archive  # noqa: B018
+
+
+def shade(genome, config=None, evaluation=None):
+    """A caller's measure the engine's table lacks: a number in [0, 1) from the genome alone."""
+    return int(hashlib.sha256(genome.to_json().encode()).hexdigest()[20:24], 16) / 65536.0
+
+
+def shade_config(seed):
+    config = config_for("nsga2", seed)
+    config["search.objectives"] = ["distance:max", "shade:min"]
+    return config
+
+
+def test_supplied_criteria_are_animat_moo_python_criteria():
+    # A criterion the engine's table lacks is computed by the caller and passed to tell, as
+    # animat.moo takes a Python criterion's values: the same selection, history and front.
+    config = shade_config(8)
+    engine = _core.SearchEngine(config, supplied=["shade"])
+    assert engine.criteria == [("distance", "max"), ("shade", "min")]
+    nsga = animat.Nsga2(
+        config, [("distance", "max"), animat.moo.Criterion("shade", "min", lambda e: 0.0)], population=12, seed=8
+    )
+    for _ in range(6):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in nsga.ask()]
+        told = [stub(g) for g in genomes]
+        assert engine.tell(told, values=[[shade(g)] for g in genomes])
+        row = nsga.tell([[f.fitness, shade(g)] if f.viable else None for g, f in zip(genomes, told)])
+        assert same(engine.history[-1][:-1], [float(x) for x in row]), (engine.history[-1], row)
+    assert engine.history[-1][2] > 2  # a front of several members: a real comparison
+    population = engine.population()
+    assert [population[i]["genome"].to_json() for i in engine.front()] == [s.genome.to_json() for s in nsga.front()]
+    again = _core.SearchEngine(config, supplied=["shade"])
+    again.restore(engine.checkpoint())
+    assert again.history == engine.history
+    assert [p["objectives"] for p in again.population()] == [p["objectives"] for p in population]
+    # a feasible member's value must be finite: refused by index and name, changing nothing
+    genomes = again.ask()
+    told = [stub(g) for g in genomes]
+    k = next(i for i, f in enumerate(told) if f.viable)
+    values = [[shade(g)] for g in genomes]
+    values[k] = [math.inf]
+    with pytest.raises(ValueError, match=f"value {k} .*criterion shade = inf"):
+        again.tell(told, values)
+    assert again.history == engine.history
+    with pytest.raises(ValueError, match="rows of supplied values for the 12 genomes"):
+        again.tell(told, values[:3])
+
+
+def test_supplied_criteria_are_checked_by_key_and_value():
+    config = shade_config(8)
+    config["search.objectives"] = ["distance:max", "shade"]
+    with pytest.raises(ValueError, match=r'search.objectives: "shade" is supplied by the caller: give its sense'):
+        _core.SearchEngine(config, supplied=["shade"])
+    with pytest.raises(ValueError, match=r'search.objectives: the caller supplies "speed", which is not one of'):
+        _core.SearchEngine(shade_config(8), supplied=["speed"])
+    with pytest.raises(ValueError, match='search.objectives: no measure "shade"'):
+        _core.SearchEngine(shade_config(8))  # not in the table and not supplied
+    with pytest.raises(ValueError, match="the GA has none"):
+        _core.SearchEngine(config_for("ga", 8), supplied=["shade"])
+    # the checkpoint keeps the supplied values: a missing one is refused on restore
+    engine = _core.SearchEngine(shade_config(8), supplied=["shade"])
+    genomes = engine.ask()
+    engine.tell([stub(g) for g in genomes], [[shade(g)] for g in genomes])
+    payload = json.loads(json.loads(engine.checkpoint())["payload"])
+    for member in payload["population"]:
+        member.pop("supplied", None)
+    body = json.dumps(payload, separators=(",", ":"))
+    with pytest.raises(ValueError, match="has no list of its 1 supplied criterion values"):
+        _core.SearchEngine(shade_config(8), supplied=["shade"]).restore(
+            json.dumps({"checksum": fnv1a(body), "payload": body})
+        )
+
+
+def fnv1a(text):
+    h = 0xCBF29CE484222325
+    for b in text.encode():
+        h = ((h ^ b) * 0x100000001B3) % (1 << 64)
+    return f"{h:016x}"
+
+
+def test_run_search_hooks_evaluate_and_describe(tmp_path):
+    # evaluate and describe replace the config's own evaluation and give the supplied values: the
+    # run is the engine's told the same stubs; an exception in a hook stops the run with its message,
+    # leaves the last checkpoint, and the resume is the uninterrupted run.
+    config = shade_config(9)
+    config["evolution.generations"] = 4
+    config["evolution.checkpoint_every"] = 1
+    calls = []
+
+    def evaluate(genomes):
+        calls.append(len(genomes))
+        return [stub(g) for g in genomes]
+
+    def describe(genomes, fitness):
+        return [[shade(g)] for g in genomes]
+
+    hooks = dict(supplied=["shade"], evaluate=evaluate, describe=describe)
+    straight = _core.run_search(config, tmp_path / "straight", **hooks)
+    assert straight["generation"] == 4 and calls == [12] * 5
+    engine = _core.SearchEngine(config, supplied=["shade"])
+    for _ in range(5):
+        genomes = engine.ask()
+        engine.tell([stub(g) for g in genomes], [[shade(g)] for g in genomes])
+    assert [row[:-1] for row in straight["history"]] == [row[:-1] for row in engine.history]
+
+    def failing(genomes, fitness):
+        if len(failing.seen) == 2:
+            raise RuntimeError("describe failed at generation 2")
+        failing.seen.append(1)
+        return describe(genomes, fitness)
+
+    failing.seen = []
+    with pytest.raises(RuntimeError, match="describe failed at generation 2"):
+        _core.run_search(config, tmp_path / "resumed", supplied=["shade"], evaluate=evaluate, describe=failing)
+    checkpoint = (tmp_path / "resumed" / "checkpoint.json").read_text()
+    assert json.loads(json.loads(checkpoint)["payload"])["generation"] == 1
+    resumed = _core.run_search(config, tmp_path / "resumed", resume=True, **hooks)
+    assert [row[:-1] for row in resumed["history"]] == [row[:-1] for row in straight["history"]]
+    with pytest.raises(ValueError, match="gives no describe hook"):
+        _core.run_search(config, tmp_path / "refused", supplied=["shade"], evaluate=evaluate)
+    assert not (tmp_path / "refused").exists()
