@@ -80,7 +80,15 @@ import numpy as np
 
 from . import _core
 from .pool import Swim, evaluate_results
-from .qd import _comparable, _on_ranks, _run_search, _same_as_run, _SearchState, _write_atomic
+from .qd import (
+    _checksum,
+    _comparable,
+    _on_ranks,
+    _run_search,
+    _same_as_run,
+    _SearchState,
+    _write_atomic,
+)
 
 __all__ = [
     "Criterion",
@@ -99,7 +107,7 @@ __all__ = [
 PathLike = Union[str, "os.PathLike[str]"]
 
 #: Version tag of :meth:`Nsga2.checkpoint`.
-CHECKPOINT_FORMAT = "animat.nsga2/1"
+CHECKPOINT_FORMAT = "animat.nsga2/2"
 
 _SENSES = {"max": "max", "maximize": "max", "maximise": "max", "min": "min", "minimize": "min", "minimise": "min"}
 
@@ -894,9 +902,10 @@ class Nsga2(_SearchState):
         return _write_atomic(Path(path), buf.getvalue())
 
     def checkpoint(self) -> Dict[str, Any]:
-        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back). A
-        pending ``ask()`` is not saved: asking again after a restore gives the same genomes."""
-        return {
+        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back), with a
+        SHA-256 ``checksum`` of the rest. A pending ``ask()`` is not saved: asking again after a
+        restore gives the same genomes."""
+        state = {
             "format": CHECKPOINT_FORMAT,
             "config": self._config.to_toml(),
             "seed": self.seed,
@@ -923,6 +932,8 @@ class Nsga2(_SearchState):
                 for s in self._population
             ],
         }
+        state["checksum"] = _checksum(state)
+        return state
 
     @classmethod
     def restore(
@@ -932,24 +943,49 @@ class Nsga2(_SearchState):
         *,
         objectives: Iterable[CriterionLike] = (),
         threads: Optional[int] = None,
+        source: str = "checkpoint",
     ) -> Nsga2:
         """An Nsga2 from :meth:`checkpoint` (a dict, or its JSON text). ``config``: default the saved
         one; another must equal it but for ``evolution.threads`` (ValueError). ``objectives``: found by
         name, first there (your own functions must be given again: a function is not saved), then in
-        :data:`CRITERIA`, with the saved sense; given ones must be the run's, in order (ValueError)."""
-        if isinstance(state, (str, bytes)):
-            state = json.loads(state)
-        assert isinstance(state, Mapping)
-        if state.get("format") != CHECKPOINT_FORMAT:
-            raise ValueError(f"not an Nsga2 checkpoint (format {state.get('format')!r}, expected {CHECKPOINT_FORMAT})")
-        saved = _core.Config.from_toml(state["config"], "checkpoint")
+        :data:`CRITERIA`, with the saved sense; given ones must be the run's, in order (ValueError).
+        A checkpoint that is not one or whose checksum does not match its content (edited or
+        corrupt) is a ValueError naming ``source`` (the file, for :meth:`load`)."""
+        try:
+            if isinstance(state, (str, bytes)):
+                state = json.loads(state)
+            if not isinstance(state, Mapping) or state.get("format") != CHECKPOINT_FORMAT:
+                found = state.get("format") if isinstance(state, Mapping) else type(state).__name__
+                raise ValueError(f"not an Nsga2 checkpoint (format {found!r}, expected {CHECKPOINT_FORMAT})")
+            if state.get("checksum") != _checksum(state):
+                raise ValueError("its checksum does not match its content (edited or corrupt)")
+            saved = _core.Config.from_toml(state["config"], source)
+        except (ValueError, KeyError, TypeError, AttributeError) as e:
+            raise ValueError(f"{source}: {e}") from None
+        try:
+            return cls._restore_checked(state, saved, config, objectives, threads, source)
+        except (KeyError, TypeError, AttributeError) as e:
+            raise ValueError(f"{source}: not a complete Nsga2 checkpoint ({type(e).__name__}: {e})") from None
+
+    @classmethod
+    def _restore_checked(
+        cls,
+        state: Mapping[str, Any],
+        saved: Any,
+        config: Any,
+        objectives: Iterable[CriterionLike],
+        threads: Optional[int],
+        source: str,
+    ) -> Nsga2:
         if config is None:
             config = saved
         else:
             mine = config.copy()
             mine["evolution.seed"] = int(state["seed"])
             if _comparable(mine) != _comparable(saved):
-                raise ValueError("Nsga2.restore: the config differs from the checkpoint's (only evolution.threads may)")
+                raise ValueError(
+                    f"{source}: Nsga2.restore: the config differs from the checkpoint's (only evolution.threads may)"
+                )
         given = list(objectives) if not isinstance(objectives, (str, Criterion)) else [objectives]
         mine_criteria = _criteria(given) if given else ()
         run = [(o["name"], o["sense"]) for o in state["objectives"]]

@@ -895,11 +895,12 @@ class _SearchState:
 
     @classmethod
     def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Any:
-        """:meth:`restore` from a file written by :meth:`save` (or the run directory of a search)."""
+        """:meth:`restore` from a file written by :meth:`save` (or the run directory of a search);
+        errors name the file."""
         path = Path(path)
         if path.is_dir():
             path = path / "checkpoint.json"
-        return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, **kwargs)
+        return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, source=str(path), **kwargs)
 
 
 def _same_config(config: Any, saved: Any, objective: ObjectiveLike, source: str) -> None:
@@ -1384,15 +1385,6 @@ class MapElites(_SearchState):
             me._engine.restore(engine_text, source)
             me._refresh()
         return me
-
-    @classmethod
-    def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Any:
-        """:meth:`restore` from a file written by :meth:`save` (or the run directory of a search);
-        errors name the file."""
-        path = Path(path)
-        if path.is_dir():
-            path = path / "checkpoint.json"
-        return cls.restore(path.read_text(encoding="utf-8"), config, source=str(path), **kwargs)
 
     def __reduce__(self) -> Tuple[Any, ...]:
         # Pickles as its checkpoint, with the Python objective and your own descriptor functions.

@@ -244,3 +244,49 @@ def test_an_nsga2_population_too_large_is_refused_before_any_file_is_written(tmp
     assert cli.main([*argv, "--population", "10000000"]) == 1
     assert "population (evolution.population) = 10000000: it must be 1 to 10000" in capsys.readouterr().err
     assert not out.exists()
+
+
+# --- NSGA-II checkpoints --------------------------------------------------------------------------
+
+
+def new_nsga2(generations=3):
+    criteria = [("distance", "max"), ("actuation_work_positive", "min")]
+    nsga = animat.Nsga2(small_config(), criteria, population=12, seed=5)
+    while nsga.generation < generations - 1:
+        told = [stub(g) for g in nsga.ask()]
+        nsga.tell([[f.fitness, f.fitness / 2] if f.viable else None for f in told])
+    return nsga
+
+
+def times_ten(state):
+    state["population"][0]["objectives"][0] *= 10
+
+
+def one_generation_more(state):
+    state["generation"] += 1
+
+
+def history_row_dropped(state):
+    del state["history"][1]
+
+
+@pytest.mark.parametrize("edit", [times_ten, one_generation_more, history_row_dropped])
+def test_an_edited_nsga2_checkpoint_is_refused_naming_the_file(tmp_path, edit):
+    nsga = new_nsga2()
+    path = nsga.save(tmp_path / "nsga.json")
+    assert animat.Nsga2.load(path).history.tolist() == nsga.history.tolist()
+    state = nsga.checkpoint()
+    edit(state)
+    path.write_text(json.dumps(state))
+    with pytest.raises(ValueError, match=rf"^{path}: its checksum does not match its content"):
+        animat.Nsga2.load(path)
+
+
+def test_a_one_digit_corruption_of_an_nsga2_checkpoint_is_refused_naming_the_file(tmp_path):
+    path = new_nsga2().save(tmp_path / "nsga.json")
+    text = path.read_text()
+    digits = [i for i, c in enumerate(text) if c.isdigit()]
+    for i in digits[:: max(1, len(digits) // 40)]:
+        path.write_text(text[:i] + str((int(text[i]) + 1) % 10) + text[i + 1 :])
+        with pytest.raises(ValueError, match=rf"^{path}: "):
+            animat.Nsga2.load(path)
