@@ -1,10 +1,12 @@
 """animat.MapElites is a wrapper over the engine's search (animat._core.SearchEngine): what the
 engine refuses, the wrapper refuses, naming the value, key or file, and a refusal changes nothing
-(the search's state, the run directory's files). A cheap deterministic stub stands in for the swims."""
+(the search's state, the run directory's files); animat.Nsga2's checkpoints and sizes are checked
+too. A cheap deterministic stub stands in for the swims."""
 
 import hashlib
 import json
 import math
+import os
 
 import pytest
 
@@ -124,17 +126,6 @@ def test_a_hand_edited_checkpoint_is_refused_naming_the_file(tmp_path, edit):
     assert path.read_text() == text
 
 
-def test_a_one_digit_corruption_is_refused_naming_the_file(tmp_path):
-    me = new_search(3)
-    path = me.save(tmp_path / "search.json")
-    text = path.read_text()
-    digits = [i for i, c in enumerate(text) if c.isdigit()]
-    for i in digits[:: max(1, len(digits) // 40)]:
-        path.write_text(text[:i] + str((int(text[i]) + 1) % 10) + text[i + 1 :])
-        with pytest.raises(ValueError, match=rf"^{path}: "):
-            animat.MapElites.load(path)
-
-
 def test_a_checkpoint_of_another_kind_is_refused_naming_the_file(tmp_path):
     path = tmp_path / "search.json"
     for text in ("[1, 2]", '{"format": "animat.map_elites/1"}', "{not json"):
@@ -156,7 +147,9 @@ def run(out, generations, **options):
     )
 
 
-def test_a_run_directory_has_one_writer(tmp_path):
+def test_a_run_directory_has_one_writer(tmp_path, capsys):
+    from animat import cli
+
     out = tmp_path / "run"
     run(out, 0)
     before = files_of(out)
@@ -169,6 +162,8 @@ def test_a_run_directory_has_one_writer(tmp_path):
             run(out, 1, resume=True)
         with pytest.raises(BlockingIOError):
             run(out, 1, overwrite=True)
+        assert cli.main(["evolve", "--resume", str(out), "--generations", "1", "--quiet"]) == 2
+        assert f"in use by another animat process (pid {os.getpid()} host" in capsys.readouterr().err
         assert {k: v for k, v in files_of(out).items() if k != ".lock"} == before
     finally:
         lock.release()
@@ -282,11 +277,13 @@ def test_an_edited_nsga2_checkpoint_is_refused_naming_the_file(tmp_path, edit):
         animat.Nsga2.load(path)
 
 
-def test_a_one_digit_corruption_of_an_nsga2_checkpoint_is_refused_naming_the_file(tmp_path):
-    path = new_nsga2().save(tmp_path / "nsga.json")
+@pytest.mark.parametrize("search", ["map_elites", "nsga2"])
+def test_a_one_digit_corruption_is_refused_naming_the_file(tmp_path, search):
+    kind, made = (animat.MapElites, new_search(3)) if search == "map_elites" else (animat.Nsga2, new_nsga2())
+    path = made.save(tmp_path / "search.json")
     text = path.read_text()
     digits = [i for i, c in enumerate(text) if c.isdigit()]
     for i in digits[:: max(1, len(digits) // 40)]:
         path.write_text(text[:i] + str((int(text[i]) + 1) % 10) + text[i + 1 :])
         with pytest.raises(ValueError, match=rf"^{path}: "):
-            animat.Nsga2.load(path)
+            kind.load(path)
