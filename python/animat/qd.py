@@ -1251,24 +1251,18 @@ class MapElites(_SearchState):
         return None if np.isnan(values).any() else values
 
     def _refresh(self) -> None:
-        """Makes :attr:`archive` the engine's elites (cell, genome, fitness, reference, generation and
-        descriptor values, read from its checkpoint)."""
+        """Makes :attr:`archive` the engine's elites (``SearchEngine.elites()``)."""
         self.archive.clear()
-        if self._engine.generation < 0:
-            return
-        payload = json.loads(json.loads(self._engine.checkpoint())["payload"])
-        select = str(self._config["evaluation.reference_check"]) == "select"
-        skip = 1 if isinstance(self.archive, CVTArchive) else 0
-        for e in payload["elites"]:
-            fitness = float(e["result"]["fitness"])
-            reference = _from_json_float(e["reference"])
-            self.archive._elites[int(e["cell"])] = Elite(
-                int(e["cell"]),
-                _core.Genome.from_json(json.dumps(e["genome"])),
-                fitness,
-                reference if select else fitness,
-                tuple(float(x) for x in e["supplied"][skip:]),
-                reference,
+        skip = 1 if isinstance(self.archive, CVTArchive) else 0  # the engine's first value is the cell
+        for e in self._engine.elites():
+            index = int(e["index"])
+            self.archive._elites[index] = Elite(
+                index,
+                e["genome"],
+                float(e["fitness"].fitness),
+                float(e["objective"]),
+                tuple(float(x) for x in e["values"][skip:]),
+                float(e["reference"]),
                 int(e["generation"]),
             )
 
