@@ -58,13 +58,7 @@ std::vector<nb::ndarray<nb::numpy, std::int64_t>> loops_to_numpy(
   return out;
 }
 
-using Contig = nb::ndarray<const double, nb::c_contig, nb::device::cpu>;
-
-/// numpy.ascontiguousarray(obj, dtype=float64), so lists and other dtypes are accepted.
-Contig as_float_array(nb::handle obj) {
-  const nb::module_ np = nb::module_::import_("numpy");
-  return nb::cast<Contig>(np.attr("ascontiguousarray")(obj, "dtype"_a = np.attr("float64")));
-}
+using Contig = FloatArray;
 
 std::string shape_string(const Contig& a) {
   std::string s = "(";

@@ -3,11 +3,13 @@
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
 
 #include <cmath>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "animat/locomotion.hpp"
 #include "bindings.hpp"
@@ -18,14 +20,11 @@ using namespace nb::literals;
 namespace animat::py {
 namespace {
 
-using Contig = nb::ndarray<const double, nb::c_contig, nb::device::cpu>;
+using Contig = FloatArray;
 
-/// numpy.ascontiguousarray(obj, dtype=float64) with `ndim` dimensions, else a ValueError naming
-/// `name`.
+/// as_float_array(obj) with `ndim` dimensions, else a ValueError naming `name`.
 Contig float_array(nb::handle obj, std::size_t ndim, const char* name) {
-  const nb::module_ np = nb::module_::import_("numpy");
-  const Contig a =
-      nb::cast<Contig>(np.attr("ascontiguousarray")(obj, "dtype"_a = np.attr("float64")));
+  const Contig a = as_float_array(obj);
   if (a.ndim() != ndim)
     throw std::invalid_argument(std::string("_classify_motion: ") + name + " must have " +
                                 std::to_string(ndim) + " dimensions, got " +
@@ -46,8 +45,29 @@ nb::dict wave_dict(const WaveMeasure& w) {
   return d;
 }
 
+nb::dict stroke_dict(const ProtrusionStroke& st) {
+  nb::dict d;
+  nb::list protrusions, pairs;
+  for (const auto& g : st.protrusions) protrusions.append(nb::tuple(nb::cast(g)));
+  for (const auto& [a, b] : st.pairs) pairs.append(nb::make_tuple(a, b));
+  d["protrusions"] = nb::tuple(protrusions);
+  d["at_rest"] = nb::tuple(nb::cast(st.at_rest));
+  d["scores"] = nb::cast(st.scores);
+  d["areas"] = nb::cast(st.areas);
+  d["pairs"] = nb::tuple(pairs);
+  d["pair_scores"] = nb::cast(st.pair_scores);
+  d["pair"] = st.pair >= 0
+                  ? nb::object(nb::make_tuple(st.pairs[st.pair].first, st.pairs[st.pair].second))
+                  : nb::object(nb::tuple());
+  d["score"] = st.score;
+  d["area"] = st.area;
+  d["strokes"] = st.strokes();
+  return d;
+}
+
 nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, double omega,
-                  double cycles, bool bending, std::optional<double> swim_start) {
+                  double cycles, bool bending, std::optional<double> swim_start,
+                  std::optional<std::vector<int>> outline, nb::handle rest_positions) {
   const Contig p = float_array(positions, 3, "positions");
   if (p.shape(2) != 2)
     throw std::invalid_argument("_classify_motion: positions must be (frames, n, 2)");
@@ -64,10 +84,21 @@ nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, do
       nb::module_::import_("numpy").attr("reshape")(springs, nb::make_tuple(-1, 2)), 2, "springs");
   IndexPairs pairs(static_cast<Eigen::Index>(s.shape(0)), 2);
   for (std::size_t k = 0; k < s.size(); ++k) pairs.data()[k] = static_cast<int>(s.data()[k]);
+  StrokeBody stroke;
+  Points rest;
+  if (outline) stroke.outline = *outline;
+  if (!rest_positions.is_none()) {
+    const Contig r = float_array(rest_positions, 2, "rest_positions");
+    if (r.shape(1) != 2)
+      throw std::invalid_argument("_classify_motion: rest_positions must be (n, 2)");
+    rest = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(
+        r.data(), static_cast<Eigen::Index>(r.shape(0)), 2);
+    stroke.rest_positions = &rest;
+  }
   LocomotionMode m;
   {
     nb::gil_scoped_release release;
-    m = classify_motion(frames, pairs, omega, cycles, bending);
+    m = classify_motion(frames, pairs, omega, cycles, bending, outline ? &stroke : nullptr);
   }
   nb::dict d;
   d["mode"] = locomotion_name(m.mode);
@@ -94,6 +125,7 @@ nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, do
   d["amplitudes"] = amplitudes;
   d["contrast"] = m.contrast;
   d["groups"] = m.groups;
+  d["stroke"] = m.has_stroke ? nb::object(stroke_dict(m.stroke)) : nb::none();
   return d;
 }
 
@@ -102,10 +134,11 @@ nb::dict classify(nb::handle positions, nb::handle times, nb::handle springs, do
 void bind_locomotion(nb::module_& m) {
   m.def("_classify_motion", &classify, "positions"_a, "times"_a, "springs"_a, "omega"_a,
         "cycles"_a = 4.0, "bending"_a = false, "swim_start"_a = nb::none(),
-        "The engine's locomotion classifier (animat.locomotion.classify_motion without an outline; "
-        "bending: also the bending wave; swim_start: the swim's first time when the frames "
-        "are only its end): a dict of the LocomotionMode's numbers, mode and mixed "
-        "as names of animat.locomotion.MODES.");
+        "outline"_a = nb::none(), "rest_positions"_a = nb::none(),
+        "The engine's locomotion classifier (animat.locomotion.classify_motion; bending: also the "
+        "bending wave; swim_start: the swim's first time when the frames are only its end; "
+        "outline, rest_positions: the stroke path's body): a dict of the LocomotionMode's "
+        "numbers, mode and mixed as names of animat.locomotion.MODES.");
   m.def(
       "_dominant_frequency",
       [](nb::handle amplitude, nb::handle frequency) {

@@ -1,6 +1,7 @@
 #pragma once
 // Each stage binds itself in its own file; module.cpp calls them in pipeline order.
 #include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
 
 #include <fmt/format.h>
 
@@ -25,6 +26,16 @@ void bind_physics(nanobind::module_& m);
 void bind_evolution(nanobind::module_& m);
 void bind_research(nanobind::module_& m);
 void bind_locomotion(nanobind::module_& m);
+
+/// A C-contiguous float64 array on the CPU: what the bindings read numbers from.
+using FloatArray = nanobind::ndarray<const double, nanobind::c_contig, nanobind::device::cpu>;
+
+/// numpy.ascontiguousarray(obj, dtype=float64), so lists and other dtypes are accepted.
+inline FloatArray as_float_array(nanobind::handle obj) {
+  const nanobind::module_ np = nanobind::module_::import_("numpy");
+  return nanobind::cast<FloatArray>(
+      np.attr("ascontiguousarray")(obj, nanobind::arg("dtype") = np.attr("float64")));
+}
 
 /// The objective `objective` names: None = the config's (evaluation.objective), a str = that
 /// built-in, otherwise a Python objective object (name, every, callable with an EvaluationRecord).

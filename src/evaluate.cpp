@@ -18,6 +18,7 @@
 #include "animat/development.hpp"
 #include "animat/embedding.hpp"
 #include "animat/errors.hpp"
+#include "animat/locomotion.hpp"
 #include "animat/objective_table.hpp"
 #include "animat/physics.hpp"
 #include "animat/random.hpp"
@@ -179,6 +180,27 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
   if (begin.settled > 0) sim.set_velocities(begin.velocities);
   std::vector<int> pushed;  // sized before the loop: pushing allocates nothing there
   pushed.reserve(static_cast<std::size_t>(body.node_count()));
+  MotionRecording* motion = options.motion;
+  // Append the frame of the current step (capacity reserved below: no allocation in the loop).
+  auto record = [&] {
+    const SwimState& st = sim.state();
+    for (int i = 0; i < st.n; ++i) {
+      motion->frames.xy.push_back(st.x[static_cast<std::size_t>(i)]);
+      motion->frames.xy.push_back(st.y[static_cast<std::size_t>(i)]);
+    }
+    motion->frames.times.push_back(sim.time());
+  };
+  if (motion) {
+    const auto count = static_cast<std::size_t>(std::max(0L, steps - motion->first_step + 1));
+    motion->start_positions = body.positions;
+    motion->frames.cells = body.node_count();
+    motion->frames.swim_start = 0.0;
+    motion->frames.xy.clear();
+    motion->frames.times.clear();
+    motion->frames.xy.reserve(count * 2 * static_cast<std::size_t>(body.node_count()));
+    motion->frames.times.reserve(count);
+    if (motion->first_step <= 0) record();
+  }
   if (options.check_embedding) sim.monitor_embedding(body);
   if (options.account_energy) sim.account_energy();
   r.min_stretch = body.spring_count() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
@@ -201,6 +223,7 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
       if (every > 0) next = std::min(next, (done / every + 1) * every);
       if (options.push_step >= 0 && done < options.push_step)
         next = std::min(next, options.push_step);
+      if (motion) next = std::min(next, std::max(done + 1, motion->first_step));
       if (options.push_step >= 0 && done == options.push_step &&
           sim.steps_done() == options.push_step) {
         const SwimState& st = sim.state();
@@ -220,6 +243,7 @@ SwimResult swim(const Body& body_in, const SceneParams& scene, const PhysicsPara
       }
       if (done % kSampleEvery == 0 || done == steps) sample(sim, body, floor, r);
       if (every > 0 && done % every == 0) observer->on_sample(sim);
+      if (motion && done >= motion->first_step) record();
       if (stop_early && broken()) {
         sample(sim, body, floor, r);
         break;
@@ -395,6 +419,16 @@ std::string swim_start(const Developed& d, const Config& config, SwimOptions opt
   const int trials = chemotaxis ? config.evaluation.source_directions : 1;
   SwimResult s;
   double progress = 0.0;
+  // The locomotion measure (needs_locomotion): the first swim's window, recorded as it swims;
+  // with evaluation.repeats only repeat 0's (the unperturbed start), whose fields the result keeps.
+  const bool classify = needs_locomotion(config) && options.start_offset == nullptr;
+  MotionRecording motion;
+  const double omega = classify ? dominant_frequency(d.body.amplitude, d.body.frequency) : 0.0;
+  if (classify) {
+    motion.first_step =
+        window_start_step(static_cast<int>(config.evaluation.steps), config.physics.dt, omega);
+    options.motion = &motion;
+  }
   for (int t = 0; t < trials; ++t) {
     SceneParams scene = config.scene;
     if (chemotaxis) scene.chemical_source = source_direction(config, t);
@@ -406,6 +440,7 @@ std::string swim_start(const Developed& d, const Config& config, SwimOptions opt
     if (t == 0) {
       s = st;
       options.observer = nullptr;
+      options.motion = nullptr;
     } else if (!st.valid) {
       s.valid = false;
       s.stable = s.stable && st.stable;
@@ -413,6 +448,10 @@ std::string swim_start(const Developed& d, const Config& config, SwimOptions opt
     }
   }
   out.source_progress = chemotaxis && s.valid ? progress / trials : 0.0;
+  if (classify && s.stable && s.steps == config.evaluation.steps &&
+      motion.frames.frame_count() >= 8)
+    out.locomotion = static_cast<int>(
+        classify_body_motion(motion.frames, d.body, 4.0, &motion.start_positions).mode);
   out.seconds_swim = seconds_since(t0);
   out.stable = s.stable;
   out.fitness = s.distance;
@@ -435,6 +474,18 @@ class DistanceScorer final : public RepeatScorer {
 };
 
 }  // namespace
+
+bool needs_locomotion(const Config& config) {
+  const SearchParams& p = config.search;
+  if (p.algorithm == "map_elites")
+    return std::find(p.descriptors.begin(), p.descriptors.end(), "locomotion") !=
+           p.descriptors.end();
+  if (p.algorithm == "nsga2")
+    return std::any_of(p.objectives.begin(), p.objectives.end(), [](const std::string& o) {
+      return std::string_view(o).substr(0, o.find(':')) == "locomotion";
+    });
+  return false;
+}
 
 Points start_perturbation(int repeat, int cells, double magnitude) {
   Points d = Points::Zero(std::max(cells, 0), 2);

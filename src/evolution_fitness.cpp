@@ -22,6 +22,7 @@ Fitness fitness_of(const EvaluationResult& r) {
   f.symmetric_pair = r.symmetric_pair;
   f.concavity = r.concavity;
   f.frequency = r.frequency;
+  f.locomotion = r.locomotion;
   return f;
 }
 

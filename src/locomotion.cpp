@@ -1,5 +1,5 @@
-// The locomotion mode of a swim (locomotion.hpp): a port of animat.locomotion.classify_motion
-// without the stroke path; the constants and the order of every test are Python's.
+// The locomotion mode of a swim (locomotion.hpp): a port of animat.locomotion.classify_motion and
+// of animat.protrusion.stroke_motion; the constants and the order of every test are Python's.
 #include "animat/locomotion.hpp"
 
 #include <Eigen/Dense>
@@ -10,10 +10,13 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <set>
 #include <stdexcept>
 #include <string>
 
+#include "animat/body.hpp"
 #include "animat/random.hpp"
+#include "animat/shape.hpp"
 
 namespace animat {
 namespace {
@@ -38,6 +41,11 @@ constexpr double kBendBackward = 135.0;
 constexpr double kBendCone = 30.0;
 constexpr double kBendBand = 0.25;
 constexpr double kSyncCoherence = 0.8;
+// animat.protrusion's thresholds.
+constexpr double kStrokeScore = 0.4;
+constexpr double kStrokeArea = 0.1;
+constexpr int kStrokeSamples = 8;
+constexpr double kGrowShare = 0.5;
 // circular_linear_fit's search: a coarse grid over |g_k| <= pi, then four 21-point refinements.
 constexpr int kGrid = 81;
 constexpr int kRefine = 21;
@@ -192,6 +200,28 @@ std::pair<std::array<double, 2>, double> circular_linear_fit(const std::vector<C
   return {best, best_r};
 }
 
+/// One grid search of a shuffle: the first of the `points` rows of `table` (m values each) that
+/// maximises |Σ_k from[k] · row[index[k]]| / total (numpy.argmax); `to` (may be `from`) becomes
+/// from · that row. Returns the maximum.
+double search_shuffled(const std::vector<Complex>& from, const Complex* table, int points,
+                       const std::vector<std::size_t>& index, double total,
+                       std::vector<Complex>& to) {
+  const std::size_t m = from.size();
+  int best = 0;
+  double r = -1.0;
+  for (int j = 0; j < points; ++j) {
+    Complex sum = 0.0;
+    for (std::size_t k = 0; k < m; ++k) sum += mul(from[k], table[j * m + index[k]]);
+    const double v = std::abs(sum) / total;
+    if (v > r) {
+      r = v;
+      best = j;
+    }
+  }
+  for (std::size_t k = 0; k < m; ++k) to[k] = mul(from[k], table[best * m + index[k]]);
+  return r;
+}
+
 /// shuffled_fits, counted: how many of `permutations` shuffles of `coords` fit zw at least as well
 /// as `fit` (the 1-D fit, same search), stopping once `enough` do. The shuffles come from
 /// Rng(kBendSeed) (Fisher-Yates).
@@ -221,33 +251,10 @@ int shuffles_fitting(const std::vector<Complex>& zw, double total,
   for (int p = 0; p < permutations; ++p) {
     std::iota(index.begin(), index.end(), std::size_t{0});
     for (std::size_t k = m; k > 1; --k) std::swap(index[k - 1], index[rng.below(k)]);
-    int best = 0;
-    double r = -1.0;
-    for (int a = 0; a < kGrid; ++a) {
-      Complex sum = 0.0;
-      for (std::size_t k = 0; k < m; ++k) sum += mul(zw[k], coarse[a * m + index[k]]);
-      const double v = std::abs(sum) / total;
-      if (v > r) {
-        r = v;
-        best = a;
-      }
-    }
-    for (std::size_t k = 0; k < m; ++k) at[k] = mul(zw[k], coarse[best * m + index[k]]);
-    for (int round = 0; round < kRefinements; ++round) {
-      const Complex* table = offset.data() + static_cast<std::size_t>(round * kRefine) * m;
-      r = -1.0;
-      best = 0;
-      for (int j = 0; j < kRefine; ++j) {
-        Complex sum = 0.0;
-        for (std::size_t k = 0; k < m; ++k) sum += mul(at[k], table[j * m + index[k]]);
-        const double v = std::abs(sum) / total;
-        if (v > r) {
-          r = v;
-          best = j;
-        }
-      }
-      for (std::size_t k = 0; k < m; ++k) at[k] = mul(at[k], table[best * m + index[k]]);
-    }
+    double r = search_shuffled(zw, coarse.data(), kGrid, index, total, at);
+    for (int round = 0; round < kRefinements; ++round)
+      r = search_shuffled(at, offset.data() + static_cast<std::size_t>(round * kRefine) * m,
+                          kRefine, index, total, at);
     if (r >= fit && ++count >= enough) break;
   }
   return count;
@@ -292,24 +299,13 @@ Aligned procrustes(const std::vector<Frame>& p) {
   return out;
 }
 
-int connected_groups(const std::vector<int>& cells, const IndexPairs& springs, int n) {
-  std::vector<int> parent(static_cast<std::size_t>(n), -1);
-  for (int c : cells) parent[c] = c;
-  auto find = [&](int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  int groups = static_cast<int>(cells.size());
-  for (Eigen::Index s = 0; s < springs.rows(); ++s) {
-    const int i = springs(s, 0), j = springs(s, 1);
-    if (parent[i] < 0 || parent[j] < 0) continue;
-    const int a = find(i), b = find(j);
-    if (a != b) {
-      parent[a] = b;
-      --groups;
-    }
-  }
-  return groups;
+/// Connected components of the spring graph restricted to `cells` (animat.locomotion._groups).
+int spring_groups(const std::vector<int>& cells, const IndexPairs& springs) {
+  std::vector<std::pair<int, int>> links;
+  links.reserve(static_cast<std::size_t>(springs.rows()));
+  for (Eigen::Index s = 0; s < springs.rows(); ++s)
+    links.emplace_back(springs(s, 0), springs(s, 1));
+  return static_cast<int>(connected_groups(cells, links).size());
 }
 
 WaveMeasure wave_fit(const std::vector<Complex>& z, const Frame& coords,
@@ -441,6 +437,202 @@ WaveMeasure bending_wave(const Aligned& al, const Harmonic& harmonic, const Inde
   return w;
 }
 
+// --- the paper's stroke (animat.protrusion)
+// -------------------------------------------------------
+
+/// The cells of one frame that stand out of its core by min_height (none without a core).
+std::vector<int> protruding(const Points& positions, std::span<const int> outline,
+                            const ShapeParams& params, double spacing) {
+  const std::vector<double> h = cell_heights(positions, outline, params, spacing);
+  std::vector<int> out;
+  for (std::size_t i = 0; i < h.size(); ++i)
+    if (h[i] >= params.min_height) out.push_back(static_cast<int>(i));
+  return out;
+}
+
+Eigen::RowVector2d mean_of(const Frame& q, const std::vector<int>& cells) {
+  Eigen::RowVector2d c = Eigen::RowVector2d::Zero();
+  for (int i : cells) c += q.row(i);
+  return c / static_cast<double>(cells.size());
+}
+
+/// +1 or −1: the side of the motion (`normal` its left) to which `group` sticks out of its
+/// `anchors` in the mean shape (from the body's centre when that is 0 or there are no anchors).
+double side_of(const Frame& mean, const std::vector<int>& group, const std::vector<int>& anchors,
+               const Eigen::RowVector2d& normal) {
+  const Eigen::RowVector2d c = mean_of(mean, group);
+  double v = anchors.empty() ? 0.0 : (c - mean_of(mean, anchors)).dot(normal);
+  if (v == 0) v = c.dot(normal);
+  return v >= 0 ? 1.0 : -1.0;
+}
+
+/// grow_protrusions: each group grown by the spring neighbours whose loop on its side (`left`, or
+/// its negation on the right) is at least kGrowShare of its largest and at least kStrokeArea s².
+std::vector<std::vector<int>> grow_protrusions(const std::vector<std::vector<int>>& groups,
+                                               const std::vector<std::set<int>>& neighbours,
+                                               const std::vector<double>& left, const Frame& mean,
+                                               const Eigen::RowVector2d& normal, double spacing) {
+  std::set<int> taken;
+  for (const auto& g : groups) taken.insert(g.begin(), g.end());
+  const double floor = kStrokeArea * spacing * spacing;
+  std::vector<std::vector<int>> out;
+  for (const auto& g : groups) {
+    std::set<int> gs(g.begin(), g.end());
+    std::set<int> around;
+    for (int c : gs) around.insert(neighbours[c].begin(), neighbours[c].end());
+    std::vector<int> anchors;
+    for (int v : around)
+      if (!gs.count(v)) anchors.push_back(v);
+    const double sign = side_of(mean, g, anchors, normal) > 0 ? 1.0 : -1.0;
+    for (;;) {
+      double top = -std::numeric_limits<double>::infinity();
+      for (int c : gs) top = std::max(top, sign * left[c]);
+      if (!(top > 0)) break;  // the protrusion makes no stroke's loop: nothing strokes with it
+      std::set<int> add;
+      for (int c : gs)
+        for (int v : neighbours[c])
+          if (!taken.count(v) && sign * left[v] >= std::max(floor, kGrowShare * top)) add.insert(v);
+      if (add.empty()) break;
+      gs.insert(add.begin(), add.end());
+      taken.insert(add.begin(), add.end());
+    }
+    out.emplace_back(gs.begin(), gs.end());
+  }
+  return out;
+}
+
+/// stroke_motion of the window's body-frame frames: `disp` the cells' complex displacement
+/// amplitudes (x, y per cell), `d` the unit direction of motion.
+ProtrusionStroke stroke_motion(const Aligned& al, const std::vector<double>& t,
+                               const Harmonic& harmonic, const std::vector<Complex>& disp,
+                               double omega, const std::array<double, 2>& motion,
+                               const StrokeBody& body, const IndexPairs& springs) {
+  ProtrusionStroke out;
+  const ShapeParams params;
+  const std::span<const int> loop = body.outline;
+  const auto nf = static_cast<Eigen::Index>(al.q.size());
+  const Eigen::Index n = al.mean.rows();
+  if (loop.size() < 3 || n < 3 || !(omega > 0) || nf < 4) return out;
+  const Frame& mean = al.mean;
+  const double s = cell_spacing(body.rest_positions ? *body.rest_positions : Points(mean));
+  std::vector<int> rest;
+  if (body.rest_positions) rest = protruding(*body.rest_positions, loop, params, s);
+  const double period = 2 * kPi / omega;
+  std::vector<Eigen::Index> in_last;
+  for (Eigen::Index f = 0; f < nf; ++f)
+    if (t[f] >= t.back() - period) in_last.push_back(f);
+  std::set<int> cell_set(rest.begin(), rest.end());
+  std::set<Eigen::Index> picks;  // numpy.linspace(0, len - 1, samples).round(), unique
+  const double last = static_cast<double>(in_last.size() - 1);
+  for (int j = 0; j < kStrokeSamples; ++j) {
+    const double x = j == kStrokeSamples - 1 ? last : j * (last / (kStrokeSamples - 1));
+    picks.insert(in_last[static_cast<std::size_t>(std::nearbyint(x))]);
+  }
+  for (Eigen::Index f : picks)
+    for (int c : protruding(Points(al.q[f]), loop, params, s)) cell_set.insert(c);
+  if (cell_set.empty()) return out;
+  const std::vector<int> cells(cell_set.begin(), cell_set.end());
+  std::vector<std::pair<int, int>> links;
+  for (std::size_t k = 0; k < loop.size(); ++k)
+    links.emplace_back(loop[k], loop[(k + 1) % loop.size()]);
+  std::vector<std::set<int>> neighbours(static_cast<std::size_t>(n));
+  for (Eigen::Index e = 0; e < springs.rows(); ++e) {
+    links.emplace_back(springs(e, 0), springs(e, 1));
+    neighbours[springs(e, 0)].insert(springs(e, 1));
+    neighbours[springs(e, 1)].insert(springs(e, 0));
+  }
+  const std::set<int> rest_set(rest.begin(), rest.end());
+  auto touches_rest = [&](const std::vector<int>& g) {
+    return std::any_of(g.begin(), g.end(), [&](int c) { return rest_set.count(c) > 0; });
+  };
+  std::vector<std::vector<int>> groups = connected_groups(cells, links);
+  std::stable_sort(groups.begin(), groups.end(), [&](const auto& a, const auto& b) {
+    const bool ra = !touches_rest(a), rb = !touches_rest(b);
+    const auto la = -static_cast<long>(a.size()), lb = -static_cast<long>(b.size());
+    return std::tie(ra, la, a) < std::tie(rb, lb, b);
+  });
+  const Eigen::RowVector2d d(motion[0], motion[1]);
+  const Eigen::RowVector2d unit = d / d.norm();
+  const Eigen::RowVector2d normal(-unit(1), unit(0));
+  // cell_loops on the left: −π Im(Y X̄), X and Y the amplitudes along the motion and its normal.
+  std::vector<double> left(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Complex x = disp[2 * i] * unit(0) + disp[2 * i + 1] * unit(1);
+    const Complex y = disp[2 * i] * normal(0) + disp[2 * i + 1] * normal(1);
+    left[i] = -kPi * (y * std::conj(x)).imag();
+  }
+  groups = grow_protrusions(groups, neighbours, left, mean, normal, s);
+  std::set<int> member;
+  for (const auto& g : groups) member.insert(g.begin(), g.end());
+  std::vector<std::array<double, 2>> centroids;
+  for (const auto& g : groups) {
+    const std::set<int> gs(g.begin(), g.end());
+    std::set<int> anchor_set;
+    for (Eigen::Index e = 0; e < springs.rows(); ++e) {
+      const int i = springs(e, 0), j = springs(e, 1);
+      if ((gs.count(i) > 0) == (gs.count(j) > 0)) continue;
+      for (int v : {i, j})
+        if (!member.count(v)) anchor_set.insert(v);
+    }
+    const std::vector<int> anchors(anchor_set.begin(), anchor_set.end());
+    const Eigen::RowVector2d centre = mean_of(mean, g);
+    centroids.push_back({centre(0), centre(1)});
+    const Eigen::RowVector2d origin =
+        anchors.empty() ? Eigen::RowVector2d::Zero() : mean_of(mean, anchors);
+    if (!((centre - origin).norm() > 0)) {
+      out.scores.push_back(kNaN);
+      out.areas.push_back(kNaN);
+      continue;
+    }
+    // cell_strokes: the sweep along the motion and the extension across it, on the group's side.
+    const Eigen::RowVector2d outward = side_of(mean, g, anchors, normal) * normal;
+    const auto k = static_cast<Eigen::Index>(g.size());
+    Eigen::MatrixXd signals(nf, 2 * k);
+    for (Eigen::Index f = 0; f < nf; ++f) {
+      const Eigen::RowVector2d base =
+          anchors.empty() ? Eigen::RowVector2d::Zero() : mean_of(al.q[f], anchors);
+      for (Eigen::Index c = 0; c < k; ++c) {
+        const Eigen::RowVector2d q = al.q[f].row(g[c]);
+        signals(f, c) = q.dot(unit);
+        signals(f, k + c) = (q - base).dot(outward);
+      }
+    }
+    const std::vector<Complex> z = harmonic.fit(signals);
+    double rowing = 0.0, weight = 0.0;
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const double r = -(z[k + c] * std::conj(z[c])).imag();
+      rowing += r;
+      weight += std::abs(z[c]) * std::abs(z[k + c]);
+    }
+    out.scores.push_back(weight > 0 ? rowing / weight : kNaN);
+    out.areas.push_back(kPi * rowing / (s * s));
+  }
+  out.pairs = symmetric_pairs(Points(mean), centroids, params, s);
+  for (const auto& g : groups) out.at_rest.push_back(touches_rest(g));
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < out.pairs.size(); ++p) {
+    const auto [a, b] = out.pairs[p];
+    const double v = std::isfinite(out.scores[a]) && std::isfinite(out.scores[b])
+                         ? std::min(out.scores[a], out.scores[b])
+                         : kNaN;
+    out.pair_scores.push_back(v);
+    // With the body at rest known, a pair counts only when both protrude at rest.
+    const bool eligible =
+        std::isfinite(v) && (!body.rest_positions || (out.at_rest[a] && out.at_rest[b]));
+    if (eligible && v > best) {
+      best = v;
+      out.pair = static_cast<int>(p);
+    }
+  }
+  if (out.pair >= 0) {
+    const auto [a, b] = out.pairs[static_cast<std::size_t>(out.pair)];
+    out.score = out.pair_scores[static_cast<std::size_t>(out.pair)];
+    out.area = std::min(out.areas[a], out.areas[b]);
+  }
+  out.protrusions = std::move(groups);
+  return out;
+}
+
 /// The window of classify_motion: its first frame and its length in periods.
 std::pair<int, double> window(const std::vector<double>& t, double swim_start, double omega,
                               double cycles) {
@@ -503,8 +695,10 @@ int window_start_step(int steps, double dt, double omega, double cycles) {
   return std::max(0, window(t, kNaN, omega, cycles).first - 1);
 }
 
+bool ProtrusionStroke::strokes() const { return score >= kStrokeScore && area >= kStrokeArea; }
+
 LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& springs, double omega,
-                               double cycles, bool bending) {
+                               double cycles, bool bending, const StrokeBody* stroke) {
   const int n = frames.cells;
   const int nf_all = frames.frame_count();
   if (n < 0 ||
@@ -525,6 +719,16 @@ LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& spr
         throw std::invalid_argument("classify_motion: spring " + std::to_string(s) +
                                     " names cell " + std::to_string(springs(s, e)) + " of " +
                                     std::to_string(n));
+  if (stroke) {
+    for (int c : stroke->outline)
+      if (c < 0 || c >= n)
+        throw std::invalid_argument("classify_motion: outline names cell " + std::to_string(c) +
+                                    " of " + std::to_string(n));
+    if (stroke->rest_positions && stroke->rest_positions->rows() != n)
+      throw std::invalid_argument(
+          "classify_motion: " + std::to_string(stroke->rest_positions->rows()) +
+          " rest positions for " + std::to_string(n) + " cells");
+  }
 
   LocomotionMode out;
   out.omega = omega;
@@ -621,9 +825,26 @@ LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& spr
                          : (c_sq > 0 ? std::numeric_limits<double>::infinity() : 0.0);
   const bool local = out.contrast >= kLocalContrast;
   const bool prot = out.concentration >= kProtrusionConcentration || local;
-  if (prot) {
-    out.groups = connected_groups(local ? c_top : out.top_cells, springs, n);
-    out.mode = out.groups >= 2 ? Locomotion::protrusions : Locomotion::tail;
+  if (stroke && stroke->outline.size() >= 3) {
+    out.has_stroke = true;
+    out.stroke = stroke_motion(al, tw, harmonic, disp, omega, out.direction, *stroke, springs);
+  }
+  const std::vector<int>& cells = local ? c_top : out.top_cells;
+  const int cell_groups = prot ? spring_groups(cells, springs) : 0;
+  const bool one_appendage =
+      prot && (cell_groups == 1 || (out.has_stroke && out.stroke.protrusions.size() == 1));
+  if (out.has_stroke && out.stroke.strokes()) {
+    // A symmetric pair rows: protrusions, or with a travelling wave its corners row with it.
+    out.groups = static_cast<int>(out.stroke.protrusions.size());
+    if (is_wave) {
+      out.mode = Locomotion::undulation;
+      out.mixed.push_back(Locomotion::protrusions);
+    } else {
+      out.mode = Locomotion::protrusions;
+    }
+  } else if (prot && (!out.has_stroke || one_appendage)) {
+    out.groups = cell_groups;
+    out.mode = out.groups >= 2 && !out.has_stroke ? Locomotion::protrusions : Locomotion::tail;
     if (is_wave) out.mixed.push_back(Locomotion::undulation);
   } else if (is_wave) {
     out.mode = Locomotion::undulation;
@@ -634,6 +855,16 @@ LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& spr
     out.mode = Locomotion::other;
   }
   return out;
+}
+
+LocomotionMode classify_body_motion(const MotionFrames& frames, const Body& body, double cycles,
+                                    const Points* rest_positions) {
+  StrokeBody stroke;
+  if (!body.skin_loops.empty()) stroke.outline = body.skin_loops[0];
+  stroke.rest_positions = rest_positions ? rest_positions : &body.positions;
+  // As classify_locomotion: the bending wave with an outline only.
+  return classify_motion(frames, body.springs, dominant_frequency(body.amplitude, body.frequency),
+                         cycles, stroke.outline.size() >= 3, &stroke);
 }
 
 }  // namespace animat

@@ -114,7 +114,8 @@ bool in_core_erosion(const P2& q, const Outline& o, double rho, const P2& lo, co
 
 /// Each cell's distance from the core in spacings (u: positions in spacings); empty when there is
 /// no core (animat.shape.cell_heights).
-std::vector<double> cell_heights(const std::vector<P2>& u, std::span<const int> loop, double rho) {
+std::vector<double> heights_above_core(const std::vector<P2>& u, std::span<const int> loop,
+                                       double rho) {
   if (u.size() < 3 || loop.size() < 3) return {};
   Outline o;
   for (std::size_t k = 0; k < loop.size(); ++k) {
@@ -211,8 +212,9 @@ std::vector<double> cell_heights(const std::vector<P2>& u, std::span<const int> 
   return heights;
 }
 
-/// Connected components of `members` (ascending) under `links`, by union-find keeping the least
-/// index as root; each sorted, in the order of their least member (animat.shape.connected_groups).
+}  // namespace
+
+// By union-find keeping the least index as root, as animat.shape.connected_groups.
 std::vector<std::vector<int>> connected_groups(const std::vector<int>& members,
                                                const std::vector<std::pair<int, int>>& links) {
   std::map<int, int> parent;
@@ -240,7 +242,44 @@ std::vector<std::vector<int>> connected_groups(const std::vector<int>& members,
   return groups;
 }
 
-}  // namespace
+std::vector<double> cell_heights(const Points& positions, std::span<const int> outline,
+                                 const ShapeParams& params, double spacing) {
+  std::vector<P2> u;
+  u.reserve(static_cast<std::size_t>(positions.rows()));
+  for (Eigen::Index i = 0; i < positions.rows(); ++i)
+    u.push_back({positions(i, 0) / spacing, positions(i, 1) / spacing});
+  return heights_above_core(u, outline, params.core_radius);
+}
+
+std::vector<std::pair<int, int>> symmetric_pairs(
+    const Points& positions, const std::vector<std::array<double, 2>>& centroids,
+    const ShapeParams& params, double spacing) {
+  std::vector<std::pair<int, int>> pairs;
+  const Eigen::Index n = positions.rows();
+  if (n == 0) return pairs;
+  const PrincipalAxes axes = principal_axes(positions, params.cell_diameter, spacing);
+  const double mx = positions.col(0).sum() / static_cast<double>(n);
+  const double my = positions.col(1).sum() / static_cast<double>(n);
+  const double s = spacing;
+  const std::size_t count = centroids.size();
+  for (std::size_t i = 0; i < count; ++i)
+    for (std::size_t j = i + 1; j < count; ++j) {
+      const auto& pi = centroids[i];
+      const auto& pj = centroids[j];
+      const double ax = (pi[0] - mx) / s, ay = (pi[1] - my) / s;
+      const double bx = (pj[0] - mx) / s, by = (pj[1] - my) / s;
+      for (const double* normal : {axes.major_axis, axes.minor_axis}) {
+        const double an = ax * normal[0] + ay * normal[1];
+        const double bn = bx * normal[0] + by * normal[1];
+        const double rx = ax - 2.0 * an * normal[0], ry = ay - 2.0 * an * normal[1];
+        if (an * bn < 0 && norm(rx - bx, ry - by) <= params.pair_tolerance) {
+          pairs.emplace_back(static_cast<int>(i), static_cast<int>(j));
+          break;
+        }
+      }
+    }
+  return pairs;
+}
 
 PrincipalAxes principal_axes(const Points& positions, double cell_diameter, double spacing) {
   const Eigen::Index n = positions.rows();
@@ -305,9 +344,7 @@ Shape describe_shape(const Points& positions, std::span<const int> outline,
   out.outline_area = a_out / (s * s);
   out.hull_area = a_hull / (s * s);
 
-  std::vector<P2> u;
-  for (Eigen::Index i = 0; i < n; ++i) u.push_back({positions(i, 0) / s, positions(i, 1) / s});
-  out.heights = cell_heights(u, outline, params.core_radius);
+  out.heights = cell_heights(positions, outline, params, s);
   if (out.heights.empty()) {
     out.heights.assign(static_cast<std::size_t>(n), 0.0);
     return out;
@@ -350,27 +387,9 @@ Shape describe_shape(const Points& positions, std::span<const int> outline,
         return std::tie(bs, ah, a.cells) < std::tie(as, bh, b.cells);
       });
 
-  // Symmetric pairs: mirror images about a principal axis, on opposite sides of it.
-  const PrincipalAxes axes = principal_axes(positions, params.cell_diameter, s);
-  const double mx = positions.col(0).sum() / static_cast<double>(n);
-  const double my = positions.col(1).sum() / static_cast<double>(n);
-  const std::size_t count = out.protrusions.size();
-  for (std::size_t i = 0; i < count; ++i)
-    for (std::size_t j = i + 1; j < count; ++j) {
-      const auto& pi = out.protrusions[i].centroid;
-      const auto& pj = out.protrusions[j].centroid;
-      const double ax = (pi[0] - mx) / s, ay = (pi[1] - my) / s;
-      const double bx = (pj[0] - mx) / s, by = (pj[1] - my) / s;
-      for (const double* normal : {axes.major_axis, axes.minor_axis}) {
-        const double an = ax * normal[0] + ay * normal[1];
-        const double bn = bx * normal[0] + by * normal[1];
-        const double rx = ax - 2.0 * an * normal[0], ry = ay - 2.0 * an * normal[1];
-        if (an * bn < 0 && norm(rx - bx, ry - by) <= params.pair_tolerance) {
-          out.symmetric_pairs.emplace_back(static_cast<int>(i), static_cast<int>(j));
-          break;
-        }
-      }
-    }
+  std::vector<std::array<double, 2>> centroids;
+  for (const Protrusion& p : out.protrusions) centroids.push_back({p.centroid[0], p.centroid[1]});
+  out.symmetric_pairs = symmetric_pairs(positions, centroids, params, s);
   return out;
 }
 

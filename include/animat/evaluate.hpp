@@ -12,6 +12,7 @@
 #include "animat/control.hpp"
 #include "animat/energy.hpp"
 #include "animat/genome.hpp"
+#include "animat/locomotion.hpp"
 
 namespace animat {
 
@@ -82,6 +83,15 @@ struct SwimResult {
   EnergyAccount energy;  ///< where the energy went (SwimOptions::account_energy)
 };
 
+/// The frames of a swim that the locomotion classifier reads (locomotion.hpp): node positions and
+/// time at every control step from first_step on (step 0: the start), and the start positions.
+/// swim() sizes the buffers before its step loop, so that recording allocates nothing there.
+struct MotionRecording {
+  long first_step = 0;
+  MotionFrames frames;     ///< swim_start = 0: the window is the whole swim's
+  Points start_positions;  ///< the cells where the swim started (the stroke rule's rest shape)
+};
+
 /// Options of swim() beyond the scene and physics.
 struct SwimOptions {
   /// Control steps simulated before the fitness clock starts, with the scene minus actuation
@@ -113,6 +123,8 @@ struct SwimOptions {
   /// positions after the ground placement and settling (nullptr: none). The body's rest lengths
   /// and areas stay as given; the embedding is checked on the displaced start (step 0).
   const Points* start_offset = nullptr;
+  /// Records the frames of the classifier's window into `motion` (nullptr: nothing recorded).
+  MotionRecording* motion = nullptr;
 };
 
 /// Where a swim starts (the crawl world, docs/worlds.md): the body and its velocities.
@@ -158,7 +170,12 @@ struct EvaluationResult {
   int protrusions = 0;
   int symmetric_pair = 0;  ///< 1 when two protrusions mirror each other, else 0
   double concavity = 0.0;
-  double frequency = 0.0;            ///< median oscillator frequency of the cells
+  double frequency = 0.0;  ///< median oscillator frequency of the cells
+  /// The locomotion mode of the swim (classify_body_motion(), the index of Locomotion: the order of
+  /// animat.locomotion.MODES), classified during the evaluation's own swim when the config's
+  /// search reads it (needs_locomotion()); -1 when not measured: no search reads it, not viable,
+  /// or the swim stopped early or was too short (fewer than 8 frames).
+  int locomotion = -1;
   std::vector<std::string> reasons;  ///< non-viability reasons or the instability description
   // Diagnostics.
   Eigen::Vector2d displacement{0.0, 0.0};  ///< COM(end) − COM(start)
@@ -328,6 +345,11 @@ void visit_fields(R& r, V&& v)
     r.concavity);
   v("frequency", "Median oscillator frequency of the cells (rad per time unit); 0 if not viable.",
     r.frequency);
+  v("locomotion",
+    "Locomotion mode of the swim, the index in animat.locomotion.MODES (the default path of "
+    "animat.classify_locomotion), classified during the swim when the config's search reads it; "
+    "-1 when not measured (no search reads it, not viable, or the swim stopped early).",
+    r.locomotion);
   v("reasons", "Non-viability reasons, or the instability description.", r.reasons);
   v("spring_count", "Springs of the body.", r.spring_count);
   v("region_count", "Regions of the body.", r.region_count);
@@ -374,6 +396,12 @@ class RepeatScorer {
   /// were stable and valid; `result` is that repeat's own (fitness = its paper's distance).
   virtual double value(int repeat, const EvaluationResult& result) = 0;
 };
+
+/// Whether the config's search reads the locomotion measure (search.algorithm "map_elites" with
+/// "locomotion" among search.descriptors, or "nsga2" with a search.objectives entry naming it):
+/// then evaluate() records the frames of the classifier's window during its swim and classifies
+/// them (EvaluationResult::locomotion); otherwise it records nothing.
+[[nodiscard]] bool needs_locomotion(const Config& config);
 
 /// genome -> develop -> build_body -> swim(config.evaluation.steps). Deterministic (same genome and
 /// config give a bit-identical fitness), thread-safe. A non-viable genome is never swum (fitness 0,

@@ -67,6 +67,9 @@ struct Fitness {
   int symmetric_pair = 0;
   double concavity = 0.0;
   double frequency = 0.0;
+  /// Locomotion mode of the swim (EvaluationResult::locomotion: the index in
+  /// animat.locomotion.MODES), classified only when the config's search reads it; -1: not measured.
+  int locomotion = -1;
   friend bool operator==(const Fitness&, const Fitness&) = default;
 };
 
@@ -112,6 +115,11 @@ void visit_fields(F& f, V&& v)
     f.symmetric_pair);
   v("concavity", "Concavity of the body at rest (animat.shape; 0 if not viable).", f.concavity);
   v("frequency", "Median oscillator frequency of the cells (0 if not viable).", f.frequency);
+  v("locomotion",
+    "Locomotion mode of the swim, the index in animat.locomotion.MODES (0 undulation ... 5 none), "
+    "classified during the evaluation's own swim when the config's search reads it "
+    "(search.descriptors or search.objectives name \"locomotion\"); -1 when not measured.",
+    f.locomotion);
 }
 
 struct EvaluationResult;  // evaluate.hpp

@@ -14,19 +14,24 @@
 // preallocate steps / 2 + 2 frames of cells × 2 doubles. Pass them with MotionFrames::swim_start
 // = 0 (the time of frame 0) and the classification is the full record's, bit for bit.
 //
-// Not ported: the stroke path of animat.locomotion (the paper's protrusion stroke of
-// animat.protrusion, which needs the shape's protruding cells of animat.shape.cell_heights). This
-// classifier is classify_motion without an outline (the earlier rules), with the bending wave
-// optional (`bending`, which animat.locomotion's stroke path turns on).
+// The stroke path. Given the body's outline (and its rest positions), the classifier also measures
+// the paper's protrusion stroke (animat.protrusion.stroke_motion: a symmetric pair of protrusions
+// extended while moving backwards) and decides "protrusions" by it first, and counts a bending
+// wave as a wave: animat.locomotion.classify_locomotion's default path, which
+// classify_body_motion() takes. Without an outline it is classify_motion without one (the earlier
+// rules), with the bending wave optional (`bending`).
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "animat/types.hpp"
 
 namespace animat {
+
+struct Body;
 
 /// The modes, in the order of animat.locomotion.MODES.
 enum class Locomotion : int {
@@ -69,6 +74,28 @@ struct WaveMeasure {
   double p_value = 0.0;
 };
 
+/// The stroke of a swim's protrusions (animat.protrusion.ProtrusionStroke).
+struct ProtrusionStroke {
+  std::vector<std::vector<int>> protrusions;  ///< cell groups (ascending), at rest ones first
+  std::vector<bool> at_rest;                  ///< per protrusion: some cell protrudes at rest
+  std::vector<double> scores;                 ///< weighted rowing correlation (NaN: no motion)
+  std::vector<double> areas;                  ///< signed loop area, spacings²
+  std::vector<std::pair<int, int>> pairs;     ///< symmetric pairs (indices into protrusions)
+  std::vector<double> pair_scores;            ///< the smaller score of each pair
+  int pair = -1;                              ///< the best eligible pair (index into pairs), or -1
+  double score = std::numeric_limits<double>::quiet_NaN();  ///< its pair score
+  double area = std::numeric_limits<double>::quiet_NaN();   ///< its smaller area
+  /// The best pair rows as the paper describes (score >= 0.4, area >= 0.1: STROKE_SCORE,
+  /// STROKE_AREA).
+  [[nodiscard]] bool strokes() const;
+};
+
+/// The body that the stroke path reads: the outer skin loop and, optionally, the rest positions.
+struct StrokeBody {
+  std::span<const int> outline;            ///< Body::skin_loops[0]
+  const Points* rest_positions = nullptr;  ///< Body::positions (nullptr: frames only)
+};
+
 /// The classifier's result: the numbers of animat.locomotion.LocomotionMode.
 struct LocomotionMode {
   Locomotion mode = Locomotion::none;
@@ -90,16 +117,28 @@ struct LocomotionMode {
   std::vector<double> phases, amplitudes;  ///< of each cell's contraction
   double contrast = 0.0;
   int groups = 0;
+  bool has_stroke = false;  ///< `stroke` was measured (an outline of >= 3 cells, a deforming body)
+  ProtrusionStroke stroke;
 };
 
 /// Classifies a swim as animat.locomotion.classify_motion(positions, times, springs=springs,
-/// omega=omega, cycles=cycles, bending=bending) does (no outline). Deterministic: the bending
+/// omega=omega, cycles=cycles, bending=bending, outline=..., rest_positions=...) does, with the
+/// stroke rule when `stroke` is given (its outline and rest positions). Deterministic: the bending
 /// wave's shuffles use Rng(kBendSeed), not numpy's generator, so its p-value differs from Python's
 /// by the sampling error of 999 shuffles. Throws std::invalid_argument for fewer than 8 frames,
-/// sizes that do not match or a spring naming no cell.
+/// sizes that do not match, or a spring or outline entry naming no cell.
 [[nodiscard]] LocomotionMode classify_motion(const MotionFrames& frames, const IndexPairs& springs,
                                              double omega, double cycles = 4.0,
-                                             bool bending = false);
+                                             bool bending = false,
+                                             const StrokeBody* stroke = nullptr);
+
+/// The default path of animat.locomotion.classify_locomotion(genome, config) on frames of `body`'s
+/// swim: its springs, its dominant frequency, the stroke rule on its outline (and on
+/// `rest_positions`, the start of the swim; nullptr: body.positions) with the bending wave; a body
+/// without skin loops has no outline: the earlier rules.
+[[nodiscard]] LocomotionMode classify_body_motion(const MotionFrames& frames, const Body& body,
+                                                  double cycles = 4.0,
+                                                  const Points* rest_positions = nullptr);
 
 /// Seed of the bending wave's shuffles (animat.locomotion.BEND_SEED's role).
 inline constexpr std::uint64_t kBendSeed = 0;

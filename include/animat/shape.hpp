@@ -2,6 +2,7 @@
 // Shape measures of a body at rest (the paper's §6): elongation, concavity, protrusions and their
 // mirror symmetry, computed as animat.shape computes them (its module docstring defines them; every
 // length in cell spacings s, cell_spacing() in body.hpp).
+#include <array>
 #include <limits>
 #include <span>
 #include <utility>
@@ -69,6 +70,25 @@ struct PrincipalAxes {
 [[nodiscard]] Shape describe_shape(const Points& positions, std::span<const int> outline,
                                    const IndexPairs* springs, const ShapeParams& params = {},
                                    double spacing = std::numeric_limits<double>::quiet_NaN());
+
+/// Each cell's distance from the core of the cells at `positions` with the outer `outline`, in
+/// spacings (`spacing` is s); empty when there is no core (animat.shape.cell_heights).
+[[nodiscard]] std::vector<double> cell_heights(const Points& positions,
+                                               std::span<const int> outline,
+                                               const ShapeParams& params, double spacing);
+
+/// The connected components of the graph on `members` (distinct cell indices) whose edges are the
+/// `links` (a link with an end outside `members` is ignored): each sorted, in the order of the
+/// first member of each in `members` (animat.shape.connected_groups).
+[[nodiscard]] std::vector<std::vector<int>> connected_groups(
+    const std::vector<int>& members, const std::vector<std::pair<int, int>>& links);
+
+/// Index pairs (i, j), i < j, of the protrusions whose `centroids`, relative to the centroid of the
+/// cells at `positions`, mirror each other about a principal axis of those cells within
+/// pair_tolerance spacings, on opposite sides of it (animat.shape.symmetric_pairs).
+[[nodiscard]] std::vector<std::pair<int, int>> symmetric_pairs(
+    const Points& positions, const std::vector<std::array<double, 2>>& centroids,
+    const ShapeParams& params, double spacing);
 
 /// The descriptors of a body at rest: its positions, outer skin loop and springs.
 [[nodiscard]] Shape body_shape(const Body& body, const ShapeParams& params = {});

@@ -35,6 +35,10 @@ constexpr Measure kMeasures[] = {
      [](const Fitness& f) { return f.concavity; }},
     {"frequency", "median oscillator frequency of the cells (rad per time unit)", 0.5, 6.0, true,
      [](const Fitness& f) { return f.frequency; }},
+    {"locomotion",
+     "locomotion mode: the index in animat.locomotion.MODES (0 undulation ... 5 none), classified "
+     "during the swim",
+     0.0, 6.0, true, [](const Fitness& f) { return static_cast<double>(f.locomotion); }},
 };
 
 }  // namespace
@@ -49,8 +53,8 @@ const Measure& find_measure(std::string_view name, const Config& config, std::st
   for (const Measure& m : kMeasures) names += (names.empty() ? "" : ", ") + std::string(m.name);
   throw ConfigError(fmt::format(
       "{}: no measure \"{}\" in animat_evolve; its measures are {} (and \"{}\", the "
-      "evaluation.objective, as \"fitness\"); animat.qd.DESCRIPTORS' locomotion and the "
-      "other criteria of animat.moo.CRITERIA run in Python (`animat evolve`)",
+      "evaluation.objective, as \"fitness\"); the other criteria of animat.moo.CRITERIA run in "
+      "Python (`animat evolve`)",
       key, name, names, config.evaluation.objective));
 }
 
