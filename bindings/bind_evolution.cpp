@@ -94,7 +94,7 @@ nb::dict elite_dict(std::size_t cell, const Elite& e) {
   return d;
 }
 
-nb::dict archive_dict(const GridArchive& a) {
+nb::dict archive_dict(const Archive& a) {
   nb::dict d;
   std::vector<std::string> names;
   std::vector<double> lower, upper;
@@ -103,12 +103,15 @@ nb::dict archive_dict(const GridArchive& a) {
     lower.push_back(a.ranges()[j].lo);
     upper.push_back(a.ranges()[j].hi);
   }
-  d["kind"] = "grid";
+  d["kind"] = std::string(a.kind());
   d["descriptors"] = names;
   d["lower"] = lower;
   d["upper"] = upper;
   d["cells"] = a.cells();
-  d["bins"] = a.bins();
+  if (a.centroids().empty())
+    d["bins"] = a.bins();
+  else
+    d["centroids"] = a.centroids();
   return d;
 }
 
@@ -126,21 +129,40 @@ nb::dict solution_dict(const Solution& s) {
 }
 
 void bind_search(nb::module_& m) {
+  // The key of cvt_centroids' sample stream: Rng.derive(seed, CVT_SAMPLES_KEY, 0).
+  m.attr("CVT_SAMPLES_KEY") = kCvtSamplesKey;
+  m.def(
+      "cvt_centroids",
+      [](std::size_t dims, std::size_t cells, std::uint64_t seed, std::size_t samples,
+         int iterations) {
+        nb::gil_scoped_release release;
+        return cvt_centroids(dims, cells, seed, samples, iterations);
+      },
+      "dims"_a, "cells"_a, "seed"_a, "samples"_a = 0, "iterations"_a = 100,
+      "The centroids of a CVT archive (search.archive = \"cvt\") in the unit cube, cells rows "
+      "of dims: Lloyd's\nk-means of samples uniform points (0: max(1000, 20 cells)) drawn from "
+      "Rng.derive(seed, CVT_SAMPLES_KEY,\n0), started from the first cells of them, as "
+      "animat.qd.CVTArchive computes its centroids from its\nsamples (docs/search.md).");
   nb::class_<SearchEngine>(m, "SearchEngine",
                            "The search of a config's search.algorithm as animat_evolve runs it "
                            "(search.hpp): \"ga\",\n\"map_elites\" or \"nsga2\", driven by "
                            "ask()/tell() or step().")
       .def(
           "__init__",
-          [](SearchEngine* e, const Config& c, const std::vector<std::string>& supplied) {
-            new (e) SearchEngine{make_search(c, {}, {}, nullptr, supplied)};
+          [](SearchEngine* e, const Config& c, const std::vector<std::string>& supplied,
+             const std::optional<std::vector<std::vector<double>>>& centroids) {
+            new (e)
+                SearchEngine{make_search(c, {}, {}, nullptr, supplied,
+                                         centroids.value_or(std::vector<std::vector<double>>{}))};
           },
-          "config"_a, "supplied"_a = std::vector<std::string>{},
+          "config"_a, "supplied"_a = std::vector<std::string>{}, "centroids"_a = nb::none(),
           "The search of config (search.algorithm); a [search] setting it cannot run is a "
           "ValueError naming\nthe key and value. supplied: names of search.descriptors "
           "(MAP-Elites; their ranges in\nsearch.ranges) or of search.objectives entries (NSGA-II; "
           "each entry NAME:max or NAME:min) whose\nvalues the caller computes and passes to "
-          "tell(fitness, values), a row per genome in supplied order.")
+          "tell(fitness, values), a row per genome in supplied order. centroids:\na CVT "
+          "archive's (search.archive = \"cvt\"), one row per cell in the unit cube; None: "
+          "cvt_centroids of\nsearch.cells, evolution.seed and search.samples.")
       .def_prop_ro("algorithm",
                    [](const SearchEngine& e) { return std::string(e.search->algorithm()); })
       .def(
@@ -224,13 +246,14 @@ void bind_search(nb::module_& m) {
             SearchLease lease(e, "archive");
             return archive_dict(engine_as<MapElites>(e, "archive", "map_elites").archive());
           },
-          "MAP-Elites: the archive's geometry, a dict: kind (\"grid\"), descriptors (names), "
-          "lower, upper\n(each descriptor's range), cells, bins (per descriptor).")
+          "MAP-Elites: the archive's geometry, a dict: kind (\"grid\" or \"cvt\"), descriptors "
+          "(names), lower,\nupper (each descriptor's range), cells, and bins (a grid's, per "
+          "descriptor) or centroids (a CVT's,\nrows in the unit cube).")
       .def(
           "index_of",
           [](const SearchEngine& e, const std::vector<double>& values) {
             SearchLease lease(e, "index_of");
-            const GridArchive& a = engine_as<MapElites>(e, "index_of", "map_elites").archive();
+            const Archive& a = engine_as<MapElites>(e, "index_of", "map_elites").archive();
             if (values.size() != a.dims())
               throw Error(fmt::format("SearchEngine.index_of: {} values for the {} descriptors",
                                       values.size(), a.dims()));

@@ -16,6 +16,7 @@
 #include "animat/errors.hpp"
 #include "animat/islands.hpp"
 #include "animat/objective.hpp"
+#include "animat/search.hpp"
 
 namespace animat {
 
@@ -565,6 +566,14 @@ void validate(const Config& config, std::string_view source) {
       fail(fmt::format("search.ranges = {}: the range of \"{}\", [{}, {}], is not finite lo < hi",
                        format_value(search.ranges), search.descriptors[j / 2],
                        format_double(search.ranges[j]), format_double(search.ranges[j + 1])));
+  if (search.archive == "cvt") {
+    try {
+      check_cvt_size(search.descriptors.size(), static_cast<std::size_t>(search.cells),
+                     static_cast<std::size_t>(search.samples), "search.cells", "search.samples");
+    } catch (const ConfigError& e) {
+      fail(e.what());
+    }
+  }
   if (config.development.min_cells > config.development.max_cells)
     fail(fmt::format("development.min_cells = {} exceeds development.max_cells = {}",
                      config.development.min_cells, config.development.max_cells));

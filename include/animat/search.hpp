@@ -1,6 +1,7 @@
 #pragma once
 // One search interface (ask / tell / checkpoint) and its algorithms: the paper's GA (evolution.hpp,
-// adapted unchanged), MAP-Elites over a grid archive and NSGA-II, chosen by search.algorithm.
+// adapted unchanged), MAP-Elites over a grid or CVT archive and NSGA-II, chosen by
+// search.algorithm.
 //
 // Design:
 // - Search: ask() gives the genomes to evaluate next, tell() takes their Fitness (evolution.hpp) in
@@ -17,6 +18,10 @@
 //   probability crossover_fraction a second one and crossover, then mutation), drawn as animat.qd
 //   and animat.moo draw it. The GA keeps its own order of draws (tournaments first), which the
 //   determinism gate pins.
+// - Supplied measures: descriptors and criteria the caller computes (Python's own) are named
+//   when the search is made and their values passed to tell(fitness, values), a row per genome.
+// - Stopping: the generation cap, the wall-clock budget and the stall (evolution.stall_generations
+//   generations without improvement: the GA's best, MAP-Elites' archive, NSGA-II's hypervolume).
 // - Checkpoints: JSON text whose payload carries an FNV-1a checksum and the run identity; restore()
 //   checks the checksum, format, version and identity, every field's type and range, and that the
 //   content is what the engine would have computed (a hand edit with a valid checksum is refused).
@@ -155,8 +160,8 @@ class Search {
   /// -1 before the first generation is complete.
   [[nodiscard]] virtual int generation() const = 0;
   [[nodiscard]] virtual std::int64_t evaluations() const = 0;
-  /// Why the run should stop now ("" = keep going): the generation cap, the wall-clock budget (and
-  /// the GA's stall).
+  /// Why the run should stop now ("" = keep going): the generation cap, the wall-clock budget or
+  /// the stall (evolution.stall_generations generations without improvement).
   [[nodiscard]] virtual std::string stop_reason() const = 0;
   [[nodiscard]] virtual std::vector<HistoryColumn> history_columns() const = 0;
   /// One row per generation, in history_columns() order.
@@ -177,13 +182,12 @@ class Search {
 /// `evaluator` (default: this process's OpenMP threads); `reference` is the exploit guard's
 /// (default swim_fitness(reference_config(config)) unless evaluation.reference_check is "off").
 /// `supplied`: MAP-Elites' descriptors or NSGA-II's criteria whose values the caller passes to
-/// tell (MapElites, Nsga2).
+/// tell (MapElites, Nsga2). `centroids`: a CVT archive's, the caller's (MapElites).
 /// Throws ConfigError for [search] settings that cannot run (naming the key and value).
-[[nodiscard]] std::unique_ptr<Search> make_search(const Config& config,
-                                                  FitnessFunction fitness = {},
-                                                  FitnessFunction reference = {},
-                                                  std::shared_ptr<Evaluator> evaluator = nullptr,
-                                                  const std::vector<std::string>& supplied = {});
+[[nodiscard]] std::unique_ptr<Search> make_search(
+    const Config& config, FitnessFunction fitness = {}, FitnessFunction reference = {},
+    std::shared_ptr<Evaluator> evaluator = nullptr, const std::vector<std::string>& supplied = {},
+    const std::vector<std::vector<double>>& centroids = {});
 
 /// The GA (Evolution) behind the Search interface: the same engine, the same results.
 class GaSearch final : public Search {
@@ -212,8 +216,36 @@ class GaSearch final : public Search {
 // ---------------------------------------------------------------------------------------------------
 // MAP-Elites
 
-/// An archive holds at most this many cells (search.bins' product).
+/// An archive holds at most this many cells (search.bins' product, or search.cells).
 inline constexpr std::int64_t kMaxArchiveCells = 1000000;
+/// The most sample-centroid distances of one Lloyd iteration of cvt_centroids (samples x cells),
+/// which keeps its k-means to seconds (animat.qd's MAX_CVT_WORK).
+inline constexpr std::int64_t kMaxCvtWork = 2000000000;
+/// The key of the random stream of cvt_centroids' samples: Rng::derive(seed, kCvtSamplesKey, 0),
+/// with seed = evolution.seed for a search's archive; far above any generation number, so it is
+/// no generation's stream.
+inline constexpr std::uint64_t kCvtSamplesKey = 0x4356540000000000ULL;  // "CVT"
+
+/// The sample count of a CVT archive: `samples`, or 0 = max(1000, 20 cells) (search.samples).
+[[nodiscard]] std::size_t cvt_samples(std::size_t cells, std::size_t samples);
+/// ConfigError naming `cells_key` unless 1 <= cells <= kMaxArchiveCells and samples x cells <=
+/// kMaxCvtWork (checked in floating point), or naming `samples_key` for fewer samples than cells.
+void check_cvt_size(std::size_t dims, std::size_t cells, std::size_t samples,
+                    std::string_view cells_key, std::string_view samples_key);
+/// The centroids of a CVT archive in the unit cube, as animat.qd.CVTArchive computes them from its
+/// samples: cvt_samples(cells, samples) points of [0, 1)^dims drawn from Rng::derive(seed,
+/// kCvtSamplesKey, 0) (uniform(), row by row); the first `cells` start Lloyd's k-means; each
+/// iteration assigns every sample to its nearest centroid (nearest_centroid) and moves each
+/// centroid to the mean of its samples (summed in sample order; a centroid without samples stays),
+/// until the assignment is unchanged or after `iterations`. Sizes as check_cvt_size.
+[[nodiscard]] std::vector<std::vector<double>> cvt_centroids(std::size_t dims, std::size_t cells,
+                                                             std::uint64_t seed,
+                                                             std::size_t samples = 0,
+                                                             int iterations = 100);
+/// The centroid nearest to `point` (squared Euclidean distance, summed over the dimensions in
+/// order); the lowest index among equals.
+[[nodiscard]] std::size_t nearest_centroid(std::span<const double> point,
+                                           const std::vector<std::vector<double>>& centroids);
 
 /// One elite of an archive.
 struct Elite {
@@ -228,26 +260,44 @@ struct Elite {
   int generation = 0;  ///< the generation that made it
 };
 
-/// The range [lo, hi) of a grid's descriptor.
+/// The range [lo, hi) of an archive's descriptor.
 struct Range {
   double lo, hi;
 };
 
-/// A regular grid over the descriptors: descriptor j is divided into bins[j] equal bins over [lo,
-/// hi) (edges lo + k (hi - lo) / bins, the last one hi); a value below lo goes to the first bin,
-/// one at or above hi to the last. The cell index is the row-major index of the bins (animat.qd's
+/// MAP-Elites' archive over the descriptors, a grid or a centroidal Voronoi tessellation (CVT).
+///
+/// A grid (search.archive = "grid"): descriptor j is divided into bins[j] equal bins over [lo, hi)
+/// (edges lo + k (hi - lo) / bins, the last one hi); a value below lo goes to the first bin, one
+/// at or above hi to the last. The cell index is the row-major index of the bins (animat.qd's
 /// GridArchive, pyribs's order).
-class GridArchive {
+///
+/// A CVT (search.archive = "cvt"): a cell per centroid of the unit cube (cvt_centroids); a value is
+/// scaled to the unit cube by each descriptor's range ((x - lo) / (hi - lo)), clipped to [0, 1],
+/// and belongs to the cell of its nearest centroid (animat.qd's CVTArchive).
+class Archive {
  public:
-  /// `ranges`: one per descriptor (search.ranges); empty: each measure's own range. ConfigError
-  /// naming search.bins for a count < 1 or a grid of more than kMaxArchiveCells cells, and naming
-  /// search.ranges for a count other than one per descriptor or a range that is not finite lo < hi.
-  GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins,
-              std::vector<Range> ranges = {});
+  /// A grid. `ranges`: one per descriptor (search.ranges); empty: each measure's own range.
+  /// ConfigError naming search.bins for a count < 1 or a grid of more than kMaxArchiveCells cells,
+  /// and naming search.ranges for a count other than one per descriptor or a range that is not
+  /// finite lo < hi.
+  Archive(std::vector<const Measure*> descriptors, std::vector<int> bins,
+          std::vector<Range> ranges = {});
+  /// A CVT of `centroids` (rows of the unit cube, one per cell); `ranges` as for a grid.
+  /// ConfigError naming `centroids` for a count outside 1..kMaxArchiveCells, a row of another
+  /// length than the descriptors' count, or a coordinate that is not a finite number in [0, 1].
+  [[nodiscard]] static Archive cvt(std::vector<const Measure*> descriptors,
+                                   std::vector<Range> ranges,
+                                   std::vector<std::vector<double>> centroids);
+  /// "grid" or "cvt".
+  [[nodiscard]] std::string_view kind() const { return centroids_.empty() ? "grid" : "cvt"; }
   [[nodiscard]] std::size_t cells() const { return cells_; }
   [[nodiscard]] std::size_t dims() const { return descriptors_.size(); }
   [[nodiscard]] const std::vector<const Measure*>& descriptors() const { return descriptors_; }
+  /// A grid's bins per descriptor (empty for a CVT).
   [[nodiscard]] const std::vector<int>& bins() const { return bins_; }
+  /// A CVT's centroids in the unit cube, one row per cell (empty for a grid).
+  [[nodiscard]] const std::vector<std::vector<double>>& centroids() const { return centroids_; }
   /// The range of every descriptor, in descriptor order.
   [[nodiscard]] const std::vector<Range>& ranges() const { return ranges_; }
   /// The cell of finite descriptor values.
@@ -267,12 +317,15 @@ class GridArchive {
   std::vector<const Measure*> descriptors_;
   std::vector<int> bins_;
   std::vector<Range> ranges_;
+  std::vector<std::vector<double>> centroids_;
   std::size_t cells_ = 1;
+  /// ConfigError naming `centroids` unless they are a CVT's (Archive::cvt).
+  void check_centroids() const;
   std::map<std::size_t, Elite> elites_;
 };
 
-/// MAP-Elites (Mouret & Clune 2015) over a GridArchive of search.descriptors with search.bins and
-/// search.ranges, as
+/// MAP-Elites (Mouret & Clune 2015) over an Archive of search.descriptors (search.archive: a grid
+/// of search.bins, or a CVT of search.cells centroids; ranges search.ranges), as
 /// animat.qd.MapElites: generation 0 (and any generation while the archive is empty) asks
 /// search.batch random viable genomes (genome i: the first viable draw of
 /// Rng::derive(seed, g, i)); later ones search.batch offspring() of elites picked uniformly in cell
@@ -282,10 +335,15 @@ class GridArchive {
 /// search.descriptors listed in `supplied` are not read from the measures table (search.ranges
 /// gives their ranges); tell(fitness, supplied) takes their values, one row per genome in
 /// `supplied`'s order, and the checkpoint keeps each elite's.
+///
+/// A CVT archive's centroids are `centroids` when given (the caller's: unit cube, a row per cell),
+/// else cvt_centroids(descriptors, search.cells, evolution.seed, search.samples); the checkpoint
+/// keeps them and restore() refuses other ones.
 class MapElites final : public Search {
  public:
   MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-            std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied = {});
+            std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied = {},
+            const std::vector<std::vector<double>>& centroids = {});
   [[nodiscard]] std::string_view algorithm() const override { return "map_elites"; }
   std::vector<Genome> ask() override;
   bool tell(const std::vector<Fitness>& fitness) override { return tell(fitness, {}); }
@@ -302,19 +360,19 @@ class MapElites final : public Search {
   [[nodiscard]] std::vector<std::vector<double>> history() const override { return history_; }
   [[nodiscard]] std::string checkpoint() const override;
   void restore(std::string_view text, std::string_view source) override;
-  [[nodiscard]] const GridArchive& archive() const { return archive_; }
+  [[nodiscard]] const Archive& archive() const { return archive_; }
   [[nodiscard]] int batch() const { return batch_; }
 
  private:
   [[nodiscard]] std::vector<double> row(int added, int discarded) const;
-  [[nodiscard]] int disagreements(const GridArchive& archive) const;
+  [[nodiscard]] int disagreements(const Archive& archive) const;
 
   std::shared_ptr<const Config> config_;
   std::uint64_t identity_;
   FitnessFunction reference_;
   bool select_ = false;  ///< the exploit guard "select": the archive compares reference fitness
   std::shared_ptr<const SuppliedMeasures> supplied_;  ///< shared by copies
-  GridArchive archive_;
+  Archive archive_;
   int batch_;
   int generation_ = -1;
   std::int64_t evaluations_ = 0, reference_evaluations_ = 0;

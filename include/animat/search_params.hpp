@@ -13,6 +13,7 @@
 namespace animat {
 
 inline constexpr std::string_view kSearchAlgorithmNames[] = {"ga", "map_elites", "nsga2"};
+inline constexpr std::string_view kSearchArchiveNames[] = {"grid", "cvt"};
 
 struct SearchParams {
   /// "ga": the paper's GA (the evolution section); "map_elites", "nsga2": run by animat_evolve
@@ -29,6 +30,13 @@ struct SearchParams {
   std::vector<double> ranges = {};
   /// map_elites: offspring per generation; 0 = evolution.population
   int batch = 0;
+  /// map_elites: the archive, "grid" (search.bins) or "cvt" (search.cells centroids; search.hpp)
+  std::string archive = "grid";
+  /// map_elites, archive "cvt": the number of centroids (cells)
+  int cells = 100;
+  /// map_elites, archive "cvt": the uniform samples whose k-means gives the centroids; 0 =
+  /// max(1000, 20 cells)
+  int samples = 0;
   /// nsga2: the objectives, "NAME" (the table's sense) or "NAME:max" / "NAME:min": names of
   /// search.hpp's measures() (animat_evolve) or of animat.moo.CRITERIA (`animat evolve`)
   std::vector<std::string> objectives = {"distance:max", "actuation_work_positive:min"};
@@ -72,6 +80,25 @@ void visit_fields(SearchParams& p, V&& v) {
               {},
               Identity::late},
     p.batch);
+  v(FieldInfo{"archive",
+              "map_elites: the archive, \"grid\" (search.bins per descriptor) or \"cvt\" "
+              "(search.cells centroids of a centroidal Voronoi tessellation; docs/search.md)",
+              Bounds::any(), kSearchArchiveNames, Identity::late},
+    p.archive);
+  v(FieldInfo{"cells",
+              "map_elites, archive \"cvt\": the number of centroids (cells); with search.samples "
+              "at most 2e9 sample-centroid distances per k-means iteration",
+              Bounds::closed(1, 1000000),
+              {},
+              Identity::late},
+    p.cells);
+  v(FieldInfo{"samples",
+              "map_elites, archive \"cvt\": the uniform samples whose k-means gives the "
+              "centroids, at least search.cells; 0 = max(1000, 20 search.cells)",
+              Bounds::closed(0, 2000000000),
+              {},
+              Identity::late},
+    p.samples);
   v(FieldInfo{"objectives",
               "nsga2: the objectives, \"NAME\" (the table's sense) or \"NAME:max\" / \"NAME:min\" "
               "(animat_evolve: fitness or the evaluation.objective's name, cells, actuation_work, "

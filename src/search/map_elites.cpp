@@ -36,21 +36,34 @@ bool archivable(const Fitness& f) { return f.viable && f.stable && f.valid; }
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
-GridArchive::GridArchive(std::vector<const Measure*> descriptors, std::vector<int> bins,
-                         std::vector<Range> ranges)
-    : descriptors_(std::move(descriptors)), bins_(std::move(bins)), ranges_(std::move(ranges)) {
-  if (ranges_.empty())
-    for (const Measure* d : descriptors_) ranges_.push_back({d->lo, d->hi});
-  if (ranges_.size() != descriptors_.size())
+namespace {
+
+// `ranges`, or empty: each descriptor's own; ConfigError naming search.ranges unless one finite
+// lo < hi per descriptor.
+std::vector<Range> checked_ranges(const std::vector<const Measure*>& descriptors,
+                                  std::vector<Range> ranges) {
+  if (ranges.empty())
+    for (const Measure* d : descriptors) ranges.push_back({d->lo, d->hi});
+  if (ranges.size() != descriptors.size())
     throw ConfigError(fmt::format("search.ranges: {} ranges for {} descriptors; give one each",
-                                  ranges_.size(), descriptors_.size()));
-  for (std::size_t j = 0; j < ranges_.size(); ++j)
-    if (!std::isfinite(ranges_[j].lo) || !std::isfinite(ranges_[j].hi) ||
-        !(ranges_[j].lo < ranges_[j].hi))
+                                  ranges.size(), descriptors.size()));
+  for (std::size_t j = 0; j < ranges.size(); ++j)
+    if (!std::isfinite(ranges[j].lo) || !std::isfinite(ranges[j].hi) ||
+        !(ranges[j].lo < ranges[j].hi))
       throw ConfigError(fmt::format(
           "search.ranges: the range of \"{}\", [{}, {}], is not finite lo < hi (a measure "
           "without a range in the table needs one in search.ranges)",
-          descriptors_[j]->name, ranges_[j].lo, ranges_[j].hi));
+          descriptors[j]->name, ranges[j].lo, ranges[j].hi));
+  return ranges;
+}
+
+}  // namespace
+
+Archive::Archive(std::vector<const Measure*> descriptors, std::vector<int> bins,
+                 std::vector<Range> ranges)
+    : descriptors_(std::move(descriptors)),
+      bins_(std::move(bins)),
+      ranges_(checked_ranges(descriptors_, std::move(ranges))) {
   if (bins_.size() != descriptors_.size())
     throw ConfigError(fmt::format("search.bins = {}: one count per descriptor ({}) is needed",
                                   bins_text(bins_), descriptors_.size()));
@@ -71,7 +84,40 @@ GridArchive::GridArchive(std::vector<const Measure*> descriptors, std::vector<in
   for (int b : bins_) cells_ *= static_cast<std::size_t>(b);
 }
 
-std::size_t GridArchive::index_of(std::span<const double> values) const {
+Archive Archive::cvt(std::vector<const Measure*> descriptors, std::vector<Range> ranges,
+                     std::vector<std::vector<double>> centroids) {
+  // a grid of one cell checks the descriptors and ranges; the centroids then replace its bins
+  const std::size_t dims = descriptors.size();
+  Archive a(std::move(descriptors), std::vector<int>(dims, 1), std::move(ranges));
+  a.bins_.clear();
+  a.centroids_ = std::move(centroids);
+  a.check_centroids();
+  a.cells_ = a.centroids_.size();
+  return a;
+}
+
+void Archive::check_centroids() const {
+  if (centroids_.empty() || centroids_.size() > static_cast<std::size_t>(kMaxArchiveCells))
+    throw ConfigError(fmt::format("centroids: {} rows; a CVT archive has 1 to {} cells",
+                                  centroids_.size(), kMaxArchiveCells));
+  for (std::size_t c = 0; c < centroids_.size(); ++c) {
+    if (centroids_[c].size() != dims())
+      throw ConfigError(fmt::format("centroids: row {} has {} values for the {} descriptors", c,
+                                    centroids_[c].size(), dims()));
+    for (double x : centroids_[c])
+      if (!(x >= 0.0 && x <= 1.0))  // NaN too
+        throw ConfigError(fmt::format(
+            "centroids: row {} holds {}; a centroid lies in the unit cube [0, 1]", c, x));
+  }
+}
+
+std::size_t Archive::index_of(std::span<const double> values) const {
+  if (!centroids_.empty()) {
+    std::vector<double> unit(dims());
+    for (std::size_t j = 0; j < dims(); ++j)
+      unit[j] = std::clamp((values[j] - ranges_[j].lo) / (ranges_[j].hi - ranges_[j].lo), 0.0, 1.0);
+    return nearest_centroid(unit, centroids_);
+  }
   std::size_t index = 0;
   for (std::size_t j = 0; j < descriptors_.size(); ++j) {
     const int n = bins_[j];
@@ -92,7 +138,7 @@ std::size_t GridArchive::index_of(std::span<const double> values) const {
   return index;
 }
 
-bool GridArchive::add(Elite elite) {
+bool Archive::add(Elite elite) {
   const std::size_t cell = index_of(elite.descriptors);
   auto it = elites_.find(cell);
   if (it != elites_.end() && !(elite.objective > it->second.objective)) return false;
@@ -100,18 +146,18 @@ bool GridArchive::add(Elite elite) {
   return true;
 }
 
-double GridArchive::qd_score() const {
+double Archive::qd_score() const {
   std::vector<double> terms;
   terms.reserve(elites_.size());
   for (const auto& [cell, e] : elites_) terms.push_back(e.objective);
   return exact_sum(terms);
 }
 
-double GridArchive::coverage() const {
+double Archive::coverage() const {
   return static_cast<double>(elites_.size()) / static_cast<double>(cells_);
 }
 
-const Elite* GridArchive::best() const {
+const Elite* Archive::best() const {
   const Elite* best = nullptr;
   for (const auto& [cell, e] : elites_)
     if (best == nullptr || e.objective > best->objective) best = &e;
@@ -149,7 +195,7 @@ std::vector<const Measure*> descriptors_of(const Config& config,
   return out;
 }
 
-// search.ranges as pairs; empty: the measures' own ranges (GridArchive).
+// search.ranges as pairs; empty: the measures' own ranges (Archive).
 std::vector<Range> ranges_of(const Config& config) {
   const auto& r = config.search.ranges;
   std::vector<Range> out;
@@ -169,15 +215,38 @@ std::vector<int> bins_of(const Config& config) {
   return out;
 }
 
+// search.archive's archive: a grid of search.bins, or a CVT of the caller's centroids or
+// search.cells centroids computed from evolution.seed's samples.
+Archive archive_of(const Config& config, std::vector<const Measure*> descriptors,
+                   const std::vector<std::vector<double>>& centroids) {
+  const SearchParams& s = config.search;
+  if (s.archive != "cvt") {
+    if (!centroids.empty())
+      throw ConfigError(fmt::format(
+          "centroids: given for search.archive = \"{}\"; centroids are a CVT archive's (\"cvt\")",
+          s.archive));
+    return Archive(std::move(descriptors), bins_of(config), ranges_of(config));
+  }
+  if (!centroids.empty()) return Archive::cvt(std::move(descriptors), ranges_of(config), centroids);
+  const std::size_t dims = descriptors.size();
+  const auto cells = static_cast<std::size_t>(s.cells);
+  const auto samples = static_cast<std::size_t>(s.samples);
+  check_cvt_size(dims, cells, samples, "search.cells", "search.samples");
+  return Archive::cvt(
+      std::move(descriptors), ranges_of(config),
+      cvt_centroids(dims, cells, static_cast<std::uint64_t>(config.evolution.seed), samples));
+}
+
 }  // namespace
 
 MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-                     std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied)
+                     std::shared_ptr<Evaluator> evaluator, const std::vector<std::string>& supplied,
+                     const std::vector<std::vector<double>>& centroids)
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
       supplied_(std::make_shared<const SuppliedMeasures>(supplied, config.search.descriptors,
                                                          "search.descriptors")),
-      archive_(descriptors_of(config, supplied_->measures), bins_of(config), ranges_of(config)),
+      archive_(archive_of(config, descriptors_of(config, supplied_->measures), centroids)),
       batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
       started_(now_seconds()) {
   if (config.evaluation.reference_check != "off") reference_ = std::move(reference);
@@ -304,7 +373,7 @@ bool MapElites::tell(const std::vector<Fitness>& fitness,
   return true;
 }
 
-int MapElites::disagreements(const GridArchive& archive) const {
+int MapElites::disagreements(const Archive& archive) const {
   int n = 0;
   for (const auto& [cell, e] : archive.elites())
     if (!std::isnan(e.reference) &&
@@ -336,7 +405,11 @@ std::vector<HistoryColumn> MapElites::history_columns() const {
 }
 
 std::string MapElites::stop_reason() const {
-  return stop_rule(*config_, generation_, wall_offset_ + now_seconds() - started_);
+  // The stall: generations since one added an elite or improved one (history's "added").
+  int stalled = 0;
+  for (const auto& row : history_) stalled = row[6] > 0 ? 0 : stalled + 1;
+  return stop_rule(*config_, generation_, wall_offset_ + now_seconds() - started_, stalled,
+                   "no elite added or improved");
 }
 
 std::string MapElites::checkpoint() const {
@@ -360,6 +433,7 @@ std::string MapElites::checkpoint() const {
     }
   }
   p["elites"] = std::move(elites);
+  if (!archive_.centroids().empty()) p["centroids"] = archive_.centroids();
   p["history"] = history_to_json(history_, history_columns());
   return seal(p);
 }
@@ -369,7 +443,13 @@ void MapElites::restore(std::string_view text, std::string_view source) {
   auto fail = [&](const std::string& what) { inconsistent(source, what); };
   reading_checkpoint(source, [&] {
     const auto [generation, evaluations, reference_evaluations, wall] = read_counters(p);
-    GridArchive archive(archive_.descriptors(), archive_.bins(), archive_.ranges());
+    if (!archive_.centroids().empty() &&
+        (!p.contains("centroids") || p["centroids"] != json(archive_.centroids())))
+      fail(
+          "the CVT archive's centroids are not this search's (search.cells, search.samples, "
+          "evolution.seed or the caller's centroids differ)");
+    Archive archive = archive_;
+    archive.elites().clear();
     if (!p.contains("elites") || !p["elites"].is_array()) fail("no list of elites");
     if (p["elites"].size() > archive.cells())
       fail(fmt::format("{} elites for {} cells", p["elites"].size(), archive.cells()));

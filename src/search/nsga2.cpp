@@ -389,7 +389,22 @@ std::vector<HistoryColumn> Nsga2::history_columns() const {
 }
 
 std::string Nsga2::stop_reason() const {
-  return stop_rule(*config_, generation_, wall_offset_ + now_seconds() - started_);
+  // The stall: generations since the hypervolume last rose above every earlier one (with three or
+  // more criteria there is none, and no stall).
+  int stalled = 0;
+  double best = kNaN;
+  for (const auto& row : history_) {
+    const double hv = row[3];
+    if (!std::isnan(hv) && (std::isnan(best) || hv > best)) {
+      best = hv;
+      stalled = 0;
+    } else {
+      ++stalled;
+    }
+  }
+  if (criteria_.size() > 2) stalled = 0;
+  return stop_rule(*config_, generation_, wall_offset_ + now_seconds() - started_, stalled,
+                   "hypervolume not increased");
 }
 
 std::string Nsga2::checkpoint() const {

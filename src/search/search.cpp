@@ -189,12 +189,17 @@ std::vector<std::vector<double>> GaSearch::history() const {
 
 std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitness,
                                     FitnessFunction reference, std::shared_ptr<Evaluator> evaluator,
-                                    const std::vector<std::string>& supplied) {
+                                    const std::vector<std::string>& supplied,
+                                    const std::vector<std::vector<double>>& centroids) {
   validate(config);
   if (!supplied.empty() && config.search.algorithm == "ga")
     throw ConfigError(
         "search.algorithm = \"ga\": measures supplied by the caller are MAP-Elites' descriptors "
         "or NSGA-II's criteria; the GA has none");
+  if (!centroids.empty() && config.search.algorithm != "map_elites")
+    throw ConfigError(
+        fmt::format("search.algorithm = \"{}\": centroids are a MAP-Elites CVT archive's",
+                    config.search.algorithm));
   if (!fitness) {
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off")
@@ -207,7 +212,7 @@ std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitnes
                                       std::move(evaluator));
   if (algorithm == "map_elites")
     return std::make_unique<MapElites>(config, std::move(fitness), std::move(reference),
-                                       std::move(evaluator), supplied);
+                                       std::move(evaluator), supplied, centroids);
   if (algorithm == "nsga2")
     return std::make_unique<Nsga2>(config, std::move(fitness), std::move(reference),
                                    std::move(evaluator), supplied);
@@ -336,12 +341,14 @@ json fitness_to_json(const Fitness& f) {
 
 Fitness fitness_from_json(const json& j) {
   Fitness f;
+  // A count is >= 0; a field whose default is below 0 (a "none" value) may also hold that value.
   visit_fields(f, [&](const char* name, const char*, auto& value) {
     using T = std::decay_t<decltype(value)>;
     if constexpr (std::is_same_v<T, bool>)
       value = bool_field(j, name);
     else if constexpr (std::is_same_v<T, int>)
-      value = static_cast<int>(int_field(j, name, 0, std::numeric_limits<int>::max()));
+      value =
+          static_cast<int>(int_field(j, name, std::min(0, value), std::numeric_limits<int>::max()));
     else if constexpr (std::is_same_v<T, long>)
       value = static_cast<long>(int_field(j, name, 0, std::numeric_limits<long>::max()));
     else
@@ -399,9 +406,13 @@ void check_last_row(const std::vector<double>& last, const std::vector<double>& 
                                        columns[c].name, last[c], state, expected[c]));
 }
 
-std::string stop_rule(const Config& config, int generation, double wall) {
+std::string stop_rule(const Config& config, int generation, double wall, int stalled,
+                      std::string_view improvement) {
   const EvolutionParams& ep = config.evolution;
   if (generation < 0) return {};
+  if (ep.stall_generations > 0 && stalled >= ep.stall_generations)
+    return fmt::format("{} for evolution.stall_generations = {} generations", improvement,
+                       ep.stall_generations);
   if (ep.generations > 0 && generation >= ep.generations)
     return fmt::format("generation cap evolution.generations = {} reached", ep.generations);
   if (ep.wall_seconds > 0 && wall >= ep.wall_seconds)

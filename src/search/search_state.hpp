@@ -84,8 +84,11 @@ void reading_checkpoint(std::string_view source, Read&& read) {
 }
 
 /// Why a run of `config` stops at generation g after `wall` seconds ("" = it does not): the
-/// generation cap evolution.generations, the wall-clock budget evolution.wall_seconds.
-std::string stop_rule(const Config& config, int generation, double wall);
+/// generation cap evolution.generations, the wall-clock budget evolution.wall_seconds, or the
+/// stall: `stalled` generations without improvement (`improvement` says what that is) reaching
+/// evolution.stall_generations.
+std::string stop_rule(const Config& config, int generation, double wall, int stalled,
+                      std::string_view improvement);
 
 /// Refuses supplied values where the search has no supplied measure (own = 0), and a row count
 /// other than one per genome of the last ask().

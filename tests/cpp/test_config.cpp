@@ -175,6 +175,7 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
         candidates.push_back(*i + 1);
         candidates.push_back(*i - 1);
         candidates.push_back(std::int64_t{3});
+        candidates.push_back(*i + 1000);  // search.samples: at least search.cells
       } else if (const bool* b = std::get_if<bool>(&def)) {
         candidates.push_back(!*b);
       } else if (const auto* s = std::get_if<std::vector<std::string>>(&def)) {
@@ -196,7 +197,7 @@ TEST(ConfigRoundTrip, NonDefaultValuesForEveryKeyRoundTripBitExactly) {
         for (const char* word :
              {"explicit", "stable", "off", "select", "distance_per_size", "chemical", "actuation",
               "grn", "point", "distance", "front", "amplitude", "morphogen_gradient", "compliant",
-              "min", "map_elites", "fixed"})
+              "min", "map_elites", "fixed", "cvt"})
           candidates.push_back(std::string(word));
       }
       for (const auto& cand : candidates) {

@@ -318,6 +318,9 @@ TEST(Islands, OneIslandIsThePapersPopulationAndKeepsTheRunIdentity) {
                           "\nbins = ",
                           "\nranges = ",
                           "\nbatch = ",
+                          "\narchive = ",
+                          "\ncells = ",
+                          "\nsamples = ",
                           "\nobjectives = "}) {
     const auto at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;

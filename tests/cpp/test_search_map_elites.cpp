@@ -26,6 +26,18 @@ using animat::test::without_wall;
 
 namespace {
 
+// Expects `run` to throw an E whose message holds every one of `parts`.
+template <class E = ConfigError>
+void expect_error(const std::function<void()>& run, std::initializer_list<std::string> parts) {
+  try {
+    run();
+    ADD_FAILURE() << "no error";
+  } catch (const E& e) {
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
 Config me_config(int threads = 1) {
   Config c;
   c.search.algorithm = "map_elites";
@@ -44,11 +56,11 @@ MapElites make(const Config& c) {
 
 }  // namespace
 
-TEST(GridArchive, BinsFollowTheEdgesAndClipOutsideTheRange) {
+TEST(Archive, BinsFollowTheEdgesAndClipOutsideTheRange) {
   Config c = me_config();
   const Measure* cells = &find_measure("cells", c, "search.descriptors");
   const Measure* fitness = &find_measure("fitness", c, "search.descriptors");
-  GridArchive a({cells, fitness}, {8, 5});  // cells: edges 1, 9, 17, ..., 65; fitness: 0, 10, ...
+  Archive a({cells, fitness}, {8, 5});  // cells: edges 1, 9, 17, ..., 65; fitness: 0, 10, ...
   EXPECT_EQ(a.cells(), 40U);
   const auto at = [&](double x, double y) {
     const double v[] = {x, y};
@@ -63,10 +75,10 @@ TEST(GridArchive, BinsFollowTheEdgesAndClipOutsideTheRange) {
   EXPECT_EQ(at(1e9, 1e9), 7U * 5 + 4);
 }
 
-TEST(GridArchive, RangesOtherThanTheTablesPlaceTheEdges) {
+TEST(Archive, RangesOtherThanTheTablesPlaceTheEdges) {
   Config c = me_config();
   const Measure* cells = &find_measure("cells", c, "search.descriptors");
-  GridArchive a({cells}, {4}, {{10.0, 30.0}});  // edges 10, 15, 20, 25, 30
+  Archive a({cells}, {4}, {{10.0, 30.0}});  // edges 10, 15, 20, 25, 30
   ASSERT_EQ(a.ranges().size(), 1U);
   EXPECT_EQ(a.ranges()[0].lo, 10.0);
   EXPECT_EQ(a.ranges()[0].hi, 30.0);
@@ -79,32 +91,92 @@ TEST(GridArchive, RangesOtherThanTheTablesPlaceTheEdges) {
   EXPECT_EQ(at(15), 1U);
   EXPECT_EQ(at(29.999), 3U);
   EXPECT_EQ(at(64), 3U);  // at or above hi: the last bin
-  GridArchive table({cells}, {4});
+  Archive table({cells}, {4});
   EXPECT_EQ(table.ranges()[0].lo, cells->lo);
   EXPECT_EQ(table.ranges()[0].hi, cells->hi);
 }
 
-TEST(GridArchive, ARangeThatIsNotFiniteLoBelowHiIsRefusedNamingTheKey) {
+TEST(Archive, ARangeThatIsNotFiniteLoBelowHiIsRefusedNamingTheKey) {
   Config c = me_config();
   const Measure* cells = &find_measure("cells", c, "search.descriptors");
   for (const Range r :
        {Range{3.0, 3.0}, Range{5.0, 1.0}, Range{0.0, std::numeric_limits<double>::infinity()},
         Range{std::numeric_limits<double>::quiet_NaN(), 1.0}}) {
-    try {
-      GridArchive a({cells}, {4}, {r});
-      FAIL() << "no error for [" << r.lo << ", " << r.hi << "]";
-    } catch (const ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find("search.ranges: the range of \"cells\""),
-                std::string::npos)
-          << e.what();
-    }
+    SCOPED_TRACE(fmt::format("[{}, {}]", r.lo, r.hi));
+    expect_error([&] { Archive a({cells}, {4}, {r}); }, {"search.ranges: the range of \"cells\""});
   }
-  EXPECT_THROW(GridArchive({cells}, {4}, {{0.0, 1.0}, {0.0, 1.0}}), ConfigError);
+  EXPECT_THROW(Archive({cells}, {4}, {{0.0, 1.0}, {0.0, 1.0}}), ConfigError);
 }
 
-TEST(GridArchive, AnEliteIsReplacedOnlyByAStrictlyBetterCandidate) {
+TEST(Archive, ACvtValueGoesToTheNearestCentroidAfterScalingAndClipping) {
   Config c = me_config();
-  GridArchive a({&find_measure("cells", c, "k")}, {4});
+  const std::vector<const Measure*> d = {&find_measure("cells", c, "k"),
+                                         &find_measure("fitness", c, "k")};
+  // unit cube corners and its centre; ranges [0, 10) and [0, 100)
+  const Archive a = Archive::cvt(d, {{0.0, 10.0}, {0.0, 100.0}},
+                                 {{0.0, 0.0}, {1.0, 1.0}, {0.5, 0.5}, {1.0, 0.0}});
+  EXPECT_EQ(a.kind(), "cvt");
+  EXPECT_EQ(a.cells(), 4U);
+  EXPECT_TRUE(a.bins().empty());
+  EXPECT_EQ(a.index_of(std::vector<double>{1.0, 5.0}), 0U);
+  EXPECT_EQ(a.index_of(std::vector<double>{5.0, 50.0}), 2U);
+  EXPECT_EQ(a.index_of(std::vector<double>{9.0, 10.0}), 3U);
+  EXPECT_EQ(a.index_of(std::vector<double>{1e9, 1e9}), 1U);    // clipped to (1, 1)
+  EXPECT_EQ(a.index_of(std::vector<double>{-5.0, -1.0}), 0U);  // clipped to (0, 0)
+  // (0.5, 0) is as near to (0, 0), (0.5, 0.5) and (1, 0): the lowest index
+  EXPECT_EQ(a.index_of(std::vector<double>{5.0, 0.0}), 0U);
+  EXPECT_EQ(nearest_centroid(std::vector<double>{0.75, 0.25}, a.centroids()), 2U);
+}
+
+TEST(Archive, CvtCentroidsOutsideTheUnitCubeOrOfTheWrongShapeAreRefused) {
+  Config c = me_config();
+  const std::vector<const Measure*> d = {&find_measure("cells", c, "k")};
+  const std::vector<Range> r = {{0.0, 10.0}};
+  expect_error([&] { (void)Archive::cvt(d, r, {}); }, {"centroids: 0 rows"});
+  expect_error([&] { (void)Archive::cvt(d, r, {{0.5}, {1.5}}); }, {"centroids: row 1 holds 1.5"});
+  expect_error([&] { (void)Archive::cvt(d, r, {{std::nan("")}}); }, {"centroids: row 0 holds nan"});
+  expect_error([&] { (void)Archive::cvt(d, r, {{0.5, 0.5}}); }, {"row 0 has 2 values for the 1"});
+}
+
+TEST(MapElites, CvtSizesAreRefusedNamingTheKeyBeforeTheSearchIsMade) {
+  Config c = me_config();
+  c.search.archive = "cvt";
+  c.search.cells = 20;
+  c.search.samples = 200;
+  const MapElites me = make(c);
+  EXPECT_EQ(me.archive().centroids(), cvt_centroids(2, 20, 3, 200));
+  c.search.cells = 1000000;
+  c.search.samples = 0;
+  expect_error([&] { validate(c); }, {"search.cells = 1000000 with search.samples = 20000000"});
+  expect_error([&] { (void)make(c); }, {"search.cells = 1000000"});
+  c.search.cells = 20;
+  c.search.samples = 10;
+  expect_error([&] { (void)make(c); }, {"search.samples = 10: fewer samples than the 20 cells"});
+}
+
+TEST(MapElites, TheStallRuleStopsAfterGenerationsWithoutANewOrBetterElite) {
+  Config c = me_config();
+  c.evolution.stall_generations = 2;
+  MapElites me = make(c);
+  const auto same = [](const std::vector<Genome>& genomes) {
+    Fitness f;
+    f.viable = f.stable = f.valid = true;
+    f.fitness = 5.0;
+    f.cell_count = 9;
+    return std::vector<Fitness>(genomes.size(), f);
+  };
+  me.tell(same(me.ask()));  // generation 0 fills one cell
+  EXPECT_EQ(me.stop_reason(), "");
+  me.tell(same(me.ask()));
+  EXPECT_EQ(me.stop_reason(), "");
+  me.tell(same(me.ask()));
+  EXPECT_EQ(me.stop_reason(),
+            "no elite added or improved for evolution.stall_generations = 2 generations");
+}
+
+TEST(Archive, AnEliteIsReplacedOnlyByAStrictlyBetterCandidate) {
+  Config c = me_config();
+  Archive a({&find_measure("cells", c, "k")}, {4});
   Elite e;
   e.descriptors = {5.0};
   e.objective = 2.0;
@@ -121,7 +193,7 @@ TEST(GridArchive, AnEliteIsReplacedOnlyByAStrictlyBetterCandidate) {
   EXPECT_EQ(a.best()->objective, 3.0);
 }
 
-TEST(GridArchive, ExactSumIsMathFsum) {
+TEST(Archive, ExactSumIsMathFsum) {
   const double terms[] = {1e16, 1.0, -1e16, 1.0};
   EXPECT_EQ(exact_sum(terms), 2.0);  // a plain sum gives 0 or 1
   const double tenths[] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1};
@@ -132,14 +204,7 @@ TEST(GridArchive, ExactSumIsMathFsum) {
 TEST(MapElites, TooManyCellsAreRefusedNamingTheKeyAndValue) {
   Config c = me_config();
   c.search.bins = {100000.0};
-  try {
-    (void)make(c);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("search.bins = [100000, 100000]"), std::string::npos)
-        << e.what();
-    EXPECT_NE(std::string(e.what()).find("1e+10 cells"), std::string::npos) << e.what();
-  }
+  expect_error([&] { (void)make(c); }, {"search.bins = [100000, 100000]", "1e+10 cells"});
   // Four descriptors of 100000 bins: 1e20 cells, past what an int64 holds, refused the same way.
   c.search.descriptors = {"cells", "fitness", "cells", "fitness"};
   EXPECT_THROW((void)make(c), ConfigError);
@@ -147,61 +212,27 @@ TEST(MapElites, TooManyCellsAreRefusedNamingTheKeyAndValue) {
 
 TEST(MapElites, DescriptorsOutsideTheTableOrWithoutARangeAreRefusedByName) {
   Config c = me_config();
-  c.search.descriptors = {"locomotion", "cells"};
-  try {
-    (void)make(c);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("search.descriptors: no measure \"locomotion\""),
-              std::string::npos)
-        << e.what();
-  }
+  c.search.descriptors = {"shade", "cells"};
+  expect_error([&] { (void)make(c); }, {"search.descriptors: no measure \"shade\""});
   c.search.descriptors = {"actuation_work_positive", "cells"};
-  try {
-    (void)make(c);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("give the descriptors' ranges in search.ranges"),
-              std::string::npos)
-        << e.what();
-  }
+  expect_error([&] { (void)make(c); }, {"give the descriptors' ranges in search.ranges"});
   // With search.ranges, a measure without a range of its own is a descriptor.
   c.search.ranges = {0.0, 100.0, 1.0, 65.0};
   const MapElites me = make(c);
   EXPECT_EQ(me.archive().ranges()[0].hi, 100.0);
   EXPECT_EQ(me.archive().ranges()[1].lo, 1.0);
   c.search.ranges = {0.0, 100.0, 1.0};
-  try {
-    (void)make(c);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("search.ranges: 3 numbers"), std::string::npos)
-        << e.what();
-  }
+  expect_error([&] { (void)make(c); }, {"search.ranges: 3 numbers"});
 }
 
 TEST(MapElites, SearchRangesAreCheckedWithTheConfig) {
   Config c = me_config();
   c.search.ranges = {0.0, 100.0};
-  try {
-    validate(c);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("search.ranges = [0.0, 100.0]: give lo and hi for each of "
-                                         "the 2 of search.descriptors"),
-              std::string::npos)
-        << e.what();
-  }
+  expect_error([&] { validate(c); }, {"search.ranges = [0.0, 100.0]: give lo and hi for each of "
+                                      "the 2 of search.descriptors"});
   c.search.ranges = {0.0, 100.0, 7.0, 7.0};
-  try {
-    validate(c);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(
-        std::string(e.what()).find("the range of \"fitness\", [7.0, 7.0], is not finite lo < hi"),
-        std::string::npos)
-        << e.what();
-  }
+  expect_error([&] { validate(c); },
+               {"the range of \"fitness\", [7.0, 7.0], is not finite lo < hi"});
   c.search.ranges = {0.0, 100.0, 0.0, 7.0};
   EXPECT_NO_THROW(validate(c));
 }
@@ -265,14 +296,8 @@ TEST(MapElites, ARefusedTellChangesNothing) {
       EXPECT_TRUE(copy.tell(f));
       continue;
     }
-    try {
-      me.tell(f);
-      FAIL() << "accepted fitness " << bad;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(fmt::format("value {}", k)), std::string::npos)
-          << e.what();
-      EXPECT_NE(std::string(e.what()).find("fitness"), std::string::npos) << e.what();
-    }
+    SCOPED_TRACE(fmt::format("fitness {}", bad));
+    expect_error<Error>([&] { me.tell(f); }, {fmt::format("value {}", k), "fitness"});
     EXPECT_EQ(me.checkpoint(), before);
     EXPECT_EQ(me.ask(), asked);
   }
@@ -440,14 +465,8 @@ TEST(MapElites, SuppliedValuesAreCheckedBeforeAnythingChanges) {
   while (!(told[k].viable && told[k].stable && told[k].valid)) ++k;
   auto bad = shades(genomes.size());
   bad[k][0] = std::numeric_limits<double>::quiet_NaN();
-  try {
-    (void)me.tell(told, bad);
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(fmt::format("value {}", k)), std::string::npos)
-        << e.what();
-    EXPECT_NE(std::string(e.what()).find("descriptor shade = nan"), std::string::npos) << e.what();
-  }
+  expect_error<Error>([&] { (void)me.tell(told, bad); },
+                      {fmt::format("value {}", k), "descriptor shade = nan"});
   EXPECT_THROW((void)me.tell(told), Error);  // no rows
   EXPECT_THROW((void)me.tell(told, shades(genomes.size() - 1)), Error);
   EXPECT_EQ(me.generation(), -1);

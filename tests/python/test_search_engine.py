@@ -6,6 +6,7 @@ import hashlib
 import json
 import math
 
+import numpy as np
 import pytest
 
 import animat
@@ -42,19 +43,24 @@ def same(a, b):
     return len(a) == len(b) and all(x == y or (math.isnan(x) and math.isnan(y)) for x, y in zip(a, b))
 
 
+def run_both(engine, me, generations=6):
+    """Drives the engine and animat.qd's MapElites (descriptors cells and fitness) with the same stubs,
+    checking that they ask the same genomes and write the same history rows."""
+    for _ in range(generations):
+        genomes = engine.ask()
+        assert [g.to_json() for g in genomes] == [g.to_json() for g in me.ask()]
+        told = [stub(g) for g in genomes]
+        assert engine.tell(told)
+        row = me.tell(told, descriptors=[[f.cell_count, f.fitness] if f.viable else None for f in told])
+        assert same(engine.history[-1][:10], [float(x) for x in row]), (engine.history[-1], row)
+
+
 def test_map_elites_is_animat_qd():
     config = config_for("map_elites", 3)
     engine = _core.SearchEngine(config)
     me = animat.MapElites(config, animat.GridArchive(["cells", "fitness"], bins=(8, 5)), batch=12, seed=3)
     assert [c[0] for c in engine.history_columns][:10] == list(animat.QD_HISTORY_DTYPE.names)
-    for _ in range(6):
-        genomes = engine.ask()
-        assert [g.to_json() for g in genomes] == [g.to_json() for g in me.ask()]
-        told = [stub(g) for g in genomes]
-        assert engine.tell(told)
-        rows = [[f.cell_count, f.fitness] if f.viable else None for f in told]
-        row = me.tell(told, descriptors=rows)
-        assert same(engine.history[-1][:10], [float(x) for x in row]), (engine.history[-1], row)
+    run_both(engine, me)
     assert engine.history[-1][5] > 3  # the archive holds several elites: a real comparison
 
 
@@ -67,13 +73,7 @@ def test_search_ranges_are_animat_qd_descriptor_ranges():
     engine = _core.SearchEngine(config)
     archive = animat.GridArchive([("cells", 10.0, 40.0), ("fitness", 5.0, 45.0)], bins=(6, 4))
     me = animat.MapElites(config, archive, batch=12, seed=4)
-    for _ in range(6):
-        genomes = engine.ask()
-        assert [g.to_json() for g in genomes] == [g.to_json() for g in me.ask()]
-        told = [stub(g) for g in genomes]
-        assert engine.tell(told)
-        row = me.tell(told, descriptors=[[f.cell_count, f.fitness] if f.viable else None for f in told])
-        assert same(engine.history[-1][:10], [float(x) for x in row]), (engine.history[-1], row)
+    run_both(engine, me)
     assert engine.history[-1][5] > 3  # several elites: a real comparison
 
 
@@ -397,3 +397,103 @@ def test_run_search_hooks_evaluate_and_describe(tmp_path):
     with pytest.raises(ValueError, match="gives no describe hook"):
         _core.run_search(config, tmp_path / "refused", supplied=["shade"], evaluate=evaluate)
     assert not (tmp_path / "refused").exists()
+
+
+def cvt_config(seed, cells=10):
+    config = config_for("map_elites", seed)
+    config["search.archive"] = "cvt"
+    config["search.cells"] = cells
+    config["search.samples"] = 400
+    config["search.ranges"] = [1.0, 65.0, 0.0, 50.0]
+    return config
+
+
+def test_cvt_centroids_are_animat_qd_kmeans_of_the_engine_samples():
+    # Lloyd's k-means of the samples of the engine's keyed stream, as animat.qd.CVTArchive computes
+    # its centroids from its samples: the same numbers, bit for bit.
+    rng = _core.Rng.derive(5, _core.CVT_SAMPLES_KEY, 0)
+    samples = np.array([[rng.uniform() for _ in range(3)] for _ in range(300)])
+    expected = animat.qd._kmeans(samples, 12, 100)
+    assert _core.cvt_centroids(3, 12, 5, 300) == expected.tolist()
+    assert _core.cvt_centroids(3, 12, 5, 300, iterations=0) == samples[:12].tolist()
+    assert len(_core.cvt_centroids(2, 4, 5)) == 4  # samples 0: max(1000, 20 cells)
+    with pytest.raises(ValueError, match="samples = 3: fewer samples than the 4 cells"):
+        _core.cvt_centroids(2, 4, 5, 3)
+    with pytest.raises(ValueError, match=r"cells = 1000000 with samples = 20000000 samples makes 2e\+13"):
+        _core.cvt_centroids(2, 1000000, 5)
+
+
+def test_map_elites_on_a_cvt_archive_is_animat_qd_cvt_archive():
+    # The engine's CVT archive, given animat.qd.CVTArchive's centroids, puts every candidate in
+    # the same cell: the same elites, parents and history as animat.qd.MapElites.
+    descriptors = [("cells", 1.0, 65.0), ("fitness", 0.0, 50.0)]
+    archive = animat.CVTArchive(descriptors, cells=10, seed=2, samples=400)
+    unit = archive.state()["centroids"]
+    engine = _core.SearchEngine(cvt_config(4), centroids=unit)
+    assert engine.archive == {
+        "kind": "cvt",
+        "descriptors": ["cells", "fitness"],
+        "lower": [1.0, 0.0],
+        "upper": [65.0, 50.0],
+        "cells": 10,
+        "centroids": unit,
+    }
+    me = animat.MapElites(config_for("map_elites", 4), archive, batch=12, seed=4)
+    run_both(engine, me)
+    assert [e["index"] for e in engine.elites()] == [e.index for e in archive.elites()]
+    assert len(engine.elites()) > 3  # several elites: a real comparison
+    # a value is scaled to the unit cube, clipped, then put in its nearest centroid's cell
+    points = [[0.0, -10.0], [30.0, 25.0], [100.0, 49.0], [64.9, 0.1]]
+    for p in points:
+        u = np.clip((np.array(p) - [1.0, 0.0]) / [64.0, 50.0], 0.0, 1.0)
+        assert engine.index_of(p) == int(np.argmin(((np.array(unit) - u) ** 2).sum(axis=1))) == archive.index_of(p)
+
+
+def test_cvt_archive_from_the_config_and_its_checks():
+    config = cvt_config(6)
+    engine = _core.SearchEngine(config)
+    assert engine.archive["centroids"] == _core.cvt_centroids(2, 10, 6, 400)
+    genomes = engine.ask()
+    engine.tell([stub(g) for g in genomes])
+    text = engine.checkpoint()
+    again = _core.SearchEngine(config)
+    again.restore(text)
+    assert [(e["index"], e["objective"]) for e in again.elites()] == [
+        (e["index"], e["objective"]) for e in engine.elites()
+    ]
+    other = [[min(1.0, x + 0.01) for x in row] for row in engine.archive["centroids"]]
+    with pytest.raises(ValueError, match="the CVT archive's centroids are not this search's"):
+        _core.SearchEngine(config, centroids=other).restore(text)
+    with pytest.raises(ValueError, match="centroids: row 1 holds 1.5; a centroid lies in the unit cube"):
+        _core.SearchEngine(config, centroids=[[0.5, 0.5], [1.5, 0.0]])
+    with pytest.raises(ValueError, match="centroids: row 0 has 3 values for the 2 descriptors"):
+        _core.SearchEngine(config, centroids=[[0.5, 0.5, 0.5]])
+    with pytest.raises(ValueError, match='centroids: given for search.archive = "grid"'):
+        _core.SearchEngine(config_for("map_elites", 6), centroids=[[0.5, 0.5]])
+    with pytest.raises(ValueError, match="search.cells = 1000000 with search.samples = 20000000 samples"):
+        config["search.samples"] = 0
+        config["search.cells"] = 1000000
+        _core.SearchEngine(config)
+
+
+@pytest.mark.parametrize(
+    "algorithm, reason",
+    [("map_elites", "no elite added or improved"), ("nsga2", "hypervolume not increased")],
+)
+def test_the_stall_rule_stops_a_search_without_improvement(tmp_path, algorithm, reason):
+    # Every genome swims the same: generation 0 fills the archive or sets the hypervolume, and
+    # nothing improves after it; evolution.stall_generations = 3 stops the run at generation 3.
+    config = config_for(algorithm, 2)
+    config["evolution.stall_generations"] = 3
+    config["evolution.generations"] = 50
+
+    def same_swim(genomes):
+        return [animat.Fitness(7.0, True, True, 9, actuation_work_positive=3.0) for _ in genomes]
+
+    run = _core.run_search(config, tmp_path / "run", evaluate=same_swim)
+    assert run["generation"] == 3
+    assert run["stop_reason"] == f"{reason} for evolution.stall_generations = 3 generations"
+    config["evolution.stall_generations"] = 5
+    config["evolution.generations"] = 7
+    resumed = _core.run_search(config, tmp_path / "run", resume=True, evaluate=same_swim)
+    assert resumed["generation"] == 5 and resumed["stop_reason"].startswith(reason)
