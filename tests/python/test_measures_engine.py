@@ -12,6 +12,7 @@ import pytest
 
 import animat
 from animat import shape
+from animat.locomotion import MODES
 
 EXE = os.environ.get("ANIMAT_EVOLVE_EXE")
 
@@ -53,3 +54,42 @@ def test_map_elites_runs_with_the_default_descriptors_and_each_elite_has_its_gen
             for e, x in zip(edges, (want.elongation, want.protrusion_count))
         )
         assert elite["cell"] == column * bins[1] + row
+
+
+def test_map_elites_with_locomotion_classifies_each_elites_own_swim(tmp_path):
+    """search.descriptors = locomotion, cells: each elite carries the mode that animat.classify_locomotion
+    gives its genome, measured during its evaluation (no second swim)."""
+    out = tmp_path / "run"
+    r = subprocess.run(
+        [
+            EXE,
+            *SMALL[:4],
+            "--set",
+            "evaluation.steps=240",
+            "--set",
+            'search.descriptors=["locomotion","cells"]',
+            "--set",
+            "search.bins=[6,16]",
+            "--seed",
+            "4",
+            "--generations",
+            "1",
+            "--threads",
+            "1",
+            "--quiet",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    config = animat.load_config(out / "config.toml")
+    elites = json.loads(json.loads((out / "checkpoint.json").read_text())["payload"])["elites"]
+    assert elites
+    for elite in elites:
+        genome = animat.Genome.from_json(json.dumps(elite["genome"]))
+        want = MODES.index(animat.classify_locomotion(genome, config).mode)
+        assert elite["result"]["locomotion"] == want
