@@ -247,14 +247,14 @@ TEST(Cli, PackagedConfigsWithADotInTheirNameResolveByName) {
 }
 
 TEST(CliErrors, SearchSettingsAnimatEvolveCannotRunAreRefusedBeforeAnyFileIsWritten) {
-  // locomotion is computed by animat.qd (Python); a grid
+  // an unknown measure is refused; a grid
   // too large for memory is refused by its size; the GA must not fill a run directory whose
   // config.toml says otherwise.
   const fs::path out = scratch_dir() / "map_elites_run";
   for (const auto& [flags, message] : std::initializer_list<std::pair<std::string, std::string>>{
            {"--set search.algorithm=map_elites --set "
-            "'search.descriptors=[\"locomotion\",\"cells\"]'",
-            "search.descriptors: no measure \"locomotion\""},
+            "'search.descriptors=[\"gait\",\"cells\"]'",
+            "search.descriptors: no measure \"gait\""},
            {"--set search.algorithm=map_elites --set 'search.descriptors=[\"cells\",\"fitness\"]' "
             "--set 'search.bins=[100000]'",
             "search.bins = [100000, 100000]"},

@@ -59,8 +59,17 @@ def library_nsga2(out, generations=3):
 
 
 def files(run: Path):
-    """Every file of a run directory, by relative path, as bytes."""
-    return {str(p.relative_to(run)): p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()}
+    """Every file of a run directory, by relative path, as bytes; a MAP-Elites checkpoint as its state
+    (history and elites), without the wall-clock seconds the engine records, which differ run to run."""
+    out = {str(p.relative_to(run)): p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()}
+    if out.get("checkpoint.json", b"").startswith(b'{"format": "animat.map_elites/'):
+        me = animat.MapElites.load(run)
+        elites = [
+            (e.index, e.genome.to_json(), e.fitness, e.reference, e.descriptors, e.generation)
+            for e in me.archive.elites()
+        ]
+        out["checkpoint.json"] = repr((me.history.tolist(), elites)).encode()
+    return out
 
 
 def mpirun(*args, ranks=2, timeout=120):
