@@ -4,12 +4,12 @@ the random draws, is excluded from both), on `--threads` threads.
 
     PYTHONPATH=build/python .venv/bin/python bench/map_elites_cost.py [--generations 5] [--threads 1] [--repeat 3]
 
-For each setting it prints the wall time per evaluated offspring (the median of `--repeat` runs, each
-part's median too) and, for MAP-Elites, where it goes:
-the swims (the evaluations, which keep their bodies), the descriptors (computed in Python under the
-GIL from those bodies, as `MapElites.step()` does) and the exploit guard's reference swims
-(`physics.substeps x evaluation.reference_substeps` = 16 x the step, per new elite under "record").
-The GA's guard re-evaluates only each new best of a generation.
+For each setting it prints the wall time per evaluated offspring (the median of `--repeat` runs). MAP-Elites
+runs on the engine's search (`animat.MapElites` over `_core.SearchEngine`): the descriptors that every
+evaluation measures during its own swim (cells, elongation, protrusions, ...) cost nothing more, and
+the exploit guard's reference swims (`physics.substeps x evaluation.reference_substeps` = 16 x the step,
+per new elite under "record") are part of `tell()`. The GA's guard re-evaluates only each new best of a
+generation.
 """
 
 import argparse
@@ -19,24 +19,6 @@ import statistics
 import time
 
 import animat
-from animat import qd
-
-
-class Clock:
-    """Wall time spent in wrapped functions, by name."""
-
-    def __init__(self):
-        self.seconds = {}
-
-    def wrap(self, name, function):
-        def timed(*args, **kwargs):
-            t = time.perf_counter()
-            try:
-                return function(*args, **kwargs)
-            finally:
-                self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t
-
-        return timed
 
 
 def ga_cost(config, generations):
@@ -49,34 +31,12 @@ def ga_cost(config, generations):
 
 
 def map_elites_cost(config, generations, batch, descriptors, bins):
-    clock = Clock()
-    core = qd._core
-    bodies, references = core._evaluate_population_bodies, qd.MapElites._references
-    # step() swims the candidates with the bodies kept and describes them in its swim function
-    # (describe=...): swims = the evaluations, descriptors = the rest of that call.
-    core._evaluate_population_bodies = clock.wrap("swims", bodies)
-    qd.MapElites._references = clock.wrap("reference", references)  # type: ignore[method-assign]
-    try:
-        me = animat.MapElites(config, animat.GridArchive(descriptors, bins), batch=batch)
-        swim = me._swim
-
-        def candidates(genomes, cfg, **options):
-            return (clock.wrap("candidates", swim) if options.get("describe") else swim)(genomes, cfg, **options)
-
-        me._swim = candidates
-        me.step()  # generation 0
-        clock.seconds.clear()
-        n0, t = me.evaluations, time.perf_counter()
-        while me.generation < generations:
-            me.step()
-        total = time.perf_counter() - t
-    finally:
-        core._evaluate_population_bodies, qd.MapElites._references = bodies, references
-    n = me.evaluations - n0
-    seconds = dict(clock.seconds)
-    seconds["descriptors"] = seconds.pop("candidates", 0.0) - seconds.get("swims", 0.0)
-    parts = {k: v / n for k, v in seconds.items()}
-    return total / n, n, parts, me
+    me = animat.MapElites(config, animat.GridArchive(descriptors, bins), batch=batch)
+    me.step()  # generation 0
+    n0, t = me.evaluations, time.perf_counter()
+    while me.generation < generations:
+        me.step()
+    return (time.perf_counter() - t) / (me.evaluations - n0), me.evaluations - n0, me
 
 
 def main() -> None:
@@ -100,16 +60,18 @@ def main() -> None:
         runs = [ga_cost(config, args.generations) for _ in range(args.repeat)]
         per, n = statistics.median(r[0] for r in runs), runs[0][1]
         print(f"GA          reference_check={guard:6s}  {1000 * per:7.1f} ms per evaluation ({n} evaluations)")
-        for descriptors, bins in ((["frequency", "cells"], (10, 64)), (["elongation", "protrusions"], (10, 8))):
+        for descriptors, bins in (
+            (["frequency", "cells"], (10, 64)),
+            (["elongation", "protrusions"], (10, 8)),
+            (["locomotion", "cells"], (6, 64)),
+        ):
             runs = [
                 map_elites_cost(config, args.generations, args.batch, descriptors, bins) for _ in range(args.repeat)
             ]
-            per, n, me = statistics.median(r[0] for r in runs), runs[0][1], runs[0][3]
-            parts = {k: statistics.median(r[2].get(k, 0.0) for r in runs) for k in runs[0][2]}
-            split = ", ".join(f"{k} {1000 * v:.1f}" for k, v in sorted(parts.items()))
+            per, n, me = statistics.median(r[0] for r in runs), runs[0][1], runs[0][2]
             print(
                 f"MAP-Elites  reference_check={guard:6s}  {1000 * per:7.1f} ms per evaluation ({n} evaluations; "
-                f"{'+'.join(descriptors)}: {split} ms; {len(me.archive)} elites, "
+                f"{'+'.join(descriptors)}; {len(me.archive)} elites, "
                 f"{me.history['reference_evaluations'][-1]} reference swims in all)"
             )
 

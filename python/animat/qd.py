@@ -138,8 +138,13 @@ class _Subject:
 
     @cached_property
     def locomotion(self) -> str:
-        from .locomotion import classify_locomotion
+        from .locomotion import MODES, classify_locomotion
 
+        # The engine classifies during the evaluation's own swim when the config's search names
+        # locomotion (Fitness.locomotion >= 0); otherwise the swim is replayed and classified here.
+        measured = int(getattr(self.evaluation, "locomotion", -1))
+        if measured >= 0:
+            return MODES[measured]
         return classify_locomotion(self.genome, self.config).mode
 
     @cached_property
@@ -277,7 +282,9 @@ DESCRIPTORS: Dict[str, Descriptor] = {
             0,
             6,
             _locomotion_index,
-            "`animat.classify_locomotion(genome, config).mode` (replays the swim and classifies it: about 12 evaluations)",
+            "`animat.classify_locomotion(genome, config).mode`: classified during the evaluation's own swim by "
+            "the engine when the config's search names it (MapElites), else by replaying the swim (about 12 "
+            "evaluations)",
         ),
         _table_entry(
             "fitness",
