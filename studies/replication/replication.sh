@@ -35,6 +35,9 @@
 # The paper's discussion (docs/notes/replication_discussion.md) and the controlled runs' section are
 # written for the paper preset only.
 set -euo pipefail
+# One brace group, read whole before anything runs: editing this file while a session runs (for
+# hours) cannot change what the running session does.
+{
 cd "$(dirname "$0")/../.."
 HERE=studies/replication
 SESSION=${1:-5400}
@@ -107,3 +110,5 @@ else
 fi
 "${PY[@]}" "$HERE/replication_report.py" --data "$DATA" --doc "$DOC" "${REPORT_ARGS[@]}"
 if [[ $status -ne 0 && $status -ne 124 && $status -ne 130 ]]; then exit 1; fi
+exit
+}
