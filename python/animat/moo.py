@@ -81,6 +81,7 @@ import numpy as np
 from . import _core
 from .pool import Swim, evaluate_results
 from .qd import (
+    _checked_state,
     _checksum,
     _comparable,
     _on_ranks,
@@ -952,13 +953,7 @@ class Nsga2(_SearchState):
         A checkpoint that is not one or whose checksum does not match its content (edited or
         corrupt) is a ValueError naming ``source`` (the file, for :meth:`load`)."""
         try:
-            if isinstance(state, (str, bytes)):
-                state = json.loads(state)
-            if not isinstance(state, Mapping) or state.get("format") != CHECKPOINT_FORMAT:
-                found = state.get("format") if isinstance(state, Mapping) else type(state).__name__
-                raise ValueError(f"not an Nsga2 checkpoint (format {found!r}, expected {CHECKPOINT_FORMAT})")
-            if state.get("checksum") != _checksum(state):
-                raise ValueError("its checksum does not match its content (edited or corrupt)")
+            state = _checked_state(state, CHECKPOINT_FORMAT, "an Nsga2")
             saved = _core.Config.from_toml(state["config"], source)
         except (ValueError, KeyError, TypeError, AttributeError) as e:
             raise ValueError(f"{source}: {e}") from None

@@ -1030,6 +1030,19 @@ def _checksum(state: Mapping[str, Any]) -> str:
     return hashlib.sha256(body.encode("utf-8")).hexdigest()
 
 
+def _checked_state(state: Any, fmt: str, what: str) -> Mapping[str, Any]:
+    """A checkpoint (a dict, or its JSON text) of format ``fmt`` whose checksum matches its content;
+    ValueError otherwise (``what``: the class it is for)."""
+    if isinstance(state, (str, bytes)):
+        state = json.loads(state)
+    if not isinstance(state, Mapping) or state.get("format") != fmt:
+        found = state.get("format") if isinstance(state, Mapping) else type(state).__name__
+        raise ValueError(f"not {what} checkpoint (format {found!r}, expected {fmt})")
+    if state.get("checksum") != _checksum(state):
+        raise ValueError("its checksum does not match its content (edited or corrupt)")
+    return state
+
+
 class MapElites(_SearchState):
     """MAP-Elites driven by ``ask``/``tell`` (or :meth:`step`), over a :class:`GridArchive` or a
     :class:`CVTArchive`: a thin layer over the engine's search (``animat._core.SearchEngine`` with
@@ -1363,13 +1376,7 @@ class MapElites(_SearchState):
         one, was edited or is inconsistent is a ValueError naming ``source`` (the file, for
         :meth:`load`), and the engine checks its own part (checksum, identity, elites, history)."""
         try:
-            if isinstance(state, (str, bytes)):
-                state = json.loads(state)
-            if not isinstance(state, Mapping) or state.get("format") != CHECKPOINT_FORMAT:
-                found = state.get("format") if isinstance(state, Mapping) else type(state).__name__
-                raise ValueError(f"not a MapElites checkpoint (format {found!r}, expected {CHECKPOINT_FORMAT})")
-            if state.get("checksum") != _checksum(state):
-                raise ValueError("its checksum does not match its content (edited or corrupt)")
+            state = _checked_state(state, CHECKPOINT_FORMAT, "a MapElites")
             saved = _core.Config.from_toml(state["config"], source)
             definition = {**state["archive"], "elites": []}
             batch = int(state["batch"])
