@@ -115,11 +115,13 @@ nb::dict archive_dict(const Archive& a) {
   return d;
 }
 
-nb::dict solution_dict(const Solution& s) {
+nb::dict solution_dict(const Nsga2& nsga, const Solution& s) {
   nb::dict d;
   d["genome"] = s.genome;
   d["fitness"] = s.result;
   d["objectives"] = s.objectives;
+  d["measured"] = nsga.measured(s);
+  d["supplied"] = s.supplied;
   d["reference"] = s.reference;
   d["generation"] = s.generation;
   d["feasible"] = s.feasible;
@@ -150,19 +152,34 @@ void bind_search(nb::module_& m) {
       .def(
           "__init__",
           [](SearchEngine* e, const Config& c, const std::vector<std::string>& supplied,
-             const std::optional<std::vector<std::vector<double>>>& centroids) {
+             const std::optional<std::vector<std::vector<double>>>& centroids,
+             nb::object reference) {
             new (e)
                 SearchEngine{make_search(c, {}, {}, nullptr, supplied,
                                          centroids.value_or(std::vector<std::vector<double>>{}))};
+            if (!reference.is_none())
+              // called from tell() (GIL released) with the GIL; never copied without it
+              e->search->set_reference_hook([reference](const std::vector<Genome>& genomes) {
+                nb::gil_scoped_acquire gil;
+                auto [fitness, values] =
+                    nb::cast<std::pair<std::vector<Fitness>, std::vector<std::vector<double>>>>(
+                        reference(genomes));
+                return Search::ReferenceSwims{std::move(fitness), std::move(values)};
+              });
           },
           "config"_a, "supplied"_a = std::vector<std::string>{}, "centroids"_a = nb::none(),
+          "reference"_a = nb::none(),
           "The search of config (search.algorithm); a [search] setting it cannot run is a "
           "ValueError naming\nthe key and value. supplied: names of search.descriptors "
           "(MAP-Elites; their ranges in\nsearch.ranges) or of search.objectives entries (NSGA-II; "
           "each entry NAME:max or NAME:min) whose\nvalues the caller computes and passes to "
           "tell(fitness, values), a row per genome in supplied order. centroids:\na CVT "
           "archive's (search.archive = \"cvt\"), one row per cell in the unit cube; None: "
-          "cvt_centroids of\nsearch.cells, evolution.seed and search.samples.")
+          "cvt_centroids of\nsearch.cells, evolution.seed and search.samples. reference: the "
+          "exploit guard's reference swims by the\ncaller (MAP-Elites, NSGA-II), "
+          "reference(genomes) "
+          "-> (a Fitness per genome, a row of supplied\nvalues per genome), both at the reference "
+          "step (animat.reference_config); None: the engine's.")
       .def_prop_ro("algorithm",
                    [](const SearchEngine& e) { return std::string(e.search->algorithm()); })
       .def(
@@ -271,12 +288,13 @@ void bind_search(nb::module_& m) {
           [](const SearchEngine& e) {
             SearchLease lease(e, "population");
             nb::list out;
-            for (const Solution& s : engine_as<Nsga2>(e, "population", "nsga2").population())
-              out.append(solution_dict(s));
+            const auto& nsga = engine_as<Nsga2>(e, "population", "nsga2");
+            for (const Solution& s : nsga.population()) out.append(solution_dict(nsga, s));
             return out;
           },
           "NSGA-II: the population in order, each a dict: genome, fitness (Fitness), objectives "
-          "(what the\nselection compares, one per criterion; NaN when infeasible), reference (the "
+          "(what the\nselection compares, one per criterion; NaN when infeasible), measured (the "
+          "criteria of its own\nswim), supplied (the supplied criteria's values), reference (the "
           "criteria at the\nexploit guard's reference step; empty when not evaluated there), "
           "generation, feasible, rank,\ncrowding.")
       .def(
@@ -299,6 +317,16 @@ void bind_search(nb::module_& m) {
           },
           "NSGA-II: the hypervolume's reference point, one value per criterion (empty until "
           "set).")
+      .def(
+          "set_reference_point",
+          [](SearchEngine& e, std::vector<double> point) {
+            SearchLease lease(e, "set_reference_point");
+            engine_as<Nsga2>(e, "set_reference_point", "nsga2")
+                .set_reference_point(std::move(point));
+          },
+          "point"_a,
+          "NSGA-II: fixes the hypervolume's reference point, one finite value per criterion, "
+          "before the first\ngeneration (otherwise the worst of the first feasible candidates).")
       .def_prop_ro(
           "criteria",
           [](const SearchEngine& e) {

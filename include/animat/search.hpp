@@ -172,10 +172,24 @@ class Search {
   virtual void restore(std::string_view text, std::string_view source) = 0;
   /// Checked between evaluations by step().
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
+  /// The exploit guard's reference swims, computed by the caller: the Fitness of every genome at
+  /// the reference step and the supplied measures' values there (a row each, supplied() order;
+  /// none when the search supplies no measure).
+  struct ReferenceSwims {
+    std::vector<Fitness> fitness;
+    std::vector<std::vector<double>> supplied;
+  };
+  using ReferenceHook = std::function<ReferenceSwims(const std::vector<Genome>&)>;
+  /// Replaces the reference swims of the exploit guard (MapElites, Nsga2; the GA: Error) by the
+  /// caller's, e.g. criteria that only the caller computes; the guard still runs only where it
+  /// did (evaluation.reference_check, and a reference function given: make_search gives one).
+  /// What the hook throws leaves the tell changing nothing.
+  void set_reference_hook(ReferenceHook hook);
 
  protected:
   StopRequest stop_;
   std::shared_ptr<Evaluator> evaluator_;
+  ReferenceHook reference_hook_;
 };
 
 /// The search of config.search.algorithm: `fitness` (default swim_fitness(config)) evaluates on
@@ -443,6 +457,14 @@ class Nsga2 final : public Search {
   /// The hypervolume's reference point: the worst value of every criterion over the feasible
   /// candidates of the first generation that had any (empty until then).
   [[nodiscard]] const std::vector<double>& reference_point() const { return reference_point_; }
+  /// Fixes the reference point instead (one finite value per criterion), before the first
+  /// generation; the checkpoint keeps it. Error otherwise.
+  void set_reference_point(std::vector<double> point);
+  /// The criteria of a member's own swim (the step's, before any reference), NaN when not
+  /// feasible.
+  [[nodiscard]] std::vector<double> measured(const Solution& s) const {
+    return criteria_of(s.result, s.supplied);
+  }
   /// The criteria's names, as search.objectives names them, in order.
   [[nodiscard]] const std::vector<std::string>& criteria() const { return names_; }
   /// Whether each criterion is maximised (else minimised), in criteria() order.

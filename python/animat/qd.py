@@ -63,7 +63,6 @@ import math
 import os
 import shutil
 import socket
-import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -1203,7 +1202,6 @@ class MapElites(_SearchState):
             raise ValueError(f"MapElites.tell: {len(results)} results for the {len(genomes)} genomes asked")
         if descriptors is not None and len(descriptors) != len(genomes):
             raise ValueError(f"MapElites.tell: {len(descriptors)} descriptor rows for {len(genomes)} genomes")
-        limit = sys.float_info.max / self.archive.cells
         fits = []
         for i, r in enumerate(results):
             if isinstance(r, (str, bytes)):
@@ -1212,11 +1210,6 @@ class MapElites(_SearchState):
                 fit = to_fitness(r)
             except (TypeError, ValueError) as e:
                 raise type(e)(f"MapElites.tell: value {i} ({r!r:.60}): {e}") from None
-            if abs(fit.fitness) > limit:
-                raise ValueError(
-                    f"MapElites.tell: value {i}: fitness {fit.fitness!r} is beyond ±{limit:.6g}, where the "
-                    f"QD-score of {self.archive.cells} cells could overflow; nothing was told"
-                )
             fits.append(fit)
         told, rows = [], []
         for i, (genome, fit, raw) in enumerate(zip(genomes, fits, results)):

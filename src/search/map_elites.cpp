@@ -301,6 +301,13 @@ bool MapElites::tell(const std::vector<Fitness>& fitness,
                          nonnegative ? fmt::format(" and >= 0 under evaluation.objective = \"{}\"",
                                                    config_->evaluation.objective)
                                      : std::string()));
+    // The QD-score sums one objective per cell: beyond this bound the sum could overflow.
+    const double limit = std::numeric_limits<double>::max() / static_cast<double>(archive_.cells());
+    if (std::abs(f.fitness) > limit)
+      refuse("MapElites", k,
+             fmt::format("fitness {} is beyond +-{:.6g}, where the QD-score of {} cells could "
+                         "overflow",
+                         f.fitness, limit, archive_.cells()));
     if (f.cell_count < 0) refuse("MapElites", k, fmt::format("cell_count {}", f.cell_count));
     if (!archivable(f)) continue;
     if (own > 0 && supplied[k].size() != own)
@@ -327,7 +334,9 @@ bool MapElites::tell(const std::vector<Fitness>& fitness,
   if (select_) {
     std::vector<const Genome*> todo;
     for (std::size_t k : candidates) todo.push_back(&genomes[k]);
-    const auto refs = evaluate_references(reference_, *config_, todo, "MapElites.tell");
+    const auto refs = evaluate_references(reference_, reference_hook_, *config_, todo,
+                                          supplied_->names.size(), "MapElites.tell")
+                          .fitness;
     for (std::size_t r = 0; r < candidates.size(); ++r)
       objective[candidates[r]] = reference[candidates[r]] = refs[r].fitness;
   }
@@ -355,7 +364,9 @@ bool MapElites::tell(const std::vector<Fitness>& fitness,
   if (reference_ && !select_) {
     std::vector<const Genome*> todo;
     for (const auto& [cell, k] : winner) todo.push_back(&genomes[k]);
-    const auto refs = evaluate_references(reference_, *config_, todo, "MapElites.tell");
+    const auto refs = evaluate_references(reference_, reference_hook_, *config_, todo,
+                                          supplied_->names.size(), "MapElites.tell")
+                          .fitness;
     std::size_t r = 0;
     for (const auto& [cell, k] : winner) reference[k] = refs[r++].fitness;
   }

@@ -261,9 +261,13 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness,
         first.push_back(k);
         todo.push_back(&candidates[k].genome);
       }
-    const auto refs = evaluate_references(reference_, *config_, todo, "Nsga2.tell");
-    for (std::size_t r = 0; r < first.size(); ++r)
-      candidates[first[r]].reference = criteria_of(refs[r], candidates[first[r]].supplied);
+    const auto refs =
+        evaluate_references(reference_, reference_hook_, *config_, todo, own, "Nsga2.tell");
+    for (std::size_t r = 0; r < first.size(); ++r) {
+      Solution& s = candidates[first[r]];
+      s.reference =
+          criteria_of(refs.fitness[r], refs.supplied.empty() ? s.supplied : refs.supplied[r]);
+    }
     referenced = static_cast<std::int64_t>(first.size());
     for (Solution& s : candidates) {
       if (!s.feasible) continue;
@@ -313,9 +317,13 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness,
         pending.push_back(k);
         todo.push_back(&population[k].genome);
       }
-    const std::vector<Fitness> refs = evaluate_references(reference_, *config_, todo, "Nsga2.tell");
-    for (std::size_t r = 0; r < pending.size(); ++r)
-      population[pending[r]].reference = criteria_of(refs[r], population[pending[r]].supplied);
+    const auto refs =
+        evaluate_references(reference_, reference_hook_, *config_, todo, own, "Nsga2.tell");
+    for (std::size_t r = 0; r < pending.size(); ++r) {
+      Solution& s = population[pending[r]];
+      s.reference =
+          criteria_of(refs.fitness[r], refs.supplied.empty() ? s.supplied : refs.supplied[r]);
+    }
     referenced = static_cast<std::int64_t>(pending.size());
   }
   // 4. Commit.
@@ -328,6 +336,22 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness,
   history_.push_back(row(population_, reference_point_, discarded, copies));
   history_.back().back() = wall_offset_ + now_seconds() - started_;
   return true;
+}
+
+void Nsga2::set_reference_point(std::vector<double> point) {
+  if (generation_ >= 0)
+    throw Error(fmt::format(
+        "Nsga2.set_reference_point: the reference point is fixed before the first generation (this "
+        "search is at generation {})",
+        generation_));
+  if (point.size() != criteria_.size())
+    throw Error(fmt::format("Nsga2.set_reference_point: {} values for the {} criteria",
+                            point.size(), criteria_.size()));
+  for (std::size_t j = 0; j < point.size(); ++j)
+    if (!std::isfinite(point[j]))
+      throw Error(fmt::format("Nsga2.set_reference_point: {} = {} (it must be finite)", names_[j],
+                              point[j]));
+  reference_point_ = std::move(point);
 }
 
 std::vector<const Solution*> Nsga2::front() const {

@@ -117,6 +117,14 @@ bool Search::tell(const std::vector<Fitness>& fitness,
   return tell(fitness);
 }
 
+void Search::set_reference_hook(ReferenceHook hook) {
+  if (algorithm() == "ga")
+    throw Error(
+        "set_reference_hook: the GA's exploit guard swims with the config's own evaluation; a "
+        "reference hook is MAP-Elites' or NSGA-II's");
+  reference_hook_ = std::move(hook);
+}
+
 const std::vector<std::string>& Search::supplied() const {
   static const std::vector<std::string> none;
   return none;
@@ -436,16 +444,38 @@ void refuse(std::string_view who, std::size_t k, const std::string& what) {
                           k, what));
 }
 
-std::vector<Fitness> evaluate_references(const FitnessFunction& reference, const Config& config,
-                                         const std::vector<const Genome*>& genomes,
-                                         std::string_view who) {
-  std::vector<Fitness> out(genomes.size());
-  parallel_for(genomes.size(), config.evolution.threads,
-               [&](std::size_t k) { out[k] = reference(*genomes[k]); });
-  for (std::size_t k = 0; k < out.size(); ++k)
-    if (!std::isfinite(out[k].fitness))
+Search::ReferenceSwims evaluate_references(const FitnessFunction& reference,
+                                           const Search::ReferenceHook& hook, const Config& config,
+                                           const std::vector<const Genome*>& genomes,
+                                           std::size_t supplied, std::string_view who) {
+  Search::ReferenceSwims out;
+  if (genomes.empty()) return out;
+  if (hook) {
+    std::vector<Genome> copies;
+    copies.reserve(genomes.size());
+    for (const Genome* g : genomes) copies.push_back(*g);
+    out = hook(copies);
+    if (out.fitness.size() != genomes.size())
+      throw Error(fmt::format("{}: the reference hook gave {} fitness values for {} genomes", who,
+                              out.fitness.size(), genomes.size()));
+    if (supplied > 0 && out.supplied.size() != genomes.size())
+      throw Error(
+          fmt::format("{}: the reference hook gave {} rows of supplied values for {} genomes", who,
+                      out.supplied.size(), genomes.size()));
+    for (std::size_t k = 0; k < out.supplied.size(); ++k)
+      if (out.supplied[k].size() != supplied)
+        throw Error(fmt::format(
+            "{}: the reference hook gave {} supplied values for genome {}; the search supplies {}",
+            who, out.supplied[k].size(), k, supplied));
+  } else {
+    out.fitness.resize(genomes.size());
+    parallel_for(genomes.size(), config.evolution.threads,
+                 [&](std::size_t k) { out.fitness[k] = reference(*genomes[k]); });
+  }
+  for (std::size_t k = 0; k < out.fitness.size(); ++k)
+    if (!std::isfinite(out.fitness[k].fitness))
       throw Error(fmt::format("{}: the exploit guard's reference evaluation {} gave fitness {}",
-                              who, k, out[k].fitness));
+                              who, k, out.fitness[k].fitness));
   return out;
 }
 

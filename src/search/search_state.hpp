@@ -98,9 +98,12 @@ void check_supplied_rows(std::string_view who, std::size_t own, std::size_t rows
 /// Error of a tell(): "WHO.tell: value K (genome K of the last ask()) is refused: WHAT".
 [[noreturn]] void refuse(std::string_view who, std::size_t k, const std::string& what);
 
-/// The reference fitness of `genomes` (the exploit guard), each checked finite.
-std::vector<Fitness> evaluate_references(const FitnessFunction& reference, const Config& config,
-                                         const std::vector<const Genome*>& genomes,
-                                         std::string_view who);
+/// The reference swims of `genomes` (the exploit guard): the caller's `hook` where it is set
+/// (its rows checked against the `supplied` measures' count), else `reference` on the config's
+/// threads (no rows); each fitness checked finite.
+Search::ReferenceSwims evaluate_references(const FitnessFunction& reference,
+                                           const Search::ReferenceHook& hook, const Config& config,
+                                           const std::vector<const Genome*>& genomes,
+                                           std::size_t supplied, std::string_view who);
 
 }  // namespace animat::search_state

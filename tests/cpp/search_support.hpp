@@ -3,10 +3,12 @@
 // the descriptors and criteria read, histories without their wall-clock column, and checkpoints
 // edited by hand (resealed with a valid checksum) or by one digit.
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <cctype>
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -33,6 +35,19 @@ inline Fitness search_stub(const Genome& g) {
   f.actuation_work_positive = f.fitness * (1.0 + static_cast<double>((h >> 8) % 100) / 50.0);
   f.max_speed = static_cast<double>((h >> 20) % 100) / 10.0;
   return f;
+}
+
+// Expects `run` to throw an E whose message holds every one of `parts`.
+template <class E = ConfigError>
+inline void expect_error(const std::function<void()>& run,
+                         std::initializer_list<std::string> parts) {
+  try {
+    run();
+    ADD_FAILURE() << "no error";
+  } catch (const E& e) {
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
 }
 
 /// History rows without their last column (wall_seconds, the only machine-dependent one).

@@ -18,6 +18,7 @@
 #include "test_support.hpp"
 
 using namespace animat;
+using animat::test::expect_error;
 using animat::test::refused_digit_changes;
 using animat::test::reseal;
 using animat::test::search_stub;
@@ -234,4 +235,82 @@ TEST(Nsga2, TheSelectGuardComparesTheReferenceCriteria) {
   resumed.step();
   nsga.step();
   EXPECT_EQ(without_wall(resumed.history()), without_wall(nsga.history()));
+}
+
+TEST(Nsga2, AReferenceHookGivesTheSuppliedCriteriaAtTheReferenceStep) {
+  Config c = nsga_config();
+  c.search.objectives = {"distance:max", "reach:min"};
+  c.evaluation.reference_check = "select";
+  const auto reach = [](const Genome& g) { return static_cast<double>(genome_hash(g) % 1000); };
+  Nsga2 nsga(c, search_stub, search_stub, make_local_evaluator(search_stub, 1), {"reach"});
+  int calls = 0;
+  nsga.set_reference_hook([&](const std::vector<Genome>& genomes) {
+    ++calls;
+    Search::ReferenceSwims out;
+    for (const Genome& g : genomes) {
+      Fitness f = search_stub(g);
+      f.fitness *= 0.5;
+      out.fitness.push_back(f);
+      out.supplied.push_back({2.0 * reach(g)});
+    }
+    return out;
+  });
+  const auto tell = [&] {
+    const std::vector<Genome> asked = nsga.ask();
+    std::vector<Fitness> f;
+    std::vector<std::vector<double>> rows;
+    for (const Genome& g : asked) {
+      f.push_back(search_stub(g));
+      rows.push_back({reach(g)});
+    }
+    return nsga.tell(f, rows);
+  };
+  for (int g = 0; g < 3; ++g) ASSERT_TRUE(tell());
+  EXPECT_EQ(calls, 3);
+  int feasible = 0;
+  for (const Solution& s : nsga.population()) {
+    if (!s.feasible) continue;
+    ++feasible;
+    const double own = reach(s.genome);
+    EXPECT_EQ(s.reference, (std::vector<double>{0.5 * s.result.fitness, 2.0 * own}));
+    EXPECT_EQ(s.objectives, s.reference);  // "select" compares the hook's values
+    EXPECT_EQ(nsga.measured(s), (std::vector<double>{s.result.fitness, own}));
+  }
+  EXPECT_GT(feasible, 0);
+  // A hook that gives rows of the wrong width is refused, and the tell changes nothing.
+  const std::string before = nsga.checkpoint();
+  nsga.set_reference_hook([](const std::vector<Genome>& genomes) {
+    Search::ReferenceSwims out;
+    for (const Genome& g : genomes) {
+      out.fitness.push_back(search_stub(g));
+      out.supplied.push_back({1.0, 2.0});
+    }
+    return out;
+  });
+  expect_error<Error>([&] { tell(); }, {"reference hook gave 2 supplied values", "supplies 1"});
+  EXPECT_EQ(nsga.checkpoint(), before);
+  // The GA has its own guard.
+  Config ga = c;
+  ga.search.algorithm = "ga";
+  auto search = make_search(ga, search_stub);
+  expect_error<Error>([&] { search->set_reference_hook({}); }, {"GA's exploit guard"});
+}
+
+TEST(Nsga2, AGivenReferencePointIsKeptAndSavedAndFixedBeforeTheFirstGeneration) {
+  Nsga2 nsga = make(nsga_config());
+  expect_error<Error>([&] { nsga.set_reference_point({1.0}); }, {"1 values for the 2 criteria"});
+  expect_error<Error>([&] { nsga.set_reference_point({0.0, inf}); },
+                      {"actuation_work_positive = inf"});
+  nsga.set_reference_point({0.0, 1000.0});
+  for (int g = 0; g < 2; ++g) nsga.step();
+  EXPECT_EQ(nsga.reference_point(), (std::vector<double>{0.0, 1000.0}));
+  // the hypervolume against it, by hand: the front's staircase up to (0, 1000)
+  std::vector<std::vector<double>> front;
+  for (const Solution* s : nsga.front()) front.push_back({-s->objectives[0], s->objectives[1]});
+  EXPECT_EQ(nsga.history().back()[3], hypervolume(front, std::vector<double>{0.0, 1000.0}));
+  Nsga2 resumed = make(nsga_config());
+  resumed.restore(nsga.checkpoint(), "checkpoint.json");
+  EXPECT_EQ(resumed.reference_point(), nsga.reference_point());
+  expect_error<Error>([&] { resumed.set_reference_point({0.0, 1.0}); },
+                      {"before the first generation"});
 }
