@@ -72,6 +72,7 @@ import io
 import json
 import math
 import os
+import weakref
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, cast
@@ -108,7 +109,7 @@ __all__ = [
 PathLike = Union[str, "os.PathLike[str]"]
 
 #: Version tag of :meth:`Nsga2.checkpoint`.
-CHECKPOINT_FORMAT = "animat.nsga2/2"
+CHECKPOINT_FORMAT = "animat.nsga2/3"
 
 _SENSES = {"max": "max", "maximize": "max", "maximise": "max", "min": "min", "minimize": "min", "minimise": "min"}
 
@@ -508,43 +509,26 @@ def history_dtype(names: Sequence[str]) -> np.dtype:
     )
 
 
-def _copies(pool: Sequence[Solution]) -> List[int]:
-    """The members of ``pool`` whose genome equals that of an earlier member."""
-    seen = set()
-    out = []
-    for i, s in enumerate(pool):
-        key = s.genome.to_json()
-        if key in seen:
-            out.append(i)
-        seen.add(key)
-    return out
-
-
-def _enc(x: float) -> Any:
-    """A float for JSON (allow_nan=False): NaN as null, infinities as strings."""
-    if math.isnan(x):
-        return None
-    if math.isinf(x):
-        return "inf" if x > 0 else "-inf"
-    return float(x)
-
-
-def _dec(x: Any) -> float:
-    return float("nan") if x is None else float(x)
-
-
-def _floats(values: Optional[Iterable[Any]]) -> Optional[Floats]:
-    return None if values is None else tuple(_dec(v) for v in values)
+def _floats(values: Iterable[Any]) -> Floats:
+    return tuple(float(v) for v in values)
 
 
 #: The largest NSGA-II population (the engine's bound): the selection compares every pair of the
 #: 2 × population parents and candidates.
 MAX_POPULATION = 10_000
 
+# What a candidate without a feasible point is told (not valid: the engine counts it discarded).
+_INFEASIBLE = _core.Fitness(0.0, True, True, 0, False)
+# What a candidate told its objective values directly is told with them.
+_TOLD_VALUES = _core.Fitness(0.0, True, True, 0)
+
 
 class Nsga2(_SearchState):
     """NSGA-II driven by ``ask``/``tell`` (or :meth:`step`) over several objectives (see the module
-    docstring for the objectives, what is feasible and the exploit guard).
+    docstring for the objectives, what is feasible and the exploit guard): a thin layer over the
+    engine's search (``animat._core.SearchEngine``, ``search.algorithm = "nsga2"``), which draws,
+    sorts, selects, runs the exploit guard and checkpoints as ``animat_evolve`` does; the criteria
+    are computed here, from each evaluation, and told to it.
 
     ``ask()`` returns the candidates of generation g = ``generation + 1``: for generation 0,
     ``population`` random viable genomes, genome i drawn by
@@ -564,7 +548,8 @@ class Nsga2(_SearchState):
     decreasing crowding distance (equal distances: parents first, then in ``ask()`` order), then, if
     fewer than ``population`` are feasible and distinct, copies and infeasible ones in that order. The new
     population keeps that order, and each member the rank and crowding distance it had in the
-    selection (those of the fronts of parents and candidates together, as in Deb et al.).
+    selection (those of the fronts of parents and candidates together, as in Deb et al.). A tell is
+    all or nothing: a refused value (an error naming it) changes nothing.
 
     Example::
 
@@ -579,9 +564,10 @@ class Nsga2(_SearchState):
             ``evaluation.objective`` must be a built-in (the ``fitness`` criterion).
         objectives: the criteria (see the module docstring).
         population: the population size N, also the offspring per generation (default
-            ``evolution.population``).
-        seed: the run's seed (default ``evolution.seed``; it is written into the config).
-        crossover_fraction: share of offspring made by crossover (default ``evolution.crossover_fraction``).
+            ``evolution.population``; written into the config).
+        seed: the run's seed (default ``evolution.seed``; written into the config).
+        crossover_fraction: share of offspring made by crossover (default ``evolution.crossover_fraction``;
+            written into the config).
         reference_point: the hypervolume's reference point, one value per objective, in the
             objectives' units (e.g. ``(0.0, 1e5)``: no distance, a work of 1e5). Default: the worst
             value of every objective over the feasible candidates of the first generation that has
@@ -603,9 +589,6 @@ class Nsga2(_SearchState):
     ) -> None:
         self.criteria: Tuple[Criterion, ...] = _criteria(objectives)
         self._config = _core.Config() if config is None else config.copy()
-        # The run's config.toml says what it is (`animat evolve --resume` dispatches on it).
-        self._config["search.algorithm"] = "nsga2"
-        self._config["search.objectives"] = [f"{c.name}:{c.sense}" for c in self.criteria]
         objective = str(self._config["evaluation.objective"])
         if objective.startswith("python:"):
             raise ValueError(
@@ -622,19 +605,16 @@ class Nsga2(_SearchState):
             self._config["evolution.seed"] = int(seed)
         if threads is not None:
             self._config["evolution.threads"] = int(threads)
-        self.seed = int(self._config["evolution.seed"])
-        self.population_size = int(self._config["evolution.population"]) if population is None else int(population)
+        size = int(self._config["evolution.population"]) if population is None else int(population)
         cf = float(self._config["evolution.crossover_fraction"]) if crossover_fraction is None else crossover_fraction
-        self.crossover_fraction = float(cf)
-        if not 1 <= self.population_size <= MAX_POPULATION:
+        if not 1 <= size <= MAX_POPULATION:
             raise ValueError(
-                f"Nsga2: population (evolution.population) = {self.population_size}: it must be 1 to "
+                f"Nsga2: population (evolution.population) = {size}: it must be 1 to "
                 f"{MAX_POPULATION} (the selection compares every pair of parents and candidates)"
             )
-        if not 0.0 <= self.crossover_fraction <= 1.0:
-            raise ValueError(f"Nsga2: crossover_fraction must be in [0, 1], got {self.crossover_fraction}")
-        self._reference_point: Optional[Floats] = None
-        self._reference_point_given = reference_point is not None
+        if not 0.0 <= float(cf) <= 1.0:
+            raise ValueError(f"Nsga2: crossover_fraction must be in [0, 1], got {cf}")
+        point: Optional[Floats] = None
         if reference_point is not None:
             point = tuple(float(x) for x in reference_point)
             if len(point) != len(self.criteria) or not all(math.isfinite(x) for x in point):
@@ -642,14 +622,24 @@ class Nsga2(_SearchState):
                     f"Nsga2: reference_point needs {len(self.criteria)} finite values (one per objective), "
                     f"got {list(reference_point)}"
                 )
-            self._reference_point = point
-        self._guard = str(self._config["evaluation.reference_check"])
+        # The run's config.toml says what it is (`animat evolve --resume` dispatches on it).
+        self._config["evolution.population"] = size
+        self._config["evolution.crossover_fraction"] = float(cf)
+        self._config["search.algorithm"] = "nsga2"
+        self._config["search.objectives"] = [f"{c.name}:{c.sense}" for c in self.criteria]
+        self.seed = int(self._config["evolution.seed"])
+        self.population_size = size
+        self.crossover_fraction = float(cf)
+        self._reference_point_given = point is not None
         self._swim = evaluate_results
-        self._generation = -1
-        self._evaluations = 0
-        self._reference_evaluations = 0
-        self._history: List[Tuple[Any, ...]] = []
-        self._population: List[Solution] = []
+        # Every criterion is computed here (from an EvaluationResult, or told as a value), so the
+        # engine is told them all, at the run's step and, through the hook, at the reference step.
+        guarded = str(self._config["evaluation.reference_check"]) != "off"
+        self._engine = _core.SearchEngine(
+            self._config, supplied=list(self.names), reference=_reference_hook(self) if guarded else None
+        )
+        if point is not None:
+            self._engine.set_reference_point(list(point))
         self._asked: Optional[List[Any]] = None
 
     # --- names ------------------------------------------------------------------------------------
@@ -666,7 +656,8 @@ class Nsga2(_SearchState):
     @property
     def reference_point(self) -> Optional[Floats]:
         """The hypervolume's reference point (None until it is set; see the class docstring)."""
-        return self._reference_point
+        point = self._engine.reference_point
+        return _floats(point) if len(point) else None
 
     @property
     def history_dtype(self) -> np.dtype:
@@ -677,32 +668,8 @@ class Nsga2(_SearchState):
     def ask(self) -> List[Any]:
         """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
         if self._asked is None:
-            self._asked = self._draw(self._generation + 1)
+            self._asked = self._engine.ask()
         return list(self._asked)
-
-    def _draw(self, g: int) -> List[Any]:
-        cfg = self._config
-        n = self.population_size
-        if not self._population:
-            return [_core.Genome.random_viable(_core.Rng.derive(self.seed, g, i), cfg)[0] for i in range(n)]
-        points = int(cfg["mutation.crossover_points"])
-        out = []
-        for i in range(n):
-            rng = _core.Rng.derive(self.seed, g, i)
-            child = self._tournament(rng).genome
-            if rng.uniform() < self.crossover_fraction:
-                other = self._tournament(rng).genome
-                child = child.crossover(other, rng, points)
-            out.append(child.mutate(rng, cfg))
-        return out
-
-    def _tournament(self, rng: Any) -> Solution:
-        top = len(self._population) - 1
-        a = self._population[rng.integer(0, top)]
-        b = self._population[rng.integer(0, top)]
-        if b.rank < a.rank or (b.rank == a.rank and b.crowding > a.crowding):
-            return b
-        return a
 
     def _measure(self, genome: Any, result: Any, config: Any) -> Tuple[Floats, bool]:
         m = len(self.criteria)
@@ -728,6 +695,23 @@ class Nsga2(_SearchState):
                 raise ValueError(f"{len(values)} values for the {m} objectives {self.names}")
         return values, all(math.isfinite(x) for x in values)
 
+    def _told(self, genomes: Sequence[Any], results: Sequence[Any], config: Any) -> Tuple[List[Any], List[List[float]]]:
+        """What the engine is told of ``results``: a Fitness and the criteria's values for each."""
+        fits, rows = [], []
+        for i, (genome, r) in enumerate(zip(genomes, results)):
+            try:
+                values, ok = self._measure(genome, r, config)
+            except (TypeError, ValueError) as e:
+                raise type(e)(f"Nsga2.tell: value {i} ({r!r:.60}): {e}") from None
+            if not ok:
+                fits.append(_INFEASIBLE if r is not None else _core.Fitness(0.0, False, True, 0))
+            elif isinstance(r, _core.EvaluationResult):
+                fits.append(_core.fitness_of(r))
+            else:
+                fits.append(_TOLD_VALUES)
+            rows.append(list(values))
+        return fits, rows
+
     def tell(self, results: Sequence[Any]) -> Any:
         """The result of every genome of the last ``ask()``, in order (see the class docstring);
         completes the generation and returns its history row (a numpy record)."""
@@ -736,121 +720,15 @@ class Nsga2(_SearchState):
         genomes = self._asked
         if len(results) != len(genomes):
             raise ValueError(f"Nsga2.tell: {len(results)} results for the {len(genomes)} genomes asked")
-        measured: List[Tuple[Floats, bool]] = []
-        for i, (genome, r) in enumerate(zip(genomes, results)):
-            try:
-                measured.append(self._measure(genome, r, self._config))
-            except (TypeError, ValueError) as e:
-                raise type(e)(f"Nsga2.tell: value {i} ({r!r:.60}): {e}") from None
-        g = self._generation + 1
-        keys = [genome.to_json() for genome in genomes]
-        references: List[Optional[Floats]] = [None] * len(genomes)
-        if self._guard == "select":
-            # A copy of a genome seen before (a parent, an earlier candidate) has its reference: the same swim.
-            known: Dict[str, Optional[Floats]] = {}
-            for s in self._population:
-                known.setdefault(s.genome.to_json(), s.reference)
-            first: List[int] = []
-            for i, (key, (_, ok)) in enumerate(zip(keys, measured)):
-                if ok and key not in known:
-                    known[key] = None
-                    first.append(i)
-            for i, ref in zip(first, self._references([genomes[i] for i in first])):
-                known[keys[i]] = ref
-            references = [known.get(key) if ok else None for key, (_, ok) in zip(keys, measured)]
-        candidates = []
-        for genome, (values, ok), ref in zip(genomes, measured, references):
-            if self._guard == "select":
-                objectives = ref if ref is not None else values
-                ok = ok and ref is not None and all(math.isfinite(x) for x in ref)
-            else:
-                objectives = values
-            candidates.append(Solution(genome, objectives, values, ref, g, ok))
-        if self._reference_point is None:
-            feasible = [s.objectives for s in candidates if s.feasible]
-            if feasible:
-                worst = np.array(feasible)
-                self._reference_point = tuple(
-                    float(worst[:, j].min() if c.maximize else worst[:, j].max()) for j, c in enumerate(self.criteria)
-                )
-        pool = self._population + candidates
-        copies = _copies(pool)
-        population = self._select(pool, self.population_size, copies)
-        if self._guard == "record":
-            pending = [k for k, s in enumerate(population) if s.rank == 0 and s.feasible and s.reference is None]
-            for k, ref in zip(pending, self._references([population[k].genome for k in pending])):
-                population[k] = replace(population[k], reference=ref)
-        self._population = population
-        self._evaluations += len(genomes)
-        self._generation = g
+        fits, rows = self._told(genomes, results, self._config)
+        self._engine.tell(fits, rows)
         self._asked = None
-        discarded = sum(1 for s in candidates if not s.feasible)
-        self._history.append(self._row(g, discarded, sum(1 for i in copies if i >= len(pool) - len(candidates))))
         return self.history[-1]
 
-    def _select(self, pool: List[Solution], n: int, copies: Iterable[int] = ()) -> List[Solution]:
-        copied = set(copies)
-        feasible = [i for i, s in enumerate(pool) if s.feasible and i not in copied]
-        values = np.array([pool[i].objectives for i in feasible], dtype=np.float64).reshape(-1, len(self.criteria))
-        fronts = non_dominated_sort(values, self.senses)
-        rank: Dict[int, int] = {}
-        crowding: Dict[int, float] = {}
-        chosen: List[int] = []
-        for k, front in enumerate(fronts):
-            if len(chosen) >= n:
-                break
-            members = [feasible[i] for i in front]
-            d = crowding_distance(values[front])
-            for i, x in zip(members, d):
-                rank[i], crowding[i] = k, float(x)
-            if len(chosen) + len(members) <= n:
-                chosen += members
-            else:
-                order = sorted(range(len(members)), key=lambda j: (-d[j], members[j]))
-                chosen += [members[j] for j in order[: n - len(chosen)]]
-        for i, s in enumerate(pool):
-            if not s.feasible or i in copied:
-                rank[i], crowding[i] = len(fronts), 0.0
-                if len(chosen) < n:
-                    chosen.append(i)
-        return [replace(pool[i], rank=rank[i], crowding=crowding[i]) for i in sorted(chosen)]
-
-    def _references(self, genomes: List[Any]) -> List[Floats]:
-        if not genomes:
-            return []
+    def _references(self, genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
+        """The exploit guard's swims (the engine's hook): every genome at the reference step."""
         ref = _core.reference_config(self._config)
-        results = self._evaluate(genomes, ref)
-        self._reference_evaluations += len(genomes)
-        return [self._measure(g, r, ref)[0] for g, r in zip(genomes, results)]
-
-    def _row(self, g: int, discarded: int, copies: int) -> Tuple[Any, ...]:
-        front = self.front()
-        hv = float("nan")
-        if self._reference_point is not None and len(self.criteria) <= 2:
-            hv = hypervolume([s.objectives for s in front], self._reference_point, self.senses)
-        best = []
-        for j, c in enumerate(self.criteria):
-            column = [s.objectives[j] for s in front]
-            best.append(float("nan") if not column else (max(column) if c.maximize else min(column)))
-        cfg = self._config
-        disagreements = sum(
-            1
-            for s in front
-            if s.reference is not None
-            and any(math.isnan(r) or _core.reference_disagrees(v, r, cfg) for v, r in zip(s.measured, s.reference))
-        )
-        return (
-            g,
-            self._evaluations,
-            len(front),
-            hv,
-            *best,
-            sum(1 for s in self._population if s.feasible),
-            discarded,
-            copies,
-            self._reference_evaluations,
-            disagreements,
-        )
+        return self._told(genomes, self._evaluate(list(genomes), ref), ref)
 
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: ``animat.evaluate`` on the config's threads: the GIL is released
@@ -861,12 +739,21 @@ class Nsga2(_SearchState):
         return self.tell(list(results))
 
     # --- state ------------------------------------------------------------------------------------
+    @property
+    def generation(self) -> int:
+        """The last completed generation (-1 before the first ``tell``)."""
+        return int(self._engine.generation)
+
+    @property
+    def evaluations(self) -> int:
+        """Candidates told so far."""
+        return int(self._engine.evaluations)
+
     def front(self) -> List[Solution]:
         """The first front of the current population: its feasible members no other member dominates,
         ordered by the first objective, best first (then the second ..., then population order)."""
-        members = [s for s in self._population if s.feasible and s.rank == 0]
-        signs = [-1.0 if c.maximize else 1.0 for c in self.criteria]
-        return sorted(members, key=lambda s: tuple(x * sign for x, sign in zip(s.objectives, signs)))
+        population = self.population
+        return [population[i] for i in self._engine.front()]
 
     def front_values(self) -> np.ndarray:
         """:meth:`front`'s objectives as a (k, objectives) float64 array."""
@@ -875,12 +762,30 @@ class Nsga2(_SearchState):
     @property
     def population(self) -> List[Solution]:
         """The current population (a list of :class:`Solution`, in selection order)."""
-        return list(self._population)
+        return [
+            Solution(
+                s["genome"],
+                _floats(s["objectives"]),
+                _floats(s["measured"]),
+                _floats(s["reference"]) if len(s["reference"]) else None,
+                int(s["generation"]),
+                bool(s["feasible"]),
+                int(s["rank"]),
+                float(s["crowding"]),
+            )
+            for s in self._engine.population()
+        ]
 
     @property
     def history(self) -> np.recarray:
         """One row per generation (:func:`history_dtype`): ``h["hypervolume"]``, ``h[-1].front_size`` ..."""
-        return np.array(self._history, dtype=self.history_dtype).view(np.recarray)
+        dtype = self.history_dtype
+        columns = len(dtype.names or ())
+        rows = [
+            tuple(int(x) if dtype[j].kind == "i" else float(x) for j, x in enumerate(row[:columns]))
+            for row in self._engine.history
+        ]
+        return np.array(rows, dtype=dtype).view(np.recarray)
 
     def write_front(self, path: PathLike) -> Path:
         """:meth:`front` as CSV, one row per genome: ``generation`` (that made it), ``crowding``, the
@@ -903,35 +808,17 @@ class Nsga2(_SearchState):
         return _write_atomic(Path(path), buf.getvalue())
 
     def checkpoint(self) -> Dict[str, Any]:
-        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back), with a
-        SHA-256 ``checksum`` of the rest. A pending ``ask()`` is not saved: asking again after a
-        restore gives the same genomes."""
-        state = {
+        """The whole state as a JSON-able dict (``json.dumps`` it; :meth:`restore` reads it back): the
+        engine's checksummed checkpoint (``engine``; None before the first ``tell``), the run's config
+        and objectives, under a SHA-256 ``checksum`` of the rest. A pending ``ask()`` is not saved:
+        asking again after a restore gives the same genomes."""
+        point = self.reference_point if self._reference_point_given else None
+        state: Dict[str, Any] = {
             "format": CHECKPOINT_FORMAT,
             "config": self._config.to_toml(),
-            "seed": self.seed,
-            "population_size": self.population_size,
-            "crossover_fraction": self.crossover_fraction,
             "objectives": [{"name": c.name, "sense": c.sense} for c in self.criteria],
-            "reference_point": None if self._reference_point is None else [_enc(x) for x in self._reference_point],
-            "reference_point_given": self._reference_point_given,
-            "generation": self._generation,
-            "evaluations": self._evaluations,
-            "reference_evaluations": self._reference_evaluations,
-            "history": [[_enc(x) if isinstance(x, float) else int(x) for x in row] for row in self._history],
-            "population": [
-                {
-                    "genome": s.genome.to_json(),
-                    "objectives": [_enc(x) for x in s.objectives],
-                    "measured": [_enc(x) for x in s.measured],
-                    "reference": None if s.reference is None else [_enc(x) for x in s.reference],
-                    "generation": s.generation,
-                    "feasible": s.feasible,
-                    "rank": s.rank,
-                    "crowding": _enc(s.crowding),
-                }
-                for s in self._population
-            ],
+            "reference_point": None if point is None else list(point),
+            "engine": self._engine.checkpoint() if self.generation >= 0 else None,
         }
         state["checksum"] = _checksum(state)
         return state
@@ -947,91 +834,34 @@ class Nsga2(_SearchState):
         source: str = "checkpoint",
     ) -> Nsga2:
         """An Nsga2 from :meth:`checkpoint` (a dict, or its JSON text). ``config``: default the saved
-        one; another must equal it but for ``evolution.threads`` (ValueError). ``objectives``: found by
-        name, first there (your own functions must be given again: a function is not saved), then in
-        :data:`CRITERIA`, with the saved sense; given ones must be the run's, in order (ValueError).
-        A checkpoint that is not one or whose checksum does not match its content (edited or
-        corrupt) is a ValueError naming ``source`` (the file, for :meth:`load`)."""
+        one; another must equal it but for ``evolution.threads`` and what the run's own arguments set
+        (seed, population, crossover fraction; ValueError). ``objectives``: found by name, first there
+        (your own functions must be given again: a function is not saved), then in :data:`CRITERIA`,
+        with the saved sense; given ones must be the run's, in order (ValueError). A checkpoint that
+        is not one, was edited or is inconsistent is a ValueError naming ``source`` (the file, for
+        :meth:`load`), and the engine checks its own part (checksum, identity, population, history)."""
         try:
             state = _checked_state(state, CHECKPOINT_FORMAT, "an Nsga2")
             saved = _core.Config.from_toml(state["config"], source)
+            run = [(str(o["name"]), str(o["sense"])) for o in state["objectives"]]
+            point = state["reference_point"]
+            engine_text = state["engine"]
         except (ValueError, KeyError, TypeError, AttributeError) as e:
             raise ValueError(f"{source}: {e}") from None
-        try:
-            return cls._restore_checked(state, saved, config, objectives, threads, source)
-        except (KeyError, TypeError, AttributeError) as e:
-            raise ValueError(f"{source}: not a complete Nsga2 checkpoint ({type(e).__name__}: {e})") from None
-
-    @classmethod
-    def _restore_checked(
-        cls,
-        state: Mapping[str, Any],
-        saved: Any,
-        config: Any,
-        objectives: Iterable[CriterionLike],
-        threads: Optional[int],
-        source: str,
-    ) -> Nsga2:
-        if config is None:
-            config = saved
-        else:
+        if config is not None:
             mine = config.copy()
-            mine["evolution.seed"] = int(state["seed"])
+            for key in ("evolution.seed", "evolution.population", "evolution.crossover_fraction"):
+                mine[key] = saved[key]
             if _comparable(mine) != _comparable(saved):
                 raise ValueError(
                     f"{source}: Nsga2.restore: the config differs from the checkpoint's (only evolution.threads may)"
                 )
-        given = list(objectives) if not isinstance(objectives, (str, Criterion)) else [objectives]
-        mine_criteria = _criteria(given) if given else ()
-        run = [(o["name"], o["sense"]) for o in state["objectives"]]
-        if mine_criteria and [(c.name, c.sense) for c in mine_criteria] != run:
-            raise ValueError(
-                f"Nsga2.restore: the objectives {[(c.name, c.sense) for c in mine_criteria]} are not the "
-                f"checkpoint's {run}"
-            )
-        by_name = {c.name: c for c in mine_criteria}
-        criteria = []
-        for name, sense in run:
-            if name in by_name:
-                criteria.append(by_name[name])
-            elif name in CRITERIA:
-                criteria.append(CRITERIA[name].with_sense(sense))
-            else:
-                raise ValueError(
-                    f"the run's objective {name!r} is not in the table: pass it again "
-                    "(objectives=[Criterion(...)] or (function, sense))"
-                )
-        point = state["reference_point"]
-        nsga = cls(
-            config,
-            criteria,
-            population=state["population_size"],
-            seed=state["seed"],
-            crossover_fraction=state["crossover_fraction"],
-            reference_point=_floats(point) if state["reference_point_given"] else None,
-            threads=threads,
-        )
-        nsga._reference_point = _floats(point)
-        nsga._generation = int(state["generation"])
-        nsga._evaluations = int(state["evaluations"])
-        nsga._reference_evaluations = int(state["reference_evaluations"])
-        dtype = nsga.history_dtype
-        nsga._history = [
-            tuple(_dec(x) if dtype[j].kind == "f" else int(x) for j, x in enumerate(row)) for row in state["history"]
-        ]
-        nsga._population = [
-            Solution(
-                _core.Genome.from_json(s["genome"]),
-                _floats(s["objectives"]) or (),
-                _floats(s["measured"]) or (),
-                _floats(s["reference"]),
-                int(s["generation"]),
-                bool(s["feasible"]),
-                int(s["rank"]),
-                _dec(s["crowding"]),
-            )
-            for s in state["population"]
-        ]
+        criteria = _run_criteria(run, objectives)
+        if threads is None and config is not None:
+            threads = int(config["evolution.threads"])
+        nsga = cls(saved, criteria, reference_point=point, threads=threads)
+        if engine_text is not None:
+            nsga._engine.restore(engine_text, source)
         return nsga
 
     def _own_criteria(self) -> Tuple[Criterion, ...]:
@@ -1047,9 +877,43 @@ class Nsga2(_SearchState):
     def __repr__(self) -> str:
         objectives = ", ".join(f"{c.name} ({c.sense})" for c in self.criteria)
         return (
-            f"<animat.Nsga2 generation {self._generation}, population {self.population_size}, {objectives}: "
-            f"front of {len(self.front())}>"
+            f"<animat.Nsga2 generation {self.generation}, population {self.population_size}, {objectives}: "
+            f"front of {len(self._engine.front())}>"
         )
+
+
+def _reference_hook(nsga: Nsga2) -> Callable[[List[Any]], Tuple[List[Any], List[List[float]]]]:
+    """:meth:`Nsga2._references` through a weak reference: the engine holds the hook, and a cycle
+    through it would keep both alive (the garbage collector does not see into the engine)."""
+    owner = weakref.ref(nsga)
+
+    def references(genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
+        return cast(Nsga2, owner())._references(genomes)
+
+    return references
+
+
+def _run_criteria(run: List[Tuple[str, str]], objectives: Iterable[CriterionLike]) -> List[Criterion]:
+    """The run's criteria (``run``: its (name, sense) pairs): given ones, by name, else the table's."""
+    given = list(objectives) if not isinstance(objectives, (str, Criterion)) else [objectives]
+    mine = _criteria(given) if given else ()
+    if mine and [(c.name, c.sense) for c in mine] != run:
+        raise ValueError(
+            f"Nsga2.restore: the objectives {[(c.name, c.sense) for c in mine]} are not the checkpoint's {run}"
+        )
+    by_name = {c.name: c for c in mine}
+    criteria = []
+    for name, sense in run:
+        if name in by_name:
+            criteria.append(by_name[name])
+        elif name in CRITERIA:
+            criteria.append(CRITERIA[name].with_sense(sense))
+        else:
+            raise ValueError(
+                f"the run's objective {name!r} is not in the table: pass it again "
+                "(objectives=[Criterion(...)] or (function, sense))"
+            )
+    return criteria
 
 
 def _restore(state: Mapping[str, Any], criteria: Tuple[Criterion, ...]) -> Nsga2:

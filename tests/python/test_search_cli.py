@@ -59,8 +59,9 @@ def library_nsga2(out, generations=3):
 
 
 def files(run: Path):
-    """Every file of a run directory, by relative path, as bytes; a MAP-Elites checkpoint as its state
-    (history and elites), without the wall-clock seconds the engine records, which differ run to run."""
+    """Every file of a run directory, by relative path, as bytes; a MAP-Elites or NSGA-II checkpoint as
+    its state (history and elites or population), without the wall-clock seconds the engine records,
+    which differ run to run."""
     out = {str(p.relative_to(run)): p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()}
     if out.get("checkpoint.json", b"").startswith(b'{"format": "animat.map_elites/'):
         me = animat.MapElites.load(run)
@@ -69,6 +70,9 @@ def files(run: Path):
             for e in me.archive.elites()
         ]
         out["checkpoint.json"] = repr((me.history.tolist(), elites)).encode()
+    elif out.get("checkpoint.json", b"").startswith(b'{"format": "animat.nsga2/'):
+        nsga = animat.Nsga2.load(run)
+        out["checkpoint.json"] = repr((nsga.history.tolist(), nsga.reference_point, nsga.population)).encode()
     return out
 
 

@@ -253,16 +253,17 @@ def new_nsga2(generations=3):
     return nsga
 
 
-def times_ten(state):
-    state["population"][0]["objectives"][0] *= 10
+def times_ten(p):
+    member = next(m for m in p["population"] if "supplied" in m)
+    member["supplied"][0] *= 10
 
 
-def one_generation_more(state):
-    state["generation"] += 1
+def one_generation_more(p):
+    p["generation"] += 1
 
 
-def history_row_dropped(state):
-    del state["history"][1]
+def history_row_dropped(p):
+    del p["history"][1]
 
 
 @pytest.mark.parametrize("edit", [times_ten, one_generation_more, history_row_dropped])
@@ -270,10 +271,16 @@ def test_an_edited_nsga2_checkpoint_is_refused_naming_the_file(tmp_path, edit):
     nsga = new_nsga2()
     path = nsga.save(tmp_path / "nsga.json")
     assert animat.Nsga2.load(path).history.tolist() == nsga.history.tolist()
-    state = nsga.checkpoint()
-    edit(state)
-    path.write_text(json.dumps(state))
+    # an edit under the outer checksum, and one resealed so that only the engine's checks can find it
+    outer = nsga.checkpoint()
+    payload = json.loads(json.loads(outer["engine"])["payload"])
+    edit(payload)
+    outer["engine"] = json.dumps({"checksum": "0" * 16, "payload": json.dumps(payload)})
+    path.write_text(json.dumps(outer))
     with pytest.raises(ValueError, match=rf"^{path}: its checksum does not match its content"):
+        animat.Nsga2.load(path)
+    path.write_text(json.dumps(resealed(nsga.checkpoint(), edit)))
+    with pytest.raises(ValueError, match=rf"^{path}: "):
         animat.Nsga2.load(path)
 
 
