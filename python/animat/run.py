@@ -16,7 +16,9 @@ A run directory holds::
   and ``manifest.json``, whose sizes and sha256 digests are checked for every file read;
 - the run directory of a MAP-Elites or NSGA-II search (:func:`animat.run_map_elites`,
   :func:`animat.run_nsga2`): ``history.csv`` with that search's columns and the snapshots
-  ``archive/gen_*.csv`` or ``front/gen_*.csv`` (:meth:`Run.snapshot`) in place of ``best/``.
+  ``archive/gen_*.csv`` or ``front/gen_*.csv`` (:meth:`Run.snapshot`) in place of ``best/``;
+  ``animat_evolve``'s run of one writes no snapshot files (and a ``wall_seconds`` history column):
+  its ``checkpoint.json`` gives the last archive or front.
 """
 
 from __future__ import annotations
@@ -172,6 +174,8 @@ def _parse_history(text: str, path: Any) -> np.ndarray:
         dtype = PROTECTED_HISTORY_DTYPE
         expected = header
     elif search is not None:
+        if header == [*(search.names or ()), "wall_seconds"]:  # animat_evolve's: the engine's clock too
+            search = np.dtype([*search.descr, ("wall_seconds", np.float64)])
         if header != list(search.names or ()):
             raise ValueError(
                 f"{path}:1: unexpected header {complete[0].strip()!r} for a search run; expected "
@@ -461,6 +465,66 @@ def _read_snapshot(path: Path, kind: str, config: Any) -> Snapshot:
     return Snapshot(kind, generation, path, columns, genomes, objectives, descriptors)
 
 
+def _engine_generation(path: Path) -> Optional[int]:
+    """The generation of the engine's checkpoint ``path`` (``animat_evolve``'s MAP-Elites or NSGA-II
+    run), or None when it is not one (a library run's checkpoint, or none)."""
+    try:
+        with open(path, "rb") as fh:
+            if not fh.read(16).startswith(b'{"checksum"'):
+                return None
+        payload = json.loads(json.loads(path.read_text(encoding="utf-8"))["payload"])
+        return int(payload["generation"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _engine_snapshot(path: Path, kind: str, config: Any) -> Snapshot:
+    """The archive or front that the engine's checkpoint ``path`` holds, as a :class:`Snapshot` with
+    the columns of the library's snapshot files; ValueError naming the file when it does not restore."""
+    engine = _core.SearchEngine(config)
+    try:
+        engine.restore(path.read_text(encoding="utf-8"), str(path))
+    except (RuntimeError, ValueError) as e:
+        raise ValueError(str(e)) from None
+    values: Dict[str, list] = {}
+    genomes = []
+    if kind == "archive":
+        descriptors = list(engine.archive["descriptors"])
+        for name in ["index", "objective", "fitness", "reference", "generation", *descriptors]:
+            values[name] = []
+        for e in engine.elites():
+            for name, v in zip(
+                ["index", "objective", "fitness", "reference", "generation"],
+                [e["index"], e["objective"], e["fitness"].fitness, e["reference"], e["generation"]],
+            ):
+                values[name].append(v)
+            for name, v in zip(descriptors, e["values"]):
+                values[name].append(v)
+            genomes.append(e["genome"].to_json())
+        objectives = [("objective", "max")]
+    else:
+        descriptors = []
+        names = [name for name, _ in engine.criteria]
+        for name in ["generation", "crowding", *names, *[f"{p}_{n}" for p in ("measured", "reference") for n in names]]:
+            values[name] = []
+        population = engine.population()
+        for i in engine.front():
+            s = population[i]
+            reference = list(s["reference"]) or [float("nan")] * len(names)
+            values["generation"].append(s["generation"])
+            values["crowding"].append(s["crowding"])
+            for j, name in enumerate(names):
+                values[name].append(s["objectives"][j])
+                values[f"measured_{name}"].append(s["measured"][j])
+                values[f"reference_{name}"].append(reference[j])
+            genomes.append(s["genome"].to_json())
+        objectives = [(name, sense) for name, sense in engine.criteria]
+    columns = {
+        n: np.asarray(v, dtype=np.int64 if n in ("index", "generation") else np.float64) for n, v in values.items()
+    }
+    return Snapshot(kind, int(engine.generation), path, columns, genomes, objectives, descriptors)
+
+
 class Run:
     """A run directory, read-only: that of the GA (``animat_evolve``, :func:`animat.evolve`), of a
     MAP-Elites or NSGA-II search (:attr:`search`), or a packed run (:attr:`packed`).
@@ -643,12 +707,19 @@ class Run:
 
     def snapshots(self) -> List[Tuple[int, Path]]:
         """A search run's snapshots, oldest first: ``(generation, path)`` of every ``archive/gen_*.csv``
-        (MAP-Elites) or ``front/gen_*.csv`` (NSGA-II); empty for a GA run."""
+        (MAP-Elites) or ``front/gen_*.csv`` (NSGA-II); for ``animat_evolve``'s run, which writes
+        none, its ``checkpoint.json`` (the last generation's); empty for a GA run."""
         folder = self.path / _SNAPSHOT_FOLDERS.get(self.search, "")
-        if self.search not in _SNAPSHOT_FOLDERS or not folder.is_dir():
+        if self.search not in _SNAPSHOT_FOLDERS:
             return []
-        found = [(int(m.group(1)), p) for p in folder.iterdir() if (m := _SNAPSHOT_NAME.match(p.name))]
-        return sorted(found)
+        if folder.is_dir():
+            found = [(int(m.group(1)), p) for p in folder.iterdir() if (m := _SNAPSHOT_NAME.match(p.name))]
+            if found:
+                return sorted(found)
+        # animat_evolve's run writes no snapshot files: its checkpoint holds the last archive or front.
+        checkpoint = self.path / "checkpoint.json"
+        generation = None if self.packed else _engine_generation(checkpoint)
+        return [] if generation is None else [(generation, checkpoint)]
 
     def snapshot(self, generation: Optional[int] = None) -> Snapshot:
         """The archive (MAP-Elites) or front (NSGA-II) written after ``generation`` (default: the last
@@ -680,7 +751,11 @@ class Run:
         cached = self._cache.get(str(path))
         if cached is not None and cached[0] == key:
             return cached[1]
-        snap = _read_snapshot(path, _SNAPSHOT_FOLDERS[self.search], self._config)
+        kind = _SNAPSHOT_FOLDERS[self.search]
+        if path.name == "checkpoint.json":
+            snap = _engine_snapshot(path, kind, self._config)
+        else:
+            snap = _read_snapshot(path, kind, self._config)
         self._cache[str(path)] = (key, snap)
         return snap
 

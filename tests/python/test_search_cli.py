@@ -262,6 +262,33 @@ def test_animat_evolve_runs_the_configs_search_and_resumes_it(tmp_path, capsys, 
     assert mine == theirs
 
 
+EXE = os.environ.get("ANIMAT_EVOLVE_EXE")
+
+
+@pytest.mark.skipif(not EXE or not os.path.exists(EXE), reason="needs ANIMAT_EVOLVE_EXE")
+@pytest.mark.parametrize("command", ["map-elites", "nsga2"])
+def test_animat_evolves_search_run_opens_as_the_library_run(tmp_path, command):
+    # animat_evolve writes no snapshot files: Run reads the last archive or front from its checkpoint.
+    engine, library = tmp_path / "engine", tmp_path / "library"
+    cmd = [EXE, "--config", str(search_config(tmp_path, command)), "--out", str(engine), "--generations", "3"]
+    done = subprocess.run([*cmd, "--threads", "1", "--quiet"], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    (library_map_elites if command == "map-elites" else library_nsga2)(library)
+    mine, theirs = animat.Run(engine), animat.Run(library)
+    assert mine.search == theirs.search
+    names = list(theirs.history.dtype.names)
+    assert list(mine.history.dtype.names) == [*names, "wall_seconds"]
+    assert [tuple(row[n] for n in names) for row in mine.history] == theirs.history.tolist()
+    a, b = mine.snapshot(), theirs.snapshot()
+    assert (a.kind, a.generation, a.path) == (b.kind, 3, engine / "checkpoint.json")
+    assert (a.genomes, a.objectives, a.descriptors) == (b.genomes, b.objectives, b.descriptors)
+    assert list(a.columns) == list(b.columns)
+    for name, column in b.columns.items():
+        np.testing.assert_array_equal(a.columns[name], column, err_msg=name)
+    assert mine.best().genome.to_json() == theirs.best().genome.to_json()
+    assert cli.main(["explore", str(engine), "--out", str(tmp_path / "page.html")]) == 0
+
+
 def test_the_library_run_records_its_search_in_config_toml(tmp_path):
     library_map_elites(tmp_path / "me", generations=0)
     c = animat.load_config(str(tmp_path / "me" / "config.toml"))
