@@ -174,7 +174,7 @@ class Search {
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
   /// The exploit guard's reference swims, computed by the caller: the Fitness of every genome at
   /// the reference step and the supplied measures' values there (a row each, supplied() order;
-  /// none when the search supplies no measure).
+  /// no rows: the values told at the run's step stand).
   struct ReferenceSwims {
     std::vector<Fitness> fitness;
     std::vector<std::vector<double>> supplied;

@@ -63,6 +63,7 @@ import math
 import os
 import shutil
 import socket
+import weakref
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -1088,8 +1089,8 @@ class MapElites(_SearchState):
         seed: the run's seed (default ``evolution.seed``; it is written into the config).
         objective: as for :class:`animat.GA`: a built-in name, a callable of an
             :class:`animat.EvaluationRecord` or an :class:`animat.Objective`. A Python objective's
-            values are computed here and told to the engine, which cannot swim with it: it needs
-            ``evaluation.reference_check = "off"`` (ValueError otherwise).
+            values are computed here and told to the engine, and so are the exploit guard's
+            reference swims (the engine cannot swim with it).
         crossover_fraction: share of offspring made by crossover (default ``evolution.crossover_fraction``).
         threads: evaluation threads of :meth:`step` and the exploit guard (default ``evolution.threads``;
             0 = all cores). The run does not depend on it.
@@ -1123,12 +1124,6 @@ class MapElites(_SearchState):
                 f"MapElites: evaluation.objective = {name!r} is a Python objective: pass "
                 "objective=animat.Objective(...) with that name"
             )
-        if self._objective is not None and str(self._config["evaluation.reference_check"]) != "off":
-            raise ValueError(
-                f"MapElites: evaluation.reference_check = {str(self._config['evaluation.reference_check'])!r} "
-                f"with the Python objective {name!r}: the engine's exploit guard swims with a built-in "
-                'objective; set evaluation.reference_check = "off"'
-            )
         if seed is not None:
             self._config["evolution.seed"] = int(seed)
         if threads is not None:
@@ -1157,7 +1152,11 @@ class MapElites(_SearchState):
             self._config["search.bins"] = [float(b) for b in archive.bins]
         self._config["search.batch"] = self.batch
         engine_config, supplied = self._engine_config()
-        self._engine = _core.SearchEngine(engine_config, supplied=supplied)
+        # The exploit guard swims here (the objective may be Python's; under MPI on the ranks).
+        guarded = str(self._config["evaluation.reference_check"]) != "off"
+        self._engine = _core.SearchEngine(
+            engine_config, supplied=supplied, reference=_reference_hook(self) if guarded else None
+        )
         self._width = len(supplied)
         self._asked: Optional[List[Any]] = None
 
@@ -1279,6 +1278,11 @@ class MapElites(_SearchState):
                 int(e["generation"]),
             )
 
+    def _references(self, genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
+        """The exploit guard's swims (the engine's hook): every genome at the reference step, scored
+        by the search's objective; the descriptors stay those of the run's step."""
+        return list(self._evaluate(list(genomes), _core.reference_config(self._config))), []
+
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: :func:`animat.evaluate_population` with the config's threads and the
         objective; over the MPI ranks under ``run_map_elites(..., mpi=True)``) and tell one generation;
@@ -1393,6 +1397,17 @@ class MapElites(_SearchState):
 
     def __repr__(self) -> str:
         return f"<animat.MapElites generation {self.generation}, batch {self.batch}, {self.archive!r}>"
+
+
+def _reference_hook(me: MapElites) -> Callable[[List[Any]], Tuple[List[Any], List[List[float]]]]:
+    """:meth:`MapElites._references` through a weak reference: the engine holds the hook, and a cycle
+    through it would keep both alive (the garbage collector does not see into the engine)."""
+    owner = weakref.ref(me)
+
+    def references(genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
+        return cast(MapElites, owner())._references(genomes)
+
+    return references
 
 
 def _restore(

@@ -458,7 +458,7 @@ Search::ReferenceSwims evaluate_references(const FitnessFunction& reference,
     if (out.fitness.size() != genomes.size())
       throw Error(fmt::format("{}: the reference hook gave {} fitness values for {} genomes", who,
                               out.fitness.size(), genomes.size()));
-    if (supplied > 0 && out.supplied.size() != genomes.size())
+    if (!out.supplied.empty() && out.supplied.size() != genomes.size())
       throw Error(
           fmt::format("{}: the reference hook gave {} rows of supplied values for {} genomes", who,
                       out.supplied.size(), genomes.size()));

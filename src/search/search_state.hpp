@@ -99,8 +99,8 @@ void check_supplied_rows(std::string_view who, std::size_t own, std::size_t rows
 [[noreturn]] void refuse(std::string_view who, std::size_t k, const std::string& what);
 
 /// The reference swims of `genomes` (the exploit guard): the caller's `hook` where it is set
-/// (its rows checked against the `supplied` measures' count), else `reference` on the config's
-/// threads (no rows); each fitness checked finite.
+/// (its rows, if any, checked against the `supplied` measures' count), else `reference` on the
+/// config's threads (no rows); each fitness checked finite.
 Search::ReferenceSwims evaluate_references(const FitnessFunction& reference,
                                            const Search::ReferenceHook& hook, const Config& config,
                                            const std::vector<const Genome*>& genomes,

@@ -214,12 +214,27 @@ def test_a_python_objective_is_told_to_the_engine_and_may_be_negative():
     genomes = me.ask()
     row = me.tell([-2.0] * len(genomes), descriptors=[[10.0]] * len(genomes))
     assert (row.elites, row.best, me.archive.best().fitness) == (1, -2.0, -2.0)
-    guarded = small_config()
-    guarded["evaluation.reference_check"] = "record"
-    with pytest.raises(
-        ValueError, match=r"evaluation.reference_check = 'record' with the Python objective 'python:below_zero'"
-    ):
-        animat.MapElites(guarded, animat.GridArchive(["cells"], 4), batch=6, objective=objective)
+
+
+def test_the_exploit_guard_scores_a_python_objective_at_the_reference_step():
+    def rightward(record):
+        return float(record.com[-1, 0] - record.com[0, 0])
+
+    objective = animat.Objective(rightward, every=50)
+    config = small_config()
+    config["evaluation.reference_check"] = "record"
+    me = animat.MapElites(config, animat.GridArchive(["cells"], 4), batch=6, objective=objective)
+    me.step()
+    me.step()
+    reference = animat.reference_config(me.config)
+    reference["evaluation.objective"] = "python:rightward"
+    elites = me.archive.elites()
+    assert elites and me.history[-1].reference_evaluations >= len(elites)
+    for e in elites:  # each elite's reference: the objective of its swim at the reference step
+        (want,) = animat.evaluate_population([e.genome], reference, 1, objective=objective)
+        assert e.reference == want.fitness
+        (own,) = animat.evaluate_population([e.genome], me.config, 1, objective=objective)
+        assert e.fitness == own.fitness != e.reference
 
 
 def test_an_nsga2_population_too_large_is_refused_before_any_file_is_written(tmp_path, capsys):
