@@ -92,7 +92,7 @@ __all__ = [
 PathLike = Union[str, "os.PathLike[str]"]
 
 #: Version tag of :meth:`MapElites.checkpoint`.
-CHECKPOINT_FORMAT = "animat.map_elites/2"
+CHECKPOINT_FORMAT = "animat.map_elites/3"
 
 # --- descriptors ----------------------------------------------------------------------------------
 
@@ -1070,9 +1070,8 @@ class MapElites(_SearchState):
     overflow (above ``sys.float_info.max / cells``), or a descriptor value that is infinite is a
     ValueError or TypeError naming the value, and the search is left as it was.
 
-    A CVT archive is searched as a grid the engine knows: the cell (the nearest centroid, computed
-    here) is a supplied descriptor with one bin per cell, and each descriptor a supplied one with one
-    bin, so the engine's cells are the archive's.
+    A CVT archive is the engine's CVT archive with the archive's own centroids, so the engine's cells
+    are the archive's.
 
     Example::
 
@@ -1154,29 +1153,31 @@ class MapElites(_SearchState):
         engine_config, supplied = self._engine_config()
         # The exploit guard swims here (the objective may be Python's; under MPI on the ranks).
         guarded = str(self._config["evaluation.reference_check"]) != "off"
+        centroids = None if isinstance(archive, GridArchive) else cast(CVTArchive, archive)._unit.tolist()
         self._engine = _core.SearchEngine(
-            engine_config, supplied=supplied, reference=_reference_hook(self) if guarded else None
+            engine_config,
+            supplied=supplied,
+            centroids=centroids,
+            reference=_reference_hook(self) if guarded else None,
         )
         self._width = len(supplied)
         self._asked: Optional[List[Any]] = None
 
     def _engine_config(self) -> Tuple[Any, List[str]]:
-        """The engine's config: the run's with the archive as a grid of supplied descriptors (a CVT
-        archive: its cell with one bin per cell, then every descriptor with one bin)."""
+        """The engine's config: the run's with the archive's descriptors, all supplied by this
+        search, and its ranges (a CVT archive: its cells; its centroids are given to the engine)."""
         cfg = self._config.copy()
         archive = self.archive
         names = [d.name for d in archive.descriptors]
-        ranges = [x for d in archive.descriptors for x in (d.lo, d.hi)]
-        if isinstance(archive, GridArchive):
-            bins = [float(b) for b in archive.bins]
-        else:
-            names = ["cvt_cell", *names]
-            bins = [float(archive.cells)] + [1.0] * archive.dims
-            ranges = [0.0, float(archive.cells), *ranges]
         cfg["search.algorithm"] = "map_elites"
         cfg["search.descriptors"] = names
-        cfg["search.bins"] = bins
-        cfg["search.ranges"] = ranges
+        cfg["search.ranges"] = [x for d in archive.descriptors for x in (d.lo, d.hi)]
+        if isinstance(archive, GridArchive):
+            cfg["search.archive"] = "grid"
+            cfg["search.bins"] = [float(b) for b in archive.bins]
+        else:
+            cfg["search.archive"] = "cvt"
+            cfg["search.cells"] = archive.cells
         cfg["search.batch"] = self.batch
         if self._objective is not None:
             # The engine cannot call Python: this search tells it the objective's values (and has no
@@ -1220,11 +1221,7 @@ class MapElites(_SearchState):
                 rows.append([math.nan] * self._width)
                 continue
             told.append(fit)
-            if isinstance(self.archive, CVTArchive):
-                cell = cast(int, self.archive.index_of(values))  # every value is a number here
-                rows.append([float(cell), *values.tolist()])
-            else:
-                rows.append(values.tolist())
+            rows.append(values.tolist())
         self._engine.tell(told, rows)
         self._asked = None
         self._refresh()
@@ -1265,7 +1262,6 @@ class MapElites(_SearchState):
     def _refresh(self) -> None:
         """Makes :attr:`archive` the engine's elites (``SearchEngine.elites()``)."""
         self.archive.clear()
-        skip = 1 if isinstance(self.archive, CVTArchive) else 0  # the engine's first value is the cell
         for e in self._engine.elites():
             index = int(e["index"])
             self.archive._elites[index] = Elite(
@@ -1273,7 +1269,7 @@ class MapElites(_SearchState):
                 e["genome"],
                 float(e["fitness"].fitness),
                 float(e["objective"]),
-                tuple(float(x) for x in e["values"][skip:]),
+                tuple(float(x) for x in e["values"]),
                 float(e["reference"]),
                 int(e["generation"]),
             )

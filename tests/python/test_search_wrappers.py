@@ -8,6 +8,7 @@ import json
 import math
 import os
 
+import numpy as np
 import pytest
 
 import animat
@@ -309,3 +310,17 @@ def test_a_one_digit_corruption_is_refused_naming_the_file(tmp_path, search):
         path.write_text(text[:i] + str((int(text[i]) + 1) % 10) + text[i + 1 :])
         with pytest.raises(ValueError, match=rf"^{path}: "):
             kind.load(path)
+
+
+def test_a_cvt_archive_is_the_engines_with_the_archives_centroids():
+    archive = animat.CVTArchive(["elongation", "frequency"], 12, seed=1, samples=200)
+    me = animat.MapElites(small_config(), archive, batch=12, seed=3)
+    me.step()
+    me.step()
+    engine = me._engine.archive
+    assert (engine["kind"], engine["cells"], engine["descriptors"]) == ("cvt", 12, ["elongation", "frequency"])
+    assert np.array_equal(np.array(engine["centroids"]), archive._unit)
+    elites = me.archive.elites()
+    assert elites
+    for e in elites:  # the engine's cell is the archive's nearest centroid
+        assert e.index == archive.index_of(e.descriptors)
