@@ -145,6 +145,29 @@ void bind_search(nb::module_& m) {
       "of dims: Lloyd's\nk-means of samples uniform points (0: max(1000, 20 cells)) drawn from "
       "Rng.derive(seed, CVT_SAMPLES_KEY,\n0), started from the first cells of them, as "
       "animat.qd.CVTArchive computes its centroids from its\nsamples (docs/search.md).");
+  // NSGA-II's pieces on minimised rows (animat.moo wraps them with senses and NaN rows).
+  m.def(
+      "non_dominated_sort",
+      [](const std::vector<std::vector<double>>& points) { return non_dominated_sort(points); },
+      "points"_a,
+      "The fronts of points (rows of equal length, every objective minimised), best first, each "
+      "listing row\nindices in increasing order (Deb et al.'s fast non-dominated sort).");
+  m.def(
+      "crowding_distance",
+      [](const std::vector<std::vector<double>>& points) { return crowding_distance(points); },
+      "points"_a,
+      "Deb et al.'s crowding distance of the rows of one front: per objective a stable sort, both "
+      "ends\ninfinity, every other row adds (next - previous) / (max - min); one or two rows: all "
+      "infinity.");
+  m.def(
+      "hypervolume",
+      [](const std::vector<std::vector<double>>& points, const std::vector<double>& reference) {
+        return hypervolume(points, reference);
+      },
+      "points"_a, "reference"_a,
+      "The hypervolume that points (minimised rows) dominate up to reference, one or two "
+      "objectives; only\nrows better than the reference in every objective count; the rectangles "
+      "summed exactly.");
   nb::class_<SearchEngine>(m, "SearchEngine",
                            "The search of a config's search.algorithm as animat_evolve runs it "
                            "(search.hpp): \"ga\",\n\"map_elites\" or \"nsga2\", driven by "

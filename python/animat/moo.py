@@ -375,56 +375,33 @@ def non_dominated_sort(points: Any, senses: Optional[Sequence[str]] = None) -> L
     """The fronts of ``points`` (one row of objective values per point; ``senses``: ``"max"`` or
     ``"min"`` per objective, default all minimised), best first: front 0 holds the points no other
     dominates, front k those dominated only by points of fronts < k (Deb et al.'s fast non-dominated
-    sort). Each front lists row indices in increasing order. Equal points are in the same front. A
-    row with a NaN is in no front (NSGA-II ranks such candidates last)."""
+    sort, the engine's). Each front lists row indices in increasing order. Equal points are in the
+    same front. A row with a NaN is in no front (NSGA-II ranks such candidates last)."""
     p = _minimized(points, senses)
     rows = np.flatnonzero(~np.isnan(p).any(axis=1)) if p.size else np.arange(len(p))
-    q = p[rows]
-    if len(q) == 0:
-        return []
-    # better[i, j]: row i dominates row j.
-    better: np.ndarray = np.logical_and(
-        (q[:, None, :] <= q[None, :, :]).all(axis=2), (q[:, None, :] < q[None, :, :]).any(axis=2)
-    )
-    count = better.sum(axis=0)  # how many rows dominate each row
-    fronts: List[List[int]] = []
-    current = np.flatnonzero(count == 0)
-    while len(current):
-        fronts.append([int(rows[i]) for i in current])
-        count = count - better[current].sum(axis=0)
-        count[current] = -1
-        current = np.flatnonzero(count == 0)
-    return fronts
+    fronts = _core.non_dominated_sort(p[rows].tolist())
+    return [[int(rows[i]) for i in front] for front in fronts]
 
 
 def crowding_distance(points: Any) -> np.ndarray:
-    """Deb et al.'s crowding distance of every point of one front (rows of objective values): for
-    each objective, the points are ordered by their value (a stable sort: equal values in row order),
-    the first and the last get infinity and every other one adds ``(next − previous) / (max − min)``
-    (nothing when max = min); the objectives are added in order. Fronts of one or two points are all
-    infinity. The sense of an objective does not change it."""
+    """Deb et al.'s crowding distance of every point of one front (rows of objective values, not
+    NaN), the engine's: for each objective, the points are ordered by their value (a stable sort:
+    equal values in row order), the first and the last get infinity and every other one adds
+    ``(next − previous) / (max − min)`` (nothing when max = min); the objectives are added in order.
+    Fronts of one or two points are all infinity. The sense of an objective does not change it."""
     p = _points(points)
-    n = len(p)
-    d = np.zeros(n)
-    if n <= 2:
-        d[:] = np.inf
-        return d
-    for j in range(p.shape[1]):
-        order = np.argsort(p[:, j], kind="stable")
-        v = p[order, j]
-        span = v[-1] - v[0]
-        if span > 0 and math.isfinite(span):
-            d[order[1:-1]] += (v[2:] - v[:-2]) / span
-        d[order[0]] = d[order[-1]] = np.inf
-    return d
+    if np.isnan(p).any():
+        raise ValueError("crowding_distance: a front's points have no NaN (a row with one is in no front)")
+    return np.asarray(_core.crowding_distance(p.tolist()), dtype=np.float64).reshape(len(p))
 
 
 def hypervolume(points: Any, reference: Sequence[float], senses: Optional[Sequence[str]] = None) -> float:
     """The hypervolume of ``points`` against ``reference`` (the volume they dominate and the reference
-    point bounds), for one or two objectives (``senses`` as for :func:`non_dominated_sort`). Only the
-    points better than the reference in every objective count (a point on its boundary adds nothing);
-    no such point: 0. Two objectives: the sum of the staircase's rectangles, ordered by the first
-    objective, taken with ``math.fsum``. ValueError for three or more objectives."""
+    point bounds), for one or two objectives (``senses`` as for :func:`non_dominated_sort`), the
+    engine's. Only the points better than the reference in every objective count (a point on its
+    boundary adds nothing); no such point: 0. Two objectives: the sum of the staircase's rectangles,
+    ordered by the first objective, summed exactly (as ``math.fsum``). ValueError for three or more
+    objectives."""
     p = _minimized(points, senses)
     r = _minimized([list(reference)], senses)[0]
     m = len(r)
@@ -434,21 +411,7 @@ def hypervolume(points: Any, reference: Sequence[float], senses: Optional[Sequen
         raise ValueError(f"hypervolume: one or two objectives, got {m}")
     if not np.isfinite(r).all():
         raise ValueError(f"hypervolume: the reference point must be finite, got {list(reference)}")
-    if not p.size:
-        return 0.0
-    p = p[np.isfinite(p).all(axis=1) & (p < r).all(axis=1)]
-    if not len(p):
-        return 0.0
-    if m == 1:
-        return float(r[0] - p[:, 0].min())
-    order = np.lexsort((p[:, 1], p[:, 0]))
-    terms = []
-    top = r[1]
-    for x, y in p[order]:
-        if y < top:
-            terms.append((r[0] - x) * (top - y))
-            top = y
-    return math.fsum(terms)
+    return float(_core.hypervolume(p.reshape(-1, m).tolist(), r.tolist()))
 
 
 # --- NSGA-II --------------------------------------------------------------------------------------
@@ -517,10 +480,6 @@ def _floats(values: Iterable[Any]) -> Floats:
 #: 2 × population parents and candidates.
 MAX_POPULATION = 10_000
 
-# What a candidate without a feasible point is told (not valid: the engine counts it discarded).
-_INFEASIBLE = _core.Fitness(0.0, True, True, 0, False)
-# What a candidate told its objective values directly is told with them.
-_TOLD_VALUES = _core.Fitness(0.0, True, True, 0)
 
 
 class Nsga2(_SearchState):
@@ -703,12 +662,12 @@ class Nsga2(_SearchState):
                 values, ok = self._measure(genome, r, config)
             except (TypeError, ValueError) as e:
                 raise type(e)(f"Nsga2.tell: value {i} ({r!r:.60}): {e}") from None
-            if not ok:
-                fits.append(_INFEASIBLE if r is not None else _core.Fitness(0.0, False, True, 0))
+            if not ok:  # not viable, or not valid: the engine counts it discarded
+                fits.append(_core.Fitness(0.0, r is not None, True, 0, False))
             elif isinstance(r, _core.EvaluationResult):
                 fits.append(_core.fitness_of(r))
-            else:
-                fits.append(_TOLD_VALUES)
+            else:  # its objective values, told directly
+                fits.append(_core.Fitness(0.0, True, True, 0))
             rows.append(list(values))
         return fits, rows
 
