@@ -145,6 +145,17 @@ void bind_search(nb::module_& m) {
       "of dims: Lloyd's\nk-means of samples uniform points (0: max(1000, 20 cells)) drawn from "
       "Rng.derive(seed, CVT_SAMPLES_KEY,\n0), started from the first cells of them, as "
       "animat.qd.CVTArchive computes its centroids from its\nsamples (docs/search.md).");
+  m.def(
+      "search_history_columns",
+      [](std::string_view algorithm, const std::vector<std::string>& criteria) {
+        std::vector<std::pair<std::string, bool>> out;
+        for (const auto& c : search_history_columns(algorithm, criteria))
+          out.emplace_back(c.name, c.integer);
+        return out;
+      },
+      "algorithm"_a, "criteria"_a = std::vector<std::string>{},
+      "(name, integer) of every history column of a \"map_elites\" or \"nsga2\" search (its "
+      "criteria's names:\na best_<name> column each), in order; the last is wall_seconds.");
   // NSGA-II's pieces on minimised rows (animat.moo wraps them with senses and NaN rows).
   m.def(
       "non_dominated_sort",

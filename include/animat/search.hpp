@@ -125,6 +125,12 @@ struct HistoryColumn {
   bool integer = false;
 };
 
+/// The history columns of a search (history.csv, in order): "map_elites" (no criteria) or
+/// "nsga2" (a best_<name> column per criterion, as search.objectives names them); the last is
+/// wall_seconds. Error for another algorithm.
+[[nodiscard]] std::vector<HistoryColumn> search_history_columns(
+    std::string_view algorithm, const std::vector<std::string>& criteria = {});
+
 /// What every search algorithm is (see the design above).
 class Search {
  public:

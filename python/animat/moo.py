@@ -85,6 +85,7 @@ from .qd import (
     _checked_state,
     _checksum,
     _comparable,
+    _history_dtype,
     _on_ranks,
     _run_search,
     _same_as_run,
@@ -455,21 +456,10 @@ def history_dtype(names: Sequence[str]) -> np.dtype:
     NaN when the front is empty), ``feasible`` (in the population), ``discarded`` (infeasible
     candidates of this generation), ``copies`` (candidates of this generation whose genome was in the
     population or earlier in the batch), ``reference_evaluations`` (the exploit guard's swims so far),
-    ``disagreements`` (front genomes whose reference disagrees)."""
-    return np.dtype(
-        [
-            ("generation", np.int64),
-            ("evaluations", np.int64),
-            ("front_size", np.int64),
-            ("hypervolume", np.float64),
-            *[(f"best_{n}", np.float64) for n in names],
-            ("feasible", np.int64),
-            ("discarded", np.int64),
-            ("copies", np.int64),
-            ("reference_evaluations", np.int64),
-            ("disagreements", np.int64),
-        ]
-    )
+    ``disagreements`` (front genomes whose reference disagrees). The engine's columns
+    (``_core.search_history_columns``) but its ``wall_seconds``: a run's history is the same on any
+    machine."""
+    return _history_dtype(_core.search_history_columns("nsga2", list(names)))
 
 
 def _floats(values: Iterable[Any]) -> Floats:
@@ -479,7 +469,6 @@ def _floats(values: Iterable[Any]) -> Floats:
 #: The largest NSGA-II population (the engine's bound): the selection compares every pair of the
 #: 2 × population parents and candidates.
 MAX_POPULATION = 10_000
-
 
 
 class Nsga2(_SearchState):

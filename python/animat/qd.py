@@ -816,21 +816,22 @@ def _kmeans(samples: np.ndarray, k: int, iterations: int) -> np.ndarray:
 
 # --- MAP-Elites -----------------------------------------------------------------------------------
 
-#: The columns of :attr:`MapElites.history` and ``history.csv``, one row per generation.
-QD_HISTORY_DTYPE = np.dtype(
-    [
-        ("generation", np.int64),
-        ("evaluations", np.int64),  # swims told so far (the batches; reference swims not counted)
-        ("qd_score", np.float64),
-        ("coverage", np.float64),
-        ("best", np.float64),  # the greatest objective in the archive (NaN when empty)
-        ("elites", np.int64),
-        ("added", np.int64),  # candidates of this generation that entered the archive
-        ("discarded", np.int64),  # candidates never archivable: non-viable, unstable, invalid, NaN descriptor
-        ("reference_evaluations", np.int64),  # the exploit guard's swims so far
-        ("disagreements", np.int64),  # elites whose fitness and reference disagree (reference_disagrees)
-    ]
-)
+
+def _history_dtype(columns: Sequence[Tuple[str, bool]]) -> np.dtype:
+    """A history's dtype from the engine's ``(name, integer)`` columns, without ``wall_seconds``."""
+    return np.dtype(
+        [(name, np.int64 if integer else np.float64) for name, integer in columns if name != "wall_seconds"]
+    )
+
+
+#: The columns of :attr:`MapElites.history` and ``history.csv``, one row per generation: the engine's
+#: (``_core.search_history_columns("map_elites")``) but its ``wall_seconds``. ``evaluations``: swims
+#: told so far (the batches; reference swims not counted); ``best``: the greatest objective in the
+#: archive (NaN when empty); ``added``: candidates of this generation that entered the archive;
+#: ``discarded``: candidates never archivable (non-viable, unstable, invalid, NaN descriptor);
+#: ``reference_evaluations``: the exploit guard's swims so far; ``disagreements``: elites whose fitness
+#: and reference disagree (:func:`animat.reference_disagrees`).
+QD_HISTORY_DTYPE = _history_dtype(_core.search_history_columns("map_elites"))
 
 
 def _json_float(x: float) -> Optional[float]:

@@ -409,10 +409,7 @@ std::vector<double> MapElites::row(int added, int discarded) const {
 }
 
 std::vector<HistoryColumn> MapElites::history_columns() const {
-  return {{"generation", true},    {"evaluations", true},  {"qd_score", false},
-          {"coverage", false},     {"best", false},        {"elites", true},
-          {"added", true},         {"discarded", true},    {"reference_evaluations", true},
-          {"disagreements", true}, {"wall_seconds", false}};
+  return search_history_columns("map_elites");
 }
 
 std::string MapElites::stop_reason() const {

@@ -401,15 +401,7 @@ std::vector<double> Nsga2::row(const std::vector<Solution>& population,
 }
 
 std::vector<HistoryColumn> Nsga2::history_columns() const {
-  std::vector<HistoryColumn> out = {
-      {"generation", true}, {"evaluations", true}, {"front_size", true}, {"hypervolume", false}};
-  // named as search.objectives names them ("best_distance" for the objective "distance")
-  for (const std::string& name : names_) out.push_back({"best_" + name, false});
-  for (const char* name :
-       {"feasible", "discarded", "copies", "reference_evaluations", "disagreements"})
-    out.push_back({name, true});
-  out.push_back({"wall_seconds", false});
-  return out;
+  return search_history_columns("nsga2", names_);
 }
 
 std::string Nsga2::stop_reason() const {

@@ -117,6 +117,30 @@ bool Search::tell(const std::vector<Fitness>& fitness,
   return tell(fitness);
 }
 
+std::vector<HistoryColumn> search_history_columns(std::string_view algorithm,
+                                                  const std::vector<std::string>& criteria) {
+  if (algorithm == "map_elites")
+    return {{"generation", true},    {"evaluations", true},  {"qd_score", false},
+            {"coverage", false},     {"best", false},        {"elites", true},
+            {"added", true},         {"discarded", true},    {"reference_evaluations", true},
+            {"disagreements", true}, {"wall_seconds", false}};
+  if (algorithm == "nsga2") {
+    std::vector<HistoryColumn> out = {
+        {"generation", true}, {"evaluations", true}, {"front_size", true}, {"hypervolume", false}};
+    // named as search.objectives names them ("best_distance" for the objective "distance")
+    for (const std::string& name : criteria) out.push_back({"best_" + name, false});
+    for (const char* name :
+         {"feasible", "discarded", "copies", "reference_evaluations", "disagreements"})
+      out.push_back({name, true});
+    out.push_back({"wall_seconds", false});
+    return out;
+  }
+  throw Error(fmt::format(
+      "search_history_columns: \"{}\" is not \"map_elites\" or \"nsga2\" (the GA's history is "
+      "the run's)",
+      algorithm));
+}
+
 void Search::set_reference_hook(ReferenceHook hook) {
   if (algorithm() == "ga")
     throw Error(

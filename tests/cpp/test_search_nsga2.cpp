@@ -314,3 +314,18 @@ TEST(Nsga2, AGivenReferencePointIsKeptAndSavedAndFixedBeforeTheFirstGeneration) 
   expect_error<Error>([&] { resumed.set_reference_point({0.0, 1.0}); },
                       {"before the first generation"});
 }
+
+TEST(SearchHistoryColumns, OneTableForTheSearchesAndTheirHistories) {
+  const auto columns = search_history_columns("nsga2", {"distance", "actuation_work_positive"});
+  std::vector<std::string> names;
+  for (const auto& c : columns) names.push_back(c.name);
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "generation", "evaluations", "front_size", "hypervolume", "best_distance",
+                       "best_actuation_work_positive", "feasible", "discarded", "copies",
+                       "reference_evaluations", "disagreements", "wall_seconds"}));
+  Nsga2 nsga = make(nsga_config());
+  nsga.step();
+  EXPECT_EQ(nsga.history_columns().size(), columns.size());
+  EXPECT_EQ(nsga.history().back().size(), columns.size());
+  expect_error<Error>([] { (void)search_history_columns("ga"); }, {"\"ga\"", "the run's"});
+}
