@@ -72,7 +72,6 @@ import io
 import json
 import math
 import os
-import weakref
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, cast
@@ -87,6 +86,7 @@ from .qd import (
     _comparable,
     _history_dtype,
     _on_ranks,
+    _reference_hook,
     _run_search,
     _same_as_run,
     _SearchState,
@@ -687,16 +687,6 @@ class Nsga2(_SearchState):
         return self.tell(list(results))
 
     # --- state ------------------------------------------------------------------------------------
-    @property
-    def generation(self) -> int:
-        """The last completed generation (-1 before the first ``tell``)."""
-        return int(self._engine.generation)
-
-    @property
-    def evaluations(self) -> int:
-        """Candidates told so far."""
-        return int(self._engine.evaluations)
-
     def front(self) -> List[Solution]:
         """The first front of the current population: its feasible members no other member dominates,
         ordered by the first objective, best first (then the second ..., then population order)."""
@@ -828,17 +818,6 @@ class Nsga2(_SearchState):
             f"<animat.Nsga2 generation {self.generation}, population {self.population_size}, {objectives}: "
             f"front of {len(self._engine.front())}>"
         )
-
-
-def _reference_hook(nsga: Nsga2) -> Callable[[List[Any]], Tuple[List[Any], List[List[float]]]]:
-    """:meth:`Nsga2._references` through a weak reference: the engine holds the hook, and a cycle
-    through it would keep both alive (the garbage collector does not see into the engine)."""
-    owner = weakref.ref(nsga)
-
-    def references(genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
-        return cast(Nsga2, owner())._references(genomes)
-
-    return references
 
 
 def _run_criteria(run: List[Tuple[str, str]], objectives: Iterable[CriterionLike]) -> List[Criterion]:

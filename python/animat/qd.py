@@ -864,8 +864,7 @@ class _SearchState:
     ``history``)."""
 
     _config: Any
-    _generation: int
-    _evaluations: int
+    _engine: Any  # the engine's search (_core.SearchEngine)
     # The swim function (animat.pool): this process's, and the MPI pool's while run_* runs one.
     _swim: Swim
     _pool: Optional[Swim] = None
@@ -881,12 +880,15 @@ class _SearchState:
     @property
     def generation(self) -> int:
         """The last completed generation (-1 before the first ``tell``)."""
-        return self._generation
+        return int(self._engine.generation)
 
     @property
     def evaluations(self) -> int:
         """Candidates told so far."""
-        return self._evaluations
+        return int(self._engine.evaluations)
+
+    def _references(self, genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
+        raise NotImplementedError
 
     def history_frame(self) -> Any:
         """:attr:`history` as a ``pandas.DataFrame`` (ImportError naming the package when pandas is missing)."""
@@ -1316,16 +1318,6 @@ class MapElites(_SearchState):
 
     # --- state ------------------------------------------------------------------------------------
     @property
-    def generation(self) -> int:
-        """The last completed generation (-1 before the first ``tell``)."""
-        return int(self._engine.generation)
-
-    @property
-    def evaluations(self) -> int:
-        """Candidates told so far."""
-        return int(self._engine.evaluations)
-
-    @property
     def history(self) -> np.recarray:
         """One row per generation (:data:`QD_HISTORY_DTYPE`): ``h["qd_score"]``, ``h[-1].coverage`` ..."""
         columns = QD_HISTORY_DTYPE.names or ()
@@ -1396,13 +1388,14 @@ class MapElites(_SearchState):
         return f"<animat.MapElites generation {self.generation}, batch {self.batch}, {self.archive!r}>"
 
 
-def _reference_hook(me: MapElites) -> Callable[[List[Any]], Tuple[List[Any], List[List[float]]]]:
-    """:meth:`MapElites._references` through a weak reference: the engine holds the hook, and a cycle
-    through it would keep both alive (the garbage collector does not see into the engine)."""
-    owner = weakref.ref(me)
+def _reference_hook(search: _SearchState) -> Callable[[List[Any]], Tuple[List[Any], List[List[float]]]]:
+    """The search's ``_references`` (the exploit guard's swims, the engine's reference hook) through a
+    weak reference: the engine holds the hook, and a cycle through it would keep both alive (the
+    garbage collector does not see into the engine)."""
+    owner = weakref.ref(search)
 
     def references(genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:
-        return cast(MapElites, owner())._references(genomes)
+        return cast(_SearchState, owner())._references(genomes)
 
     return references
 
