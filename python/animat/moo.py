@@ -613,12 +613,6 @@ class Nsga2(_SearchState):
         return history_dtype(self.names)
 
     # --- the loop ---------------------------------------------------------------------------------
-    def ask(self) -> List[Any]:
-        """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
-        if self._asked is None:
-            self._asked = self._engine.ask()
-        return list(self._asked)
-
     def _measure(self, genome: Any, result: Any, config: Any) -> Tuple[Floats, bool]:
         m = len(self.criteria)
         if result is None:

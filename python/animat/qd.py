@@ -865,6 +865,7 @@ class _SearchState:
 
     _config: Any
     _engine: Any  # the engine's search (_core.SearchEngine)
+    _asked: Optional[List[Any]]  # the genomes of the pending ask()
     # The swim function (animat.pool): this process's, and the MPI pool's while run_* runs one.
     _swim: Swim
     _pool: Optional[Swim] = None
@@ -876,6 +877,13 @@ class _SearchState:
     def config(self) -> Any:
         """The run's :class:`animat.Config` (a copy)."""
         return self._config.copy()
+
+    def ask(self) -> List[Any]:
+        """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
+        asked = self._asked
+        if asked is None:
+            asked = self._asked = list(self._engine.ask())
+        return list(asked)
 
     @property
     def generation(self) -> int:
@@ -1189,12 +1197,6 @@ class MapElites(_SearchState):
         return cfg, names
 
     # --- the loop ---------------------------------------------------------------------------------
-    def ask(self) -> List[Any]:
-        """The genomes of the next generation (a list of :class:`animat.Genome`; see the class docstring)."""
-        if self._asked is None:
-            self._asked = self._engine.ask()
-        return list(self._asked)
-
     def tell(self, results: Sequence[Any], descriptors: Optional[Sequence[Optional[Values]]] = None) -> Any:
         """The result of every genome of the last ``ask()``, in order (see the class docstring);
         completes the generation and returns its history row (a numpy record)."""
