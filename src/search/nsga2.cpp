@@ -243,6 +243,18 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness,
   // 2. The exploit guard "select": the reference criteria of every feasible candidate, which the
   // selection then compares (a copy of a genome seen before takes its reference: the same swim).
   std::int64_t referenced = 0;
+  // The reference swims of `members`, their criteria there stored with each (the hook's supplied
+  // values where it gives them, else the member's own).
+  const auto swim_references = [&](const std::vector<Solution*>& members) {
+    std::vector<const Genome*> todo;
+    for (const Solution* s : members) todo.push_back(&s->genome);
+    const auto refs =
+        evaluate_references(reference_, reference_hook_, *config_, todo, own, "Nsga2.tell");
+    for (std::size_t r = 0; r < members.size(); ++r)
+      members[r]->reference = criteria_of(
+          refs.fitness[r], refs.supplied.empty() ? members[r]->supplied : refs.supplied[r]);
+    return static_cast<std::int64_t>(members.size());
+  };
   if (select_) {
     // by hash, in order: the first of equal genomes is the one a copy takes its reference from
     std::unordered_map<std::uint64_t, std::vector<const Solution*>> known;
@@ -253,22 +265,13 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness,
           if (s->genome == g) return s;
       return nullptr;
     };
-    std::vector<std::size_t> first;
-    std::vector<const Genome*> todo;
-    for (std::size_t k = 0; k < candidates.size(); ++k)
-      if (candidates[k].feasible && find(candidates[k].genome) == nullptr) {
-        known[genome_hash(candidates[k].genome)].push_back(&candidates[k]);
-        first.push_back(k);
-        todo.push_back(&candidates[k].genome);
+    std::vector<Solution*> first;
+    for (Solution& c : candidates)
+      if (c.feasible && find(c.genome) == nullptr) {
+        known[genome_hash(c.genome)].push_back(&c);
+        first.push_back(&c);
       }
-    const auto refs =
-        evaluate_references(reference_, reference_hook_, *config_, todo, own, "Nsga2.tell");
-    for (std::size_t r = 0; r < first.size(); ++r) {
-      Solution& s = candidates[first[r]];
-      s.reference =
-          criteria_of(refs.fitness[r], refs.supplied.empty() ? s.supplied : refs.supplied[r]);
-    }
-    referenced = static_cast<std::int64_t>(first.size());
+    referenced = swim_references(first);
     for (Solution& s : candidates) {
       if (!s.feasible) continue;
       if (const Solution* seen = find(s.genome); seen != &s) s.reference = seen->reference;
@@ -310,21 +313,10 @@ bool Nsga2::tell(const std::vector<Fitness>& fitness,
   // 3. The exploit guard "record": the front's new members at the reference step (may throw:
   // nothing has changed yet).
   if (reference_ && !select_) {
-    std::vector<std::size_t> pending;
-    std::vector<const Genome*> todo;
-    for (std::size_t k = 0; k < population.size(); ++k)
-      if (population[k].rank == 0 && population[k].feasible && population[k].reference.empty()) {
-        pending.push_back(k);
-        todo.push_back(&population[k].genome);
-      }
-    const auto refs =
-        evaluate_references(reference_, reference_hook_, *config_, todo, own, "Nsga2.tell");
-    for (std::size_t r = 0; r < pending.size(); ++r) {
-      Solution& s = population[pending[r]];
-      s.reference =
-          criteria_of(refs.fitness[r], refs.supplied.empty() ? s.supplied : refs.supplied[r]);
-    }
-    referenced = static_cast<std::int64_t>(pending.size());
+    std::vector<Solution*> pending;
+    for (Solution& m : population)
+      if (m.rank == 0 && m.feasible && m.reference.empty()) pending.push_back(&m);
+    referenced = swim_references(pending);
   }
   // 4. Commit.
   population_ = std::move(population);
