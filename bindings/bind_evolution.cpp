@@ -130,6 +130,65 @@ nb::dict solution_dict(const Nsga2& nsga, const Solution& s) {
   return d;
 }
 
+// run_search from Python: the hooks run on the calling thread with the GIL; what they raise stops
+// the run as it is. `engine`: the caller's search (SearchEngine.run), free for the callback's use
+// between generations.
+nb::dict run_search_hooked(const Config& c, std::filesystem::path out, bool resume, bool overwrite,
+                           bool quiet, RunOptions opt, nb::object evaluate, nb::object describe,
+                           nb::object callback, SearchEngine* engine) {
+  opt.out = std::move(out);
+  opt.resume = resume;
+  opt.overwrite = overwrite;
+  opt.quiet = quiet;
+  if (!evaluate.is_none())
+    opt.evaluate = [evaluate](const std::vector<Genome>& genomes) {
+      nb::gil_scoped_acquire gil;
+      return nb::cast<std::vector<Fitness>>(evaluate(genomes));
+    };
+  if (!describe.is_none())
+    opt.describe = [describe](const std::vector<Genome>& genomes,
+                              const std::vector<Fitness>& fitness) {
+      nb::gil_scoped_acquire gil;
+      return nb::cast<std::vector<std::vector<double>>>(describe(genomes, fitness));
+    };
+  std::optional<SearchLease> lease;
+  if (engine != nullptr) {
+    lease.emplace(*engine, "run");
+    opt.search = engine->search.get();
+  }
+  if (!callback.is_none())
+    opt.search_callback = [&](const Search& s) {
+      nb::gil_scoped_acquire gil;
+      lease.reset();  // the callback reads the engine (elites, population)
+      const nb::object answer = callback(s.generation());
+      const bool go_on = answer.is_none() || nb::cast<bool>(nb::bool_(answer));
+      if (engine != nullptr) lease.emplace(*engine, "run");
+      return go_on;
+    };
+  bool interrupted = false;
+  // Polled between evaluations (about every 20 ms): Ctrl-C stops the run with a checkpoint.
+  opt.stop_poll = [&interrupted] {
+    nb::gil_scoped_acquire gil;
+    interrupted = interrupted || PyErr_CheckSignals() != 0;
+    return interrupted;
+  };
+  SearchSummary summary;
+  {
+    nb::gil_scoped_release release;
+    summary = run_search(c, opt);
+  }
+  if (interrupted) throw nb::python_error();  // the KeyboardInterrupt, after the checkpoint
+  nb::dict d;
+  d["algorithm"] = summary.algorithm;
+  nb::list columns;
+  for (const auto& col : summary.columns) columns.append(col.name);
+  d["columns"] = columns;
+  d["history"] = summary.history;
+  d["stop_reason"] = summary.stop_reason;
+  d["generation"] = summary.generation;
+  return d;
+}
+
 void bind_search(nb::module_& m) {
   // The key of cvt_centroids' sample stream: Rng.derive(seed, CVT_SAMPLES_KEY, 0).
   m.attr("CVT_SAMPLES_KEY") = kCvtSamplesKey;
@@ -188,8 +247,17 @@ void bind_search(nb::module_& m) {
           [](SearchEngine* e, const Config& c, const std::vector<std::string>& supplied,
              const std::optional<std::vector<std::vector<double>>>& centroids,
              nb::object reference) {
+            // A Python objective's values are told by the caller: the engine never swims with it.
+            FitnessFunction told;
+            if (c.evaluation.objective.starts_with(kPythonObjectivePrefix))
+              told = [name = c.evaluation.objective](const Genome&) -> Fitness {
+                throw Error(fmt::format(
+                    "evaluation.objective = \"{}\" is a Python objective: the caller evaluates "
+                    "and tells its values (the engine cannot call it)",
+                    name));
+              };
             new (e)
-                SearchEngine{make_search(c, {}, {}, nullptr, supplied,
+                SearchEngine{make_search(c, told, told, nullptr, supplied,
                                          centroids.value_or(std::vector<std::vector<double>>{}))};
             if (!reference.is_none())
               // called from tell() (GIL released) with the GIL; never copied without it
@@ -248,6 +316,22 @@ void bind_search(nb::module_& m) {
             e.search->step();
           },
           "Ask, evaluate with the config's own evaluation on evolution.threads, tell.")
+      .def(
+          "run",
+          [](SearchEngine& e, const Config& c, std::filesystem::path out, bool resume,
+             bool overwrite, bool quiet, nb::object evaluate, nb::object describe,
+             nb::object callback) {
+            return run_search_hooked(c, std::move(out), resume, overwrite, quiet, RunOptions{},
+                                     std::move(evaluate), std::move(describe), std::move(callback),
+                                     &e);
+          },
+          "config"_a, "out"_a, "resume"_a = false, "overwrite"_a = false, "quiet"_a = true,
+          "evaluate"_a = nb::none(), "describe"_a = nb::none(), "callback"_a = nb::none(),
+          "run_search with this search, made from config and not yet told a generation: the "
+          "run directory out\nas animat_evolve writes it (a resume restores its checkpoint into "
+          "this search). evaluate, describe:\nas run_search's; callback(generation) after every "
+          "generation (the engine readable), False stops\nthe run (checkpointed). Returns "
+          "run_search's dict.")
       .def_prop_ro("generation", [](const SearchEngine& e) { return e.search->generation(); })
       .def_prop_ro("evaluations", [](const SearchEngine& e) { return e.search->evaluations(); })
       .def_prop_ro(
@@ -876,45 +960,9 @@ void bind_evolution(nb::module_& m) {
       [](const Config& c, std::filesystem::path out, bool resume, bool overwrite, bool quiet,
          const std::vector<std::string>& supplied, nb::object evaluate, nb::object describe) {
         RunOptions opt;
-        opt.out = std::move(out);
-        opt.resume = resume;
-        opt.overwrite = overwrite;
-        opt.quiet = quiet;
         opt.supplied = supplied;
-        // The hooks run on this thread with the GIL; what they raise stops the run as it is.
-        if (!evaluate.is_none())
-          opt.evaluate = [evaluate](const std::vector<Genome>& genomes) {
-            nb::gil_scoped_acquire gil;
-            return nb::cast<std::vector<Fitness>>(evaluate(genomes));
-          };
-        if (!describe.is_none())
-          opt.describe = [describe](const std::vector<Genome>& genomes,
-                                    const std::vector<Fitness>& fitness) {
-            nb::gil_scoped_acquire gil;
-            return nb::cast<std::vector<std::vector<double>>>(describe(genomes, fitness));
-          };
-        bool interrupted = false;
-        // Polled between evaluations (about every 20 ms): Ctrl-C stops the run with a checkpoint.
-        opt.stop_poll = [&interrupted] {
-          nb::gil_scoped_acquire gil;
-          interrupted = interrupted || PyErr_CheckSignals() != 0;
-          return interrupted;
-        };
-        SearchSummary summary;
-        {
-          nb::gil_scoped_release release;
-          summary = run_search(c, opt);
-        }
-        if (interrupted) throw nb::python_error();  // the KeyboardInterrupt, after the checkpoint
-        nb::dict d;
-        d["algorithm"] = summary.algorithm;
-        nb::list columns;
-        for (const auto& col : summary.columns) columns.append(col.name);
-        d["columns"] = columns;
-        d["history"] = summary.history;
-        d["stop_reason"] = summary.stop_reason;
-        d["generation"] = summary.generation;
-        return d;
+        return run_search_hooked(c, std::move(out), resume, overwrite, quiet, std::move(opt),
+                                 std::move(evaluate), std::move(describe), nb::none(), nullptr);
       },
       "config"_a, "out"_a, "resume"_a = false, "overwrite"_a = false, "quiet"_a = true,
       "supplied"_a = std::vector<std::string>{}, "evaluate"_a = nb::none(),

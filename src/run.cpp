@@ -364,9 +364,9 @@ class RunLock {
 };
 
 // What a run writes into its directory (RunOptions::overwrite removes these and nothing else).
-const std::vector<std::string> kRunFiles = {"config.toml", "history.csv",   "checkpoint.json",
-                                            "islands.csv", "genealogy.csv", "resume.log",
-                                            "stopped.txt", "best",          "figures"};
+const std::vector<std::string> kRunFiles = {
+    "config.toml", "history.csv", "checkpoint.json", "islands.csv", "genealogy.csv", "resume.log",
+    "stopped.txt", "best",        "figures",         "archive",     "front"};
 
 // NAME.PID.tmp or NAME.tmp next to a run file: left by a process killed while writing NAME.
 bool is_leftover_temporary(const std::string& name) {
@@ -805,8 +805,15 @@ SearchSummary run_search_unchecked(const Config& config, const RunOptions& opt,
     probe_lock(opt.out);
     checkpoint_text = check();
   }
-  std::unique_ptr<Search> search =
-      make_search(config, std::move(fitness), std::move(reference), opt.evaluator, opt.supplied);
+  std::unique_ptr<Search> made;
+  if (opt.search == nullptr)
+    made =
+        make_search(config, std::move(fitness), std::move(reference), opt.evaluator, opt.supplied);
+  else if (opt.search->algorithm() != config.search.algorithm || opt.search->generation() >= 0)
+    throw Error(fmt::format(
+        "run_search: the caller's search is {} at generation {}; a run starts a new {} search",
+        opt.search->algorithm(), opt.search->generation(), config.search.algorithm));
+  Search* const search = made ? made.get() : opt.search;
   if (!search->supplied().empty() && !opt.describe)
     throw Error(fmt::format(
         "run_search: the caller supplies {} ({}) but gives no describe hook",

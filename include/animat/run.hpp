@@ -47,6 +47,9 @@ struct RunOptions {
   Search::EvaluateHook evaluate;
   /// run_search: the supplied values of every genome of a generation (Search::step's hook).
   Search::DescribeHook describe;
+  /// run_search: the caller's search, made from the same config (animat.MapElites and animat.Nsga2
+  /// run theirs, with their own centroids, reference hook and reference point); null = make_search.
+  Search* search = nullptr;
   /// Called once every check has passed and the run directory is locked, before the first write to
   /// it (animat_evolve shows and removes stopped.txt here, so that a refused command leaves it in
   /// place).

@@ -80,8 +80,9 @@ struct Measure {
 struct SuppliedMeasures {
   /// ConfigError unless every name is one of `allowed` (the entries of the config key `key`) and
   /// is listed once.
+  /// A name of the measures table under `config` (find_measure) keeps its range and sense.
   SuppliedMeasures(std::vector<std::string> names, const std::vector<std::string>& allowed,
-                   std::string_view key);
+                   std::string_view key, const Config& config);
   SuppliedMeasures(const SuppliedMeasures&) = delete;
   SuppliedMeasures& operator=(const SuppliedMeasures&) = delete;
   /// The position of `m` in `names` (m one of `measures`).
@@ -89,9 +90,14 @@ struct SuppliedMeasures {
     return static_cast<std::size_t>(m - measures.data());
   }
   [[nodiscard]] const Measure* find(std::string_view name) const;
+  /// Every supplied value computed by the measures table from a swim's Fitness, when every name is
+  /// a table measure: a checkpoint of a search that measured them itself (animat_evolve's) holds
+  /// no supplied values, and these are the ones its caller would have supplied.
+  [[nodiscard]] std::optional<std::vector<double>> from_table(const Fitness& f) const;
 
   std::vector<std::string> names;
   std::vector<Measure> measures;
+  std::vector<const Measure*> table;  ///< each name's table measure, or null
 };
 
 /// The exactly rounded sum of `values` (Python's math.fsum): the QD-score and the hypervolume do

@@ -613,6 +613,8 @@ def cmd_nsga2(args) -> int:
             objectives = objectives_from_config(config)
         except ValueError as e:
             raise ValueError(f"--objectives {text!r}: {str(e).partition(': ')[2]}") from None
+        # written with their senses: the run's config says what it optimises
+        config.apply_overrides([f"search.objectives={json.dumps([f'{n}:{s}' for n, s in objectives])}"])
     return _search(
         args,
         config,

@@ -84,9 +84,12 @@ from .qd import (
     _checked_state,
     _checksum,
     _comparable,
+    _engine_checkpoint,
     _history_dtype,
+    _holds,
     _on_ranks,
     _reference_hook,
+    _run_config,
     _run_search,
     _same_as_run,
     _SearchState,
@@ -574,7 +577,11 @@ class Nsga2(_SearchState):
         self._config["evolution.population"] = size
         self._config["evolution.crossover_fraction"] = float(cf)
         self._config["search.algorithm"] = "nsga2"
-        self._config["search.objectives"] = [f"{c.name}:{c.sense}" for c in self.criteria]
+        # the config's entries where they say the same (a sense left to the table's)
+        given = [str(e).partition(":") for e in self._config["search.objectives"]]
+        meant = [(n, s or (CRITERIA[n].sense if n in CRITERIA else "")) for n, _, s in given]
+        if meant != [(c.name, c.sense) for c in self.criteria]:
+            self._config["search.objectives"] = [f"{c.name}:{c.sense}" for c in self.criteria]
         self.seed = int(self._config["evolution.seed"])
         self.population_size = size
         self.crossover_fraction = float(cf)
@@ -671,6 +678,48 @@ class Nsga2(_SearchState):
         """The exploit guard's swims (the engine's hook): every genome at the reference step."""
         ref = _core.reference_config(self._config)
         return self._told(genomes, self._evaluate(list(genomes), ref), ref)
+
+    def _run_hooks(
+        self,
+    ) -> Tuple[Callable[[List[Any]], List[Any]], Callable[[List[Any], List[Any]], List[List[float]]]]:
+        """The engine's evaluate and describe hooks of a run (:func:`run_nsga2`): one generation's
+        swims as :meth:`step` swims them, and the criteria of the same swims."""
+        rows: List[List[float]] = []
+
+        def evaluate(genomes: List[Any]) -> List[Any]:
+            fits, rows[:] = self._told(genomes, self._evaluate(list(genomes), self._config), self._config)
+            return fits
+
+        return evaluate, lambda genomes, fitness: rows
+
+    @classmethod
+    def _from_run(
+        cls,
+        path: Path,
+        run: Any,
+        config: Any = None,
+        *,
+        objectives: Iterable[CriterionLike] = (),
+        threads: Optional[int] = None,
+    ) -> Nsga2:
+        """The search of a run directory's config ``run``, not yet restored (its hypervolume reference
+        point comes with the checkpoint). ``config``: must be the run's but for the keys a run may
+        change (ValueError naming the file)."""
+        source = str(path / "config.toml")
+        _holds(run, "nsga2", source)
+        if config is not None:
+            _same_run_config(config, run, source)
+        pairs = []
+        for entry in run["search.objectives"]:
+            name, _, sense = str(entry).partition(":")
+            pairs.append((name, sense or (CRITERIA[name].sense if name in CRITERIA else "")))
+        try:
+            criteria = _run_criteria(pairs, objectives)
+        except ValueError as e:
+            raise ValueError(f"{source}: {e}") from None
+        if threads is None and config is not None:
+            threads = int(config["evolution.threads"])
+        return cls(run, criteria, threads=threads)
 
     def step(self, evaluate: Optional[Callable[[List[Any]], Sequence[Any]]] = None) -> Any:
         """Ask, evaluate (default: ``animat.evaluate`` on the config's threads: the GIL is released
@@ -781,13 +830,7 @@ class Nsga2(_SearchState):
         except (ValueError, KeyError, TypeError, AttributeError) as e:
             raise ValueError(f"{source}: {e}") from None
         if config is not None:
-            mine = config.copy()
-            for key in ("evolution.seed", "evolution.population", "evolution.crossover_fraction"):
-                mine[key] = saved[key]
-            if _comparable(mine) != _comparable(saved):
-                raise ValueError(
-                    f"{source}: Nsga2.restore: the config differs from the checkpoint's (only evolution.threads may)"
-                )
+            _same_run_config(config, saved, source)
         criteria = _run_criteria(run, objectives)
         if threads is None and config is not None:
             threads = int(config["evolution.threads"])
@@ -811,6 +854,18 @@ class Nsga2(_SearchState):
         return (
             f"<animat.Nsga2 generation {self.generation}, population {self.population_size}, {objectives}: "
             f"front of {len(self._engine.front())}>"
+        )
+
+
+def _same_run_config(config: Any, saved: Any, source: str) -> None:
+    """Refuses a config that differs from the run's ``saved`` but for ``evolution.threads`` and
+    what the run's own arguments set (seed, population, crossover fraction, length)."""
+    mine = config.copy()
+    for key in ("evolution.seed", "evolution.population", "evolution.crossover_fraction"):
+        mine[key] = saved[key]
+    if _comparable(mine) != _comparable(saved):
+        raise ValueError(
+            f"{source}: Nsga2.restore: the config differs from the checkpoint's (only evolution.threads may)"
         )
 
 
@@ -873,15 +928,20 @@ def run_nsga2(
     """Run NSGA-II up to generation ``generations`` (generation 0 is the initial population, as
     ``evolution.generations`` counts) in the run directory ``out``:
 
-    - ``config.toml``: the run's config (its ``evolution.seed`` is the run's seed);
+    The run goes through the engine's run layer (``SearchEngine.run``), the format ``animat_evolve``
+    writes and resumes (docs/search.md); the engine's stall and wall-clock rules may stop it before.
+
+    - ``config.toml``: the run's config (its ``evolution.seed`` is the run's seed; ``search.objectives``
+      the criteria with their senses; ``evolution.generations`` the cap);
     - ``history.csv``: :func:`history_dtype`'s columns (``generation, evaluations, front_size,
-      hypervolume, best_<name>..., feasible, discarded, reference_evaluations, disagreements``), one
-      row per generation;
+      hypervolume, best_<name>..., feasible, discarded, reference_evaluations, disagreements``) and
+      ``wall_seconds``, one row per generation;
     - ``front/gen_NNNNNN.csv``: the front after every ``front_every``-th generation and the last
       (:meth:`Nsga2.write_front`: one row per genome);
-    - ``checkpoint.json``: written after every generation (:meth:`Nsga2.checkpoint`); ``resume=True``
-      continues from it and gives the very run an uninterrupted one gives (``objectives`` may then
-      be None; your own functions must be passed again, and given objectives must be the run's).
+    - ``checkpoint.json``: the engine's checkpoint (with the hypervolume's reference point), every
+      ``evolution.checkpoint_every`` generations and at the end; ``resume=True`` continues from it
+      and gives the very run an uninterrupted one gives (``objectives`` may then be None; your own
+      functions must be passed again, and given objectives must be the run's).
 
     A new run with ``objectives`` None optimises the config's ``search.objectives``
     (:func:`objectives_from_config`): a config with ``search.algorithm = "nsga2"`` defines the whole run,
@@ -900,7 +960,9 @@ def run_nsga2(
     given = () if objectives is None else objectives
 
     def load(path: Path) -> Nsga2:
-        nsga = Nsga2.load(path, config, objectives=given, threads=threads)
+        nsga = Nsga2._from_run(path, _run_config(path, generations), config, objectives=given, threads=threads)
+        # the run's reference point is its checkpoint's (checked when the engine restores it)
+        point = _engine_checkpoint(path).get("reference_point")
         _same_as_run(
             "run_nsga2",
             population=(population, nsga.population_size),
@@ -908,7 +970,7 @@ def run_nsga2(
             crossover_fraction=(crossover_fraction, nsga.crossover_fraction),
             reference_point=(
                 None if reference_point is None else tuple(float(x) for x in reference_point),
-                nsga.reference_point if nsga._reference_point_given else None,
+                None if not isinstance(point, list) else tuple(float(x) for x in point),
             ),
         )
         return nsga
@@ -918,8 +980,11 @@ def run_nsga2(
             objectives_from_config(config)  # the names and senses, before any file is written
 
     def new() -> Nsga2:
+        run = _core.Config() if config is None else config.copy()
+        if generations > 0:  # 0: no cap in the config; the run stops after generation 0
+            run["evolution.generations"] = generations
         return Nsga2(
-            config,
+            run,
             objectives if objectives is not None else objectives_from_config(config),
             population=population,
             seed=seed,

@@ -55,14 +55,11 @@ Example::
 from __future__ import annotations
 
 import csv
-import fcntl
 import hashlib
 import io
 import json
 import math
 import os
-import shutil
-import socket
 import weakref
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
@@ -714,12 +711,14 @@ class CVTArchive(_Archive):
     in the descriptor box; a value belongs to the cell of its nearest centroid.
 
     The centroids are computed once, deterministically, in the box scaled to the unit cube (each
-    descriptor's ``(v - lo) / (hi - lo)``, so every descriptor weighs the same): ``samples`` points are
-    drawn uniformly with ``numpy.random.default_rng(seed).random((samples, d))``, the first ``cells`` of
-    them start Lloyd's k-means, and each iteration assigns every sample to its nearest centroid (the
-    lowest index among equals) and moves each centroid to the mean of its samples (a centroid with
-    none stays), until the assignment no longer changes or after ``iterations``. Checkpoints store the
-    centroids, so a restored archive does not depend on numpy's generator.
+    descriptor's ``(v - lo) / (hi - lo)``, so every descriptor weighs the same), by the engine's
+    ``animat._core.cvt_centroids(d, cells, seed, samples, iterations)``: ``samples`` points drawn
+    uniformly from the keyed stream ``animat.Rng.derive(seed, CVT_SAMPLES_KEY, 0)``, the first
+    ``cells`` of them start Lloyd's k-means, and each iteration assigns every sample to its nearest
+    centroid (the lowest index among equals) and moves each centroid to the mean of its samples (a
+    centroid with none stays), until the assignment no longer changes or after ``iterations``. With
+    the run's ``evolution.seed`` and the default iterations these are the centroids of a config's
+    ``search.archive = "cvt"`` (what ``animat_evolve`` searches); checkpoints store the centroids.
 
     A value is scaled the same way and clipped to the unit cube, then put in the cell of its nearest
     centroid (the lowest index among equals); a NaN is never archived.
@@ -759,7 +758,7 @@ class CVTArchive(_Archive):
             )
         self.seed = int(seed)
         self.samples = n
-        self._unit = _kmeans(np.random.default_rng(self.seed).random((n, self.dims)), cells, int(iterations))
+        self._unit = np.array(_core.cvt_centroids(self.dims, cells, self.seed, n, int(iterations)), dtype=np.float64)
 
     @classmethod
     def _with_centroids(
@@ -798,22 +797,6 @@ def _nearest(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
     return out
 
 
-def _kmeans(samples: np.ndarray, k: int, iterations: int) -> np.ndarray:
-    centroids = samples[:k].copy()
-    previous: Optional[np.ndarray] = None
-    for _ in range(max(0, iterations)):
-        labels = _nearest(samples, centroids)
-        if previous is not None and np.array_equal(labels, previous):
-            break
-        counts = np.bincount(labels, minlength=k)
-        filled = counts > 0
-        for j in range(samples.shape[1]):
-            sums = np.bincount(labels, weights=samples[:, j], minlength=k)
-            centroids[filled, j] = sums[filled] / counts[filled]
-        previous = labels
-    return centroids
-
-
 # --- MAP-Elites -----------------------------------------------------------------------------------
 
 
@@ -824,8 +807,8 @@ def _history_dtype(columns: Sequence[Tuple[str, bool]]) -> np.dtype:
     )
 
 
-#: The columns of :attr:`MapElites.history` and ``history.csv``, one row per generation: the engine's
-#: (``_core.search_history_columns("map_elites")``) but its ``wall_seconds``. ``evaluations``: swims
+#: The columns of :attr:`MapElites.history`, one row per generation: the engine's
+#: (``_core.search_history_columns("map_elites")``, a run's ``history.csv``) but its ``wall_seconds``. ``evaluations``: swims
 #: told so far (the batches; reference swims not counted); ``best``: the greatest objective in the
 #: archive (NaN when empty); ``added``: candidates of this generation that entered the archive;
 #: ``discarded``: candidates never archivable (non-viable, unstable, invalid, NaN descriptor);
@@ -852,6 +835,7 @@ def _write_atomic(path: Path, text: str) -> Path:
 def _comparable(config: Any) -> Dict[str, Any]:
     d = config.to_dict()
     d.get("evolution", {}).pop("threads", None)
+    d.get("evolution", {}).pop("generations", None)  # a run's length is run_*'s argument
     # [search] says how a new run from the config searches; a started run's checkpoint holds its
     # archive or objectives (and runs started before [search] existed hold the defaults).
     d.pop("search", None)
@@ -911,14 +895,26 @@ class _SearchState:
         """Write :meth:`checkpoint` as JSON to ``path`` atomically."""
         return _write_atomic(Path(path), json.dumps(cast(Any, self).checkpoint(), allow_nan=False))
 
+    def _refresh(self) -> None:
+        """Brings views of the engine's state up to date (MapElites' archive)."""
+
     @classmethod
     def load(cls, path: PathLike, config: Any = None, **kwargs: Any) -> Any:
-        """:meth:`restore` from a file written by :meth:`save` (or the run directory of a search);
-        errors name the file."""
+        """:meth:`restore` from a file written by :meth:`save`, or the search of a run directory (its
+        config.toml and checkpoint.json, as :func:`run_map_elites`, :func:`run_nsga2` and
+        ``animat_evolve`` write them; ``config``, if given, must be the run's but for
+        ``evolution.threads`` and ``evolution.generations``); errors name the file."""
         path = Path(path)
-        if path.is_dir():
-            path = path / "checkpoint.json"
-        return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, source=str(path), **kwargs)
+        if not path.is_dir():
+            return cast(Any, cls).restore(path.read_text(encoding="utf-8"), config, source=str(path), **kwargs)
+        checkpoint = path / "checkpoint.json"
+        if not checkpoint.is_file():
+            raise FileNotFoundError(f"{checkpoint}: the run directory has no checkpoint")
+        run = _run_config(path)
+        search = cast(Any, cls)._from_run(path, run, config, **kwargs)
+        search._engine.restore(checkpoint.read_text(encoding="utf-8"), str(checkpoint))
+        search._refresh()
+        return search
 
 
 def _same_config(config: Any, saved: Any, objective: ObjectiveLike, source: str) -> None:
@@ -1154,19 +1150,14 @@ class MapElites(_SearchState):
         self.crossover_fraction = float(cf)
         self._config["evolution.crossover_fraction"] = self.crossover_fraction
         self.archive = archive
-        # The run's config.toml says what it is (`animat evolve --resume` dispatches on it); the
-        # checkpoint holds the archive itself (a CVT archive's centroids, custom ranges).
-        self._config["search.algorithm"] = "map_elites"
-        self._config["search.descriptors"] = [d.name for d in archive.descriptors]
-        if isinstance(archive, GridArchive):
-            self._config["search.bins"] = [float(b) for b in archive.bins]
-        self._config["search.batch"] = self.batch
-        engine_config, supplied = self._engine_config()
+        # The run's config says what search it is (its [search] section: what a run directory's
+        # config.toml holds, and what animat_evolve resumes); a CVT archive's centroids are given.
+        self._config, supplied = self._engine_config()
         # The exploit guard swims here (the objective may be Python's; under MPI on the ranks).
         guarded = str(self._config["evaluation.reference_check"]) != "off"
         centroids = None if isinstance(archive, GridArchive) else cast(CVTArchive, archive)._unit.tolist()
         self._engine = _core.SearchEngine(
-            engine_config,
+            self._config,
             supplied=supplied,
             centroids=centroids,
             reference=_reference_hook(self) if guarded else None,
@@ -1175,25 +1166,38 @@ class MapElites(_SearchState):
         self._asked: Optional[List[Any]] = None
 
     def _engine_config(self) -> Tuple[Any, List[str]]:
-        """The engine's config: the run's with the archive's descriptors, all supplied by this
-        search, and its ranges (a CVT archive: its cells; its centroids are given to the engine)."""
+        """The engine's config, the run's: its [search] section describes the archive (its
+        descriptors, all supplied by this search; ranges, bins or cells) and the batch. A key the
+        config already gives as the archive has it is left as written (``search.bins = [10]`` for
+        every descriptor, ``search.ranges = []`` for the table's ranges), so that a run started by
+        animat_evolve from the same config is the same run."""
         cfg = self._config.copy()
         archive = self.archive
         names = [d.name for d in archive.descriptors]
         cfg["search.algorithm"] = "map_elites"
         cfg["search.descriptors"] = names
-        cfg["search.ranges"] = [x for d in archive.descriptors for x in (d.lo, d.hi)]
+        ranges = [x for d in archive.descriptors for x in (d.lo, d.hi)]
+        table = [
+            x
+            for d in archive.descriptors
+            if _is_table_entry(d)
+            for x in (DESCRIPTORS[d.name].lo, DESCRIPTORS[d.name].hi)
+        ]
+        if list(cfg["search.ranges"]) != ranges and not (not list(cfg["search.ranges"]) and table == ranges):
+            cfg["search.ranges"] = ranges
         if isinstance(archive, GridArchive):
             cfg["search.archive"] = "grid"
-            cfg["search.bins"] = [float(b) for b in archive.bins]
+            bins = [float(b) for b in archive.bins]
+            given = [float(b) for b in cfg["search.bins"]]
+            if given != bins and not (len(given) == 1 and bins == given * len(bins)):
+                cfg["search.bins"] = bins
         else:
             cfg["search.archive"] = "cvt"
             cfg["search.cells"] = archive.cells
-        cfg["search.batch"] = self.batch
-        if self._objective is not None:
-            # The engine cannot call Python: this search tells it the objective's values (and has no
-            # exploit guard), so its config names a built-in objective that may be negative instead.
-            cfg["evaluation.objective"] = "speed_toward"
+            if (int(cfg["search.samples"]) or max(1000, 20 * archive.cells)) != archive.samples:
+                cfg["search.samples"] = archive.samples
+        if self.batch != (int(cfg["search.batch"]) or int(cfg["evolution.population"])):
+            cfg["search.batch"] = self.batch
         return cfg, names
 
     # --- the loop ---------------------------------------------------------------------------------
@@ -1207,6 +1211,17 @@ class MapElites(_SearchState):
             raise ValueError(f"MapElites.tell: {len(results)} results for the {len(genomes)} genomes asked")
         if descriptors is not None and len(descriptors) != len(genomes):
             raise ValueError(f"MapElites.tell: {len(descriptors)} descriptor rows for {len(genomes)} genomes")
+        told, rows = self._told(genomes, results, descriptors)
+        self._engine.tell(told, rows)
+        self._asked = None
+        self._refresh()
+        return self.history[-1]
+
+    def _told(
+        self, genomes: List[Any], results: Sequence[Any], descriptors: Optional[Sequence[Optional[Values]]]
+    ) -> Tuple[List[Any], List[List[float]]]:
+        """What the engine is told of ``results``: a Fitness and the descriptors' values for each (a
+        row of NaN and a Fitness that cannot enter for a candidate without descriptors)."""
         fits = []
         for i, r in enumerate(results):
             if isinstance(r, (str, bytes)):
@@ -1227,10 +1242,7 @@ class MapElites(_SearchState):
                 continue
             told.append(fit)
             rows.append(values.tolist())
-        self._engine.tell(told, rows)
-        self._asked = None
-        self._refresh()
-        return self.history[-1]
+        return told, rows
 
     def _values(
         self, i: int, genome: Any, fit: Any, raw: Any, rows: Optional[Sequence[Optional[Values]]]
@@ -1293,6 +1305,11 @@ class MapElites(_SearchState):
         genomes = self.ask()
         if evaluate is not None:
             return self.tell(list(evaluate(genomes)))
+        fits, rows = self._swim_and_describe(genomes)
+        return self.tell(fits, descriptors=rows)
+
+    def _swim_and_describe(self, genomes: List[Any]) -> Tuple[List[Any], List[Optional[np.ndarray]]]:
+        """Every genome's Fitness and descriptor values (None when it is not a candidate)."""
         names = _worker_descriptors(self.archive.descriptors)
         pairs = self._evaluate(genomes, self._config, describe=names) if names else None
         fits = [p[0] for p in pairs] if pairs is not None else self._evaluate(genomes, self._config)
@@ -1316,7 +1333,21 @@ class MapElites(_SearchState):
                     dtype=np.float64,
                 )
             )
-        return self.tell(fits, descriptors=rows)
+        return fits, rows
+
+    def _run_hooks(
+        self,
+    ) -> Tuple[Callable[[List[Any]], List[Any]], Callable[[List[Any], List[Any]], List[List[float]]]]:
+        """The engine's evaluate and describe hooks of a run (:func:`run_map_elites`): one
+        generation's swims as :meth:`step` swims them, and the descriptor rows of the same swims."""
+        rows: List[List[float]] = []
+
+        def evaluate(genomes: List[Any]) -> List[Any]:
+            fits, values = self._swim_and_describe(list(genomes))
+            told, rows[:] = self._told(list(genomes), fits, values)
+            return told
+
+        return evaluate, lambda genomes, fitness: rows
 
     # --- state ------------------------------------------------------------------------------------
     @property
@@ -1381,6 +1412,51 @@ class MapElites(_SearchState):
             me._engine.restore(engine_text, source)
             me._refresh()
         return me
+
+    @classmethod
+    def _from_run(
+        cls,
+        path: Path,
+        run: Any,
+        config: Any = None,
+        *,
+        objective: ObjectiveLike = None,
+        descriptors: Iterable[DescriptorLike] = (),
+        threads: Optional[int] = None,
+    ) -> MapElites:
+        """The search of a run directory's config ``run``, not yet restored: its archive from
+        [search] (your own descriptor functions by name in ``descriptors``; a CVT archive's centroids
+        from the checkpoint). ``config``: must be the run's but for the keys a run may change."""
+        source = str(path / "config.toml")
+        _holds(run, "map_elites", source)
+        if config is not None:
+            _same_config(config, run, objective, source)
+        names = [str(n) for n in run["search.descriptors"]]
+        ranges = [float(x) for x in run["search.ranges"]]
+        own = {d.name: d for d in map(_descriptor, descriptors)}
+        ds = []
+        for j, name in enumerate(names):
+            d = own.get(name, DESCRIPTORS.get(name))
+            if d is None:
+                raise ValueError(
+                    f"{source}: search.descriptors names {name!r}, not in animat.qd.DESCRIPTORS: pass your "
+                    "descriptor function again (descriptors=[...])"
+                )
+            ds.append(d.with_range(ranges[2 * j], ranges[2 * j + 1]) if ranges else d)
+        archive: _Archive
+        if str(run["search.archive"]) == "cvt":
+            state = _engine_checkpoint(path)
+            try:
+                unit = np.asarray(state["centroids"], dtype=np.float64)
+            except (KeyError, TypeError, ValueError):
+                raise ValueError(f"{path / 'checkpoint.json'}: a CVT run's checkpoint without its centroids") from None
+            samples = int(run["search.samples"]) or max(1000, 20 * len(unit))
+            archive = CVTArchive._with_centroids(ds, unit, int(run["evolution.seed"]), samples, 0.0)
+        else:
+            bins = [int(b) for b in run["search.bins"]]
+            archive = GridArchive(ds, bins[0] if len(bins) == 1 else bins)
+        batch = int(run["search.batch"]) or int(run["evolution.population"])
+        return cls(run, archive, batch=batch, objective=objective, threads=threads)
 
     def __reduce__(self) -> Tuple[Any, ...]:
         # Pickles as its checkpoint, with the Python objective and your own descriptor functions.
@@ -1463,108 +1539,100 @@ def _run_search(
     callback: Optional[Callable[[Any], Optional[bool]]],
     pool: Optional[Swim] = None,
 ) -> Any:
-    """The run directory of a search (MAP-Elites, NSGA-II): ``config.toml``, ``history.csv``,
-    ``<snapshots>/gen_NNNNNN.csv`` every ``every`` generations and at the last, ``checkpoint.json``
-    after every generation. Every refusal comes before any file is touched. ``pool``: where the
-    search swims meanwhile (default its own threads)."""
+    """The run directory of a search (MAP-Elites, NSGA-II), written by the engine's run layer as
+    ``animat_evolve`` writes it (``SearchEngine.run``: the lock, the checked checkpoint, the resume's
+    config comparison): ``config.toml``, ``history.csv``, ``checkpoint.json``; and here
+    ``<snapshots>/gen_NNNNNN.csv`` every ``every`` generations and at the last. ``load(out)``: the
+    search of the run's config.toml, not yet restored (the engine restores it); every refusal comes
+    before any file is touched. ``pool``: where the search swims meanwhile (default its threads)."""
     if resume and overwrite:
         raise ValueError(f"{what}: resume=True and overwrite=True contradict each other")
     if every < 1:
         raise ValueError(f"{what}: {snapshots}_every must be >= 1, got {every}")
+    if generations < 0:
+        raise ValueError(f"{what}: generations must be >= 0, got {generations}")
     out = Path(out)
-    has_run = any((out / f).exists() for f in _RUN_FILES) or (out / snapshots).exists()
     if resume:
         if not (out / "checkpoint.json").is_file():
             raise FileNotFoundError(f"{out / 'checkpoint.json'}: no checkpoint to resume")
         search = load(out)
+        if int(_engine_checkpoint(out).get("generation", -1)) >= generations:
+            # there already: nothing to run, no file is written
+            search._engine.restore((out / "checkpoint.json").read_text(encoding="utf-8"), str(out / "checkpoint.json"))
+            search._refresh()
+            return search
     else:
+        has_run = any((out / f).exists() for f in _RUN_FILES) or (out / snapshots).exists()
         if has_run and not overwrite:
             raise FileExistsError(f"{out} holds a run: pass resume=True or overwrite=True")
         check_new()
         search = new()  # its sizes are checked here, before any file is touched
-    lock = _RunLock(out)
+
+    def after(generation: int) -> bool:
+        search._refresh()
+        last = generation >= generations
+        (out / snapshots).mkdir(exist_ok=True)
+        snapshot = out / snapshots / f"gen_{generation:06d}.csv"
+        if generation % every == 0 or last:
+            write_snapshot(search, snapshot)
+        if callback is not None and callback(search.history[-1]) is False:
+            write_snapshot(search, snapshot)
+            return False
+        return not last
+
+    evaluate, describe = search._run_hooks()
+    search._pool = pool
     try:
-        if overwrite:
-            for f in _RUN_FILES:
-                (out / f).unlink(missing_ok=True)
-            shutil.rmtree(out / snapshots, ignore_errors=True)
-        (out / snapshots).mkdir(parents=True, exist_ok=True)
-        _write_atomic(out / "config.toml", search.config.to_toml())
-        _steps(search, out, snapshots, every, generations, write_snapshot, callback, pool)
+        search._engine.run(
+            search._config,
+            str(out),
+            resume=resume,
+            overwrite=overwrite,
+            evaluate=evaluate,
+            describe=describe,
+            callback=after,
+        )
     finally:
-        lock.release()
+        search._pool = None
+    search._refresh()
     return search
 
 
-def _steps(
-    search: Any,
-    out: Path,
-    snapshots: str,
-    every: int,
-    generations: int,
-    write_snapshot: Callable[[Any, Path], Any],
-    callback: Optional[Callable[[Any], Optional[bool]]],
-    pool: Optional[Swim],
-) -> None:
-    """The generations of :func:`_run_search`, each saved as it completes."""
-    search._pool = pool
+def _run_config(path: Path, generations: Optional[int] = None) -> Any:
+    """A run directory's config (its config.toml), for a run to ``generations`` if given."""
+    source = path / "config.toml"
     try:
-        while search.generation < generations:
-            row = search.step()
-            g = search.generation
-            snapshot = out / snapshots / f"gen_{g:06d}.csv"
-            if g % every == 0 or g == generations:
-                write_snapshot(search, snapshot)
-            _write_atomic(out / "history.csv", _history_csv(search.history))
-            search.save(out / "checkpoint.json")
-            if callback is not None and callback(row) is False:
-                write_snapshot(search, snapshot)
-                break
-    finally:
-        search._pool = None
+        text = source.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{source}: the run directory has a checkpoint but no config.toml") from None
+    config = _core.Config.from_toml(text, str(source))
+    if generations:
+        config["evolution.generations"] = generations
+    return config
 
 
-class _RunLock:
-    """One writer per run directory: an advisory lock (flock) on ``out/.lock``, the lock file that
-    ``animat_evolve`` and :func:`animat.evolve` hold (src/run.cpp), so a second writer of any of them
-    is refused (BlockingIOError naming the holder's pid) before it writes anything. The file names
-    its holder; the holder removes it on release. The kernel drops the lock when its process ends."""
+def _holds(run: Any, algorithm: str, source: str) -> None:
+    """Refuses a run directory's config ``run`` whose search is not ``algorithm``."""
+    if str(run["search.algorithm"]) != algorithm:
+        raise ValueError(
+            f'{source}: search.algorithm = "{run["search.algorithm"]}": the run directory holds a '
+            f"{run['search.algorithm']} run, not a {algorithm} one (animat evolve --resume continues any)"
+        )
 
-    def __init__(self, out: Path) -> None:
-        out.mkdir(parents=True, exist_ok=True)
-        self.path = out / ".lock"
-        for _ in range(100):
-            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC | os.O_NOFOLLOW, 0o644)
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                holder = " ".join(os.pread(fd, 512, 0).decode("utf-8", "replace").split())
-                os.close(fd)
-                raise BlockingIOError(
-                    f"{out}: the run directory is in use by another animat process "
-                    f"({holder or 'one just starting'}, holding {self.path}); one process writes a run "
-                    "directory at a time. Wait for it to end, then resume; or use another directory. "
-                    "Nothing was written."
-                ) from None
-            # its last holder removes the file on release: the file locked must be the one on disk
-            try:
-                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
-            os.close(fd)
-        else:
-            raise OSError(f"{self.path}: cannot lock the run directory: the lock file keeps being replaced")
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"pid {os.getpid()}\nhost {socket.gethostname() or 'unknown'}\n".encode(), 0)
-        self.fd = fd
 
-    def release(self) -> None:
-        try:
-            self.path.unlink(missing_ok=True)
-        finally:
-            os.close(self.fd)
+def _engine_checkpoint(path: Path) -> Mapping[str, Any]:
+    """The JSON of the engine checkpoint a run directory holds (checked when it is restored)."""
+    source = path / "checkpoint.json"
+    try:
+        state = json.loads(source.read_text(encoding="utf-8"))
+        if not isinstance(state, dict):
+            raise ValueError("not a JSON object")
+        payload = json.loads(state["payload"])
+        if not isinstance(payload, dict):
+            raise ValueError("its payload is not a JSON object")
+    except (ValueError, KeyError, TypeError) as e:
+        raise ValueError(f"{source}: not an animat checkpoint: {e}") from None
+    return cast(Mapping[str, Any], payload)
 
 
 def run_map_elites(
@@ -1587,16 +1655,20 @@ def run_map_elites(
     mpi: bool = False,
 ) -> MapElites:
     """Run MAP-Elites up to generation ``generations`` (generation 0 is the initial batch, as
-    ``evolution.generations`` counts) in the run directory ``out``:
+    ``evolution.generations`` counts; the engine's stall and wall-clock rules may stop it before) in
+    the run directory ``out``, through the engine's run layer (``SearchEngine.run``), the format
+    ``animat_evolve`` writes and resumes (docs/search.md):
 
-    - ``config.toml``: the run's config (its ``evolution.seed`` is the run's seed);
+    - ``config.toml``: the run's config (its ``evolution.seed`` is the run's seed; its [search]
+      section the archive and batch; ``evolution.generations`` the cap);
     - ``history.csv``: :data:`QD_HISTORY_DTYPE`'s columns (``generation, evaluations, qd_score,
-      coverage, best, ...``), one row per generation;
+      coverage, best, ...``) and ``wall_seconds``, one row per generation (``qd_score`` with no
+      offset);
     - ``archive/gen_NNNNNN.csv``: the archive after every ``archive_every``-th generation and the last
       (:meth:`GridArchive.write_csv`: one row per elite);
-    - ``checkpoint.json``: written after every generation (:meth:`MapElites.checkpoint`); ``resume=True``
-      continues from it (then ``archive`` may be None; your own descriptor functions go in
-      ``descriptors``) and gives the very run an uninterrupted one gives.
+    - ``checkpoint.json``: the engine's checkpoint, every ``evolution.checkpoint_every`` generations
+      and at the end; ``resume=True`` continues from it (then ``archive`` may be None; your own
+      descriptor functions go in ``descriptors``) and gives the very run an uninterrupted one gives.
 
     A new run without ``archive`` searches the grid of the config's ``search.descriptors`` and
     ``search.bins`` (:meth:`GridArchive.from_config`), with ``search.batch`` offspring per generation
@@ -1621,7 +1693,9 @@ def run_map_elites(
     def load(path: Path) -> MapElites:
         # the run's config first: a given archive is then compared with the run's by name
         own = threads if threads is not None or config is None else int(config["evolution.threads"])
-        me = MapElites.load(path, objective=objective, descriptors=extra, threads=own)
+        me = MapElites._from_run(
+            path, _run_config(path, generations), config, objective=objective, descriptors=extra, threads=own
+        )
         _same_as_run(
             "run_map_elites",
             archive=(None if archive is None else _archive_definition(archive), _archive_definition(me.archive)),
@@ -1630,8 +1704,6 @@ def run_map_elites(
             seed=(seed, me.seed),
             crossover_fraction=(crossover_fraction, me.crossover_fraction),
         )
-        if config is not None:
-            _same_config(config, me._config, objective, str(path / "checkpoint.json"))
         return me
 
     def check_new() -> None:
@@ -1640,8 +1712,11 @@ def run_map_elites(
 
     def new() -> MapElites:
         from_config = int(config["search.batch"]) or None
+        run = _config_for(config, _objective(objective))
+        if generations > 0:  # 0: no cap in the config; the run stops after generation 0
+            run["evolution.generations"] = generations
         return MapElites(
-            config,
+            run,
             archive if archive is not None else GridArchive.from_config(config),
             batch=batch if batch is not None else from_config,
             initial=initial,
@@ -1687,9 +1762,11 @@ def _same_as_run(what: str, **given: Tuple[Any, Any]) -> None:
 def _archive_definition(archive: _Archive) -> str:
     """An archive's cells in words (its kind, descriptors, ranges, bins or centroids), not its elites."""
     ranges = ", ".join(f"{d.name} [{d.lo!r}, {d.hi!r}]" for d in archive.descriptors)
-    geometry = {k: v for k, v in archive._geometry().items() if k != "centroids"}
+    geometry = {k: v for k, v in archive._geometry().items() if k not in ("centroids", "seed", "samples")}
     if isinstance(archive, CVTArchive):
+        # its cells are its centroids (however drawn): named by a digest
         geometry["cells"] = archive.cells
+        geometry["centroids"] = "sha256:" + hashlib.sha256(archive._unit.tobytes()).hexdigest()[:12]
     if archive.qd_offset:
         geometry["qd_offset"] = archive.qd_offset
     return f"{archive.kind} archive of {ranges}, " + ", ".join(f"{k} {v!r}" for k, v in geometry.items())

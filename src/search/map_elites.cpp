@@ -175,10 +175,10 @@ std::vector<const Measure*> descriptors_of(const Config& config,
     const auto own = std::find_if(supplied.begin(), supplied.end(),
                                   [&](const Measure& m) { return m.name == name; });
     if (own != supplied.end()) {
-      if (config.search.ranges.empty())
+      if (config.search.ranges.empty() && !(own->lo < own->hi))
         throw ConfigError(fmt::format(
-            "search.descriptors: \"{}\" is supplied by the caller: give the descriptors' ranges "
-            "in search.ranges",
+            "search.descriptors: \"{}\" is supplied by the caller and has no range in the measures "
+            "table: give the descriptors' ranges in search.ranges",
             name));
       out.push_back(&*own);
       continue;
@@ -245,7 +245,7 @@ MapElites::MapElites(const Config& config, FitnessFunction fitness, FitnessFunct
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
       supplied_(std::make_shared<const SuppliedMeasures>(supplied, config.search.descriptors,
-                                                         "search.descriptors")),
+                                                         "search.descriptors", config)),
       archive_(archive_of(config, descriptors_of(config, supplied_->measures), centroids)),
       batch_(config.search.batch > 0 ? config.search.batch : config.evolution.population),
       started_(now_seconds()) {
@@ -476,15 +476,17 @@ void MapElites::restore(std::string_view text, std::string_view source) {
         fail(fmt::format("the elite of cell {} has fitness {} (a fitness is >= 0)", cell,
                          e.result.fitness));
       const std::size_t own = supplied_->names.size();
-      if (own > 0 &&
-          (!je.contains("supplied") || !je["supplied"].is_array() || je["supplied"].size() != own))
+      json supplied = je.contains("supplied") ? je["supplied"] : json();
+      if (own > 0 && supplied.is_null())  // a search that measured them itself (animat_evolve)
+        if (const auto measured = supplied_->from_table(e.result)) supplied = *measured;
+      if (own > 0 && (!supplied.is_array() || supplied.size() != own))
         fail(fmt::format("the elite of cell {} has no list of its {} supplied descriptor values",
                          cell, own));
       for (const Measure* d : archive.descriptors()) {
         double x = std::numeric_limits<double>::quiet_NaN();
         if (d->of) {
           x = d->of(e.result);
-        } else if (const json& v = je["supplied"][supplied_->index_of(d)]; v.is_number()) {
+        } else if (const json& v = supplied[supplied_->index_of(d)]; v.is_number()) {
           x = v.get<double>();
         }
         if (!std::isfinite(x))

@@ -64,7 +64,7 @@ Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction refe
     : config_(std::make_shared<const Config>(config)),
       identity_(run_identity(config)),
       supplied_(std::make_shared<const SuppliedMeasures>(supplied, objective_names(config),
-                                                         "search.objectives")),
+                                                         "search.objectives", config)),
       size_(config.evolution.population),
       started_(now_seconds()) {
   if (size_ > kMaxNsga2Population)
@@ -76,7 +76,9 @@ Nsga2::Nsga2(const Config& config, FitnessFunction fitness, FitnessFunction refe
     const auto colon = spec.find(':');
     const std::string name = spec.substr(0, colon);
     const Measure* own = supplied_->find(name);
-    if (own != nullptr && colon == std::string::npos)
+    // a supplied criterion outside the measures table has no sense of its own
+    if (own != nullptr && colon == std::string::npos &&
+        supplied_->table[supplied_->index_of(own)] == nullptr)
       throw ConfigError(fmt::format(
           "search.objectives: \"{}\" is supplied by the caller: give its sense, \"{}:max\" or "
           "\"{}:min\"",
@@ -475,11 +477,13 @@ void Nsga2::restore(std::string_view text, std::string_view source) {
       s.feasible = archivable(s.result);
       const std::size_t own = supplied_->names.size();
       if (own > 0 && s.feasible) {
-        if (!j.contains("supplied") || !j["supplied"].is_array() || j["supplied"].size() != own)
+        json supplied = j.contains("supplied") ? j["supplied"] : json();
+        if (supplied.is_null())  // a search that measured them itself (animat_evolve)
+          if (const auto measured = supplied_->from_table(s.result)) supplied = *measured;
+        if (!supplied.is_array() || supplied.size() != own)
           fail(fmt::format("member {} has no list of its {} supplied criterion values",
                            population.size(), own));
-        for (const json& x : j["supplied"])
-          s.supplied.push_back(x.is_number() ? x.get<double>() : kNaN);
+        for (const json& x : supplied) s.supplied.push_back(x.is_number() ? x.get<double>() : kNaN);
       }
       s.objectives = criteria_of(s.result, s.supplied);
       if (s.feasible)

@@ -88,7 +88,8 @@ Genome offspring(const Config& config, std::uint64_t seed, int g, std::size_t i,
 // The interface
 
 SuppliedMeasures::SuppliedMeasures(std::vector<std::string> names_in,
-                                   const std::vector<std::string>& allowed, std::string_view key)
+                                   const std::vector<std::string>& allowed, std::string_view key,
+                                   const Config& config)
     : names(std::move(names_in)) {
   for (const std::string& name : names) {
     if (std::count(names.begin(), names.end(), name) > 1)
@@ -98,8 +99,27 @@ SuppliedMeasures::SuppliedMeasures(std::vector<std::string> names_in,
           fmt::format("{}: the caller supplies \"{}\", which is not one of its entries ({})", key,
                       name, fmt::join(allowed, ", ")));
     // `name` lives in `names`, which no longer changes: the pointer stays valid
-    measures.push_back(Measure{name.c_str(), "supplied by the caller", 0.0, 0.0, true, nullptr});
+    // a name of the measures table keeps its range and sense (the caller computes its values)
+    const Measure* entry = nullptr;
+    for (const Measure& m : animat::measures())
+      if (name == m.name ||
+          (name == config.evaluation.objective && &m == animat::measures().data()))
+        entry = &m;
+    table.push_back(entry);
+    measures.push_back(
+        entry == nullptr ? Measure{name.c_str(), "supplied by the caller", 0.0, 0.0, true, nullptr}
+                         : Measure{name.c_str(), entry->meaning, entry->lo, entry->hi,
+                                   entry->maximize, nullptr});
   }
+}
+
+std::optional<std::vector<double>> SuppliedMeasures::from_table(const Fitness& f) const {
+  std::vector<double> out;
+  for (const Measure* m : table) {
+    if (m == nullptr || m->of == nullptr) return std::nullopt;
+    out.push_back(m->of(f));
+  }
+  return out;
 }
 
 const Measure* SuppliedMeasures::find(std::string_view name) const {

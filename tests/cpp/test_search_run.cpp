@@ -124,6 +124,43 @@ TEST(SearchRun, AStoppedRunResumesToTheSameResults) {
   }
 }
 
+TEST(SearchRun, TheCallersSearchRunsAsTheOneItWouldMake) {
+  // animat.MapElites and animat.Nsga2 run their own search (RunOptions::search): the same run
+  // directory as run_search's own, and a resume restores into a new caller's search.
+  for (const char* algorithm : {"map_elites", "nsga2"}) {
+    SCOPED_TRACE(algorithm);
+    Config c = search_config(algorithm);
+    const fs::path own = fresh_dir("search_run", std::string(algorithm) + "_own");
+    const fs::path callers = fresh_dir("search_run", std::string(algorithm) + "_callers");
+    (void)run_search(c, quiet_in(own), search_stub);
+    c.evolution.generations = 3;
+    auto first = make_search(c, search_stub);
+    RunOptions o = quiet_in(callers);
+    o.search = first.get();
+    EXPECT_EQ(run_search(c, o).generation, 3);
+    EXPECT_EQ(first->generation(), 3);  // the caller's search is the one that ran
+    c.evolution.generations = 6;
+    auto second = make_search(c, search_stub);
+    o.search = second.get();
+    o.resume = true;
+    EXPECT_EQ(run_search(c, o).generation, 6);
+    EXPECT_EQ(csv_without_wall(slurp(callers / "history.csv")),
+              csv_without_wall(slurp(own / "history.csv")));
+    // A search already told a generation, or of another algorithm, is refused and writes nothing.
+    const auto before = snapshot(callers);
+    o.resume = false;
+    o.overwrite = true;
+    EXPECT_THROW((void)run_search(c, o), Error);
+    auto other = make_search(
+        search_config(std::string(algorithm) == "nsga2" ? "map_elites" : "nsga2"), search_stub);
+    o.search = other.get();
+    EXPECT_THROW((void)run_search(c, o), Error);
+    EXPECT_EQ(snapshot(callers), before);
+    fs::remove_all(own);
+    fs::remove_all(callers);
+  }
+}
+
 TEST(SearchRun, RefusedCommandsChangeNoFile) {
   const Config c = search_config("map_elites");
   const fs::path dir = fresh_dir("search_run", "refused");

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from run_dirs import without_wall
 
 import animat
 from animat import cli
@@ -59,20 +60,14 @@ def library_nsga2(out, generations=3):
 
 
 def files(run: Path):
-    """Every file of a run directory, by relative path, as bytes; a MAP-Elites or NSGA-II checkpoint as
-    its state (history and elites or population), without the wall-clock seconds the engine records,
-    which differ run to run."""
+    """Every file of a run directory, by relative path, as bytes; history.csv and checkpoint.json
+    without the wall-clock seconds the engine records, which differ run to run, and without the
+    resume.log of a resumed run."""
     out = {str(p.relative_to(run)): p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()}
-    if out.get("checkpoint.json", b"").startswith(b'{"format": "animat.map_elites/'):
-        me = animat.MapElites.load(run)
-        elites = [
-            (e.index, e.genome.to_json(), e.fitness, e.reference, e.descriptors, e.generation)
-            for e in me.archive.elites()
-        ]
-        out["checkpoint.json"] = repr((me.history.tolist(), elites)).encode()
-    elif out.get("checkpoint.json", b"").startswith(b'{"format": "animat.nsga2/'):
-        nsga = animat.Nsga2.load(run)
-        out["checkpoint.json"] = repr((nsga.history.tolist(), nsga.reference_point, nsga.population)).encode()
+    if "checkpoint.json" in out:
+        rows, payload = without_wall(run)
+        out["history.csv"], out["checkpoint.json"] = repr(rows).encode(), repr(payload).encode()
+    out.pop("resume.log", None)
     return out
 
 
@@ -198,7 +193,7 @@ def test_a_config_without_a_generation_cap_needs_generations(tmp_path, capsys):
 @pytest.mark.parametrize(
     "command, extra, change, message",
     [
-        ("map-elites", ME, ["--bins", "8,6"], "archive 'grid archive of cells [1.0, 65.0], frequency [0.5, 6.0], bins"),
+        ("map-elites", ME, ["--bins", "8,6"], "search.bins = [8.0, 6.0] is not the run's [8.0, 5.0]"),
         ("map-elites", ME, ["--batch", "7"], "batch 7 is not the run's 6"),
         ("map-elites", ME, ["--seed", "9"], "seed 9 is not the run's 1"),
         ("map-elites", ME, ["--set", "evaluation.steps=300"], "the config differs from the checkpoint's"),
@@ -218,7 +213,7 @@ def test_a_resume_that_would_change_the_run_is_refused_and_touches_nothing(
     # The other search's command on this directory is refused too.
     other = "nsga2" if command == "map-elites" else "map-elites"
     assert cli.main([other, *SMALL, "--out", str(out), "--generations", "2"]) == 1
-    assert "checkpoint (format 'animat." in capsys.readouterr().err
+    assert f"the run directory holds a {command.replace('-', '_')} run" in capsys.readouterr().err
     assert files(out) == before
 
 
@@ -276,9 +271,12 @@ def test_animat_evolves_search_run_opens_as_the_library_run(tmp_path, command):
     (library_map_elites if command == "map-elites" else library_nsga2)(library)
     mine, theirs = animat.Run(engine), animat.Run(library)
     assert mine.search == theirs.search
-    names = list(theirs.history.dtype.names)
-    assert list(mine.history.dtype.names) == [*names, "wall_seconds"]
-    assert [tuple(row[n] for n in names) for row in mine.history] == theirs.history.tolist()
+    # one format: the same columns (the wall-clock seconds differ run to run)
+    assert mine.history.dtype == theirs.history.dtype
+    names = [n for n in theirs.history.dtype.names if n != "wall_seconds"]
+    assert [tuple(row[n] for n in names) for row in mine.history] == [
+        tuple(row[n] for n in names) for row in theirs.history
+    ]
     a, b = mine.snapshot(), theirs.snapshot()
     assert (a.kind, a.generation, a.path) == (b.kind, 3, engine / "checkpoint.json")
     assert (a.genomes, a.objectives, a.descriptors) == (b.genomes, b.objectives, b.descriptors)
@@ -287,6 +285,44 @@ def test_animat_evolves_search_run_opens_as_the_library_run(tmp_path, command):
         np.testing.assert_array_equal(a.columns[name], column, err_msg=name)
     assert mine.best().genome.to_json() == theirs.best().genome.to_json()
     assert cli.main(["explore", str(engine), "--out", str(tmp_path / "page.html")]) == 0
+
+
+@pytest.mark.skipif(not EXE or not os.path.exists(EXE), reason="needs ANIMAT_EVOLVE_EXE")
+@pytest.mark.parametrize("command", ["map-elites", "nsga2"])
+def test_animat_evolve_and_the_library_resume_each_others_runs(tmp_path, command):
+    # One run directory format: a library run continued by animat_evolve, then by the library
+    # again, is the uninterrupted library run (the wall-clock seconds aside).
+    library = library_map_elites if command == "map-elites" else library_nsga2
+    straight, shared = tmp_path / "straight", tmp_path / "shared"
+    library(straight, generations=4)
+    library(shared, generations=2)
+    cmd = [EXE, "--resume", str(shared), "--generations", "3", "--threads", "1", "--quiet"]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert without_wall(shared)[0] == without_wall(straight)[0][:5]  # the header, generations 0-3
+    if command == "map-elites":
+        animat.run_map_elites(small_config(), shared, 4, resume=True, threads=1)
+    else:
+        animat.run_nsga2(small_config(), None, shared, 4, resume=True, threads=1)
+    assert without_wall(shared) == without_wall(straight)
+    snapshot = ("archive" if command == "map-elites" else "front") + "/gen_000004.csv"
+    for name in ("config.toml", snapshot):
+        assert (shared / name).read_bytes() == (straight / name).read_bytes(), name
+    # and animat_evolve's own run, continued by the library, is animat_evolve's uninterrupted one
+    engine, resumed = tmp_path / "engine", tmp_path / "resumed"
+    config = search_config(tmp_path, command)
+    for out, generations in ((engine, "3"), (resumed, "2")):
+        cmd = [EXE, "--config", str(config), "--out", str(out), "--generations", generations, "--threads", "1"]
+        assert subprocess.run([*cmd, "--quiet"], capture_output=True, timeout=600).returncode == 0
+    if command == "map-elites":
+        animat.run_map_elites(None, resumed, 3, resume=True)
+    else:
+        animat.run_nsga2(None, None, resumed, 3, resume=True)
+    # the same state; the library's checkpoint also lists the values it supplied (the table's)
+    rows, payload = without_wall(resumed)
+    for member in payload.get("elites", payload.get("population")):
+        member.pop("supplied", None)
+    assert (rows, payload) == without_wall(engine)
 
 
 def test_the_library_run_records_its_search_in_config_toml(tmp_path):

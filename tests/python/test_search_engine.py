@@ -408,12 +408,33 @@ def cvt_config(seed, cells=10):
     return config
 
 
-def test_cvt_centroids_are_animat_qd_kmeans_of_the_engine_samples():
-    # Lloyd's k-means of the samples of the engine's keyed stream, as animat.qd.CVTArchive computes
-    # its centroids from its samples: the same numbers, bit for bit.
+def lloyd(samples, k, iterations):
+    """Lloyd's k-means as the engine documents it, in numpy: the first k samples start; each
+    iteration assigns every sample to its nearest centroid (the first among equals) and moves each
+    centroid to the mean of its samples (one without samples stays), until nothing changes."""
+    centroids = samples[:k].copy()
+    previous = None
+    for _ in range(iterations):
+        labels = np.argmin(((samples[:, None, :] - centroids[None, :, :]) ** 2).sum(axis=2), axis=1)
+        if previous is not None and np.array_equal(labels, previous):
+            break
+        counts = np.bincount(labels, minlength=k)
+        filled = counts > 0
+        for j in range(samples.shape[1]):
+            sums = np.bincount(labels, weights=samples[:, j], minlength=k)
+            centroids[filled, j] = sums[filled] / counts[filled]
+        previous = labels
+    return centroids
+
+
+def test_cvt_centroids_are_lloyd_kmeans_of_the_engine_samples():
+    # Lloyd's k-means of the samples of the engine's keyed stream, computed independently in numpy:
+    # the same numbers, bit for bit; animat.qd.CVTArchive's centroids are the engine's.
     rng = _core.Rng.derive(5, _core.CVT_SAMPLES_KEY, 0)
     samples = np.array([[rng.uniform() for _ in range(3)] for _ in range(300)])
-    expected = animat.qd._kmeans(samples, 12, 100)
+    expected = lloyd(samples, 12, 100)
+    names = [("cells", 1.0, 65.0), ("fitness", 0.0, 50.0), ("elongation", 1.0, 4.0)]
+    assert animat.CVTArchive(names, 12, seed=5, samples=300).state()["centroids"] == expected.tolist()
     assert _core.cvt_centroids(3, 12, 5, 300) == expected.tolist()
     assert _core.cvt_centroids(3, 12, 5, 300, iterations=0) == samples[:12].tolist()
     assert len(_core.cvt_centroids(2, 4, 5)) == 4  # samples 0: max(1000, 20 cells)

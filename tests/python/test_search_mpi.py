@@ -4,12 +4,12 @@ process and on 2 ranks x 1-2 threads, bit for bit but for the wall-clock seconds
 Needs ANIMAT_EVOLVE_EXE and mpirun (as tests/python/test_mpi.py; ANIMAT_TEST_MPI=1 makes their
 absence a failure)."""
 
-import json
 import os
 import shutil
 import subprocess
 
 import pytest
+from run_dirs import without_wall
 
 EXE = os.environ.get("ANIMAT_EVOLVE_EXE")
 MPIRUN = shutil.which("mpirun")
@@ -43,16 +43,6 @@ def search(out, algorithm, ranks=None, threads=1):
         cmd = [MPIRUN, "-np", str(ranks), "--oversubscribe", *cmd]
     done = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
-
-
-def without_wall(out):
-    """history.csv and the checkpoint's payload without their wall-clock seconds."""
-    rows = [line.rsplit(",", 1)[0] for line in (out / "history.csv").read_text().splitlines()]
-    payload = json.loads(json.loads((out / "checkpoint.json").read_text())["payload"])
-    payload.pop("wall_seconds")
-    for row in payload["history"]:
-        row.pop("wall_seconds")
-    return rows, payload
 
 
 @pytest.mark.parametrize("algorithm", sorted(SEARCHES))

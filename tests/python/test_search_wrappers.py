@@ -3,10 +3,12 @@ engine refuses, the wrapper refuses, naming the value, key or file, and a refusa
 (the search's state, the run directory's files); animat.Nsga2's checkpoints and sizes are checked
 too. A cheap deterministic stub stands in for the swims."""
 
+import fcntl
 import hashlib
 import json
 import math
 import os
+import socket
 
 import numpy as np
 import pytest
@@ -155,19 +157,22 @@ def test_a_run_directory_has_one_writer(tmp_path, capsys):
     run(out, 0)
     before = files_of(out)
     assert ".lock" not in before  # released at the end of the run
-    lock = qd._RunLock(out)  # another writer holds it
+    lock = os.open(out / ".lock", os.O_RDWR | os.O_CREAT)  # another writer holds it, as the engine does
+    fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    os.write(lock, f"pid {os.getpid()}\nhost {socket.gethostname()}\n".encode())
     try:
         with pytest.raises(
-            BlockingIOError, match=r"in use by another animat process \(pid \d+ host .*Nothing was written"
+            BlockingIOError, match=r"in use by another animat process \(pid \d+ on host .*Nothing was written"
         ):
             run(out, 1, resume=True)
         with pytest.raises(BlockingIOError):
             run(out, 1, overwrite=True)
         assert cli.main(["evolve", "--resume", str(out), "--generations", "1", "--quiet"]) == 2
-        assert f"in use by another animat process (pid {os.getpid()} host" in capsys.readouterr().err
+        assert f"in use by another animat process (pid {os.getpid()} on host" in capsys.readouterr().err
         assert {k: v for k, v in files_of(out).items() if k != ".lock"} == before
     finally:
-        lock.release()
+        os.close(lock)
+    (out / ".lock").unlink()
     assert run(out, 1, resume=True).generation == 1
 
 
@@ -182,7 +187,7 @@ def test_a_resume_with_changed_search_keys_is_refused_naming_the_key(tmp_path):
     animat.run_map_elites(config, out, 0, resume=True)  # the same config resumes
     changed = config.copy()
     changed["search.bins"] = [6.0]
-    with pytest.raises(ValueError, match=r"checkpoint.json: search.bins = \[6.0, 6.0\] is not the run\'s \[4.0, 4.0\]"):
+    with pytest.raises(ValueError, match=r"run/config.toml: search.bins = \[6.0\] is not the run\'s \[4.0\]"):
         animat.run_map_elites(changed, out, 1, resume=True)
     assert files_of(out) == before
 
