@@ -61,6 +61,26 @@ struct SearchEngine {
   std::unique_ptr<Search> search;
 };
 
+// MAP-Elites' archive on its own (animat.qd's GridArchive and CVTArchive keep one): the engine's
+// cells and insertion rule over descriptors named by the caller.
+struct ArchiveCore {
+  std::shared_ptr<const SuppliedMeasures> measures;
+  Archive archive;
+};
+
+ArchiveCore make_archive_core(const std::vector<std::string>& names,
+                              const std::vector<std::pair<double, double>>& ranges,
+                              const std::vector<int>& bins,
+                              const std::vector<std::vector<double>>& centroids) {
+  auto measures = std::make_shared<const SuppliedMeasures>(names, names, "descriptors", Config{});
+  std::vector<const Measure*> descriptors;
+  for (const Measure& m : measures->measures) descriptors.push_back(&m);
+  std::vector<Range> r;
+  for (const auto& [lo, hi] : ranges) r.push_back(Range{lo, hi});
+  if (centroids.empty()) return ArchiveCore{measures, Archive(descriptors, bins, r)};
+  return ArchiveCore{measures, Archive::cvt(descriptors, r, centroids)};
+}
+
 class SearchLease : public ThreadLease<SearchEngine> {
  public:
   SearchLease(const SearchEngine& s, const char* method)
@@ -238,6 +258,52 @@ void bind_search(nb::module_& m) {
       "The hypervolume that points (minimised rows) dominate up to reference, one or two "
       "objectives; only\nrows better than the reference in every objective count; the rectangles "
       "summed exactly.");
+  nb::class_<ArchiveCore>(m, "Archive",
+                          "MAP-Elites' archive (search.hpp's Archive) on its own: a grid or a CVT "
+                          "over named descriptors,\nthe cells and the insertion rule the engine's "
+                          "searches use (animat.GridArchive and animat.CVTArchive\nkeep one).")
+      .def(
+          "__init__",
+          [](ArchiveCore* a, const std::vector<std::string>& names,
+             const std::vector<std::pair<double, double>>& ranges, const std::vector<int>& bins,
+             const std::vector<std::vector<double>>& centroids) {
+            new (a) ArchiveCore(make_archive_core(names, ranges, bins, centroids));
+          },
+          "names"_a, "ranges"_a, "bins"_a = std::vector<int>{},
+          "centroids"_a = std::vector<std::vector<double>>{},
+          "A grid of bins per descriptor, or (bins empty) a CVT of centroids (rows of the unit "
+          "cube); ranges:\n(lo, hi) per descriptor. A ValueError names what it refuses (more than "
+          "1e6 cells, a range that\nis not finite lo < hi, a centroid outside the unit cube).")
+      .def_prop_ro("cells", [](const ArchiveCore& a) { return a.archive.cells(); })
+      .def(
+          "index_of",
+          [](const ArchiveCore& a, const std::vector<double>& values) {
+            if (values.size() != a.archive.dims())
+              throw Error(fmt::format("Archive.index_of: {} values for the {} descriptors",
+                                      values.size(), a.archive.dims()));
+            for (double x : values)
+              if (std::isnan(x)) throw Error("Archive.index_of: a NaN value has no cell");
+            return a.archive.index_of(values);
+          },
+          "values"_a,
+          "The cell of descriptor values (not NaN; below a range: its first bin, at or above it: "
+          "its last).")
+      .def(
+          "add",
+          [](ArchiveCore& a, const Genome& genome, double fitness,
+             const std::vector<double>& values, double objective, double reference,
+             int generation) {
+            if (values.size() != a.archive.dims())
+              throw Error(fmt::format("Archive.add: {} values for the {} descriptors",
+                                      values.size(), a.archive.dims()));
+            Fitness f;
+            f.fitness = fitness;
+            return a.archive.add(Elite{genome, f, values, objective, reference, generation});
+          },
+          "genome"_a, "fitness"_a, "values"_a, "objective"_a, "reference"_a, "generation"_a,
+          "Offers a candidate: it enters when its cell is empty or its objective is strictly "
+          "greater than the\nelite's; returns whether it entered.")
+      .def("clear", [](ArchiveCore& a) { a.archive.elites().clear(); });
   nb::class_<SearchEngine>(m, "SearchEngine",
                            "The search of a config's search.algorithm as animat_evolve runs it "
                            "(search.hpp): \"ga\",\n\"map_elites\" or \"nsga2\", driven by "

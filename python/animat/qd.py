@@ -399,6 +399,15 @@ class _Archive:
         if not math.isfinite(self.qd_offset):
             raise ValueError(f"qd_offset must be finite, got {qd_offset}")
         self._elites: Dict[int, Elite] = {}
+        self._core: Any = None  # the engine's archive (_core.Archive): its cells and rule
+
+    def _make_core(self, bins: Sequence[int] = (), centroids: Any = ()) -> None:
+        """The engine's archive of these descriptors (a grid of ``bins``, or a CVT of ``centroids``)."""
+        ranges = [(d.lo, d.hi) for d in self.descriptors]
+        try:
+            self._core = _core.Archive(list(self.names), ranges, bins=list(bins), centroids=list(centroids))
+        except ValueError as e:
+            raise ValueError(f"{type(self).__name__}: {e}") from None
 
     # --- to override ------------------------------------------------------------------------------
     @property
@@ -407,7 +416,7 @@ class _Archive:
         raise NotImplementedError
 
     def _index(self, values: np.ndarray) -> int:
-        raise NotImplementedError
+        return int(self._core.index_of(values.tolist()))
 
     def _geometry(self) -> Dict[str, Any]:
         raise NotImplementedError
@@ -451,8 +460,9 @@ class _Archive:
         generation: int = -1,
     ) -> bool:
         """Offer a candidate; returns whether it entered (its cell was empty, or its ``objective``,
-        default the fitness, is strictly greater than the elite's: a tie keeps the elite). A NaN
-        descriptor is never archived (False); a fitness or objective that is not finite is a ValueError."""
+        default the fitness, is strictly greater than the elite's: a tie keeps the elite; the engine's
+        rule). A NaN descriptor is never archived (False); a fitness or objective that is not finite is
+        a ValueError."""
         fitness = float(fitness)
         obj = fitness if objective is None else float(objective)
         if not (math.isfinite(fitness) and math.isfinite(obj)):
@@ -460,15 +470,29 @@ class _Archive:
         index = self.index_of(descriptors)
         if index is None:
             return False
-        old = self._elites.get(index)
-        if old is not None and not obj > old.objective:
-            return False
-        values = tuple(float(x) for x in np.asarray(descriptors, dtype=np.float64).reshape(-1))
-        self._elites[index] = Elite(index, genome, fitness, obj, values, float(reference), int(generation))
-        return True
+        return self._put(
+            Elite(index, genome, fitness, obj, self._values(descriptors), float(reference), int(generation))
+        )
 
-    def _set_reference(self, index: int, reference: float) -> None:
-        self._elites[index] = replace(self._elites[index], reference=float(reference))
+    @staticmethod
+    def _values(descriptors: Values) -> Tuple[float, ...]:
+        return tuple(float(x) for x in np.asarray(descriptors, dtype=np.float64).reshape(-1))
+
+    def _put(self, elite: Elite) -> bool:
+        """Offers an elite of its cell to the engine's archive; keeps it when it entered."""
+        entered = bool(
+            self._core.add(
+                elite.genome,
+                elite.fitness,
+                list(elite.descriptors),
+                elite.objective,
+                elite.reference,
+                elite.generation,
+            )
+        )
+        if entered:
+            self._elites[elite.index] = elite
+        return entered
 
     def __len__(self) -> int:
         return len(self._elites)
@@ -503,6 +527,7 @@ class _Archive:
 
     def clear(self) -> None:
         self._elites.clear()
+        self._core.clear()
 
     # --- export -----------------------------------------------------------------------------------
     def data(self) -> Dict[str, np.ndarray]:
@@ -613,7 +638,7 @@ class _Archive:
                 _from_json_float(e["reference"]),
                 int(e["generation"]),
             )
-            archive._elites[elite.index] = elite
+            archive._put(elite)
         return archive
 
     def _own_descriptors(self) -> Tuple[Descriptor, ...]:
@@ -657,6 +682,7 @@ class GridArchive(_Archive):
         if len(b) != self.dims or min(b) < 1:
             raise ValueError(f"bins: one count >= 1 per descriptor ({self.dims}), got {bins}")
         self.bins: Tuple[int, ...] = tuple(b)
+        self._make_core(bins=self.bins)
         #: Bin edges per descriptor (``bins[j] + 1`` values, from lo to hi).
         self.edges: Tuple[np.ndarray, ...] = tuple(
             np.linspace(d.lo, d.hi, n + 1) for d, n in zip(self.descriptors, self.bins)
@@ -686,15 +712,7 @@ class GridArchive(_Archive):
             raise ValueError(f"{len(v)} descriptor values for an archive of {self.dims} descriptors {self.names}")
         if np.isnan(v).any():
             return None
-        return tuple(
-            int(min(max(np.searchsorted(e, x, side="right") - 1, 0), n - 1))
-            for e, x, n in zip(self.edges, v, self.bins)
-        )
-
-    def _index(self, values: np.ndarray) -> int:
-        b = self.bin_of(values)
-        assert b is not None
-        return int(np.ravel_multi_index(b, self.bins))
+        return tuple(int(x) for x in np.unravel_index(self._index(v), self.bins))
 
     def _geometry(self) -> Dict[str, Any]:
         return {"bins": list(self.bins)}
@@ -759,6 +777,7 @@ class CVTArchive(_Archive):
         self.seed = int(seed)
         self.samples = n
         self._unit = np.array(_core.cvt_centroids(self.dims, cells, self.seed, n, int(iterations)), dtype=np.float64)
+        self._make_core(centroids=self._unit.tolist())
 
     @classmethod
     def _with_centroids(
@@ -768,6 +787,7 @@ class CVTArchive(_Archive):
         _Archive.__init__(archive, descriptors, qd_offset)
         archive.seed, archive.samples = int(seed), int(samples)
         archive._unit = unit.reshape(-1, archive.dims).copy()
+        archive._make_core(centroids=archive._unit.tolist())
         return archive
 
     @property
@@ -779,22 +799,8 @@ class CVTArchive(_Archive):
         """(cells, d) centroids in descriptor units."""
         return self.lower + self._unit * (self.upper - self.lower)
 
-    def _index(self, values: np.ndarray) -> int:
-        u = np.clip((values - self.lower) / (self.upper - self.lower), 0.0, 1.0)
-        return int(_nearest(u[None, :], self._unit)[0])
-
     def _geometry(self) -> Dict[str, Any]:
         return {"seed": self.seed, "samples": self.samples, "centroids": self._unit.tolist()}
-
-
-def _nearest(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
-    """Index of the nearest centroid of every point (the first among equals), in chunks of bounded memory."""
-    out = np.empty(len(points), dtype=np.int64)
-    step = max(1, 2_000_000 // max(1, centroids.size))
-    for a in range(0, len(points), step):
-        d = ((points[a : a + step, None, :] - centroids[None, :, :]) ** 2).sum(axis=2)
-        out[a : a + step] = np.argmin(d, axis=1)
-    return out
 
 
 # --- MAP-Elites -----------------------------------------------------------------------------------
@@ -1281,14 +1287,16 @@ class MapElites(_SearchState):
         self.archive.clear()
         for e in self._engine.elites():
             index = int(e["index"])
-            self.archive._elites[index] = Elite(
-                index,
-                e["genome"],
-                float(e["fitness"].fitness),
-                float(e["objective"]),
-                tuple(float(x) for x in e["values"]),
-                float(e["reference"]),
-                int(e["generation"]),
+            self.archive._put(
+                Elite(
+                    index,
+                    e["genome"],
+                    float(e["fitness"].fitness),
+                    float(e["objective"]),
+                    tuple(float(x) for x in e["values"]),
+                    float(e["reference"]),
+                    int(e["generation"]),
+                )
             )
 
     def _references(self, genomes: List[Any]) -> Tuple[List[Any], List[List[float]]]:

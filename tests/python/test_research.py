@@ -693,7 +693,8 @@ def test_public_exports_and_docstrings():
         "start_state",
         "source_direction",  # animat.trajectory.chemotaxis_source
         "SearchEngine",  # the C++ searches' parity with animat.MapElites and animat.Nsga2 (test_search_engine.py)
-        "run_search",  # animat_evolve's search run directory, for the Python wrappers to come
+        "run_search",  # animat_evolve's search run directory (SearchEngine.run: the wrappers')
+        "Archive",  # the engine's archive inside animat.GridArchive and animat.CVTArchive
         "fitness_of",  # animat.to_fitness
         "shape_elongation",  # animat.shape.elongation
         "describe_shape",  # animat.shape.body_shape
