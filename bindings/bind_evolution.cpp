@@ -225,6 +225,17 @@ void bind_search(nb::module_& m) {
       "Rng.derive(seed, CVT_SAMPLES_KEY,\n0), started from the first cells of them, as "
       "animat.qd.CVTArchive computes its centroids from its\nsamples (docs/search.md).");
   m.def(
+      "measures",
+      [] {
+        std::vector<std::tuple<std::string, std::string, double, double, bool>> out;
+        for (const Measure& x : measures())
+          out.emplace_back(x.name, x.meaning, x.lo, x.hi, x.maximize);
+        return out;
+      },
+      "The engine's measures table (search.hpp), in order: (name, meaning, lo, hi, maximize) of "
+      "every\nmeasure a swim records; lo == hi: a criterion only (no descriptor range). "
+      "animat.DESCRIPTORS'\nranges and animat.CRITERIA's senses of these names are these.");
+  m.def(
       "search_history_columns",
       [](std::string_view algorithm, const std::vector<std::string>& criteria) {
         std::vector<std::pair<std::string, bool>> out;

@@ -208,9 +208,14 @@ class Descriptor:
         return float(self.function(subject.genome, subject.config, subject.evaluation))
 
 
-def _table_entry(
-    name: str, meaning: str, lo: float, hi: float, of_subject: Callable[[_Subject], float], computed: str
-) -> Descriptor:
+#: The engine's measures table (``_core.measures()``): name -> (meaning, lo, hi, maximize).
+_MEASURES = {name: (meaning, lo, hi, maximize) for name, meaning, lo, hi, maximize in _core.measures()}
+
+
+def _table_entry(name: str, meaning: str, of_subject: Callable[[_Subject], float], computed: str) -> Descriptor:
+    """A descriptor of the table, with the engine's range for it (one owner: ``_core.measures()``)."""
+    _, lo, hi, _ = _MEASURES[name]
+
     def function(genome: Any, config: Any = None, evaluation: Any = None) -> float:
         return float(of_subject(_Subject(genome, config, evaluation)))
 
@@ -220,7 +225,7 @@ def _table_entry(
 
 #: The named descriptors, in table order: name -> :class:`Descriptor`. Integer descriptors have a
 #: range one wider than their values (``[0, 8]`` for 0..7 protrusions) so that a grid of ``hi - lo``
-#: bins gives each value its own bin. The ranges are those of the paper's settings; change them with
+#: bins gives each value its own bin. The ranges are the engine's measures table (``_core.measures()``, the paper's settings); change them with
 #: :meth:`Descriptor.with_range` (or a ``(name, lo, hi)`` tuple) for others.
 DESCRIPTORS: Dict[str, Descriptor] = {
     d.name: d
@@ -228,56 +233,42 @@ DESCRIPTORS: Dict[str, Descriptor] = {
         _table_entry(
             "cells",
             "number of cells of the developed embryo",
-            1,
-            65,
             lambda s: s.cells,
             "`animat.develop(genome, config)`: the number of cell centres",
         ),
         _table_entry(
             "elongation",
             "sqrt(λ1/λ2) of the cells' second moments: 1 for a round body",
-            1,
-            4,
             lambda s: s.shape.elongation,
             "`animat.shape.body_shape(body).elongation` of the body at rest",
         ),
         _table_entry(
             "protrusions",
             "number of protrusions: parts sticking out of the body's core",
-            0,
-            8,
             lambda s: s.shape.protrusion_count,
             "`animat.shape.body_shape(body).protrusion_count`",
         ),
         _table_entry(
             "symmetric_pair",
             "1 when two protrusions mirror each other about a principal axis, else 0",
-            0,
-            2,
             lambda s: 1.0 if s.shape.symmetric_pair else 0.0,
             "`animat.shape.body_shape(body).symmetric_pair`",
         ),
         _table_entry(
             "concavity",
             "1 − outline area / convex hull area: 0 for a convex body",
-            0,
-            0.5,
             lambda s: s.shape.concavity,
             "`animat.shape.body_shape(body).concavity`",
         ),
         _table_entry(
             "frequency",
             "median oscillator frequency of the cells (rad per time unit)",
-            0.5,
-            6,
             lambda s: float(np.median(s.frequency)),
             "`numpy.median(animat.develop(genome, config).frequency)`",
         ),
         _table_entry(
             "locomotion",
             "locomotion mode: the index in animat.locomotion.MODES (0 undulation ... 5 none)",
-            0,
-            6,
             _locomotion_index,
             "`animat.classify_locomotion(genome, config).mode`: classified during the evaluation's own swim by "
             "the engine when the config's search names it (MapElites), else by replaying the swim (about 12 "
@@ -286,8 +277,6 @@ DESCRIPTORS: Dict[str, Descriptor] = {
         _table_entry(
             "fitness",
             "the objective's own value (the paper's distance: up to about 44 in 4000 steps)",
-            0,
-            50,
             lambda s: s.fitness,
             "`evaluation.fitness` (evaluated again when no evaluation is given)",
         ),

@@ -10,8 +10,8 @@ namespace animat {
 
 namespace {
 
-// Descriptor ranges are animat.qd.DESCRIPTORS' (the paper's settings): integer descriptors one
-// wider than their values, so that hi - lo bins give each value its own bin.
+// Descriptor ranges (the paper's settings; animat.qd.DESCRIPTORS takes them from here): integer
+// descriptors one wider than their values, so that hi - lo bins give each value its own bin.
 constexpr Measure kMeasures[] = {
     {"fitness", "the objective's value (evaluation.objective)", 0.0, 50.0, true,
      [](const Fitness& f) { return f.fitness; }},

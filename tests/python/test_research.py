@@ -695,6 +695,7 @@ def test_public_exports_and_docstrings():
         "SearchEngine",  # the C++ searches' parity with animat.MapElites and animat.Nsga2 (test_search_engine.py)
         "run_search",  # animat_evolve's search run directory (SearchEngine.run: the wrappers')
         "Archive",  # the engine's archive inside animat.GridArchive and animat.CVTArchive
+        "measures",  # the engine's measures table: animat.DESCRIPTORS' ranges
         "fitness_of",  # animat.to_fitness
         "shape_elongation",  # animat.shape.elongation
         "describe_shape",  # animat.shape.body_shape
