@@ -225,8 +225,9 @@ def _table_entry(name: str, meaning: str, of_subject: Callable[[_Subject], float
 
 #: The named descriptors, in table order: name -> :class:`Descriptor`. Integer descriptors have a
 #: range one wider than their values (``[0, 8]`` for 0..7 protrusions) so that a grid of ``hi - lo``
-#: bins gives each value its own bin. The ranges are the engine's measures table (``_core.measures()``, the paper's settings); change them with
-#: :meth:`Descriptor.with_range` (or a ``(name, lo, hi)`` tuple) for others.
+#: bins gives each value its own bin. The ranges are the engine's measures table's
+#: (``_core.measures()``, the paper's settings); change them with :meth:`Descriptor.with_range` (or a
+#: ``(name, lo, hi)`` tuple) for others.
 DESCRIPTORS: Dict[str, Descriptor] = {
     d.name: d
     for d in (
