@@ -1566,8 +1566,11 @@ def _run_search(
         check_new()
         search = new()  # its sizes are checked here, before any file is touched
 
+    stepped: List[int] = []
+
     def after(generation: int) -> bool:
         search._refresh()
+        stepped.append(generation)
         last = generation >= generations
         (out / snapshots).mkdir(exist_ok=True)
         snapshot = out / snapshots / f"gen_{generation:06d}.csv"
@@ -1593,6 +1596,11 @@ def _run_search(
     finally:
         search._pool = None
     search._refresh()
+    if stepped and stepped[-1] == search.generation:
+        # stopped by the engine's stall or wall-clock rule: the last generation's snapshot too
+        snapshot = out / snapshots / f"gen_{search.generation:06d}.csv"
+        if not snapshot.exists():
+            write_snapshot(search, snapshot)
     return search
 
 

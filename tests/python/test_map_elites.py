@@ -357,6 +357,18 @@ def test_the_run_directory_resumes_to_the_same_files(tmp_path):
     assert animat.load_config(str(a / "config.toml"))["evolution.seed"] == 2
 
 
+def test_a_run_the_stall_rule_stops_keeps_its_last_archive(tmp_path):
+    # The engine's run layer stops the run at its stall rule; the last generation's archive is
+    # written even when it is not one of every archive_every.
+    config = small_config()
+    config["evolution.stall_generations"] = 1
+    out = tmp_path / "run"
+    me = animat.run_map_elites(config, out, 50, animat.GridArchive(["cells"], 4), batch=6, archive_every=100)
+    assert 1 <= me.generation < 50
+    assert sorted(p.name for p in (out / "archive").iterdir()) == ["gen_000000.csv", f"gen_{me.generation:06d}.csv"]
+    assert len((out / "history.csv").read_text().splitlines()) == 1 + me.generation + 1
+
+
 def test_non_viable_unstable_and_invalid_genomes_are_never_archived():
     me = new_run()
     genomes = me.ask()
