@@ -184,6 +184,11 @@ void Evolution::check_reference() {
   if (!b.result.viable) return;
   Individual& mutable_best = population_[static_cast<std::size_t>(&b - population_.data())];
   if (std::isnan(mutable_best.reference)) {
+    if (const double* known = remembered_reference(mutable_best.genome)) {
+      mutable_best.reference = *known;
+      history_.back().best_reference = mutable_best.reference;
+      return;
+    }
     const Fitness r = reference_(mutable_best.genome);
     check_fitness(r,
                   fmt::format("exploit guard, generation {}: the reference evaluation of the best",
@@ -201,8 +206,14 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
   for (std::size_t k = 0; k < order.size() && cand.size() < 2 * elites; ++k)
     if (population_[order[k]].result.viable) cand.push_back(order[k]);
   std::vector<std::size_t> todo;
-  for (std::size_t c : cand)
-    if (std::isnan(population_[c].reference)) todo.push_back(c);
+  std::vector<std::pair<std::size_t, double>> remembered;
+  for (std::size_t c : cand) {
+    if (!std::isnan(population_[c].reference)) continue;
+    if (const double* r = remembered_reference(population_[c].genome))
+      remembered.emplace_back(c, *r);
+    else
+      todo.push_back(c);
+  }
   std::vector<const Genome*> genomes;
   for (std::size_t c : todo) genomes.push_back(&population_[c].genome);
   // inside tell(): not stoppable
@@ -215,11 +226,25 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
   // Stored only once every one is known and acceptable: an exception leaves the population as it
   // was.
   for (std::size_t k = 0; k < todo.size(); ++k) population_[todo[k]].reference = refs[k].fitness;
+  for (const auto& [c, r] : remembered) population_[c].reference = r;
   std::stable_sort(cand.begin(), cand.end(), [&](std::size_t a, std::size_t b) {
     return population_[a].reference > population_[b].reference;
   });
   if (cand.size() > elites) cand.resize(elites);
   return cand;
+}
+
+const double* Evolution::remembered_reference(const Genome& genome) const {
+  for (const auto& [g, r] : reference_memo_)
+    if (g == genome) return &r;
+  return nullptr;
+}
+
+void Evolution::remember_references() {
+  reference_memo_.clear();
+  if (!reference_) return;
+  for (const Individual& ind : population_)
+    if (!std::isnan(ind.reference)) reference_memo_.emplace_back(ind.genome, ind.reference);
 }
 
 void Evolution::reference_elite_candidates() {
@@ -404,6 +429,7 @@ bool Evolution::tell_initial(const std::vector<Fitness>& fitness) {
   history_.push_back(statistics(true, wall_offset_ + now_seconds() - started_,
                                 static_cast<int>(population_.size())));
   check_reference();
+  remember_references();
   return true;
 }
 
@@ -544,6 +570,7 @@ bool Evolution::tell_generation(const std::vector<Fitness>& fitness) {
       statistics(!(b.genome == previous_best), wall_offset_ + now_seconds() - started_, swims));
   history_.back().crossovers = next_crossovers_;
   check_reference();
+  remember_references();
   return true;
 }
 
@@ -904,6 +931,7 @@ void Evolution::restore(std::string_view text, std::string_view source) {
     check_semantics(pop, hist, stall, best_ever, evaluations, wall, nonnegative_objective(*config_),
                     selects_by_reference(*config_), source);
     population_ = std::move(pop);
+    remember_references();
     slots_.clear();
     next_.clear();
     next_origin_.clear();

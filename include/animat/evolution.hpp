@@ -411,6 +411,11 @@ class Evolution {
   /// "select", when a generation is complete: the reference fitness of every island's elite
   /// candidates, so that best() can be the best by reference (the next ask() finds them known).
   void reference_elite_candidates();
+  /// A reference fitness this engine computed for an equal genome in the last completed generation
+  /// (reference_memo_), or null.
+  [[nodiscard]] const double* remembered_reference(const Genome& genome) const;
+  /// Keep every reference fitness of the completed generation for the next one's lookups.
+  void remember_references();
 
   std::vector<Genome> ask_initial(int lookahead);
   std::vector<Genome> ask_generation();
@@ -449,6 +454,10 @@ class Evolution {
   };
   std::vector<Origin> next_origin_;
   int next_crossovers_ = 0;
+  /// The genomes that had a reference fitness when the last generation completed, with it: a
+  /// clone of an elite or of an elite candidate is not swum at the reference step again (the
+  /// reference is a function of the genome, so the results are the same). Not checkpointed.
+  std::vector<std::pair<Genome, double>> reference_memo_;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()
   int stall_ = 0;
