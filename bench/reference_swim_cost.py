@@ -6,12 +6,18 @@ evaluations (animat.evaluate, here) apart from the CPU time inside ask() and tel
 reference swims at dt/reference_substeps of the elite candidates plus the GA's own work (about a
 millisecond a generation, docs/performance.md).
 
+It also counts the reference swims from the checkpoint after each generation (exact, independent of
+load): "swum" are the referenced individuals whose genome no individual referenced in the previous
+generation had (the engine reuses a remembered genome's reference), "without reuse" those that are not
+the elites carried over with their reference (what the engine swam before it remembered references).
+
     PYTHONPATH=build/python .venv/bin/python bench/reference_swim_cost.py --generations 20 --seed 1
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import sys
 import time
@@ -33,8 +39,13 @@ def main() -> int:
     config["evolution.seed"] = args.seed
     config["evolution.threads"] = 1  # the reference swims on this thread too
     ga = animat.GA(config)
-    rows = []  # per completed generation: (generation, evaluations, evaluation CPU s, guard CPU s)
+    elites = int(config["evolution.elites"])
+    if int(config["evolution.islands"]) != 1:
+        ap.error("the counts assume one island (the elites are the population's first places)")
+    # per completed generation: (generation, evaluations, evaluation CPU s, guard CPU s, swum, without reuse)
+    rows = []
     evaluations, eval_cpu, guard_cpu = 0, 0.0, 0.0
+    previous: set = set()
     while len(rows) <= args.generations:
         t0 = time.process_time()
         genomes = ga.ask()
@@ -47,27 +58,49 @@ def main() -> int:
         stats = ga.tell(results)
         guard_cpu += time.process_time() - t0
         if stats is not None:
-            rows.append((stats.generation, evaluations, eval_cpu, guard_cpu))
+            population = json.loads(json.loads(ga.checkpoint())["payload"])["population"]
+            referenced = [
+                (i, json.dumps(p["genome"])) for i, p in enumerate(population) if p.get("reference") is not None
+            ]
+            swum = sum(1 for _, g in referenced if g not in previous)
+            without_reuse = sum(1 for i, _ in referenced if i >= elites or stats.generation == 0)
+            previous = {g for _, g in referenced}
+            rows.append((stats.generation, evaluations, eval_cpu, guard_cpu, swum, without_reuse))
             evaluations, eval_cpu, guard_cpu = 0, 0.0, 0.0
     print(
         f"config {args.config}, seed {args.seed}, reference_check = {config['evaluation.reference_check']}, "
         f"reference_substeps = {config['evaluation.reference_substeps']}; CPU seconds, one thread"
     )
     print(
-        "| generation | evaluations | their CPU s | CPU s in ask() + tell() (reference swims) | guard over evaluations |"
+        "| generation | evaluations | their CPU s | CPU s in ask() + tell() (reference swims) | guard over evaluations "
+        "| reference swims | without reuse |"
     )
-    print("|---|---|---|---|---|")
-    for g, n, e, r in rows:
-        print(f"| {g} | {n} | {e:.2f} | {r:.2f} | {r / e:.2f}x |")
+    print("|---|---|---|---|---|---|---|")
+    for g, n, e, r, s, w in rows:
+        print(f"| {g} | {n} | {e:.2f} | {r:.2f} | {r / e:.2f}x | {s} | {w} |")
     later = rows[1:]
     if later:
         e = statistics.median(r[2] for r in later)
         r = statistics.median(r[3] for r in later)
-        share = sum(x[3] for x in later) / sum(x[2] + x[3] for x in later)
+        evaluation_cpu = sum(x[2] for x in later)
+        guard = sum(x[3] for x in later)
+        swum = sum(x[4] for x in later)
+        without = sum(x[5] for x in later)
         print(
             f"\nlater generations (median): evaluations {e:.2f} s, guard {r:.2f} s; "
-            f"the guard is {share:.0%} of their CPU time in all"
+            f"the guard is {guard / (evaluation_cpu + guard):.0%} of their CPU time in all"
         )
+        if swum:
+            # the guard's CPU is almost all reference swims (the GA's own work is about a millisecond)
+            per_swim = guard / swum
+            guard_without = per_swim * without
+            print(
+                f"reference swims: {swum} ({swum / len(later):.1f} a generation) against {without} without reuse "
+                f"({without / len(later):.1f}); at {per_swim:.3f} CPU s a swim the guard would take "
+                f"{guard_without:.2f} s without reuse, {guard_without / (evaluation_cpu + guard_without):.0%} of "
+                f"the CPU time; a generation costs {(evaluation_cpu + guard) / (evaluation_cpu + guard_without):.2f} "
+                "of what it would"
+            )
     return 0
 
 
