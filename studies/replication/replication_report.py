@@ -277,6 +277,28 @@ def read_env(path: Path) -> Optional[EnvReport]:
 
 # --- per-run analysis -------------------------------------------------------------------------------------
 
+#: New bests within this many generations of the last one reached count as recent (a run still refining).
+RECENT_GENERATIONS = 100
+
+
+def new_best_generations(history: np.ndarray) -> List[int]:
+    """The generations whose best fitness exceeds that of every earlier generation: history column
+    ``best_reference`` (the exploit guard's reference step) where every row has it, else ``best``."""
+    if len(history) == 0:
+        return []
+    names = history.dtype.names
+    column = "best_reference" if "best_reference" in names else "best"
+    f = np.asarray(history[column], dtype=float)
+    if column == "best_reference" and not np.all(np.isfinite(f)):
+        f = np.asarray(history["best"], dtype=float)
+    gens = np.asarray(history["generation"], dtype=int)
+    out, top = [], f[0]
+    for g, v in zip(gens[1:], f[1:]):
+        if v > top:
+            out.append(int(g))
+            top = v
+    return out
+
 
 def analyse_run(r: RunReport) -> None:
     """Develop and replay the run's best and measure it; the swim stays in ``r.trajectory`` for the figures."""
@@ -672,6 +694,19 @@ def calibration_lines(results: Dict[str, List[KS.KnownResult]]) -> List[str]:
     return out
 
 
+def stall_rule_words(envs: List[EnvReport]) -> str:
+    """What the stall rule (evolution.stall_generations, 0: none) of the environments does."""
+    stalls = {e.name: int(e.config["evolution.stall_generations"]) for e in envs}
+    if len(set(stalls.values())) > 1:
+        return (
+            "the stall rule stops a run "
+            + ", ".join(f"`{n}` {k} generations" if k else f"`{n}` never" for n, k in stalls.items())
+            + " after its last"
+        )
+    k = next(iter(stalls.values()), 0)
+    return f"the stall rule stops a run {k} generations after its last" if k else "no stall rule stops the runs"
+
+
 def statistics_lines(envs: List[EnvReport]) -> List[str]:
     """Mode counts next to the paper's with Fisher's exact test, best fitness with bootstrap intervals,
     generations to the last morphology change, reference fitness."""
@@ -769,6 +804,28 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
             continue
         w(
             f"| `{e.name}` | {', '.join(str(g) for g in last)} | {statistics.median(last):g} | "
+            f"{fmt_range([float(r.generations) for r in e.runs], 0)} |"
+        )
+    w("")
+    w("### Generations of the last new best")
+    w("")
+    w(
+        "A new best is a generation whose best fitness exceeds that of every earlier generation (history column "
+        "`best_reference`, the fitness at the exploit guard's reference step, where the run records it; else "
+        f"`best`). A run still refining sets new bests late; {stall_rule_words(envs)}."
+    )
+    w("")
+    w(
+        f"| environment | last new best, per run | new bests in each run's last {RECENT_GENERATIONS} generations | "
+        f"runs with one there | generations reached |"
+    )
+    w("| --- | --- | --- | --- | --- |")
+    for e in envs:
+        news = [new_best_generations(r.history) for r in e.runs]
+        recent = [sum(1 for g in n if g > r.generations - RECENT_GENERATIONS) for n, r in zip(news, e.runs)]
+        w(
+            f"| `{e.name}` | {', '.join(str(n[-1]) if n else '—' for n in news)} | "
+            f"{', '.join(str(k) for k in recent)} | {sum(1 for k in recent if k > 0)} of {len(e.runs)} | "
             f"{fmt_range([float(r.generations) for r in e.runs], 0)} |"
         )
     w("")
