@@ -282,15 +282,11 @@ RECENT_GENERATIONS = 100
 
 
 def new_best_generations(history: np.ndarray) -> List[int]:
-    """The generations whose best fitness exceeds that of every earlier generation: history column
-    ``best_reference`` (the exploit guard's reference step) where every row has it, else ``best``."""
+    """The generations whose best fitness (history column ``best``, the fitness selection ranks by)
+    exceeds that of every earlier generation: the improvements the stall rule counts."""
     if len(history) == 0:
         return []
-    names = history.dtype.names
-    column = "best_reference" if "best_reference" in names else "best"
-    f = np.asarray(history[column], dtype=float)
-    if column == "best_reference" and not np.all(np.isfinite(f)):
-        f = np.asarray(history["best"], dtype=float)
+    f = np.asarray(history["best"], dtype=float)
     gens = np.asarray(history["generation"], dtype=int)
     out, top = [], f[0]
     for g, v in zip(gens[1:], f[1:]):
@@ -810,9 +806,9 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
     w("### Generations of the last new best")
     w("")
     w(
-        "A new best is a generation whose best fitness exceeds that of every earlier generation (history column "
-        "`best_reference`, the fitness at the exploit guard's reference step, where the run records it; else "
-        f"`best`). A run still refining sets new bests late; {stall_rule_words(envs)}."
+        "A new best is a generation whose best fitness (history column `best`, the fitness selection ranks by) "
+        "exceeds that of every earlier generation: the improvements the stall rule counts. A run still refining "
+        f"sets new bests late; {stall_rule_words(envs)}."
     )
     w("")
     w(
