@@ -10,7 +10,8 @@ classifier's calibration on hand-built swimmers of known mode (the confusion mat
 path on the calibration and held-out sets of studies/locomotion/known_swimmers.py, swum here as
 studies/locomotion/confusion.py swims them), then the statistics (mode counts against the paper's
 with Fisher's exact test of whether the mode depends on the drag, best fitness with bootstrap
-intervals, generations to the last morphology change, reference fitness of every best), then for
+intervals, generations to the last morphology change and to the last new best, reference fitness of
+every best), then for
 every environment directory (dn0.5, dn2, dn10, dn0.2_64cells, then any other) and every run_<i> in
 it, finished or still running: the best-fitness curves (paper Figs. 8-9), the motion cycle (Figs.
 4-6), phase map (Fig. 7) and GIF of the environment's best run, the paper's claims about the best
@@ -282,7 +283,7 @@ RECENT_GENERATIONS = 100
 
 
 def new_best_generations(history: np.ndarray) -> List[int]:
-    """The generations whose best fitness (history column ``best``, the fitness selection ranks by)
+    """The generations whose best fitness (history column ``best``, the fitness the tournaments compare)
     exceeds that of every earlier generation: the improvements the stall rule counts."""
     if len(history) == 0:
         return []
@@ -705,7 +706,7 @@ def stall_rule_words(envs: List[EnvReport]) -> str:
 
 def statistics_lines(envs: List[EnvReport]) -> List[str]:
     """Mode counts next to the paper's with Fisher's exact test, best fitness with bootstrap intervals,
-    generations to the last morphology change, reference fitness."""
+    generations to the last morphology change and to the last new best, reference fitness."""
     out: List[str] = []
     w = out.append
     w("## Statistics")
@@ -806,7 +807,7 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
     w("### Generations of the last new best")
     w("")
     w(
-        "A new best is a generation whose best fitness (history column `best`, the fitness selection ranks by) "
+        "A new best is a generation whose best fitness (history column `best`, the fitness the tournaments compare) "
         "exceeds that of every earlier generation: the improvements the stall rule counts. A run still refining "
         f"sets new bests late; {stall_rule_words(envs)}."
     )
