@@ -749,8 +749,13 @@ def statistics_lines(envs: List[EnvReport]) -> List[str]:
     )
     w("")
     drag_envs = [e for e in envs if e.max_cells == 32]
+    count_words = {2: "two", 3: "three", 4: "four", 5: "five"}
+    drag_title = (
+        f"the {count_words.get(len(drag_envs), str(len(drag_envs)))} 32-cell environments "
+        f"(d_N = {', '.join(f'{e.drag_normal:g}' for e in drag_envs)}: does the mode depend on the drag?)"
+    )
     for title, group in (
-        ("the three 32-cell environments (d_N = 0.5, 2, 10: does the mode depend on the drag?)", drag_envs),
+        (drag_title, drag_envs),
         ("all environments", envs),
     ):
         if len(group) < 2:

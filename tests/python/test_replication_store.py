@@ -150,7 +150,10 @@ def test_report_rebuilds_from_packed_data_alone(tmp_path):
     assert "**Scale, exactly:** 2 runs: 1 in `dn2`, 1 in `dn10` of the 3 per environment" in text
     assert "generations reached: 100 " in text
     assert "Runs not started yet: `dn2` run 1, run 2; `dn10` run 1, run 2." in text
-    assert "Fisher's exact test (Freeman–Halton, r × c) over the three 32-cell environments" in text
+    assert (
+        "Fisher's exact test (Freeman–Halton, r × c) over the two 32-cell environments (d_N = 2, 10: does the mode"
+        in text
+    )
     assert "| `dn2` | 0 | 21.665 | 21.670 | +0.02 % |" in text  # evolved and reference fitness of the best
     # the last new best and the new bests of the last 100 generations (all 100 here)
     assert "| `dn2` | 43 | 8 | 1 of 1 | 100 |" in text
