@@ -53,13 +53,16 @@ def state_of(me):
     "told, error, message",
     [
         (1e308, ValueError, r"value 0 .*fitness 1e\+308 is beyond \+-4\.49\d*e\+306, where the QD-score of 40 cells"),
-        (animat.Fitness(1e308, True, True, 3), ValueError, r"value 0 .*fitness 1e\+308 is beyond"),
+        # Built in the test: a Fitness among the collected parameters outlives animat._core at exit,
+        # which nanobind reports as a leaked instance.
+        (lambda: animat.Fitness(1e308, True, True, 3), ValueError, r"value 0 .*fitness 1e\+308 is beyond"),
         (-1.0, ValueError, r"value 0 .*fitness -1 \(a fitness must be finite and >= 0"),
         ("3.0", TypeError, r"value 0 \('3\.0'\) is a string"),
         (math.inf, ValueError, r"value 0 \(inf\): a fitness must be finite"),
     ],
 )
 def test_a_refused_tell_changes_nothing(told, error, message):
+    told = told() if callable(told) else told
     me = new_search()
     before = state_of(me)
     genomes = me.ask()
