@@ -344,10 +344,6 @@ def test_sigkill_at_random_moments_then_resume_equals_an_uninterrupted_run(refer
     finish_and_compare(run, reference)
 
 
-def files_of(run: Path) -> dict:
-    return {p.relative_to(run): p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()}
-
-
 @needs_exe
 def test_a_row_past_the_checkpoint_stays_until_a_resume_evolves(reference, tmp_path):
     # A SIGKILL between the history append of a generation and its checkpoint leaves history.csv one
@@ -363,10 +359,10 @@ def test_a_row_past_the_checkpoint_stays_until_a_resume_evolves(reference, tmp_p
     assert len(one_more) == len(reference["history"]) + 1
     (run / "checkpoint.json").write_bytes(earlier)
     # A resume already at its cap has nothing to evolve: it writes no file, so the row stays.
-    before = files_of(run)
+    before = snapshot(run)
     r = subprocess.run([*resume, str(FINAL_GENERATION)], capture_output=True, text=True, timeout=HANG_GUARD_SECONDS)
     assert r.returncode == 0, r.stderr
-    assert files_of(run) == before
+    assert snapshot(run) == before
     # A resume that evolves rewrites history.csv from the checkpoint; the row comes back the same.
     r = subprocess.run([*resume, str(FINAL_GENERATION + 2)], capture_output=True, text=True, timeout=HANG_GUARD_SECONDS)
     assert r.returncode == 0, r.stderr
