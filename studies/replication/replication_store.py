@@ -45,6 +45,7 @@ import json
 import os
 import re
 import shutil
+import statistics
 import sys
 import tarfile
 import tempfile
@@ -843,6 +844,52 @@ def growth_lines(root: Path) -> List[str]:
     return lines
 
 
+def _wall_seconds(run: Path) -> List[Tuple[int, float]]:
+    """(generation, history column ``wall_seconds``) of every row of a packed run's history."""
+    text = gzip.decompress((run / "history.csv.gz").read_bytes()).decode()
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    header = lines[0].split(",")
+    if "wall_seconds" not in header:
+        raise StoreError(f"{run / 'history.csv.gz'}: no column wall_seconds")
+    g, w = header.index("generation"), header.index("wall_seconds")
+    return [(int(c[g]), float(c[w])) for c in (ln.split(",") for ln in lines[1:])]
+
+
+def pace(root: Path, last: int = 50, until: Optional[int] = None, target: int = 2000) -> List[str]:
+    """What growing the packed runs under ``root`` to generation ``target`` costs, at the pace of each run's
+    ``last`` generations up to generation ``until`` (default: its last). A generation's cost is the rise of
+    the history's ``wall_seconds`` (cumulative over resumes; one run is one process on one core); each run's
+    pace is the median over its window, so a generation slowed by other work on the machine moves it less
+    than a mean. One line per environment (the median and range of its runs' paces, the generations left
+    and their core-hours: runs the stall rule stopped have none left), then the total."""
+    if last < 1 or target < 1:
+        raise ValueError(f"pace: last and target must be >= 1, got {last}, {target}")
+    lines, total = [], 0.0
+    for env, runs in packed_runs(root).items():
+        paces, ends, left, hours = [], [], 0, 0.0
+        for run in runs:
+            rows = [(g, w) for g, w in _wall_seconds(run) if until is None or g <= until]
+            window = rows[-(last + 1) :]
+            steps = [(b - a) / (gb - ga) for (ga, a), (gb, b) in zip(window, window[1:]) if gb > ga]
+            if not steps:
+                raise StoreError(f"{run}: fewer than two generations up to {until}")
+            paces.append(statistics.median(steps))
+            ends.append(window[-1][0])
+            status = json.loads((run / "status.json").read_text())
+            if STALLED not in str(status.get("stop_reason", "")):
+                gens = max(0, target - int(status["generation"]))
+                left += gens
+                hours += gens * paces[-1] / 3600
+        total += hours
+        lines.append(
+            f"{env}: {len(runs)} run{'s' if len(runs) != 1 else ''}, median {statistics.median(paces):.1f} s a "
+            f"generation (runs {min(paces):.1f}-{max(paces):.1f}) over the {last} generations up to {_span(ends)}; "
+            f"{left} generations left to {target}: {hours:.1f} core-hours"
+        )
+    lines.append(f"all: {total:.1f} core-hours to generation {target}")
+    return lines
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(
         prog="replication_store.py",
@@ -863,7 +910,22 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     c.add_argument("--round", type=int, required=True, dest="round_size")
     st = sub.add_parser("status", help="print how far the packed runs under DATA have grown, per environment")
     st.add_argument("data", type=Path)
+    pc = sub.add_parser("pace", help="print what growing the packed runs under DATA to --target generations costs")
+    pc.add_argument("data", type=Path)
+    pc.add_argument("--last", type=int, default=50, help="generations each run's pace is the median over (50)")
+    pc.add_argument("--until", type=int, default=None, help="the window ends at this generation (default: the last)")
+    pc.add_argument("--target", type=int, default=2000, help="the generation every open run grows to (2000)")
     args = p.parse_args(argv)
+    if args.command == "pace":
+        if not args.data.is_dir():
+            print(f"replication_store: {args.data}: no such directory", file=sys.stderr)
+            return 1
+        try:
+            print("\n".join(pace(args.data, args.last, args.until, args.target)))
+        except (StoreError, ValueError, OSError) as e:
+            print(f"replication_store: error: {e}", file=sys.stderr)
+            return 1
+        return 0
     if args.command == "status":
         if not args.data.is_dir():
             print(f"replication_store: {args.data}: no such directory", file=sys.stderr)

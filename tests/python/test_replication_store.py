@@ -119,6 +119,48 @@ def test_status_says_how_far_each_environment_has_grown(tmp_path, capsys):
     assert R.main(["status", str(tmp_path / "missing")]) == 1
 
 
+def _timed_run(data: Path, env: str, i: int, seconds: list, stop_reason: str = "interrupted") -> None:
+    """A packed run (as far as pace reads one) whose generation g took seconds[g - 1] of wall time."""
+    run = data / env / f"run_{i}"
+    run.mkdir(parents=True)
+    (run / "config.toml").write_text("")
+    (run / "checkpoint.json.gz").write_bytes(gzip.compress(b"{}"))
+    wall = [0.0]
+    for s in seconds:
+        wall.append(wall[-1] + s)
+    rows = ["generation,best,wall_seconds"] + [f"{g},1,{w}" for g, w in enumerate(wall)]
+    (run / "history.csv.gz").write_bytes(gzip.compress(("\n".join(rows) + "\n").encode()))
+    (run / "status.json").write_text(json.dumps({"generation": len(seconds), "stop_reason": stop_reason}))
+
+
+def test_pace_prices_the_generations_left_at_each_runs_median_generation(tmp_path, capsys):
+    data = tmp_path / "data"
+    # Run 0: 2 s a generation, one generation slowed to 500 s by other work (the median ignores it).
+    _timed_run(data, "a", 0, [2.0] * 5 + [500.0] + [2.0] * 4)
+    _timed_run(data, "a", 1, [4.0] * 10)
+    _timed_run(data, "b", 0, [7.0] * 8, stop_reason="no improvement for evolution.stall_generations = 500 generations")
+    _timed_run(data, "b", 1, [1.0] * 8 + [3.0] * 2)
+    lines = R.pace(data, last=4, target=1810)
+    assert lines == [
+        # (1810 - 10) generations at 2 s and at 4 s: 10,800 s
+        "a: 2 runs, median 3.0 s a generation (runs 2.0-4.0) over the 4 generations up to 10; "
+        "3600 generations left to 1810: 3.0 core-hours",
+        # the stalled run has nothing left; run 1's last 4 generations: 1, 1, 3, 3 s, median 2
+        "b: 2 runs, median 4.5 s a generation (runs 2.0-7.0) over the 4 generations up to 8-10; "
+        "1800 generations left to 1810: 1.0 core-hours",
+        "all: 4.0 core-hours to generation 1810",
+    ]
+    # The window can end earlier: run b/1 up to generation 8 took 1 s a generation.
+    assert R.pace(data, last=4, until=8, target=1000)[1].startswith(
+        "b: 2 runs, median 4.0 s a generation (runs 1.0-7.0)"
+    )
+    assert R.main(["pace", str(data), "--last", "4", "--target", "3610"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "all: 8.0 core-hours to generation 3610"
+    assert R.main(["pace", str(tmp_path / "missing")]) == 1
+    assert R.main(["pace", str(data), "--until", "0"]) == 1
+    assert "fewer than two generations up to 0" in capsys.readouterr().err
+
+
 def _two_packed_runs_and_report_command(tmp_path):
     """Data with the two frozen packed runs (dn2 and dn10, 100 generations) and the report command over it."""
     data = tmp_path / "data"
