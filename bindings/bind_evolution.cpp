@@ -940,6 +940,7 @@ void bind_evolution(nb::module_& m) {
         FitnessFunction reference;
         if (c.evaluation.reference_check != "off")
           reference = objective_fitness(reference_config(c), scored_by);
+        opt.fitness_key = evaluation_key(c);
         RunSummary summary;
         {
           nb::gil_scoped_release release;

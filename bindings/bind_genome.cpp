@@ -374,6 +374,15 @@ void bind_genome(nb::module_& m) {
           "Viability criterion 1: paths from the inputs to divide, amplitude, frequency and phase.")
       .def("to_dot", &Grn::to_dot, "Graphviz DOT text of the network.")
       .def(
+          "network_key",
+          [](const Grn& g) {
+            const std::string key = g.network_key();
+            return nb::bytes(key.data(), key.size());
+          },
+          "Bytes of everything development and a swim read from the network (units, outputs,\n"
+          "morphogen units, edges with their weights' bits): two genomes with equal keys develop\n"
+          "and swim identically under development.jitter_stream = \"fixed\".")
+      .def(
           "run",
           [](const Grn& g, int steps, std::array<double, 3> maternal,
              std::optional<std::vector<double>> morphogens,

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <sstream>
+#include <string>
 #include <tuple>
 #include <unordered_map>
 
@@ -237,14 +238,22 @@ std::vector<std::size_t> Evolution::reference_ranked(const std::vector<std::size
 const double* Evolution::remembered_reference(const Genome& genome) const {
   for (const auto& [g, r] : reference_memo_)
     if (g == genome) return &r;
+  if (!key_ || reference_memo_.empty()) return nullptr;
+  const std::string key = key_(genome);
+  for (std::size_t k = 0; k < reference_memo_.size(); ++k)
+    if (reference_memo_keys_[k] == key) return &reference_memo_[k].second;
   return nullptr;
 }
 
 void Evolution::remember_references() {
   reference_memo_.clear();
+  reference_memo_keys_.clear();
   if (!reference_) return;
   for (const Individual& ind : population_)
-    if (!std::isnan(ind.reference)) reference_memo_.emplace_back(ind.genome, ind.reference);
+    if (!std::isnan(ind.reference)) {
+      reference_memo_.emplace_back(ind.genome, ind.reference);
+      if (key_) reference_memo_keys_.push_back(key_(ind.genome));
+    }
 }
 
 void Evolution::reference_elite_candidates() {
@@ -480,9 +489,13 @@ std::vector<Genome> Evolution::ask_generation() {
   const int protection = ep.protection_generations;
   int crossovers = 0;
   // Previous genomes by hash: an unchanged offspring keeps its parent's fitness (never evaluated
-  // twice).
+  // twice); with a fitness key, so does an offspring whose key one of them has (e.g. a mutation of
+  // an element that takes part in no interaction of the network).
   std::unordered_multimap<std::uint64_t, std::size_t> known;
   for (std::size_t i = 0; i < n; ++i) known.emplace(genome_hash(population_[i].genome), i);
+  std::unordered_map<std::string, std::size_t> known_keys;
+  if (key_)
+    for (std::size_t i = 0; i < n; ++i) known_keys.emplace(key_(population_[i].genome), i);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t isl = layout.island_of(i);        // [islands]
     if (i < layout.begin(isl) + copied[isl]) continue;  // an elite
@@ -513,6 +526,11 @@ std::vector<Genome> Evolution::ask_generation() {
         child.result = population_[it->second].result;
         needs_eval[i] = false;
         break;
+      }
+    if (needs_eval[i] && key_)
+      if (const auto it = known_keys.find(key_(child.genome)); it != known_keys.end()) {
+        child.result = population_[it->second].result;
+        needs_eval[i] = false;
       }
   }
   next_crossovers_ = crossovers;

@@ -1,11 +1,13 @@
 // The GA's real fitness: the whole chain of evaluate.hpp, scored by the config's objective.
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
 #include "animat/evaluate.hpp"
 #include "animat/evolution.hpp"
+#include "animat/grn.hpp"
 #include "animat/objective.hpp"
 
 namespace animat {
@@ -38,6 +40,12 @@ FitnessFunction objective_fitness(const Config& config,
   return [shared, objective = std::move(objective)](const Genome& genome) {
     return fitness_of(evaluate(genome, *shared, *objective));
   };
+}
+
+GenomeKey evaluation_key(const Config& config) {
+  if (config.development.jitter_stream != "fixed") return {};
+  return
+      [params = config.genome](const Genome& genome) { return Grn(genome, params).network_key(); };
 }
 
 Config reference_config(const Config& config) {

@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <map>
 
 namespace animat {
@@ -107,6 +110,26 @@ int Grn::source_unit(int s) const {
   if (s < kPaperInputCount) return s;
   if (s >= kPaperInputCount + 2 * units_) return s - 2 * units_;  // an extension input's channel
   return (s - kPaperInputCount) % std::max(units_, 1);
+}
+
+std::string Grn::network_key() const {
+  std::string key;
+  auto put = [&key](auto value) {
+    const auto bytes = std::bit_cast<std::array<char, sizeof value>>(value);
+    key.append(bytes.data(), bytes.size());
+  };
+  put(units_);
+  put(outputs_);
+  put(morphogen_units_.size());
+  for (const int u : morphogen_units_) put(u);
+  // the rest is the edges (their count follows from the key's length): weights by their bits, so
+  // that equal keys mean the same sums in step()
+  for (const Edge& e : edges_) {
+    put(e.source);
+    put(e.target);
+    put(std::bit_cast<std::uint64_t>(e.weight));
+  }
+  return key;
 }
 
 GrnState Grn::initial_state() const {

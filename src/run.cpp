@@ -534,14 +534,17 @@ RunSummary run_evolution_unchecked(const Config& config, const RunOptions& opt,
                                    FitnessFunction fitness, FitnessFunction reference) {
   validate(config);
   require_ga(config);
+  GenomeKey key = opt.fitness_key;
   if (!fitness) {
     // the real swim: its exploit guard re-evaluates each new best at the reference step
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off")
       reference = swim_fitness(reference_config(config));
+    key = evaluation_key(config);
   }
   Evolution evo(config, std::move(fitness), std::move(reference), opt.evaluator);
   evo.set_stop(StopRequest{opt.stop_flag, opt.stop_poll});
+  evo.set_fitness_key(std::move(key));
   const std::string tag = opt.label.empty() ? std::string() : "[" + opt.label + "] ";
   const bool writing = !opt.out.empty();
   // [islands] islands.csv

@@ -142,6 +142,17 @@ class Objective;
 [[nodiscard]] FitnessFunction objective_fitness(const Config& config,
                                                 std::shared_ptr<const Objective> objective);
 
+/// What a fitness function reads of a genome, as bytes: genomes with equal keys get equal Fitness
+/// (and equal reference fitness), so the GA evaluates one of them and copies the result. Empty:
+/// the whole genome (any deterministic fitness function).
+using GenomeKey = std::function<std::string(const Genome&)>;
+
+/// The key of swim_fitness and objective_fitness under `config`: the genome's network
+/// (Grn::network_key) when development reads nothing else of the genome
+/// (development.jitter_stream = "fixed"), else empty (the whole genome: under "genome" the
+/// placement jitter is seeded by the genome's hash).
+[[nodiscard]] GenomeKey evaluation_key(const Config& config);
+
 /// No parent (an initial individual; the second parent of a mutant); Individual::parent_a, _b.
 inline constexpr std::int64_t kNoParent = -1;
 
@@ -347,14 +358,21 @@ class Evolution {
   GenerationStats step();
   /// Checked by initialize() and step() (see StopRequest); empty = never stop.
   void set_stop(StopRequest stop) { stop_ = std::move(stop); }
+  /// What the fitness (and reference) function reads of a genome (GenomeKey, evaluation_key()):
+  /// an offspring whose key equals that of an individual of the previous generation keeps its
+  /// fitness instead of being evaluated, and an elite candidate takes a remembered reference
+  /// fitness of an equal key. Empty (the default): only an offspring equal to an evaluated genome
+  /// keeps its fitness. Results are the same either way; only the evaluations differ.
+  void set_fitness_key(GenomeKey key) { key_ = std::move(key); }
 
   /// The genomes that need a fitness next, in order. Before generation 0: the next random draw of
   /// every initial slot not yet holding a viable individual (slot i draws from
   /// Rng::derive(seed, initial, i)); with `lookahead` > 1, that many consecutive draws per slot
   /// (speculative: those after a slot's first viable draw are discarded and not counted, so the run
   /// does not depend on it). After that: the offspring of the next generation that are not copies
-  /// of an evaluated genome (elites and unchanged copies keep their fitness; the list may be
-  /// empty). ask() again before tell() returns the same genomes.
+  /// of an evaluated genome (elites and unchanged copies keep their fitness, as do offspring with
+  /// an evaluated genome's key: set_fitness_key; the list may be empty). ask() again before tell()
+  /// returns the same genomes.
   std::vector<Genome> ask(int lookahead = 1);
   /// The fitness of every genome of the last ask(), in order. Returns true when this completed a
   /// generation (history().back() holds its statistics). Throws Error for a count mismatch, a value
@@ -411,8 +429,8 @@ class Evolution {
   /// "select", when a generation is complete: the reference fitness of every island's elite
   /// candidates, so that best() can be the best by reference (the next ask() finds them known).
   void reference_elite_candidates();
-  /// A reference fitness this engine computed for an equal genome in the last completed generation
-  /// (reference_memo_), or null.
+  /// A reference fitness this engine computed for an equal genome (or one of equal key_) in the
+  /// last completed generation (reference_memo_), or null.
   [[nodiscard]] const double* remembered_reference(const Genome& genome) const;
   /// Keep every reference fitness of the completed generation for the next one's lookups.
   void remember_references();
@@ -458,6 +476,9 @@ class Evolution {
   /// clone of an elite or of an elite candidate is not swum at the reference step again (the
   /// reference is a function of the genome, so the results are the same). Not checkpointed.
   std::vector<std::pair<Genome, double>> reference_memo_;
+  GenomeKey key_;  ///< set_fitness_key(); empty: the whole genome
+  /// key_ of each genome of reference_memo_ (empty without key_), in its order
+  std::vector<std::string> reference_memo_keys_;
   std::vector<GenerationStats> history_;
   int generation_ = -1;  ///< -1 before initialize()
   int stall_ = 0;

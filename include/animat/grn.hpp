@@ -86,6 +86,13 @@ class Grn {
   /// Viability criterion 1 (paper §5): paths from the inputs to divide and to the three oscillator
   /// outputs.
   [[nodiscard]] bool has_required_paths() const;
+  /// The bytes of everything development and a swim read from this network: the unit and output
+  /// counts, the morphogen units and every edge with its weight's bits (not to_dot()'s inputs
+  /// present, nor which units have an internal gene). Two genomes with equal keys develop the same
+  /// embryo bit for bit when development reads nothing else of the genome
+  /// (development.jitter_stream = "fixed"): a mutation of an element that takes part in no
+  /// interaction leaves the key as it was.
+  [[nodiscard]] std::string network_key() const;
   /// Graphviz DOT of the network (inputs, units, outputs; red edges inhibit).
   [[nodiscard]] std::string to_dot() const;
 

@@ -33,6 +33,10 @@ struct RunOptions {
   std::function<bool()> stop_poll;
   /// how to evaluate (evaluator.hpp); null = OpenMP threads
   std::shared_ptr<Evaluator> evaluator;
+  /// run_evolution: what the given fitness function reads of a genome (Evolution::set_fitness_key;
+  /// evaluation_key(config) for swim_fitness and objective_fitness). Ignored when run_evolution
+  /// makes the fitness function itself: it then uses evaluation_key(config).
+  GenomeKey fitness_key;
   /// Called after every generation, generation 0 of a new run included; return false to stop
   /// (checkpointed).
   std::function<bool(const GenerationStats&, const Evolution&)> callback;

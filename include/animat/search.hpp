@@ -218,8 +218,9 @@ class Search {
 /// The GA (Evolution) behind the Search interface: the same engine, the same results.
 class GaSearch final : public Search {
  public:
+  /// `key`: what `fitness` reads of a genome (Evolution::set_fitness_key; empty: the genome).
   GaSearch(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-           std::shared_ptr<Evaluator> evaluator);
+           std::shared_ptr<Evaluator> evaluator, GenomeKey key = {});
   [[nodiscard]] std::string_view algorithm() const override { return "ga"; }
   std::vector<Genome> ask() override;
   bool tell(const std::vector<Fitness>& fitness) override;

@@ -236,7 +236,9 @@ class GA:
     anywhere (a process pool, a cluster, your own simulator), ``tell()`` their fitness.
 
     It is the engine of :func:`evolve`: a GA loop evaluating with ``animat.evaluate`` gives the very
-    run ``evolve`` gives (same populations, same history). Before generation 0 it asks for random
+    run ``evolve`` gives (same populations, same history; under ``development.jitter_stream =
+    "fixed"`` ``evolve`` also reuses the fitness of an equal network, so its ``evaluations`` and
+    ``swims`` columns are smaller). Before generation 0 it asks for random
     genomes, one per initial slot still lacking a viable individual, until every slot has one; then
     each ``ask()`` returns the offspring of the next generation that need a fitness (elites and
     unchanged copies keep theirs; the list may be empty: tell ``[]``).

@@ -199,8 +199,9 @@ void Search::step(const EvaluateHook& evaluate, const DescribeHook& describe) {
 }
 
 GaSearch::GaSearch(const Config& config, FitnessFunction fitness, FitnessFunction reference,
-                   std::shared_ptr<Evaluator> evaluator)
+                   std::shared_ptr<Evaluator> evaluator, GenomeKey key)
     : evo_(config, fitness, std::move(reference), evaluator) {
+  evo_.set_fitness_key(std::move(key));
   // step() evaluates as Evolution::step() would: with the given evaluator, else on this process's
   // threads.
   evaluator_ = evaluator ? std::move(evaluator)
@@ -252,16 +253,18 @@ std::unique_ptr<Search> make_search(const Config& config, FitnessFunction fitnes
     throw ConfigError(
         fmt::format("search.algorithm = \"{}\": centroids are a MAP-Elites CVT archive's",
                     config.search.algorithm));
+  GenomeKey key;  // the genome itself, for a caller's fitness function
   if (!fitness) {
     fitness = swim_fitness(config);
     if (config.evaluation.reference_check != "off")
       reference = swim_fitness(reference_config(config));
+    key = evaluation_key(config);
   }
   if (!evaluator) evaluator = make_local_evaluator(config, fitness);
   const std::string& algorithm = config.search.algorithm;
   if (algorithm == "ga")
     return std::make_unique<GaSearch>(config, std::move(fitness), std::move(reference),
-                                      std::move(evaluator));
+                                      std::move(evaluator), std::move(key));
   if (algorithm == "map_elites")
     return std::make_unique<MapElites>(config, std::move(fitness), std::move(reference),
                                        std::move(evaluator), supplied, centroids);

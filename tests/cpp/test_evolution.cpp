@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <string>
+#include <tuple>
 
 #include "animat/config.hpp"
 #include "animat/errors.hpp"
@@ -188,6 +190,81 @@ TEST(Evolution, UnchangedOffspringAreNeverReEvaluated) {
   const int after_init = calls.load();
   for (int g = 0; g < 5; ++g) evo.step();
   EXPECT_EQ(calls.load(), after_init);  // every offspring is a copy of a parent: nothing to swim
+}
+
+namespace {
+
+// Every column that is a result (not evaluations, swims, their rates or the wall time).
+void expect_same_results(const std::vector<GenerationStats>& a,
+                         const std::vector<GenerationStats>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
+    EXPECT_EQ(a[i].mean, b[i].mean) << "generation " << i;
+    EXPECT_EQ(a[i].median, b[i].median) << "generation " << i;
+    EXPECT_EQ(a[i].viable_fraction, b[i].viable_fraction) << "generation " << i;
+    EXPECT_EQ(a[i].best_cells, b[i].best_cells) << "generation " << i;
+    EXPECT_EQ(a[i].best_changed, b[i].best_changed) << "generation " << i;
+    EXPECT_EQ(a[i].crossovers, b[i].crossovers) << "generation " << i;
+    EXPECT_EQ(std::isnan(a[i].best_reference), std::isnan(b[i].best_reference));
+    if (!std::isnan(a[i].best_reference)) {
+      EXPECT_EQ(a[i].best_reference, b[i].best_reference) << "generation " << i;
+    }
+    EXPECT_EQ(a[i].invalid, b[i].invalid) << "generation " << i;
+  }
+}
+
+void expect_same_population(const std::vector<Individual>& a, const std::vector<Individual>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_TRUE(a[i].genome == b[i].genome) << "individual " << i;
+    EXPECT_TRUE(a[i].result == b[i].result) << "individual " << i;
+  }
+}
+
+}  // namespace
+
+TEST(Evolution, OffspringOfAnEvaluatedNetworkKeepItsFitness) {
+  // A fitness that reads only the genome's network, and a reference that reads only it too.
+  Config c = small_config(30);
+  c.development.jitter_stream = "fixed";
+  c.evaluation.reference_check = "select";
+  const GenomeKey key = evaluation_key(c);
+  ASSERT_TRUE(key);
+  std::atomic<int> calls{0};
+  const auto of_network = [&, key](double scale) {
+    return [&, key, scale](const Genome& g) {
+      ++calls;
+      Fitness f;
+      f.viable = true;
+      f.stable = true;
+      f.cell_count = 5;
+      f.fitness = scale * static_cast<double>(std::hash<std::string>{}(key(g)) % 1000);
+      return f;
+    };
+  };
+  auto evolve = [&](bool keyed) {
+    calls = 0;
+    Evolution evo(c, of_network(1.0), of_network(1.01));
+    if (keyed) evo.set_fitness_key(key);
+    evo.initialize();
+    for (int g = 0; g < 25; ++g) evo.step();
+    return std::tuple{evo.history(), evo.population(), calls.load()};
+  };
+  const auto [h_genome, pop_genome, calls_genome] = evolve(false);
+  const auto [h_keyed, pop_keyed, calls_keyed] = evolve(true);
+  expect_same_results(h_genome, h_keyed);
+  expect_same_population(pop_genome, pop_keyed);
+  EXPECT_LT(calls_keyed, calls_genome);
+  EXPECT_LT(h_keyed.back().evaluations, h_genome.back().evaluations);
+}
+
+TEST(Evolution, TheGenomeIsTheKeyWhenDevelopmentReadsItsHash) {
+  Config c = small_config();
+  EXPECT_EQ(c.development.jitter_stream, "genome");
+  EXPECT_FALSE(evaluation_key(c));  // the placement jitter is seeded by the genome's hash
+  c.development.jitter_stream = "fixed";
+  EXPECT_TRUE(evaluation_key(c));
 }
 
 TEST(Evolution, DeterministicForAnyThreadCountAndSeed) {
@@ -432,6 +509,29 @@ TEST(EndToEnd, RealRunIsIdenticalOnOneAndTwoThreads) {
   const RunSummary two = run_evolution(c, opt);
   expect_same_history(one.history, two.history);
   EXPECT_TRUE(one.best.genome == two.best.genome);
+}
+
+TEST(EndToEnd, ARealRunKeyedByTheNetworkHasTheSameResultsWithFewerEvaluations) {
+  // The real chain at the fixed jitter stream: run_evolution keys by the network
+  // (evaluation_key); the same fitness handed over without a key evaluates every new genome.
+  Config c;
+  c.development.jitter_stream = "fixed";
+  c.evolution.population = 16;
+  c.evolution.generations = 6;
+  c.evolution.seed = 3;
+  c.evolution.threads = 2;
+  c.evaluation.steps = 400;
+  c.evaluation.reference_check = "select";
+  RunOptions opt;
+  opt.quiet = true;
+  const RunSummary keyed = run_evolution(c, opt);
+  const RunSummary whole =
+      run_evolution(c, opt, swim_fitness(c), swim_fitness(reference_config(c)));
+  expect_same_results(whole.history, keyed.history);
+  EXPECT_TRUE(whole.best.genome == keyed.best.genome);
+  EXPECT_TRUE(whole.best.result == keyed.best.result);
+  expect_same_population(whole.population, keyed.population);
+  EXPECT_LT(keyed.history.back().evaluations, whole.history.back().evaluations);
 }
 
 // --- The Python paths held to the engine's rules (tell, statistics, the exploit guard)

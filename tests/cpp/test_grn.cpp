@@ -155,6 +155,39 @@ TEST(GrnStructure, OutputsAreAcceptorsNotProducts) {
   EXPECT_EQ(grn2.edges()[0].target, grn2.output_node(OutputChannel::grow));
 }
 
+TEST(GrnStructure, NetworkKeyIsWhatTheNetworkReads) {
+  const GenomeParams p;
+  // bias -> unit 0 (promoter at distance 1) -> divide (gene at distance 1.5); the gene at (30, 30)
+  // and the maternal1 input at (50, 0) are beyond the cut-off of every partner.
+  auto make = [](double gene_x, double input_x, double promoter_x) {
+    return genome({in(InputChannel::bias, 0, 0), el(P, promoter_x, 0), el(G, 10, 10), el(P, 20, 20),
+                   el(G, gene_x, 30), in(InputChannel::maternal1, input_x, 0),
+                   out(OutputChannel::divide, 10, 11.5)});
+  };
+  const std::string key = Grn(make(30, 50, 1), p).network_key();
+  // a different genome, the same network: elements that take part in no interaction moved
+  EXPECT_EQ(Grn(make(33, 50, 1), p).network_key(), key);
+  EXPECT_EQ(Grn(make(30, 58, 1), p).network_key(), key);
+  // a weight changed (the promoter moved within the cut-off), or an edge gained: another key
+  EXPECT_NE(Grn(make(30, 50, 1.25), p).network_key(), key);
+  EXPECT_NE(Grn(make(30, 1, 1), p).network_key(), key);
+  // a weight's sign, and the kind of a gene (internal against morphogen), are read too
+  Genome flipped = make(30, 50, 1);
+  flipped.elements[1].sign = -1;
+  EXPECT_NE(Grn(flipped, p).network_key(), key);
+  Genome morphogen = make(30, 50, 1);
+  morphogen.elements[2].type = M;
+  EXPECT_NE(Grn(morphogen, p).network_key(), key);
+  // an input that regulates nothing is not read: without it, the same key
+  Genome without = make(30, 50, 1);
+  without.elements.erase(without.elements.begin() + 5);
+  EXPECT_EQ(Grn(without, p).network_key(), key);
+  // an output without edges is: it decides the number of output nodes
+  Genome wider = make(30, 50, 1);
+  wider.elements.push_back(out(OutputChannel::stiffness, 90, 90));
+  EXPECT_NE(Grn(wider, p).network_key(), key);
+}
+
 TEST(GrnStructure, MorphogenUnitsAndProductSources) {
   // Units: 0 internal only, 1 morphogen only, 2 both kinds, 3 morphogen only.
   const Genome g = genome({el(P, 0, 0), el(G, 1, 1), el(P, 2, 2), el(M, 3, 3), el(P, 4, 4),
