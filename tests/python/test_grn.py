@@ -225,3 +225,19 @@ def test_random_genome_grn_runs():
     assert L.shape == (401, 16)
     assert np.all(L[0] == 0.0)
     assert np.all((L >= 0) & (L < 1))
+
+
+def test_network_key_ignores_elements_in_no_interaction_and_reads_every_weight():
+    def network(gene_x, promoter_x):
+        # bias -> unit 0 -> divide; the second unit's gene at (gene_x, 30) is beyond every cut-off
+        return animat.Grn(
+            genome(
+                [(I, BIAS, 0, 0), (P, 0, promoter_x, 0), (G, 0, 10, 10), (P, 0, 20, 20), (G, 0, gene_x, 30)]
+                + [(O, DIVIDE, 10, 11.5)]
+            )
+        )
+
+    key = network(30, 1).network_key()
+    assert isinstance(key, bytes) and len(key) > 0
+    assert network(34, 1).network_key() == key  # a different genome, the same network
+    assert network(30, 1.25).network_key() != key  # one weight changed
