@@ -23,6 +23,9 @@ using namespace animat;
 
 namespace {
 
+using animat::test::expect_same_history;
+using animat::test::expect_same_population;
+using animat::test::expect_same_results;
 using animat::test::slurp;
 using animat::test::stub_fitness;
 
@@ -40,20 +43,6 @@ std::vector<GenerationStats> run(const Config& c, int generations) {
   evo.initialize();
   for (int g = 0; g < generations; ++g) evo.step();
   return evo.history();
-}
-
-void expect_same_history(const std::vector<GenerationStats>& a,
-                         const std::vector<GenerationStats>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].generation, b[i].generation);
-    EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
-    EXPECT_EQ(a[i].mean, b[i].mean) << "generation " << i;
-    EXPECT_EQ(a[i].median, b[i].median) << "generation " << i;
-    EXPECT_EQ(a[i].viable_fraction, b[i].viable_fraction);
-    EXPECT_EQ(a[i].best_cells, b[i].best_cells);
-    EXPECT_EQ(a[i].evaluations, b[i].evaluations);
-  }
 }
 
 std::filesystem::path fresh_dir(const std::string& name) {
@@ -191,38 +180,6 @@ TEST(Evolution, UnchangedOffspringAreNeverReEvaluated) {
   for (int g = 0; g < 5; ++g) evo.step();
   EXPECT_EQ(calls.load(), after_init);  // every offspring is a copy of a parent: nothing to swim
 }
-
-namespace {
-
-// Every column that is a result (not evaluations, swims, their rates or the wall time).
-void expect_same_results(const std::vector<GenerationStats>& a,
-                         const std::vector<GenerationStats>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
-    EXPECT_EQ(a[i].mean, b[i].mean) << "generation " << i;
-    EXPECT_EQ(a[i].median, b[i].median) << "generation " << i;
-    EXPECT_EQ(a[i].viable_fraction, b[i].viable_fraction) << "generation " << i;
-    EXPECT_EQ(a[i].best_cells, b[i].best_cells) << "generation " << i;
-    EXPECT_EQ(a[i].best_changed, b[i].best_changed) << "generation " << i;
-    EXPECT_EQ(a[i].crossovers, b[i].crossovers) << "generation " << i;
-    EXPECT_EQ(std::isnan(a[i].best_reference), std::isnan(b[i].best_reference));
-    if (!std::isnan(a[i].best_reference)) {
-      EXPECT_EQ(a[i].best_reference, b[i].best_reference) << "generation " << i;
-    }
-    EXPECT_EQ(a[i].invalid, b[i].invalid) << "generation " << i;
-  }
-}
-
-void expect_same_population(const std::vector<Individual>& a, const std::vector<Individual>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_TRUE(a[i].genome == b[i].genome) << "individual " << i;
-    EXPECT_TRUE(a[i].result == b[i].result) << "individual " << i;
-  }
-}
-
-}  // namespace
 
 TEST(Evolution, OffspringOfAnEvaluatedNetworkKeepItsFitness) {
   // A fitness that reads only the genome's network, and a reference that reads only it too.

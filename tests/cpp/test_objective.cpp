@@ -22,6 +22,8 @@ using namespace animat;
 
 namespace {
 
+using animat::test::expect_same_history;
+using animat::test::expect_same_population;
 using animat::test::stub_fitness;
 
 Config small_config(int population = 20, std::int64_t seed = 7) {
@@ -42,27 +44,6 @@ Genome viable_genome(const Config& c, std::uint64_t seed) {
     if (develop(g, c.genome, c.grn, c.development).viable) return g;
   }
   throw Error("no viable genome");
-}
-
-void expect_same_population(const Evolution& a, const Evolution& b) {
-  ASSERT_EQ(a.population().size(), b.population().size());
-  for (std::size_t i = 0; i < a.population().size(); ++i) {
-    EXPECT_TRUE(a.population()[i].genome == b.population()[i].genome) << "individual " << i;
-    EXPECT_EQ(a.population()[i].result, b.population()[i].result) << "individual " << i;
-    EXPECT_EQ(a.population()[i].tries, b.population()[i].tries) << "individual " << i;
-  }
-}
-
-void expect_same_history(const std::vector<GenerationStats>& a,
-                         const std::vector<GenerationStats>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
-    EXPECT_EQ(a[i].mean, b[i].mean) << "generation " << i;
-    EXPECT_EQ(a[i].median, b[i].median) << "generation " << i;
-    EXPECT_EQ(a[i].evaluations, b[i].evaluations) << "generation " << i;
-    EXPECT_EQ(a[i].crossovers, b[i].crossovers) << "generation " << i;
-  }
 }
 
 Body triangle_body() {
@@ -95,7 +76,10 @@ TEST(AskTell, DrivenFromOutsideEqualsTheEngineRunningItself) {
     EXPECT_GT(rounds,
               15);  // the initial slots needed more than one round (1 genome in 4 is non-viable)
     expect_same_history(itself.history(), driven.history());
-    expect_same_population(itself, driven);
+    for (std::size_t g = 0; g < itself.history().size(); ++g)
+      EXPECT_EQ(itself.history()[g].crossovers, driven.history()[g].crossovers)
+          << "generation " << g;
+    expect_same_population(itself.population(), driven.population());
   }
 }
 

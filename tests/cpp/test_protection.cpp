@@ -25,6 +25,7 @@ using namespace animat;
 
 namespace {
 
+using animat::test::expect_same_history;
 using animat::test::slurp;
 using animat::test::stub_fitness;
 
@@ -78,19 +79,6 @@ void expect_same_individuals(const std::vector<Individual>& a, const std::vector
       EXPECT_EQ(a[i].result.morphology_kind, b[i].result.morphology_kind) << "individual " << i;
       EXPECT_EQ(a[i].morphology_age, b[i].morphology_age) << "individual " << i;
     }
-  }
-}
-
-void expect_same_history(const std::vector<GenerationStats>& a,
-                         const std::vector<GenerationStats>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].best, b[i].best) << "generation " << i;
-    EXPECT_EQ(a[i].mean, b[i].mean) << "generation " << i;
-    EXPECT_EQ(a[i].median, b[i].median) << "generation " << i;
-    EXPECT_EQ(a[i].viable_fraction, b[i].viable_fraction) << "generation " << i;
-    EXPECT_EQ(a[i].evaluations, b[i].evaluations) << "generation " << i;
-    EXPECT_EQ(a[i].protected_count, b[i].protected_count) << "generation " << i;
   }
 }
 

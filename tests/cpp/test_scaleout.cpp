@@ -20,6 +20,7 @@
 #include "test_support.hpp"
 
 using namespace animat;
+using animat::test::expect_same_population;
 using animat::test::stub_fitness;
 
 namespace {
@@ -36,14 +37,6 @@ Config island_config(int islands = 3, int population = 12, int interval = 2, int
   c.evolution.migration_interval = interval;
   c.evolution.migrants = migrants;
   return c;
-}
-
-void expect_same_population(const std::vector<Individual>& a, const std::vector<Individual>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_TRUE(a[i].genome == b[i].genome) << "individual " << i;
-    EXPECT_EQ(a[i].result, b[i].result) << "individual " << i;
-  }
 }
 
 // Counts calls and answers like the stub: an evaluator that is not the OpenMP one.
