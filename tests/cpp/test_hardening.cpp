@@ -32,6 +32,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -116,17 +117,26 @@ Shell run_exe(const std::vector<std::string>& args) {
 
 const std::string kExe = ANIMAT_EVOLVE_EXE;
 
+/// A directory removed when the test process exits (forked children leave by _exit and keep it).
+struct RemovedAtExit {
+  fs::path dir;
+  ~RemovedAtExit() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+
 /// A small real run on disk (the CLI), made once per test process.
 const fs::path& small_run() {
-  static const fs::path dir = [] {
+  static const RemovedAtExit run = [] {
     const fs::path d = fresh_dir("run");
     const Shell r = run_exe({kExe, "--quiet", "--threads", "1", "--seed", "3", "--set",
                              "evolution.population=4", "--set", "evaluation.steps=50",
                              "--generations", "1", "--out", d.string()});
     EXPECT_EQ(r.rc, 0) << r.err;
-    return d;
+    return RemovedAtExit{d};
   }();
-  return dir;
+  return run.dir;
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -625,10 +635,12 @@ TEST(Rows, Box2DAssertValuesAreRefused) {
     Config c;
     EXPECT_THROW(apply_override(c, o), ConfigError) << o;
   }
+  const fs::path out = fresh_dir("damping");
   const Shell r = run_exe({kExe, "--quiet", "--set", "development.damping=1e39", "--out",
-                           fresh_dir("damping").string()});
+                           out.string()});
   EXPECT_EQ(r.rc, 2) << r.err;
   EXPECT_NE(r.err.find("development.damping"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "a refused run created its --out";
 }
 
 TEST(Rows, MoveSigmaCannotOverflowACoordinate) {
