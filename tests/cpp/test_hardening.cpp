@@ -636,8 +636,8 @@ TEST(Rows, Box2DAssertValuesAreRefused) {
     EXPECT_THROW(apply_override(c, o), ConfigError) << o;
   }
   const fs::path out = fresh_dir("damping");
-  const Shell r = run_exe({kExe, "--quiet", "--set", "development.damping=1e39", "--out",
-                           out.string()});
+  const Shell r =
+      run_exe({kExe, "--quiet", "--set", "development.damping=1e39", "--out", out.string()});
   EXPECT_EQ(r.rc, 2) << r.err;
   EXPECT_NE(r.err.find("development.damping"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out)) << "a refused run created its --out";
